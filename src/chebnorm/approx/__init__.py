@@ -1,0 +1,29 @@
+"""Stage 2: targets, fitting, certified error bounds, fixed point, tables.
+
+>>> from chebnorm.approx import fit
+>>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, kind="minimax", var="z")
+>>> t.max_abs_error <= t.abs_error_bound <= 1.01 * t.max_abs_error
+True
+"""
+
+from .api import MAX_DEGREE, fit, quantize
+from .certify import Certificate, certify
+from .expr import Function1D, parse_function, parse_number
+from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint
+from .targets import TARGETS, Target, get_target, target_names
+
+__all__ = [
+    "CoefficientTable", "FixedPoint", "SCHEMA_VERSION", "fit", "quantize", "MAX_DEGREE",
+    "Certificate", "certify", "Function1D", "parse_function", "parse_number",
+    "Target", "TARGETS", "get_target", "target_names", "fit_target",
+]
+
+
+def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = None,
+               error: str = "abs", frac_bits: int | None = None) -> CoefficientTable:
+    """Fit a registered target: ``fit_target("dichotomy", 2)``."""
+    t = get_target(name)
+    return fit(t.expression, t.interval(psi_max), degree, kind=kind or t.kind, error=error,
+               var=t.variable, name=f"{name}_d{degree}", frac_bits=frac_bits,
+               command=f"chebnorm.approx.fit_target({name!r}, {degree}, psi_max={psi_max!r}, "
+                       f"kind={(kind or t.kind)!r}, error={error!r}, frac_bits={frac_bits!r})")

@@ -1,0 +1,238 @@
+"""``fit`` and ``quantize``: the public entry points of the approximation stage."""
+
+from __future__ import annotations
+
+import math
+from importlib.metadata import PackageNotFoundError, version as _pkg_version
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .certify import Certificate, arb_enclose, certify
+from .expr import Function1D, parse_function, parse_number
+from .fitting import chebyshev_interpolant, cheb_to_monomial, remez
+from .table import CoefficientTable, FixedPoint
+
+__all__ = ["fit", "quantize", "MAX_DEGREE", "Interval", "check_interval"]
+
+MAX_DEGREE = 30
+KINDS = ("chebyshev", "minimax")
+ERROR_KINDS = ("abs", "rel")
+
+
+def _versions() -> dict[str, str]:
+    out = {}
+    for name in ("chebnorm", "numpy", "mpmath", "sympy", "python-flint"):
+        try:
+            out[name] = _pkg_version(name)
+        except PackageNotFoundError:
+            out[name] = "unknown"
+    return out
+
+
+class Interval:
+    """Exact endpoints (sympy) with their float values. Internal."""
+
+    def __init__(self, lo, hi):
+        self.lo = parse_number(lo)
+        self.hi = parse_number(hi)
+        self.lo_f = float(sp.N(self.lo, 30))
+        self.hi_f = float(sp.N(self.hi, 30))
+        if not arb_enclose(self.lo) < arb_enclose(self.hi):
+            raise ValueError(f"interval [{self.lo}, {self.hi}] is empty or reversed: "
+                             f"LO must be strictly less than HI")
+
+    @property
+    def strings(self) -> tuple[str, str]:
+        return (sp.sstr(self.lo), sp.sstr(self.hi))
+
+
+def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndarray:
+    """Sample ``f`` on the interval and reject it where it is not finite and real.
+
+    Returns the samples. The certification later proves finiteness on the
+    whole interval; this check only gives an early, precise message.
+    """
+    x = np.linspace(iv.lo_f, iv.hi_f, samples)
+    x[0], x[-1] = iv.lo_f, iv.hi_f
+    with np.errstate(all="ignore"):
+        try:
+            y = np.asarray(sp.lambdify(fn.var, fn.expr, "numpy")(x.astype(complex)), dtype=complex)
+        except (ZeroDivisionError, OverflowError):
+            y = np.full(x.shape, np.nan, dtype=complex)
+        y = y * np.ones_like(x)
+    bad = ~np.isfinite(y) | (np.abs(y.imag) > 1e-12 * np.maximum(1.0, np.abs(y.real)))
+    if bad.any():
+        where = x[np.argmax(bad)]
+        raise ValueError(f"{fn.expr} is not finite and real on [{iv.lo}, {iv.hi}] "
+                         f"(for example at {fn.var} = {where:.6g}); accepted: an interval "
+                         f"where the function is defined, finite and real")
+    return y.real
+
+
+def _certify_both(fn, coeffs, iv, need_rel: bool):
+    cert_abs = certify(fn, coeffs, iv.lo, iv.hi, "abs")
+    try:
+        cert_rel = certify(fn, coeffs, iv.lo, iv.hi, "rel")
+    except ValueError:
+        if need_rel:
+            raise ValueError(f"relative error is undefined: {fn.expr} vanishes on "
+                             f"[{iv.lo}, {iv.hi}]; accepted for error='rel': an interval "
+                             f"where the function has no zero") from None
+        cert_rel = None
+    return cert_abs, cert_rel
+
+
+def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs", *,
+        var: str = "x", name: str | None = None, frac_bits: int | None = None,
+        command: str | None = None) -> CoefficientTable:
+    """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
+
+    ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
+    ``kind="minimax"``: the Remez exchange, minimizing the absolute
+    (``error="abs"``) or relative (``error="rel"``) error. Every table carries
+    rigorous bounds of both errors (see :mod:`chebnorm.approx.certify`).
+    With ``frac_bits`` the table also gets a re-certified fixed-point part.
+
+    Seed 000, method 4 (claim C5): the degree-2 Chebyshev fit of
+    ``1/sqrt(2+z)`` on ``[sqrt(2), 2]``:
+
+    >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z")
+    >>> [round(c, 5) for c in t.coefficients]
+    [0.68076, -0.11881, 0.01422]
+    >>> round(t.max_abs_error, 7), t.abs_error_bound >= t.max_abs_error
+    (2.16e-05, True)
+
+    Choice of degree: each extra degree buys roughly a factor
+    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy.
+    Possible issues: coefficients are stored in the original variable's
+    monomial basis, which is ill-conditioned on intervals far from 0 at high
+    degree; the certified bound is that of the stored floats, so it stays
+    honest, but it may then sit above the minimax error.
+    """
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
+        raise ValueError(f"degree {degree!r} is not an integer; accepted: 0 <= degree <= {MAX_DEGREE}")
+    degree = int(degree)
+    if not 0 <= degree <= MAX_DEGREE:
+        raise ValueError(f"degree {degree} is out of range; accepted: 0 <= degree <= {MAX_DEGREE}")
+    if kind not in KINDS:
+        raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
+    if error not in ERROR_KINDS:
+        raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
+    if error == "rel" and kind == "chebyshev":
+        pass  # Chebyshev interpolation has no error kind; relative bounds are certified anyway
+    try:
+        lo, hi = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    fn = expr if isinstance(expr, Function1D) else parse_function(expr, var)
+    iv = Interval(lo, hi)
+    samples = check_interval(fn, iv)
+    if error == "rel" and (np.any(samples == 0) or np.ptp(np.sign(samples)) > 0):
+        raise ValueError(f"relative error is undefined: {fn.expr} vanishes on [{iv.lo}, {iv.hi}]; "
+                         f"accepted for error='rel': an interval where the function has no zero")
+
+    if kind == "chebyshev":
+        coeffs = chebyshev_interpolant(fn.mpmath, sp.N(iv.lo, 50), sp.N(iv.hi, 50), degree)
+    else:
+        f_np = fn.numpy
+        weight = (lambda x: np.ones_like(x)) if error == "abs" else (lambda x: 1.0 / np.abs(f_np(x)))
+        res = remez(f_np, weight, iv.lo_f, iv.hi_f, degree)
+        coeffs = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
+    cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel")
+    provenance = _versions()
+    provenance["command"] = command or (
+        f"chebnorm.fit({str(fn.expr)!r}, {iv.strings!r}, {degree}, kind={kind!r}, "
+        f"error={error!r}, var={var!r})")
+    table = CoefficientTable(
+        name=name or "table", expression=sp.sstr(fn.expr), variable=fn.var.name,
+        interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
+        error_kind=error, coefficients=tuple(coeffs),
+        abs_error_bound=cert_abs.bound, rel_error_bound=None if cert_rel is None else cert_rel.bound,
+        max_abs_error=cert_abs.maximum, max_abs_at=cert_abs.at,
+        max_rel_error=None if cert_rel is None else cert_rel.maximum,
+        max_rel_at=None if cert_rel is None else cert_rel.at,
+        provenance=provenance)
+    if frac_bits is not None:
+        table = quantize(table, frac_bits)
+    return table
+
+
+def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
+    if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
+        raise ValueError(f"frac-bits {frac_bits!r} is not a non-negative integer")
+    limit = 2 ** (word_bits - 1) - 1
+    biggest = max(abs(c) for c in coeffs)
+    if biggest == 0:
+        return
+    max_f = math.floor(math.log2((limit + 0.5) / biggest))
+    for k, c in enumerate(coeffs):
+        if abs(round(math.ldexp(c, frac_bits))) > limit:
+            raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: coefficient of "
+                             f"x^{k} = {c:.6g} becomes {round(math.ldexp(c, frac_bits))}; "
+                             f"accepted: frac-bits <= {max_f}")
+
+
+def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
+             reoptimize: bool = True) -> CoefficientTable:
+    """Round the coefficients to ``frac_bits`` fractional bits and re-certify.
+
+    With ``reoptimize`` the coefficients are rounded from the highest power
+    down, the lower ones refitted (Remez, same error kind) after each
+    rounding -- a greedy version of Sollya's ``fpminimax`` -- and the result
+    is kept only when its certified error beats plain rounding.
+
+    >>> t = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 20)
+    >>> t.fixed_point.integers[0] / 2**20 - t.coefficients[0] < 2**-20
+    True
+    """
+    _check_frac_bits(frac_bits, table.coefficients, word_bits)
+    frac_bits = int(frac_bits)
+    fn = parse_function(table.expression, table.variable)
+    iv = Interval(*table.interval)
+    scale = 2 ** frac_bits
+    candidates = {"rounded": [round(math.ldexp(c, frac_bits)) for c in table.coefficients]}
+    if reoptimize and table.degree >= 1:
+        candidates["reoptimized"] = _greedy_integers(fn, iv, table, frac_bits)
+    best = None
+    limit = 2 ** (word_bits - 1) - 1
+    for method, ints in candidates.items():
+        if max(abs(q) for q in ints) > limit:
+            continue
+        coeffs = [math.ldexp(q, -frac_bits) for q in ints]
+        ca, cr = _certify_both(fn, coeffs, iv, table.error_kind == "rel")
+        key = ca.bound if table.error_kind == "abs" else (cr.bound if cr else math.inf)
+        if best is None or key < best[0]:
+            best = (key, method, ints, ca, cr)
+    _, method, ints, ca, cr = best
+    fixed = FixedPoint(frac_bits=frac_bits, integers=tuple(int(q) for q in ints), word_bits=word_bits,
+                       method=method, abs_error_bound=ca.bound,
+                       rel_error_bound=None if cr is None else cr.bound,
+                       max_abs_error=ca.maximum, max_rel_error=None if cr is None else cr.maximum)
+    from dataclasses import replace
+    return replace(table, fixed_point=fixed)
+
+
+def _greedy_integers(fn: Function1D, iv: Interval, table: CoefficientTable, frac_bits: int):
+    f_np = fn.numpy
+    n = table.degree
+    fixed: dict[int, int] = {}
+    current = list(table.coefficients)
+    for k in range(n, -1, -1):
+        fixed[k] = round(math.ldexp(current[k], frac_bits))
+        if k == 0:
+            break
+        high = {j: math.ldexp(q, -frac_bits) for j, q in fixed.items()}
+
+        def residual(x, high=high):
+            return f_np(x) - sum(c * x ** j for j, c in high.items())
+
+        if table.error_kind == "rel":
+            weight = lambda x: 1.0 / np.abs(f_np(x))
+        else:
+            weight = lambda x: np.ones_like(x)
+        res = remez(residual, weight, iv.lo_f, iv.hi_f, k - 1)
+        low = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
+        current = low + [math.ldexp(fixed[j], -frac_bits) for j in range(k, n + 1)]
+    return [fixed[k] for k in range(n + 1)]

@@ -1,0 +1,65 @@
+"""The registry of named approximation targets (SPEC.md).
+
+Each target is a function of one variable on an interval that depends on
+``psi_max``, the largest angle between the two unit normals at the ends of
+an edge or span (radians, default pi/4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+__all__ = ["Target", "TARGETS", "get_target", "target_names"]
+
+
+@dataclass(frozen=True)
+class Target:
+    """A named function, its variable, its interval as a function of psi_max,
+    the degrees and kind the main job exports, and what it is for."""
+
+    name: str
+    expression: str
+    variable: str
+    interval_text: tuple[str, str]  # sympy text in terms of psi_max
+    degrees: tuple[int, ...]
+    kind: str
+    meaning: str
+
+    def interval(self, psi_max: float | str = "pi/4") -> tuple[str, str]:
+        """Exact endpoint strings with psi_max substituted (sympy syntax)."""
+        psi = sp.sympify(str(psi_max)) if not isinstance(psi_max, float) else sp.Rational(psi_max)
+        if not (0 < float(psi) < float(sp.pi)):
+            raise ValueError(f"psi_max = {psi_max} is out of range; accepted: 0 < psi_max < pi")
+        out = []
+        for text in self.interval_text:
+            value = sp.sympify(text, locals={"psi_max": sp.Symbol("psi_max")}).subs("psi_max", psi)
+            out.append(sp.sstr(sp.nsimplify(value) if value.is_Float else value))
+        return (out[0], out[1])
+
+
+TARGETS: dict[str, Target] = {t.name: t for t in (
+    Target("dichotomy", "1/sqrt(2+z)", "z", ("2*cos(psi_max)", "2"), (1, 2), "chebyshev",
+           "seed 000, method 4: denominator of the dichotomy midpoint (N1 + N2)/sqrt(2 + z), "
+           "z = 2 cos(theta)"),
+    Target("midpoint", "1/sqrt(2*(1+x))", "x", ("cos(psi_max)", "1"), (1, 2), "chebyshev",
+           "seed 000, method 5: normalizing factor of the span midpoint (N_l + N_r)/sqrt(2(1 + x)), "
+           "x = N_l.N_r"),
+    Target("eta_term", "sqrt(2*(1+x))/2", "x", ("0", "1"), (1, 2), "chebyshev",
+           "seed 003: one edge term of the normalization criterion eta, x = N_i.N_j in [0, 1]"),
+    Target("rsqrt", "1/sqrt(x)", "x", ("cos(psi_max/2)**2", "1"), (2, 3), "minimax",
+           "renormalization 1/|N| from x = N.N of a linearly interpolated normal; "
+           "|N|^2 >= cos^2(psi_max/2) on a span of angle psi_max"),
+)}
+
+
+def target_names() -> list[str]:
+    return sorted(TARGETS)
+
+
+def get_target(name: str) -> Target:
+    try:
+        return TARGETS[name]
+    except KeyError:
+        raise ValueError(f"unknown target {name!r}; accepted: {', '.join(target_names())}") from None
