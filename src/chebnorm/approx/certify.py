@@ -116,12 +116,12 @@ def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     best = ends[0].upper().max(ends[1].upper())
     box = arb(0, r.upper())
     if c2.contains(0):
-        inner = abs(c0 + c1 * box + c2 * box ** 2)
+        inner = abs(c0 + c1 * box + c2 * (box * box))
         return best.max(inner.upper())
     hstar = -c1 / (2 * c2)
     if hstar.overlaps(box):
         h = hstar.intersection(box)
-        inner = abs(c0 + c1 * h + c2 * h ** 2)
+        inner = abs(c0 + c1 * h + c2 * (h * h))
         best = best.max(inner.upper())
     return best
 
@@ -178,7 +178,7 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
             c0, c1, c2 = (sm.coeffs() + [arb(0)] * 3)[:3]
             sx = g(arb_series([a.union(b), 1], prec=4))
             c3 = (sx.coeffs() + [arb(0)] * 4)[3]
-            upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * r ** 3
+            upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r)
             if not upper.is_finite():
                 if (b - a) < min_width or count > max_subintervals:
                     where = float(m.mid())

@@ -26,6 +26,7 @@ from sympy.parsing.sympy_parser import (
     convert_xor,
     implicit_multiplication_application,
     parse_expr,
+    rationalize,
     standard_transformations,
 )
 
@@ -70,8 +71,8 @@ def parse_number(text: str | float | int) -> sp.Expr:
             raise ValueError(f"interval endpoint {text!r} is not finite")
         return sp.Rational(float(text))
     try:
-        value = parse_expr(str(text), local_dict=_local_names("_"), transformations=_TRANSFORMS,
-                           evaluate=True)
+        value = parse_expr(str(text), local_dict=_local_names("_"),
+                           transformations=_TRANSFORMS + (rationalize,), evaluate=True)
     except Exception as exc:  # sympy raises many kinds
         raise ValueError(f"cannot parse interval endpoint {text!r}: {exc}") from None
     if not isinstance(value, sp.Expr) or value.free_symbols:
@@ -97,6 +98,20 @@ def _arb_const(value: sp.Expr) -> arb:
     if value is sp.E:
         return arb(1).exp()
     raise ValueError(f"unsupported constant {value!r}")
+
+
+def _ipow(v, n: int):
+    """``v**n`` by repeated squaring with multiplications only (Arb's ``**``
+    goes through exp/log and returns nan for balls that contain 0)."""
+    result = None
+    base = v
+    while n:
+        if n & 1:
+            result = base if result is None else result * base
+        n >>= 1
+        if n:
+            base = base * base
+    return v * 0 + 1 if result is None else result
 
 
 def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
@@ -131,8 +146,8 @@ def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
             if ex.is_Integer:
                 n = int(ex)
                 if n >= 0:
-                    return lambda x: b(x) ** n
-                return lambda x: 1 / (b(x) ** (-n))
+                    return lambda x: _ipow(b(x), n)
+                return lambda x: 1 / _ipow(b(x), -n)
             if ex == sp.Rational(1, 2):
                 return lambda x: b(x).sqrt()
             if ex == sp.Rational(-1, 2):

@@ -1,0 +1,5 @@
+import sys
+
+from chebnorm.cli import main
+
+sys.exit(main())

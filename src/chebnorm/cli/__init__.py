@@ -1,0 +1,67 @@
+"""Stage 5: the ``chebnorm`` command line.
+
+Each subcommand lives in its own module of this package and exposes
+``register(subparsers)``, which adds its parser and sets ``func`` to a
+function ``(args) -> int``. Errors the user can fix (``ValueError``,
+``OSError``) end the program with status 2 and one line on stderr, never a
+traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+__all__ = ["main", "build_parser", "UsageError"]
+
+#: subcommand modules, in the order ``chebnorm --help`` lists them
+SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "hw", "repro")
+
+
+class UsageError(ValueError):
+    """A user error detected by the CLI itself."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse's own errors: one line, status 2
+        raise UsageError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from chebnorm import __version__
+
+    parser = _Parser(prog="chebnorm", description="Certified polynomial fits and error analysis "
+                     "for fast normal-vector normalization in Phong shading.")
+    parser.add_argument("--version", action="version", version=f"chebnorm {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in SUBCOMMANDS:
+        try:
+            module = importlib.import_module(f"chebnorm.cli.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"chebnorm.cli.{name}":
+                continue  # subcommand not built yet
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        args.argv = ["chebnorm", *argv]
+        return int(args.func(args) or 0)
+    except (ValueError, OSError) as exc:
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"chebnorm: error: {message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("chebnorm: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,50 @@
+"""``chebnorm fit``, ``chebnorm export`` and ``chebnorm targets`` live here and
+in the sibling modules; this one fits and certifies one polynomial."""
+
+from __future__ import annotations
+
+from chebnorm.approx import MAX_DEGREE, fit
+
+from ._common import command_line, print_json
+
+
+def register(sub) -> None:
+    p = sub.add_parser("fit", help="fit and certify a polynomial",
+                       description="Fit a polynomial to EXPR on [LO, HI] and certify its "
+                       "absolute and relative error bounds.")
+    p.add_argument("expr", metavar="EXPR", help='function in sympy syntax, e.g. "1/sqrt(2+z)"')
+    p.add_argument("--var", default="x", help="the variable of EXPR (default x)")
+    p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
+                   help='endpoints in sympy syntax, e.g. "sqrt(2)" 2')
+    p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
+    p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
+    p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
+    p.add_argument("--frac-bits", type=int, default=None, help="also quantize to F fractional bits")
+    p.add_argument("--name", default="table", help="table name (a C identifier)")
+    p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
+    p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
+                var=args.var, name=args.name, frac_bits=args.frac_bits,
+                command=command_line(args))
+    if args.output:
+        table.save(args.output)
+    if args.json:
+        print_json(table.to_dict())
+    elif not args.output:
+        print(f"{table.name}: {table.kind} degree {table.degree} fit of {table.expression} "
+              f"on [{table.interval[0]}, {table.interval[1]}]")
+        print("coefficients (ascending powers of {}): {}".format(
+            table.variable, ", ".join(f"{c:.17g}" for c in table.coefficients)))
+        print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
+              f"certified bound {table.abs_error_bound:.6e}")
+        if table.rel_error_bound is not None:
+            print(f"max |p/f - 1| = {table.max_rel_error:.6e}; certified bound {table.rel_error_bound:.6e}")
+        if table.fixed_point is not None:
+            fp = table.fixed_point
+            print(f"fixed point ({fp.frac_bits} fractional bits, {fp.method}): {list(fp.integers)}; "
+                  f"certified |p_q - f| <= {fp.abs_error_bound:.6e}")
+    return 0

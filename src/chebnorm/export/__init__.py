@@ -1,0 +1,34 @@
+"""Stage 3: printers of a CoefficientTable, one per target format.
+
+``FORMATS`` maps a format name to ``(printer, file suffix)``; a printer takes
+the table and the generating command and returns text. Use
+:func:`export_table` to print and write atomically.
+"""
+
+from __future__ import annotations
+
+from chebnorm.approx import CoefficientTable
+from chebnorm.approx._io import write_atomic
+
+from .c import c_header, horner_rounding_bound
+
+
+def json_text(table: CoefficientTable, command: str = "") -> str:
+    """The table's JSON contract (sorted keys, shortest float repr)."""
+    return table.to_json()
+
+
+FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json")}
+
+__all__ = ["FORMATS", "c_header", "json_text", "export_table", "horner_rounding_bound"]
+
+
+def export_table(table: CoefficientTable, fmt: str, path, command: str = "") -> str:
+    """Print ``table`` in format ``fmt`` and write it to ``path`` atomically."""
+    try:
+        printer, _ = FORMATS[fmt]
+    except KeyError:
+        raise ValueError(f"unknown export format {fmt!r}; accepted: {', '.join(sorted(FORMATS))}") from None
+    text = printer(table, command)
+    write_atomic(path, text)
+    return text
