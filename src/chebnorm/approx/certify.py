@@ -89,6 +89,12 @@ def _float_down(x: arb) -> float:
     return f
 
 
+def _coeffs(series: arb_series, n: int) -> list[arb]:
+    """The first ``n`` Taylor coefficients (flint drops trailing zeros)."""
+    c = series.coeffs()
+    return (c + [arb(0)] * n)[:n]
+
+
 def _horner(coeffs: Sequence[arb], x):
     acc = coeffs[-1] + 0 * x if len(coeffs) else 0 * x
     for c in reversed(coeffs[:-1]):
@@ -175,9 +181,9 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
             m = (a + b) / 2
             r = (b - a) / 2
             sm = g(arb_series([m, 1], prec=3))
-            c0, c1, c2 = (sm.coeffs() + [arb(0)] * 3)[:3]
+            c0, c1, c2 = _coeffs(sm, 3)
             sx = g(arb_series([a.union(b), 1], prec=4))
-            c3 = (sx.coeffs() + [arb(0)] * 4)[3]
+            c3 = _coeffs(sx, 4)[3]
             upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r)
             if not upper.is_finite():
                 if (b - a) < min_width or count > max_subintervals:
@@ -209,7 +215,7 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
             work.extend([(a, m), (m, b)])
     lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)
     for end in (lo_f, hi_f):  # the endpoints are often where the error peaks
-        v = abs(g(arb_series([arb(end), 1], prec=1)).coeffs()[0])
+        v = abs(_coeffs(g(arb_series([arb(end), 1], prec=1)), 1)[0])
         if v.is_finite() and v.lower() > best_lower:
             best_lower, best_at = v.lower(), end
     maximum, at = _refine_maximum(g, best_lower, best_at, lo_f, hi_f)
@@ -222,7 +228,7 @@ def _refine_maximum(g, lower: arb, at: float, lo: float, hi: float) -> tuple[flo
     best, best_at = float(lower), at
     x = at
     for _ in range(8):
-        s = g(arb_series([arb(x), 1], prec=3)).coeffs() + [arb(0)] * 3
+        s = _coeffs(g(arb_series([arb(x), 1], prec=3)), 3)
         v = abs(s[0])
         if v.is_finite() and float(v.mid()) > best:
             best, best_at = float(v.mid()), x

@@ -149,6 +149,7 @@ def midpoint_normal(na, nb) -> np.ndarray:
     func = "midpoint_normal"
     a = _checks.unit_vectors(na, "na", func)
     b = _checks.unit_vectors(nb, "nb", func)
+    a, b = _checks.broadcast(func, "na and nb", a, b)
     cc = _checks.dot(a, b)
     _checks.not_antiparallel(cc, "na and nb", func)
     scale = np.asarray(_midpoint_scale_kernel()(cc), dtype=float)
@@ -272,7 +273,7 @@ def delta_s(phi, n):
     >>> print(f"{delta_s(0.2, 1.0):.7f}")
     0.0049958
     >>> print(f"{delta_s(0.2, 64):.4f}")
-    0.2738
+    0.2742
     """
     func = "delta_s"
     x = _check_phi(phi, func)
@@ -327,6 +328,7 @@ def eta(na, nb, nc):
     va = _checks.unit_vectors(na, "na", func)
     vb = _checks.unit_vectors(nb, "nb", func)
     vc = _checks.unit_vectors(nc, "nc", func)
+    va, vb, vc = _checks.broadcast(func, "na, nb and nc", va, vb, vc)
     cos = [np.clip(_checks.dot(x, y), -1.0, 1.0) for x, y in ((va, vb), (vb, vc), (va, vc))]
     return _checks.scalar_or_array(np.asarray(_eta_kernel()(*cos), dtype=float))
 
@@ -408,18 +410,13 @@ def quadratic_coefficients(nl, nr, nc=None) -> QuadraticCoefficients:
     func = "quadratic_coefficients"
     left = _checks.unit_vectors(nl, "nl", func)
     right = _checks.unit_vectors(nr, "nr", func)
+    left, right = _checks.broadcast(func, "nl and nr", left, right)
     if nc is None:
         _checks.not_antiparallel(_checks.dot(left, right), "nl and nr", func)
         centre = midpoint_normal(left, right)
     else:
         centre = _checks.vectors(nc, "nc", func)
-    try:
-        left, centre, right = np.broadcast_arrays(left, centre, right)
-    except ValueError as exc:
-        raise ValueError(
-            f"{func}: nl, nc, nr must broadcast; got shapes "
-            f"{np.shape(nl)}, {np.shape(centre)}, {np.shape(nr)}"
-        ) from exc
+    left, centre, right = _checks.broadcast(func, "nl, nc and nr", left, centre, right)
     shape = left.shape
     gg, pp, qq = (
         np.broadcast_to(np.asarray(k(left, centre, right), dtype=float), shape).copy()
