@@ -29,7 +29,7 @@ UNIT_RTOL = 1e-6
 DOT_ATOL = 3 * UNIT_RTOL
 
 
-def _where(mask: np.ndarray) -> str:
+def where_text(mask: np.ndarray) -> str:
     """Describe the first ``True`` entry of ``mask`` (for error messages)."""
     if mask.ndim == 0:
         return ""
@@ -46,7 +46,7 @@ def real_array(x, name: str, func: str) -> np.ndarray:
     bad = ~np.isfinite(arr)
     if bad.any():
         raise ValueError(
-            f"{func}: {name} must be finite; got {arr[bad].flat[0]!r}{_where(bad)}"
+            f"{func}: {name} must be finite; got {arr[bad].flat[0]!r}{where_text(bad)}"
         )
     return arr
 
@@ -60,7 +60,7 @@ def in_range(
     if bad.any():
         raise ValueError(
             f"{func}: {name} must lie in {range_text}; "
-            f"got {arr[bad].flat[0]!r}{_where(bad)}"
+            f"got {arr[bad].flat[0]!r}{where_text(bad)}"
         )
     return arr
 
@@ -90,7 +90,7 @@ def nonzero_vectors(x, name: str, func: str) -> tuple[np.ndarray, np.ndarray]:
     length = np.linalg.norm(arr, axis=-1)
     bad = length == 0.0
     if bad.any():
-        raise ValueError(f"{func}: {name} contains a zero vector{_where(bad)}")
+        raise ValueError(f"{func}: {name} contains a zero vector{where_text(bad)}")
     return arr, length
 
 
@@ -102,7 +102,7 @@ def unit_vectors(x, name: str, func: str) -> np.ndarray:
     if bad.any():
         raise ValueError(
             f"{func}: {name} must be unit vectors (| |v| - 1 | <= UNIT_RTOL = "
-            f"{UNIT_RTOL:g}); got |v| = {length[bad].flat[0]!r}{_where(bad)}"
+            f"{UNIT_RTOL:g}); got |v| = {length[bad].flat[0]!r}{where_text(bad)}"
         )
     return arr
 
@@ -113,7 +113,7 @@ def not_antiparallel(c: np.ndarray, names: str, func: str) -> None:
     if bad.any():
         raise ValueError(
             f"{func}: {names} are antiparallel (1 + N_a.N_b = "
-            f"{1.0 + c[bad].flat[0]!r}{_where(bad)}); the formula divides by "
+            f"{1.0 + c[bad].flat[0]!r}{where_text(bad)}); the formula divides by "
             f"1 + N_a.N_b, which must exceed DOT_ATOL = {DOT_ATOL:g}"
         )
 

@@ -97,8 +97,9 @@ def norm2_linear_np(t, c):
     func = "norm2_linear_np"
     tt = _checks.real_array(t, "t", func)
     cc = _checks.cosine(c, "c", func)
+    tt, cc = _checks.broadcast(func, "t and c", tt, cc)
     out = np.asarray(_norm2_linear_kernel()(tt, cc), dtype=float)
-    return _checks.scalar_or_array(np.broadcast_to(out, np.broadcast(tt, cc).shape).copy())
+    return _checks.scalar_or_array(np.broadcast_to(out, tt.shape).copy())
 
 
 # ------------------------------------------------------ 2. midpoint normal
@@ -278,6 +279,7 @@ def delta_s(phi, n):
     func = "delta_s"
     x = _check_phi(phi, func)
     m = _checks.in_range(n, "n", func, 0.0, np.inf, "[0, inf)")
+    x, m = _checks.broadcast(func, "phi and n", x, m)
     out = np.asarray(_delta_s_kernel()(x, m), dtype=float)
     return _checks.scalar_or_array(out)
 
