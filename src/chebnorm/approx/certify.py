@@ -113,7 +113,14 @@ def _error_function(fn: Function1D, coeffs: Sequence[arb], kind: str):
             return _horner(coeffs, s) / f(s) - 1
     else:
         raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
-    return g
+
+    def safe(s):
+        # Arb refuses to divide by a ball that contains 0: report "not finite"
+        try:
+            return g(s)
+        except (ValueError, ZeroDivisionError):
+            return arb_series([arb("nan")] * s.prec, prec=s.prec)
+    return safe
 
 
 def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:

@@ -1,0 +1,113 @@
+"""An independent cross-check with Sollya (https://www.sollya.org), when installed.
+
+``remez`` runs Sollya's ``remez`` and returns its coefficients and the
+``supnorm`` of its error; ``supnorm`` certifies given float coefficients. The
+polynomial is passed to Sollya exactly (each float as ``m * 2^e``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from fractions import Fraction
+
+import sympy as sp
+
+from .expr import parse_function, parse_number
+
+__all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm"]
+
+
+def available() -> bool:
+    """True when the ``sollya`` executable is on PATH."""
+    return shutil.which("sollya") is not None
+
+
+@dataclass(frozen=True)
+class SollyaSupnorm:
+    """Sollya's certified enclosure ``[lower, upper]`` of ``sup |p - f|``."""
+
+    lower: float
+    upper: float
+
+
+def _sollya_expr(expr: str, var: str) -> str:
+    fn = parse_function(expr, var)
+    x = sp.Symbol("x", real=True)
+    text = sp.sstr(fn.expr.subs(fn.var, x))
+    return text.replace("**", "^").replace("E", "exp(1)")
+
+
+def _exact(value: float) -> str:
+    m, e = math.frexp(value)
+    mant = int(m * 2 ** 53)
+    return f"({mant}*2^({e - 53}))"
+
+
+def _poly(coefficients) -> str:
+    return " + ".join(f"{_exact(float(c))}*x^{k}" for k, c in enumerate(coefficients)) or "0"
+
+
+def _interval(lo: str, hi: str) -> str:
+    return f"[{sp.sstr(parse_number(lo))};{sp.sstr(parse_number(hi))}]".replace("**", "^")
+
+
+def _run(script: str, timeout: float = 600) -> str:
+    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
+        fh.write(script + "quit;\n")
+        path = fh.name
+    try:
+        proc = subprocess.run(["sollya", "--warnonstderr", path], capture_output=True, text=True,
+                              timeout=timeout, stdin=subprocess.DEVNULL)
+    finally:
+        import os
+        os.unlink(path)
+    if proc.returncode != 0:
+        raise RuntimeError(f"sollya failed: {proc.stderr.strip()[:500]}")
+    return proc.stdout
+
+
+_NUM = r"[-+]?[0-9.]+(?:e[-+]?[0-9]+)?"
+
+
+def script_supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: str = "abs",
+                   accuracy: float = 2.0 ** -8) -> str:
+    mode = "absolute" if kind == "abs" else "relative"
+    return (f"prec=200!;\ndisplay=decimal!;\nf={_sollya_expr(expr, var)};\np={_poly(coefficients)};\n"
+            f"r=supnorm(p, f, {_interval(lo, hi)}, {mode}, {accuracy!r});\n"
+            f"print(\"SUP\", inf(r), sup(r));\n")
+
+
+def supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: str = "abs",
+            accuracy: float = 2.0 ** -8) -> SollyaSupnorm:
+    """Sollya's certified supnorm of ``p - f`` (or ``p/f - 1``)."""
+    out = _run(script_supnorm(expr, var, coefficients, lo, hi, kind, accuracy))
+    m = re.search(rf"SUP\s+({_NUM})\s+({_NUM})", out)
+    if not m:
+        raise RuntimeError(f"unexpected sollya output: {out[:300]!r}")
+    return SollyaSupnorm(float(m.group(1)), float(m.group(2)))
+
+
+def remez(expr: str, var: str, lo: str, hi: str, degree: int, kind: str = "abs",
+          accuracy: float = 2.0 ** -8) -> tuple[list[float], SollyaSupnorm]:
+    """Sollya's ``remez`` fit (abs: weight 1; rel: weight 1/f) and its supnorm."""
+    f = _sollya_expr(expr, var)
+    weight = "1" if kind == "abs" else f"1/({f})"
+    mode = "absolute" if kind == "abs" else "relative"
+    script = (f"prec=200!;\ndisplay=decimal!;\nf={f};\nd={_interval(lo, hi)};\n"
+              f"p=remez(f, {degree}, d, {weight});\n"
+              + "".join(f"print(\"C{k}\", coeff(p, {k}));\n" for k in range(degree + 1))
+              + f"r=supnorm(p, f, d, {mode}, {accuracy!r});\nprint(\"SUP\", inf(r), sup(r));\n")
+    out = _run(script)
+    coeffs = []
+    for k in range(degree + 1):
+        m = re.search(rf"C{k}\s+({_NUM})", out)
+        coeffs.append(float(m.group(1)) if m else 0.0)
+    m = re.search(rf"SUP\s+({_NUM})\s+({_NUM})", out)
+    if not m:
+        raise RuntimeError(f"unexpected sollya output: {out[:300]!r}")
+    return coeffs, SollyaSupnorm(float(m.group(1)), float(m.group(2)))
