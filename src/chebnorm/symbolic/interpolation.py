@@ -312,7 +312,11 @@ def eta_expr() -> sp.Expr:
 
 @lru_cache(maxsize=None)
 def _eta_kernel():
-    return sp.lambdify((c_ab, c_bc, c_ac), eta_expr(), modules="numpy")
+    # powsimp joins sqrt(2)*sqrt(1 + c) into sqrt(2c + 2) (valid: 1 + c >= 0
+    # after clipping), which is exactly 2 at c = 1, so that each edge bound,
+    # and eta, is never negative in floating point either.
+    expr = sp.powsimp(eta_expr(), force=True)
+    return sp.lambdify((c_ab, c_bc, c_ac), expr, modules="numpy")
 
 
 def eta(na, nb, nc):
