@@ -1,0 +1,273 @@
+"""The error budget of a :class:`~chebnorm.hw.horner.HornerDesign`, its
+exhaustive check over every valid input code, and gappa's cross-check.
+
+Budget (all in the units of ``y``, i.e. absolute errors of the value)::
+
+    |y - f(x)| <= |p_q(x) - f(x)| + |y - p_q(x)|
+               <= min(approx + quant, quantized) + sum_j rho_j |x|^j + rho_out
+
+* ``approximation``: the table's certified ``sup |p - f|``;
+* ``quantization``: a certified ``sup |p_q - p|`` (Arb Taylor forms, the
+  float coefficients of ``p`` taken as exact rationals);
+* ``quantized``: the table's re-certified ``sup |p_q - f|`` (at most
+  ``approximation + quantization`` by the triangle inequality, often less);
+* ``rounding_steps[j]``: the rounding of ``a_j`` (``rho_j`` = one ulp of the
+  accumulator for truncation, half of one for ``rne``) carried to the output
+  through ``j`` multiplications by ``x``;
+* ``output_rounding``: rounding to the output's ``Fy`` fractional bits.
+
+Every bound is a float rounded upward.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+import sympy as sp
+
+from chebnorm.approx import parse_function, parse_number
+from chebnorm.approx.certify import certify
+
+from .fixed import rounding_error_bound
+from .horner import HornerDesign
+
+__all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script",
+           "gappa_bound", "SHADING_LEVELS"]
+
+#: an 8-bit shading output has 255 steps between black and full intensity
+SHADING_LEVELS = 255
+
+
+def _up(x: Fraction) -> float:
+    f = float(x)
+    while Fraction(f) < x:
+        f = math.nextafter(f, math.inf)
+    return f
+
+
+@dataclass(frozen=True)
+class ErrorBudget:
+    """Certified parts of the error (see module docstring); ``total`` is
+    ``min(approximation + quantization, quantized) + rounding``."""
+
+    approximation: float
+    quantization: float
+    quantized: float
+    rounding_steps: tuple[float, ...]
+    output_rounding: float
+    rounding: float
+    total: float
+    y_lsb: float
+    gappa_rounding: float | None = None
+
+    def as_dict(self) -> dict:
+        return {"approximation": self.approximation, "quantization": self.quantization,
+                "quantized_certified": self.quantized,
+                "rounding_steps": list(self.rounding_steps),
+                "output_rounding": self.output_rounding, "rounding": self.rounding,
+                "total": self.total, "total_lsb": self.total / self.y_lsb,
+                "gappa_rounding": self.gappa_rounding}
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """Errors measured over every valid input code (exhaustive).
+
+    ``rounding`` and ``step_rounding`` are exact (integer arithmetic);
+    ``approximation`` (``max |p - f|``), ``quantization`` (``max |p_q - p|``)
+    and ``total`` (``max |y - f|``) use float64 values of ``f`` and ``p``,
+    whose own error (about 1e-16) is far below the bounds compared with.
+    ``rel_total`` is ``max |y / f - 1|``, ``shading_levels`` is
+    ``255 * rel_total``: the largest change of an 8-bit intensity
+    ``I <= 1`` when the normal is scaled by ``y`` instead of ``f``.
+    """
+
+    codes: int
+    total: float
+    total_at_code: int
+    rel_total: float
+    approximation: float
+    quantization: float
+    rounding: float
+    step_rounding: tuple[float, ...]
+    overflows: int
+    y_lsb: float
+
+    @property
+    def total_lsb(self) -> float:
+        return self.total / self.y_lsb
+
+    @property
+    def shading_levels(self) -> float:
+        return SHADING_LEVELS * self.rel_total
+
+    def as_dict(self) -> dict:
+        return {"codes": self.codes, "total": self.total, "total_at_code": self.total_at_code,
+                "total_lsb": self.total_lsb, "rel_total": self.rel_total,
+                "shading_levels": self.shading_levels, "approximation": self.approximation,
+                "quantization": self.quantization, "rounding": self.rounding,
+                "step_rounding": list(self.step_rounding), "overflows": self.overflows}
+
+
+def _poly_function(table):
+    """``p`` itself as an exact sympy function (its floats as rationals)."""
+    v = sp.Symbol(table.variable)
+    expr = sum(sp.Rational(c) * v ** k for k, c in enumerate(table.coefficients))
+    return parse_function(expr, table.variable)
+
+
+def quantization_bound(design: HornerDesign) -> float:
+    """Certified ``sup |p_q - p|`` on the table's interval."""
+    t = design.table
+    coeffs = [math.ldexp(q, -design.coef_frac_bits) for q in design.integers]
+    lo, hi = (parse_number(v) for v in t.interval)
+    return certify(_poly_function(t), coeffs, lo, hi, "abs").bound
+
+
+def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
+    """The certified budget; with ``gappa`` also gappa's rounding bound (if installed)."""
+    t = design.table
+    xmax = design.max_abs_x()
+    steps = []
+    for st in design.stages[:-1]:
+        rho = rounding_error_bound(st.out_frac_bits, design.rounding, st.round_shift)
+        steps.append(rho * xmax ** st.power)
+    top_frac = design.stages[-1].sum_frac_bits if design.stages else design.coef_frac_bits
+    fy = design.y_format.frac_bits
+    out = rounding_error_bound(fy, design.rounding, top_frac - fy) if top_frac > fy else Fraction(0)
+    rounding = sum(steps, Fraction(0)) + out
+    approx, quant = t.abs_error_bound, quantization_bound(design)
+    quantized = t.fixed_point.abs_error_bound
+    poly = min(Fraction(approx) + Fraction(quant), Fraction(quantized))
+    g = gappa_bound(design) if gappa else None
+    return ErrorBudget(approximation=approx, quantization=quant, quantized=quantized,
+                       rounding_steps=tuple(_up(s) for s in steps), output_rounding=_up(out),
+                       rounding=_up(rounding), total=_up(poly + rounding),
+                       y_lsb=float(design.y_format.lsb), gappa_rounding=g)
+
+
+def measure(design: HornerDesign) -> Measurement:
+    """Measure every error over all valid input codes (see :class:`Measurement`)."""
+    lo, hi = design.valid_codes
+    k = np.arange(lo, hi + 1, dtype=np.int64)
+    wires = design.evaluate(k, intermediates=True)
+    y = wires["y"]
+    xf = design.x_format.values(k)
+    yv = design.y_format.values(y)
+    fn = parse_function(design.table.expression, design.table.variable)
+    f = np.asarray(fn.numpy(xf), dtype=np.float64) * np.ones_like(xf)
+    p = np.polynomial.polynomial.polyval(xf, design.table.coefficients)
+    num, den = design.exact_numerators(k)
+    pq = _to_float(num, den)
+    # exact rounding error: y - p_q, both over the common denominator 2**D
+    fy = design.y_format.frac_bits
+    yn = (y.astype(object) + design.y_format.offset_code)
+    if den >= fy:
+        diff = yn * 2 ** (den - fy) - num
+        scale = den
+    else:
+        diff = yn - num * 2 ** (fy - den)
+        scale = fy
+    worst = max(abs(int(diff.max())), abs(int(diff.min())))
+    rounding = _up(Fraction(worst, 2 ** scale))
+    steps = []
+    xs = wires["xs"]
+    acc = np.full(k.shape, design.integers[-1], dtype=np.int64)
+    for st in design.stages[:-1]:
+        t = ((acc * xs) << st.product_shift) + st.coef_shifted
+        a = wires[f"a{st.power}"]
+        err = np.abs((a << st.round_shift) - t)
+        steps.append(float(Fraction(int(err.max()), 2 ** st.sum_frac_bits)))
+        acc = a
+    e = np.abs(yv - f)
+    i = int(np.argmax(e))
+    return Measurement(codes=len(k), total=float(e[i]), total_at_code=int(k[i]),
+                       rel_total=float(np.max(np.abs(yv / f - 1))),
+                       approximation=float(np.max(np.abs(p - f))),
+                       quantization=float(np.max(np.abs(pq - p))), rounding=rounding,
+                       step_rounding=tuple(steps), overflows=int(wires["overflow"].sum()),
+                       y_lsb=float(design.y_format.lsb))
+
+
+def _to_float(num, den) -> np.ndarray:
+    """Object-int numerators over ``2**den`` to float64 (correctly rounded)."""
+    d = 1 << den
+    return np.array([int(v) / d for v in num], dtype=np.float64)
+
+
+# -- gappa ---------------------------------------------------------------------
+
+def _dyadic(q: int, frac: int) -> str:
+    return f"{q}b{-frac}" if q else "0"
+
+
+def gappa_script(design: HornerDesign) -> str:
+    """A gappa script bounding ``|y - p_q(x)|`` of the datapath (rounding only)."""
+    mode = {"rne": "ne", "trunc": "dn"}[design.rounding]
+    fc = design.coef_frac_bits
+    q = design.integers
+    n = design.degree
+    lo, hi = design.valid_codes
+    xf = design.x_format
+    lines = [f"# gappa: rounding error of the Horner datapath of {design.module_name}",
+             f"# x in the valid codes {lo}..{hi}; coefficients q_j * 2^-{fc}",
+             f"@ry = fixed<{-design.y_format.frac_bits},{mode}>;"]
+    if n >= 2:
+        lines.append(f"@ra = fixed<{-design.acc_frac_bits},{mode}>;")
+    exact = _dyadic(q[n], fc)
+    hw = exact
+    for j in range(n - 1, -1, -1):
+        c = _dyadic(q[j], fc)
+        exact_j = f"M{j} = {'M' + str(j + 1) if j < n - 1 else exact} * x + {c};"
+        lines.append(exact_j)
+        rnd = "ry" if j == 0 else "ra"
+        prev = hw if j == n - 1 else f"a{j + 1}"
+        lines.append(f"a{j} {rnd}= {prev} * x + {c};")
+    if n == 0:
+        lines.append(f"M0 = {exact};")
+        lines.append(f"a0 ry= {exact};")
+    x_lo = _dyadic(xf.offset_code + lo, xf.frac_bits)
+    x_hi = _dyadic(xf.offset_code + hi, xf.frac_bits)
+    lines.append(f"{{ x in [{x_lo}, {x_hi}] -> |a0 - M0| in ? }}")
+    return "\n".join(lines) + "\n"
+
+
+_NUM = re.compile(r"^\s*(-?\d+)(?:b(-?\d+))?\s*$")
+
+
+def parse_gappa_upper(text: str) -> Fraction:
+    """The upper end of gappa's ``|...| in [lo, hi]`` answer, exactly.
+
+    >>> parse_gappa_upper("|a0 - M0| in [0, 1b-21 {4.76837e-07, 2^(-21)}]")
+    Fraction(1, 2097152)
+    """
+    m = re.search(r"in \[(.*)\]", text)
+    if not m:
+        raise ValueError(f"gappa gave no bound: {text.strip()[:200]!r}")
+    plain = re.sub(r"\{[^}]*\}", "", m.group(1))
+    upper = plain.split(",")[-1]
+    n = _NUM.match(upper)
+    if not n:
+        raise ValueError(f"cannot read gappa's bound {upper.strip()!r}")
+    mant, exp = int(n.group(1)), int(n.group(2) or 0)
+    return Fraction(mant) * Fraction(2) ** exp
+
+
+def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
+    """gappa's bound of ``|y - p_q(x)|``, or None when gappa is not installed."""
+    exe = shutil.which("gappa")
+    if exe is None:
+        return None
+    proc = subprocess.run([exe], input=gappa_script(design), capture_output=True, text=True,
+                          timeout=timeout)
+    out = proc.stdout + proc.stderr
+    if proc.returncode != 0 or "in [" not in out:
+        raise ValueError(f"gappa could not bound the datapath of {design.module_name}: "
+                         f"{' '.join(out.split())[:300]}")
+    return _up(parse_gappa_upper(out))

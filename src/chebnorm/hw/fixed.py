@@ -1,0 +1,202 @@
+"""Fixed-point arithmetic, bit-accurate: Q formats, rounding, overflow.
+
+Conventions
+-----------
+* A fixed-point *code* ``k`` (an integer) in format ``QFormat(frac_bits=F,
+  offset=O)`` stands for the value ``O + k / 2**F``. ``O`` is a multiple of
+  ``2**-F`` (held as the integer ``offset_code = O * 2**F``), so every
+  value of the format is ``(offset_code + k) / 2**F`` exactly.
+* ``signed`` formats hold ``-2**(bits-1) <= k < 2**(bits-1)`` (two's
+  complement), unsigned ones ``0 <= k < 2**bits``.
+* Rounding modes (:data:`ROUNDINGS`): ``"trunc"`` -- toward minus infinity,
+  i.e. dropping bits of a two's-complement number (Verilog ``>>>``);
+  ``"rne"`` -- to nearest, ties to even. A right shift by ``s`` bits with
+  ``"trunc"`` errs by ``(-2**-F', 0]`` in the result's units ``2**-F'``;
+  with ``"rne"`` by at most half of one.
+* Overflow modes (:data:`OVERFLOWS`): ``"saturate"`` clamps to the
+  representable range, ``"wrap"`` keeps the low bits (two's complement);
+  both report which codes overflowed.
+
+The kernels take Python ints or numpy ``int64`` arrays and do not check
+that int64 does not overflow; :func:`check_int64` is the boundary check.
+
+>>> import numpy as np
+>>> shift_round(np.array([5, 6, 7, -5, -6]), 1, "rne").tolist()   # 2.5 3 3.5 -2.5 -3
+[2, 3, 4, -2, -3]
+>>> shift_round(np.array([5, -5]), 1, "trunc").tolist()
+[2, -3]
+>>> fit_bits(np.array([-3, 9, 300]), 8, signed=False, overflow="saturate")
+(array([  0,   9, 255]), array([ True, False,  True]))
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+__all__ = ["QFormat", "ROUNDINGS", "OVERFLOWS", "shift_round", "fit_bits", "signed_bits",
+           "unsigned_bits", "rounding_error_bound", "check_int64", "check_width"]
+
+ROUNDINGS = ("trunc", "rne")
+OVERFLOWS = ("saturate", "wrap")
+
+#: widest integer the vectorized model keeps in int64 (sign bit and a margin)
+INT64_BITS = 62
+
+
+@dataclass(frozen=True)
+class QFormat:
+    """An unsigned or signed fixed-point format: code ``k`` stands for
+    ``(offset_code + k) / 2**frac_bits``.
+
+    >>> q = QFormat(bits=16, frac_bits=16, offset_code=92681)
+    >>> float(q.value(0)), float(q.value(q.max_code))
+    (1.4141998291015625, 2.4141845703125)
+    >>> q.as_dict()
+    {'bits': 16, 'frac_bits': 16, 'offset': 1.4141998291015625, 'offset_code': 92681, 'signed': False}
+    """
+
+    bits: int
+    frac_bits: int
+    offset_code: int = 0
+    signed: bool = False
+
+    @property
+    def offset(self) -> Fraction:
+        return Fraction(self.offset_code, 2 ** self.frac_bits) if self.frac_bits >= 0 else \
+            Fraction(self.offset_code * 2 ** -self.frac_bits)
+
+    @property
+    def min_code(self) -> int:
+        return -(2 ** (self.bits - 1)) if self.signed else 0
+
+    @property
+    def max_code(self) -> int:
+        return 2 ** (self.bits - 1) - 1 if self.signed else 2 ** self.bits - 1
+
+    @property
+    def lsb(self) -> Fraction:
+        return Fraction(1, 2 ** self.frac_bits) if self.frac_bits >= 0 else Fraction(2 ** -self.frac_bits)
+
+    def value(self, code) -> Fraction:
+        """The exact value of one code."""
+        return self.offset + int(code) * self.lsb
+
+    def values(self, codes) -> np.ndarray:
+        """Float64 values of an array of codes (exact while they fit 53 bits)."""
+        return (np.asarray(codes, dtype=np.float64) + float(self.offset_code)) * 2.0 ** -self.frac_bits
+
+    def as_dict(self) -> dict:
+        return {"bits": self.bits, "frac_bits": self.frac_bits, "offset": float(self.offset),
+                "offset_code": self.offset_code, "signed": self.signed}
+
+    def q_name(self) -> str:
+        """Texas-Instruments style name of the code's format, ``UQm.F`` or ``Qm.F``."""
+        m = self.bits - self.frac_bits - (1 if self.signed else 0)
+        return f"{'' if self.signed else 'U'}Q{m}.{self.frac_bits}"
+
+
+def shift_round(v, shift: int, mode: str):
+    """``v / 2**shift`` rounded to an integer (``shift >= 0``), ints or int64 arrays.
+
+    Does not check its arguments (inner kernel).
+    """
+    if shift == 0:
+        return v
+    q = v >> shift
+    if mode == "trunc":
+        return q
+    r = v - (q << shift)
+    half = 1 << (shift - 1)
+    if isinstance(v, np.ndarray):
+        return q + ((r > half) | ((r == half) & ((q & 1) == 1))).astype(q.dtype)
+    return q + int(r > half or (r == half and q & 1 == 1))
+
+
+def fit_bits(v, bits: int, *, signed: bool, overflow: str):
+    """Force ``v`` into a ``bits``-wide code; returns ``(codes, overflowed)``.
+
+    ``"saturate"`` clamps, ``"wrap"`` keeps the low ``bits`` bits (two's
+    complement when ``signed``). ``overflowed`` flags the codes that did
+    not fit before the operation.
+    """
+    lo = -(1 << (bits - 1)) if signed else 0
+    hi = (1 << (bits - 1)) - 1 if signed else (1 << bits) - 1
+    v = np.asarray(v)
+    over = (v < lo) | (v > hi)
+    if overflow == "saturate":
+        out = np.clip(v, lo, hi)
+    elif overflow == "wrap":
+        out = v & ((1 << bits) - 1)
+        if signed:
+            out = np.where(out > hi, out - (1 << bits), out)
+    else:
+        raise ValueError(f"overflow mode {overflow!r} is unknown; accepted: {', '.join(OVERFLOWS)}")
+    return out, over
+
+
+def signed_bits(lo: int, hi: int) -> int:
+    """Smallest two's-complement width holding every integer of ``[lo, hi]``.
+
+    >>> signed_bits(-4, 3), signed_bits(0, 4), signed_bits(-5, 0)
+    (3, 4, 4)
+    """
+    n = 1
+    while not (-(1 << (n - 1)) <= lo and hi <= (1 << (n - 1)) - 1):
+        n += 1
+    return n
+
+
+def unsigned_bits(hi: int) -> int:
+    """Smallest unsigned width holding ``0..hi`` (at least 1)."""
+    return max(1, int(hi).bit_length())
+
+
+def rounding_error_bound(frac_bits: int, mode: str, dropped_bits: int | None = None) -> Fraction:
+    """Largest ``|rounded - exact|`` when rounding to ``frac_bits`` fractional bits.
+
+    With ``dropped_bits`` (the exact value has ``frac_bits + dropped_bits``
+    fractional bits) truncation errs by at most ``2**-F - 2**-(F + d)``.
+    """
+    ulp = Fraction(1, 2 ** frac_bits) if frac_bits >= 0 else Fraction(2 ** -frac_bits)
+    if dropped_bits == 0:
+        return Fraction(0)
+    if mode == "rne":
+        return ulp / 2
+    if mode == "trunc":
+        return ulp if dropped_bits is None else ulp - ulp / 2 ** dropped_bits
+    raise ValueError(f"rounding mode {mode!r} is unknown; accepted: {', '.join(ROUNDINGS)}")
+
+
+def check_int64(bits: int, what: str) -> None:
+    """Boundary check: a value of ``bits`` signed bits fits the int64 model."""
+    if bits > INT64_BITS:
+        raise ValueError(f"{what} needs {bits} bits, which overflows the 64-bit bit-accurate "
+                         f"model; accepted: at most {INT64_BITS} bits (use fewer input, "
+                         f"coefficient or datapath bits)")
+
+
+def check_width(value, name: str, lo: int, hi: int) -> int:
+    """Validate a bit width given by the user: an integer in ``[lo, hi]``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
+    if not lo <= int(value) <= hi:
+        raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
+    return int(value)
+
+
+def _exact_log2_floor(x: Fraction) -> int:
+    """floor(log2(x)) for x > 0, exactly."""
+    e = x.numerator.bit_length() - x.denominator.bit_length()
+    while Fraction(2) ** e > x:
+        e -= 1
+    while Fraction(2) ** (e + 1) <= x:
+        e += 1
+    return e
+
+
+def _ceil_div_pow2(x: Fraction, f: int) -> int:
+    return math.ceil(x * Fraction(2) ** f)

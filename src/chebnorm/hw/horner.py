@@ -1,0 +1,342 @@
+"""A bit-accurate fixed-point Horner evaluator built from a quantized table.
+
+The datapath (``n`` = degree, ``q_j`` the table's fixed-point integers with
+``Fc`` fractional bits, ``x = (K0 + k) / 2**Fx`` for the input code ``k``)::
+
+    a_n     = q_n / 2**Fc                                   (exact)
+    a_j     = R_Fa(a_{j+1} * x + q_j / 2**Fc),   j = n-1 .. 1
+    y_raw   = R_Fy(a_1 * x + q_0 / 2**Fc) - Oy,  y = saturate(y_raw)
+
+Each step is a multiply-add done exactly, then one rounding (``R_F``: to
+``F`` fractional bits, ``"trunc"`` or ``"rne"``); the output offset ``Oy``
+is subtracted after rounding (exactly, it is a multiple of ``2**-Fy``).
+Every intermediate wire is sized from its exact range over *all*
+``2**in_bits`` input codes, so nothing but the output ever overflows, and
+the output saturates. The input format maps the table's interval onto the
+codes (``Fx`` as large as the interval allows); codes whose value lies
+outside the table's interval are *invalid*: the circuit still answers (and
+the test bench checks it), but the error budget holds on the valid codes,
+whose range :attr:`HornerDesign.valid_codes` reports.
+
+>>> from chebnorm.approx import fit_target
+>>> d = design_horner(fit_target("dichotomy", 2), 16, 16, coef_bits=20)
+>>> d.x_format.frac_bits, d.y_format.frac_bits, d.valid_codes
+(16, 20, (0, 38390))
+>>> y = d.evaluate([0, 38390])
+>>> [round(float(d.y_format.value(c)), 6) for c in y]
+[0.541196, 0.500006]
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+import sympy as sp
+
+from chebnorm.approx import CoefficientTable, parse_number, quantize
+
+from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, rounding_error_bound,
+                    shift_round, signed_bits, unsigned_bits)
+
+__all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
+           "MAX_FRAC_BITS"]
+
+MAX_IN_BITS = 20
+MAX_OUT_BITS = 32
+MAX_FRAC_BITS = 40
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One Horner step ``a_j = R(a_{j+1} * x + c_j)`` with its exact widths.
+
+    ``product_bits``/``sum_bits``: signed widths of ``a_{j+1} * xs`` and of the
+    aligned sum (``sum_frac_bits`` fractional bits); ``out_bits``: width of
+    the rounded result with ``out_frac_bits`` fractional bits;
+    ``coef_shifted``: the integer added, ``q_j`` aligned to the sum.
+    """
+
+    power: int
+    acc_bits: int
+    product_bits: int
+    product_shift: int
+    coef_shifted: int
+    sum_bits: int
+    sum_frac_bits: int
+    out_bits: int
+    out_frac_bits: int
+    round_shift: int
+
+
+@dataclass(frozen=True)
+class HornerDesign:
+    """A fully sized fixed-point polynomial evaluator (see module docstring)."""
+
+    name: str
+    table: CoefficientTable
+    in_bits: int
+    out_bits: int
+    rounding: str
+    x_format: QFormat
+    y_format: QFormat
+    coef_frac_bits: int
+    integers: tuple[int, ...]
+    acc_frac_bits: int
+    xs_bits: int
+    stages: tuple[Stage, ...]
+    top_bits: int
+    raw_bits: int
+    valid_codes: tuple[int, int]
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def degree(self) -> int:
+        return len(self.integers) - 1
+
+    @property
+    def module_name(self) -> str:
+        return f"chebnorm_{self.name}"
+
+    # -- bit-accurate model --------------------------------------------------
+    def evaluate(self, codes=None, *, intermediates: bool = False):
+        """Output codes of the circuit for input ``codes`` (default: all).
+
+        Returns an int64 array; with ``intermediates`` a dict holding every
+        wire as well (``xs``, ``a<j>``, ``raw``, ``y``, ``overflow``).
+        """
+        if codes is None:
+            codes = np.arange(2 ** self.in_bits, dtype=np.int64)
+        k = np.asarray(codes, dtype=np.int64)
+        wires = _run(self, k)
+        return wires if intermediates else wires["y"]
+
+    def exact_numerators(self, codes) -> tuple[np.ndarray, int]:
+        """``p_q(x_k)`` exactly as ``(N_k, D)``: value ``N_k / 2**D`` (object ints)."""
+        n = self.degree
+        fx, fc = self.x_format.frac_bits, self.coef_frac_bits
+        xs = np.asarray(codes, dtype=np.int64).astype(object) + self.x_format.offset_code
+        acc = np.full(xs.shape, self.integers[n], dtype=object)
+        for j in range(n - 1, -1, -1):
+            acc = acc * xs + self.integers[j] * 2 ** ((n - j) * fx)
+        return acc, fc + n * fx
+
+    def max_abs_x(self) -> Fraction:
+        lo, hi = self.valid_codes
+        return max(abs(self.x_format.value(lo)), abs(self.x_format.value(hi)))
+
+
+def _run(d: HornerDesign, k: np.ndarray) -> dict:
+    xs = k + d.x_format.offset_code
+    wires = {"xs": xs}
+    n = d.degree
+    if n == 0:
+        top = np.full(k.shape, d.integers[0], dtype=np.int64)
+        top_frac = d.coef_frac_bits
+    else:
+        acc = np.full(k.shape, d.integers[n], dtype=np.int64)
+        for st in d.stages[:-1]:
+            t = ((acc * xs) << st.product_shift) + st.coef_shifted
+            acc = shift_round(t, st.round_shift, d.rounding)
+            wires[f"a{st.power}"] = acc
+        last = d.stages[-1]
+        top = ((acc * xs) << last.product_shift) + last.coef_shifted
+        top_frac = last.sum_frac_bits
+    wires["top"] = top
+    shift = top_frac - d.y_format.frac_bits
+    rounded = shift_round(top, shift, d.rounding) if shift >= 0 else top << -shift
+    raw = rounded - d.y_format.offset_code
+    wires["raw"] = raw
+    wires["overflow"] = (raw < 0) | (raw > d.y_format.max_code)
+    wires["y"] = np.clip(raw, 0, d.y_format.max_code)
+    return wires
+
+
+# -- construction ------------------------------------------------------------
+
+def _require_fixed_point(table: CoefficientTable, coef_bits):
+    if coef_bits is not None:
+        coef_bits = check_width(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
+        if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
+            table = quantize(table, coef_bits)
+        return table
+    if table.fixed_point is None:
+        raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
+                         f"quantized with `chebnorm fit ... --frac-bits F`, or give "
+                         f"--coef-bits B (1 <= B <= {MAX_FRAC_BITS}) to quantize it here")
+    return table
+
+
+def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
+    lo, hi = (parse_number(v) for v in table.interval)
+    span_codes = 2 ** in_bits - 1
+
+    def fits(f):
+        k0 = int(sp.floor(lo * sp.Integer(2) ** f))
+        return k0, (sp.Integer(k0 + span_codes) / sp.Integer(2) ** f) >= hi
+
+    if x_frac_bits is None:
+        width = float(sp.N(hi - lo, 20))
+        f = min(MAX_FRAC_BITS, in_bits - math.floor(math.log2(width)) + 1)
+        while f >= -MAX_FRAC_BITS:
+            k0, ok = fits(f)
+            if ok:
+                break
+            f -= 1
+    else:
+        f = check_width(x_frac_bits, "x-frac-bits", -MAX_FRAC_BITS, MAX_FRAC_BITS)
+        k0, ok = fits(f)
+        if not ok:
+            best = None
+            g = in_bits - math.floor(math.log2(float(sp.N(hi - lo, 20)))) + 1
+            while g > -MAX_FRAC_BITS and not fits(g)[1]:
+                g -= 1
+            best = g
+            cover_hi = float((k0 + span_codes) / sp.Integer(2) ** f)
+            raise ValueError(f"table {table.name!r}: interval [{table.interval[0]}, "
+                             f"{table.interval[1]}] does not fit the input format of {in_bits} "
+                             f"bits with {f} fractional bits (codes cover "
+                             f"[{float(k0 / sp.Integer(2) ** f):.9g}, {cover_hi:.9g}]); accepted: "
+                             f"x-frac-bits <= {best}, or more input bits")
+    fmt = QFormat(bits=in_bits, frac_bits=f, offset_code=k0, signed=False)
+    scale = sp.Integer(2) ** f
+    k_lo = max(0, int(sp.ceiling(lo * scale)) - k0)
+    k_hi = min(span_codes, int(sp.floor(hi * scale)) - k0)
+    if k_lo > k_hi:
+        raise ValueError(f"table {table.name!r}: no input code falls inside [{table.interval[0]}, "
+                         f"{table.interval[1]}] with {in_bits} bits and {f} fractional bits; "
+                         f"accepted: more input bits or fractional bits")
+    return fmt, (k_lo, k_hi)
+
+
+def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
+    """Size the Horner steps exactly by running them over all codes."""
+    n = len(integers) - 1
+    stages = []
+    acc = np.full(k_all_xs.shape, integers[n], dtype=np.int64)
+    acc_frac = fc
+    acc_bits = signed_bits(integers[n], integers[n])
+    xs_bits = signed_bits(xs_lo, xs_hi)
+    for j in range(n - 1, -1, -1):
+        check_int64(acc_bits + xs_bits, f"the product a_{j + 1} * x")
+        prod = acc * k_all_xs
+        prod_frac = acc_frac + fx
+        s = max(prod_frac, fc)
+        check_int64(signed_bits(int(prod.min()), int(prod.max())) + s - prod_frac + 1,
+                    f"the sum of step {j}")
+        pshift = s - prod_frac
+        coef = integers[j] << (s - fc)
+        t = (prod << pshift) + coef
+        p_lo, p_hi = int(prod.min()) << pshift, int(prod.max()) << pshift
+        sum_bits = signed_bits(min(p_lo, int(t.min()), coef), max(p_hi, int(t.max()), coef))
+        if j > 0:
+            rshift = s - fa
+            if rshift < 0:
+                raise ValueError(f"datapath frac bits {fa} exceed the exact sum's {s} fractional "
+                                 f"bits at step {j}; accepted: acc-bits <= {s}")
+            acc = shift_round(t, rshift, rounding)
+            out_bits = signed_bits(int(acc.min()), int(acc.max()))
+            out_frac = fa
+        else:
+            rshift, out_bits, out_frac = 0, sum_bits, s
+            acc = t
+        stages.append(Stage(power=j, acc_bits=acc_bits,
+                            product_bits=signed_bits(int(prod.min()), int(prod.max())),
+                            product_shift=pshift, coef_shifted=int(coef), sum_bits=sum_bits,
+                            sum_frac_bits=s, out_bits=out_bits, out_frac_bits=out_frac,
+                            round_shift=rshift))
+        acc_bits, acc_frac = out_bits, out_frac
+    return tuple(stages), acc
+
+
+def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
+                  coef_bits: int | None = None, acc_bits: int | None = None,
+                  rounding: str = "rne", x_frac_bits: int | None = None,
+                  y_frac_bits: int | None = None, guard_bits: int = 3,
+                  name: str | None = None) -> HornerDesign:
+    """Size a fixed-point Horner evaluator of ``table`` (see module docstring).
+
+    ``in_bits``/``out_bits``: widths of the unsigned codes ``x`` and ``y``;
+    ``coef_bits``: fractional bits of the coefficients (re-quantizes the
+    table with :func:`chebnorm.approx.quantize`; default: the table's own
+    fixed-point part); ``acc_bits``: fractional bits of the intermediate
+    accumulators (default ``y_frac_bits + guard_bits``); ``x_frac_bits`` and
+    ``y_frac_bits`` default to the largest the interval and the output range
+    allow. Raises ValueError naming the problem and the accepted range.
+    """
+    in_bits = check_width(in_bits, "in-bits", 1, MAX_IN_BITS)
+    out_bits = check_width(out_bits, "out-bits", 1, MAX_OUT_BITS)
+    if rounding not in ROUNDINGS:
+        raise ValueError(f"rounding {rounding!r} is unknown; accepted: {', '.join(ROUNDINGS)}")
+    if acc_bits is not None:
+        acc_bits = check_width(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
+    if y_frac_bits is not None:
+        y_frac_bits = check_width(y_frac_bits, "y-frac-bits", -MAX_FRAC_BITS, MAX_FRAC_BITS + 20)
+    guard_bits = check_width(guard_bits, "guard-bits", 0, 32)
+    name = name or table.name
+    if not name.isidentifier() or not name.isascii():
+        raise ValueError(f"table name {name!r} is not a Verilog identifier; accepted: letters, "
+                         f"digits and underscores, not starting with a digit")
+    table = _require_fixed_point(table, coef_bits)
+    fp = table.fixed_point
+    integers, fc = tuple(int(q) for q in fp.integers), fp.frac_bits
+    x_fmt, valid = _x_format(table, in_bits, x_frac_bits)
+    fx = x_fmt.frac_bits
+    all_k = np.arange(2 ** in_bits, dtype=np.int64)
+    xs_all = all_k + x_fmt.offset_code
+    xs_lo, xs_hi = x_fmt.offset_code, x_fmt.offset_code + 2 ** in_bits - 1
+    notes = []
+
+    # exact range of p_q on the valid codes fixes the output format
+    proto = HornerDesign(name=name, table=table, in_bits=in_bits, out_bits=out_bits,
+                         rounding=rounding, x_format=x_fmt, y_format=QFormat(out_bits, 0),
+                         coef_frac_bits=fc, integers=integers, acc_frac_bits=0, xs_bits=0,
+                         stages=(), top_bits=0, raw_bits=0, valid_codes=valid)
+    num, den = proto.exact_numerators(np.arange(valid[0], valid[1] + 1))
+    v_lo, v_hi = Fraction(int(num.min()), 2 ** den), Fraction(int(num.max()), 2 ** den)
+    span = v_hi - v_lo
+    if y_frac_bits is None:
+        fy = out_bits + (-math.floor(math.log2(span)) if span > 0 else MAX_FRAC_BITS)
+        fy = min(fy, MAX_FRAC_BITS)
+        candidates = range(fy, -MAX_FRAC_BITS - 1, -1)
+    else:
+        candidates = [y_frac_bits]
+    for fy in candidates:
+        fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
+        if len(integers) > 1:
+            stages, top = _stages(integers, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding)
+            top_frac = stages[-1].sum_frac_bits
+        else:
+            stages, top, top_frac = (), np.full(all_k.shape, integers[0], dtype=np.int64), fc
+        shift = top_frac - fy
+        check_int64(signed_bits(int(top.min()), int(top.max())) + max(0, -shift), "the output")
+        rounded = shift_round(top, shift, rounding) if shift >= 0 else top << -shift
+        r_valid = rounded[valid[0]:valid[1] + 1]
+        y_off = int(r_valid.min())
+        if int(r_valid.max()) - y_off <= 2 ** out_bits - 1:
+            break
+        if y_frac_bits is not None:
+            lo_v, hi_v = float(v_lo), float(v_hi)
+            raise ValueError(f"out-bits {out_bits} with y-frac-bits {fy} cannot hold the outputs "
+                             f"[{lo_v:.9g}, {hi_v:.9g}] of {name!r} (they need "
+                             f"{unsigned_bits(int(r_valid.max()) - y_off)} bits); accepted: "
+                             f"fewer y-frac-bits or more out-bits")
+    raw = rounded - y_off
+    y_fmt = QFormat(bits=out_bits, frac_bits=fy, offset_code=y_off, signed=False)
+    raw_bits = signed_bits(min(int(raw.min()), 0), max(int(raw.max()), y_fmt.max_code))
+    n_sat = int(((raw < 0) | (raw > y_fmt.max_code)).sum())
+    n_valid = valid[1] - valid[0] + 1
+    if n_valid < 2 ** in_bits:
+        notes.append(f"{n_valid} of {2 ** in_bits} input codes lie in the table's interval "
+                     f"(codes {valid[0]}..{valid[1]}); the budget holds there, the other codes "
+                     f"are evaluated (and saturate where needed) but not guaranteed")
+    if n_sat:
+        notes.append(f"{n_sat} input codes outside the valid range saturate the output")
+    return HornerDesign(name=name, table=table, in_bits=in_bits, out_bits=out_bits,
+                        rounding=rounding, x_format=x_fmt, y_format=y_fmt, coef_frac_bits=fc,
+                        integers=integers, acc_frac_bits=fa if len(integers) > 2 else fy,
+                        xs_bits=signed_bits(xs_lo, xs_hi), stages=stages,
+                        top_bits=signed_bits(int(top.min()), int(top.max())), raw_bits=raw_bits,
+                        valid_codes=valid, notes=tuple(notes))
