@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from importlib.metadata import PackageNotFoundError, version as _pkg_version
 
@@ -21,6 +22,7 @@ KINDS = ("chebyshev", "minimax")
 ERROR_KINDS = ("abs", "rel")
 
 
+@functools.lru_cache(maxsize=1)
 def _versions() -> dict[str, str]:
     out = {}
     for name in ("chebnorm", "numpy", "mpmath", "sympy", "python-flint"):
@@ -141,7 +143,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         res = remez(f_np, weight, iv.lo_f, iv.hi_f, degree)
         coeffs = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
     cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel")
-    provenance = _versions()
+    provenance = dict(_versions())
     provenance["command"] = command or (
         f"chebnorm.fit({str(fn.expr)!r}, {iv.strings!r}, {degree}, kind={kind!r}, "
         f"error={error!r}, var={var!r})")

@@ -200,7 +200,7 @@ class Function1D:
 
 
 def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:
-    """Parse ``text`` as a real function of the single variable ``var``.
+    """Parse ``text`` as a real function of the single variable ``var`` (cached).
 
     >>> parse_function("1/sqrt(2+z)", "z").expr
     1/sqrt(z + 2)
@@ -208,6 +208,11 @@ def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:
     Raises ValueError for text sympy cannot parse, for symbols other than
     ``var`` and for functions the certification engine does not support.
     """
+    return _parse_function(text, var)
+
+
+@functools.lru_cache(maxsize=256)
+def _parse_function(text, var: str) -> Function1D:
     if not isinstance(var, str) or not var.isidentifier():
         raise ValueError(f"variable name {var!r} is not an identifier")
     symbol = sp.Symbol(var, real=True)

@@ -89,12 +89,18 @@ def _refine(t_grid, idx, err_fn):
     lo = np.where(inner, t_grid[np.maximum(i - 1, 0)], t_grid[i])
     hi = np.where(inner, t_grid[np.minimum(i + 1, len(t_grid) - 1)], t_grid[i])
     g = 0.6180339887498949
-    for _ in range(40):
-        x1 = hi - g * (hi - lo)
-        x2 = lo + g * (hi - lo)
-        left = np.abs(err_fn(x1)) > np.abs(err_fn(x2))
+    x1 = hi - g * (hi - lo)
+    x2 = lo + g * (hi - lo)
+    f1, f2 = np.abs(err_fn(x1)), np.abs(err_fn(x2))
+    for _ in range(24):  # golden section, one evaluation per step, vectorized
+        left = f1 > f2
         hi = np.where(left, x2, hi)
         lo = np.where(left, lo, x1)
+        x1n = np.where(left, hi - g * (hi - lo), x2)
+        x2n = np.where(left, x1, lo + g * (hi - lo))
+        fe = np.abs(err_fn(np.where(left, x1n, x2n)))
+        f1, f2 = np.where(left, fe, f2), np.where(left, f1, fe)
+        x1, x2 = x1n, x2n
     x = 0.5 * (lo + hi)
     base = t_grid[i]
     better = np.abs(err_fn(x)) > np.abs(err_fn(base))

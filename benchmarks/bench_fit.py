@@ -1,0 +1,119 @@
+"""Fit-and-certify benchmark: chebnorm against Sollya on the 18-case workload.
+
+Runs, in one process and one sitting:
+* chebnorm: Remez fit, then certification of sup|p - f| at relative
+  tightness TIGHT (bound <= (1 + TIGHT) * sup), timed separately;
+* Sollya (when installed): ``remez`` then ``supnorm(..., absolute, TIGHT)``
+  on the same cases, in one sollya process, each part timed by Sollya's own
+  ``time()``; so the ratio compares certification with certification.
+
+Usage: python benchmarks/bench_fit.py [--json] [--repeat N] [--tight T ...]
+Not a test: timings are printed, nothing is asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import sympy as sp
+
+from chebnorm.approx import fit, parse_function, sollya
+from chebnorm.approx.certify import certify
+
+WORKLOAD = (
+    [("1/sqrt(2+x)", ("sqrt(2)", "2"), d) for d in range(1, 5)]
+    + [("1/sqrt(2*(1+x))", ("0", "1"), d) for d in range(1, 5)]
+    + [("sqrt(2*(1+x))/2", ("0", "1"), d) for d in range(1, 5)]
+    + [("1/sqrt(x)", ("1/2", "2"), d) for d in range(1, 7)]
+)
+
+
+def run_chebnorm(tight: float):
+    fits, certs, worst_ratio = [], [], 0.0
+    tables = []
+    for expr, (lo, hi), d in WORKLOAD:
+        t0 = time.perf_counter()
+        t = fit(expr, (lo, hi), d, kind="minimax")
+        fits.append(time.perf_counter() - t0)
+        tables.append(t)
+    for (expr, (lo, hi), d), t in zip(WORKLOAD, tables):
+        fn = parse_function(expr)
+        t0 = time.perf_counter()
+        c = certify(fn, t.coefficients, sp.sympify(lo), sp.sympify(hi), "abs", tol=tight)
+        certs.append(time.perf_counter() - t0)
+        worst_ratio = max(worst_ratio, c.bound / c.maximum - 1)
+    return sum(fits), sum(certs), worst_ratio, tables
+
+
+def run_sollya(tight: float):
+    lines = ["prec=200!;", "display=decimal!;", "tr=0; ts=0; w=0;"]
+    for k, (expr, (lo, hi), d) in enumerate(WORKLOAD):
+        f = sollya._sollya_expr(expr, "x")
+        dom = sollya._interval(lo, hi)
+        lines += [f"f={f};", f"d={dom};",
+                  f"t=time(p=remez(f, {d}, d)); tr=tr+t;",
+                  f"t=time(r=supnorm(p, f, d, absolute, {tight!r})); ts=ts+t;",
+                  "w=max(w, sup(r)/inf(r)-1);"]
+    lines += ['print("TIMES", tr, ts, w);', "quit;"]
+    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
+        fh.write("\n".join(lines) + "\n")
+    t0 = time.perf_counter()
+    out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
+                         stdin=subprocess.DEVNULL).stdout
+    wall = time.perf_counter() - t0
+    m = re.search(r"TIMES\s+(\S+)\s+(\S+)\s+(\S+)", out)
+    return float(m.group(1)), float(m.group(2)), float(m.group(3)), wall
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--tight", type=float, nargs="+", default=[2.0 ** -8, 2.0 ** -20])
+    args = ap.parse_args(argv)
+    fit(*WORKLOAD[0][:2], 1)  # warm-up: imports, lambdify caches
+    results = []
+    for tight in args.tight:
+        ours = [run_chebnorm(tight) for _ in range(args.repeat)]
+        row = {"tightness": tight, "cases": len(WORKLOAD),
+               "chebnorm_fit_s": statistics.median(o[0] for o in ours),
+               "chebnorm_certify_s": statistics.median(o[1] for o in ours),
+               "chebnorm_worst_bound_over_max": max(o[2] for o in ours)}
+        if sollya.available():
+            theirs = [run_sollya(tight) for _ in range(args.repeat)]
+            row.update({"sollya_remez_s": statistics.median(t[0] for t in theirs),
+                        "sollya_supnorm_s": statistics.median(t[1] for t in theirs),
+                        "sollya_worst_upper_over_lower": max(t[2] for t in theirs),
+                        "sollya_wall_s": statistics.median(t[3] for t in theirs)})
+            row["certify_speedup"] = row["sollya_supnorm_s"] / row["chebnorm_certify_s"]
+            row["fit_and_certify_speedup"] = ((row["sollya_remez_s"] + row["sollya_supnorm_s"])
+                                              / (row["chebnorm_fit_s"] + row["chebnorm_certify_s"]))
+        else:
+            row["sollya"] = "not installed: apt-get install sollya to compare"
+        results.append(row)
+    if args.json:
+        print(json.dumps(results, indent=2, sort_keys=True))
+    else:
+        for r in results:
+            print(f"tightness {r['tightness']:.3g}: chebnorm fit {r['chebnorm_fit_s']:.3f} s, "
+                  f"certify {r['chebnorm_certify_s']:.3f} s (worst bound/max - 1 = "
+                  f"{r['chebnorm_worst_bound_over_max']:.2e})")
+            if "sollya_supnorm_s" in r:
+                print(f"  sollya remez {r['sollya_remez_s']:.3f} s, supnorm {r['sollya_supnorm_s']:.3f} s "
+                      f"(worst upper/lower - 1 = {r['sollya_worst_upper_over_lower']:.2e})")
+                print(f"  certification speed-up {r['certify_speedup']:.1f}x; "
+                      f"fit + certify {r['fit_and_certify_speedup']:.1f}x")
+            else:
+                print(f"  {r['sollya']}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,83 @@
+"""The command line: acceptance commands, JSON keys, one-line errors with status 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from chebnorm.cli import main
+
+
+def run(*args):
+    """Run the real console entry point in a subprocess (no shared state)."""
+    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def test_fit_json_acceptance_c5():
+    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
+                       "--degree", "2", "--kind", "chebyshev", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    for key in ("coefficients", "max_abs_error", "abs_error_bound", "max_rel_error", "rel_error_bound",
+                "degree", "kind", "interval", "name"):
+        assert key in d
+    assert [round(c, 5) for c in d["coefficients"]] == [0.68076, -0.11881, 0.01422]
+    assert round(d["max_abs_error"], 7) == 2.16e-5 and round(d["max_rel_error"] * 100, 4) == 0.0040
+    assert d["interval_float"] == [2 ** 0.5, 2.0] and d["interval"] == ["sqrt(2)", "2"]
+    assert "fit 1/sqrt(2+z) --var z" in d["provenance"]["command"].replace("'", "")
+
+
+def test_fit_minimax_acceptance():
+    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
+                       "--degree", "2", "--kind", "minimax", "--json")
+    d = json.loads(out)
+    assert abs(d["max_abs_error"] - 2.016e-5) < 1e-8
+    assert d["abs_error_bound"] >= d["max_abs_error"]
+
+
+def test_fit_export_targets_round_trip(tmp_path, capsys):
+    table = tmp_path / "t.json"
+    assert main(["fit", "sqrt(2*(1+x))/2", "--interval", "0", "1", "--degree", "1",
+                 "--name", "eta_d1", "--frac-bits", "16", "-o", str(table)]) == 0
+    assert main(["export", str(table), "--format", "c", "-o", str(tmp_path / "eta.h")]) == 0
+    h = (tmp_path / "eta.h").read_text()
+    assert "chebnorm_eta_d1_q_eval" in h and f"Command: chebnorm export {table}" in h
+    assert main(["export", str(table), "--format", "json", "-o", str(tmp_path / "copy.json")]) == 0
+    assert (tmp_path / "copy.json").read_text() == table.read_text()
+    capsys.readouterr()
+    assert main(["targets", "--json"]) == 0
+    names = [t["name"] for t in json.loads(capsys.readouterr().out)]
+    assert names == ["dichotomy", "eta_term", "midpoint", "rsqrt"]
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["fit", "1/sqrt(x)", "--interval", "-1", "1", "--degree", "2"], "not finite and real"),
+    (["fit", "x", "--interval", "1", "0", "--degree", "2"], "LO must be strictly less than HI"),
+    (["fit", "x", "--interval", "0", "1", "--degree", "-1"], "accepted: 0 <= degree <= 30"),
+    (["fit", "x", "--interval", "0", "1", "--degree", "31"], "accepted: 0 <= degree <= 30"),
+    (["fit", "sqrt(", "--interval", "0", "1", "--degree", "2"], "cannot parse expression"),
+    (["fit", "x+y", "--interval", "0", "1", "--degree", "2"], "unknown variable"),
+    (["fit", "exp(x)", "--interval", "0", "1", "--degree", "3", "--frac-bits", "40"], "overflows int32"),
+    (["fit", "x", "--interval", "0", "1"], "required: --degree"),
+    (["export", "missing.json", "-o", "x.h"], "cannot read coefficient table"),
+    (["nonsense"], "invalid choice"),
+])
+def test_bad_input_one_line_status_2(args, needle, tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True,
+                          cwd=tmp_path)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert proc.stdout == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written
+
+
+def test_failed_fit_leaves_no_output(tmp_path):
+    out = tmp_path / "t.json"
+    assert main(["fit", "1/sqrt(x)", "--interval", "-1", "1", "--degree", "2", "-o", str(out)]) == 2
+    assert not out.exists()
