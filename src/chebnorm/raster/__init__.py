@@ -1,0 +1,1 @@
+"""Stage 4: meshes, scan-line spans, shading modes and image metrics."""
