@@ -1,0 +1,196 @@
+"""Operation counts measured by running the kernels on :class:`~.ops.Counted` scalars.
+
+Nothing here is a hand-written table: :func:`count_ops` runs the very kernel
+:func:`~.spans.span_normals` runs, on one span, and reads the tallies.
+
+* ``per_span`` -- operations in the kernel's set-up phase (once per span;
+  for ``dichotomy`` this includes the per-level denominators, so it grows
+  with ``log2 m``; for ``angular`` and ``quadratic`` it includes the first
+  pixel(s), which the set-up produces);
+* ``per_pixel`` -- operations in the per-pixel phase divided by the pixels
+  that phase produced (``pixels_in_loop``). For a steady loop this is an
+  exact integer; for ``dichotomy`` off the dyadic grid, or ``angular`` with
+  re-anchoring, it is an average.
+
+``total = per_span + per_pixel * pixels_in_loop`` holds exactly. Multiplications
+by a power of two (``* 0.5``, ``* 2``, ``* 4``) are included in ``mul`` and
+tallied again in ``pow2_per_pixel`` / ``pow2_per_span``: in hardware they are
+exponent (or wire) shifts.
+
+Claim C9 (seeds 000, 003): :func:`normalization_ops` counts the normalization
+step alone (no interpolation):
+
+>>> for name in ("exact", "newton", "lyon"):
+...     c = normalization_ops(name); print(name, c.ops, "pow2:", c.pow2)
+exact {'add': 2, 'mul': 3, 'div': 3, 'sqrt': 1, 'trig': 0, 'cmp': 0} pow2: 0
+newton {'add': 3, 'mul': 7, 'div': 0, 'sqrt': 0, 'trig': 0, 'cmp': 0} pow2: 1
+lyon {'add': 4, 'mul': 8, 'div': 0, 'sqrt': 0, 'trig': 0, 'cmp': 0} pow2: 0
+
+Newton-Raphson ``N (3 - N.N) / 2`` is 6 general mul (3 for ``N.N``, 3 for the
+scaling of N), 3 add (2 in ``N.N``, 1 in ``3 - N.N``) and one halving. Seed
+000 counts the halving as 1 div (``(3 - N.N)/2`` once, then 6 mul, 3 add);
+seed 003's 3 div halve each component of ``N (3 - N.N)``. Neither division
+is needed: ``/2`` is a multiplication by 0.5, i.e. an exponent decrement in
+floating point (a shift in fixed point), so the honest count is 6 mul, 3 add,
+0 div (+1 free shift); seed 000's count is right if its "div" is read as that
+shift, seed 003's 3 div is an artefact of where the halving is written.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import kernels as K
+from .ops import OP_KINDS, Counted, Counter, CountingOps
+from .spans import METHODS, TABLE_METHODS, _check_method, _levels, _resolve_table, span_normals
+
+__all__ = ["OpCounts", "count_ops", "NormalizationCounts", "normalization_ops", "PAPER_COUNTS"]
+
+#: the counts the papers state (claim C9); missing kinds are not stated
+PAPER_COUNTS = {
+    "exact": {"seed 000": {"mul": 3, "add": 2, "sqrt": 1, "div": 3}},
+    "newton": {"seed 000": {"div": 1, "mul": 6, "add": 3}, "seed 003": {"div": 3}},
+    "lyon": {},
+}
+
+_NORMALIZERS = {"exact": K.normalize_classic, "newton": K.normalize_newton, "lyon": K.normalize_lyon}
+
+
+def _clean(v):
+    return int(v) if float(v).is_integer() else float(v)
+
+
+@dataclass(frozen=True)
+class OpCounts:
+    """Counts of one method on one span (see the module docstring)."""
+
+    method: str
+    m: int
+    per_pixel: dict
+    per_span: dict
+    pixels_in_setup: int
+    pixels_in_loop: int
+    pow2_per_pixel: float
+    pow2_per_span: int
+    total: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {"method": self.method, "m": self.m, "per_pixel": dict(self.per_pixel),
+                "per_span": dict(self.per_span), "pixels_in_setup": self.pixels_in_setup,
+                "pixels_in_loop": self.pixels_in_loop, "pow2_per_pixel": self.pow2_per_pixel,
+                "pow2_per_span": self.pow2_per_span, "total": dict(self.total)}
+
+
+@dataclass(frozen=True)
+class NormalizationCounts:
+    """Counts of a normalization step alone (claim C9)."""
+
+    method: str
+    ops: dict
+    pow2: int
+
+
+def normalization_ops(method: str) -> NormalizationCounts:
+    """Count ``exact`` (classic ``N/sqrt(N.N)``), ``newton`` or ``lyon`` on one vector."""
+    if method not in _NORMALIZERS:
+        raise ValueError(f"method {method!r} has no separate normalization step; accepted: "
+                         f"{', '.join(_NORMALIZERS)}")
+    c = Counter()
+    n = tuple(Counted(v, c) for v in (0.6, 0.5, 0.4))
+    _NORMALIZERS[method](CountingOps(c), n)
+    return NormalizationCounts(method, dict(c.counts["setup"]), c.pow2["setup"])
+
+
+def _generic_pair(psi: float):
+    e1 = np.array([2.0, 1.0, 2.0]) / 3.0
+    e2 = np.array([1.0, 2.0, -2.0]) / 3.0
+    return e1, math.cos(psi) * e1 + math.sin(psi) * e2
+
+
+def _run_counting(method, nl, nr, t0, dt, count, coeffs, levels, reanchor):
+    """Run ``method`` on one span with counting scalars; returns (counter, values (count, 3))."""
+    c = Counter()
+    ops = CountingOps(c)
+    a = tuple(Counted(v, c) for v in nl)
+    b = tuple(Counted(v, c) for v in nr)
+    ct0, cdt = Counted(t0, c), Counted(dt, c)
+    vals = []
+    if method in K.DIRECT:
+        kern = K.DIRECT[method]
+        st = kern.setup(ops, a, b)
+        ops.phase("pixel")
+        for j in range(count):
+            vals.append(kern.pixel(ops, st, Counted(t0 + j * dt, c)))
+            ops.produced(1)
+    elif method == "quadratic":
+        vals = list(K.quadratic_steps(ops, a, b, ct0, cdt, count, coefficients=coeffs,
+                                      start_at_left=t0 == 0))
+    elif method == "angular":
+        vals = list(K.angular_steps(ops, a, b, ct0, cdt, count, start_at_left=t0 == 0,
+                                    reanchor=reanchor))
+    else:
+        nodes = K.dichotomy_tree(ops, a, b, levels, coeffs)
+        ts = [t0 + j * dt for j in range(count)]
+        scale = 2 ** levels
+        if all(float(t * scale).is_integer() for t in ts):
+            vals = [nodes[int(t * scale)] for t in ts]
+            c.pixels["setup"] += max(count - c.pixels["pixel"], 0)
+        else:
+            c.pixels["pixel"] = 0  # the midpoints are nodes, the pixels are the picks
+            ops.phase("pixel")
+            for t in ts:
+                k, f = K.dichotomy_fraction(ops, Counted(t, c), levels)
+                ka, kb = int(k.v), min(int(k.v) + 1, scale)
+                vals.append(K.dichotomy_pick(ops, nodes[ka], nodes[kb], f))
+                ops.produced(1)
+    values = np.array([[float(x) for x in v] for v in vals])
+    return c, values
+
+
+def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
+              count: int | None = None, tables=None, angular_reanchor: int | None = None,
+              psi: float = math.pi / 4, return_values: bool = False) -> OpCounts:
+    """Operation counts of ``method`` on one span of length ``m``, measured by the kernel.
+
+    Arguments as in :func:`~.spans.span_normals` for one span (``psi`` is the
+    angle of the generic end normals used; counts do not depend on it).
+    With ``return_values`` the result is ``(OpCounts, values)``, the values
+    being the float64 normals the counting run computed (equal to
+    ``span_normals`` in float64 up to the libm's last bit).
+
+    >>> c = count_ops("exact", 8)
+    >>> c.per_pixel["sqrt"], c.per_pixel["div"], c.per_span["add"]
+    (1, 3, 3)
+    >>> count_ops("quadratic", 64).per_pixel
+    {'add': 6, 'mul': 0, 'div': 0, 'sqrt': 0, 'trig': 0, 'cmp': 0}
+    """
+    method = _check_method(method)
+    nl, nr = _generic_pair(psi)
+    if isinstance(m, bool) or not isinstance(m, (int, np.integer)):
+        raise ValueError(f"span length m = {m!r} is not an integer; accepted: m >= 1")
+    m = int(m)
+    res = span_normals(method, nl[None], nr[None], [m], t0=None if t0 == 0 else [t0],
+                       dt=None if dt is None else [dt], count=None if count is None else [count],
+                       tables=tables, angular_reanchor=angular_reanchor)  # validates
+    dt = 1.0 / m if dt is None else float(dt)
+    count = m + 1 if count is None else int(count)
+    levels = int(_levels(np.array([dt]))[0]) if method == "dichotomy" else 0
+    coeffs = None
+    if method in TABLE_METHODS:
+        table = _resolve_table(method, tables, np.array([float(nl @ nr)]), np.array([levels]))
+        coeffs = None if table is None else table.coefficients
+    c, values = _run_counting(method, nl, nr, float(t0), dt, count, coeffs, levels, angular_reanchor)
+    loop = c.pixels["pixel"]
+    per_pixel = {k: _clean(c.counts["pixel"][k] / loop) if loop else 0 for k in OP_KINDS}
+    out = OpCounts(method=method, m=m, per_pixel=per_pixel, per_span=dict(c.counts["setup"]),
+                   pixels_in_setup=c.pixels["setup"], pixels_in_loop=loop,
+                   pow2_per_pixel=_clean(c.pow2["pixel"] / loop) if loop else 0,
+                   pow2_per_span=c.pow2["setup"],
+                   total={k: c.counts["setup"][k] + c.counts["pixel"][k] for k in OP_KINDS})
+    if return_values:
+        del res
+        return out, values
+    return out

@@ -1,0 +1,247 @@
+"""The eight span-interpolation kernels of seed 000, written once against :mod:`.ops`.
+
+Every kernel runs unchanged on numpy arrays (:class:`~.ops.NumpyOps`, one
+array entry per span or per pixel) and on counting scalars
+(:class:`~.ops.CountingOps`). Vectors are 3-tuples of scalars.
+
+**These kernels do not validate anything**: they assume unit end normals,
+``1 + N_l.N_r > 0``, positive steps and tables covering the angles, as
+checked once by :func:`chebnorm.methods.span_normals`.
+
+Three shapes of kernel:
+
+* direct (``exact``, ``none``, ``newton``, ``lyon``, ``slerp``): ``setup``
+  once per span, then ``pixel(t)`` at any position ``t``, independently;
+* stepping (``quadratic``, ``angular``): a generator yielding the pixels
+  ``t0, t0 + dt, ...`` in order (forward differences, recurrence);
+* tree (``dichotomy``): successive angle halving, then a pick per pixel.
+
+Linear interpolation is ``N(t) = N_l + t (N_r - N_l)`` (3 mul, 3 add per
+pixel, the difference once per span).
+"""
+
+from __future__ import annotations
+
+__all__ = ["DIRECT", "dot", "normalize_classic", "normalize_newton", "normalize_lyon",
+           "angular_steps", "quadratic_steps", "dichotomy_tree", "dichotomy_pick",
+           "dichotomy_fraction", "horner", "TINY"]
+
+#: guard for divisions by sin(psi) or sin of a zero angle (parallel end normals)
+TINY = 1e-30
+
+
+# --------------------------------------------------------------- vectors
+def vadd(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def vsub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def vmul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def dot(a, b):
+    """``a.b``: 3 mul, 2 add."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def lerp(a, d, t):
+    """``a + t d``: 3 mul, 3 add."""
+    return (a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2])
+
+
+def horner(ops, coefficients, x):
+    """``p(x)`` from ascending coefficients (degree d: d mul, d add)."""
+    p = ops.const(coefficients[-1])
+    for c in reversed(coefficients[:-1]):
+        p = p * x + ops.const(c)
+    return p
+
+
+# ---------------------------------------------------------- normalizers
+def normalize_classic(ops, n):
+    """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div."""
+    r = ops.sqrt(dot(n, n))
+    return (n[0] / r, n[1] / r, n[2] / r)
+
+
+def normalize_newton(ops, n):
+    """One Newton-Raphson step from 1 for ``1/sqrt(x)``: ``N (3 - N.N) / 2`` (seed 000, method 1).
+
+    The halving is written as a multiplication by 0.5 (an exponent shift)."""
+    s = (3.0 - dot(n, n)) * 0.5
+    return vmul(n, s)
+
+
+def normalize_lyon(ops, n):
+    """Lyon's three-term Taylor series ``N (15 - 10 x + 3 x^2) / 8``, ``x = N.N``
+    (seed 000, method 2), the 1/8 folded into the coefficients (Horner)."""
+    x = dot(n, n)
+    s = (x * 0.375 - 1.25) * x + 1.875
+    return vmul(n, s)
+
+
+# -------------------------------------------------------- direct kernels
+class _Linear:
+    """Linear interpolation followed by a normalizer (or none)."""
+
+    def __init__(self, normalizer):
+        self.normalizer = normalizer
+
+    def setup(self, ops, nl, nr):
+        return {"a": nl, "d": vsub(nr, nl)}
+
+    def pixel(self, ops, st, t):
+        n = lerp(st["a"], st["d"], t)
+        return n if self.normalizer is None else self.normalizer(ops, n)
+
+
+class _Slerp:
+    """Seed 000, method 3: ``[sin((1-t) psi) N_a + sin(t psi) N_b] / sin psi``,
+    ``psi = arccos(N_a.N_b)``; ``1/sin psi`` once per span. Parallel end
+    normals (psi = 0) use ``psi = TINY``, which reduces to linear interpolation."""
+
+    def setup(self, ops, nl, nr):
+        c = ops.minimum(dot(nl, nr), 1.0)
+        psi = ops.maximum(ops.arccos(c), TINY)
+        return {"a": nl, "b": nr, "psi": psi, "inv": 1.0 / ops.sin(psi)}
+
+    def pixel(self, ops, st, t):
+        wa = ops.sin((1.0 - t) * st["psi"]) * st["inv"]
+        wb = ops.sin(t * st["psi"]) * st["inv"]
+        return vadd(vmul(st["a"], wa), vmul(st["b"], wb))
+
+
+#: the direct kernels by method name
+DIRECT = {
+    "exact": _Linear(normalize_classic),
+    "none": _Linear(None),
+    "newton": _Linear(normalize_newton),
+    "lyon": _Linear(normalize_lyon),
+    "slerp": _Slerp(),
+}
+
+
+# ------------------------------------------------------ stepping kernels
+def _angular_point(ops, nl, nk, angle):
+    ca, sa = ops.cos(angle), ops.sin(angle)
+    return vadd(vmul(nl, ca), vmul(nk, sa)), ca, sa
+
+
+def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None):
+    """Seed 000, method 6: ``N(t) = N_a cos(t psi) + N_k sin(t psi)`` by the recurrence
+    ``N_{j+1} = 2 cos(phi) N_j - N_{j-1}``, ``phi = psi dt`` (``psi/m`` by default).
+
+    Yields ``n`` pixels. Set-up: ``N_k = (N_b - c N_a)/sqrt(1 - c^2)``, psi,
+    cos phi, sin phi, the first two pixels. Per pixel: 3 mul, 3 add.
+    ``reanchor=K`` recomputes ``N_{j-1}, N_j`` from the closed form every K
+    pixels (4 trig, 14 mul, 8 add per anchor), bounding the float32 drift.
+    """
+    c = ops.minimum(dot(nl, nr), 1.0)
+    psi = ops.arccos(c)
+    inv_w = 1.0 / ops.maximum(ops.sqrt(1.0 - c * c), TINY)
+    nk = vmul(vsub(nr, vmul(nl, c)), inv_w)
+    phi = psi * dt
+    cp, sp = ops.cos(phi), ops.sin(phi)
+    k2 = cp * 2.0
+    if start_at_left:
+        p0 = nl
+        p1 = vadd(vmul(nl, cp), vmul(nk, sp))
+    else:
+        p0, ca, sa = _angular_point(ops, nl, nk, t0 * psi)
+        q0 = vsub(vmul(nk, ca), vmul(nl, sa))  # d/d(angle) of N at t0
+        p1 = vadd(vmul(p0, cp), vmul(q0, sp))
+    ops.produced(1)
+    yield p0
+    if n < 2:
+        return
+    ops.produced(1)
+    yield p1
+    ops.phase("pixel")
+    for j in range(2, n):
+        if reanchor and j % reanchor == 0:
+            base = 0.0 if start_at_left else t0
+            p0 = _angular_point(ops, nl, nk, (base + dt * float(j - 1)) * psi)[0]
+            p1 = _angular_point(ops, nl, nk, (base + dt * float(j)) * psi)[0]
+        else:
+            p0, p1 = p1, vsub(vmul(p1, k2), p0)
+        ops.produced(1)
+        yield p1
+
+
+def quadratic_steps(ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=False):
+    """Seed 000, method 5: ``N(t) = G t^2 + P t + Q`` through ``N_l``, ``N_c``, ``N_r``,
+    ``N_c = (N_l + N_r) p(N_l.N_r)`` with ``p ~ 1/sqrt(2(1+x))`` (the ``midpoint``
+    table; ``coefficients=None``: exact ``1/sqrt``), evaluated by forward
+    differences (6 add per pixel) and not normalized.
+
+    ``Q = N_l``, ``G = 2 N_l + 2 N_r - 4 N_c``, ``P = 4 N_c - 3 N_l - N_r``.
+    """
+    x = dot(nl, nr)
+    s = vadd(nl, nr)
+    r = horner(ops, coefficients, x) if coefficients is not None \
+        else 1.0 / ops.sqrt((x + 1.0) * 2.0)
+    nc4 = vmul(vmul(s, r), 4.0)
+    g = vsub(vmul(s, 2.0), nc4)
+    p = vsub(vsub(nc4, vmul(nl, 2.0)), s)
+    h2 = dt * dt
+    d2 = vmul(g, h2 * 2.0)
+    if start_at_left:
+        v = nl
+        d1 = vadd(vmul(p, dt), vmul(g, h2))
+    else:
+        v = vadd(nl, vmul(vadd(p, vmul(g, t0)), t0))
+        d1 = vadd(vmul(p, dt), vmul(g, (t0 * dt) * 2.0 + h2))
+    ops.produced(1)
+    yield v
+    ops.phase("pixel")
+    for _ in range(1, n):
+        v = vadd(v, d1)
+        d1 = vadd(d1, d2)
+        ops.produced(1)
+        yield v
+
+
+# ------------------------------------------------------------ dichotomy
+def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
+    """Seed 000, method 4: ``levels`` rounds of angle halving; returns the
+    ``2**levels + 1`` nodes from ``N_l`` to ``N_r`` (the slerp points at
+    ``k / 2**levels``).
+
+    A midpoint is ``(N_1 + N_2) / sqrt(2 + z)``, ``z = 2 cos(theta)``: per level
+    one denominator ``r = p(z)`` (the ``dichotomy`` table; ``None``: exact
+    ``1/sqrt``) and the next level's ``z' = sqrt(2 + z) = (2 + z) r`` (one mul,
+    no sqrt); per midpoint 3 add, 3 mul.
+    """
+    z = dot(nl, nr) * 2.0
+    nodes = [nl, nr]
+    for level in range(levels):
+        ops.phase("setup")
+        s = z + 2.0
+        r = horner(ops, coefficients, z) if coefficients is not None else 1.0 / ops.sqrt(s)
+        if level < levels - 1:
+            z = s * r
+        ops.phase("pixel")
+        new = [nodes[0]]
+        for a, b in zip(nodes[:-1], nodes[1:]):
+            new.append(vmul(vadd(a, b), r))
+            ops.produced(1)
+            new.append(b)
+        nodes = new
+    return nodes
+
+
+def dichotomy_fraction(ops, t, levels):
+    """Position ``t`` on the dyadic grid: node index ``k = floor(t 2**levels)`` (a scalar)
+    and fraction ``f`` (1 pow2 mul, 1 cmp, 1 add)."""
+    u = t * float(2 ** levels)
+    k = ops.floor(u)
+    return k, u - k
+
+
+def dichotomy_pick(ops, a, b, f):
+    """Linear pick between the nodes around an off-grid pixel: ``A + f (B - A)``."""
+    return lerp(a, vsub(b, a), f)

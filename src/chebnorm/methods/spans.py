@@ -1,0 +1,317 @@
+"""``span_normals``: the public span interpolator, its input validation and default tables."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from chebnorm.approx import CoefficientTable, fit_target
+
+from . import kernels as K
+from .ops import NumpyOps
+
+__all__ = ["METHODS", "TABLE_METHODS", "SpanNormals", "span_normals", "default_tables",
+           "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES"]
+
+#: the eight methods of seed 000, in the order the papers and the CLI list them
+METHODS = ("exact", "none", "newton", "lyon", "slerp", "dichotomy", "quadratic", "angular")
+#: methods that read a CoefficientTable, and the registry target each table approximates
+TABLE_METHODS = {"dichotomy": "dichotomy", "quadratic": "midpoint"}
+#: accepted | |N| - 1 | of an end normal
+UNIT_TOL = 1e-5
+#: accepted smallest 1 + N_l.N_r / (|N_l| |N_r|) (angle between end normals below pi)
+ANTIPARALLEL_TOL = 1e-6
+#: deepest dichotomy (steps down to 2**-MAX_LEVELS)
+MAX_LEVELS = 20
+DTYPES = (np.float32, np.float64)
+#: slack on a table's interval when checking that it covers the spans' range
+#: (rounding of N_l.N_r; the polynomial is smooth just outside its interval)
+_COVER_SLACK = 1e-9
+
+
+@dataclass(frozen=True)
+class SpanNormals:
+    """Pixel normals of S spans: span i's pixels are ``normals[offsets[i]:offsets[i+1]]``,
+    at positions ``t[offsets[i]:offsets[i+1]]`` (0 at ``N_l``, 1 at ``N_r``)."""
+
+    normals: np.ndarray   # (P, 3), dtype of the computation
+    offsets: np.ndarray   # (S + 1,) int64
+    t: np.ndarray         # (P,) float64
+
+    def span(self, i: int) -> np.ndarray:
+        """The normals of span ``i``."""
+        return self.normals[self.offsets[i]:self.offsets[i + 1]]
+
+
+@lru_cache(maxsize=None)
+def default_tables(psi_max: float | str = "pi/4", degree: int = 2) -> dict[str, CoefficientTable]:
+    """The tables used when ``span_normals`` gets none: ``fit_target("dichotomy", degree)``
+    and ``fit_target("midpoint", degree)`` for end normals up to ``psi_max`` apart
+    (built once per process and argument).
+
+    >>> t = default_tables()
+    >>> [round(c, 5) for c in t["dichotomy"].coefficients]
+    [0.68076, -0.11881, 0.01422]
+    """
+    return {m: fit_target(target, degree, psi_max=psi_max) for m, target in TABLE_METHODS.items()}
+
+
+# ------------------------------------------------------------ validation
+def _as_vectors(name, a) -> np.ndarray:
+    try:
+        arr = np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of shape (S, 3) of numbers") from None
+    if arr.ndim == 1 and arr.shape == (3,):
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 3 or arr.shape[0] < 1:
+        raise ValueError(f"{name} has shape {arr.shape}; accepted: (S, 3) with S >= 1")
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name}[{i}] = {arr[i].tolist()} is not finite (NaN or inf); "
+                         f"accepted: finite unit vectors")
+    norm = np.sqrt(np.einsum("ij,ij->i", arr, arr))
+    dev = np.abs(norm - 1.0)
+    if (dev > UNIT_TOL).any():
+        i = int(np.argmax(dev))
+        what = "is zero" if norm[i] == 0 else f"has length {norm[i]:.9g}"
+        raise ValueError(f"{name}[{i}] {what}; accepted: unit vectors, | |N| - 1 | <= {UNIT_TOL:g}")
+    return arr
+
+
+def _as_per_span(name, a, s, dtype, default):
+    if a is None:
+        return default
+    arr = np.asarray(a)
+    if arr.ndim == 0:
+        arr = np.full(s, arr)
+    if arr.shape != (s,):
+        raise ValueError(f"{name} has shape {arr.shape}; accepted: ({s},), one value per span")
+    try:
+        out = arr.astype(dtype, casting="safe" if dtype is np.int64 else "unsafe")
+    except TypeError:
+        raise ValueError(f"{name} must hold {'integers' if dtype is np.int64 else 'numbers'}, "
+                         f"got {arr.dtype}") from None
+    if dtype is not np.int64 and not np.isfinite(out).all():
+        raise ValueError(f"{name} holds NaN or inf; accepted: finite numbers")
+    return out
+
+
+def _check_method(method) -> str:
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; accepted: {', '.join(METHODS)}")
+    return method
+
+
+def _check_dtype(dtype):
+    try:
+        dt = np.dtype(dtype).type
+    except TypeError:
+        dt = None
+    if dt not in DTYPES:
+        raise ValueError(f"dtype {dtype!r} is not supported; accepted: float32, float64")
+    return dt
+
+
+def _angle_range_of_table(method: str, table: CoefficientTable) -> tuple[float, float]:
+    """(smallest, largest) angle between end normals the table's interval covers."""
+    lo, hi = table.interval_float
+    scale = 2.0 if method == "dichotomy" else 1.0
+    big = math.acos(min(1.0, max(-1.0, lo / scale)))
+    small = math.acos(min(1.0, max(-1.0, hi / scale)))
+    return small, big
+
+
+def _resolve_table(method, tables, cosines, levels):
+    """The table for ``method`` (None: exact), checked to cover what the spans need."""
+    defaults = tables is None or method not in tables
+    table = default_tables()[method] if defaults else tables[method]
+    if table is None:
+        return None
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"tables[{method!r}] is a {type(table).__name__}; accepted: a "
+                         f"CoefficientTable, or None for exact denominators")
+    c = np.clip(cosines, -1.0, 1.0)
+    psi = np.arccos(c)
+    if method == "dichotomy":
+        need_lo = 2.0 * float(np.min(c[levels > 0])) if (levels > 0).any() else None
+        deepest = psi / np.exp2(np.maximum(levels - 1, 0))
+        need_hi = 2.0 * float(np.max(np.cos(deepest[levels > 0]))) if (levels > 0).any() else None
+    else:
+        need_lo, need_hi = 2.0 * 0 + float(np.min(c)), float(np.max(c))
+    if need_lo is None:
+        return table
+    lo, hi = table.interval_float
+    small, big = _angle_range_of_table(method, table)
+    var = "z = 2 cos(psi)" if method == "dichotomy" else "x = cos(psi)"
+    where = "the default" if defaults else "the given"
+    if lo > need_lo + _COVER_SLACK:
+        raise ValueError(
+            f"largest span angle {float(np.max(psi)):.9g} rad exceeds {where} {method} table "
+            f"{table.name!r}: its interval [{lo:.9g}, {hi:.9g}] of {var} covers angles "
+            f"{small:.9g} to {big:.9g} rad; pass tables={{{method!r}: fit_target("
+            f"{TABLE_METHODS[method]!r}, 2, psi_max=...)}} covering the spans, or None for exact")
+    if hi < need_hi - _COVER_SLACK:
+        raise ValueError(
+            f"smallest angle the {method} method needs, "
+            f"{math.acos(min(1.0, need_hi / (2.0 if method == 'dichotomy' else 1.0))):.9g} rad, "
+            f"is below the range of {where} {method} table {table.name!r}: its interval "
+            f"[{lo:.9g}, {hi:.9g}] of {var} covers angles {small:.9g} to {big:.9g} rad")
+    return table
+
+
+def _levels(dt: np.ndarray) -> np.ndarray:
+    """Dichotomy depth per span: the smallest L >= 0 with 2**-L <= dt (within 1e-12)."""
+    with np.errstate(divide="ignore"):
+        lv = np.ceil(np.log2(1.0 / dt) - 1e-12)
+    return np.maximum(lv, 0).astype(np.int64)
+
+
+# --------------------------------------------------------------- driver
+def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, tables=None,
+                 dtype=np.float64, angular_reanchor: int | None = None) -> SpanNormals:
+    """Pixel normals of many scan-line spans by one of the seed-000 methods.
+
+    ``n_left``, ``n_right``: (S, 3) unit end normals; ``m``: (S,) span lengths
+    (>= 1). Span i has pixels at ``t = t0[i] + j dt[i]``, ``j = 0 .. count[i]-1``
+    (defaults ``t0 = 0``, ``dt = 1/m``, ``count = m + 1``: both ends
+    included). The computation runs in ``dtype`` (float32 or float64).
+
+    Methods (seed 000): ``exact`` (linear then ``N/sqrt(N.N)``, the
+    reference), ``none``, ``newton`` (eq. ``N(3 - N.N)/2``), ``lyon``
+    (``N(15 - 10 N.N + 3 (N.N)^2)/8``), ``slerp``, ``dichotomy`` (method 4),
+    ``quadratic`` (method 5), ``angular`` (method 6); see :mod:`.kernels`.
+
+    Positions: ``quadratic`` and ``angular`` step with ``dt`` from ``t0``.
+    ``dichotomy`` halves each span to depth ``L``, the smallest with
+    ``2**-L <= dt`` (``ceil(log2 m)`` by default); a pixel on the dyadic grid
+    takes its node, one off the grid (``m`` not a power of two, or arbitrary
+    ``t0``) is linearly picked between its two neighbouring nodes (so it is
+    not exactly unit: at most ``1 - cos(psi / 2**(L+1))`` short).
+
+    Tables: ``tables={"dichotomy": T1, "quadratic": T2}``; a missing key uses
+    :func:`default_tables` (degree 2, angles up to pi/4); the value ``None``
+    means exact denominators (``1/sqrt``). A table must cover the spans:
+    ``z = 2 N_l.N_r .. 2 cos(psi / 2**(L-1))`` for dichotomy, ``x = N_l.N_r``
+    for quadratic (up to a 1e-9 slack for rounding).
+
+    ``angular_reanchor=K``: the angular recurrence is restarted from the
+    closed form every K pixels (see :func:`chebnorm.methods.angular_drift`).
+
+    Raises ``ValueError`` for: an unknown method or dtype; end normals that
+    are not finite, zero, or not unit (``| |N| - 1 | > UNIT_TOL = 1e-5``);
+    antiparallel end normals (``1 + cos psi <= 1e-6``); ``m < 1``; ``count < 1``;
+    ``dt <= 0``; pixels outside ``[0, 1]``; tables not covering the angles.
+
+    >>> import numpy as np
+    >>> nl = np.array([[1.0, 0.0, 0.0]]); nr = np.array([[0.0, 1.0, 0.0]])
+    >>> out = span_normals("none", nl, nr, [2])
+    >>> out.normals.tolist(), out.offsets.tolist()
+    ([[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.0, 1.0, 0.0]], [0, 3])
+    >>> np.linalg.norm(span_normals("slerp", nl, nr, [4]).normals, axis=1).round(15).tolist()
+    [1.0, 1.0, 1.0, 1.0, 1.0]
+    """
+    method = _check_method(method)
+    dtype = _check_dtype(dtype)
+    nl = _as_vectors("n_left", n_left)
+    nr = _as_vectors("n_right", n_right)
+    if nl.shape != nr.shape:
+        raise ValueError(f"n_left has shape {nl.shape} but n_right {nr.shape}; accepted: equal (S, 3)")
+    s = nl.shape[0]
+    cos = np.einsum("ij,ij->i", nl, nr) / (np.linalg.norm(nl, axis=1) * np.linalg.norm(nr, axis=1))
+    if (1.0 + cos <= ANTIPARALLEL_TOL).any():
+        i = int(np.argmin(cos))
+        raise ValueError(f"end normals of span {i} are antiparallel (1 + N_l.N_r = {1 + cos[i]:.3g}); "
+                         f"accepted: angle below pi, 1 + N_l.N_r > {ANTIPARALLEL_TOL:g}")
+    m_arr = _as_per_span("m", m, s, np.int64, None)
+    if m_arr is None:
+        raise ValueError("m is required; accepted: span lengths >= 1")
+    if (m_arr < 1).any():
+        i = int(np.argmin(m_arr))
+        raise ValueError(f"span length m[{i}] = {int(m_arr[i])}; accepted: m >= 1")
+    dt_arr = _as_per_span("dt", dt, s, np.float64, 1.0 / m_arr)
+    if (dt_arr <= 0).any():
+        raise ValueError(f"dt holds {float(dt_arr.min())}; accepted: dt > 0")
+    t0_arr = _as_per_span("t0", t0, s, np.float64, np.zeros(s))
+    cnt = _as_per_span("count", count, s, np.int64, m_arr + 1)
+    if (cnt < 1).any():
+        raise ValueError(f"count holds {int(cnt.min())}; accepted: count >= 1 (pixels per span)")
+    last = t0_arr + (cnt - 1) * dt_arr
+    tol = 1e-9
+    if (t0_arr < -tol).any() or (last > 1 + tol).any():
+        i = int(np.argmax((t0_arr < -tol) | (last > 1 + tol)))
+        raise ValueError(f"span {i} has pixels at t = {t0_arr[i]:.9g} .. {last[i]:.9g}; "
+                         f"accepted: 0 <= t0 and t0 + (count-1) dt <= 1")
+    if angular_reanchor is not None and (not isinstance(angular_reanchor, (int, np.integer))
+                                         or isinstance(angular_reanchor, bool)
+                                         or angular_reanchor < 2):
+        raise ValueError(f"angular_reanchor = {angular_reanchor!r}; accepted: None or an integer >= 2")
+
+    offsets = np.zeros(s + 1, dtype=np.int64)
+    np.cumsum(cnt, out=offsets[1:])
+    p = int(offsets[-1])
+    sid = np.repeat(np.arange(s), cnt)
+    j = np.arange(p) - offsets[sid]
+    t = t0_arr[sid] + j * dt_arr[sid]
+
+    levels = _levels(dt_arr) if method == "dichotomy" else None
+    if method == "dichotomy" and (levels > MAX_LEVELS).any():
+        raise ValueError(f"dichotomy step dt = {float(dt_arr.min()):.3g} needs more than "
+                         f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
+    table = _resolve_table(method, tables, cos, levels) if method in TABLE_METHODS else None
+    coeffs = None if table is None else table.coefficients
+
+    ops = NumpyOps(dtype)
+    a = tuple(nl.astype(dtype).T)
+    b = tuple(nr.astype(dtype).T)
+    out = np.empty((p, 3), dtype=dtype)
+    if method in K.DIRECT:
+        kern = K.DIRECT[method]
+        st = kern.setup(ops, a, b)
+        st = {k: (tuple(c[sid] for c in v) if isinstance(v, tuple) else v[sid]) for k, v in st.items()}
+        res = kern.pixel(ops, st, t.astype(dtype))
+        for c in range(3):
+            out[:, c] = res[c]
+    elif method in ("quadratic", "angular"):
+        left = bool((t0_arr == 0).all())
+        n = int(cnt.max())
+        if method == "quadratic":
+            gen = K.quadratic_steps(ops, a, b, t0_arr.astype(dtype), dt_arr.astype(dtype), n,
+                                    coefficients=coeffs, start_at_left=left)
+        else:
+            gen = K.angular_steps(ops, a, b, t0_arr.astype(dtype), dt_arr.astype(dtype), n,
+                                  start_at_left=left, reanchor=angular_reanchor)
+        starts = offsets[:-1]
+        for jj, v in enumerate(gen):
+            act = cnt > jj
+            out[starts[act] + jj] = np.stack(v, axis=-1)[act]
+    else:
+        _dichotomy(ops, a, b, levels, coeffs, t, sid, out, dtype)
+    return SpanNormals(normals=out, offsets=offsets, t=t)
+
+
+def _dichotomy(ops, a, b, levels, coeffs, t, sid, out, dtype):
+    for lv in np.unique(levels):
+        spans = np.flatnonzero(levels == lv)
+        pix = np.flatnonzero(levels[sid] == lv)
+        lv = int(lv)
+        nodes = K.dichotomy_tree(ops, tuple(c[spans] for c in a), tuple(c[spans] for c in b),
+                                 lv, coeffs)
+        comp = [np.stack([nd[c] for nd in nodes], axis=1) for c in range(3)]  # (S_g, 2**lv + 1)
+        local = np.searchsorted(spans, sid[pix])
+        tt = t[pix].astype(dtype)
+        k, f = K.dichotomy_fraction(ops, tt, lv)
+        k = k.astype(np.int64)
+        node_a = tuple(cc[local, k] for cc in comp)
+        if (f == 0).all():
+            res = node_a
+        else:
+            kb = np.minimum(k + 1, 2 ** lv)
+            node_b = tuple(cc[local, kb] for cc in comp)
+            res = K.dichotomy_pick(ops, node_a, node_b, f)
+        for c in range(3):
+            out[pix, c] = res[c]
