@@ -169,7 +169,7 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
     a0, b0 = lo_b.lower(), hi_b.upper()
     degree = max(len(coeffs) - 1, 0)
-    pieces = 4 * (degree + 2)
+    pieces = 2 * (degree + 2)
     edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
     # exact binary split points (the outer two keep the enclosing endpoints)
     edges = [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
