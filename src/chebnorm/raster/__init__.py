@@ -1,1 +1,37 @@
-"""Stage 4: meshes, scan-line spans, shading modes and image metrics."""
+"""Stage 4: meshes, scan-line spans, shading modes and image metrics.
+
+Layer rule: imports chebnorm.symbolic, chebnorm.approx and chebnorm.methods
+(when present), never chebnorm.hw or the CLI.
+
+>>> from chebnorm.raster import render, compare
+>>> ref = render("sphere", "phong", "exact", size=(48, 48), tess=8)
+>>> m, _ = compare(render("sphere", "phong", "exact", size=(48, 48), tess=8), ref, flip=False)
+>>> m.max_abs_8bit
+0
+
+Public API: :func:`render` (one frame, any mode), :func:`compare` (metrics
+and the signed 8-bit difference), :func:`error_map_rgb`, :func:`write_png`;
+meshes (:func:`get_mesh` and the generators); studies for the paper
+reproduction (:func:`eta_study`, :func:`split_gouraud_study`,
+:func:`bump_comparison`, :func:`write_bump_figures`).
+"""
+
+from .meshes import (MESH_NAMES, Mesh, crease_normals, get_mesh, icosphere, load_mesh, square,
+                     teapot, torus, uv_sphere)
+from .metrics import ImageMetrics, compare, error_map_rgb, write_png
+from .render import (BUMP_VARIANTS, SHADING_MODES, HeightMap, Lighting, RenderResult,
+                     available_methods, get_span_normals, render, to_8bit)
+from .spans import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
+from .studies import (BumpCase, EtaLevel, SplitGouraudStudy, bump_comparison, eta_study,
+                      split_gouraud_study, write_bump_figures)
+
+__all__ = [
+    "render", "compare", "error_map_rgb", "write_png", "to_8bit",
+    "RenderResult", "ImageMetrics", "Lighting", "HeightMap", "SHADING_MODES", "BUMP_VARIANTS",
+    "available_methods", "get_span_normals",
+    "Mesh", "MESH_NAMES", "get_mesh", "uv_sphere", "icosphere", "torus", "square", "teapot",
+    "load_mesh", "crease_normals",
+    "Camera", "Spans", "default_camera", "fit_camera", "project", "setup_spans", "zbuffer",
+    "eta_study", "EtaLevel", "split_gouraud_study", "SplitGouraudStudy", "bump_comparison",
+    "BumpCase", "write_bump_figures",
+]

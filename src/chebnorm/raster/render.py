@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -181,6 +182,10 @@ class RenderResult:
     triangles: int
     fragments: int
     stats: dict = field(default_factory=dict)
+    #: (H, W) index into mesh.faces of the visible triangle, -1 on background
+    triangle: np.ndarray | None = None
+    #: (H, W) |N| of the pixel normal before shading (phong, adaptive), NaN on background
+    normal_length: np.ndarray | None = None
 
     @property
     def image8(self) -> np.ndarray:
@@ -314,8 +319,10 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         image, mask, frags, stats = _split_gouraud(st, lighting, q)
     else:
         image, mask, frags, stats = _bump(st, method, bump, height_map or HeightMap(), k, **kw)
+    tri_map = stats.pop("_triangle", None)
+    nlen_map = stats.pop("_normal_length", None)
     return RenderResult(image, mask, mesh.name, shading, method, time.perf_counter() - t_start,
-                        int(len(mesh.faces)), int(frags), stats)
+                        int(len(mesh.faces)), int(frags), stats, tri_map, nlen_map)
 
 
 def _to_image(st, sp, vis, values):
@@ -324,6 +331,12 @@ def _to_image(st, sp, vis, values):
     img[sp.frag_pixel[vis]] = values
     mask[sp.frag_pixel[vis]] = True
     return np.clip(img, 0.0, 1.0).reshape(st.height, st.width), mask.reshape(st.height, st.width)
+
+
+def _pixel_map(st, sp, vis, values, fill):
+    out = np.full(st.width * st.height, fill, dtype=np.asarray(values).dtype)
+    out[sp.frag_pixel[vis]] = values
+    return out.reshape(st.height, st.width)
 
 
 # ---------------------------------------------------------------- gouraud
@@ -366,6 +379,34 @@ def _interpolated_normals(sp, cols, method, interp, tables, dtype, sel=None):
     return out
 
 
+_TABLE_METHODS = ("dichotomy", "quadratic")
+
+
+def _auto_tables(method, sp, cols, tables, stats):
+    """Default tables cover end normals up to pi/4 apart.  When ``tables`` is
+    None and a frame has wider spans (the teapot's spout lip), fit degree-2
+    tables on the smallest ``psi_max = j pi/32`` covering them, and say so in
+    ``stats["table_psi_max"]``."""
+    if tables is not None or method not in _TABLE_METHODS or len(sp.count) == 0:
+        return tables
+    nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
+    psi = float(np.arccos(np.clip(np.min(_dot(nl, nr)), -1.0, 1.0)))
+    stats["span_angle_max"] = psi
+    if psi <= np.pi / 4:
+        return None
+    j = min(31, int(np.ceil(psi / (np.pi / 32) + 1e-9)))
+    stats["table_psi_max"] = f"{j}*pi/32"
+    return _fitted_tables(f"{j}*pi/32")
+
+
+@lru_cache(maxsize=None)
+def _fitted_tables(psi_max):
+    from chebnorm.approx import fit_target
+
+    return {"dichotomy": fit_target("dichotomy", 2, psi_max=psi_max),
+            "quadratic": fit_target("midpoint", 2, psi_max=psi_max)}
+
+
 def _eta(nrm):
     try:
         from chebnorm.symbolic import eta
@@ -381,6 +422,7 @@ def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
     sp, vis = st.rasterize(np.concatenate(extra, axis=2))
     ncols = [1, 2, 3]
     stats = {}
+    tables = _auto_tables(method, sp, ncols, tables, stats)
     if skip_eta is None:
         N = _interpolated_normals(sp, ncols, method, interp, tables, dtype)
     else:
@@ -392,7 +434,7 @@ def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
         N[skip_frag] = _interpolated_normals(sp, ncols, "none", interp, tables, dtype, skip_span)
         N[~skip_frag] = _interpolated_normals(sp, ncols, method, interp, tables, dtype, ~skip_span)
         drawn = np.unique(sp.tri)
-        stats = {
+        stats.update({
             "eta_threshold": float(skip_eta),
             "triangles_front": int(len(st.tri)),
             "triangles_drawn": int(len(drawn)),
@@ -401,7 +443,7 @@ def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
             "pixels_skipped": int(skip_frag[vis].sum()),
             "pixels_skipped_fraction": float(skip_frag[vis].mean()) if len(vis) else 0.0,
             "eta_max": float(eta.max()) if len(eta) else 0.0,
-        }
+        })
     N = N[vis]
     if per_pixel_h:
         H = _half_vectors(st.L, st.camera.eye, sp.lerp([4, 5, 6])[vis])
@@ -409,6 +451,8 @@ def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
         H = _tri_half(st)[sp.tri[sp.frag_span[vis]]]
     vals = lighting.intensity(N @ st.L, _dot(N, H))
     img, mask = _to_image(st, sp, vis, vals)
+    stats["_triangle"] = _pixel_map(st, sp, vis, st.tri[sp.tri[sp.frag_span[vis]]], -1)
+    stats["_normal_length"] = _pixel_map(st, sp, vis, np.linalg.norm(N, axis=1), np.nan)
     return img, mask, sp.n_fragments, stats
 
 
@@ -512,6 +556,8 @@ def _bump(st, method, variant, height_map, k, *, lighting, interp, tables, dtype
         Hts = np.stack([_dot(Hv, Tt), _dot(Hv, Bt), _dot(Hv, Nh)], axis=-1)
         extra = np.concatenate([uv, Pu, Pv, Lts, Hts], axis=2)
     sp, vis = st.rasterize(extra)
+    tables = _auto_tables(method, sp, [9, 10, 11], tables, stats)
+    tables = _auto_tables(method, sp, [12, 13, 14], tables, stats)
     # L and H: interpolated along spans, normalized per pixel by the method
     Lp = _interpolated_normals(sp, [9, 10, 11], method, interp, tables, dtype)[vis]
     Hp = _interpolated_normals(sp, [12, 13, 14], method, interp, tables, dtype)[vis]

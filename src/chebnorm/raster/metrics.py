@@ -1,0 +1,123 @@
+"""Image-error metrics against a reference render, error heat maps, and
+atomic PNG writing.
+
+All metrics are computed on the 8-bit images (``round(255 I)``), so "0
+error" means identical 8-bit output.  Over the *covered* pixels (the union of
+both masks): ``max_abs_8bit``, ``pixels_off_1`` (pixels off by one level or
+more), ``mean_abs_8bit``, ``psnr`` (dB, peak 255; ``None`` for identical
+images, whose PSNR is infinite), ``flip`` (mean FLIP error, LDR, default 67
+pixels per degree).  ``ssim`` is scikit-image's structural similarity over the
+whole image with an explicit ``data_range=255``.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+__all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_png"]
+
+
+@dataclass(frozen=True)
+class ImageMetrics:
+    max_abs_8bit: int
+    pixels_off_1: int
+    mean_abs_8bit: float
+    psnr: float | None
+    ssim: float
+    flip: float
+    pixels: int
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _as_8bit(x):
+    from .render import RenderResult, to_8bit
+
+    if isinstance(x, RenderResult):
+        return x.image8, x.mask
+    a = np.asarray(x)
+    if a.dtype != np.uint8:
+        a = to_8bit(a)
+    return a, np.ones(a.shape, dtype=bool)
+
+
+def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.ndarray]:
+    """Metrics of ``test`` against ``reference`` (RenderResults or images in
+    ``[0, 1]`` / uint8) and the signed difference ``test - reference`` in
+    8-bit levels, shape ``(H, W)``.
+
+    >>> import numpy as np
+    >>> m, d = compare(np.zeros((8, 8)), np.zeros((8, 8)), flip=False)
+    >>> m.max_abs_8bit, m.psnr
+    (0, None)
+    """
+    from skimage.metrics import structural_similarity
+
+    a, ma = _as_8bit(test)
+    b, mb = _as_8bit(reference)
+    if a.shape != b.shape:
+        raise ValueError(f"cannot compare images of shapes {a.shape} and {b.shape}")
+    mask = ma | mb
+    diff = a.astype(np.int64) - b.astype(np.int64)
+    ad = np.abs(diff)[mask]
+    n = int(mask.sum())
+    mse = float(np.mean(ad.astype(float) ** 2)) if n else 0.0
+    psnr = None if mse == 0 else float(10 * np.log10(255.0 ** 2 / mse))
+    win = min(7, *a.shape)
+    win -= 1 - win % 2
+    ssim = float(structural_similarity(a, b, data_range=255, win_size=max(win, 1))) if win >= 3 else \
+        float(a.tobytes() == b.tobytes())
+    flip_mean = 0.0
+    if flip and n and ad.max() > 0:
+        import flip_evaluator
+
+        ref = np.repeat((b.astype(np.float32) / 255.0)[..., None], 3, axis=2)
+        tst = np.repeat((a.astype(np.float32) / 255.0)[..., None], 3, axis=2)
+        fmap, _, _ = flip_evaluator.evaluate(ref, tst, "LDR", applyMagma=False)
+        fmap = np.asarray(fmap, dtype=float)
+        fmap = fmap.reshape(a.shape) if fmap.size == a.size else fmap.reshape(*a.shape, -1)[..., 0]
+        flip_mean = float(fmap[mask].mean())
+    metrics = ImageMetrics(int(ad.max()) if n else 0, int((ad >= 1).sum()),
+                           float(ad.mean()) if n else 0.0, psnr, ssim, flip_mean, n)
+    return metrics, diff
+
+
+def error_map_rgb(diff, scale: float | None = None) -> np.ndarray:
+    """A heat map (uint8 RGB) of ``|diff|`` in 8-bit levels: black (0) through
+    red and yellow to white at ``scale`` levels (default: the largest error,
+    at least 1)."""
+    e = np.abs(np.asarray(diff, dtype=float))
+    s = float(scale) if scale is not None else max(1.0, float(e.max()))
+    x = np.clip(e / s, 0.0, 1.0)
+    r = np.clip(3 * x, 0, 1)
+    g = np.clip(3 * x - 1, 0, 1)
+    b = np.clip(3 * x - 2, 0, 1)
+    return np.round(np.stack([r, g, b], -1) * 255).astype(np.uint8)
+
+
+def write_png(path, array) -> None:
+    """Write a uint8 image (H, W) or (H, W, 3) as PNG atomically: a temporary
+    file in the same directory, then ``os.replace``."""
+    from PIL import Image
+
+    a = np.asarray(array)
+    if a.dtype != np.uint8 or a.ndim not in (2, 3):
+        raise ValueError(f"write_png needs a uint8 (H, W) or (H, W, 3) array; got {a.dtype} {a.shape}")
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise ValueError(f"cannot write {path!r}: directory {directory!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".png", dir=directory)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            Image.fromarray(a).save(fh, format="PNG")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
