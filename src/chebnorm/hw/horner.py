@@ -21,10 +21,10 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 >>> from chebnorm.approx import fit_target
 >>> d = design_horner(fit_target("dichotomy", 2), 16, 16, coef_bits=20)
 >>> d.x_format.frac_bits, d.y_format.frac_bits, d.valid_codes
-(16, 20, (0, 38390))
->>> y = d.evaluate([0, 38390])
+(16, 20, (1, 38391))
+>>> y = d.evaluate([1, 38391])
 >>> [round(float(d.y_format.value(c)), 6) for c in y]
-[0.541196, 0.500006]
+[0.541175, 0.500016]
 """
 
 from __future__ import annotations

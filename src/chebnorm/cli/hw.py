@@ -1,0 +1,129 @@
+"""``chebnorm hw verilog|report|sweep``: fixed-point hardware of a table."""
+
+from __future__ import annotations
+
+import json
+
+from chebnorm.approx import CoefficientTable
+
+from ._common import command_line, print_json
+
+
+def _design_args(p) -> None:
+    p.add_argument("table", metavar="TABLE.json")
+    p.add_argument("--in-bits", type=int, required=True, help="input code width, 1..20")
+    p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
+    p.add_argument("--coef-bits", type=int, default=None,
+                   help="coefficient fractional bits (re-quantizes; default: the table's own)")
+    p.add_argument("--acc-bits", type=int, default=None,
+                   help="accumulator fractional bits (default: output's + 3)")
+    p.add_argument("--rounding", default="rne", help="rne (default) or trunc")
+    p.add_argument("--x-frac-bits", type=int, default=None, help="default: the largest that fits")
+    p.add_argument("--y-frac-bits", type=int, default=None, help="default: the largest that fits")
+
+
+def register(sub) -> None:
+    hw = sub.add_parser("hw", help="bit-accurate hardware: Verilog, error budget, sweep",
+                        description="Fixed-point Horner evaluators of a coefficient table: "
+                        "Verilog checked in Icarus Verilog, sized by Yosys; error budgets "
+                        "checked over every input code; design-space sweeps.")
+    hsub = hw.add_subparsers(dest="hw_command", metavar="HW_COMMAND")
+    hsub.required = True
+
+    v = hsub.add_parser("verilog", help="write the module, its test bench and vectors")
+    _design_args(v)
+    v.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
+    v.add_argument("--simulate", action="store_true", help="also run the test bench in iverilog")
+    v.set_defaults(func=run_verilog)
+
+    r = hsub.add_parser("report", help="error budget, measured errors, costs, Q formats")
+    _design_args(r)
+    r.add_argument("--json", action="store_true", help="print the report as JSON")
+    r.add_argument("--no-synth", action="store_true", help="skip yosys")
+    r.add_argument("--no-gappa", action="store_true", help="skip gappa")
+    r.set_defaults(func=run_report)
+
+    s = hsub.add_parser("sweep", help="degree x coefficient bits x datapath bits vs area")
+    s.add_argument("--target", default="dichotomy", help="registered target (default dichotomy)")
+    s.add_argument("--psi-max", default="pi/4", help="largest angle between normals (default pi/4)")
+    s.add_argument("--degrees", type=int, nargs="+", default=None, help="1..4 (default 1 2 3 4)")
+    s.add_argument("--coef-bits", type=int, nargs="+", default=None, help="default 10 14 18")
+    s.add_argument("--acc-bits", type=int, nargs="+", default=None, help="default 14 18")
+    s.add_argument("--in-bits", type=int, default=12, help="default 12")
+    s.add_argument("--out-bits", type=int, default=12, help="default 12")
+    s.add_argument("--rounding", default="rne")
+    s.add_argument("--no-synth", action="store_true", help="area estimate instead of yosys cells")
+    s.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
+    s.set_defaults(func=run_sweep)
+
+
+def _analyze(args, synth: bool, gappa: bool):
+    from chebnorm.hw.report import analyze
+
+    table = CoefficientTable.load(args.table)
+    return analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
+                   acc_bits=args.acc_bits, rounding=args.rounding, x_frac_bits=args.x_frac_bits,
+                   y_frac_bits=args.y_frac_bits, gappa=gappa, synth=synth)
+
+
+def run_verilog(args) -> int:
+    from pathlib import Path
+
+    from chebnorm import __version__
+    from chebnorm.hw.report import verilog_outputs, write_outputs
+    from chebnorm.hw.verilog import simulate
+
+    if not Path(args.output).is_dir():
+        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    report = _analyze(args, synth=False, gappa=False)
+    files = verilog_outputs(report, version=__version__, command=command_line(args))
+    files[f"{report.design.module_name}_report.json"] = json.dumps(
+        report.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
+    for path in write_outputs(args.output, files):
+        print(path)
+    if args.simulate:
+        res = simulate(args.output, report.design)
+        print(res.line)
+        return 0 if res.passed else 1
+    return 0
+
+
+def run_report(args) -> int:
+    report = _analyze(args, synth=not args.no_synth, gappa=not args.no_gappa)
+    if args.json:
+        print_json(report.as_dict())
+    else:
+        print("\n".join(report.lines()))
+    return 0
+
+
+def run_sweep(args) -> int:
+    from pathlib import Path
+
+    from chebnorm.approx._io import write_atomic
+    from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
+
+    out = Path(args.output)
+    if not out.is_dir():
+        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    res = sweep(args.target, degrees=args.degrees or DEFAULT_DEGREES,
+                coef_bits=args.coef_bits or DEFAULT_COEF_BITS,
+                acc_bits=args.acc_bits or DEFAULT_ACC_BITS, in_bits=args.in_bits,
+                out_bits=args.out_bits, rounding=args.rounding, psi_max=args.psi_max,
+                synth=not args.no_synth)
+    csv, png = res.csv(), res.plot_png()
+    stem = f"sweep_{args.target}"
+    write_atomic(out / f"{stem}.csv", csv)
+    write_atomic(out / f"{stem}.png", png)
+    print(out / f"{stem}.csv")
+    print(out / f"{stem}.png")
+    best = res.cheapest
+    if best is None:
+        print("no design stays at or under half a level of 8-bit shading")
+    else:
+        area = f"{best.yosys_cells} yosys cells" if best.yosys_cells is not None else \
+            f"~{best.area_fa:.0f} FA (estimate)"
+        print(f"cheapest design at or under half a level: degree {best.degree}, coefficient "
+              f"bits {best.coef_bits}, accumulator bits {best.acc_bits or '-'}: {area}, "
+              f"{best.shading_levels:.4f} levels, {best.max_error_lsb:.2f} LSB")
+    return 0

@@ -1,0 +1,108 @@
+"""Resource costs of datapath blocks, composable in series and in parallel.
+
+A :class:`Cost` counts multipliers (with their operand widths), adders
+(add, subtract, compare; with their widths), square-root and divider units
+(with their result widths), multiplexer bits, ROM bits, and the pipeline
+latency. The area estimate is in *full-adder equivalents* (FA): an ``a x b``
+array multiplier ~ ``a*b``, an ``n``-bit adder ~ ``n``, a ``w``-bit
+digit-recurrence square root ~ ``w*w/2`` and divider ~ ``w*w``, a 2:1 mux bit
+~ 1/2, a ROM bit ~ 1/8. Latency assumes one register level per multiply or
+add level and one result bit per cycle for square root and division. These
+are estimates for comparing designs; Yosys's cell count of the exported
+Verilog is the real figure (:func:`chebnorm.hw.verilog.synthesize`).
+
+>>> a = Cost(multipliers=((16, 16),), adders=(32,), latency=2)
+>>> b = Cost(adders=(16, 16), latency=1)
+>>> (a + b).area, (a + b).latency, a.parallel(b).latency
+(320.0, 3, 2)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = ["Cost", "Block"]
+
+
+@dataclass(frozen=True)
+class Cost:
+    """Resources of a block (see module docstring). ``+`` composes in series."""
+
+    multipliers: tuple[tuple[int, int], ...] = ()
+    adders: tuple[int, ...] = ()
+    sqrts: tuple[int, ...] = ()
+    dividers: tuple[int, ...] = ()
+    mux_bits: int = 0
+    rom_bits: int = 0
+    latency: int = 0
+
+    @property
+    def area(self) -> float:
+        return float(sum(a * b for a, b in self.multipliers) + sum(self.adders)
+                     + sum(w * w / 2 for w in self.sqrts) + sum(w * w for w in self.dividers)
+                     + self.mux_bits / 2 + self.rom_bits / 8)
+
+    def _merge(self, other: "Cost", latency: int) -> "Cost":
+        return Cost(self.multipliers + other.multipliers, self.adders + other.adders,
+                    self.sqrts + other.sqrts, self.dividers + other.dividers,
+                    self.mux_bits + other.mux_bits, self.rom_bits + other.rom_bits, latency)
+
+    def __add__(self, other: "Cost") -> "Cost":
+        return self._merge(other, self.latency + other.latency)
+
+    def parallel(self, other: "Cost") -> "Cost":
+        """Side by side: resources add, latency is the larger."""
+        return self._merge(other, max(self.latency, other.latency))
+
+    def times(self, n: int) -> "Cost":
+        """``n`` copies side by side."""
+        out = Cost()
+        for _ in range(n):
+            out = out.parallel(self)
+        return out
+
+    def as_dict(self) -> dict:
+        return {"multipliers": [f"{a}x{b}" for a, b in self.multipliers],
+                "adders": list(self.adders), "sqrts": list(self.sqrts),
+                "dividers": list(self.dividers), "mux_bits": self.mux_bits,
+                "rom_bits": self.rom_bits, "latency": self.latency, "area_fa": self.area,
+                "multiplier_count": len(self.multipliers), "adder_count": len(self.adders)}
+
+
+@dataclass(frozen=True)
+class Block:
+    """A named datapath block: its own cost plus its sub-blocks.
+
+    ``serial`` children follow each other (latencies add), otherwise they
+    work side by side (the larger latency counts).
+    """
+
+    name: str
+    own: Cost = field(default_factory=Cost)
+    children: tuple["Block", ...] = ()
+    serial: bool = True
+    note: str = ""
+
+    @property
+    def cost(self) -> Cost:
+        inner = Cost()
+        for i, c in enumerate(self.children):
+            inner = (inner + c.cost) if (self.serial or i == 0) else inner.parallel(c.cost)
+        return self.own + inner
+
+    def as_dict(self) -> dict:
+        d = {"name": self.name, "cost": self.cost.as_dict()}
+        if self.note:
+            d["note"] = self.note
+        if self.children:
+            d["children"] = [c.as_dict() for c in self.children]
+        return d
+
+    def lines(self, indent: int = 0) -> list[str]:
+        c = self.cost
+        out = [f"{'  ' * indent}{self.name}: {len(c.multipliers)} mul, {len(c.adders)} add, "
+               f"{len(c.sqrts)} sqrt, {len(c.dividers)} div, {c.mux_bits} mux bits, "
+               f"{c.rom_bits} ROM bits, latency {c.latency}, area ~{c.area:.0f} FA"]
+        for ch in self.children:
+            out += ch.lines(indent + 1)
+        return out

@@ -1,0 +1,191 @@
+"""Datapath models of the papers' normalization hardware, as composable
+:class:`~chebnorm.hw.cost.Block` trees, with bit-accurate kernels for the
+classic unit, the dichotomy midpoint and the forward-difference stepper.
+
+Vector components are signed fixed-point codes with ``frac_bits``
+fractional bits (value ``code / 2**frac_bits``), arrays of shape ``(..., 3)``.
+Widths ``w`` below are the signed component widths (``frac_bits + 2`` holds
+``[-2, 2)``, enough for unit vectors and sums of two).
+
+Blocks (seed 000 and seed 001):
+
+* :func:`classic_unit` -- ``N / sqrt(N.N)``: 3 mul, 2 add, 1 sqrt, 3 div.
+* :func:`dichotomy_unit` -- ``(N1 + N2) * p(z)``, ``z' = sqrt(2 + z)``
+  (seed 000, method 4): 3 add, the polynomial evaluator, 3 mul, and the
+  next level's add and square root.
+* :func:`quadratic_midpoint_unit` and :func:`forward_difference_stepper`
+  (seed 000, method 5): the midpoint ``N_c`` and the coefficients ``G, P, Q``;
+  then two additions per component and pixel.
+* :func:`eta_unit` (seed 003): three dot products, three polynomial
+  evaluators, the sum and the threshold compare.
+* :func:`phong_pipeline` and :func:`bump_pipeline` (seed 001): interpolation,
+  normalization and intensity blocks; bump mapping adds one multiplexer.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .cost import Block, Cost
+from .fixed import shift_round
+from .horner import HornerDesign
+
+__all__ = ["horner_block", "dot_block", "classic_unit", "dichotomy_unit",
+           "quadratic_midpoint_unit", "forward_difference_stepper", "eta_unit",
+           "phong_pipeline", "bump_pipeline", "classic_normalize", "dichotomy_midpoint",
+           "forward_difference"]
+
+
+def horner_block(design: HornerDesign) -> Block:
+    """The polynomial evaluator: one multiplier and adder per degree, the
+    input-offset adder, rounding incrementers, the output offset and clamp."""
+    mults = tuple((st.acc_bits, design.xs_bits) for st in design.stages)
+    adders = [design.xs_bits] + [st.sum_bits for st in design.stages]
+    adders += [st.out_bits for st in design.stages[:-1] if st.round_shift]
+    adders += [design.raw_bits, design.raw_bits]  # output rounding + offset, clamp compare
+    rom = sum(max(abs(q), 1).bit_length() + 1 for q in design.integers)
+    return Block(f"horner {design.module_name}",
+                 Cost(multipliers=mults, adders=tuple(adders), rom_bits=rom,
+                      mux_bits=design.out_bits, latency=1 + 2 * design.degree),
+                 note=f"degree {design.degree}, {design.in_bits}-bit x, {design.out_bits}-bit y")
+
+
+def dot_block(w: int) -> Block:
+    """``A.B`` of two 3-vectors of ``w``-bit components."""
+    return Block("dot product", Cost(multipliers=((w, w),) * 3, adders=(2 * w, 2 * w + 1),
+                                     latency=3))
+
+
+def classic_unit(w: int) -> Block:
+    """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div."""
+    return Block("classic normalization", children=(
+        dot_block(w),
+        Block("square root", Cost(sqrts=(w,), latency=w)),
+        Block("3 dividers", Cost(dividers=(w,) * 3, latency=w)),
+    ))
+
+
+def dichotomy_unit(design: HornerDesign, w: int) -> Block:
+    """Dichotomy midpoint ``(N1 + N2) p(z)`` and next level ``z' = sqrt(2 + z)``."""
+    return Block("dichotomy midpoint", children=(
+        Block("N1 + N2", Cost(adders=(w + 1,) * 3, latency=1)),
+        horner_block(design),
+        Block("scale", Cost(multipliers=((w + 1, design.out_bits),) * 3, latency=1)),
+        Block("next level z' = sqrt(2 + z)", Cost(adders=(design.in_bits + 1,),
+                                                   sqrts=(design.in_bits,),
+                                                   latency=1 + design.in_bits)),
+    ), note="seed 000, method 4")
+
+
+def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
+    """Midpoint ``N_c = (N_l + N_r) p(N_l.N_r)`` and ``G, P, Q`` (seed 000, method 5)."""
+    return Block("quadratic-interpolation midpoint", children=(
+        dot_block(w),
+        horner_block(design),
+        Block("N_c = (N_l + N_r) * p", Cost(adders=(w + 1,) * 3,
+                                            multipliers=((w + 1, design.out_bits),) * 3,
+                                            latency=2)),
+        Block("G = 2N_l + 2N_r - 4N_c, P = 4N_c - 3N_l - N_r",
+              Cost(adders=(w + 3,) * 3 * 4, latency=2), note="shifts are wiring"),
+    ), note="seed 000, method 5")
+
+
+def forward_difference_stepper(w: int, guard: int = 8) -> Block:
+    """Per pixel ``N += D1; D1 += D2`` for each component: 6 adders, no multiplier."""
+    return Block("forward-difference stepper", Cost(adders=(w + guard,) * 6, latency=1),
+                 note="seed 000, method 5: additions only")
+
+
+def eta_unit(design: HornerDesign, w: int) -> Block:
+    """eta = 3 - sum of three g(N_i.N_j) (seed 003) and the threshold compare."""
+    return Block("eta criterion", children=(
+        Block("3 dot products", children=(dot_block(w),) * 3, serial=False),
+        Block("3 evaluators", children=(horner_block(design),) * 3, serial=False),
+        Block("sum, 3 - sum, compare", Cost(adders=(design.out_bits + 2,) * 4, latency=3)),
+    ), note="seed 003")
+
+
+def _intensity(w: int, shininess_bits: int = 7) -> Block:
+    """Diffuse L.N and specular (H.N)^n by repeated squaring, then the sum."""
+    return Block("intensity", children=(
+        Block("L.N, H.N", children=(dot_block(w), dot_block(w)), serial=False),
+        Block("(H.N)^n", Cost(multipliers=((w, w),) * shininess_bits, latency=shininess_bits)),
+        Block("I = Ia + kd Id + ks Is", Cost(multipliers=((w, w),) * 2, adders=(w,) * 2,
+                                             latency=2)),
+    ))
+
+
+def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
+    """Phong pipeline (seed 001): interpolate N, L, H; normalize each; intensity."""
+    norm = normalizer or classic_unit(w)
+    return Block("Phong pipeline", children=(
+        Block("interpolation of N, L, H", Cost(adders=(w + 8,) * 9, latency=1)),
+        Block("normalization of N, L, H", children=(norm,) * 3, serial=False),
+        _intensity(w),
+    ), note="seed 001")
+
+
+def bump_pipeline(w: int, normalizer: Block | None = None) -> Block:
+    """Bump mapping on the Phong pipeline (seed 001): the perturbed normal comes
+    from a texture; one added 3w-bit 2:1 multiplexer selects it over the
+    interpolated normal."""
+    base = phong_pipeline(w, normalizer)
+    return Block("bump-mapping pipeline", children=(
+        base, Block("multiplexer N / texture normal", Cost(mux_bits=3 * w)),
+    ), note="seed 001: Phong speed, one extra multiplexer")
+
+
+# -- bit-accurate kernels ----------------------------------------------------------
+
+def _isqrt(v: np.ndarray) -> np.ndarray:
+    """floor(sqrt(v)) of non-negative int64, exactly."""
+    r = np.floor(np.sqrt(v.astype(np.float64))).astype(np.int64)
+    r = np.where(r * r > v, r - 1, r)
+    r = np.where((r + 1) * (r + 1) <= v, r + 1, r)
+    return r
+
+
+def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
+    """Bit-accurate classic unit: ``s = isqrt(N.N)`` (``F`` fractional bits),
+    each component ``(n_i << F) / s`` rounded (``"trunc"``: toward minus
+    infinity). ``n``: int codes ``(..., 3)`` with ``F`` fractional bits.
+
+    >>> classic_normalize(np.array([[3 << 10, 4 << 10, 0]]), 12).tolist()
+    [[2457, 3276, 0]]
+    """
+    n = np.asarray(n, dtype=np.int64)
+    dot = np.sum(n * n, axis=-1)
+    s = np.maximum(_isqrt(dot), 1)[..., None]
+    num = n << frac_bits
+    q = np.floor_divide(num, s)
+    if rounding == "rne":
+        r2 = 2 * (num - q * s)
+        q = q + ((r2 > s) | ((r2 == s) & (q % 2 == 1)))
+    return q
+
+
+def dichotomy_midpoint(n1, n2, z_codes, design: HornerDesign, frac_bits: int) -> np.ndarray:
+    """Bit-accurate dichotomy midpoint ``(N1 + N2) * p(z)`` (seed 000, method 4),
+    the product rounded to nearest-even back to ``frac_bits``."""
+    s = np.asarray(n1, dtype=np.int64) + np.asarray(n2, dtype=np.int64)
+    y = design.evaluate(z_codes)[..., None] + design.y_format.offset_code
+    return shift_round(s * y, design.y_format.frac_bits, "rne")
+
+
+def forward_difference(G, P, Q, m: int, frac_bits: int, guard: int = 8) -> np.ndarray:
+    """Pixel values of ``G t^2 + P t + Q`` at ``t = i/m``, ``i = 0..m``, by forward
+    differences in fixed point (``frac_bits + guard`` fractional bits inside,
+    the start values rounded once): additions only, as the hardware does it.
+    ``G, P, Q``: float arrays ``(..., 3)``. Returns float values ``(..., m+1, 3)``.
+    """
+    scale = 2.0 ** (frac_bits + guard)
+    G, P, Q = (np.asarray(a, dtype=np.float64) for a in (G, P, Q))
+    v = np.rint(Q * scale).astype(np.int64)
+    d1 = np.rint((G / m ** 2 + P / m) * scale).astype(np.int64)
+    d2 = np.rint((2 * G / m ** 2) * scale).astype(np.int64)
+    out = [v]
+    for _ in range(m):
+        v = v + d1
+        d1 = d1 + d2
+        out.append(v)
+    return np.stack(out, axis=-2) / scale

@@ -1,0 +1,159 @@
+"""One call from a table to a checked design: budget, exhaustive
+measurement, gappa, yosys, costs; and the writer of the Verilog outputs.
+
+>>> from chebnorm.approx import fit_target
+>>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_bits=16, synth=False, gappa=False)
+>>> r.checks["within_budget"], r.checks["budget_within_2x"]
+(True, True)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from chebnorm.approx import CoefficientTable
+from chebnorm.approx._io import write_atomic
+
+from .budget import ErrorBudget, Measurement, error_budget, measure
+from .cost import Block
+from .datapaths import horner_block
+from .horner import HornerDesign, design_horner
+from .verilog import (SynthResult, synthesize_text, vector_file, verilog_module,
+                      verilog_testbench)
+
+__all__ = ["HardwareReport", "analyze", "verilog_outputs", "write_outputs"]
+
+
+@dataclass(frozen=True)
+class HardwareReport:
+    """A sized design with its certified budget, its exhaustive measurement,
+    its cost block and (when yosys ran) its cell count."""
+
+    design: HornerDesign
+    budget: ErrorBudget
+    measurement: Measurement
+    block: Block
+    synth: SynthResult | None
+
+    @property
+    def checks(self) -> dict:
+        """Each part of the budget checked on its own (all should be True).
+
+        * ``within_budget``: measured ``max |y - f|`` <= ``total``;
+        * ``budget_within_2x``: ``total <= 2 * measured``;
+        * ``quantization_consistent``: the re-certified bounds of ``p`` and
+          ``p_q`` agree within the certified ``sup |p_q - p|`` (triangle
+          inequality, both ways), and the measured ``max |p_q - p|`` stays under it;
+        * ``rounding_within_bound``: the exact enumerated ``max |y - p_q|``
+          (and each step's own rounding) stays within its analytic bound,
+          and within gappa's when gappa ran;
+        * ``no_overflow``: no valid code saturates the output.
+        """
+        b, m, t = self.budget, self.measurement, self.design.table
+        fp = t.fixed_point
+        eps = 1e-15  # float64 evaluation of f in the measurement
+        steps_ok = all(s <= float(st) for s, st in zip(
+            m.step_rounding, [_local(st, self.design) for st in self.design.stages[:-1]]))
+        return {
+            "within_budget": m.total <= b.total + eps,
+            "budget_within_2x": b.total <= 2 * m.total,
+            "quantization_consistent": (fp.max_abs_error <= t.abs_error_bound + b.quantization
+                                        and t.max_abs_error <= fp.abs_error_bound + b.quantization
+                                        and m.quantization <= b.quantization + eps),
+            "rounding_within_bound": (m.rounding <= b.rounding and steps_ok
+                                      and (b.gappa_rounding is None
+                                           or m.rounding <= b.gappa_rounding)),
+            "no_overflow": m.overflows == 0,
+        }
+
+    def as_dict(self) -> dict:
+        d, b = self.design, self.budget
+        return {
+            "module": d.module_name, "table": d.table.name, "expression": d.table.expression,
+            "interval": list(d.table.interval), "degree": d.degree,
+            "in_bits": d.in_bits, "out_bits": d.out_bits, "rounding": d.rounding,
+            "x_format": {"frac_bits": d.x_format.frac_bits, "offset": float(d.x_format.offset),
+                         "offset_code": d.x_format.offset_code, "q": d.x_format.q_name()},
+            "y_format": {"frac_bits": d.y_format.frac_bits, "offset": float(d.y_format.offset),
+                         "offset_code": d.y_format.offset_code, "q": d.y_format.q_name()},
+            "coef_frac_bits": d.coef_frac_bits, "coefficients_q": list(d.integers),
+            "acc_frac_bits": d.acc_frac_bits, "valid_codes": list(d.valid_codes),
+            "total_error_bound": b.total, "budget": b.as_dict(),
+            "measured": self.measurement.as_dict(), "checks": self.checks,
+            "cost": self.block.as_dict(),
+            "yosys_cells": None if self.synth is None else self.synth.cells,
+            "notes": list(d.notes),
+        }
+
+    def lines(self) -> list[str]:
+        d, b, m = self.design, self.budget, self.measurement
+        xf, yf = d.x_format, d.y_format
+        out = [f"{d.module_name}: degree {d.degree}, x {d.in_bits} bits, y {d.out_bits} bits, "
+               f"coefficients {d.coef_frac_bits} fractional bits, rounding {d.rounding}",
+               f"x_format: code k -> {float(xf.offset)!r} + k / 2^{xf.frac_bits}; valid codes "
+               f"{d.valid_codes[0]}..{d.valid_codes[1]}",
+               f"y_format: code k -> {float(yf.offset)!r} + k / 2^{yf.frac_bits} "
+               f"(1 LSB = {b.y_lsb:.6e})",
+               "error budget (bound | measured over every valid code):",
+               f"  approximation   {b.approximation:.6e} | {m.approximation:.6e}",
+               f"  quantization    {b.quantization:.6e} | {m.quantization:.6e}  "
+               f"(p_q re-certified {b.quantized:.6e})"]
+        for st, (bound, meas) in zip(d.stages[:-1], zip(b.rounding_steps, m.step_rounding)):
+            out.append(f"  rounding a{st.power}     {bound:.6e} (local {_local(st, d):.6e}) "
+                       f"| local {meas:.6e}")
+        out += [f"  output rounding {b.output_rounding:.6e}",
+                f"  rounding total  {b.rounding:.6e} | {m.rounding:.6e}"
+                + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
+                f"  total           {b.total:.6e} | {m.total:.6e}  "
+                f"({b.total / b.y_lsb:.3f} | {m.total_lsb:.3f} LSB; ratio {b.total / m.total:.3f})",
+                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output",
+                "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]
+        out += self.block.lines()
+        if self.synth is not None:
+            out.append(f"yosys: {self.synth.cells} cells")
+        out += [f"note: {n}" for n in d.notes]
+        return out
+
+
+def _local(stage, design) -> float:
+    from .fixed import rounding_error_bound
+    return float(rounding_error_bound(stage.out_frac_bits, design.rounding, stage.round_shift))
+
+
+def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=None,
+            acc_bits=None, rounding: str = "rne", x_frac_bits=None, y_frac_bits=None,
+            gappa: bool = True, synth: bool = True) -> HardwareReport:
+    """Design, budget, measure (exhaustively) and optionally synthesize."""
+    design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
+                           rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits)
+    import shutil
+    budget = error_budget(design, gappa=gappa and shutil.which("gappa") is not None)
+    meas = measure(design)
+    syn = None
+    if synth and shutil.which("yosys") is not None:
+        syn = synthesize_text(verilog_module(design), design.module_name)
+    return HardwareReport(design, budget, meas, horner_block(design), syn)
+
+
+def verilog_outputs(report: HardwareReport, *, version: str = "",
+                    command: str | None = None) -> dict[str, str]:
+    """File name -> text of the module, its test bench and its vector file."""
+    d = report.design
+    name = d.module_name
+    return {f"{name}.v": verilog_module(d, version=version, command=command, budget=report.budget),
+            f"tb_{name}.v": verilog_testbench(d),
+            f"{name}.hex": vector_file(d)}
+
+
+def write_outputs(directory, files: dict[str, str]) -> list[Path]:
+    """Write every file atomically into an existing ``directory``; check first."""
+    folder = Path(directory)
+    if not folder.is_dir():
+        raise ValueError(f"output folder {str(folder)!r} does not exist; accepted: an existing "
+                         f"folder")
+    paths = []
+    for fname, text in files.items():
+        write_atomic(folder / fname, text)
+        paths.append(folder / fname)
+    return paths

@@ -1,0 +1,183 @@
+"""Design-space sweep: degree x coefficient bits x datapath bits -> measured
+error (output LSBs, 8-bit shading levels) against area (Yosys cells), with a
+Pareto plot and a deterministic CSV.
+
+The shading error of a design is ``255 * max |y / f - 1|`` over every valid
+input code: the largest change, in levels of an 8-bit output, of an
+intensity ``I <= 1`` whose normal is scaled by ``y`` instead of ``f``.
+"""
+
+from __future__ import annotations
+
+import io
+import shutil
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+from chebnorm.approx import fit_target, get_target
+
+from .budget import error_budget, measure
+from .datapaths import horner_block
+from .fixed import check_width
+from .horner import MAX_FRAC_BITS, design_horner
+from .verilog import synthesize_text, verilog_module
+
+__all__ = ["SweepPoint", "SweepResult", "sweep", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
+           "DEFAULT_ACC_BITS", "HALF_LEVEL"]
+
+DEFAULT_DEGREES = (1, 2, 3, 4)
+DEFAULT_COEF_BITS = (10, 14, 18)
+DEFAULT_ACC_BITS = (14, 18)
+HALF_LEVEL = 0.5
+
+COLUMNS = ("degree", "coef_bits", "acc_bits", "in_bits", "out_bits", "y_frac_bits",
+           "max_error", "max_error_lsb", "budget", "budget_lsb", "shading_levels",
+           "yosys_cells", "area_fa", "pareto", "meets_half_level")
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    degree: int
+    coef_bits: int
+    acc_bits: int | None
+    in_bits: int
+    out_bits: int
+    y_frac_bits: int
+    max_error: float
+    max_error_lsb: float
+    budget: float
+    budget_lsb: float
+    shading_levels: float
+    yosys_cells: int | None
+    area_fa: float
+    pareto: bool = False
+
+    @property
+    def area(self) -> float:
+        """Yosys cells when available, otherwise the FA estimate."""
+        return float(self.yosys_cells) if self.yosys_cells is not None else self.area_fa
+
+    @property
+    def meets_half_level(self) -> bool:
+        return self.shading_levels <= HALF_LEVEL
+
+    def row(self) -> list[str]:
+        f = lambda v: f"{v:.6e}"
+        return [str(self.degree), str(self.coef_bits),
+                "" if self.acc_bits is None else str(self.acc_bits), str(self.in_bits),
+                str(self.out_bits), str(self.y_frac_bits), f(self.max_error),
+                f"{self.max_error_lsb:.4f}", f(self.budget), f"{self.budget_lsb:.4f}",
+                f"{self.shading_levels:.6f}",
+                "" if self.yosys_cells is None else str(self.yosys_cells),
+                f"{self.area_fa:.1f}", str(int(self.pareto)), str(int(self.meets_half_level))]
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    target: str
+    points: tuple[SweepPoint, ...]
+    area_source: str
+
+    @property
+    def cheapest(self) -> SweepPoint | None:
+        """The smallest-area design whose shading error is at most half a level."""
+        ok = [p for p in self.points if p.meets_half_level]
+        return min(ok, key=lambda p: (p.area, p.max_error, p.degree, p.coef_bits,
+                                      p.acc_bits or 0)) if ok else None
+
+    def csv(self) -> str:
+        out = io.StringIO()
+        out.write(",".join(COLUMNS) + "\n")
+        for p in self.points:
+            out.write(",".join(p.row()) + "\n")
+        return out.getvalue()
+
+    def plot_png(self) -> bytes:
+        """The Pareto plot (matplotlib, Agg), as PNG bytes."""
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(7, 4.5), dpi=120)
+        for deg in sorted({p.degree for p in self.points}):
+            pts = [p for p in self.points if p.degree == deg]
+            ax.scatter([p.area for p in pts], [p.shading_levels for p in pts], s=18,
+                       label=f"degree {deg}")
+        front = sorted((p for p in self.points if p.pareto), key=lambda p: p.area)
+        ax.step([p.area for p in front], [p.shading_levels for p in front], where="post",
+                color="k", lw=1, label="Pareto front")
+        ax.axhline(HALF_LEVEL, color="r", ls="--", lw=1, label="half a level (8-bit)")
+        best = self.cheapest
+        if best is not None:
+            ax.scatter([best.area], [best.shading_levels], s=90, facecolors="none",
+                       edgecolors="r", label="cheapest under half a level")
+        ax.set_xlabel("Yosys cells" if self.area_source == "yosys" else "area estimate (FA)")
+        ax.set_ylabel("max shading error (8-bit levels)")
+        ax.set_yscale("log")
+        ax.set_title(f"{self.target}: error against area")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", metadata={"Software": None})
+        plt.close(fig)
+        return buf.getvalue()
+
+
+def _validate_list(values, name, lo, hi) -> tuple[int, ...]:
+    vals = tuple(sorted({check_width(v, name, lo, hi) for v in values}))
+    if not vals:
+        raise ValueError(f"{name} list is empty; accepted: one or more values in {lo}..{hi}")
+    return vals
+
+
+def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAULT_COEF_BITS,
+          acc_bits=DEFAULT_ACC_BITS, in_bits: int = 12, out_bits: int = 12,
+          rounding: str = "rne", psi_max="pi/4", synth: bool = True, jobs: int = 4,
+          progress: bool = True) -> SweepResult:
+    """Evaluate every design of the grid exhaustively and (with yosys) synthesize it.
+
+    Degree-1 designs have no intermediate accumulator, so ``acc_bits`` does
+    not apply to them (one point per coefficient width).
+    """
+    get_target(target)
+    degrees = _validate_list(degrees, "degree", 1, 4)
+    coef_bits = _validate_list(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
+    acc_bits = _validate_list(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
+    tables = {d: fit_target(target, d, psi_max=psi_max) for d in degrees}
+    grid = [(d, c, a if d >= 2 else None) for d in degrees for c in coef_bits
+            for a in (acc_bits if d >= 2 else (None,))]
+    use_yosys = synth and shutil.which("yosys") is not None
+    from tqdm import tqdm
+
+    designs = []
+    for d, c, a in tqdm(grid, desc=f"sweep {target}", unit="design", disable=not progress,
+                        leave=False):
+        design = design_horner(tables[d], in_bits, out_bits, coef_bits=c, acc_bits=a,
+                               rounding=rounding, name=f"{target}_d{d}_c{c}_a{a or 0}")
+        designs.append((d, c, a, design, error_budget(design), measure(design)))
+    cells = [None] * len(designs)
+    if use_yosys:
+        def run(item):
+            design = item[3]
+            return synthesize_text(verilog_module(design), design.module_name).cells
+        with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            cells = list(tqdm(pool.map(run, designs), total=len(designs), desc="yosys",
+                              unit="design", disable=not progress, leave=False))
+    points = []
+    for (d, c, a, design, b, m), n_cells in zip(designs, cells):
+        points.append(SweepPoint(degree=d, coef_bits=c, acc_bits=a, in_bits=in_bits,
+                                 out_bits=out_bits, y_frac_bits=design.y_format.frac_bits,
+                                 max_error=m.total, max_error_lsb=m.total_lsb, budget=b.total,
+                                 budget_lsb=b.total / b.y_lsb, shading_levels=m.shading_levels,
+                                 yosys_cells=n_cells, area_fa=horner_block(design).cost.area))
+    # Pareto front: no other point is at most as large and at most as wrong, one strictly
+    marked = []
+    for p in points:
+        dominated = any((q.area <= p.area and q.shading_levels <= p.shading_levels)
+                        and (q.area < p.area or q.shading_levels < p.shading_levels)
+                        for q in points)
+        marked.append(SweepPoint(**{**p.__dict__, "pareto": not dominated}))
+    marked.sort(key=lambda p: (p.degree, p.coef_bits, p.acc_bits or 0))
+    return SweepResult(target=target, points=tuple(marked),
+                       area_source="yosys" if use_yosys else "estimate")
