@@ -105,8 +105,9 @@ def normalization_ops(method: str) -> NormalizationCounts:
 
 
 def _generic_pair(psi: float):
-    e1 = np.array([2.0, 1.0, 2.0]) / 3.0
-    e2 = np.array([1.0, 2.0, -2.0]) / 3.0
+    """Unit normals at angle psi in a generic plane (no component zero or equal)."""
+    e1 = np.array([2.0, 3.0, 6.0]) / 7.0
+    e2 = np.array([3.0, -6.0, 2.0]) / 7.0
     return e1, math.cos(psi) * e1 + math.sin(psi) * e2
 
 

@@ -138,7 +138,8 @@ def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None)
     Yields ``n`` pixels. Set-up: ``N_k = (N_b - c N_a)/sqrt(1 - c^2)``, psi,
     cos phi, sin phi, the first two pixels. Per pixel: 3 mul, 3 add.
     ``reanchor=K`` recomputes ``N_{j-1}, N_j`` from the closed form every K
-    pixels (4 trig, 14 mul, 8 add per anchor), bounding the float32 drift.
+    pixels (4 trig, 16 mul, 8 add per anchor instead of 3 mul, 3 add),
+    bounding the float32 drift.
     """
     c = ops.minimum(dot(nl, nr), 1.0)
     psi = ops.arccos(c)

@@ -1,0 +1,264 @@
+"""Error analysis of the span interpolators, as functions of the span angle and length.
+
+Errors of a method's pixel normal ``N`` at position ``t`` are measured (in
+float64, whatever dtype computed ``N``) against ``R(t)``, the exactly
+normalized linear interpolant ``(N_l + t(N_r - N_l)) / |...|`` computed in
+float64 from the same (float64) end normals:
+
+* length error ``| |N| - 1 |``;
+* angle error ``atan2(|N x R|, N.R)`` (radians). The slerp family (``slerp``,
+  ``angular``, ``dichotomy``) spaces its normals evenly in *angle*, not along
+  the chord, so against ``R`` it shows a parametrization difference of
+  order ``psi^3/40`` even in exact arithmetic; ``max_angle_error_slerp`` is
+  the angle against the slerp point ``S(t)`` instead (that family's own ideal);
+* vector error ``|N - R|``: the largest absolute diffuse error
+  ``|L.N - L.R|`` over all unit lights, for ``I0 k_d = 1``;
+* diffuse error ``|N.R - 1|``: the relative diffuse error with the light
+  along the true normal (where seed 003's ``delta_d`` is measured);
+* specular errors ``|(N.R)^n - 1|``, ``n = 1..128``: relative specular error
+  with the half vector along the true normal (seed 003's ``delta_s``).
+
+All are maxima over the pixels of the span. The end normals are a fixed
+generic pair at angle ``psi`` (not aligned with the axes).
+
+>>> r = analyze("none", 0.7853981633974483, 64)
+>>> round(r.max_length_error, 7), round(r.specular_error(1), 7)
+(0.0761205, 0.0761205)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .counting import OpCounts, _generic_pair, count_ops
+from .spans import METHODS, TABLE_METHODS, _check_dtype, _check_method, default_tables, span_normals
+
+__all__ = ["MethodReport", "analyze", "ErrorSweep", "error_sweep", "DriftReport", "angular_drift",
+           "N_SPECULAR", "reference_normals", "slerp_normals"]
+
+#: specular exponents analysed: 1 .. N_SPECULAR
+N_SPECULAR = 128
+_DEFAULT_PSI_MAX = math.pi / 4
+
+
+def _check_psi(psi) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(psi, dtype=np.float64))
+    if arr.ndim != 1 or not np.isfinite(arr).all() or (arr < 0).any() or (arr >= math.pi).any():
+        raise ValueError(f"span angle psi = {psi!r} is out of range; accepted: 0 <= psi < pi (radians)")
+    return arr
+
+
+def _check_m(m) -> int:
+    if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or m < 1:
+        raise ValueError(f"span length m = {m!r}; accepted: an integer m >= 1")
+    return int(m)
+
+
+def reference_normals(nl, nr, t) -> np.ndarray:
+    """``R(t)``: linear interpolation then exact normalization, float64, (P, 3)."""
+    n = nl + t[:, None] * (nr - nl)
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def slerp_normals(nl, nr, psi, t) -> np.ndarray:
+    """``S(t)``: the slerp point at angle fraction ``t``, float64, (P, 3); ``psi`` per pixel."""
+    psi = np.broadcast_to(psi, t.shape)
+    small = psi < 1e-300
+    s = np.where(small, 1.0, np.sin(psi))
+    wa = np.where(small, 1.0 - t, np.sin((1.0 - t) * psi) / s)
+    wb = np.where(small, t, np.sin(t * psi) / s)
+    return wa[:, None] * nl + wb[:, None] * nr
+
+
+def _angle(a, b) -> np.ndarray:
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+
+
+def _pixel_errors(n, nl, nr, psi, t):
+    """Per-pixel errors: dict of (P,) arrays and the (P, 128) specular errors."""
+    ref = reference_normals(nl, nr, t)
+    sl = slerp_normals(nl, nr, psi, t)
+    cosr = np.einsum("ij,ij->i", n, ref)
+    spec = np.abs(np.power(cosr[:, None], np.arange(1, N_SPECULAR + 1)[None, :]) - 1.0)
+    return {"length": np.abs(np.linalg.norm(n, axis=1) - 1.0), "angle": _angle(n, ref),
+            "angle_slerp": _angle(n, sl), "vector": np.linalg.norm(n - ref, axis=1),
+            "diffuse": np.abs(cosr - 1.0)}, spec
+
+
+@dataclass(frozen=True)
+class MethodReport:
+    """Errors and operation counts of one method on one span (see the module docstring)."""
+
+    method: str
+    psi: float
+    m: int
+    dtype: str
+    max_length_error: float
+    max_angle_error: float
+    max_angle_error_slerp: float
+    max_vector_error: float
+    diffuse_error: float
+    specular_errors: tuple[float, ...]  # n = 1 .. N_SPECULAR
+    ops: OpCounts
+
+    def specular_error(self, n: int) -> float:
+        """Largest ``|(N.R)^n - 1|`` over the span, ``1 <= n <= 128``."""
+        if not 1 <= n <= N_SPECULAR:
+            raise ValueError(f"specular exponent n = {n}; accepted: 1 <= n <= {N_SPECULAR}")
+        return self.specular_errors[n - 1]
+
+    def to_dict(self) -> dict:
+        return {"name": self.method, "angle": self.psi, "span": self.m, "dtype": self.dtype,
+                "max_length_error": self.max_length_error, "max_angle_error": self.max_angle_error,
+                "max_angle_error_slerp": self.max_angle_error_slerp,
+                "max_vector_error": self.max_vector_error, "diffuse_error": self.diffuse_error,
+                "specular_errors": {str(n): self.specular_errors[n - 1] for n in (1, 2, 4, 8, 16, 32, 64, 128)},
+                "ops_per_pixel": dict(self.ops.per_pixel), "ops_per_span": dict(self.ops.per_span)}
+
+
+def _tables_for(tables, psi_max: float):
+    if tables is not None or psi_max <= _DEFAULT_PSI_MAX:
+        return tables
+    return default_tables(float(psi_max))
+
+
+def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
+            angular_reanchor: int | None = None) -> MethodReport:
+    """Errors of ``method`` on one span of angle ``psi`` (radians) and length ``m``, in ``dtype``.
+
+    ``tables`` as in :func:`~.spans.span_normals`; when None and ``psi`` exceeds
+    pi/4, the degree-2 tables fitted for ``psi_max = psi`` are used
+    (:func:`~.spans.default_tables`).
+
+    >>> r = analyze("newton", 0.7853981633974483, 64)
+    >>> round(r.max_length_error, 6), r.ops.per_pixel["sqrt"]
+    (0.008471, 0)
+    """
+    method = _check_method(method)
+    dt = _check_dtype(dtype)
+    (psi_v,) = _check_psi(psi)
+    m = _check_m(m)
+    nl, nr = _generic_pair(psi_v)
+    tab = _tables_for(tables, psi_v)
+    res = span_normals(method, nl[None], nr[None], [m], dtype=dt, tables=tab,
+                       angular_reanchor=angular_reanchor)
+    err, spec = _pixel_errors(res.normals.astype(np.float64), nl, nr, psi_v, res.t)
+    ops = count_ops(method, m, tables=tab, angular_reanchor=angular_reanchor, psi=psi_v)
+    return MethodReport(method=method, psi=float(psi_v), m=m, dtype=np.dtype(dt).name,
+                        max_length_error=float(err["length"].max()),
+                        max_angle_error=float(err["angle"].max()),
+                        max_angle_error_slerp=float(err["angle_slerp"].max()),
+                        max_vector_error=float(err["vector"].max()),
+                        diffuse_error=float(err["diffuse"].max()),
+                        specular_errors=tuple(float(v) for v in spec.max(axis=0)), ops=ops)
+
+
+@dataclass(frozen=True)
+class ErrorSweep:
+    """Errors over a grid: arrays indexed ``[method, dtype, psi, m]`` (specular: ``[..., n-1]``)."""
+
+    methods: tuple[str, ...]
+    dtypes: tuple[str, ...]
+    psis: np.ndarray
+    ms: tuple[int, ...]
+    length_error: np.ndarray
+    angle_error: np.ndarray
+    angle_error_slerp: np.ndarray
+    vector_error: np.ndarray
+    diffuse_error: np.ndarray
+    specular_error: np.ndarray
+
+    def get(self, quantity: str, method: str, dtype="float64", m=None) -> np.ndarray:
+        """One curve over psi (or, with ``m=None``, the ``(len(psis), len(ms))`` block)."""
+        arr = getattr(self, quantity)
+        i, d = self.methods.index(method), self.dtypes.index(np.dtype(dtype).name)
+        out = arr[i, d]
+        return out if m is None else out[:, self.ms.index(m)]
+
+
+def error_sweep(methods=METHODS, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np.float32), *,
+                tables=None) -> ErrorSweep:
+    """Errors of every method over span angles ``psis`` (default 33 points on [0, pi/2]),
+    span lengths ``ms`` and dtypes; vectorized over the angles (one span per angle).
+
+    ``tables=None``: the default degree-2 tables for pi/4 when they cover
+    ``max(psis)``, else the degree-2 tables fitted for ``psi_max = max(psis)``.
+
+    >>> s = error_sweep(("none",), [0.2], (4,), (np.float64,))
+    >>> round(float(s.get("diffuse_error", "none", m=4)[0]), 7)   # delta_d(0.2), claim C1
+    0.0049958
+    """
+    methods = tuple(_check_method(mm) for mm in methods)
+    psis = np.linspace(0.0, math.pi / 2, 33) if psis is None else _check_psi(psis)
+    ms = tuple(_check_m(mm) for mm in ms)
+    dts = tuple(_check_dtype(d) for d in dtypes)
+    tab = _tables_for(tables, float(psis.max()))
+    shape = (len(methods), len(dts), len(psis), len(ms))
+    out = {k: np.zeros(shape) for k in ("length", "angle", "angle_slerp", "vector", "diffuse")}
+    spec_out = np.zeros(shape + (N_SPECULAR,))
+    pairs = [_generic_pair(p) for p in psis]
+    nl = np.array([a for a, _ in pairs])
+    nr = np.array([b for _, b in pairs])
+    for i, meth in enumerate(methods):
+        for d, dt in enumerate(dts):
+            for k, m in enumerate(ms):
+                res = span_normals(meth, nl, nr, np.full(len(psis), m), dtype=dt,
+                                   tables=tab if meth in TABLE_METHODS else None)
+                sid = np.repeat(np.arange(len(psis)), np.diff(res.offsets))
+                err, spec = _pixel_errors(res.normals.astype(np.float64), nl[sid], nr[sid],
+                                          psis[sid], res.t)
+                starts = res.offsets[:-1]
+                for key, v in err.items():
+                    out[key][i, d, :, k] = np.maximum.reduceat(v, starts)
+                spec_out[i, d, :, k, :] = np.maximum.reduceat(spec, starts, axis=0)
+    return ErrorSweep(methods=methods, dtypes=tuple(np.dtype(d).name for d in dts), psis=psis, ms=ms,
+                      length_error=out["length"], angle_error=out["angle"],
+                      angle_error_slerp=out["angle_slerp"], vector_error=out["vector"],
+                      diffuse_error=out["diffuse"], specular_error=spec_out)
+
+
+@dataclass(frozen=True)
+class DriftReport:
+    """Per-pixel errors of the ``angular`` recurrence against its ideal, slerp (float64)."""
+
+    psi: float
+    m: int
+    dtype: str
+    reanchor: int | None
+    t: np.ndarray
+    length_error: np.ndarray
+    angle_error: np.ndarray        # against the slerp point S(t)
+    max_length_error: float
+    max_angle_error: float
+    final_length_error: float
+    final_angle_error: float
+    ops: OpCounts
+
+
+def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,
+                  reanchor: int | None = None) -> DriftReport:
+    """The drift of the spherical-angular recurrence (seed 000, method 6) along one span.
+
+    ``reanchor=K`` restarts the recurrence from the closed form every K
+    pixels; its cost is in ``ops`` (``per_pixel`` is then an average).
+
+    >>> d = angular_drift(math.pi / 4, 512, np.float64)
+    >>> d.max_angle_error < 1e-11
+    True
+    """
+    dt = _check_dtype(dtype)
+    (psi_v,) = _check_psi(psi)
+    m = _check_m(m)
+    nl, nr = _generic_pair(psi_v)
+    res = span_normals("angular", nl[None], nr[None], [m], dtype=dt, angular_reanchor=reanchor)
+    n = res.normals.astype(np.float64)
+    length = np.abs(np.linalg.norm(n, axis=1) - 1.0)
+    angle = _angle(n, slerp_normals(nl, nr, psi_v, res.t))
+    return DriftReport(psi=float(psi_v), m=m, dtype=np.dtype(dt).name, reanchor=reanchor, t=res.t,
+                       length_error=length, angle_error=angle,
+                       max_length_error=float(length.max()), max_angle_error=float(angle.max()),
+                       final_length_error=float(length[-1]), final_angle_error=float(angle[-1]),
+                       ops=count_ops("angular", m, angular_reanchor=reanchor, psi=psi_v))
