@@ -3,7 +3,19 @@
 One module per paper, one function per figure or table. ``REGISTRY`` maps a
 job name to a callable ``job(out_dir: pathlib.Path) -> list[pathlib.Path]``
 returning the files it wrote; ``chebnorm repro`` finds it through the
-``chebnorm.repro`` entry point. Uses chebnorm's public API only.
+``chebnorm.repro`` entry point and runs the jobs in sorted name order, so the
+claims ledger (``zz_claims``) comes last. Uses chebnorm's public API only.
+
+=====================  ======================  =====================
+job                    module                  writes under figures/
+=====================  ======================  =====================
+``seed003_criterion``  :mod:`.criterion`       ``criterion/``
+``zz_claims``          :mod:`.claims`          ``claims/`` (+ ledger)
+=====================  ======================  =====================
 """
 
-REGISTRY: dict = {}
+from . import criterion
+
+REGISTRY: dict = {
+    criterion.JOB: criterion.run,
+}

@@ -1,0 +1,147 @@
+"""One figure style for the whole reproduction, and deterministic writers.
+
+* Figures are drawn on the Agg canvas (no display, no pyplot: importing
+  this module selects no backend and changes no global state), with one
+  rcParams set (:data:`RC`) applied inside :func:`figure` and
+  :func:`save_figure` only.
+* :func:`save_figure` writes ``<stem>.png``, ``<stem>.svg`` and the caption
+  ``<stem>.txt``; PNG and SVG carry no date or software version and the SVG
+  ids come from a fixed hash salt, so two runs give identical bytes.
+* :func:`write_csv` writes the figure's data with a ``#`` header (caption,
+  producing command, notes), ``%.10g`` floats, rows in the order given (the
+  callers give them sorted).
+
+Every file goes through :func:`chebnorm.approx._io.write_atomic` (temporary
+file, then rename).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import matplotlib
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from chebnorm.approx._io import write_atomic
+
+__all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "write_csv", "write_json",
+           "write_text", "fmt", "COLORS"]
+
+#: the float format of every CSV cell
+FLOAT_FORMAT = "%.10g"
+#: a colour-blind-safe cycle (Okabe-Ito)
+COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
+RC = {
+    "figure.figsize": (6.4, 4.2),
+    "figure.dpi": 100,
+    "savefig.dpi": 120,
+    "font.size": 9,
+    "axes.titlesize": 9,
+    "axes.labelsize": 9,
+    "legend.fontsize": 8,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.prop_cycle": matplotlib.cycler(color=COLORS),
+    "lines.linewidth": 1.4,
+    "svg.hashsalt": "chebnorm-repro",
+    "svg.fonttype": "path",
+    "path.simplify": False,
+    "image.cmap": "viridis",
+}
+
+
+@contextmanager
+def figure(nrows: int = 1, ncols: int = 1, **kwargs):
+    """``fig, axes`` in the reproduction's style; closed on exit."""
+    with matplotlib.rc_context(RC):
+        fig = Figure(figsize=kwargs.pop("figsize", RC["figure.figsize"]),
+                     layout=kwargs.pop("layout", "constrained"))
+        FigureCanvasAgg(fig)
+        axes = fig.subplots(nrows, ncols, **kwargs)
+        yield fig, axes
+
+
+def write_text(path: Path, text: str) -> Path:
+    write_atomic(path, text)
+    return Path(path)
+
+
+def save_figure(fig, folder: Path, stem: str, caption: str) -> list[Path]:
+    """Write ``fig`` as ``folder/stem.png`` and ``.svg`` (deterministic bytes)
+    and its caption as ``folder/stem.txt``; return the three paths."""
+    folder = Path(folder)
+    written = []
+    with matplotlib.rc_context(RC):
+        for ext, meta in (("png", {"Software": None}),
+                          ("svg", {"Date": None, "Creator": None})):
+            buf = io.BytesIO()
+            fig.savefig(buf, format=ext, metadata=meta, bbox_inches="tight")
+            path = folder / f"{stem}.{ext}"
+            write_atomic(path, buf.getvalue())
+            written.append(path)
+    written.append(write_text(folder / f"{stem}.txt", caption.strip() + "\n"))
+    return written
+
+
+def fmt(value) -> str:
+    """One CSV cell: ``%.10g`` for floats, ``str`` for the rest ("nan"/"inf" spelled so)."""
+    if isinstance(value, (bool, np.bool_)):
+        return "1" if value else "0"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return FLOAT_FORMAT % v
+    text = str(value)
+    if any(ch in text for ch in ",\n\""):
+        text = '"' + text.replace('"', '""') + '"'
+    return text
+
+
+def write_csv(folder: Path, stem: str, columns: Sequence[str], rows: Iterable[Sequence],
+              caption: str, command: str, notes: Sequence[str] = ()) -> Path:
+    """Write ``folder/stem.csv``: ``#`` comment lines (caption, command, notes),
+    then the header and the rows, in the order given."""
+    lines = [f"# {line}" for line in caption.strip().splitlines()]
+    lines.append(f"# command: {command}")
+    lines += [f"# {n}" for n in notes]
+    lines.append(",".join(columns))
+    for row in rows:
+        if len(row) != len(columns):
+            raise ValueError(f"{stem}.csv: row {row!r} has {len(row)} cells; expected {len(columns)}")
+        lines.append(",".join(fmt(v) for v in row))
+    path = Path(folder) / f"{stem}.csv"
+    write_atomic(path, "\n".join(lines) + "\n")
+    return path
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        v = float(obj)
+        return float(FLOAT_FORMAT % v) if math.isfinite(v) else str(v)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+def write_json(path: Path, data) -> Path:
+    """Sorted keys, floats rounded to ``%.10g``, two-space indent, final newline."""
+    write_atomic(path, json.dumps(_jsonable(data), sort_keys=True, indent=2, ensure_ascii=False) + "\n")
+    return Path(path)
