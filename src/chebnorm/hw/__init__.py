@@ -10,6 +10,12 @@ of a format with ``F`` fractional bits and offset ``O`` stands for
 from .budget import ErrorBudget, Measurement, error_budget, gappa_bound, gappa_script, measure
 from .fixed import QFormat, fit_bits, shift_round
 from .horner import HornerDesign, design_horner
+from .cost import Block, Cost
+from .datapaths import (bump_pipeline, classic_normalize, classic_unit, dichotomy_midpoint,
+                        dichotomy_unit, eta_unit, forward_difference, forward_difference_stepper,
+                        horner_block, phong_pipeline, quadratic_midpoint_unit)
+from .report import HardwareReport, analyze, verilog_outputs, write_outputs
+from .sweep import SweepPoint, SweepResult, sweep
 from .verilog import (SimResult, SynthResult, simulate, synthesize, verilog_module,
                       verilog_testbench, vector_file)
 
@@ -19,4 +25,9 @@ __all__ = [
     "ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script", "gappa_bound",
     "verilog_module", "verilog_testbench", "vector_file", "simulate", "synthesize",
     "SimResult", "SynthResult",
+    "Cost", "Block", "horner_block", "classic_unit", "dichotomy_unit", "quadratic_midpoint_unit",
+    "forward_difference_stepper", "eta_unit", "phong_pipeline", "bump_pipeline",
+    "classic_normalize", "dichotomy_midpoint", "forward_difference",
+    "HardwareReport", "analyze", "verilog_outputs", "write_outputs",
+    "SweepPoint", "SweepResult", "sweep",
 ]
