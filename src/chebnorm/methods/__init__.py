@@ -31,7 +31,7 @@ Layer rule: imports numpy and :mod:`chebnorm.approx` only.
 """
 
 from .analysis import (N_SPECULAR, DriftReport, ErrorSweep, MethodReport, analyze, angular_drift,
-                       error_sweep, reference_normals, slerp_normals)
+                       error_sweep, length_error_bound, reference_normals, slerp_normals)
 from .counting import PAPER_COUNTS, NormalizationCounts, OpCounts, count_ops, normalization_ops
 from .ops import OP_KINDS
 from .spans import (ANTIPARALLEL_TOL, METHODS, TABLE_METHODS, UNIT_TOL, SpanNormals, default_tables,
@@ -41,5 +41,5 @@ __all__ = [
     "METHODS", "TABLE_METHODS", "SpanNormals", "span_normals", "default_tables", "UNIT_TOL",
     "ANTIPARALLEL_TOL", "OP_KINDS", "OpCounts", "count_ops", "NormalizationCounts",
     "normalization_ops", "PAPER_COUNTS", "MethodReport", "analyze", "ErrorSweep", "error_sweep",
-    "DriftReport", "angular_drift", "N_SPECULAR", "reference_normals", "slerp_normals",
+    "DriftReport", "angular_drift", "length_error_bound", "N_SPECULAR", "reference_normals", "slerp_normals",
 ]

@@ -37,7 +37,7 @@ from .counting import OpCounts, _generic_pair, count_ops
 from .spans import METHODS, TABLE_METHODS, _check_dtype, _check_method, default_tables, span_normals
 
 __all__ = ["MethodReport", "analyze", "ErrorSweep", "error_sweep", "DriftReport", "angular_drift",
-           "N_SPECULAR", "reference_normals", "slerp_normals"]
+           "N_SPECULAR", "reference_normals", "slerp_normals", "length_error_bound"]
 
 #: specular exponents analysed: 1 .. N_SPECULAR
 N_SPECULAR = 128
@@ -218,6 +218,73 @@ def error_sweep(methods=METHODS, psis=None, ms=(8, 64, 512), dtypes=(np.float64,
                       length_error=out["length"], angle_error=out["angle"],
                       angle_error_slerp=out["angle_slerp"], vector_error=out["vector"],
                       diffuse_error=out["diffuse"], specular_error=spec_out)
+
+
+def _levels_of(m: int) -> int:
+    return max(0, math.ceil(math.log2(m) - 1e-12))
+
+
+def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np.float64) -> float:
+    """An analytic bound of ``max | |N| - 1 |`` for ``method`` on a span of angle ``psi``, length ``m``
+    (default positions), including a rounding allowance in ``dtype``.
+
+    With ``r = cos(psi/2)`` the smallest length of the linear interpolant:
+
+    * ``exact`` 16 eps, ``slerp`` 32 eps (rounding only);
+    * ``none``: ``1 - r`` (seed 003's delta_d, attained at the midpoint);
+    * ``newton``: ``1 - r(3 - r^2)/2`` (the step is increasing on [0, 1],
+      derivative ``3(1 - x^2)/2``, and maps 1 to 1);
+    * ``lyon``: ``1 - r(15 - 10 r^2 + 3 r^4)/8`` (derivative ``15(1 - x^2)^2/8``);
+    * ``dichotomy`` (table of certified relative error ``e``, L levels):
+      level k's denominator is off by ``rho_k``, the propagated ``z`` by
+      ``zeta_k``; to first order ``zeta_{k+1} = eps_k + zeta_k/4`` and
+      ``rho_k = eps_k - zeta_k/4`` (``|d log f / d log z| = z/(2(2+z)) <= 1/4``),
+      so ``|rho_k| <= e (1 + (1 - 4^-k)/3)``; a midpoint's length error is the
+      mean of its neighbours' plus ``rho_k``, so the bound is ``sum_k |rho_k|
+      + (L e)^2``; off the dyadic grid (m not a power of two) add the pick's
+      ``1 - cos(psi / 2^(L+1))``;
+    * ``quadratic`` (midpoint table of relative error ``e``):
+      ``1 - sqrt(1 - (1 - r)^2/4) + e(1 + e)``, the first term exact (in the
+      plane of the normals ``|N|^2 = 1 - (1-r)^2 u(1-u)``, ``u = (2t-1)^2``),
+      the table moving ``|N(t)|`` by at most ``4t(1-t) e``; plus ``8 (m+1)
+      eps`` for the forward differences;
+    * ``angular``: an *estimate*, not a rigorous bound: ``2 cos(phi)`` is
+      off by ~eps, a frequency error ~``eps/phi``, so after m steps
+      ``4 m eps m / psi`` (capped at ``4 m sqrt(eps)``) + 64 eps.
+
+    Tables as in :func:`~.spans.span_normals` (missing keys: the defaults).
+
+    >>> round(length_error_bound("none", math.pi / 4, 64), 7)
+    0.0761205
+    """
+    method = _check_method(method)
+    eps = float(np.finfo(_check_dtype(dtype)).eps)
+    (psi,) = _check_psi(psi)
+    m = _check_m(m)
+    r = math.cos(psi / 2)
+    if method in ("dichotomy", "quadratic"):
+        table = default_tables()[method] if tables is None or method not in tables else tables[method]
+        e = 0.0 if table is None else table.rel_error_bound
+    if method == "exact":
+        return 16 * eps
+    if method == "slerp":
+        return 32 * eps
+    if method == "none":
+        return 1 - r + 16 * eps
+    if method == "newton":
+        return 1 - r * (3 - r * r) / 2 + 16 * eps
+    if method == "lyon":
+        return 1 - r * (15 - 10 * r ** 2 + 3 * r ** 4) / 8 + 16 * eps
+    if method == "dichotomy":
+        lv = _levels_of(m)
+        b = sum(e * (1 + (1 - 4.0 ** -k) / 3) for k in range(lv)) + (lv * e) ** 2
+        if 2 ** lv != m:
+            b += 1 - math.cos(psi / 2 ** (lv + 1))
+        return b + 16 * (lv + 1) * eps
+    if method == "quadratic":
+        return 1 - math.sqrt(1 - (1 - r) ** 2 / 4) + e * (1 + e) + 8 * (m + 1) * eps
+    drift = 4 * m * eps * m / psi if psi > 0 else 0.0
+    return min(drift, 4 * m * math.sqrt(eps)) + 64 * eps
 
 
 @dataclass(frozen=True)
