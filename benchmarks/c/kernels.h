@@ -1,0 +1,411 @@
+/*
+ * kernels.h -- the normalization methods of seed 000 as scalar float32 span
+ * kernels in C99, plus the baselines and the shading kernels of claim C13.
+ *
+ * Every kernel computes the pixels of one scan-line span: end normals nl, nr
+ * (unit), pixel positions t = t0 + j dt, j = 0 .. count-1, and writes three
+ * floats per pixel to out (one float per pixel for the shading kernels).
+ * The operations follow chebnorm.methods.kernels one for one (same order,
+ * same constants), so the outputs agree with
+ * chebnorm.methods.span_normals(..., dtype=np.float32) to a few ulps per
+ * operation; tests/test_bench_kernels.py checks that.
+ *
+ * The two fitted polynomials come from chebnorm's exported headers, generated
+ * at build time by benchmarks/ckernels.py with chebnorm.export.c_header:
+ *   chebnorm_dichotomy_d2_f(z) ~ 1/sqrt(2 + z)      (dichotomy, method 4)
+ *   chebnorm_midpoint_d2_f(x)  ~ 1/sqrt(2 (1 + x))  (quadratic, method 5)
+ * Nothing here types a coefficient in by hand.
+ *
+ * These kernels do not validate their input (span_normals does, in Python).
+ */
+#ifndef CHEBNORM_BENCH_KERNELS_H
+#define CHEBNORM_BENCH_KERNELS_H
+
+#include <math.h>
+#include <stddef.h>
+
+#include "chebnorm_dichotomy_d2.h"
+#include "chebnorm_midpoint_d2.h"
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#define BENCH_HAVE_SSE 1
+#else
+#define BENCH_HAVE_SSE 0
+#endif
+
+typedef struct {
+    float nl[3];
+    float nr[3];
+    float t0;
+    float dt;
+    int count;
+} span_t;
+
+/* guard of divisions by sin(psi) for parallel end normals (kernels.TINY) */
+#define BENCH_TINY 1e-30f
+/* deepest dichotomy tree the kernel holds (span_normals.MAX_LEVELS is 20) */
+#define BENCH_MAX_LEVELS 16
+
+static inline float dot3(const float a[3], const float b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline float pixel_t(const span_t *s, int j)
+{
+    return s->t0 + (float)j * s->dt;
+}
+
+/* ------------------------------------------------ linear interpolation + normalizer */
+/* N(t) = N_l + t (N_r - N_l): 3 mul, 3 add per pixel, the difference once per span. */
+#define LINEAR_KERNEL(NAME, NORMALIZE)                                          \
+    static inline void NAME(const span_t *s, float *restrict out)              \
+    {                                                                           \
+        const float a0 = s->nl[0], a1 = s->nl[1], a2 = s->nl[2];                \
+        const float d0 = s->nr[0] - a0, d1 = s->nr[1] - a1, d2 = s->nr[2] - a2; \
+        for (int j = 0; j < s->count; ++j) {                                    \
+            const float t = pixel_t(s, j);                                      \
+            float n0 = a0 + t * d0, n1 = a1 + t * d1, n2 = a2 + t * d2;         \
+            NORMALIZE                                                           \
+            out[3 * j] = n0;                                                    \
+            out[3 * j + 1] = n1;                                                \
+            out[3 * j + 2] = n2;                                                \
+        }                                                                       \
+    }
+
+/* classic N / sqrt(N.N): 3 mul, 2 add, 1 sqrt, 3 div (the paper's count) */
+#define NORM_CLASSIC                                   \
+    {                                                  \
+        const float r = sqrtf(n0 * n0 + n1 * n1 + n2 * n2); \
+        n0 = n0 / r; n1 = n1 / r; n2 = n2 / r;         \
+    }
+/* 1/sqrtf once, then three multiplications */
+#define NORM_RSQRT                                            \
+    {                                                         \
+        const float r = 1.0f / sqrtf(n0 * n0 + n1 * n1 + n2 * n2); \
+        n0 = n0 * r; n1 = n1 * r; n2 = n2 * r;                \
+    }
+/* method 1: one Newton-Raphson step from 1, N (3 - N.N) * 0.5 */
+#define NORM_NEWTON                                              \
+    {                                                            \
+        const float sc = (3.0f - (n0 * n0 + n1 * n1 + n2 * n2)) * 0.5f; \
+        n0 = n0 * sc; n1 = n1 * sc; n2 = n2 * sc;                \
+    }
+/* method 2: Lyon, N (15 - 10 x + 3 x^2)/8 with the 1/8 folded in (Horner) */
+#define NORM_LYON                                                \
+    {                                                            \
+        const float x = n0 * n0 + n1 * n1 + n2 * n2;             \
+        const float sc = (x * 0.375f - 1.25f) * x + 1.875f;      \
+        n0 = n0 * sc; n1 = n1 * sc; n2 = n2 * sc;                \
+    }
+#define NORM_NONE {}
+
+LINEAR_KERNEL(k_classic, NORM_CLASSIC)
+LINEAR_KERNEL(k_rsqrt_mul, NORM_RSQRT)
+LINEAR_KERNEL(k_none, NORM_NONE)
+LINEAR_KERNEL(k_newton, NORM_NEWTON)
+LINEAR_KERNEL(k_lyon, NORM_LYON)
+
+#if BENCH_HAVE_SSE
+/* the hardware limit: rsqrtss (12-bit estimate) and one Newton step
+ * r' = r (1.5 - 0.5 x r^2), then three multiplications */
+#define NORM_SSE                                                          \
+    {                                                                     \
+        const float x = n0 * n0 + n1 * n1 + n2 * n2;                      \
+        float r = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(x)));             \
+        r = r * (1.5f - 0.5f * x * r * r);                                \
+        n0 = n0 * r; n1 = n1 * r; n2 = n2 * r;                            \
+    }
+LINEAR_KERNEL(k_sse_rsqrt, NORM_SSE)
+#endif
+
+/* ------------------------------------------------------------ slerp, method 3 */
+static inline void k_slerp(const span_t *s, float *restrict out)
+{
+    const float c = fminf(dot3(s->nl, s->nr), 1.0f);
+    const float psi = fmaxf(acosf(c), BENCH_TINY);
+    const float inv = 1.0f / sinf(psi);
+    for (int j = 0; j < s->count; ++j) {
+        const float t = pixel_t(s, j);
+        const float wa = sinf((1.0f - t) * psi) * inv;
+        const float wb = sinf(t * psi) * inv;
+        for (int k = 0; k < 3; ++k)
+            out[3 * j + k] = s->nl[k] * wa + s->nr[k] * wb;
+    }
+}
+
+/* -------------------------------------------- spherical-angular, method 6 */
+/* shared set-up: N_k = (N_b - c N_a)/sqrt(1 - c^2), psi = acos c */
+#define ANGULAR_SETUP                                                   \
+    const float c = fminf(dot3(s->nl, s->nr), 1.0f);                    \
+    const float psi = acosf(c);                                         \
+    const float inv_w = 1.0f / fmaxf(sqrtf(1.0f - c * c), BENCH_TINY);  \
+    float nk[3];                                                        \
+    for (int k = 0; k < 3; ++k)                                         \
+        nk[k] = (s->nr[k] - s->nl[k] * c) * inv_w;
+
+/* the recurrence N_{j+1} = 2 cos(phi) N_j - N_{j-1}, phi = psi dt: 3 mul, 3 add per pixel */
+static inline void k_angular(const span_t *s, float *restrict out)
+{
+    ANGULAR_SETUP
+    const float phi = psi * s->dt;
+    const float cp = cosf(phi), sp = sinf(phi);
+    const float k2 = cp * 2.0f;
+    const float ang = s->t0 * psi;
+    const float ca = cosf(ang), sa = sinf(ang);
+    float p0[3], p1[3];
+    for (int k = 0; k < 3; ++k) {
+        const float q0 = nk[k] * ca - s->nl[k] * sa;
+        p0[k] = s->nl[k] * ca + nk[k] * sa;
+        p1[k] = p0[k] * cp + q0 * sp;
+    }
+    for (int k = 0; k < 3; ++k)
+        out[k] = p0[k];
+    if (s->count < 2)
+        return;
+    for (int k = 0; k < 3; ++k)
+        out[3 + k] = p1[k];
+    float a0 = p0[0], a1 = p0[1], a2 = p0[2], b0 = p1[0], b1 = p1[1], b2 = p1[2];
+    for (int j = 2; j < s->count; ++j) {
+        const float c0 = b0 * k2 - a0, c1 = b1 * k2 - a1, c2 = b2 * k2 - a2;
+        a0 = b0; a1 = b1; a2 = b2;
+        b0 = c0; b1 = c1; b2 = c2;
+        out[3 * j] = b0;
+        out[3 * j + 1] = b1;
+        out[3 * j + 2] = b2;
+    }
+}
+
+/* direct angular interpolation, N(t) = N_a cos(t psi) + N_k sin(t psi) at every
+ * pixel (what the recurrence replaces; claim C8) */
+static inline void k_angular_direct(const span_t *s, float *restrict out)
+{
+    ANGULAR_SETUP
+    for (int j = 0; j < s->count; ++j) {
+        const float a = pixel_t(s, j) * psi;
+        const float ca = cosf(a), sa = sinf(a);
+        for (int k = 0; k < 3; ++k)
+            out[3 * j + k] = s->nl[k] * ca + nk[k] * sa;
+    }
+}
+
+/* ------------------------------------------------------ quadratic, method 5 */
+/* N(t) = G t^2 + P t + Q through N_l, N_c, N_r; N_c = (N_l + N_r) p(N_l.N_r);
+ * forward differences, 6 add per pixel, not normalized. */
+static inline void k_quadratic(const span_t *s, float *restrict out)
+{
+    const float x = dot3(s->nl, s->nr);
+    const float r = chebnorm_midpoint_d2_f(x);
+    const float t0 = s->t0, dt = s->dt;
+    const float h2 = dt * dt;
+    float v[3], d1[3], d2[3];
+    for (int k = 0; k < 3; ++k) {
+        const float sk = s->nl[k] + s->nr[k];
+        const float nc4 = (sk * r) * 4.0f;
+        const float g = sk * 2.0f - nc4;
+        const float p = (nc4 - s->nl[k] * 2.0f) - sk;
+        d2[k] = g * (h2 * 2.0f);
+        v[k] = s->nl[k] + (p + g * t0) * t0;
+        d1[k] = p * dt + g * ((t0 * dt) * 2.0f + h2);
+    }
+    float v0 = v[0], v1 = v[1], v2 = v[2];
+    float e0 = d1[0], e1 = d1[1], e2 = d1[2];
+    const float f0 = d2[0], f1 = d2[1], f2 = d2[2];
+    for (int j = 0; j < s->count; ++j) {
+        out[3 * j] = v0;
+        out[3 * j + 1] = v1;
+        out[3 * j + 2] = v2;
+        v0 += e0; v1 += e1; v2 += e2;
+        e0 += f0; e1 += f1; e2 += f2;
+    }
+}
+
+/* ------------------------------------------------------ dichotomy, method 4 */
+/* depth L: the smallest L >= 0 with 2^-L <= dt (as span_normals' _levels) */
+static inline int dichotomy_levels(float dt)
+{
+    int L = 0;
+    while (L < BENCH_MAX_LEVELS && ldexpf(dt, L) < 1.0f - 1e-6f)
+        ++L;
+    return L;
+}
+
+static inline void k_dichotomy(const span_t *s, float *restrict out)
+{
+    static float node[((1 << BENCH_MAX_LEVELS) + 1) * 3];
+    const int L = dichotomy_levels(s->dt);
+    const int n = 1 << L;
+    for (int k = 0; k < 3; ++k) {
+        node[k] = s->nl[k];
+        node[3 * n + k] = s->nr[k];
+    }
+    /* each level: r = p(z) ~ 1/sqrt(2 + z), midpoints (N1 + N2) r, z' = (2 + z) r */
+    float z = dot3(s->nl, s->nr) * 2.0f;
+    for (int level = 0, stride = n; level < L; ++level, stride >>= 1) {
+        const float sz = z + 2.0f;
+        const float r = chebnorm_dichotomy_d2_f(z);
+        if (level < L - 1)
+            z = sz * r;
+        const int h = stride >> 1;
+        for (int i = h; i < n; i += stride) {
+            const float *A = node + 3 * (i - h), *B = node + 3 * (i + h);
+            float *M = node + 3 * i;
+            M[0] = (A[0] + B[0]) * r;
+            M[1] = (A[1] + B[1]) * r;
+            M[2] = (A[2] + B[2]) * r;
+        }
+    }
+    /* pixels: the node on the dyadic grid, or a linear pick between two nodes */
+    const float scale = (float)n;
+    for (int j = 0; j < s->count; ++j) {
+        const float u = pixel_t(s, j) * scale;
+        const float kf = floorf(u);
+        const float f = u - kf;
+        int ka = (int)kf;
+        if (ka > n) ka = n;
+        const int kb = ka + 1 > n ? n : ka + 1;
+        const float *A = node + 3 * ka, *B = node + 3 * kb;
+        out[3 * j] = A[0] + f * (B[0] - A[0]);
+        out[3 * j + 1] = A[1] + f * (B[1] - A[1]);
+        out[3 * j + 2] = A[2] + f * (B[2] - A[2]);
+    }
+}
+
+/* ------------------------------------------- midpoint alone (claim C7, part 1) */
+/* classic: normalize N_l + N_r: 3 add, 3 mul, 2 add, 1 sqrt, 3 div */
+static inline void k_midpoint_classic(const span_t *s, float *restrict out)
+{
+    const float s0 = s->nl[0] + s->nr[0], s1 = s->nl[1] + s->nr[1], s2 = s->nl[2] + s->nr[2];
+    const float r = sqrtf(s0 * s0 + s1 * s1 + s2 * s2);
+    out[0] = s0 / r;
+    out[1] = s1 / r;
+    out[2] = s2 / r;
+}
+
+/* seed 000, method 5: (N_l + N_r) p(N_l.N_r), p from the exported midpoint table */
+static inline void k_midpoint_poly(const span_t *s, float *restrict out)
+{
+    const float r = chebnorm_midpoint_d2_f(dot3(s->nl, s->nr));
+    out[0] = (s->nl[0] + s->nr[0]) * r;
+    out[1] = (s->nl[1] + s->nr[1]) * r;
+    out[2] = (s->nl[2] + s->nr[2]) * r;
+}
+
+/* ------------------------------------------------ shading kernels (claim C13) */
+/* Blinn-Phong I = kd max(N.L, 0) + ks max(N.H, 0)^32 (5 squarings); one float per pixel */
+#define SHADE_KD 0.6f
+#define SHADE_KS 0.3f
+static inline float shade(float n0, float n1, float n2, const float L[3], const float H[3])
+{
+    const float nl = fmaxf(n0 * L[0] + n1 * L[1] + n2 * L[2], 0.0f);
+    float h = fmaxf(n0 * H[0] + n1 * H[1] + n2 * H[2], 0.0f);
+    h *= h; h *= h; h *= h; h *= h; h *= h;
+    return SHADE_KD * nl + SHADE_KS * h;
+}
+
+#define CLASSIC3(v0, v1, v2)                                  \
+    {                                                         \
+        const float r_ = sqrtf(v0 * v0 + v1 * v1 + v2 * v2);  \
+        v0 = v0 / r_; v1 = v1 / r_; v2 = v2 / r_;             \
+    }
+
+/* fixed light and half vector of the shading kernels (directional light, far viewer) */
+static const float SHADE_L[3] = {0.48f, 0.36f, 0.8f};
+static const float SHADE_H[3] = {0.0f, 0.6f, 0.8f};
+
+/* span-end tangent-space L and H, and texture coordinates, derived from the span
+ * (any smooth values do for timing: they cost the same as real ones) */
+static inline void light_ends(const span_t *s, float Ll[3], float Lr[3], float Hl[3], float Hr[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        Ll[k] = 0.5f * s->nl[(k + 1) % 3] + 0.5f * SHADE_L[k];
+        Lr[k] = 0.5f * s->nr[(k + 1) % 3] + 0.5f * SHADE_L[k];
+        Hl[k] = 0.5f * s->nl[(k + 2) % 3] + 0.5f * SHADE_H[k];
+        Hr[k] = 0.5f * s->nr[(k + 2) % 3] + 0.5f * SHADE_H[k];
+    }
+}
+
+/* Phong, directional light and far viewer: interpolate and normalize N only */
+static inline void k_phong_n(const span_t *s, float *restrict out)
+{
+    const float a0 = s->nl[0], a1 = s->nl[1], a2 = s->nl[2];
+    const float d0 = s->nr[0] - a0, d1 = s->nr[1] - a1, d2 = s->nr[2] - a2;
+    for (int j = 0; j < s->count; ++j) {
+        const float t = pixel_t(s, j);
+        float n0 = a0 + t * d0, n1 = a1 + t * d1, n2 = a2 + t * d2;
+        CLASSIC3(n0, n1, n2)
+        out[j] = shade(n0, n1, n2, SHADE_L, SHADE_H);
+    }
+}
+
+/* Phong as in the hardware model's pipeline: interpolate N, L, H; normalize all three */
+static inline void k_phong_nlh(const span_t *s, float *restrict out)
+{
+    float Ll[3], Lr[3], Hl[3], Hr[3];
+    light_ends(s, Ll, Lr, Hl, Hr);
+    for (int j = 0; j < s->count; ++j) {
+        const float t = pixel_t(s, j);
+        float n0 = s->nl[0] + t * (s->nr[0] - s->nl[0]);
+        float n1 = s->nl[1] + t * (s->nr[1] - s->nl[1]);
+        float n2 = s->nl[2] + t * (s->nr[2] - s->nl[2]);
+        float L[3], H[3];
+        for (int k = 0; k < 3; ++k) {
+            L[k] = Ll[k] + t * (Lr[k] - Ll[k]);
+            H[k] = Hl[k] + t * (Hr[k] - Hl[k]);
+        }
+        CLASSIC3(n0, n1, n2)
+        CLASSIC3(L[0], L[1], L[2])
+        CLASSIC3(H[0], H[1], H[2])
+        out[j] = shade(n0, n1, n2, L, H);
+    }
+}
+
+/* bump-map texture: unit perturbed normals [-F_u/k, -F_v/k, 1]/|.| of the
+ * square-patch simplification (seed 001), BUMP_TEX x BUMP_TEX texels */
+#define BUMP_TEX 256
+static float bump_texture[BUMP_TEX * BUMP_TEX * 3];
+
+static inline void bump_texture_init(void)
+{
+    const float two_pi = 6.28318530717958647692f, amp = 0.01f, freq = 8.0f;
+    for (int iv = 0; iv < BUMP_TEX; ++iv)
+        for (int iu = 0; iu < BUMP_TEX; ++iu) {
+            const float u = (iu + 0.5f) / BUMP_TEX, v = (iv + 0.5f) / BUMP_TEX;
+            const float a = two_pi * freq * u, b = two_pi * freq * v;
+            const float fu = amp * two_pi * freq * cosf(a) * sinf(b);
+            const float fv = amp * two_pi * freq * sinf(a) * cosf(b);
+            const float r = 1.0f / sqrtf(fu * fu + fv * fv + 1.0f);
+            float *T = bump_texture + 3 * (iv * BUMP_TEX + iu);
+            T[0] = -fu * r;
+            T[1] = -fv * r;
+            T[2] = r;
+        }
+}
+
+/* bump mapping on the Phong pipeline (seed 001): interpolate tangent-space L, H
+ * and (u, v); normalize L and H; the perturbed normal is a texture fetch */
+static inline void k_bump(const span_t *s, float *restrict out)
+{
+    float Ll[3], Lr[3], Hl[3], Hr[3];
+    light_ends(s, Ll, Lr, Hl, Hr);
+    const float ul = s->nl[0] * 0.5f + 0.5f, ur = s->nr[0] * 0.5f + 0.5f;
+    const float vl = s->nl[1] * 0.5f + 0.5f, vr = s->nr[1] * 0.5f + 0.5f;
+    for (int j = 0; j < s->count; ++j) {
+        const float t = pixel_t(s, j);
+        float L[3], H[3];
+        for (int k = 0; k < 3; ++k) {
+            L[k] = Ll[k] + t * (Lr[k] - Ll[k]);
+            H[k] = Hl[k] + t * (Hr[k] - Hl[k]);
+        }
+        const float u = ul + t * (ur - ul), v = vl + t * (vr - vl);
+        const int iu = (int)(u * (float)BUMP_TEX) & (BUMP_TEX - 1);
+        const int iv = (int)(v * (float)BUMP_TEX) & (BUMP_TEX - 1);
+        const float *T = bump_texture + 3 * (iv * BUMP_TEX + iu);
+        CLASSIC3(L[0], L[1], L[2])
+        CLASSIC3(H[0], H[1], H[2])
+        out[j] = shade(T[0], T[1], T[2], L, H);
+    }
+}
+
+#endif /* CHEBNORM_BENCH_KERNELS_H */

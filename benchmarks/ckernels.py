@@ -1,0 +1,171 @@
+"""Build and run the C kernels of ``benchmarks/c`` (``kernels.h``, ``harness.c``).
+
+:func:`build` writes the two fitted polynomials as C headers with
+:func:`chebnorm.export.c.c_header` (``chebnorm_dichotomy_d2.h``,
+``chebnorm_midpoint_d2.h``; nothing typed in by hand) and compiles the harness
+with gcc. :func:`evaluate` runs one kernel on spans and returns its outputs;
+:func:`bench` times kernels side by side (interleaved rounds) and returns
+nanoseconds per pixel per round.
+
+Kernels (C name -> what it computes; ``PY_METHOD`` names the Python
+``span_normals`` method it mirrors):
+
+* ``classic`` linear then ``N / sqrtf(N.N)`` (3 div) -- the paper's classic, Python ``exact``;
+* ``rsqrt_mul`` linear then ``1/sqrtf(N.N)`` and 3 mul (baseline);
+* ``sse_rsqrt`` linear then ``_mm_rsqrt_ss`` + one Newton step (the hardware limit; x86 only);
+* ``none``, ``newton``, ``lyon``, ``slerp``, ``dichotomy``, ``quadratic``, ``angular`` as in Python;
+* ``angular_direct`` ``N_a cos(t psi) + N_k sin(t psi)`` per pixel (C8's reference; the slerp points);
+* ``midpoint_classic`` / ``midpoint_poly``: the span midpoint alone, per span (C7, part 1);
+* ``phong_n``, ``phong_nlh``, ``bump``: per-pixel shading, one float per pixel (C13).
+
+Used by ``benchmarks/run.py`` and ``tests/test_bench_kernels.py``; it is not a
+library module (chebnorm never imports it).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+C_DIR = HERE / "c"
+
+#: the two timing configurations of the issue
+CONFIGS = {"O2": ["-O2"], "O3-native": ["-O3", "-march=native"]}
+#: the strict flags of the smoke test
+STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"]
+
+#: C kernel -> Python span_normals method it mirrors (None: no Python twin)
+PY_METHOD = {
+    "classic": "exact", "rsqrt_mul": "exact", "sse_rsqrt": "exact", "none": "none",
+    "newton": "newton", "lyon": "lyon", "slerp": "slerp", "dichotomy": "dichotomy",
+    "quadratic": "quadratic", "angular": "angular", "angular_direct": "slerp",
+    "midpoint_classic": None, "midpoint_poly": None,
+    "phong_n": None, "phong_nlh": None, "bump": None,
+}
+#: kernels writing a unit-ish normal per pixel (accuracy is measured on these)
+NORMAL_KERNELS = ("classic", "rsqrt_mul", "sse_rsqrt", "none", "newton", "lyon", "slerp",
+                  "dichotomy", "quadratic", "angular", "angular_direct")
+SHADING_KERNELS = ("phong_n", "phong_nlh", "bump")
+MIDPOINT_KERNELS = ("midpoint_classic", "midpoint_poly")
+
+
+class ToolMissing(RuntimeError):
+    """A needed external tool (gcc) is not installed."""
+
+
+def gcc() -> str:
+    """Path of gcc, or raise :class:`ToolMissing` with what to do."""
+    path = shutil.which(os.environ.get("CC", "gcc"))
+    if path is None:
+        raise ToolMissing("gcc not found on PATH: apt-get install gcc (or set CC) to build "
+                          "the C kernels; the C part of the benchmark is skipped")
+    return path
+
+
+def tables(psi_max="pi/4"):
+    """The two degree-2 tables the C kernels use (those of ``span_normals``'
+    defaults for ``psi_max = pi/4``)."""
+    from chebnorm.approx import fit_target
+
+    return {"dichotomy": fit_target("dichotomy", 2, psi_max=psi_max),
+            "midpoint": fit_target("midpoint", 2, psi_max=psi_max)}
+
+
+def write_headers(directory: Path, psi_max="pi/4") -> list[Path]:
+    """Export the tables as C headers into ``directory`` with chebnorm's printer."""
+    from chebnorm.export.c import c_header
+
+    out = []
+    for t in tables(psi_max).values():
+        p = Path(directory) / f"chebnorm_{t.name}.h"
+        p.write_text(c_header(t, command=f"benchmarks/ckernels.py (psi_max={psi_max})"))
+        out.append(p)
+    return out
+
+
+def build(build_dir, flags, *, psi_max="pi/4", name="harness") -> dict:
+    """Write the headers and compile the harness with ``gcc flags``.
+
+    Returns ``{"binary": Path, "command": str, "vectorized": [...], "gcc": version}``;
+    ``vectorized`` lists the kernel source lines gcc reports as vectorized
+    (``-fopt-info-vec-optimized``). Raises :class:`ToolMissing` without gcc and
+    ``RuntimeError`` with gcc's message when compilation fails."""
+    cc = gcc()
+    build_dir = Path(build_dir)
+    build_dir.mkdir(parents=True, exist_ok=True)
+    write_headers(build_dir, psi_max)
+    binary = build_dir / name
+    cmd = [cc, *flags, f"-I{build_dir}", f"-I{C_DIR}", str(C_DIR / "harness.c"), "-o",
+           str(binary), "-lm"]
+    info = build_dir / f"{name}.vec.txt"
+    res = subprocess.run(cmd + [f"-fopt-info-vec-optimized={info}"], capture_output=True,
+                         text=True)
+    if res.returncode != 0:
+        raise RuntimeError(f"gcc failed ({' '.join(cmd)}):\n{res.stderr}")
+    vec = []
+    if info.exists():
+        vec = sorted({line.split(": ")[0].rsplit("/", 1)[-1] for line in info.read_text().splitlines()
+                      if "vectorized" in line and "kernels.h" in line})
+    version = subprocess.run([cc, "-dumpfullversion"], capture_output=True, text=True).stdout.strip()
+    return {"binary": binary, "command": " ".join([Path(cc).name, *flags, "harness.c", "-lm"]),
+            "vectorized": vec, "gcc": version}
+
+
+def kernel_names(binary) -> list[str]:
+    out = subprocess.run([str(binary), "list"], capture_output=True, text=True, check=True).stdout
+    return [line.split()[0] for line in out.splitlines() if line.strip()]
+
+
+def write_spans(path, nl, nr, t0, dt, count) -> None:
+    """The harness's span file: int64 S, S x 8 float32 (nl, nr, t0, dt), S int32 counts."""
+    nl = np.asarray(nl, np.float32).reshape(-1, 3)
+    nr = np.asarray(nr, np.float32).reshape(-1, 3)
+    s = len(nl)
+    rec = np.empty((s, 8), np.float32)
+    rec[:, 0:3], rec[:, 3:6] = nl, nr
+    rec[:, 6] = np.broadcast_to(np.asarray(t0, np.float32), (s,))
+    rec[:, 7] = np.broadcast_to(np.asarray(dt, np.float32), (s,))
+    cnt = np.broadcast_to(np.asarray(count, np.int32), (s,)).astype(np.int32)
+    with open(path, "wb") as fh:
+        fh.write(np.int64(s).tobytes())
+        fh.write(rec.tobytes())
+        fh.write(cnt.tobytes())
+
+
+def evaluate(binary, kernel, nl, nr, t0, dt, count, width=3, per_span=False) -> np.ndarray:
+    """Run ``kernel`` on the spans; returns (P, width) float32 (P = sum of counts,
+    or S for the per-span midpoint kernels)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        spans, out = Path(tmp) / "spans.bin", Path(tmp) / "out.bin"
+        write_spans(spans, nl, nr, t0, dt, count)
+        res = subprocess.run([str(binary), "eval", kernel, str(spans), str(out)],
+                             capture_output=True, text=True)
+        if res.returncode != 0:
+            raise RuntimeError(f"harness eval {kernel} failed: {res.stderr.strip()}")
+        return np.fromfile(out, np.float32).reshape(-1, width)
+
+
+def bench(binary, spans_file, kernels, *, reps=15, warmup=2, target_ms=4.0) -> dict:
+    """Time ``kernels`` side by side over the span file.
+
+    Returns ``{"passes": n, "pixels": P, "ns": {kernel: [ns per pixel (or per
+    span for the midpoint kernels), one per round]}}``."""
+    res = subprocess.run([str(binary), "bench", str(spans_file), str(reps), str(warmup),
+                          str(target_ms), *kernels], capture_output=True, text=True)
+    if res.returncode != 0:
+        raise RuntimeError(f"harness bench failed: {res.stderr.strip()}")
+    ns: dict[str, list[float]] = {k: [] for k in kernels}
+    head = {}
+    for line in res.stdout.splitlines():
+        parts = line.split()
+        if parts and parts[0] == "time":
+            ns[parts[2]].append(float(parts[3]) / float(parts[4]))
+        elif parts and parts[0] == "spans":
+            head = {"spans": int(parts[1]), "pixels": int(parts[3]), "passes": int(parts[5])}
+    return {**head, "ns": ns}
