@@ -313,3 +313,23 @@ class TestCli:
         assert main(["methods", "--angle", "0.5", "--span", "16", "--dtype", "float32", "--drift"]) == 0
         out = capsys.readouterr().out
         assert "angular recurrence drift, float32" in out and "dichotomy" in out
+
+
+def test_dichotomy_off_grid_short_span_is_not_left_unnormalized():
+    """Regression (found by the rasterizer): a one-pixel span between normals
+    34 degrees apart, its pixel off the dyadic grid, used to get the linear
+    pick between the two end normals, short by 1 - cos(psi/2) = 4.4 %. The
+    span is now halved until the pick's length error is within PICK_TOL, so
+    only that and the table's certified error remain."""
+    from chebnorm.methods.spans import PICK_TOL, default_tables
+    nl = np.array([[0.45887367, -0.31327354, 0.83144131]])
+    nr = np.array([[0.80657731, -0.45386425, 0.37873513]])
+    nl /= np.linalg.norm(nl)
+    nr /= np.linalg.norm(nr)
+    res = span_normals("dichotomy", nl, nr, [1], t0=[0.372131099587695], dt=[1.4665924939946784],
+                       count=[1])
+    length = np.linalg.norm(res.normals, axis=1)
+    psi = np.arccos(nl[0] @ nr[0])
+    levels = int(np.ceil(np.log2(psi / (2 * np.arccos(1 - PICK_TOL)))))
+    e = default_tables()["dichotomy"].rel_error_bound
+    assert np.all(np.abs(length - 1) <= PICK_TOL + 2 * levels * e)

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counting import OpCounts, _generic_pair, count_ops
-from .spans import METHODS, TABLE_METHODS, _check_dtype, _check_method, default_tables, span_normals
+from .spans import _levels, METHODS, TABLE_METHODS, _check_dtype, _check_method, default_tables, span_normals
 
 __all__ = ["MethodReport", "analyze", "ErrorSweep", "error_sweep", "DriftReport", "angular_drift",
            "N_SPECULAR", "reference_normals", "slerp_normals", "length_error_bound"]
@@ -276,9 +276,10 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
     if method == "lyon":
         return 1 - r * (15 - 10 * r ** 2 + 3 * r ** 4) / 8 + 16 * eps
     if method == "dichotomy":
-        lv = _levels_of(m)
+        lv = int(_levels(np.array([1.0 / m]), np.array([0.0]), np.array([m + 1]),
+                         np.array([math.cos(psi)]))[0])
         b = sum(e * (1 + (1 - 4.0 ** -k) / 3) for k in range(lv)) + (lv * e) ** 2
-        if 2 ** lv != m:
+        if 2 ** _levels_of(m) != m:  # off the dyadic grid: the linear pick between nodes
             b += 1 - math.cos(psi / 2 ** (lv + 1))
         return b + 16 * (lv + 1) * eps
     if method == "quadratic":

@@ -178,7 +178,8 @@ def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
                        tables=tables, angular_reanchor=angular_reanchor)  # validates
     dt = 1.0 / m if dt is None else float(dt)
     count = m + 1 if count is None else int(count)
-    levels = int(_levels(np.array([dt]))[0]) if method == "dichotomy" else 0
+    levels = (int(_levels(np.array([dt]), np.array([float(t0)]), np.array([count]),
+                          np.array([float(nl @ nr)]))[0]) if method == "dichotomy" else 0)
     coeffs = None
     if method in TABLE_METHODS:
         table = _resolve_table(method, tables, np.array([float(nl @ nr)]), np.array([levels]))
