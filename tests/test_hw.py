@@ -111,11 +111,25 @@ class TestHorner:
         (dict(out_bits=4, y_frac_bits=20), "cannot hold the outputs"),
         (dict(acc_bits=60), "acc-bits"),
         (dict(rounding="up"), "rounding 'up' is unknown"),
+        (dict(coef_bits=32), r"accepted: 1 <= coef-bits <= 31 \(quantized coefficients are "
+                             r"signed 32-bit"),
+        (dict(coef_bits=0), "coef-bits = 0 is out of range; accepted: 1 <= coef-bits <= 31"),
     ])
     def test_raises(self, d2, kw, msg):
         args = dict(in_bits=16, out_bits=16, coef_bits=20) | kw
         with pytest.raises(ValueError, match=msg):
             design_horner(d2, args.pop("in_bits"), args.pop("out_bits"), **args)
+
+
+def test_max_coef_bits_is_quantize_limit(d2):
+    """The accepted range of coef-bits is exactly what quantize (int32) takes."""
+    from chebnorm.hw.horner import max_coef_bits
+
+    hi = max_coef_bits(d2)
+    assert hi == 31
+    quantize(d2, hi, reoptimize=False)
+    with pytest.raises(ValueError, match="overflows int32"):
+        quantize(d2, hi + 1, reoptimize=False)
 
 
 class TestBudget:
@@ -297,6 +311,8 @@ class TestCLI:
         (["--in-bits", "16", "--out-bits", "16", "--coef-bits", "20", "--x-frac-bits", "18"],
          "does not fit the input format"),
         (["--in-bits", "16", "--out-bits", "-2", "--coef-bits", "20"], "out-bits = -2"),
+        (["--in-bits", "16", "--out-bits", "16", "--coef-bits", "40"],
+         "accepted: 1 <= coef-bits <= 31"),
     ])
     def test_errors_leave_nothing(self, table_json, tmp_path, capsys, extra, msg):
         out = tmp_path / "out"

@@ -14,7 +14,8 @@ def _design_args(p) -> None:
     p.add_argument("--in-bits", type=int, required=True, help="input code width, 1..20")
     p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
     p.add_argument("--coef-bits", type=int, default=None,
-                   help="coefficient fractional bits (re-quantizes; default: the table's own)")
+                   help="coefficient fractional bits, 1..31 or fewer: the table's coefficients "
+                   "must fit int32 (re-quantizes; default: the table's own)")
     p.add_argument("--acc-bits", type=int, default=None,
                    help="accumulator fractional bits (default: output's + 3)")
     p.add_argument("--rounding", default="rne", help="rne (default) or trunc")

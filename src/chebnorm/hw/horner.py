@@ -42,7 +42,7 @@ from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, rounding_error
                     shift_round, signed_bits, unsigned_bits)
 
 __all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
-           "MAX_FRAC_BITS"]
+           "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
 
 MAX_IN_BITS = 20
 MAX_OUT_BITS = 32
@@ -156,16 +156,55 @@ def _run(d: HornerDesign, k: np.ndarray) -> dict:
 
 # -- construction ------------------------------------------------------------
 
+#: :func:`chebnorm.approx.quantize` stores coefficients as int32 integers
+COEF_WORD_BITS = 32
+
+
+def max_coef_bits(table: CoefficientTable) -> int:
+    """Largest ``coef-bits`` for which every coefficient of ``table`` still fits
+    the signed 32-bit integers of :func:`chebnorm.approx.quantize` (at most
+    :data:`MAX_FRAC_BITS`; about 31 minus the binary exponent of the
+    largest coefficient).
+
+    >>> from chebnorm.approx import fit_target
+    >>> max_coef_bits(fit_target("dichotomy", 2))   # largest |c_j| ~ 0.68
+    31
+    """
+    limit = 2 ** (COEF_WORD_BITS - 1) - 1
+    best = 0
+    for f in range(1, MAX_FRAC_BITS + 1):
+        if all(abs(round(math.ldexp(float(c), f))) <= limit for c in table.coefficients):
+            best = f
+    return best
+
+
+def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
+    """Boundary check of ``coef-bits`` against the table's int32 coefficient limit."""
+    hi = max_coef_bits(table)
+    if hi < 1:
+        raise ValueError(f"table {table.name!r}: its largest coefficient does not fit a signed "
+                         f"{COEF_WORD_BITS}-bit integer at any coef-bits; accepted: a table with "
+                         f"coefficients under 2^{COEF_WORD_BITS - 2}")
+    if isinstance(coef_bits, bool) or not isinstance(coef_bits, (int, np.integer)):
+        return check_width(coef_bits, "coef-bits", 1, hi)  # raises: not an integer
+    if not 1 <= int(coef_bits) <= hi:
+        big = max(abs(float(c)) for c in table.coefficients)
+        raise ValueError(f"coef-bits = {coef_bits} is out of range; accepted: 1 <= coef-bits "
+                         f"<= {hi} (quantized coefficients are signed {COEF_WORD_BITS}-bit "
+                         f"integers and the largest of table {table.name!r} is {big:.6g})")
+    return int(coef_bits)
+
+
 def _require_fixed_point(table: CoefficientTable, coef_bits):
     if coef_bits is not None:
-        coef_bits = check_width(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
+        coef_bits = check_coef_bits(table, coef_bits)
         if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
             table = quantize(table, coef_bits)
         return table
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
                          f"quantized with `chebnorm fit ... --frac-bits F`, or give "
-                         f"--coef-bits B (1 <= B <= {MAX_FRAC_BITS}) to quantize it here")
+                         f"--coef-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
     return table
 
 

@@ -19,7 +19,7 @@ from chebnorm.approx import fit_target, get_target
 from .budget import error_budget, measure
 from .datapaths import horner_block
 from .fixed import check_width
-from .horner import MAX_FRAC_BITS, design_horner
+from .horner import MAX_FRAC_BITS, design_horner, max_coef_bits
 from .verilog import synthesize_text, verilog_module
 
 __all__ = ["SweepPoint", "SweepResult", "sweep", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
@@ -145,6 +145,9 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     coef_bits = _validate_list(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
     acc_bits = _validate_list(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
     tables = {d: fit_target(target, d, psi_max=psi_max) for d in degrees}
+    # quantize keeps int32 coefficients: the real limit depends on the tables
+    coef_bits = _validate_list(coef_bits, "coef-bits", 1,
+                               min(max_coef_bits(t) for t in tables.values()))
     grid = [(d, c, a if d >= 2 else None) for d in degrees for c in coef_bits
             for a in (acc_bits if d >= 2 else (None,))]
     use_yosys = synth and shutil.which("yosys") is not None
