@@ -222,19 +222,35 @@ static inline void k_quadratic(const span_t *s, float *restrict out)
 }
 
 /* ------------------------------------------------------ dichotomy, method 4 */
-/* depth L: the smallest L >= 0 with 2^-L <= dt (as span_normals' _levels) */
-static inline int dichotomy_levels(float dt)
+/* largest length error 1 - cos(theta/2) accepted from the linear pick between
+ * two nodes theta apart (span_normals' PICK_TOL = 2^-12) */
+#define BENCH_PICK_TOL 0x1p-12f
+
+/* depth L, as span_normals' _levels: the smallest L >= 0 with 2^-L <= dt; a span
+ * with a pixel off that dyadic grid is halved deeper, until the node angle
+ * psi / 2^L is at most theta_max = 2 acos(1 - PICK_TOL) */
+static inline int dichotomy_levels(const span_t *s)
 {
     int L = 0;
-    while (L < BENCH_MAX_LEVELS && ldexpf(dt, L) < 1.0f - 1e-6f)
+    while (L < BENCH_MAX_LEVELS && ldexpf(s->dt, L) < 1.0f - 1e-6f)
         ++L;
+    const float g0 = ldexpf(s->t0, L), g1 = ldexpf(s->dt, L);
+    if (g0 != floorf(g0) || (s->count > 1 && g1 != floorf(g1))) {
+        const float psi = acosf(fmaxf(fminf(dot3(s->nl, s->nr), 1.0f), -1.0f));
+        const float theta_max = 2.0f * acosf(1.0f - BENCH_PICK_TOL);
+        int need = 0;
+        while (need < BENCH_MAX_LEVELS && ldexpf(theta_max, need) < psi)
+            ++need;
+        if (need > L)
+            L = need;
+    }
     return L;
 }
 
 static inline void k_dichotomy(const span_t *s, float *restrict out)
 {
     static float node[((1 << BENCH_MAX_LEVELS) + 1) * 3];
-    const int L = dichotomy_levels(s->dt);
+    const int L = dichotomy_levels(s);
     const int n = 1 << L;
     for (int k = 0; k < 3; ++k) {
         node[k] = s->nl[k];
