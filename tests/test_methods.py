@@ -333,3 +333,23 @@ def test_dichotomy_off_grid_short_span_is_not_left_unnormalized():
     levels = int(np.ceil(np.log2(psi / (2 * np.arccos(1 - PICK_TOL)))))
     e = default_tables()["dichotomy"].rel_error_bound
     assert np.all(np.abs(length - 1) <= PICK_TOL + 2 * levels * e)
+
+
+def test_angular_drift_in_fixed_point():
+    """Fixed point: 2 cos(phi) rounded to F bits shifts the recurrence's
+    frequency by d_phi = phi_q - phi, so the angle drifts by about m |d_phi|
+    at the end of the span -- the same order, reduced because the two exact
+    start vectors bend the orbit into an ellipse (the rounding adds noise)."""
+    psi, m = math.pi / 4, 512
+    errs = [angular_drift(psi, m, frac_bits=F).max_angle_error for F in (16, 20, 24, 30)]
+    assert errs == sorted(errs, reverse=True)
+    for F in (24, 30):
+        d = angular_drift(psi, m, frac_bits=F)
+        k2 = round(2 * math.cos(psi / m) * 2 ** F)
+        d_phi = abs(math.acos(k2 / 2 ** (F + 1)) - psi / m)
+        assert d.dtype == f"Q.{F}"
+        assert 0.1 * m * d_phi <= d.final_angle_error <= 2 * m * d_phi + m * 2.0 ** -F / math.sin(psi / m)
+    assert (angular_drift(psi, m, frac_bits=20, reanchor=32).max_length_error
+            < angular_drift(psi, m, frac_bits=20).max_length_error / 10)
+    with pytest.raises(ValueError, match="accepted: an integer 4..30"):
+        angular_drift(psi, m, frac_bits=40)

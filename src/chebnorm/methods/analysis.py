@@ -307,16 +307,25 @@ class DriftReport:
 
 
 def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,
-                  reanchor: int | None = None) -> DriftReport:
+                  reanchor: int | None = None, *, frac_bits: int | None = None) -> DriftReport:
     """The drift of the spherical-angular recurrence (seed 000, method 6) along one span.
 
     ``reanchor=K`` restarts the recurrence from the closed form every K
     pixels; its cost is in ``ops`` (``per_pixel`` is then an average).
+    ``frac_bits=F`` runs it in fixed point instead (``dtype`` ignored): the
+    two start vectors and ``2 cos(phi)`` rounded to F fractional bits, each
+    product ``2 cos(phi) N_j`` rounded to nearest (ties up) back to F bits,
+    the subtraction exact -- what an integer datapath does; ``dtype`` of the
+    report is then ``"Q.F"``.
 
     >>> d = angular_drift(math.pi / 4, 512, np.float64)
     >>> d.max_angle_error < 1e-11
     True
+    >>> angular_drift(math.pi / 4, 512, frac_bits=16).max_length_error > 1e-4
+    True
     """
+    if frac_bits is not None:
+        return _angular_drift_fixed(psi, m, frac_bits, reanchor)
     dt = _check_dtype(dtype)
     (psi_v,) = _check_psi(psi)
     m = _check_m(m)
@@ -326,6 +335,40 @@ def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,
     length = np.abs(np.linalg.norm(n, axis=1) - 1.0)
     angle = _angle(n, slerp_normals(nl, nr, psi_v, res.t))
     return DriftReport(psi=float(psi_v), m=m, dtype=np.dtype(dt).name, reanchor=reanchor, t=res.t,
+                       length_error=length, angle_error=angle,
+                       max_length_error=float(length.max()), max_angle_error=float(angle.max()),
+                       final_length_error=float(length[-1]), final_angle_error=float(angle[-1]),
+                       ops=count_ops("angular", m, angular_reanchor=reanchor, psi=psi_v))
+
+
+def _angular_drift_fixed(psi, m, frac_bits, reanchor) -> DriftReport:
+    if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) \
+            or not 4 <= frac_bits <= 30:
+        raise ValueError(f"frac_bits = {frac_bits!r}; accepted: an integer 4..30 "
+                         f"(products must fit int64)")
+    if reanchor is not None and (not isinstance(reanchor, (int, np.integer)) or reanchor < 2):
+        raise ValueError(f"reanchor = {reanchor!r}; accepted: None or an integer >= 2")
+    (psi_v,) = _check_psi(psi)
+    m = _check_m(m)
+    F = int(frac_bits)
+    one = 1 << F
+    nl, nr = _generic_pair(psi_v)
+    t = np.arange(m + 1) / m
+    exact = slerp_normals(nl, nr, psi_v, t)
+    q = lambda v: np.round(np.asarray(v) * one).astype(np.int64)
+    k2 = int(round(2 * math.cos(psi_v / m) * one))
+    out = np.empty((m + 1, 3), dtype=np.int64)
+    out[0], out[1] = q(exact[0]), q(exact[1])
+    half = one >> 1
+    for j in range(2, m + 1):
+        if reanchor and j % reanchor == 0:
+            out[j - 1], out[j] = q(exact[j - 1]), q(exact[j])
+        else:
+            out[j] = ((k2 * out[j - 1] + half) >> F) - out[j - 2]
+    n = out.astype(np.float64) / one
+    length = np.abs(np.linalg.norm(n, axis=1) - 1.0)
+    angle = _angle(n, exact)
+    return DriftReport(psi=float(psi_v), m=m, dtype=f"Q.{F}", reanchor=reanchor, t=t,
                        length_error=length, angle_error=angle,
                        max_length_error=float(length.max()), max_angle_error=float(angle.max()),
                        final_length_error=float(length[-1]), final_angle_error=float(angle[-1]),
