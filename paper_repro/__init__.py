@@ -9,13 +9,19 @@ claims ledger (``zz_claims``) comes last. Uses chebnorm's public API only.
 =====================  ======================  =====================
 job                    module                  writes under figures/
 =====================  ======================  =====================
+``seed000_normalization`` :mod:`.normalization` ``normalization/``
+``seed001_bump``       :mod:`.bump`            ``bump/``
+``seed002_highlight``   :mod:`.highlight`       ``highlight/``
 ``seed003_criterion``  :mod:`.criterion`       ``criterion/``
 ``zz_claims``          :mod:`.claims`          ``claims/`` (+ ledger)
 =====================  ======================  =====================
 """
 
-from . import criterion
+from . import bump, criterion, highlight, normalization
 
 REGISTRY: dict = {
     criterion.JOB: criterion.run,
+    normalization.JOB: normalization.run,
+    bump.JOB: bump.run,
+    highlight.JOB: highlight.run,
 }

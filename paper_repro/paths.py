@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parent.parent
 FIGURES = ROOT / "figures"
 #: paper (seed) -> its folder under the output root, named by topic
 PAPERS = {
-    "000": "methods",     # efficient normalization methods, compared
+    "000": "normalization",  # efficient normalization methods, compared
     "001": "bump",        # bump mapping on the Phong pipeline
     "002": "highlight",   # highlight detection for Gouraud shading
     "003": "criterion",   # the normalization criterion eta
