@@ -109,7 +109,7 @@ def _refine(t_grid, idx, err_fn):
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray],
-          lo: float, hi: float, degree: int, max_iter: int = 60, rtol: float = 1e-10
+          lo: float, hi: float, degree: int, max_iter: int = 60, rtol: float = 1e-8
           ) -> RemezResult:
     """Minimax fit of ``f`` minimizing ``max |w (p - f)|`` on ``[lo, hi]``.
 
