@@ -17,11 +17,12 @@ job                    module                  writes under figures/
 =====================  ======================  =====================
 """
 
-from . import bump, criterion, highlight, normalization
+from . import bump, claims, criterion, highlight, normalization
 
 REGISTRY: dict = {
     criterion.JOB: criterion.run,
     normalization.JOB: normalization.run,
     bump.JOB: bump.run,
     highlight.JOB: highlight.run,
+    claims.JOB: claims.run,
 }

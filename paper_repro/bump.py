@@ -50,7 +50,7 @@ def _cases():
 
 def measure_c12() -> dict:
     """Square-patch (and object-space) against full coefficients per mesh."""
-    return {"coefficients_square": str(bump_coefficients_square_expr()),
+    return {"coefficients_square": "[" + ", ".join(str(e) for e in bump_coefficients_square_expr()) + "]",
             "size": list(SIZE), "cases": {c.mesh: c.to_dict() for c in _cases()}}
 
 

@@ -53,6 +53,10 @@ OPS = ("add", "mul", "div", "sqrt", "trig", "cmp")
 C4_ABS, C4_REL = 5e-4, 0.0012
 C5_ABS, C5_REL = 2e-5, 0.00004
 C5_COEFFS = (0.681, -0.119, 0.014)   # ascending powers of z
+#: the angular recurrence's number formats: (label, dtype, re-anchor period, fixed-point bits)
+DRIFT_VARIANTS = (("float64", np.float64, None, None), ("float32", np.float32, None, None),
+                  ("float32_reanchor64", np.float32, 64, None), ("Q.16", None, None, 16),
+                  ("Q.24", None, None, 24), ("Q.30", None, None, 30))
 
 
 def _dir(out) -> Path:
@@ -169,12 +173,10 @@ def measure_inaccuracy_thresholds() -> dict:
 
 @lru_cache(maxsize=None)
 def measure_drift() -> dict:
-    """The angular recurrence over 512 pixels at pi/4: float32, float64, and
-    float32 re-anchored every 64 pixels."""
+    """The angular recurrence over 512 pixels at pi/4 in each of :data:`DRIFT_VARIANTS`."""
     out = {}
-    for label, dt, re in (("float64", np.float64, None), ("float32", np.float32, None),
-                          ("float32_reanchor64", np.float32, 64)):
-        d = angular_drift(math.pi / 4, 512, dt, reanchor=re)
+    for label, dt, re, fb in DRIFT_VARIANTS:
+        d = angular_drift(math.pi / 4, 512, dt, reanchor=re, frac_bits=fb)
         out[label] = {"max_length_error": d.max_length_error, "max_angle_error_rad": d.max_angle_error,
                       "final_length_error": d.final_length_error,
                       "final_angle_error_rad": d.final_angle_error,
@@ -386,17 +388,18 @@ def fig_angular_drift(out) -> list[Path]:
     d = measure_drift()
     caption = ("Seed 000, method 6: drift of the spherical-angular recurrence "
                "N(t+1) = 2 cos(phi) N(t) - N(t-1) along a 512-pixel span of pi/4, as the length "
-               "error | |N| - 1 | and the angle to the exact slerp point, in float64, float32, and "
-               "float32 restarted from the closed form every 64 pixels.")
+               "error | |N| - 1 | and the angle to the exact slerp point, in float64, float32, "
+               "float32 restarted from the closed form every 64 pixels, and fixed point with 16, 24 "
+               "and 30 fractional bits (2 cos(phi) and each product rounded to F bits).")
     rows = []
-    for label in ("float64", "float32", "float32_reanchor64"):
+    for label, *_ in DRIFT_VARIANTS:
         r = d[label]
         rows += [(label, float(t), float(a), float(b))
                  for t, a, b in zip(r["t"], r["length_error"], r["angle_error"])]
     paths = [write_csv(folder, "angular_drift", ("variant", "t", "length_error", "angle_error_rad"),
                        rows, caption, CMD)]
     with figure(figsize=(7.0, 4.0)) as (fig, ax):
-        for i, label in enumerate(("float64", "float32", "float32_reanchor64")):
+        for i, (label, *_) in enumerate(DRIFT_VARIANTS):
             r = d[label]
             ax.plot(r["t"] * 512, np.maximum(r["angle_error"], 1e-17), color=f"C{i}", label=label)
         ax.set_yscale("log")
