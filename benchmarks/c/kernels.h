@@ -272,13 +272,25 @@ static inline void k_dichotomy(const span_t *s, float *restrict out)
             M[2] = (A[2] + B[2]) * r;
         }
     }
-    /* pixels: the node on the dyadic grid, or a linear pick between two nodes */
+    /* pixels on the dyadic grid (t0 2^L and dt 2^L integers) take their node */
+    const float g0 = ldexpf(s->t0, L), g1 = ldexpf(s->dt, L);
+    if (g0 == floorf(g0) && (s->count < 2 || g1 == floorf(g1))) {
+        const int k0 = (int)g0, step = (int)g1;
+        for (int j = 0; j < s->count; ++j) {
+            const float *A = node + 3 * (k0 + j * step);
+            out[3 * j] = A[0];
+            out[3 * j + 1] = A[1];
+            out[3 * j + 2] = A[2];
+        }
+        return;
+    }
+    /* off the grid: a linear pick between the two nodes around the pixel
+     * (u >= 0, so truncation is floor) */
     const float scale = (float)n;
     for (int j = 0; j < s->count; ++j) {
         const float u = pixel_t(s, j) * scale;
-        const float kf = floorf(u);
-        const float f = u - kf;
-        int ka = (int)kf;
+        int ka = (int)u;
+        const float f = u - (float)ka;
         if (ka > n) ka = n;
         const int kb = ka + 1 > n ? n : ka + 1;
         const float *A = node + 3 * ka, *B = node + 3 * kb;
