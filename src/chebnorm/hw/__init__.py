@@ -12,8 +12,12 @@ from .fixed import QFormat, fit_bits, shift_round
 from .horner import HornerDesign, design_horner
 from .cost import Block, Cost
 from .datapaths import (bump_pipeline, classic_normalize, classic_unit, dichotomy_midpoint,
-                        dichotomy_unit, eta_unit, forward_difference, forward_difference_stepper,
-                        horner_block, phong_pipeline, quadratic_midpoint_unit)
+                        dichotomy_next_z, dichotomy_unit, eta_criterion, eta_unit,
+                        forward_difference, forward_difference_codes, forward_difference_setup,
+                        forward_difference_stepper, horner_block, phong_pipeline,
+                        quadratic_midpoint, quadratic_midpoint_unit)
+from .units import (UNIT_KINDS, UnitDesign, UnitReport, analyze_unit, design_unit, unit_outputs,
+                    unit_verilog)
 from .report import HardwareReport, analyze, verilog_outputs, write_outputs
 from .sweep import SweepPoint, SweepResult, sweep
 from .verilog import (SimResult, SynthResult, simulate, synthesize, verilog_module,
@@ -27,7 +31,10 @@ __all__ = [
     "SimResult", "SynthResult",
     "Cost", "Block", "horner_block", "classic_unit", "dichotomy_unit", "quadratic_midpoint_unit",
     "forward_difference_stepper", "eta_unit", "phong_pipeline", "bump_pipeline",
-    "classic_normalize", "dichotomy_midpoint", "forward_difference",
+    "classic_normalize", "dichotomy_midpoint", "dichotomy_next_z", "quadratic_midpoint",
+    "eta_criterion", "forward_difference", "forward_difference_setup", "forward_difference_codes",
+    "UNIT_KINDS", "UnitDesign", "UnitReport", "design_unit", "unit_outputs", "unit_verilog",
+    "analyze_unit",
     "HardwareReport", "analyze", "verilog_outputs", "write_outputs",
     "SweepPoint", "SweepResult", "sweep",
 ]

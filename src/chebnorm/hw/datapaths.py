@@ -33,7 +33,8 @@ from .horner import HornerDesign
 __all__ = ["horner_block", "dot_block", "classic_unit", "dichotomy_unit",
            "quadratic_midpoint_unit", "forward_difference_stepper", "eta_unit",
            "phong_pipeline", "bump_pipeline", "classic_normalize", "dichotomy_midpoint",
-           "forward_difference"]
+           "dichotomy_next_z", "dot_to_code", "quadratic_midpoint", "forward_difference",
+           "forward_difference_setup", "forward_difference_codes", "eta_criterion"]
 
 
 def horner_block(design: HornerDesign) -> Block:
@@ -170,6 +171,95 @@ def dichotomy_midpoint(n1, n2, z_codes, design: HornerDesign, frac_bits: int) ->
     s = np.asarray(n1, dtype=np.int64) + np.asarray(n2, dtype=np.int64)
     y = design.evaluate(z_codes)[..., None] + design.y_format.offset_code
     return shift_round(s * y, design.y_format.frac_bits, "rne")
+
+
+def dichotomy_next_z(z_codes, design: HornerDesign) -> np.ndarray:
+    """Bit-accurate next level ``z' = sqrt(2 + z)`` (seed 000, method 4) in the
+    input format of ``design`` (``Fx >= 0`` fractional bits, offset ``K0``):
+    the square root rounded to nearest (no ties: ``sqrt`` of an integer is
+    never a half-integer), computed as ``(isqrt(4 X 2^Fx) + 1) >> 1`` with
+    ``X = 2^(Fx+1) + K0 + k``; the code ``z' 2^Fx - K0`` saturates to
+    ``0 .. 2^in_bits - 1``. For a valid ``z`` the result is valid (``z' > z``).
+    """
+    fx, k0 = design.x_format.frac_bits, design.x_format.offset_code
+    x = np.asarray(z_codes, dtype=np.int64) + (2 << fx) + k0
+    r = (_isqrt(x << (fx + 2)) + 1) >> 1
+    return np.clip(r - k0, 0, 2 ** design.in_bits - 1)
+
+
+def dot_to_code(dot, dot_frac_bits: int, design: HornerDesign) -> np.ndarray:
+    """Input code of ``design`` for a dot product ``dot / 2**dot_frac_bits``:
+    rounded to nearest-even to the ``Fx`` fractional bits of the input, less
+    the offset, saturated to ``0 .. 2^in_bits - 1``."""
+    fx, k0 = design.x_format.frac_bits, design.x_format.offset_code
+    dot = np.asarray(dot, dtype=np.int64)
+    v = shift_round(dot, dot_frac_bits - fx, "rne") if dot_frac_bits >= fx else \
+        dot << (fx - dot_frac_bits)
+    return np.clip(v - k0, 0, 2 ** design.in_bits - 1)
+
+
+def _scaled_sum(n1, n2, y_codes, design: HornerDesign) -> np.ndarray:
+    """``(N1 + N2) * y`` rounded to nearest-even by the ``Fy`` bits of ``y``."""
+    s = np.asarray(n1, dtype=np.int64) + np.asarray(n2, dtype=np.int64)
+    y = np.asarray(y_codes, dtype=np.int64)[..., None] + design.y_format.offset_code
+    return shift_round(s * y, design.y_format.frac_bits, "rne")
+
+
+def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
+    """Bit-accurate quadratic-interpolation set-up (seed 000, method 5).
+
+    ``x = N_l.N_r`` (exact, ``2F`` fractional bits) becomes the input code of
+    ``design`` (a table of ``1/sqrt(2(1+x))``) by :func:`dot_to_code`; the
+    midpoint ``N_c = (N_l + N_r) p(x)`` is rounded to nearest-even back to
+    ``F`` bits; ``G = 2N_l + 2N_r - 4N_c``, ``P = 4N_c - 3N_l - N_r``,
+    ``Q = N_l`` are exact. Returns ``(G, P, Q, N_c)``, int codes ``(..., 3)``
+    with ``F`` fractional bits.
+    """
+    nl, nr = np.asarray(nl, dtype=np.int64), np.asarray(nr, dtype=np.int64)
+    k = dot_to_code(np.sum(nl * nr, axis=-1), 2 * frac_bits, design)
+    nc = _scaled_sum(nl, nr, design.evaluate(k), design)
+    return 2 * nl + 2 * nr - 4 * nc, 4 * nc - 3 * nl - nr, nl, nc
+
+
+def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarray:
+    """Bit-accurate ``eta = 3 - g(N_A.N_B) - g(N_B.N_C) - g(N_A.N_C)`` (seed 003)
+    with ``g ~ sqrt(2(1+x))/2`` the polynomial of ``design``: each dot product
+    exact, converted by :func:`dot_to_code`; the sum exact. Returns the codes of
+    eta with the ``Fy`` fractional bits of ``design``'s output (value
+    ``code / 2**Fy``, no offset)."""
+    na, nb, nc = (np.asarray(a, dtype=np.int64) for a in (na, nb, nc))
+    fy, ky = design.y_format.frac_bits, design.y_format.offset_code
+    total = np.zeros(na.shape[:-1], dtype=np.int64)
+    for a, b in ((na, nb), (nb, nc), (na, nc)):
+        total = total + design.evaluate(dot_to_code(np.sum(a * b, axis=-1), 2 * frac_bits,
+                                                    design)) + ky
+    return (3 << fy) - total if fy >= 0 else 3 * 2 ** fy - total
+
+
+def forward_difference_setup(G, P, Q, log_m: int, guard: int):
+    """Start values of the stepper for ``m = 2**log_m`` pixels, integer codes:
+    ``v0 = Q 2^g``, ``d1 = R((G + m P) 2^g / m^2)``, ``d2 = R(2 G 2^g / m^2)``
+    (``R``: nearest-even, exact when ``g >= 2 log_m``), the shifts being wiring.
+    ``G, P, Q``: int codes ``(..., 3)``; the results have ``g`` more fractional
+    bits. Equal to what :func:`forward_difference` computes from the values."""
+    G, P, Q = (np.asarray(a, dtype=np.int64) for a in (G, P, Q))
+
+    def scale(v, up):
+        sh = 2 * log_m - up
+        return shift_round(v, sh, "rne") if sh >= 0 else v << -sh
+    return Q << guard, scale(G + (P << log_m), guard), scale(G, guard + 1)
+
+
+def forward_difference_codes(v0, d1, d2, m: int) -> np.ndarray:
+    """``m + 1`` pixel codes ``v_i`` by ``v += d1; d1 += d2`` (additions only);
+    int arrays ``(..., 3)`` in, ``(..., m+1, 3)`` out."""
+    v, d1, d2 = (np.asarray(a, dtype=np.int64) for a in (v0, d1, d2))
+    out = [v]
+    for _ in range(m):
+        v = v + d1
+        d1 = d1 + d2
+        out.append(v)
+    return np.stack(out, axis=-2)
 
 
 def forward_difference(G, P, Q, m: int, frac_bits: int, guard: int = 8) -> np.ndarray:
