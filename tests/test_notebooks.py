@@ -1,0 +1,48 @@
+"""Each notebook under notebooks/ runs top to bottom (nbclient, kernel python3).
+
+The notebooks are stored without outputs (checked here too); executing them
+is the test. Skipped, with the reason, when nbclient/nbformat/ipykernel are
+not installed (``pip install -e ".[test]"`` installs them).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat", reason="nbformat not installed (pip install -e '.[test]')")
+nbclient = pytest.importorskip("nbclient", reason="nbclient not installed (pip install -e '.[test]')")
+pytest.importorskip("ipykernel", reason="ipykernel not installed: no python3 kernel to run notebooks")
+
+NOTEBOOKS = sorted((Path(__file__).resolve().parent.parent / "notebooks").glob("*.ipynb"))
+TIMEOUT = 300  # seconds per cell
+
+
+def test_there_are_notebooks():
+    assert {p.stem for p in NOTEBOOKS} >= {"error_surfaces", "fit_explorer"}
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_stored_without_outputs(path):
+    nb = nbformat.read(path, as_version=4)
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            assert cell.outputs == [] and cell.execution_count is None, \
+                f"{path.name}: a code cell has stored outputs; clear them before committing"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_notebook_runs(path, tmp_path):
+    nb = nbformat.read(path, as_version=4)
+    env_backend = os.environ.get("MPLBACKEND")
+    os.environ["MPLBACKEND"] = "Agg" if env_backend is None else env_backend
+    try:
+        client = nbclient.NotebookClient(nb, timeout=TIMEOUT, kernel_name="python3",
+                                         resources={"metadata": {"path": str(tmp_path)}})
+        client.execute()
+    finally:
+        if env_backend is None:
+            os.environ.pop("MPLBACKEND", None)
