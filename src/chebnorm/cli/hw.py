@@ -23,6 +23,16 @@ def _design_args(p) -> None:
     p.add_argument("--y-frac-bits", type=int, default=None, help="default: the largest that fits")
 
 
+def _unit_width_args(p) -> None:
+    p.add_argument("--frac-bits", type=int, default=14,
+                   help="unit: fractional bits F of the vector components, 1..26 (default 14)")
+    p.add_argument("--comp-bits", type=int, default=None,
+                   help="unit: signed component width W, 2..28 (default F + 2)")
+    p.add_argument("--log-m", type=int, default=4, help="stepper: m = 2^LOG_M pixels, 0..10")
+    p.add_argument("--guard", type=int, default=None,
+                   help="stepper: guard bits, 0..24 (default 2 LOG_M: exact set-up)")
+
+
 def register(sub) -> None:
     hw = sub.add_parser("hw", help="bit-accurate hardware: Verilog, error budget, sweep",
                         description="Fixed-point Horner evaluators of a coefficient table: "
@@ -42,7 +52,36 @@ def register(sub) -> None:
     r.add_argument("--json", action="store_true", help="print the report as JSON")
     r.add_argument("--no-synth", action="store_true", help="skip yosys")
     r.add_argument("--no-gappa", action="store_true", help="skip gappa")
+    r.add_argument("--unit", action="append", default=[], metavar="KIND",
+                   help="also cost a normalization unit (dichotomy, classic, quadratic, stepper, "
+                   "eta; repeatable): model area beside yosys cells; units with an evaluator "
+                   "use TABLE and its widths")
+    _unit_width_args(r)
     r.set_defaults(func=run_report)
+
+    u = hsub.add_parser("unit", help="Verilog of a normalization unit, its test bench, vectors",
+                        description="A normalization unit as synthesizable Verilog, bit-for-bit "
+                        "equal to the Python kernels, with a self-checking test bench.")
+    u.add_argument("kind", choices=("dichotomy", "classic", "quadratic", "stepper", "eta"))
+    u.add_argument("--table", metavar="TABLE.json", default=None,
+                   help="table of the unit's evaluator (default: the degree-2 fit of dichotomy, "
+                   "midpoint or eta_term for psi_max = pi/4)")
+    u.add_argument("--in-bits", type=int, default=16, help="evaluator input width, 1..20")
+    u.add_argument("--out-bits", type=int, default=16, help="evaluator output width, 1..32")
+    u.add_argument("--coef-bits", type=int, default=None,
+                   help="coefficient fractional bits (default: the table's own, or out-bits + 4 "
+                   "for the default table)")
+    u.add_argument("--rounding", default=None,
+                   help="classic: trunc (default) or rne quotient; others: the evaluator's")
+    _unit_width_args(u)
+    u.add_argument("--vectors", type=int, default=5000,
+                   help="random and realistic rows each (default 5000; all codes when the "
+                   "inputs have at most 16 bits)")
+    u.add_argument("--seed", type=int, default=0)
+    u.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
+    u.add_argument("--simulate", action="store_true", help="also run the test bench in iverilog")
+    u.add_argument("--synth", action="store_true", help="also count cells with yosys")
+    u.set_defaults(func=run_unit)
 
     s = hsub.add_parser("sweep", help="degree x coefficient bits x datapath bits vs area")
     s.add_argument("--target", default="dichotomy", help="registered target (default dichotomy)")
@@ -89,12 +128,69 @@ def run_verilog(args) -> int:
     return 0
 
 
+def _unit(args, kind, table=None):
+    from chebnorm.hw.units import design_unit
+
+    return design_unit(kind, frac_bits=args.frac_bits, comp_bits=args.comp_bits, table=table,
+                       in_bits=args.in_bits, out_bits=args.out_bits, coef_bits=args.coef_bits,
+                       rounding=args.rounding, log_m=args.log_m, guard=args.guard)
+
+
 def run_report(args) -> int:
+    from chebnorm.hw.units import UNIT_KINDS, analyze_unit
+
+    for kind in args.unit:
+        if kind not in UNIT_KINDS:
+            raise ValueError(f"unit {kind!r} is unknown; accepted: {', '.join(UNIT_KINDS)}")
     report = _analyze(args, synth=not args.no_synth, gappa=not args.no_gappa)
+    units = []
+    for kind in dict.fromkeys(args.unit):
+        rounding = args.rounding if kind != "classic" else None
+        unit = _unit(argparse_ns(args, rounding=rounding), kind, table=report.design.table)
+        units.append(analyze_unit(unit, synth=not args.no_synth))
     if args.json:
-        print_json(report.as_dict())
+        d = report.as_dict()
+        if units:
+            d["units"] = [u.as_dict() for u in units]
+        print_json(d)
     else:
         print("\n".join(report.lines()))
+        for u in units:
+            print("\n".join(u.lines()))
+    return 0
+
+
+def argparse_ns(args, **changes):
+    """A copy of ``args`` with some attributes changed."""
+    import argparse
+
+    return argparse.Namespace(**{**vars(args), **changes})
+
+
+def run_unit(args) -> int:
+    from pathlib import Path
+
+    from chebnorm import __version__
+    from chebnorm.hw.report import write_outputs
+    from chebnorm.hw.units import analyze_unit, unit_outputs
+    from chebnorm.hw.verilog import simulate
+
+    if not Path(args.output).is_dir():
+        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    table = CoefficientTable.load(args.table) if args.table else None
+    unit = _unit(args, args.kind, table)
+    rep = analyze_unit(unit, synth=args.synth)
+    files = unit_outputs(unit, count=args.vectors, seed=args.seed, version=__version__,
+                         command=command_line(args))
+    files[f"{unit.module_name}_report.json"] = json.dumps(
+        rep.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
+    for path in write_outputs(args.output, files):
+        print(path)
+    print("\n".join(rep.lines()))
+    if args.simulate:
+        res = simulate(args.output, unit)
+        print(res.line)
+        return 0 if res.passed else 1
     return 0
 
 

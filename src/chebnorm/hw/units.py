@@ -337,7 +337,7 @@ def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
     ins = unit.inputs
     f, w = unit.frac_bits, unit.comp_bits
     if unit.clocked:
-        return _stepper_rows(unit, rng, max(1, count // ((1 << unit.log_m) + 1)))
+        return _stepper_rows(unit, rng, -(-count // ((1 << unit.log_m) + 1)))
     if sum(p.bits for p in ins) <= EXHAUSTIVE_BITS:
         grids = np.meshgrid(*[np.arange(_edges(p)[0], _edges(p)[-1] + 1) for p in ins],
                             indexing="ij")

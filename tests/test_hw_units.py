@@ -1,0 +1,230 @@
+"""Tests of chebnorm.hw.units: Verilog normalization units bit-for-bit against
+the Python kernels (iverilog), yosys cell counts, kernels, errors and CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from chebnorm.approx import fit_target
+from chebnorm.hw import design_horner
+from chebnorm.hw.datapaths import (dichotomy_next_z, eta_criterion, forward_difference,
+                                   forward_difference_codes, forward_difference_setup,
+                                   quadratic_midpoint)
+from chebnorm.hw.report import write_outputs
+from chebnorm.hw.units import (UNIT_KINDS, analyze_unit, design_unit, unit_outputs,
+                               unit_vectors)
+from chebnorm.hw.verilog import simulate
+
+no_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
+                                 reason="iverilog (Icarus Verilog) is not installed")
+no_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
+
+#: small widths keep simulation and synthesis fast; the structure is the same
+SMALL = dict(frac_bits=6, in_bits=8, out_bits=8)
+
+
+def small(kind, **kw):
+    args = SMALL | kw
+    if kind in ("classic", "stepper"):
+        args.pop("in_bits"), args.pop("out_bits")
+    return design_unit(kind, **args)
+
+
+@pytest.fixture(scope="module")
+def d16():
+    return design_horner(fit_target("dichotomy", 2), 16, 16, coef_bits=20)
+
+
+class TestKernels:
+    def test_next_z_is_nearest_sqrt(self, d16):
+        k = np.arange(d16.valid_codes[0], d16.valid_codes[1] + 1, 7)
+        zn = dichotomy_next_z(k, d16)
+        fx, k0 = d16.x_format.frac_bits, d16.x_format.offset_code
+        exact = np.array([math.sqrt(2 + (k0 + int(c)) / 2 ** fx) * 2 ** fx - k0 for c in k])
+        assert np.all(np.abs(zn - exact) <= 0.5 + 1e-6)
+        assert np.all((zn >= d16.valid_codes[0]) & (zn <= d16.valid_codes[1]))  # stays valid
+
+    def test_stepper_codes_equal_float_forward_difference(self):
+        rng = np.random.default_rng(0)
+        f = 12
+        G, P, Q = (rng.integers(-2 ** 13, 2 ** 13, (20, 3)) for _ in range(3))
+        for log_m, guard in [(4, 8), (6, 8), (3, 0), (2, 10)]:
+            m = 1 << log_m
+            codes = forward_difference_codes(*forward_difference_setup(G, P, Q, log_m, guard), m)
+            ref = forward_difference(G / 2 ** f, P / 2 ** f, Q / 2 ** f, m, f, guard)
+            assert np.array_equal(codes, ref * 2.0 ** (f + guard))
+
+    def test_quadratic_through_three_points(self):
+        d = design_horner(fit_target("midpoint", 2), 12, 12, coef_bits=16)
+        rng = np.random.default_rng(1)
+        f = 12
+        a = rng.normal(size=(200, 3))
+        a /= np.linalg.norm(a, axis=1, keepdims=True)
+        b = a + 0.3 * rng.normal(size=a.shape)
+        b /= np.linalg.norm(b, axis=1, keepdims=True)
+        nl, nr = np.rint(a * 2 ** f).astype(np.int64), np.rint(b * 2 ** f).astype(np.int64)
+        G, P, Q, nc = quadratic_midpoint(nl, nr, d, f)
+        assert np.array_equal(Q, nl) and np.array_equal(G + P + Q, nr)
+        assert np.array_equal(G + 2 * P + 4 * Q, 4 * nc)  # N(1/2) = Nc exactly
+        # inside the table's interval (angle <= pi/4) the midpoint is unit length within
+        # the evaluator's error and the roundings; outside, the input code saturates
+        inside = np.sum(a * b, axis=1) >= math.cos(math.pi / 4) + 1e-3
+        assert inside.sum() > 100
+        assert np.max(np.abs(np.linalg.norm(nc[inside], axis=1) / 2 ** f - 1)) < 2e-3
+
+    def test_eta_matches_formula(self):
+        d = design_horner(fit_target("eta_term", 2), 12, 16, coef_bits=20)
+        rng = np.random.default_rng(2)
+        f = 14
+        v = rng.normal(size=(3, 300, 3))
+        v /= np.linalg.norm(v, axis=2, keepdims=True)
+        v[1] = v[0] + 0.4 * v[1]
+        v[2] = v[0] + 0.4 * v[2]
+        v /= np.linalg.norm(v, axis=2, keepdims=True)
+        codes = np.rint(v * 2 ** f).astype(np.int64)
+        eta = eta_criterion(*codes, d, f) / 2 ** d.y_format.frac_bits
+        c = [np.sum(v[i] * v[j], axis=1) for i, j in ((0, 1), (1, 2), (0, 2))]
+        ok = np.all(np.stack(c) >= 0, axis=0)  # the table covers N_i.N_j in [0, 1]
+        ref = 3 - sum(np.sqrt(2 * (1 + x)) / 2 for x in c)
+        # three quadratic fits (~3e-3 each) and the rounding of the dot products
+        assert np.max(np.abs(eta - ref)[ok]) < 1.2e-2
+
+
+class TestUnits:
+    @no_iverilog
+    @pytest.mark.parametrize("kind", UNIT_KINDS)
+    def test_bit_for_bit(self, kind, tmp_path):
+        unit = small(kind)
+        write_outputs(tmp_path, unit_outputs(unit, count=300, seed=1))
+        res = simulate(tmp_path, unit)
+        assert res.passed and res.mismatches == 0 and res.vectors >= 300, res.line
+
+    @no_iverilog
+    @pytest.mark.parametrize("rounding", ["trunc", "rne"])
+    def test_classic_exhaustive(self, rounding, tmp_path):
+        unit = design_unit("classic", frac_bits=3, comp_bits=5, rounding=rounding)
+        rows = unit_vectors(unit)
+        assert len(rows["n_x"]) == 2 ** 15  # every input code
+        write_outputs(tmp_path, unit_outputs(unit))
+        res = simulate(tmp_path, unit)
+        assert res.passed and res.vectors == 2 ** 15, res.line
+
+    @no_iverilog
+    def test_dichotomy_realistic_widths(self, tmp_path):
+        unit = design_unit("dichotomy", frac_bits=14, in_bits=16, out_bits=16, coef_bits=20)
+        write_outputs(tmp_path, unit_outputs(unit, count=1500))
+        assert simulate(tmp_path, unit).passed
+
+    @no_iverilog
+    @pytest.mark.parametrize("kind", ["dichotomy", "stepper"])
+    def test_bench_detects_a_wrong_vector(self, kind, tmp_path):
+        unit = small(kind)
+        files = unit_outputs(unit, count=100)
+        name = f"{unit.module_name}.hex"
+        lines = files[name].splitlines(keepends=True)
+        last = lines[20][-2]  # lowest hex digit: the last output's low bits
+        lines[20] = lines[20][:-2] + ("1" if last != "1" else "0") + "\n"
+        files[name] = "".join(lines)
+        write_outputs(tmp_path, files)
+        res = simulate(tmp_path, unit)
+        assert not res.passed and res.mismatches >= 1
+
+    def test_vectors_are_seeded(self):
+        u = small("eta")
+        a, b = unit_outputs(u, count=50, seed=3), unit_outputs(u, count=50, seed=3)
+        assert a == b
+        assert unit_outputs(u, count=50, seed=4) != a
+
+    def test_module_text(self):
+        text = unit_outputs(small("classic"), count=10)["chebnorm_classic_unit.v"]
+        assert "parameter W = 8," in text and "parameter F = 6," in text
+        assert "output wire signed [F+1:0] u_x" in text
+        text = unit_outputs(small("dichotomy"), count=10)["chebnorm_dichotomy_unit.v"]
+        assert "module chebnorm_dichotomy_d2 #(" in text and "poly (.x(z), .y(y))" in text
+
+    @pytest.mark.parametrize("kw, msg", [
+        (dict(kind="cordic"), "unit 'cordic' is unknown; accepted: dichotomy, classic"),
+        (dict(frac_bits=0), "frac-bits = 0 is out of range; accepted: 1 <= frac-bits <= 26"),
+        (dict(frac_bits=-4), "frac-bits = -4 is out of range"),
+        (dict(comp_bits=1), "accepted: 2 <= comp-bits <= 28"),
+        (dict(comp_bits=29), "accepted: 2 <= comp-bits <= 28"),
+        (dict(kind="classic", rounding="up"), "rounding 'up' is unknown"),
+        (dict(kind="stepper", log_m=11), "accepted: 0 <= log-m <= 10"),
+        (dict(kind="stepper", guard=-1), "accepted: 0 <= guard <= 24"),
+        (dict(in_bits=0), "in-bits = 0 is out of range"),
+        (dict(coef_bits=33), "accepted: 1 <= coef-bits <= 31"),
+        (dict(kind="classic", frac_bits=26, comp_bits=28), None),
+    ])
+    def test_raises(self, kw, msg):
+        args = dict(kind="dichotomy", frac_bits=10) | kw
+        if msg is None:
+            design_unit(**args)  # the widest accepted widths still fit the int64 model
+            return
+        with pytest.raises(ValueError, match=msg):
+            design_unit(**args)
+
+    @no_yosys
+    def test_yosys_cells_beside_model_area(self):
+        reps = [analyze_unit(small(k, frac_bits=4, in_bits=6, out_bits=6)) for k in
+                ("classic", "stepper")]
+        for r in reps:
+            d = r.as_dict()
+            assert d["yosys_cells"] > 50 and d["area_fa"] > 0
+            assert "yosys cells" in r.lines()[0]
+
+
+class TestCLI:
+    def run(self, argv, capsys):
+        from chebnorm.cli import main
+
+        code = main(argv)
+        out, err = capsys.readouterr()
+        return code, out, err
+
+    @no_iverilog
+    def test_unit_writes_and_passes(self, tmp_path, capsys):
+        code, out, _ = self.run(["hw", "unit", "quadratic", "--frac-bits", "6", "--in-bits", "8",
+                                 "--out-bits", "8", "--vectors", "200", "-o", str(tmp_path),
+                                 "--simulate"], capsys)
+        assert code == 0 and "PASS:" in out and " 0 mismatches" in out
+        names = sorted(p.name for p in tmp_path.iterdir())
+        assert names == ["chebnorm_quadratic_unit.hex", "chebnorm_quadratic_unit.v",
+                         "chebnorm_quadratic_unit_report.json", "tb_chebnorm_quadratic_unit.v"]
+
+    def test_report_with_units(self, tmp_path, capsys):
+        t = tmp_path / "t.json"
+        fit_target("dichotomy", 2).save(t)
+        code, out, _ = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
+                                 "--coef-bits", "12", "--json", "--no-gappa", "--no-synth",
+                                 "--unit", "dichotomy", "--unit", "classic",
+                                 "--frac-bits", "6"], capsys)
+        assert code == 0
+        units = json.loads(out)["units"]
+        assert [u["unit"] for u in units] == ["dichotomy", "classic"]
+        assert all(u["area_fa"] > 0 and "yosys_cells" in u for u in units)
+
+    @pytest.mark.parametrize("extra, msg", [
+        (["classic", "--frac-bits", "0"], "frac-bits = 0 is out of range"),
+        (["eta", "--comp-bits", "40"], "accepted: 2 <= comp-bits <= 28"),
+        (["dichotomy", "--in-bits", "-1"], "in-bits = -1"),
+        (["dichotomy", "--coef-bits", "40"], "accepted: 1 <= coef-bits <= 31"),
+        (["stepper", "--log-m", "12"], "accepted: 0 <= log-m <= 10"),
+    ])
+    def test_errors_leave_nothing(self, tmp_path, capsys, extra, msg):
+        out = tmp_path / "out"
+        out.mkdir()
+        code, _, err = self.run(["hw", "unit", *extra, "-o", str(out)], capsys)
+        assert code == 2 and msg in err and err.count("\n") == 1
+        assert list(out.iterdir()) == []
+
+    def test_report_unknown_unit(self, tmp_path, capsys):
+        t = tmp_path / "t.json"
+        fit_target("dichotomy", 2).save(t)
+        code, _, err = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
+                                 "--coef-bits", "12", "--unit", "cordic"], capsys)
+        assert code == 2 and "unit 'cordic' is unknown" in err
