@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -65,10 +66,15 @@ def run_sollya(tight: float):
     with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
         fh.write("\n".join(lines) + "\n")
     t0 = time.perf_counter()
-    out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
-                         stdin=subprocess.DEVNULL).stdout
+    try:
+        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
+                             stdin=subprocess.DEVNULL).stdout
+    finally:
+        os.unlink(fh.name)
     wall = time.perf_counter() - t0
     m = re.search(r"TIMES\s+(\S+)\s+(\S+)\s+(\S+)", out)
+    if m is None:
+        raise RuntimeError(f"sollya printed no timing line; its output began: {out[:200]!r}")
     return float(m.group(1)), float(m.group(2)), float(m.group(3)), wall
 
 
@@ -86,8 +92,13 @@ def main(argv=None) -> int:
                "chebnorm_fit_s": statistics.median(o[0] for o in ours),
                "chebnorm_certify_s": statistics.median(o[1] for o in ours),
                "chebnorm_worst_bound_over_max": max(o[2] for o in ours)}
+        theirs = None
         if sollya.available():
-            theirs = [run_sollya(tight) for _ in range(args.repeat)]
+            try:
+                theirs = [run_sollya(tight) for _ in range(args.repeat)]
+            except (RuntimeError, OSError) as exc:
+                row["sollya"] = f"sollya run failed: {exc}"
+        if theirs:
             row.update({"sollya_remez_s": statistics.median(t[0] for t in theirs),
                         "sollya_supnorm_s": statistics.median(t[1] for t in theirs),
                         "sollya_worst_upper_over_lower": max(t[2] for t in theirs),
@@ -95,7 +106,7 @@ def main(argv=None) -> int:
             row["certify_speedup"] = row["sollya_supnorm_s"] / row["chebnorm_certify_s"]
             row["fit_and_certify_speedup"] = ((row["sollya_remez_s"] + row["sollya_supnorm_s"])
                                               / (row["chebnorm_fit_s"] + row["chebnorm_certify_s"]))
-        else:
+        elif "sollya" not in row:
             row["sollya"] = "not installed: apt-get install sollya to compare"
         results.append(row)
     if args.json:
