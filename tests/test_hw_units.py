@@ -228,3 +228,46 @@ class TestCLI:
         code, _, err = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
                                  "--coef-bits", "12", "--unit", "cordic"], capsys)
         assert code == 2 and "unit 'cordic' is unknown" in err
+
+
+class TestPipelined:
+    @no_iverilog
+    @pytest.mark.parametrize("degree, rounding", [(1, "trunc"), (3, "rne")])
+    def test_bit_for_bit_with_latency(self, degree, rounding, tmp_path):
+        from chebnorm.hw.report import analyze, verilog_outputs
+
+        r = analyze(fit_target("midpoint", degree), 10, 10, coef_bits=16, rounding=rounding,
+                    synth=False, gappa=False)
+        files = verilog_outputs(r, pipelined=True)
+        name = f"{r.design.module_name}_pipe"
+        assert f"parameter LATENCY = {degree}" in files[f"{name}.v"]
+        write_outputs(tmp_path, files)
+        res = simulate(tmp_path, name)
+        assert res.passed and res.vectors == 1024, res.line
+        # the bench really accounts for the latency: one cycle off fails
+        bench = files[f"tb_{name}.v"].replace(f"localparam LATENCY = {degree};",
+                                              f"localparam LATENCY = {degree + 1};")
+        (tmp_path / f"tb_{name}.v").write_text(bench)
+        assert not simulate(tmp_path, name).passed
+
+    def test_degree_zero_refused(self):
+        from chebnorm.hw.verilog import verilog_pipelined_module
+
+        d = design_horner(fit_target("dichotomy", 1), 8, 8, coef_bits=12)
+        d0 = d.__class__(**{**d.__dict__, "integers": d.integers[:1], "stages": ()})
+        with pytest.raises(ValueError, match="accepted: degree >= 1"):
+            verilog_pipelined_module(d0)
+
+    @no_iverilog
+    def test_cli_pipelined(self, tmp_path, capsys):
+        from chebnorm.cli import main
+
+        t = tmp_path / "t.json"
+        fit_target("dichotomy", 2).save(t)
+        out = tmp_path / "out"
+        out.mkdir()
+        code = main(["hw", "verilog", str(t), "--in-bits", "10", "--out-bits", "10",
+                     "--coef-bits", "16", "-o", str(out), "--simulate", "--pipelined"])
+        text = capsys.readouterr().out
+        assert code == 0 and text.count("PASS:") == 2 and "latency 2" in text
+        assert (out / "chebnorm_dichotomy_d2_pipe.v").exists()

@@ -45,6 +45,9 @@ def register(sub) -> None:
     _design_args(v)
     v.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
     v.add_argument("--simulate", action="store_true", help="also run the test bench in iverilog")
+    v.add_argument("--pipelined", action="store_true",
+                   help="also write the pipelined variant chebnorm_NAME_pipe (clk, one register "
+                   "per Horner step, latency = degree) and its bench")
     v.set_defaults(func=run_verilog)
 
     r = hsub.add_parser("report", help="error budget, measured errors, costs, Q formats")
@@ -116,15 +119,26 @@ def run_verilog(args) -> int:
     if not Path(args.output).is_dir():
         raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
     report = _analyze(args, synth=False, gappa=False)
-    files = verilog_outputs(report, version=__version__, command=command_line(args))
+    if args.pipelined and report.design.degree < 1:
+        raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
+                         f"pipeline; accepted: --pipelined with degree >= 1")
+    files = verilog_outputs(report, version=__version__, command=command_line(args),
+                            pipelined=args.pipelined)
     files[f"{report.design.module_name}_report.json"] = json.dumps(
         report.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
     for path in write_outputs(args.output, files):
         print(path)
     if args.simulate:
-        res = simulate(args.output, report.design)
-        print(res.line)
-        return 0 if res.passed else 1
+        from chebnorm.hw.verilog import pipelined_name
+
+        names = [report.design.module_name] + \
+            ([pipelined_name(report.design)] if args.pipelined else [])
+        ok = True
+        for name in names:
+            res = simulate(args.output, name)
+            print(res.line)
+            ok = ok and res.passed
+        return 0 if ok else 1
     return 0
 
 

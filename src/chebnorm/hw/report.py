@@ -19,7 +19,8 @@ from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
 from .datapaths import horner_block
 from .horner import HornerDesign, design_horner
-from .verilog import (SynthResult, synthesize_text, vector_file, verilog_module,
+from .verilog import (SynthResult, pipelined_name, synthesize_text, vector_file,
+                      verilog_module, verilog_pipelined_module, verilog_pipelined_testbench,
                       verilog_testbench)
 
 __all__ = ["HardwareReport", "analyze", "verilog_outputs", "write_outputs"]
@@ -136,14 +137,23 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     return HardwareReport(design, budget, meas, horner_block(design), syn)
 
 
-def verilog_outputs(report: HardwareReport, *, version: str = "",
-                    command: str | None = None) -> dict[str, str]:
-    """File name -> text of the module, its test bench and its vector file."""
+def verilog_outputs(report: HardwareReport, *, version: str = "", command: str | None = None,
+                    pipelined: bool = False) -> dict[str, str]:
+    """File name -> text of the module, its test bench and its vector file; with
+    ``pipelined`` also those of the pipelined variant ``chebnorm_NAME_pipe``."""
     d = report.design
     name = d.module_name
-    return {f"{name}.v": verilog_module(d, version=version, command=command, budget=report.budget),
-            f"tb_{name}.v": verilog_testbench(d),
-            f"{name}.hex": vector_file(d)}
+    files = {f"{name}.v": verilog_module(d, version=version, command=command,
+                                         budget=report.budget),
+             f"tb_{name}.v": verilog_testbench(d),
+             f"{name}.hex": vector_file(d)}
+    if pipelined:
+        pipe = pipelined_name(d)
+        files[f"{pipe}.v"] = verilog_pipelined_module(d, version=version, command=command,
+                                                      budget=report.budget)
+        files[f"tb_{pipe}.v"] = verilog_pipelined_testbench(d)
+        files[f"{pipe}.hex"] = files[f"{name}.hex"]
+    return files
 
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:

@@ -29,7 +29,8 @@ import numpy as np
 from .horner import HornerDesign
 
 __all__ = ["verilog_module", "verilog_testbench", "vector_file", "SimResult", "SynthResult",
-           "simulate", "synthesize", "synthesize_text"]
+           "simulate", "synthesize", "synthesize_text", "verilog_pipelined_module",
+           "verilog_pipelined_testbench", "pipelined_name"]
 
 
 def _lit(value: int, bits: int) -> str:
@@ -133,6 +134,138 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
     return "\n".join(out)
 
 
+def pipelined_name(design: HornerDesign) -> str:
+    """Module name of the pipelined variant: ``chebnorm_NAME_pipe``."""
+    return f"{design.module_name}_pipe"
+
+
+def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
+                             command: str | None = None, budget=None) -> str:
+    """The pipelined variant of :func:`verilog_module`: the same datapath, bit
+    for bit, with ``clk`` and one register stage after each Horner step (the
+    delayed ``x`` travels beside the accumulator). Latency: ``degree`` cycles
+    -- ``y`` after the ``degree``-th rising edge belongs to the ``x`` applied
+    before the first; a new ``x`` can be applied every cycle."""
+    n = design.degree
+    if n < 1:
+        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
+                         f"degree >= 1")
+    xf, yf = design.x_format, design.y_format
+    name = pipelined_name(design)
+    out = _banner(design, version, command, budget)
+    out[0] = out[0].replace(design.module_name, name, 1)
+    out[-1] = (f"// Pipelined: one register stage per Horner step, latency {n} cycles "
+               f"(LATENCY); one result per cycle. Constants sized for these widths.")
+    out += [f"module {name} #(",
+            f"    parameter IN_BITS = {design.in_bits},",
+            f"    parameter OUT_BITS = {design.out_bits},",
+            f"    parameter LATENCY = {n}",
+            ") (",
+            "    input  wire                clk,",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");"]
+    xw = design.xs_bits
+    out += [f"    localparam signed [{xw - 1}:0] K0 = {_lit(xf.offset_code, xw)};",
+            f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
+    aw = max(design.stages[0].acc_bits, 2)
+    out.append(f"    localparam signed [{aw - 1}:0] A{n} = {_lit(design.integers[n], aw)};")
+    prev = f"A{n}"
+    for s, st in enumerate(design.stages):
+        j = st.power
+        out.append(f"    // stage {s + 1}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})")
+        out.append(f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * xs{s};")
+        shift = f" <<< {st.product_shift}" if st.product_shift else ""
+        out.append(f"    localparam signed [{st.sum_bits - 1}:0] C{j} = "
+                   f"{_lit(st.coef_shifted, st.sum_bits)};")
+        out.append(f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};")
+        if j > 0:
+            out += _round(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits,
+                          design.rounding)
+            out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
+                    f"    reg signed [{xw - 1}:0] xs{s + 1};",
+                    "    always @(posedge clk) begin",
+                    f"        a{j}_r <= a{j};",
+                    f"        xs{s + 1} <= xs{s};",
+                    "    end"]
+            prev = f"a{j}_r"
+    top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
+    out += [f"    reg signed [{top_bits - 1}:0] top;",
+            "    always @(posedge clk) top <= t0;"]
+    shift = top_frac - yf.frac_bits
+    rw = max(design.raw_bits, top_bits + max(0, -shift) + 1, design.out_bits + 2,
+             yf.offset_code.bit_length() + 2)
+    out.append(f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate")
+    if shift > 0:
+        out += _round("top", "r", top_bits, shift, rw, design.rounding)
+    elif shift == 0:
+        out.append(f"    wire signed [{rw - 1}:0] r = top;")
+    else:
+        out.append(f"    wire signed [{rw - 1}:0] r = top <<< {-shift};")
+    out += [f"    localparam signed [{rw - 1}:0] KY = {_lit(yf.offset_code, rw)};",
+            f"    localparam signed [{rw - 1}:0] YMAX = {_lit(yf.max_code, rw)};",
+            f"    wire signed [{rw - 1}:0] raw = r - KY;",
+            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
+            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
+            "endmodule", ""]
+    return "\n".join(out)
+
+
+def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
+    """Exhaustive self-checking bench of the pipelined variant: one new input
+    code per cycle; the output after edge ``i`` is checked against the model's
+    answer for code ``i - LATENCY + 1`` (the first ``LATENCY - 1`` edges are
+    the pipeline filling and are not checked)."""
+    name = pipelined_name(design)
+    vectors = vectors or f"{name}.hex"
+    count = 2 ** design.in_bits
+    n = design.degree
+    return "\n".join([
+        f"// tb_{name}: exhaustive self-checking test bench of {name}, latency {n}.",
+        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
+        "`timescale 1ns/1ps",
+        f"module tb_{name};",
+        f"    localparam IN_BITS = {design.in_bits};",
+        f"    localparam OUT_BITS = {design.out_bits};",
+        f"    localparam LATENCY = {n};",
+        f"    localparam COUNT = {count};",
+        "    reg clk;",
+        "    reg  [IN_BITS-1:0]  x;",
+        "    wire [OUT_BITS-1:0] y;",
+        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
+        "    integer i, errors, checked;",
+        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS), .LATENCY(LATENCY)) dut "
+        "(.clk(clk), .x(x), .y(y));",
+        "    initial begin",
+        f"        $readmemh(\"{vectors}\", expected);",
+        "        errors = 0;",
+        "        checked = 0;",
+        "        clk = 0;",
+        "        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin",
+        "            x = (i < COUNT) ? i : 0;",
+        "            #1 clk = 1;",
+        "            #1;",
+        "            if (i >= LATENCY - 1) begin",
+        "                checked = checked + 1;",
+        "                if (y !== expected[i - LATENCY + 1]) begin",
+        "                    errors = errors + 1;",
+        "                    if (errors <= 10)",
+        "                        $display(\"MISMATCH x=%h y=%h expected=%h\", i - LATENCY + 1, y,",
+        "                                 expected[i - LATENCY + 1]);",
+        "                end",
+        "            end",
+        "            clk = 0;",
+        "        end",
+        "        if (errors == 0)",
+        f"            $display(\"PASS: %0d vectors, 0 mismatches ({name}, latency %0d)\", "
+        "checked, LATENCY);",
+        "        else",
+        f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", checked, errors);",
+        "        $finish;",
+        "    end",
+        "endmodule", ""])
+
+
 def _round(src: str, dst: str, src_bits: int, shift: int, dst_bits: int, mode: str) -> list[str]:
     """Verilog lines: ``dst = round(src / 2^shift)`` (floor, or nearest-even)."""
     lines = [f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};"]
@@ -217,11 +350,12 @@ def _need(tool: str) -> str:
     return exe
 
 
-def simulate(directory, design: HornerDesign, timeout: float = 600) -> SimResult:
-    """Compile and run ``tb_chebnorm_NAME.v`` in ``directory`` with Icarus Verilog."""
+def simulate(directory, design, timeout: float = 600) -> SimResult:
+    """Compile and run ``tb_M.v`` and ``M.v`` in ``directory`` with Icarus Verilog;
+    ``design``: anything with a ``module_name`` (a design, a unit), or the name ``M``."""
     iverilog, vvp = _need("iverilog"), _need("vvp")
     d = Path(directory)
-    name = design.module_name
+    name = design if isinstance(design, str) else design.module_name
     with tempfile.TemporaryDirectory() as tmp:
         exe = Path(tmp) / "sim.vvp"
         comp = subprocess.run([iverilog, "-g2005", "-Wall", "-o", str(exe), f"tb_{name}.v",
