@@ -58,10 +58,10 @@ from chebnorm.approx import CoefficientTable, fit_target
 
 from .cost import Block
 from .datapaths import (classic_normalize, classic_unit, dichotomy_midpoint, dichotomy_next_z,
-                        dichotomy_unit, eta_criterion, eta_unit, forward_difference_codes,
-                        forward_difference_setup, forward_difference_stepper,
+                        dichotomy_unit, eta_criterion, eta_unit, forward_difference_setup,
+                        forward_difference_codes, forward_difference_stepper,
                         quadratic_midpoint, quadratic_midpoint_unit)
-from .fixed import INT64_BITS, check_int64, check_width, shift_round, signed_bits, unsigned_bits
+from .fixed import check_int64, check_width, shift_round, signed_bits, unsigned_bits
 from .horner import HornerDesign, design_horner
 from .verilog import SynthResult, _lit, _round, synthesize_text, verilog_module
 
@@ -165,18 +165,13 @@ class UnitDesign:
         else:
             v0, d1, d2 = forward_difference_setup(vec("g"), vec("p"), vec("q"), self.log_m,
                                                   self.guard)
-            rows = len(g["load"])
-            v = np.zeros((rows, 3), dtype=np.int64)
-            cur = cd1 = cd2 = None
-            for i in range(rows):
-                if g["load"][i]:
-                    cur, cd1, cd2 = v0[i], d1[i], d2[i]
-                elif cur is None:
-                    raise ValueError("the stepper's first row must load; accepted: load=1 first")
-                else:
-                    cur, cd1 = cur + cd1, cd1 + cd2
-                v[i] = cur
-            put("v", v)
+            # each load starts a span: forward_difference_codes gives its pixels
+            starts = np.flatnonzero(g["load"]).tolist()
+            if not starts or starts[0] != 0:
+                raise ValueError("the stepper's first row must load; accepted: load=1 first")
+            ends = starts[1:] + [len(g["load"])]
+            put("v", np.concatenate([forward_difference_codes(v0[a], d1[a], d2[a], b - a - 1)
+                                     for a, b in zip(starts, ends)]))
         return out
 
 
@@ -192,8 +187,11 @@ def _unit_horner(kind: str, table, in_bits, out_bits, coef_bits, rounding) -> Ho
         coef_bits = coef_bits if coef_bits is not None else min(out_bits + 4, 30)
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"table {table!r} is not a CoefficientTable; accepted: a loaded table")
-    d = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, rounding=rounding,
-                      name=table.name)
+    try:
+        d = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, rounding=rounding,
+                          name=table.name)
+    except ValueError as e:
+        raise ValueError(f"the evaluator of unit {kind!r}: {e}") from None
     if d.x_format.frac_bits < 0 or d.y_format.frac_bits < 1:
         raise ValueError(f"unit {kind!r} needs an input format with >= 0 and an output with "
                          f">= 1 fractional bits; table {table.name!r} gives "
@@ -328,8 +326,9 @@ def _edges(port: Port) -> list[int]:
 
 def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
     """Input rows (name -> int64 array) for the test bench of ``unit``: every
-    input code when the inputs have at most 16 bits; else edge cases (every
-    combination of extreme codes per port group), ``count`` realistic rows
+    input code when the inputs have at most 16 bits; else edge cases (each
+    input takes each of its extreme codes -- min, -1, 0, 1, max -- while the
+    others cycle through theirs), ``count`` realistic rows
     (quantized unit normals at angles inside the table's interval, and
     their ``z``/threshold) and ``count`` rows of uniformly random codes."""
     count = check_width(count, "vectors", 1, 10 ** 6)
