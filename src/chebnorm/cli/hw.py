@@ -116,8 +116,7 @@ def run_verilog(args) -> int:
     from chebnorm.hw.report import verilog_outputs, write_outputs
     from chebnorm.hw.verilog import simulate
 
-    if not Path(args.output).is_dir():
-        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    _check_output(args.output)
     report = _analyze(args, synth=False, gappa=False)
     if args.pipelined and report.design.degree < 1:
         raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
@@ -189,8 +188,7 @@ def run_unit(args) -> int:
     from chebnorm.hw.units import analyze_unit, unit_outputs
     from chebnorm.hw.verilog import simulate
 
-    if not Path(args.output).is_dir():
-        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    _check_output(args.output)
     table = CoefficientTable.load(args.table) if args.table else None
     unit = _unit(args, args.kind, table)
     rep = analyze_unit(unit, synth=args.synth)
@@ -215,14 +213,14 @@ def run_sweep(args) -> int:
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)
-    if not out.is_dir():
-        raise ValueError(f"output folder {args.output!r} does not exist; accepted: an existing folder")
+    _check_output(out)
     res = sweep(args.target, degrees=args.degrees or DEFAULT_DEGREES,
                 coef_bits=args.coef_bits or DEFAULT_COEF_BITS,
                 acc_bits=args.acc_bits or DEFAULT_ACC_BITS, in_bits=args.in_bits,
                 out_bits=args.out_bits, rounding=args.rounding, psi_max=args.psi_max,
                 synth=not args.no_synth)
     csv, png = res.csv(), res.plot_png()
+    out.mkdir(parents=True, exist_ok=True)  # only now: nothing is created when the sweep fails
     stem = f"sweep_{args.target}"
     write_atomic(out / f"{stem}.csv", csv)
     write_atomic(out / f"{stem}.png", png)
@@ -238,3 +236,13 @@ def run_sweep(args) -> int:
               f"bits {best.coef_bits}, accumulator bits {best.acc_bits or '-'}: {area}, "
               f"{best.shading_levels:.4f} levels, {best.max_error_lsb:.2f} LSB")
     return 0
+
+
+def _check_output(path) -> None:
+    """-o DIR: an existing folder, or a new one to create once everything has passed."""
+    from pathlib import Path
+
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise ValueError(f"output {str(path)!r} exists and is not a folder; accepted: a folder "
+                         f"(created if missing)")

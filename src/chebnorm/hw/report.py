@@ -157,11 +157,13 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
-    """Write every file atomically into an existing ``directory``; check first."""
+    """Write every file atomically into ``directory`` (created if missing); the
+    caller has checked everything before, so nothing is half-written."""
     folder = Path(directory)
-    if not folder.is_dir():
-        raise ValueError(f"output folder {str(folder)!r} does not exist; accepted: an existing "
-                         f"folder")
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"output {str(folder)!r} exists and is not a folder; accepted: a folder "
+                         f"(created if missing)")
+    folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for fname, text in files.items():
         write_atomic(folder / fname, text)
