@@ -122,8 +122,6 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
     if error not in ERROR_KINDS:
         raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
-    if error == "rel" and kind == "chebyshev":
-        pass  # Chebyshev interpolation has no error kind; relative bounds are certified anyway
     try:
         lo, hi = interval
     except (TypeError, ValueError):

@@ -115,6 +115,14 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
                 prev = f"a{j}"
         top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
         out.append(f"    wire signed [{top_bits - 1}:0] top = t0;")
+    out += _output_stage(design, yf, top_bits, top_frac)
+    return "\n".join(out)
+
+
+def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
+    """The evaluator's last lines, shared by the combinational and pipelined
+    modules: round ``top`` to y's fractional bits, remove y's offset, saturate."""
+    out = []
     shift = top_frac - yf.frac_bits
     rw = max(design.raw_bits, top_bits + max(0, -shift) + 1, design.out_bits + 2,
              yf.offset_code.bit_length() + 2)
@@ -131,7 +139,7 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
             f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
             f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
             "endmodule", ""]
-    return "\n".join(out)
+    return out
 
 
 def pipelined_name(design: HornerDesign) -> str:
@@ -192,22 +200,7 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
     out += [f"    reg signed [{top_bits - 1}:0] top;",
             "    always @(posedge clk) top <= t0;"]
-    shift = top_frac - yf.frac_bits
-    rw = max(design.raw_bits, top_bits + max(0, -shift) + 1, design.out_bits + 2,
-             yf.offset_code.bit_length() + 2)
-    out.append(f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate")
-    if shift > 0:
-        out += _round("top", "r", top_bits, shift, rw, design.rounding)
-    elif shift == 0:
-        out.append(f"    wire signed [{rw - 1}:0] r = top;")
-    else:
-        out.append(f"    wire signed [{rw - 1}:0] r = top <<< {-shift};")
-    out += [f"    localparam signed [{rw - 1}:0] KY = {_lit(yf.offset_code, rw)};",
-            f"    localparam signed [{rw - 1}:0] YMAX = {_lit(yf.max_code, rw)};",
-            f"    wire signed [{rw - 1}:0] raw = r - KY;",
-            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
-            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
-            "endmodule", ""]
+    out += _output_stage(design, yf, top_bits, top_frac)
     return "\n".join(out)
 
 
