@@ -271,3 +271,14 @@ class TestPipelined:
         text = capsys.readouterr().out
         assert code == 0 and text.count("PASS:") == 2 and "latency 2" in text
         assert (out / "chebnorm_dichotomy_d2_pipe.v").exists()
+
+
+def test_unit_rejects_a_table_of_another_function():
+    """A unit's evaluator must approximate its own target's function."""
+    from chebnorm.approx import fit_target
+    from chebnorm.hw.units import design_unit, table_matches
+
+    eta = fit_target("eta_term", 2)
+    assert table_matches("eta", eta) and not table_matches("dichotomy", eta)
+    with pytest.raises(ValueError, match="unit 'dichotomy' needs 1/sqrt"):
+        design_unit("dichotomy", table=eta)

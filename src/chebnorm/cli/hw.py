@@ -150,7 +150,7 @@ def _unit(args, kind, table=None):
 
 
 def run_report(args) -> int:
-    from chebnorm.hw.units import UNIT_KINDS, analyze_unit
+    from chebnorm.hw.units import UNIT_KINDS, UNIT_TARGETS, analyze_unit, table_matches
 
     for kind in args.unit:
         if kind not in UNIT_KINDS:
@@ -159,7 +159,11 @@ def run_report(args) -> int:
     units = []
     for kind in dict.fromkeys(args.unit):
         rounding = args.rounding if kind != "classic" else None
-        unit = _unit(argparse_ns(args, rounding=rounding), kind, table=report.design.table)
+        # a unit whose function is not the report's table gets its own target's table
+        table = report.design.table
+        if kind in UNIT_TARGETS and not table_matches(kind, table):
+            table = None
+        unit = _unit(argparse_ns(args, rounding=rounding), kind, table=table)
         units.append(analyze_unit(unit, synth=not args.no_synth))
     if args.json:
         d = report.as_dict()

@@ -65,7 +65,7 @@ from .fixed import check_int64, check_width, shift_round, signed_bits, unsigned_
 from .horner import HornerDesign, design_horner
 from .verilog import SynthResult, _lit, _round, synthesize_text, verilog_module
 
-__all__ = ["UNIT_KINDS", "UNIT_TARGETS", "Port", "UnitDesign", "UnitReport", "design_unit",
+__all__ = ["UNIT_KINDS", "UNIT_TARGETS", "table_matches", "Port", "UnitDesign", "UnitReport", "design_unit",
            "unit_vectors", "unit_verilog", "unit_testbench", "unit_vector_file",
            "unit_outputs", "analyze_unit", "MAX_COMP_BITS", "MAX_UNIT_FRAC_BITS"]
 
@@ -181,12 +181,32 @@ def _check_kind(kind: str) -> str:
     return kind
 
 
+def table_matches(kind: str, table: CoefficientTable) -> bool:
+    """True when ``table`` approximates the function of unit ``kind``'s target
+    (:data:`UNIT_TARGETS`), whatever its variable is called."""
+    import sympy as sp
+
+    from chebnorm.approx import get_target, parse_function
+
+    target = get_target(UNIT_TARGETS[kind])
+    want = parse_function(target.expression, target.variable)
+    have = parse_function(table.expression, table.variable)
+    return sp.simplify(have.expr.subs(have.var, want.var) - want.expr) == 0
+
+
 def _unit_horner(kind: str, table, in_bits, out_bits, coef_bits, rounding) -> HornerDesign:
     if table is None:
         table = fit_target(UNIT_TARGETS[kind], 2)
         coef_bits = coef_bits if coef_bits is not None else min(out_bits + 4, 30)
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"table {table!r} is not a CoefficientTable; accepted: a loaded table")
+    if not table_matches(kind, table):
+        from chebnorm.approx import get_target
+
+        target = get_target(UNIT_TARGETS[kind])
+        raise ValueError(f"table {table.name!r} approximates {table.expression}, but unit {kind!r} "
+                         f"needs {target.expression} (target {target.name!r}); accepted: a table "
+                         f"of that function")
     try:
         d = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, rounding=rounding,
                           name=table.name)
