@@ -57,12 +57,17 @@ def dot_block(w: int) -> Block:
                                      latency=3))
 
 
-def classic_unit(w: int) -> Block:
-    """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div."""
+def classic_unit(w: int, frac_bits: int | None = None) -> Block:
+    """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div.
+
+    With ``frac_bits = F`` the dividers are priced as in :func:`classic_normalize`:
+    a ``W + F``-bit quotient of ``N << F`` (without it, a ``W``-bit quotient).
+    """
+    q = w if frac_bits is None else w + frac_bits
     return Block("classic normalization", children=(
         dot_block(w),
         Block("square root", Cost(sqrts=(w,), latency=w)),
-        Block("3 dividers", Cost(dividers=(w,) * 3, latency=w)),
+        Block("3 dividers", Cost(dividers=(q,) * 3, latency=q)),
     ))
 
 

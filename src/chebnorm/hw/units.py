@@ -131,7 +131,7 @@ class UnitDesign:
         """The cost model of the unit (:mod:`chebnorm.hw.datapaths`)."""
         w = self.comp_bits
         if self.kind == "classic":
-            return classic_unit(w)
+            return classic_unit(w, self.frac_bits)
         if self.kind == "dichotomy":
             return dichotomy_unit(self.horner, w)
         if self.kind == "quadratic":
