@@ -104,20 +104,27 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
             j = st.power
             out.append(f"    // step {j}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})"
                        f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
-            out.append(f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * xs;")
-            shift = f" <<< {st.product_shift}" if st.product_shift else ""
-            out.append(f"    localparam signed [{st.sum_bits - 1}:0] C{j} = "
-                       f"{_lit(st.coef_shifted, st.sum_bits)};")
-            out.append(f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};")
+            out += _horner_step(design, st, prev, "xs")
             if j > 0:
-                out += _round(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits,
-                              design.rounding)
                 prev = f"a{j}"
         top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
         out.append(f"    wire signed [{top_bits - 1}:0] top = t0;")
     out += _output_stage(design, yf, top_bits, top_frac)
     return "\n".join(out)
 
+
+
+def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
+    """One Horner step ``a_j = R(a_{j+1} * x + q_j)``, shared by the
+    combinational and pipelined evaluators (``prev``: a_{j+1}; ``xs``: x)."""
+    j = st.power
+    shift = f" <<< {st.product_shift}" if st.product_shift else ""
+    out = [f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * {xs};",
+           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {_lit(st.coef_shifted, st.sum_bits)};",
+           f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};"]
+    if j > 0:
+        out += _round(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
+    return out
 
 def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
     """The evaluator's last lines, shared by the combinational and pipelined
@@ -182,14 +189,8 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     for s, st in enumerate(design.stages):
         j = st.power
         out.append(f"    // stage {s + 1}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})")
-        out.append(f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * xs{s};")
-        shift = f" <<< {st.product_shift}" if st.product_shift else ""
-        out.append(f"    localparam signed [{st.sum_bits - 1}:0] C{j} = "
-                   f"{_lit(st.coef_shifted, st.sum_bits)};")
-        out.append(f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};")
+        out += _horner_step(design, st, prev, f"xs{s}")
         if j > 0:
-            out += _round(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits,
-                          design.rounding)
             out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
                     f"    reg signed [{xw - 1}:0] xs{s + 1};",
                     "    always @(posedge clk) begin",

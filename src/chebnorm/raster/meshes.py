@@ -90,9 +90,7 @@ class Mesh:
         if fac.min() < 0 or fac.max() >= len(pos):
             raise ValueError(f"mesh {name!r}: face indices must lie in [0, {len(pos) - 1}]; "
                              f"got [{fac.min()}, {fac.max()}]")
-        area2 = np.linalg.norm(_face_cross(pos, fac), axis=1)
-        diag2 = float(np.sum((pos.max(axis=0) - pos.min(axis=0)) ** 2))
-        bad = area2 <= AREA_RTOL * max(diag2, np.finfo(float).tiny)
+        bad = _degenerate_faces(pos, fac)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(f"mesh {name!r}: triangle {i} (vertices {fac[i].tolist()}) is degenerate "
@@ -122,6 +120,14 @@ class Mesh:
         """Centre of the bounding box and the radius of its bounding sphere."""
         lo, hi = self.positions.min(axis=0), self.positions.max(axis=0)
         return (lo + hi) / 2, float(np.linalg.norm(hi - lo) / 2)
+
+
+def _degenerate_faces(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Mask of triangles whose doubled area is at most AREA_RTOL times the
+    squared bounding-box diagonal (zero area, up to rounding)."""
+    area2 = np.linalg.norm(_face_cross(pos, faces), axis=1)
+    diag2 = float(np.sum((pos.max(axis=0) - pos.min(axis=0)) ** 2))
+    return area2 <= AREA_RTOL * max(diag2, np.finfo(float).tiny)
 
 
 def _face_cross(pos, faces):
@@ -383,9 +389,7 @@ def load_mesh(path, crease_angle: float = np.radians(30.0)) -> Mesh:
     faces = np.asarray(tm.faces, dtype=np.int64)
     if not np.isfinite(pos).all():
         raise ValueError(f"mesh file {path!r}: non-finite vertex coordinates")
-    area2 = np.linalg.norm(_face_cross(pos, faces), axis=1)
-    diag2 = float(np.sum((pos.max(axis=0) - pos.min(axis=0)) ** 2))
-    bad = area2 <= AREA_RTOL * max(diag2, np.finfo(float).tiny)
+    bad = _degenerate_faces(pos, faces)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"mesh file {path!r}: triangle {i} is degenerate (zero area); "
