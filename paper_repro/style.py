@@ -11,7 +11,7 @@
   producing command, notes), ``%.10g`` floats, rows in the order given (the
   callers give them sorted).
 
-Every file goes through :func:`chebnorm.approx._io.write_atomic` (temporary
+Every file goes through :func:`chebnorm.approx.files.write_atomic` (temporary
 file, then rename).
 """
 
@@ -29,7 +29,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from chebnorm.approx._io import write_atomic
+from chebnorm.approx.files import write_atomic
 
 __all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "write_csv", "write_json",
            "write_text", "fmt", "COLORS"]

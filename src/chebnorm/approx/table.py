@@ -171,6 +171,6 @@ class CoefficientTable:
 
     def save(self, path) -> None:
         """Write the JSON atomically (temporary file, then rename)."""
-        from ._io import write_atomic
+        from .files import write_atomic
 
         write_atomic(path, self.to_json())

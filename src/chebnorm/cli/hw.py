@@ -213,7 +213,7 @@ def run_unit(args) -> int:
 def run_sweep(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx._io import write_atomic
+    from chebnorm.approx.files import write_atomic
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)

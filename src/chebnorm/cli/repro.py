@@ -16,7 +16,7 @@ from pathlib import Path
 
 from chebnorm.approx import TARGETS, fit_target, target_names
 from chebnorm.export import c_header, json_text
-from chebnorm.approx._io import write_atomic
+from chebnorm.approx.files import write_atomic
 
 #: fractional bits of the fixed-point part of the exported tables
 EXPORT_FRAC_BITS = 24

@@ -8,7 +8,7 @@ the table and the generating command and returns text. Use
 from __future__ import annotations
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx._io import write_atomic
+from chebnorm.approx.files import write_atomic
 
 from .c import c_header, horner_rounding_bound
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx._io import write_atomic
+from chebnorm.approx.files import write_atomic
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block

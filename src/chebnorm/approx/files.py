@@ -1,4 +1,4 @@
-"""Atomic file writing: a reader never sees a half-written output."""
+"""Atomic file writing, the one writer for every file chebnorm writes (images included): a reader never sees a half-written output."""
 
 from __future__ import annotations
 

@@ -1,0 +1,93 @@
+"""Text that reaches generated code: one validation/escaping function per use.
+
+Every string chebnorm writes into generated C, C++, Verilog, VHDL, GLSL, WGSL,
+HLSL or CSV comes from somewhere a user controls (a table file, a command
+line), so it passes through exactly one of these functions first:
+
+* :func:`identifier` -- a name that becomes part of a symbol (function,
+  macro, module, entity, port). It must match ``[A-Za-z_][A-Za-z0-9_]*``;
+  anything else is refused, never "fixed".
+* :func:`comment_text` -- free text placed inside a comment of any of the
+  target languages. The result is one line of printable ASCII that cannot
+  close or open a block comment (``*/``, ``/*``: WGSL's block comments
+  nest), cannot continue a line comment onto the next line (a trailing
+  backslash, or the C trigraph ``??/``), and contains no line terminator,
+  so it is inert in ``//``, ``/* */`` and ``--`` comments alike.
+* :func:`csv_cell` -- a text cell of a CSV file (RFC 4180 quoting, and no
+  leading ``= + - @`` that a spreadsheet would run as a formula).
+
+>>> identifier("dichotomy_d2")
+'dichotomy_d2'
+>>> comment_text("1/sqrt(x) */ int injected = 1; /*")
+'1/sqrt(x) * / int injected = 1; / *'
+>>> csv_cell('=cmd|" /C calc"!A0')
+'"\\'=cmd|"" /C calc""!A0"'
+"""
+
+from __future__ import annotations
+
+import re
+
+__all__ = ["identifier", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
+
+IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
+_IDENT = re.compile(IDENTIFIER_PATTERN + r"\Z")
+_MAX_IDENT = 63  # C99 guarantees 63 significant characters in an internal identifier
+
+
+def identifier(name, *, field: str = "name") -> str:
+    """Return ``name`` if it is a safe identifier in every target, else raise.
+
+    Accepted: ``[A-Za-z_][A-Za-z0-9_]*``, at most 63 characters (C99's
+    significant length). Raises :class:`ValueError` naming ``field``.
+
+    >>> identifier("rsqrt d2", field="table.name")
+    Traceback (most recent call last):
+    ...
+    ValueError: table.name: 'rsqrt d2' is not an identifier: expected [A-Za-z_][A-Za-z0-9_]*, at most 63 characters
+    """
+    if not isinstance(name, str) or not _IDENT.match(name) or len(name) > _MAX_IDENT:
+        shown = name if isinstance(name, str) else type(name).__name__
+        raise ValueError(f"{field}: {shown!r:.80} is not an identifier: expected "
+                         f"{IDENTIFIER_PATTERN}, at most {_MAX_IDENT} characters")
+    return name
+
+
+def comment_text(text, *, max_length: int = 400) -> str:
+    """Make ``text`` inert inside a comment of C, Verilog, VHDL, GLSL, WGSL or HLSL.
+
+    Characters outside printable ASCII (line breaks included) become ``_``;
+    backslashes become ``_`` (line continuation); ``*/`` and ``/*`` get a space
+    between their characters, ``??`` too (trigraphs), repeatedly until none is
+    left. Longer texts are cut to ``max_length`` characters and end in ``...``.
+    """
+    text = str(text)
+    out = "".join(ch if " " <= ch <= "~" and ch != "\\" else "_" for ch in text)
+    while True:
+        fixed = out.replace("*/", "* /").replace("/*", "/ *").replace("??", "? ?")
+        if fixed == out:
+            break
+        out = fixed
+    if len(out) > max_length:
+        out = out[: max_length - 3].rstrip() + "..."
+        # cutting cannot create a pair: every pair was split above and '...' starts none
+    return out
+
+
+def csv_cell(text) -> str:
+    """Quote ``text`` as one CSV cell (RFC 4180), neutralising spreadsheet formulas.
+
+    A cell starting with ``=``, ``+``, ``-``, ``@``, tab or carriage return that
+    is not a plain number gets a leading apostrophe (the OWASP advice for CSV
+    injection); a cell holding a comma, quote or line break is quoted with
+    doubled quotes.
+    """
+    text = str(text)
+    if text[:1] in ("=", "+", "-", "@", "\t", "\r"):
+        try:
+            float(text)
+        except ValueError:
+            text = "'" + text
+    if any(ch in text for ch in ',"\n\r'):
+        text = '"' + text.replace('"', '""') + '"'
+    return text
