@@ -40,17 +40,25 @@ CONFIGS = {"O2": ["-O2"], "O3-native": ["-O3", "-march=native"]}
 #: the strict flags of the smoke test
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"]
 
+def method_kernels() -> dict:
+    """C kernel -> the registered method it implements (the registry's ``c_kernel``)."""
+    from chebnorm.methods import registered_methods
+
+    return {m.c_kernel: m.name for m in registered_methods() if m.c_kernel}
+
+
+#: the C kernels that are no registered method: baselines of the classic
+#: normalization and the direct angular interpolation (C8), with the Python
+#: method whose output each approximates
+BASELINES = {"rsqrt_mul": "exact", "sse_rsqrt": "exact", "angular_direct": "slerp"}
+_METHODS_C = method_kernels()
 #: C kernel -> Python span_normals method it mirrors (None: no Python twin)
-PY_METHOD = {
-    "classic": "exact", "rsqrt_mul": "exact", "sse_rsqrt": "exact", "none": "none",
-    "newton": "newton", "lyon": "lyon", "slerp": "slerp", "dichotomy": "dichotomy",
-    "quadratic": "quadratic", "angular": "angular", "angular_direct": "slerp",
-    "midpoint_classic": None, "midpoint_poly": None,
-    "phong_n": None, "phong_nlh": None, "bump": None,
-}
-#: kernels writing a unit-ish normal per pixel (accuracy is measured on these)
-NORMAL_KERNELS = ("classic", "rsqrt_mul", "sse_rsqrt", "none", "newton", "lyon", "slerp",
-                  "dichotomy", "quadratic", "angular", "angular_direct")
+PY_METHOD = {**_METHODS_C, **BASELINES, "midpoint_classic": None, "midpoint_poly": None,
+             "phong_n": None, "phong_nlh": None, "bump": None}
+#: kernels writing a unit-ish normal per pixel (accuracy is measured on these): the
+#: classic one first, its baselines, the other methods' kernels, direct angular last
+NORMAL_KERNELS = ("classic", "rsqrt_mul", "sse_rsqrt",
+                  *[k for k in _METHODS_C if k != "classic"], "angular_direct")
 SHADING_KERNELS = ("phong_n", "phong_nlh", "bump")
 MIDPOINT_KERNELS = ("midpoint_classic", "midpoint_poly")
 
@@ -69,12 +77,12 @@ def gcc() -> str:
 
 
 def tables(psi_max="pi/4"):
-    """The two degree-2 tables the C kernels use (those of ``span_normals``'
-    defaults for ``psi_max = pi/4``)."""
-    from chebnorm.approx import fit_target
+    """The degree-2 tables the C kernels use, by target name (``span_normals``'
+    defaults, :func:`chebnorm.methods.default_tables`, for ``psi_max``)."""
+    from chebnorm.methods import default_tables, table_methods
 
-    return {"dichotomy": fit_target("dichotomy", 2, psi_max=psi_max),
-            "midpoint": fit_target("midpoint", 2, psi_max=psi_max)}
+    specs = table_methods()
+    return {specs[m].target: t for m, t in default_tables(psi_max=psi_max).items()}
 
 
 def write_headers(directory: Path, psi_max="pi/4") -> list[Path]:

@@ -80,6 +80,8 @@ sys.path.insert(0, str(HERE))
 
 import ckernels as ck  # noqa: E402
 
+from chebnorm.methods import get_method  # noqa: E402
+
 #: the claims' speed-ups (seed 000, SPEC.md claims ledger)
 CLAIM_C6 = 2.5
 CLAIM_C7_MIDPOINT = 2.5
@@ -98,7 +100,10 @@ LABELS = {
     "dichotomy": "dichotomy (deg-2 table)", "quadratic": "quadratic (midpoint table, fwd diff)",
     "angular": "angular recurrence", "angular_direct": "direct angular (cos/sin per pixel)",
 }
-SLERP_FAMILY = ("slerp", "dichotomy", "angular", "angular_direct")
+#: kernels whose ideal is the slerp point (evenly spaced in angle): the methods
+#: registered with ``ideal="slerp"`` and direct angular interpolation
+SLERP_FAMILY = (*[k for k, m in ck.method_kernels().items() if get_method(m).ideal == "slerp"],
+                "angular_direct")
 
 
 # ------------------------------------------------------------------ spans

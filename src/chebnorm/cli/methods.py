@@ -1,4 +1,4 @@
-"""``chebnorm methods``: errors and operation counts of every seed-000 method on one span."""
+"""``chebnorm methods``: errors and operation counts of every registered method on one span."""
 
 from __future__ import annotations
 
@@ -31,14 +31,14 @@ def _ops(d: dict) -> dict:
 
 
 def run(args) -> int:
-    from chebnorm.methods import METHODS, analyze, angular_drift
+    from chebnorm.methods import analyze, angular_drift, method_names
 
     if args.dtype not in ("float32", "float64"):
         raise ValueError(f"dtype {args.dtype!r} is not supported; accepted: float32, float64")
     if not math.isfinite(args.angle):
         raise ValueError(f"angle {args.angle!r} is not finite; accepted: 0 <= PSI < pi (radians)")
     dtype = np.dtype(args.dtype).type
-    reports = [analyze(m, args.angle, args.span, dtype) for m in METHODS]
+    reports = [analyze(m, args.angle, args.span, dtype) for m in method_names()]
     drift = None
     if args.drift:
         drift = {dt: angular_drift(args.angle, args.span, np.dtype(dt).type) for dt in ("float32", "float64")}

@@ -9,7 +9,7 @@ from ._common import print_json
 
 
 def register(sub) -> None:
-    from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
+    from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES, available_methods
 
     p = sub.add_parser("render", help="render a mesh and measure the shading error",
                        description="Render a mesh with a shading mode and compare it with a "
@@ -19,7 +19,8 @@ def register(sub) -> None:
                    help=f"{'|'.join(MESH_NAMES)} or an .obj/.ply/.stl path (default teapot)")
     p.add_argument("--shading", default="phong", help=f"{'|'.join(SHADING_MODES)} (default phong)")
     p.add_argument("--method", default="exact",
-                   help="normalization method for phong/adaptive/bump (default exact)")
+                   help=f"normalization method for phong/adaptive/bump: "
+                   f"{'|'.join(available_methods())} (default exact; checked by render)")
     p.add_argument("--size", nargs=2, type=int, default=(512, 512), metavar=("W", "H"),
                    help="image size in pixels (default 512 512)")
     p.add_argument("--tess", type=int, default=None, help="tessellation level (mesh default)")

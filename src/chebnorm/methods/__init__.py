@@ -20,6 +20,12 @@ method         what it does                                                seed 
 ``angular``    ``N_{j+1} = 2 cos(phi) N_j - N_{j-1}``                      method 6
 =============  ==========================================================  ==========
 
+The methods themselves are entries of the method registry
+(:mod:`chebnorm.approx.method_registry`): :func:`method_names` lists them,
+:func:`register` adds one (an entry plus its kernel), :mod:`.registry` binds
+their kernels and fits their default tables. ``METHODS`` is
+``method_names()`` at the time it is read.
+
 Layer rule: imports numpy and :mod:`chebnorm.approx` only.
 
 >>> import numpy as np
@@ -34,12 +40,23 @@ from .analysis import (N_SPECULAR, DriftReport, ErrorSweep, MethodReport, analyz
                        error_sweep, length_error_bound, reference_normals, slerp_normals)
 from .counting import PAPER_COUNTS, NormalizationCounts, OpCounts, count_ops, normalization_ops
 from .ops import OP_KINDS
-from .spans import (ANTIPARALLEL_TOL, METHODS, TABLE_METHODS, UNIT_TOL, SpanNormals, default_tables,
-                    span_normals)
+from .registry import (MethodSpec, TableSpec, default_tables, get_method, method_kernel,
+                       method_kernels, method_names, register, registered_methods, table_methods,
+                       unit_tables, unregister)
+from .spans import ANTIPARALLEL_TOL, UNIT_TOL, SpanNormals, span_normals
 
 __all__ = [
-    "METHODS", "TABLE_METHODS", "SpanNormals", "span_normals", "default_tables", "UNIT_TOL",
+    "METHODS", "method_names", "get_method", "register", "unregister", "MethodSpec", "TableSpec",
+    "registered_methods", "method_kernel", "method_kernels", "table_methods", "unit_tables",
+    "SpanNormals", "span_normals", "default_tables", "UNIT_TOL",
     "ANTIPARALLEL_TOL", "OP_KINDS", "OpCounts", "count_ops", "NormalizationCounts",
     "normalization_ops", "PAPER_COUNTS", "MethodReport", "analyze", "ErrorSweep", "error_sweep",
     "DriftReport", "angular_drift", "length_error_bound", "N_SPECULAR", "reference_normals", "slerp_normals",
 ]
+
+
+def __getattr__(name):
+    # METHODS stays a tuple of names, read from the registry when accessed (PEP 562)
+    if name == "METHODS":
+        return method_names()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -34,7 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counting import OpCounts, _generic_pair, count_ops
-from .spans import _levels, METHODS, TABLE_METHODS, _check_dtype, _check_method, default_tables, span_normals
+from .registry import default_tables, method_names
+from .spans import _check_dtype, _check_method, _levels, span_normals
 
 __all__ = ["MethodReport", "analyze", "ErrorSweep", "error_sweep", "DriftReport", "angular_drift",
            "N_SPECULAR", "reference_normals", "slerp_normals", "length_error_bound"]
@@ -137,7 +138,7 @@ def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
     >>> round(r.max_length_error, 6), r.ops.per_pixel["sqrt"]
     (0.008471, 0)
     """
-    method = _check_method(method)
+    method = _check_method(method).name
     dt = _check_dtype(dtype)
     (psi_v,) = _check_psi(psi)
     m = _check_m(m)
@@ -179,9 +180,9 @@ class ErrorSweep:
         return out if m is None else out[:, self.ms.index(m)]
 
 
-def error_sweep(methods=METHODS, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np.float32), *,
+def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np.float32), *,
                 tables=None) -> ErrorSweep:
-    """Errors of every method over span angles ``psis`` (default 33 points on [0, pi/2]),
+    """Errors of ``methods`` (None: every registered method) over span angles ``psis`` (default 33 points on [0, pi/2]),
     span lengths ``ms`` and dtypes; vectorized over the angles (one span per angle).
 
     ``tables=None``: the default degree-2 tables for pi/4 when they cover
@@ -191,7 +192,8 @@ def error_sweep(methods=METHODS, psis=None, ms=(8, 64, 512), dtypes=(np.float64,
     >>> round(float(s.get("diffuse_error", "none", m=4)[0]), 7)   # delta_d(0.2), claim C1
     0.0049958
     """
-    methods = tuple(_check_method(mm) for mm in methods)
+    specs = tuple(_check_method(mm) for mm in (method_names() if methods is None else methods))
+    methods = tuple(sp.name for sp in specs)
     psis = np.linspace(0.0, math.pi / 2, 33) if psis is None else _check_psi(psis)
     ms = tuple(_check_m(mm) for mm in ms)
     dts = tuple(_check_dtype(d) for d in dtypes)
@@ -202,11 +204,11 @@ def error_sweep(methods=METHODS, psis=None, ms=(8, 64, 512), dtypes=(np.float64,
     pairs = [_generic_pair(p) for p in psis]
     nl = np.array([a for a, _ in pairs])
     nr = np.array([b for _, b in pairs])
-    for i, meth in enumerate(methods):
+    for i, entry in enumerate(specs):
         for d, dt in enumerate(dts):
             for k, m in enumerate(ms):
-                res = span_normals(meth, nl, nr, np.full(len(psis), m), dtype=dt,
-                                   tables=tab if meth in TABLE_METHODS else None)
+                res = span_normals(entry, nl, nr, np.full(len(psis), m), dtype=dt,
+                                   tables=tab if entry.table is not None else None)
                 sid = np.repeat(np.arange(len(psis)), np.diff(res.offsets))
                 err, spec = _pixel_errors(res.normals.astype(np.float64), nl[sid], nr[sid],
                                           psis[sid], res.t)
@@ -257,12 +259,13 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
     >>> round(length_error_bound("none", math.pi / 4, 64), 7)
     0.0761205
     """
-    method = _check_method(method)
+    spec = _check_method(method)
+    method = spec.name
     eps = float(np.finfo(_check_dtype(dtype)).eps)
     (psi,) = _check_psi(psi)
     m = _check_m(m)
     r = math.cos(psi / 2)
-    if method in ("dichotomy", "quadratic"):
+    if spec.table is not None:
         table = default_tables()[method] if tables is None or method not in tables else tables[method]
         e = 0.0 if table is None else table.rel_error_bound
     if method == "exact":
@@ -284,8 +287,11 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
         return b + 16 * (lv + 1) * eps
     if method == "quadratic":
         return 1 - math.sqrt(1 - (1 - r) ** 2 / 4) + e * (1 + e) + 8 * (m + 1) * eps
-    drift = 4 * m * eps * m / psi if psi > 0 else 0.0
-    return min(drift, 4 * m * math.sqrt(eps)) + 64 * eps
+    if method == "angular":
+        drift = 4 * m * eps * m / psi if psi > 0 else 0.0
+        return min(drift, 4 * m * math.sqrt(eps)) + 64 * eps
+    raise ValueError(f"no analytic length bound is known for method {method!r}; known for: "
+                     f"exact, slerp, none, newton, lyon, dichotomy, quadratic, angular")
 
 
 @dataclass(frozen=True)

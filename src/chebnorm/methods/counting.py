@@ -43,9 +43,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels as K
 from .ops import OP_KINDS, Counted, Counter, CountingOps
-from .spans import METHODS, TABLE_METHODS, _check_method, _levels, _resolve_table, span_normals
+from .registry import method_kernel, method_kernels
+from .spans import _check_method, _levels, _resolve_table, span_normals
 
 __all__ = ["OpCounts", "count_ops", "NormalizationCounts", "normalization_ops", "PAPER_COUNTS"]
 
@@ -56,7 +56,12 @@ PAPER_COUNTS = {
     "lyon": {},
 }
 
-_NORMALIZERS = {"exact": K.normalize_classic, "newton": K.normalize_newton, "lyon": K.normalize_lyon}
+
+
+def _normalizers() -> dict:
+    """The methods whose kernel is linear interpolation then a normalization step."""
+    return {name: k.normalizer for name, k in method_kernels().items()
+            if getattr(k, "normalizer", None) is not None}
 
 
 def _clean(v):
@@ -94,13 +99,15 @@ class NormalizationCounts:
 
 
 def normalization_ops(method: str) -> NormalizationCounts:
-    """Count ``exact`` (classic ``N/sqrt(N.N)``), ``newton`` or ``lyon`` on one vector."""
-    if method not in _NORMALIZERS:
+    """Count ``exact`` (classic ``N/sqrt(N.N)``), ``newton`` or ``lyon`` (any method
+    whose kernel has a ``normalizer``) on one vector."""
+    normalizers = _normalizers()
+    if method not in normalizers:
         raise ValueError(f"method {method!r} has no separate normalization step; accepted: "
-                         f"{', '.join(_NORMALIZERS)}")
+                         f"{', '.join(normalizers)}")
     c = Counter()
     n = tuple(Counted(v, c) for v in (0.6, 0.5, 0.4))
-    _NORMALIZERS[method](CountingOps(c), n)
+    normalizers[method](CountingOps(c), n)
     return NormalizationCounts(method, dict(c.counts["setup"]), c.pow2["setup"])
 
 
@@ -111,29 +118,25 @@ def _generic_pair(psi: float):
     return e1, math.cos(psi) * e1 + math.sin(psi) * e2
 
 
-def _run_counting(method, nl, nr, t0, dt, count, coeffs, levels, reanchor):
-    """Run ``method`` on one span with counting scalars; returns (counter, values (count, 3))."""
+def _run_counting(kern, nl, nr, t0, dt, count, coeffs, levels, reanchor):
+    """Run kernel ``kern`` on one span with counting scalars; returns (counter, values (count, 3))."""
     c = Counter()
     ops = CountingOps(c)
     a = tuple(Counted(v, c) for v in nl)
     b = tuple(Counted(v, c) for v in nr)
     ct0, cdt = Counted(t0, c), Counted(dt, c)
     vals = []
-    if method in K.DIRECT:
-        kern = K.DIRECT[method]
-        st = kern.setup(ops, a, b)
+    if kern.shape == "direct":
+        st = kern.setup(ops, a, b, coeffs)
         ops.phase("pixel")
         for j in range(count):
             vals.append(kern.pixel(ops, st, Counted(t0 + j * dt, c)))
             ops.produced(1)
-    elif method == "quadratic":
-        vals = list(K.quadratic_steps(ops, a, b, ct0, cdt, count, coefficients=coeffs,
-                                      start_at_left=t0 == 0))
-    elif method == "angular":
-        vals = list(K.angular_steps(ops, a, b, ct0, cdt, count, start_at_left=t0 == 0,
-                                    reanchor=reanchor))
+    elif kern.shape == "steps":
+        vals = list(kern.steps(ops, a, b, ct0, cdt, count, coefficients=coeffs,
+                               start_at_left=t0 == 0, reanchor=reanchor))
     else:
-        nodes = K.dichotomy_tree(ops, a, b, levels, coeffs)
+        nodes = kern.tree(ops, a, b, levels, coeffs)
         ts = [t0 + j * dt for j in range(count)]
         scale = 2 ** levels
         if all(float(t * scale).is_integer() for t in ts):
@@ -143,9 +146,9 @@ def _run_counting(method, nl, nr, t0, dt, count, coeffs, levels, reanchor):
             c.pixels["pixel"] = 0  # the midpoints are nodes, the pixels are the picks
             ops.phase("pixel")
             for t in ts:
-                k, f = K.dichotomy_fraction(ops, Counted(t, c), levels)
+                k, f = kern.fraction(ops, Counted(t, c), levels)
                 ka, kb = int(k.v), min(int(k.v) + 1, scale)
-                vals.append(K.dichotomy_pick(ops, nodes[ka], nodes[kb], f))
+                vals.append(kern.pick(ops, nodes[ka], nodes[kb], f))
                 ops.produced(1)
     values = np.array([[float(x) for x in v] for v in vals])
     return c, values
@@ -168,26 +171,29 @@ def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
     >>> count_ops("quadratic", 64).per_pixel
     {'add': 6, 'mul': 0, 'div': 0, 'sqrt': 0, 'trig': 0, 'cmp': 0}
     """
-    method = _check_method(method)
+    spec = _check_method(method)
+    kern = method_kernel(spec)
     nl, nr = _generic_pair(psi)
     if isinstance(m, bool) or not isinstance(m, (int, np.integer)):
         raise ValueError(f"span length m = {m!r} is not an integer; accepted: m >= 1")
     m = int(m)
-    res = span_normals(method, nl[None], nr[None], [m], t0=None if t0 == 0 else [t0],
+    res = span_normals(spec, nl[None], nr[None], [m], t0=None if t0 == 0 else [t0],
                        dt=None if dt is None else [dt], count=None if count is None else [count],
                        tables=tables, angular_reanchor=angular_reanchor)  # validates
     dt = 1.0 / m if dt is None else float(dt)
     count = m + 1 if count is None else int(count)
+    tree = kern.shape == "tree"
     levels = (int(_levels(np.array([dt]), np.array([float(t0)]), np.array([count]),
-                          np.array([float(nl @ nr)]))[0]) if method == "dichotomy" else 0)
+                          np.array([float(nl @ nr)]))[0]) if tree else 0)
     coeffs = None
-    if method in TABLE_METHODS:
-        table = _resolve_table(method, tables, np.array([float(nl @ nr)]), np.array([levels]))
+    if spec.table is not None:
+        table = _resolve_table(spec, tables, np.array([float(nl @ nr)]),
+                               np.array([levels]) if tree else None)
         coeffs = None if table is None else table.coefficients
-    c, values = _run_counting(method, nl, nr, float(t0), dt, count, coeffs, levels, angular_reanchor)
+    c, values = _run_counting(kern, nl, nr, float(t0), dt, count, coeffs, levels, angular_reanchor)
     loop = c.pixels["pixel"]
     per_pixel = {k: _clean(c.counts["pixel"][k] / loop) if loop else 0 for k in OP_KINDS}
-    out = OpCounts(method=method, m=m, per_pixel=per_pixel, per_span=dict(c.counts["setup"]),
+    out = OpCounts(method=spec.name, m=m, per_pixel=per_pixel, per_span=dict(c.counts["setup"]),
                    pixels_in_setup=c.pixels["setup"], pixels_in_loop=loop,
                    pow2_per_pixel=_clean(c.pow2["pixel"] / loop) if loop else 0,
                    pow2_per_span=c.pow2["setup"],

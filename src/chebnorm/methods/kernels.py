@@ -8,13 +8,22 @@ array entry per span or per pixel) and on counting scalars
 ``1 + N_l.N_r > 0``, positive steps and tables covering the angles, as
 checked once by :func:`chebnorm.methods.span_normals`.
 
-Three shapes of kernel:
+Three shapes of kernel object, told apart by its ``shape`` attribute (the
+method registry, :mod:`chebnorm.approx.method_registry`, names one object per
+method; :func:`chebnorm.methods.span_normals` dispatches on the shape only):
 
-* direct (``exact``, ``none``, ``newton``, ``lyon``, ``slerp``): ``setup``
-  once per span, then ``pixel(t)`` at any position ``t``, independently;
-* stepping (``quadratic``, ``angular``): a generator yielding the pixels
+* ``"direct"`` (``exact``, ``none``, ``newton``, ``lyon``, ``slerp``):
+  ``setup(ops, nl, nr, coefficients)`` once per span, then
+  ``pixel(ops, state, t)`` at any position ``t``, independently;
+* ``"steps"`` (``quadratic``, ``angular``): ``steps(ops, nl, nr, t0, dt, n, *,
+  coefficients, start_at_left, reanchor)``, a generator yielding the pixels
   ``t0, t0 + dt, ...`` in order (forward differences, recurrence);
-* tree (``dichotomy``): successive angle halving, then a pick per pixel.
+* ``"tree"`` (``dichotomy``): ``tree(ops, nl, nr, levels, coefficients)``,
+  successive angle halving, then ``fraction`` and ``pick`` per pixel.
+
+``coefficients`` are those of the method's table (ascending, None: exact
+``1/sqrt``); a kernel's ``table_scale`` says what its table's variable is:
+``table_scale * cos(angle)`` of the two normals it combines.
 
 Linear interpolation is ``N(t) = N_l + t (N_r - N_l)`` (3 mul, 3 add per
 pixel, the difference once per span).
@@ -22,10 +31,13 @@ pixel, the difference once per span).
 
 from __future__ import annotations
 
-__all__ = ["DIRECT", "dot", "normalize_classic", "normalize_newton", "normalize_lyon",
+__all__ = ["SHAPES", "EXACT", "NONE", "NEWTON", "LYON", "SLERP", "QUADRATIC", "ANGULAR",
+           "DICHOTOMY", "dot", "normalize_classic", "normalize_newton", "normalize_lyon",
            "angular_steps", "quadratic_steps", "dichotomy_tree", "dichotomy_pick",
            "dichotomy_fraction", "horner", "TINY"]
 
+#: the kernel shapes (see the module docstring)
+SHAPES = ("direct", "steps", "tree")
 #: guard for divisions by sin(psi) or sin of a zero angle (parallel end normals)
 TINY = 1e-30
 
@@ -88,10 +100,13 @@ def normalize_lyon(ops, n):
 class _Linear:
     """Linear interpolation followed by a normalizer (or none)."""
 
+    shape = "direct"
+    table_scale = 1.0
+
     def __init__(self, normalizer):
         self.normalizer = normalizer
 
-    def setup(self, ops, nl, nr):
+    def setup(self, ops, nl, nr, coefficients=None):
         return {"a": nl, "d": vsub(nr, nl)}
 
     def pixel(self, ops, st, t):
@@ -104,7 +119,11 @@ class _Slerp:
     ``psi = arccos(N_a.N_b)``; ``1/sin psi`` once per span. Parallel end
     normals (psi = 0) use ``psi = TINY``, which reduces to linear interpolation."""
 
-    def setup(self, ops, nl, nr):
+    shape = "direct"
+    table_scale = 1.0
+    normalizer = None
+
+    def setup(self, ops, nl, nr, coefficients=None):
         c = ops.minimum(dot(nl, nr), 1.0)
         psi = ops.maximum(ops.arccos(c), TINY)
         return {"a": nl, "b": nr, "psi": psi, "inv": 1.0 / ops.sin(psi)}
@@ -115,14 +134,11 @@ class _Slerp:
         return vadd(vmul(st["a"], wa), vmul(st["b"], wb))
 
 
-#: the direct kernels by method name
-DIRECT = {
-    "exact": _Linear(normalize_classic),
-    "none": _Linear(None),
-    "newton": _Linear(normalize_newton),
-    "lyon": _Linear(normalize_lyon),
-    "slerp": _Slerp(),
-}
+EXACT = _Linear(normalize_classic)
+NONE = _Linear(None)
+NEWTON = _Linear(normalize_newton)
+LYON = _Linear(normalize_lyon)
+SLERP = _Slerp()
 
 
 # ------------------------------------------------------ stepping kernels
@@ -206,6 +222,28 @@ def quadratic_steps(ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=
         yield v
 
 
+class _Steps:
+    """A stepping kernel: ``steps`` runs ``generator`` (which takes the options it names)."""
+
+    shape = "steps"
+    table_scale = 1.0
+    normalizer = None
+
+    def __init__(self, generator, options):
+        self.generator = generator
+        self.options = options
+
+    def steps(self, ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=False,
+              reanchor=None):
+        given = {"coefficients": coefficients, "reanchor": reanchor}
+        kw = {k: given[k] for k in self.options}
+        return self.generator(ops, nl, nr, t0, dt, n, start_at_left=start_at_left, **kw)
+
+
+QUADRATIC = _Steps(quadratic_steps, ("coefficients",))
+ANGULAR = _Steps(angular_steps, ("reanchor",))
+
+
 # ------------------------------------------------------------ dichotomy
 def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
     """Seed 000, method 4: ``levels`` rounds of angle halving; returns the
@@ -246,3 +284,17 @@ def dichotomy_fraction(ops, t, levels):
 def dichotomy_pick(ops, a, b, f):
     """Linear pick between the nodes around an off-grid pixel: ``A + f (B - A)``."""
     return lerp(a, vsub(b, a), f)
+
+
+class _Tree:
+    """The dichotomy kernel: its table's variable is ``z = 2 cos(theta)``."""
+
+    shape = "tree"
+    table_scale = 2.0
+    normalizer = None
+    tree = staticmethod(dichotomy_tree)
+    fraction = staticmethod(dichotomy_fraction)
+    pick = staticmethod(dichotomy_pick)
+
+
+DICHOTOMY = _Tree()

@@ -1,25 +1,24 @@
-"""``span_normals``: the public span interpolator, its input validation and default tables."""
+"""``span_normals``: the public span interpolator and its input validation.
+
+Methods, their kernels and tables come from the method registry
+(:mod:`chebnorm.approx.method_registry`, bound in :mod:`.registry`).
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
-from chebnorm.approx import CoefficientTable, fit_target
+from chebnorm.approx import CoefficientTable, get_target
+from chebnorm.approx.method_registry import MethodSpec, get_method
 
-from . import kernels as K
 from .ops import NumpyOps
+from .registry import default_tables, method_kernel
 
-__all__ = ["METHODS", "TABLE_METHODS", "SpanNormals", "span_normals", "default_tables",
-           "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES"]
+__all__ = ["SpanNormals", "span_normals", "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES"]
 
-#: the eight methods of seed 000, in the order the papers and the CLI list them
-METHODS = ("exact", "none", "newton", "lyon", "slerp", "dichotomy", "quadratic", "angular")
-#: methods that read a CoefficientTable, and the registry target each table approximates
-TABLE_METHODS = {"dichotomy": "dichotomy", "quadratic": "midpoint"}
 #: accepted | |N| - 1 | of an end normal
 UNIT_TOL = 1e-5
 #: accepted smallest 1 + N_l.N_r / (|N_l| |N_r|) (angle between end normals below pi)
@@ -44,19 +43,6 @@ class SpanNormals:
     def span(self, i: int) -> np.ndarray:
         """The normals of span ``i``."""
         return self.normals[self.offsets[i]:self.offsets[i + 1]]
-
-
-@lru_cache(maxsize=None)
-def default_tables(psi_max: float | str = "pi/4", degree: int = 2) -> dict[str, CoefficientTable]:
-    """The tables used when ``span_normals`` gets none: ``fit_target("dichotomy", degree)``
-    and ``fit_target("midpoint", degree)`` for end normals up to ``psi_max`` apart
-    (built once per process and argument).
-
-    >>> t = default_tables()
-    >>> [round(c, 5) for c in t["dichotomy"].coefficients]
-    [0.68076, -0.11881, 0.01422]
-    """
-    return {m: fit_target(target, degree, psi_max=psi_max) for m, target in TABLE_METHODS.items()}
 
 
 # ------------------------------------------------------------ validation
@@ -101,10 +87,9 @@ def _as_per_span(name, a, s, dtype, default):
     return out
 
 
-def _check_method(method) -> str:
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; accepted: {', '.join(METHODS)}")
-    return method
+def _check_method(method) -> MethodSpec:
+    """The registry entry of ``method`` (a name, or an entry already looked up)."""
+    return method if isinstance(method, MethodSpec) else get_method(method)
 
 
 def _check_dtype(dtype):
@@ -117,17 +102,30 @@ def _check_dtype(dtype):
     return dt
 
 
-def _angle_range_of_table(method: str, table: CoefficientTable) -> tuple[float, float]:
-    """(smallest, largest) angle between end normals the table's interval covers."""
+def _angle_range_of_table(scale: float, table: CoefficientTable) -> tuple[float, float]:
+    """(smallest, largest) angle between end normals the table's interval covers,
+    the table's variable being ``scale * cos(angle)``."""
     lo, hi = table.interval_float
-    scale = 2.0 if method == "dichotomy" else 1.0
     big = math.acos(min(1.0, max(-1.0, lo / scale)))
     small = math.acos(min(1.0, max(-1.0, hi / scale)))
     return small, big
 
 
-def _resolve_table(method, tables, cosines, levels):
-    """The table for ``method`` (None: exact), checked to cover what the spans need."""
+def _needed_range(scale, cosines, levels):
+    """(lowest, highest) value of the table's variable the spans need (None: no table use)."""
+    c = np.clip(cosines, -1.0, 1.0)
+    if levels is None:
+        return scale * float(np.min(c)), scale * float(np.max(c))
+    if not (levels > 0).any():
+        return None, None
+    deepest = np.arccos(c) / np.exp2(np.maximum(levels - 1, 0))
+    return scale * float(np.min(c[levels > 0])), scale * float(np.max(np.cos(deepest[levels > 0])))
+
+
+def _resolve_table(spec, tables, cosines, levels):
+    """The table for method ``spec`` (None: exact), checked to cover what the spans need
+    (``levels``: the tree kernel's depth per span, None for the others)."""
+    method = spec.name
     defaults = tables is None or method not in tables
     table = default_tables()[method] if defaults else tables[method]
     if table is None:
@@ -135,30 +133,26 @@ def _resolve_table(method, tables, cosines, levels):
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"tables[{method!r}] is a {type(table).__name__}; accepted: a "
                          f"CoefficientTable, or None for exact denominators")
-    c = np.clip(cosines, -1.0, 1.0)
-    psi = np.arccos(c)
-    if method == "dichotomy":
-        need_lo = 2.0 * float(np.min(c[levels > 0])) if (levels > 0).any() else None
-        deepest = psi / np.exp2(np.maximum(levels - 1, 0))
-        need_hi = 2.0 * float(np.max(np.cos(deepest[levels > 0]))) if (levels > 0).any() else None
-    else:
-        need_lo, need_hi = 2.0 * 0 + float(np.min(c)), float(np.max(c))
+    scale = float(method_kernel(spec).table_scale)
+    need_lo, need_hi = _needed_range(scale, cosines, levels)
     if need_lo is None:
         return table
     lo, hi = table.interval_float
-    small, big = _angle_range_of_table(method, table)
-    var = "z = 2 cos(psi)" if method == "dichotomy" else "x = cos(psi)"
+    small, big = _angle_range_of_table(scale, table)
+    var = f"{get_target(spec.table.target).variable} = {'' if scale == 1 else f'{scale:g} '}cos(psi)"
     where = "the default" if defaults else "the given"
     if lo > need_lo + _COVER_SLACK:
+        psi = np.arccos(np.clip(cosines, -1.0, 1.0))
         raise ValueError(
             f"largest span angle {float(np.max(psi)):.9g} rad exceeds {where} {method} table "
             f"{table.name!r}: its interval [{lo:.9g}, {hi:.9g}] of {var} covers angles "
             f"{small:.9g} to {big:.9g} rad; pass tables={{{method!r}: fit_target("
-            f"{TABLE_METHODS[method]!r}, 2, psi_max=...)}} covering the spans, or None for exact")
+            f"{spec.table.target!r}, {spec.table.degree}, psi_max=...)}} covering the spans, "
+            f"or None for exact")
     if hi < need_hi - _COVER_SLACK:
         raise ValueError(
             f"smallest angle the {method} method needs, "
-            f"{math.acos(min(1.0, need_hi / (2.0 if method == 'dichotomy' else 1.0))):.9g} rad, "
+            f"{math.acos(min(1.0, need_hi / scale)):.9g} rad, "
             f"is below the range of {where} {method} table {table.name!r}: its interval "
             f"[{lo:.9g}, {hi:.9g}] of {var} covers angles {small:.9g} to {big:.9g} rad")
     return table
@@ -214,6 +208,8 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     reference), ``none``, ``newton`` (eq. ``N(3 - N.N)/2``), ``lyon``
     (``N(15 - 10 N.N + 3 (N.N)^2)/8``), ``slerp``, ``dichotomy`` (method 4),
     ``quadratic`` (method 5), ``angular`` (method 6); see :mod:`.kernels`.
+    ``method`` is a name of the method registry
+    (:func:`chebnorm.methods.method_names`) or its entry (:class:`MethodSpec`).
 
     Positions: ``quadratic`` and ``angular`` step with ``dt`` from ``t0``.
     ``dichotomy`` halves each span to depth ``L``, the smallest with
@@ -223,7 +219,7 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     not exactly unit: at most ``1 - cos(psi / 2**(L+1))`` short).
 
     Tables: ``tables={"dichotomy": T1, "quadratic": T2}``; a missing key uses
-    :func:`default_tables` (degree 2, angles up to pi/4); the value ``None``
+    :func:`~.registry.default_tables` (degree 2, angles up to pi/4); the value ``None``
     means exact denominators (``1/sqrt``). A table must cover the spans:
     ``z = 2 N_l.N_r .. 2 cos(psi / 2**(L-1))`` for dichotomy, ``x = N_l.N_r``
     for quadratic (up to a 1e-9 slack for rounding).
@@ -244,18 +240,67 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     >>> np.linalg.norm(span_normals("slerp", nl, nr, [4]).normals, axis=1).round(15).tolist()
     [1.0, 1.0, 1.0, 1.0, 1.0]
     """
-    method = _check_method(method)
+    spec = _check_method(method)
     dtype = _check_dtype(dtype)
+    kern = method_kernel(spec)
+    nl, nr, cos = _end_normals(n_left, n_right)
+    m_arr, dt_arr, t0_arr, cnt = _positions(nl.shape[0], m, dt, t0, count)
+    if angular_reanchor is not None and (not isinstance(angular_reanchor, (int, np.integer))
+                                         or isinstance(angular_reanchor, bool)
+                                         or angular_reanchor < 2):
+        raise ValueError(f"angular_reanchor = {angular_reanchor!r}; accepted: None or an integer >= 2")
+
+    offsets = np.zeros(nl.shape[0] + 1, dtype=np.int64)
+    np.cumsum(cnt, out=offsets[1:])
+    sid = np.repeat(np.arange(nl.shape[0]), cnt)
+    t = t0_arr[sid] + (np.arange(int(offsets[-1])) - offsets[sid]) * dt_arr[sid]
+
+    levels = _levels(dt_arr, t0_arr, cnt, cos) if kern.shape == "tree" else None
+    if levels is not None and (levels > MAX_LEVELS).any():
+        raise ValueError(f"{spec.name} step dt = {float(dt_arr.min()):.3g} needs more than "
+                         f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
+    table = _resolve_table(spec, tables, cos, levels) if spec.table is not None else None
+    coeffs = None if table is None else table.coefficients
+
+    ops = NumpyOps(dtype)
+    a = tuple(nl.astype(dtype).T)
+    b = tuple(nr.astype(dtype).T)
+    out = np.empty((int(offsets[-1]), 3), dtype=dtype)
+    if kern.shape == "direct":
+        st = kern.setup(ops, a, b, coeffs)
+        st = {k: (tuple(c[sid] for c in v) if isinstance(v, tuple) else v[sid]) for k, v in st.items()}
+        res = kern.pixel(ops, st, t.astype(dtype))
+        for c in range(3):
+            out[:, c] = res[c]
+    elif kern.shape == "steps":
+        gen = kern.steps(ops, a, b, t0_arr.astype(dtype), dt_arr.astype(dtype), int(cnt.max()),
+                         coefficients=coeffs, start_at_left=bool((t0_arr == 0).all()),
+                         reanchor=angular_reanchor)
+        starts = offsets[:-1]
+        for jj, v in enumerate(gen):
+            act = cnt > jj
+            out[starts[act] + jj] = np.stack(v, axis=-1)[act]
+    else:
+        _tree(kern, ops, a, b, levels, coeffs, t, sid, out, dtype)
+    return SpanNormals(normals=out, offsets=offsets, t=t)
+
+
+def _end_normals(n_left, n_right):
+    """Validated (S, 3) end normals and the cosines of their angles."""
     nl = _as_vectors("n_left", n_left)
     nr = _as_vectors("n_right", n_right)
     if nl.shape != nr.shape:
         raise ValueError(f"n_left has shape {nl.shape} but n_right {nr.shape}; accepted: equal (S, 3)")
-    s = nl.shape[0]
     cos = np.einsum("ij,ij->i", nl, nr) / (np.linalg.norm(nl, axis=1) * np.linalg.norm(nr, axis=1))
     if (1.0 + cos <= ANTIPARALLEL_TOL).any():
         i = int(np.argmin(cos))
         raise ValueError(f"end normals of span {i} are antiparallel (1 + N_l.N_r = {1 + cos[i]:.3g}); "
                          f"accepted: angle below pi, 1 + N_l.N_r > {ANTIPARALLEL_TOL:g}")
+    return nl, nr, cos
+
+
+def _positions(s, m, dt, t0, count):
+    """Validated per-span ``m, dt, t0, count`` of ``s`` spans (defaults filled in)."""
     m_arr = _as_per_span("m", m, s, np.int64, None)
     if m_arr is None:
         raise ValueError("m is required; accepted: span lengths >= 1")
@@ -275,65 +320,19 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
         i = int(np.argmax((t0_arr < -tol) | (last > 1 + tol)))
         raise ValueError(f"span {i} has pixels at t = {t0_arr[i]:.9g} .. {last[i]:.9g}; "
                          f"accepted: 0 <= t0 and t0 + (count-1) dt <= 1")
-    if angular_reanchor is not None and (not isinstance(angular_reanchor, (int, np.integer))
-                                         or isinstance(angular_reanchor, bool)
-                                         or angular_reanchor < 2):
-        raise ValueError(f"angular_reanchor = {angular_reanchor!r}; accepted: None or an integer >= 2")
-
-    offsets = np.zeros(s + 1, dtype=np.int64)
-    np.cumsum(cnt, out=offsets[1:])
-    p = int(offsets[-1])
-    sid = np.repeat(np.arange(s), cnt)
-    j = np.arange(p) - offsets[sid]
-    t = t0_arr[sid] + j * dt_arr[sid]
-
-    levels = _levels(dt_arr, t0_arr, cnt, cos) if method == "dichotomy" else None
-    if method == "dichotomy" and (levels > MAX_LEVELS).any():
-        raise ValueError(f"dichotomy step dt = {float(dt_arr.min()):.3g} needs more than "
-                         f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
-    table = _resolve_table(method, tables, cos, levels) if method in TABLE_METHODS else None
-    coeffs = None if table is None else table.coefficients
-
-    ops = NumpyOps(dtype)
-    a = tuple(nl.astype(dtype).T)
-    b = tuple(nr.astype(dtype).T)
-    out = np.empty((p, 3), dtype=dtype)
-    if method in K.DIRECT:
-        kern = K.DIRECT[method]
-        st = kern.setup(ops, a, b)
-        st = {k: (tuple(c[sid] for c in v) if isinstance(v, tuple) else v[sid]) for k, v in st.items()}
-        res = kern.pixel(ops, st, t.astype(dtype))
-        for c in range(3):
-            out[:, c] = res[c]
-    elif method in ("quadratic", "angular"):
-        left = bool((t0_arr == 0).all())
-        n = int(cnt.max())
-        if method == "quadratic":
-            gen = K.quadratic_steps(ops, a, b, t0_arr.astype(dtype), dt_arr.astype(dtype), n,
-                                    coefficients=coeffs, start_at_left=left)
-        else:
-            gen = K.angular_steps(ops, a, b, t0_arr.astype(dtype), dt_arr.astype(dtype), n,
-                                  start_at_left=left, reanchor=angular_reanchor)
-        starts = offsets[:-1]
-        for jj, v in enumerate(gen):
-            act = cnt > jj
-            out[starts[act] + jj] = np.stack(v, axis=-1)[act]
-    else:
-        _dichotomy(ops, a, b, levels, coeffs, t, sid, out, dtype)
-    return SpanNormals(normals=out, offsets=offsets, t=t)
+    return m_arr, dt_arr, t0_arr, cnt
 
 
-def _dichotomy(ops, a, b, levels, coeffs, t, sid, out, dtype):
+def _tree(kern, ops, a, b, levels, coeffs, t, sid, out, dtype):
     for lv in np.unique(levels):
         spans = np.flatnonzero(levels == lv)
         pix = np.flatnonzero(levels[sid] == lv)
         lv = int(lv)
-        nodes = K.dichotomy_tree(ops, tuple(c[spans] for c in a), tuple(c[spans] for c in b),
-                                 lv, coeffs)
+        nodes = kern.tree(ops, tuple(c[spans] for c in a), tuple(c[spans] for c in b), lv, coeffs)
         comp = [np.stack([nd[c] for nd in nodes], axis=1) for c in range(3)]  # (S_g, 2**lv + 1)
         local = np.searchsorted(spans, sid[pix])
         tt = t[pix].astype(dtype)
-        k, f = K.dichotomy_fraction(ops, tt, lv)
+        k, f = kern.fraction(ops, tt, lv)
         k = k.astype(np.int64)
         node_a = tuple(cc[local, k] for cc in comp)
         if (f == 0).all():
@@ -341,6 +340,6 @@ def _dichotomy(ops, a, b, levels, coeffs, t, sid, out, dtype):
         else:
             kb = np.minimum(k + 1, 2 ** lv)
             node_b = tuple(cc[local, kb] for cc in comp)
-            res = K.dichotomy_pick(ops, node_a, node_b, f)
+            res = kern.pick(ops, node_a, node_b, f)
         for c in range(3):
             out[pix, c] = res[c]

@@ -16,20 +16,24 @@ exception: it is "normalization skipped" (seed 003), so neither the span
 ends nor the pixels are normalized and the pixel normal is the plain
 screen-space linear interpolation of the vertex normals.
 
-The per-pixel normals come from a pluggable span interpolator with the
-signature of :func:`chebnorm.methods.span_normals`; when chebnorm.methods is
-not importable a built-in fallback provides ``exact`` and ``none``.
+The per-pixel normals come from :func:`chebnorm.methods.span_normals` (or a
+replacement with its signature); the methods are those of the method registry
+(:func:`chebnorm.methods.method_names`).
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 
-from .meshes import Mesh, get_mesh
+from chebnorm.approx import parse_number
+from chebnorm.methods import default_tables, get_method, method_names
+from chebnorm.methods import span_normals as _span_normals
+from chebnorm.symbolic import eta as _eta_criterion
+
+from .meshes import Mesh, _unit, get_mesh
 from .spans import Camera, fit_camera, project, setup_spans, zbuffer
 
 __all__ = [
@@ -39,12 +43,6 @@ __all__ = [
 
 SHADING_MODES = ("gouraud", "phong", "adaptive", "split-gouraud", "bump")
 BUMP_VARIANTS = ("full", "square", "object")
-#: the methods the Methods issue defines (chebnorm.methods.METHODS)
-CONTRACT_METHODS = ("exact", "none", "newton", "lyon", "slerp", "dichotomy", "quadratic", "angular")
-
-
-def _unit(v):
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def _dot(a, b):
@@ -52,62 +50,14 @@ def _dot(a, b):
 
 
 # ------------------------------------------------------------------ methods
-@dataclass(frozen=True)
-class _FallbackSpanNormals:
-    normals: np.ndarray
-    offsets: np.ndarray
-    t: np.ndarray
-
-
-def _fallback_span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, tables=None,
-                           dtype=np.float64):
-    """``exact`` and ``none`` with the contract of chebnorm.methods.span_normals."""
-    if method not in ("exact", "none"):
-        raise ValueError(f"method {method!r} needs chebnorm.methods, which is not available; "
-                         "available here: exact, none")
-    n_left = np.asarray(n_left, dtype=dtype)
-    n_right = np.asarray(n_right, dtype=dtype)
-    m = np.asarray(m, dtype=np.int64)
-    t0 = np.zeros(len(m)) if t0 is None else np.asarray(t0, float)
-    dt = 1.0 / m if dt is None else np.asarray(dt, float)
-    count = m + 1 if count is None else np.asarray(count, np.int64)
-    offsets = np.zeros(len(m) + 1, dtype=np.int64)
-    np.cumsum(count, out=offsets[1:])
-    span = np.repeat(np.arange(len(m)), count)
-    j = np.arange(offsets[-1]) - offsets[:-1][span]
-    t = (t0[span] + j * dt[span])
-    tt = t.astype(dtype)[:, None]
-    n = n_left[span] + tt * (n_right[span] - n_left[span])
-    if method == "exact":
-        n = n / np.sqrt(np.sum(n * n, axis=1, keepdims=True))
-    return _FallbackSpanNormals(n, offsets, t)
-
-
 def get_span_normals():
-    """The span interpolator: chebnorm.methods.span_normals if it exists,
-    else the built-in ``exact``/``none`` fallback."""
-    try:
-        from chebnorm.methods import span_normals
-        return span_normals
-    except ImportError:
-        return _fallback_span_normals
+    """The default span interpolator, :func:`chebnorm.methods.span_normals`."""
+    return _span_normals
 
 
 def available_methods() -> tuple[str, ...]:
-    try:
-        from chebnorm.methods import METHODS
-        return tuple(METHODS)
-    except ImportError:
-        return ("exact", "none")
-
-
-def _check_method(method):
-    avail = available_methods()
-    if method not in avail:
-        if method in CONTRACT_METHODS:
-            raise ValueError(f"method {method!r} needs chebnorm.methods, which is not available; "
-                             f"available: {', '.join(avail)}")
-        raise ValueError(f"unknown method {method!r}; accepted: {', '.join(avail)}")
+    """The normalization methods ``render`` accepts: every registered method."""
+    return method_names()
 
 
 # ----------------------------------------------------------------- lighting
@@ -289,40 +239,64 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     w, h = _validate_size(size)
     lighting = lighting or Lighting()
     lighting.validate()
+    spec = None
     if shading in ("phong", "adaptive", "bump"):
         method = method or "exact"
-        if span_normals is None:
-            _check_method(method)
+        if span_normals is None or method in method_names():
+            spec = get_method(method)  # the one check of the method name
     else:
         method = None
-    if shading == "bump" and bump not in BUMP_VARIANTS:
-        raise ValueError(f"unknown bump variant {bump!r}; accepted: {', '.join(BUMP_VARIANTS)}")
-    if not (np.isfinite(eta_threshold) and eta_threshold >= 0):
-        raise ValueError(f"eta_threshold must be a finite number >= 0; got {eta_threshold!r}")
-    if not (np.isfinite(q) and q >= 0):
-        raise ValueError(f"q must be a finite number >= 0; got {q!r}")
+    _check_options(shading, bump, eta_threshold, q)
     mesh = get_mesh(mesh, tess)
     if shading == "bump" and not mesh.has_parametrization:
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
     st = _setup(mesh, camera, (w, h), cull)
     st.L = lighting.direction(st.camera)
-    interp = span_normals or get_span_normals()
-    kw = dict(lighting=lighting, interp=interp, tables=tables, dtype=dtype)
+    kw = dict(lighting=lighting, interp=_interpolator(spec, span_normals), tables=tables,
+              dtype=dtype)
     if shading == "gouraud":
-        image, mask, frags, stats = _gouraud(st, lighting)
+        out = _gouraud(st, lighting)
     elif shading == "phong":
-        image, mask, frags, stats = _phong(st, method, **kw)
+        out = _phong(st, method, spec, **kw)
     elif shading == "adaptive":
-        image, mask, frags, stats = _phong(st, method, skip_eta=eta_threshold, **kw)
+        out = _phong(st, method, spec, skip_eta=eta_threshold, **kw)
     elif shading == "split-gouraud":
-        image, mask, frags, stats = _split_gouraud(st, lighting, q)
+        out = _split_gouraud(st, lighting, q)
     else:
-        image, mask, frags, stats = _bump(st, method, bump, height_map or HeightMap(), k, **kw)
-    tri_map = stats.pop("_triangle", None)
-    nlen_map = stats.pop("_normal_length", None)
-    return RenderResult(image, mask, mesh.name, shading, method, time.perf_counter() - t_start,
-                        int(len(mesh.faces)), int(frags), stats, tri_map, nlen_map)
+        out = _bump(st, method, spec, bump, height_map or HeightMap(), k, **kw)
+    return RenderResult(out.image, out.mask, mesh.name, shading, method,
+                        time.perf_counter() - t_start, int(len(mesh.faces)), int(out.fragments),
+                        out.stats, out.triangle, out.normal_length)
+
+
+def _check_options(shading, bump, eta_threshold, q):
+    if shading == "bump" and bump not in BUMP_VARIANTS:
+        raise ValueError(f"unknown bump variant {bump!r}; accepted: {', '.join(BUMP_VARIANTS)}")
+    if not (np.isfinite(eta_threshold) and eta_threshold >= 0):
+        raise ValueError(f"eta_threshold must be a finite number >= 0; got {eta_threshold!r}")
+    if not (np.isfinite(q) and q >= 0):
+        raise ValueError(f"q must be a finite number >= 0; got {q!r}")
+
+
+def _interpolator(spec, span_normals):
+    """The span interpolator ``render`` calls: a given one gets the method's name,
+    the built-in one the registry entry ``render`` already looked up."""
+    if span_normals is not None:
+        return span_normals
+    return lambda _name, *args, **kw: _span_normals(spec, *args, **kw)
+
+
+@dataclass
+class _ModeResult:
+    """What a shading mode hands back to :func:`render`."""
+
+    image: np.ndarray
+    mask: np.ndarray
+    fragments: int
+    stats: dict
+    triangle: np.ndarray | None = None
+    normal_length: np.ndarray | None = None
 
 
 def _to_image(st, sp, vis, values):
@@ -355,7 +329,7 @@ def _gouraud(st, lighting):
     sp, vis = st.rasterize(I[..., None])
     vals = sp.lerp([1])[vis, 0]
     img, mask = _to_image(st, sp, vis, vals)
-    return img, mask, sp.n_fragments, {"vertices_shaded": int(3 * len(st.tri))}
+    return _ModeResult(img, mask, sp.n_fragments, {"vertices_shaded": int(3 * len(st.tri))})
 
 
 # ------------------------------------------------------------------ phong
@@ -379,54 +353,38 @@ def _interpolated_normals(sp, cols, method, interp, tables, dtype, sel=None):
     return out
 
 
-_TABLE_METHODS = ("dichotomy", "quadratic")
-
-
-def _auto_tables(method, sp, cols, tables, stats):
-    """Default tables cover end normals up to pi/4 apart.  When ``tables`` is
-    None and a frame has wider spans (the teapot's spout lip), fit degree-2
-    tables on the smallest ``psi_max = j pi/32`` covering them, and say so in
-    ``stats["table_psi_max"]``."""
-    if tables is not None or method not in _TABLE_METHODS or len(sp.count) == 0:
+def _auto_tables(spec, sp, col_groups, tables, stats):
+    """The default tables cover end normals up to the registered ``psi_max`` (pi/4)
+    apart.  When ``tables`` is None and a frame has wider spans (the teapot's spout
+    lip) in any of ``col_groups`` (the normal columns the method interpolates), use
+    :func:`chebnorm.methods.default_tables` on the smallest ``psi_max = j pi/32``
+    covering them, and say so in ``stats["table_psi_max"]``; the widest angle is
+    ``stats["span_angle_max"]``."""
+    if tables is not None or spec is None or spec.table is None or len(sp.count) == 0:
         return tables
-    nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
-    psi = float(np.arccos(np.clip(np.min(_dot(nl, nr)), -1.0, 1.0)))
+    psi = 0.0
+    for cols in col_groups:
+        nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
+        psi = max(psi, float(np.arccos(np.clip(np.min(_dot(nl, nr)), -1.0, 1.0))))
     stats["span_angle_max"] = psi
-    if psi <= np.pi / 4:
+    if psi <= float(parse_number(spec.table.psi_max)):
         return None
     j = min(31, int(np.ceil(psi / (np.pi / 32) + 1e-9)))
     stats["table_psi_max"] = f"{j}*pi/32"
-    return _fitted_tables(f"{j}*pi/32")
+    return default_tables(psi_max=f"{j}*pi/32")
 
 
-@lru_cache(maxsize=None)
-def _fitted_tables(psi_max):
-    from chebnorm.approx import fit_target
-
-    return {"dichotomy": fit_target("dichotomy", 2, psi_max=psi_max),
-            "quadratic": fit_target("midpoint", 2, psi_max=psi_max)}
-
-
-def _eta(nrm):
-    try:
-        from chebnorm.symbolic import eta
-        return np.asarray(eta(nrm[:, 0], nrm[:, 1], nrm[:, 2]), dtype=float)
-    except ImportError:  # pragma: no cover - symbolic is a lower stage and exists
-        c = [np.clip(_dot(nrm[:, i], nrm[:, j]), -1, 1) for i, j in ((0, 1), (1, 2), (0, 2))]
-        return 3 - 0.5 * sum(np.sqrt(2 * (1 + x)) for x in c)
-
-
-def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
+def _phong(st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None):
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.nrm] + ([st.pos] if per_pixel_h else [])
     sp, vis = st.rasterize(np.concatenate(extra, axis=2))
     ncols = [1, 2, 3]
     stats = {}
-    tables = _auto_tables(method, sp, ncols, tables, stats)
+    tables = _auto_tables(spec, sp, [ncols], tables, stats)
     if skip_eta is None:
         N = _interpolated_normals(sp, ncols, method, interp, tables, dtype)
     else:
-        eta = _eta(st.nrm)
+        eta = np.asarray(_eta_criterion(st.nrm[:, 0], st.nrm[:, 1], st.nrm[:, 2]), dtype=float)
         skip_tri = eta < skip_eta
         skip_span = skip_tri[sp.tri]
         skip_frag = skip_span[sp.frag_span]
@@ -451,9 +409,9 @@ def _phong(st, method, *, lighting, interp, tables, dtype, skip_eta=None):
         H = _tri_half(st)[sp.tri[sp.frag_span[vis]]]
     vals = lighting.intensity(N @ st.L, _dot(N, H))
     img, mask = _to_image(st, sp, vis, vals)
-    stats["_triangle"] = _pixel_map(st, sp, vis, st.tri[sp.tri[sp.frag_span[vis]]], -1)
-    stats["_normal_length"] = _pixel_map(st, sp, vis, np.linalg.norm(N, axis=1), np.nan)
-    return img, mask, sp.n_fragments, stats
+    return _ModeResult(img, mask, sp.n_fragments, stats,
+                       triangle=_pixel_map(st, sp, vis, st.tri[sp.tri[sp.frag_span[vis]]], -1),
+                       normal_length=_pixel_map(st, sp, vis, np.linalg.norm(N, axis=1), np.nan))
 
 
 # ---------------------------------------------------------- split gouraud
@@ -528,11 +486,11 @@ def _split_gouraud(st, lighting, q):
         "triangles_split_4": int((n_split == 3).sum()),
         "sub_triangles": int(len(sub_tri)),
     }
-    return img, mask, sp.n_fragments, stats
+    return _ModeResult(img, mask, sp.n_fragments, stats)
 
 
 # -------------------------------------------------------------------- bump
-def _bump(st, method, variant, height_map, k, *, lighting, interp, tables, dtype):
+def _bump(st, method, spec, variant, height_map, k, *, lighting, interp, tables, dtype):
     from chebnorm.symbolic import bump_coefficients, bump_coefficients_square
 
     mesh = st.mesh
@@ -556,8 +514,7 @@ def _bump(st, method, variant, height_map, k, *, lighting, interp, tables, dtype
         Hts = np.stack([_dot(Hv, Tt), _dot(Hv, Bt), _dot(Hv, Nh)], axis=-1)
         extra = np.concatenate([uv, Pu, Pv, Lts, Hts], axis=2)
     sp, vis = st.rasterize(extra)
-    tables = _auto_tables(method, sp, [9, 10, 11], tables, stats)
-    tables = _auto_tables(method, sp, [12, 13, 14], tables, stats)
+    tables = _auto_tables(spec, sp, [[9, 10, 11], [12, 13, 14]], tables, stats)
     # L and H: interpolated along spans, normalized per pixel by the method
     Lp = _interpolated_normals(sp, [9, 10, 11], method, interp, tables, dtype)[vis]
     Hp = _interpolated_normals(sp, [12, 13, 14], method, interp, tables, dtype)[vis]
@@ -580,4 +537,4 @@ def _bump(st, method, variant, height_map, k, *, lighting, interp, tables, dtype
         Np = _unit(bump_coefficients_square(F_u, F_v, k))
     vals = lighting.intensity(_dot(Np, Lp), _dot(Np, Hp))
     img, mask = _to_image(st, sp, vis, vals)
-    return img, mask, sp.n_fragments, stats
+    return _ModeResult(img, mask, sp.n_fragments, stats)

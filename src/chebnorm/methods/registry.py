@@ -1,0 +1,96 @@
+"""The methods' half of the method registry: kernels bound, default tables fitted.
+
+The entries themselves live in :mod:`chebnorm.approx.method_registry` (one
+per method, read by every stage); this module resolves each entry's span
+kernel (:func:`method_kernel`, :func:`method_kernels`) and fits the tables
+the kernels read when the caller gives none (:func:`default_tables`, the one
+place chebnorm fits them).
+
+>>> sorted(method_kernels())[:3]
+['angular', 'dichotomy', 'exact']
+>>> method_kernel("dichotomy").shape
+'tree'
+"""
+
+from __future__ import annotations
+
+import importlib
+from functools import lru_cache
+
+from chebnorm.approx import CoefficientTable, fit_target
+from chebnorm.approx.method_registry import (MethodSpec, TableSpec, get_method, method_names,
+                                             register, registered_methods, unit_tables,
+                                             unregister)
+
+from .kernels import SHAPES
+
+__all__ = ["MethodSpec", "TableSpec", "register", "unregister", "get_method", "method_names",
+           "registered_methods", "unit_tables", "method_kernel", "method_kernels",
+           "table_methods", "default_tables"]
+
+_REQUIRED = {"direct": ("setup", "pixel"), "steps": ("steps",),
+             "tree": ("tree", "fraction", "pick")}
+
+
+def _resolve(spec: MethodSpec):
+    kernel = spec.kernel
+    if isinstance(kernel, str):
+        module, _, attr = kernel.partition(":")
+        try:
+            kernel = getattr(importlib.import_module(module), attr)
+        except (ImportError, AttributeError) as exc:
+            raise ValueError(f"method {spec.name!r}: kernel {spec.kernel!r} cannot be "
+                             f"loaded ({exc})") from None
+    shape = getattr(kernel, "shape", None)
+    if shape not in SHAPES:
+        raise ValueError(f"method {spec.name!r}: kernel {kernel!r} has shape {shape!r}; "
+                         f"accepted: {', '.join(SHAPES)} (see chebnorm.methods.kernels)")
+    missing = [a for a in _REQUIRED[shape] if not callable(getattr(kernel, a, None))]
+    if missing:
+        raise ValueError(f"method {spec.name!r}: {shape} kernel {kernel!r} lacks "
+                         f"{', '.join(missing)}")
+    return kernel
+
+
+@lru_cache(maxsize=None)
+def _kernel_of(spec: MethodSpec):
+    return _resolve(spec)
+
+
+def method_kernel(method: str | MethodSpec):
+    """The span kernel object of ``method`` (a name or a registry entry)."""
+    spec = method if isinstance(method, MethodSpec) else get_method(method)
+    return _kernel_of(spec)
+
+
+def method_kernels() -> dict:
+    """Every registered method's span kernel: ``{name: kernel}``."""
+    return {s.name: _kernel_of(s) for s in registered_methods()}
+
+
+def table_methods() -> dict[str, TableSpec]:
+    """The methods that read a coefficient table, and the table each reads."""
+    return {s.name: s.table for s in registered_methods() if s.table is not None}
+
+
+@lru_cache(maxsize=None)
+def _fit(target: str, degree: int, psi_max) -> CoefficientTable:
+    return fit_target(target, degree, psi_max=psi_max)
+
+
+def default_tables(psi_max: float | str | None = None,
+                   degree: int | None = None) -> dict[str, CoefficientTable]:
+    """The tables used when ``span_normals`` gets none: for each method with a
+    table (:func:`table_methods`), ``fit_target(target, degree, psi_max=psi_max)``,
+    None meaning the registered degree (2) and ``psi_max`` (``"pi/4"``).
+    Each table is fitted once per process and argument.
+
+    >>> t = default_tables()
+    >>> [round(c, 5) for c in t["dichotomy"].coefficients]
+    [0.68076, -0.11881, 0.01422]
+    >>> t["quadratic"].name
+    'midpoint_d2'
+    """
+    return {m: _fit(spec.target, spec.degree if degree is None else degree,
+                    spec.psi_max if psi_max is None else psi_max)
+            for m, spec in table_methods().items()}
