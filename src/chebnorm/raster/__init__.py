@@ -1,7 +1,7 @@
 """Stage 4: meshes, scan-line spans, shading modes and image metrics.
 
-Layer rule: imports chebnorm.symbolic, chebnorm.approx and chebnorm.methods
-(when present), never chebnorm.hw or the CLI.
+Layer rule: imports chebnorm.symbolic, chebnorm.approx and chebnorm.methods,
+never chebnorm.hw or the CLI.
 
 >>> from chebnorm.raster import render, compare
 >>> ref = render("sphere", "phong", "exact", size=(48, 48), tess=8)

@@ -217,7 +217,8 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     shading mode.
 
     ``method``: the normalization method of ``phong`` (and of the normalized
-    triangles of ``adaptive``); ignored by ``gouraud`` and ``split-gouraud``;
+    triangles of ``adaptive``), any registered method (:func:`available_methods`),
+    checked here once; ignored by ``gouraud`` and ``split-gouraud``;
     for ``bump`` it normalizes the interpolated tangent-space ``L`` and ``H``.
     ``tables``, ``dtype``: passed to the span interpolator.
     ``eta_threshold``: ``adaptive`` skips normalization on triangles with
