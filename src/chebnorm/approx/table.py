@@ -191,7 +191,7 @@ class CoefficientTable:
         >>> replace(t, abs_error_bound=t.abs_error_bound / 2).verify()
         Traceback (most recent call last):
         ...
-        ValueError: abs_error_bound: stated 1.6e-02 but the coefficients' certified error is 3.1e-02; |p - f| reaches 3.1e-02 at x = 0.0
+        ValueError: abs_error_bound: stated 1.56e-02 but the coefficients' certified error is 3.13e-02; |p - f| reaches 3.12e-02 at x = 0.0
         """
         return type(self).from_dict(self.to_dict())
 
@@ -401,8 +401,8 @@ _RETRY_SUBINTERVALS = 20_000
 
 
 def _fmt2(a: float, b: float) -> tuple[str, str]:
-    """``a`` and ``b`` with the fewest digits (at least 2) that tell them apart."""
-    for digits in range(1, 17):
+    """``a`` and ``b`` with the fewest digits (at least 3) that tell them apart."""
+    for digits in range(2, 17):
         sa, sb = f"{a:.{digits}e}", f"{b:.{digits}e}"
         if sa != sb or a == b:
             return sa, sb
@@ -444,6 +444,7 @@ def _within(x: float, lo_ball, hi_ball) -> bool:
 
 def _verify(t: "CoefficientTable") -> "CoefficientTable":
     """Re-prove the claims of a table whose fields :func:`_read` checked."""
+    import sympy as sp
     from flint import arb
 
     from .certify import arb_enclose
@@ -464,11 +465,11 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
     if not balls[0] < balls[1]:
         raise ValueError(f"interval: [{t.interval[0]}, {t.interval[1]}] is empty or reversed; "
                          f"accepted: interval[0] < interval[1]")
-    for i, (ball, x) in enumerate(zip(balls, t.interval_float)):
+    for i, (ball, x, exact) in enumerate(zip(balls, t.interval_float, ends)):
         # the stored double must be a rounding of the exact endpoint (one ulp at most)
         if arb(math.nextafter(x, -math.inf)) > ball or arb(math.nextafter(x, math.inf)) < ball:
             raise ValueError(f"interval_float[{i}]: {x!r} is not interval[{i}] = {t.interval[i]} "
-                             f"rounded to a double; accepted: {float(ball.mid())!r}")
+                             f"rounded to a double; accepted: {float(sp.N(exact, 30))!r}")
     for key, x in (("max_abs_at", t.max_abs_at), ("max_rel_at", t.max_rel_at)):
         if x is not None and not _within(x, *balls):
             raise ValueError(f"{key}: {t.variable} = {x!r} lies outside the interval "
