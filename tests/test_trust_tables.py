@@ -508,7 +508,7 @@ def _check_outcome(code, err, field, produced):
         assert err.count("\n") == 1, err
         named = err.split(".json': ", 1)[-1]
         top = re.split(r"[.\[]", field)[0]
-        assert named.startswith(field) or named.startswith(top), err
+        assert named.startswith(top), err
         assert not produced, produced
         return False
     assert code == 0, err
@@ -575,7 +575,11 @@ def test_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
 @needs_iverilog
 def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     from chebnorm.hw.horner import design_horner
-    from chebnorm.hw.verilog import verilog_module, verilog_pipelined_module, verilog_testbench
+    from chebnorm.hw.verilog import (
+        verilog_module,
+        verilog_pipelined_module,
+        verilog_testbench,
+    )
 
     t, bad = _hostile_table()
     d = design_horner(CoefficientTable.load(BASE), 8, 8)
@@ -613,3 +617,22 @@ def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
     assert code == 0, err
     assert strip_verilog_comments((vdir / "chebnorm_dichotomy_d2.v").read_text()) == clean[1]
 
+
+
+@needs_iverilog
+@pytest.mark.xfail(strict=True, reason="hw/units.py prints the command line, the version and "
+                   "the table's expression and interval into its banner raw; the lead applies "
+                   "chebnorm.approx.textsafe there after the units split (then drop this mark)")
+def test_unit_banner_keeps_hostile_command_line_inert(tmp_path, capsys):
+    def unit_code(table, out):
+        code, _, err = run_cli(["hw", "unit", "dichotomy", "--table", table, "--in-bits", "8",
+                                "--out-bits", "8", "--frac-bits", "6", "--vectors", "50",
+                                "-o", out], capsys)
+        assert code == 0, err
+        return strip_verilog_comments((out / "chebnorm_dichotomy_unit.v").read_text())
+
+    folder = tmp_path / "x *" / "\n`define injected 1\nmodule injected; endmodule\n"
+    folder.mkdir(parents=True)
+    table = folder / "t.json"
+    table.write_text(BASE.read_text())
+    assert unit_code(table, tmp_path / "hostile") == unit_code(BASE, tmp_path / "clean")
