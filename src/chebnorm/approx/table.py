@@ -7,10 +7,20 @@ maxima, an optional fixed-point version, and where it came from.
 
 JSON schema (version 1): every field of the dataclasses below, floats written
 with Python's shortest round-trip repr, keys sorted.
+
+Tables are files people exchange, so reading one (:meth:`CoefficientTable.load`,
+``from_json``, ``from_dict``) trusts nothing in it: every field is checked for
+type and range, and every stated bound is re-certified for exactly the stored
+coefficients (and fixed-point integers) against the stored expression and
+interval (:meth:`CoefficientTable.verify`). A refusal is a ValueError that
+names the field, e.g. ``coefficients[2]: expected a finite number, got 'abc'``
+or ``abs_error_bound: stated 4.24e-03 but the coefficients' certified error is
+4.79e-03``. At the registered degrees (1 to 3) verification takes milliseconds.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import asdict, dataclass, field
@@ -18,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["CoefficientTable", "FixedPoint", "SCHEMA_VERSION"]
+__all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint"]
 
 SCHEMA_VERSION = 1
 
@@ -64,8 +74,8 @@ class CoefficientTable:
     >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
     ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
     ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
-    ...     abs_error_bound=0.0, rel_error_bound=0.0, max_abs_error=0.0,
-    ...     max_abs_at=0.0, max_rel_error=0.0, max_rel_at=0.0)
+    ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
+    ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None)
     >>> CoefficientTable.from_json(t.to_json()) == t
     True
     >>> float(t(0.5))
@@ -119,58 +129,364 @@ class CoefficientTable:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "CoefficientTable":
-        if not isinstance(d, dict):
-            raise ValueError(f"a coefficient table must be a JSON object, got {type(d).__name__}")
-        version = d.get("schema_version")
-        if version != SCHEMA_VERSION:
-            raise ValueError(f"coefficient table schema version {version!r} is not supported "
-                             f"(accepted: {SCHEMA_VERSION})")
-        try:
-            fp = d.get("fixed_point")
-            fixed = None if fp is None else FixedPoint(
-                frac_bits=int(fp["frac_bits"]), integers=tuple(int(q) for q in fp["integers"]),
-                word_bits=int(fp["word_bits"]), method=str(fp["method"]),
-                abs_error_bound=float(fp["abs_error_bound"]),
-                rel_error_bound=None if fp["rel_error_bound"] is None else float(fp["rel_error_bound"]),
-                max_abs_error=float(fp["max_abs_error"]),
-                max_rel_error=None if fp["max_rel_error"] is None else float(fp["max_rel_error"]))
-            opt = lambda v: None if v is None else float(v)
-            table = cls(
-                name=str(d["name"]), expression=str(d["expression"]), variable=str(d["variable"]),
-                interval=tuple(str(v) for v in d["interval"]),
-                interval_float=tuple(float(v) for v in d["interval_float"]),
-                degree=int(d["degree"]), kind=str(d["kind"]), error_kind=str(d["error_kind"]),
-                coefficients=tuple(float(c) for c in d["coefficients"]),
-                abs_error_bound=float(d["abs_error_bound"]), rel_error_bound=opt(d["rel_error_bound"]),
-                max_abs_error=float(d["max_abs_error"]), max_abs_at=float(d["max_abs_at"]),
-                max_rel_error=opt(d["max_rel_error"]), max_rel_at=opt(d["max_rel_at"]),
-                fixed_point=fixed, provenance=dict(d.get("provenance", {})),
-                schema_version=SCHEMA_VERSION)
-        except (KeyError, TypeError) as exc:
-            raise ValueError(f"coefficient table is missing or has a malformed field: {exc}") from None
-        if len(table.coefficients) != table.degree + 1:
-            raise ValueError(f"coefficient table {table.name!r} has {len(table.coefficients)} "
-                             f"coefficients for degree {table.degree} (expected degree + 1)")
-        return table
+        """Read a table from its JSON object, checking every field, and verify it.
+
+        Each field is checked for type and range (a refusal names the field:
+        ``coefficients[2]: expected a finite number, got 'abc'``); then the
+        claims are re-proved: see :meth:`verify`.
+        """
+        return _verify(_read(cls, d))
 
     @classmethod
     def from_json(cls, text: str) -> "CoefficientTable":
+        """Parse JSON text and read it with :meth:`from_dict` (so: verified)."""
         try:
             d = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"coefficient table is not valid JSON: {exc}") from None
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError, huge integers, deep nesting
+            raise ValueError(f"coefficient table is not valid JSON: "
+                             f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
         return cls.from_dict(d)
 
     @classmethod
     def load(cls, path) -> "CoefficientTable":
+        """Read and verify the table in file ``path`` (at most 1 MiB of JSON).
+
+        A refusal starts with the file name and names the field.
+        """
         try:
-            with open(path, encoding="utf-8") as fh:
-                return cls.from_json(fh.read())
+            with open(path, "rb") as fh:
+                raw = fh.read(MAX_TABLE_BYTES + 1)
         except OSError as exc:
             raise ValueError(f"cannot read coefficient table {str(path)!r}: {exc.strerror}") from None
+        if len(raw) > MAX_TABLE_BYTES:
+            raise ValueError(f"coefficient table {str(path)!r} is larger than {MAX_TABLE_BYTES} "
+                             f"bytes; accepted: a table written by chebnorm (a few kB)")
+        try:
+            return cls.from_json(raw.decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"coefficient table {str(path)!r} is not UTF-8 text (byte "
+                             f"{exc.start})") from None
+        except ValueError as exc:
+            raise ValueError(f"coefficient table {str(path)!r}: {exc}") from None
+
+    def verify(self) -> "CoefficientTable":
+        """Re-prove every claim of the table; return it unchanged, or raise.
+
+        Checks every field as :meth:`from_dict` does, then re-certifies the
+        float coefficients (and the fixed-point integers) against
+        ``expression`` on ``interval`` (:func:`chebnorm.approx.certify`):
+        each stated bound must be at least a certified upper bound of the
+        true supremum, re-certified more tightly when the first pass is
+        looser than the statement (so a bound stated from a looser
+        certification passes, a bound below the supremum never does); the
+        located maxima must not exceed their bounds and must lie in the
+        interval; ``interval_float`` must be the exact endpoints rounded to
+        doubles (within one ulp). Raises :class:`ValueError` naming the field.
+
+        >>> from chebnorm.approx import fit
+        >>> t = fit("x**3", ("0", "1"), 2)
+        >>> t.verify() == t
+        True
+        >>> from dataclasses import replace
+        >>> replace(t, abs_error_bound=t.abs_error_bound / 2).verify()
+        Traceback (most recent call last):
+        ...
+        ValueError: abs_error_bound: stated 1.56e-02 but the coefficients' certified error is 3.13e-02; |p - f| reaches 3.12e-02 at x = 0.0
+        """
+        return type(self).from_dict(self.to_dict())
 
     def save(self, path) -> None:
         """Write the JSON atomically (temporary file, then rename)."""
         from .files import write_atomic
 
         write_atomic(path, self.to_json())
+
+
+# -- reading: every field checked, each refusal naming its field ---------------
+
+#: largest table file :meth:`CoefficientTable.load` reads (a table is a few kB)
+MAX_TABLE_BYTES = 1 << 20
+#: longest free text accepted in a field (expression, endpoint, provenance value)
+MAX_TEXT = 1000
+#: most provenance entries, and the longest provenance key
+MAX_PROVENANCE = 32
+_MAX_KEY = 64
+#: exactness of the fixed-point coefficients: ``q / 2**frac_bits`` must be a
+#: double (the certifier evaluates the stored doubles exactly), so ``|q| < 2**53``
+#: (``word_bits <= 53``) and ``frac_bits <= 1074`` (the smallest subnormal)
+MAX_WORD_BITS = 53
+MAX_FRAC_BITS = 1074
+FIXED_METHODS = ("rounded", "reoptimized")
+_OPTIONAL = {"fixed_point": None, "provenance": {}}
+
+
+def _show(value) -> str:
+    """A value as the user wrote it in JSON, cut to a readable length."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, dict):
+        return "an object"
+    if isinstance(value, (list, tuple)):
+        return f"an array of {len(value)}"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _bad(field: str, expected: str, value) -> ValueError:
+    return ValueError(f"{field}: expected {expected}, got {_show(value)}")
+
+
+def _number(value, field: str, *, optional: bool = False, nonneg: bool = False) -> float | None:
+    if value is None and optional:
+        return None
+    what = "a finite number" + (" >= 0" if nonneg else "") + (" or null" if optional else "")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _bad(field, what, value)
+    try:
+        out = float(value)
+    except OverflowError:
+        raise _bad(field, what, value) from None
+    if not math.isfinite(out) or (nonneg and out < 0):
+        raise _bad(field, what, value)
+    return out
+
+
+def _integer(value, field: str, lo: int | None = None, hi: int | None = None) -> int:
+    what = "an integer" if lo is None else f"an integer in {lo}..{hi}"
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise _bad(field, what, value)
+    if lo is not None and not lo <= value <= hi:
+        raise _bad(field, what, value)
+    return int(value)
+
+
+def _text(value, field: str, max_length: int = MAX_TEXT, *, empty: bool = False) -> str:
+    if not isinstance(value, str):
+        raise _bad(field, "a string", value)
+    if not value and not empty:
+        raise _bad(field, "a non-empty string", value)
+    if len(value) > max_length:
+        raise ValueError(f"{field}: {len(value)} characters; accepted: at most {max_length}")
+    return value
+
+
+def _choice(value, field: str, choices) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise _bad(field, "one of " + ", ".join(repr(c) for c in choices), value)
+    return value
+
+
+def _array(value, field: str, what: str) -> list:
+    if not isinstance(value, list):
+        raise _bad(field, f"an array of {what}", value)
+    return value
+
+
+def _object(d, field: str, allowed, optional=()) -> None:
+    """Refuse unknown and missing keys of the JSON object ``d``."""
+    if not isinstance(d, dict):
+        raise _bad(field or "coefficient table", "a JSON object", d)
+    prefix = f"{field}." if field else ""
+    unknown = sorted(k for k in d if k not in allowed)
+    if unknown:
+        raise ValueError(f"{prefix}{str(unknown[0])[:60]}: unknown field; accepted: "
+                         f"{', '.join(sorted(allowed))}")
+    for key in sorted(allowed):
+        if key not in d and key not in optional:
+            raise ValueError(f"{prefix}{key}: missing (a required field)")
+
+
+def _read_fixed(fp, degree: int) -> FixedPoint | None:
+    if fp is None:
+        return None
+    allowed = [f.name for f in dataclasses.fields(FixedPoint)]
+    _object(fp, "fixed_point", allowed)
+    frac_bits = _integer(fp["frac_bits"], "fixed_point.frac_bits", 0, MAX_FRAC_BITS)
+    word_bits = _integer(fp["word_bits"], "fixed_point.word_bits", 2, MAX_WORD_BITS)
+    ints = _array(fp["integers"], "fixed_point.integers", "integers")
+    integers = tuple(_integer(q, f"fixed_point.integers[{k}]") for k, q in enumerate(ints))
+    if len(integers) != degree + 1:
+        raise ValueError(f"fixed_point.integers: {len(integers)} integers for degree {degree}; "
+                         f"expected degree + 1 = {degree + 1}")
+    for k, q in enumerate(integers):
+        if not -(1 << (word_bits - 1)) <= q < (1 << (word_bits - 1)):
+            need = max(q.bit_length() + 1, (-q - 1).bit_length() + 1)
+            raise ValueError(f"fixed_point.word_bits: {word_bits} bits cannot hold "
+                             f"fixed_point.integers[{k}] = {q} (two's complement); accepted: "
+                             f"word_bits >= {need}")
+    rel = _number(fp["rel_error_bound"], "fixed_point.rel_error_bound", optional=True, nonneg=True)
+    max_rel = _number(fp["max_rel_error"], "fixed_point.max_rel_error", optional=True, nonneg=True)
+    if (rel is None) != (max_rel is None):
+        raise ValueError("fixed_point.max_rel_error: must be null exactly when "
+                         "fixed_point.rel_error_bound is null")
+    return FixedPoint(
+        frac_bits=frac_bits, integers=integers, word_bits=word_bits,
+        method=_choice(fp["method"], "fixed_point.method", FIXED_METHODS),
+        abs_error_bound=_number(fp["abs_error_bound"], "fixed_point.abs_error_bound", nonneg=True),
+        rel_error_bound=rel,
+        max_abs_error=_number(fp["max_abs_error"], "fixed_point.max_abs_error", nonneg=True),
+        max_rel_error=max_rel)
+
+
+def _read(cls, d) -> "CoefficientTable":
+    """Build a table from a JSON object, every field checked (no certification)."""
+    from .api import ERROR_KINDS, KINDS, MAX_DEGREE
+    from .textsafe import identifier
+
+    if not isinstance(d, dict):
+        raise ValueError(f"a coefficient table must be a JSON object, got {_show(d)}")
+    version = d.get("schema_version")
+    if isinstance(version, bool) or not isinstance(version, int) or version != SCHEMA_VERSION:
+        raise ValueError(f"schema_version: schema version {_show(version)} is not supported; accepted: "
+                         f"{SCHEMA_VERSION}")
+    allowed = [f.name for f in dataclasses.fields(cls)]
+    _object(d, "", allowed, optional=_OPTIONAL)
+    d = {**_OPTIONAL, **d}
+    degree = _integer(d["degree"], "degree", 0, MAX_DEGREE)
+    coeffs = _array(d["coefficients"], "coefficients", "numbers")
+    coefficients = tuple(_number(c, f"coefficients[{k}]") for k, c in enumerate(coeffs))
+    if len(coefficients) != degree + 1:
+        raise ValueError(f"coefficients: {len(coefficients)} numbers for degree {degree}; "
+                         f"expected degree + 1 = {degree + 1}")
+    interval = _array(d["interval"], "interval", "2 strings")
+    if len(interval) != 2:
+        raise _bad("interval", "an array of 2 strings (exact constants such as \"sqrt(2)\")",
+                   interval)
+    interval_float = _array(d["interval_float"], "interval_float", "2 numbers")
+    if len(interval_float) != 2:
+        raise _bad("interval_float", "an array of 2 numbers", interval_float)
+    provenance = d["provenance"]
+    if not isinstance(provenance, dict):
+        raise _bad("provenance", "an object of strings", provenance)
+    if len(provenance) > MAX_PROVENANCE:
+        raise ValueError(f"provenance: {len(provenance)} entries; accepted: at most {MAX_PROVENANCE}")
+    for key, value in provenance.items():
+        _text(key, f"provenance key {key[:60]!r}", _MAX_KEY)
+        _text(value, f"provenance.{key}", empty=True)
+    rel = _number(d["rel_error_bound"], "rel_error_bound", optional=True, nonneg=True)
+    max_rel = _number(d["max_rel_error"], "max_rel_error", optional=True, nonneg=True)
+    max_rel_at = _number(d["max_rel_at"], "max_rel_at", optional=True)
+    if (rel is None) != (max_rel is None) or (rel is None) != (max_rel_at is None):
+        raise ValueError("max_rel_error, max_rel_at: must be null exactly when "
+                         "rel_error_bound is null")
+    return cls(
+        name=identifier(d["name"], field="name"),
+        expression=_text(d["expression"], "expression"),
+        variable=identifier(d["variable"], field="variable"),
+        interval=tuple(_text(v, f"interval[{i}]") for i, v in enumerate(interval)),
+        interval_float=tuple(_number(v, f"interval_float[{i}]")
+                             for i, v in enumerate(interval_float)),
+        degree=degree, kind=_choice(d["kind"], "kind", KINDS),
+        error_kind=_choice(d["error_kind"], "error_kind", ERROR_KINDS),
+        coefficients=coefficients,
+        abs_error_bound=_number(d["abs_error_bound"], "abs_error_bound", nonneg=True),
+        rel_error_bound=rel,
+        max_abs_error=_number(d["max_abs_error"], "max_abs_error", nonneg=True),
+        max_abs_at=_number(d["max_abs_at"], "max_abs_at"),
+        max_rel_error=max_rel, max_rel_at=max_rel_at,
+        fixed_point=_read_fixed(d["fixed_point"], degree),
+        provenance=dict(provenance), schema_version=SCHEMA_VERSION)
+
+
+# -- verifying: every stated bound re-proved for exactly the stored numbers -----
+
+#: tolerances of the re-certification: the certifier's default first, then
+#: tighter ones (each costs milliseconds at the registered degrees) until the
+#: stated bound is shown or the last one (near double precision) fails
+_TOLS = (None, 2.0 ** -16, 2.0 ** -24, 2.0 ** -32, 2.0 ** -40, 2.0 ** -50)
+#: subinterval cap of the tighter passes (the first pass uses the certifier's)
+_RETRY_SUBINTERVALS = 20_000
+
+
+def _fmt2(a: float, b: float) -> tuple[str, str]:
+    """``a`` and ``b`` with the fewest digits (at least 3) that tell them apart."""
+    for digits in range(2, 17):
+        sa, sb = f"{a:.{digits}e}", f"{b:.{digits}e}"
+        if sa != sb or a == b:
+            return sa, sb
+    return repr(a), repr(b)
+
+
+def _prove(field: str, stated: float, fn, coefficients, lo, hi, kind: str, what: str):
+    """Certify ``sup |g|`` (``g = p - f`` or ``p/f - 1``) until ``stated`` is
+    shown to bound it; raise naming ``field`` when it cannot be."""
+    from .certify import certify
+
+    cert = None
+    for tol in _TOLS:
+        opts = {} if tol is None else {"tol": tol, "max_subintervals": _RETRY_SUBINTERVALS}
+        try:
+            cert = certify(fn, coefficients, lo, hi, kind, **opts)
+        except ValueError as exc:
+            raise ValueError(f"{field}: {what} cannot be certified: {exc}") from None
+        if stated >= cert.bound:
+            return cert
+        # the located maximum is |g| at a point (a double within half an ulp of a
+        # 128-bit ball): a statement one ulp below it is false, no tighter pass helps
+        if stated < math.nextafter(cert.maximum, 0.0):
+            break
+    s, u = _fmt2(stated, cert.bound)
+    msg = f"{field}: stated {s} but {what} is {u}"
+    if stated < cert.maximum:
+        g = "|p - f|" if kind == "abs" else "|p/f - 1|"
+        msg += f"; {g} reaches {_fmt2(stated, cert.maximum)[1]} at {fn.var} = {cert.at!r}"
+    raise ValueError(msg)
+
+
+def _within(x: float, lo_ball, hi_ball) -> bool:
+    """False only when ``x`` is provably outside ``[lo, hi]``."""
+    from flint import arb
+
+    return not (arb(x) < lo_ball or arb(x) > hi_ball)
+
+
+def _verify(t: "CoefficientTable") -> "CoefficientTable":
+    """Re-prove the claims of a table whose fields :func:`_read` checked."""
+    import sympy as sp
+    from flint import arb
+
+    from .certify import arb_enclose
+    from .expr import parse_function, parse_number
+
+    try:
+        fn = parse_function(t.expression, t.variable)
+    except ValueError as exc:
+        raise ValueError(f"expression: {exc}") from None
+    ends = []
+    for i, text in enumerate(t.interval):
+        try:
+            ends.append(parse_number(text))
+        except ValueError as exc:
+            raise ValueError(f"interval[{i}]: {exc}") from None
+    lo, hi = ends
+    balls = [arb_enclose(lo), arb_enclose(hi)]
+    if not balls[0] < balls[1]:
+        raise ValueError(f"interval: [{t.interval[0]}, {t.interval[1]}] is empty or reversed; "
+                         f"accepted: interval[0] < interval[1]")
+    for i, (ball, x, exact) in enumerate(zip(balls, t.interval_float, ends)):
+        # the stored double must be a rounding of the exact endpoint (one ulp at most)
+        if arb(math.nextafter(x, -math.inf)) > ball or arb(math.nextafter(x, math.inf)) < ball:
+            raise ValueError(f"interval_float[{i}]: {x!r} is not interval[{i}] = {t.interval[i]} "
+                             f"rounded to a double; accepted: {float(sp.N(exact, 30))!r}")
+    for key, x in (("max_abs_at", t.max_abs_at), ("max_rel_at", t.max_rel_at)):
+        if x is not None and not _within(x, *balls):
+            raise ValueError(f"{key}: {t.variable} = {x!r} lies outside the interval "
+                             f"[{t.interval[0]}, {t.interval[1]}]")
+    parts = [("", t.coefficients, t, "the coefficients'")]
+    if t.fixed_point is not None:
+        parts.append(("fixed_point.", t.fixed_point.coefficients, t.fixed_point,
+                      "the fixed-point coefficients'"))
+    for prefix, coeffs, claims, whose in parts:
+        for kind, bound, maximum in (("abs", claims.abs_error_bound, claims.max_abs_error),
+                                     ("rel", claims.rel_error_bound, claims.max_rel_error)):
+            if bound is None:
+                continue
+            what = f"{whose} certified {'relative ' if kind == 'rel' else ''}error"
+            _prove(f"{prefix}{kind}_error_bound", bound, fn, coeffs, lo, hi, kind, what)
+            if maximum > bound:
+                s, m = _fmt2(bound, maximum)
+                raise ValueError(f"{prefix}max_{kind}_error: the located maximum {m} exceeds "
+                                 f"{prefix}{kind}_error_bound = {s}")
+    return t
