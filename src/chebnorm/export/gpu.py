@@ -44,25 +44,26 @@ class ToolMissing(RuntimeError):
 
 
 def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> np.ndarray:
-    """Every float32 in the table's interval (rounded inward), or
-    ``max_samples`` of them evenly spaced in their ordering, both ends kept.
+    """Every float32 in the table's interval (rounded inward), sorted; when
+    there are more than ``max_samples``, half of them evenly spaced in value
+    and half evenly spaced in float32 order (which reaches the tiny
+    magnitudes near a zero endpoint), both ends kept.
 
-    >>> from chebnorm.approx import CoefficientTable
-    >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
-    ...     interval=("1", "1 + 2**-20"), interval_float=(1.0, 1.0 + 2**-20), degree=0,
-    ...     coefficients=(1.0,), kind="chebyshev", error_kind="abs", abs_error_bound=3e-6,
-    ...     rel_error_bound=None, max_abs_error=3e-6, max_abs_at=1.0, max_rel_error=None,
-    ...     max_rel_at=None, fixed_point=None, provenance={})
+    >>> from chebnorm.approx import fit
+    >>> t = fit("1/x", ("1", "1 + 2**-20"), 1)
     >>> float32_inputs(t).size  # 2^-20 / 2^-23 steps, both ends
     9
     """
     lo, hi = _interval32(table)
     a = _ordered(np.float32(lo))
     b = _ordered(np.float32(hi))
-    count = b - a + 1
-    keys = np.arange(a, b + 1, dtype=np.int64) if count <= max_samples else \
-        np.unique(np.round(np.linspace(a, b, max_samples)).astype(np.int64))
-    return _from_ordered(keys)
+    if b - a + 1 <= max_samples:
+        return _from_ordered(np.arange(a, b + 1, dtype=np.int64))
+    half = max_samples // 2
+    by_order = _from_ordered(np.round(np.linspace(a, b, half)).astype(np.int64))
+    by_value = np.clip(np.linspace(lo, hi, max_samples - half).astype(np.float32),
+                       np.float32(lo), np.float32(hi))
+    return np.unique(np.concatenate([by_order, by_value]))
 
 
 def _ordered(f: np.float32) -> int:

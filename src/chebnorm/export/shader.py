@@ -160,9 +160,10 @@ def float32_literal(value: float, suffix: str = "") -> str:
     significant digits, then the exact decimal expansion, which always works.
 
     >>> float32_literal(0.1), float32_literal(-1.5, "f"), float32_literal(0.0)
-    ('1.00000001e-01', '-1.5e+00f', '0.0e+00')
+    ('1.0e-01', '-1.5e+00f', '0.0e+00')
     """
-    target = np.float32(value)
+    with np.errstate(over="ignore"):
+        target = np.float32(value)
     if not np.isfinite(target):
         raise ValueError(f"coefficient {value!r} is not finite in float32; accepted: "
                          f"|value| < 3.4e38")
