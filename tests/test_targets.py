@@ -405,27 +405,29 @@ def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
 
 @need_ghdl
 @need_iverilog
-@pytest.mark.parametrize("table,bits,extra", [
-    ("rsqrt_d3.json", 9, ("--rounding", "trunc")),
-    ("midpoint_d1.json", 8, ()),
-    ("eta_term_d2.json", 8, ("--coef-bits", "12", "--acc-bits", "6")),
+@pytest.mark.parametrize("table,bits,kw", [
+    ("rsqrt_d3.json", 9, {"rounding": "trunc"}),
+    ("midpoint_d1.json", 8, {}),
+    ("eta_term_d2.json", 8, {"coef_bits": 12, "acc_bits": 6}),
 ])
-def test_vhdl_pipelined_and_combinational_agree_with_verilog(tmp_path, table, bits, extra):
-    from chebnorm.hw.report import analyze
+def test_vhdl_pipelined_and_combinational_agree_with_verilog(tmp_path, table, bits, kw):
+    from chebnorm.hw.report import analyze, verilog_outputs
+    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
 
-    path = ROOT / "figures" / "coefficients" / table
-    out, stdout = _hw(tmp_path, path, bits, bits, "--pipelined", *extra)
-    assert stdout.count("PASS:") == 2
-    kw = {}
-    if "--rounding" in extra:
-        kw["rounding"] = "trunc"
-    if "--coef-bits" in extra:
-        kw.update(coef_bits=12, acc_bits=6)
-    design = analyze(CoefficientTable.load(path), bits, bits, gappa=False, synth=False,
-                     **kw).design
-    vlog = _verilog_dump(out, design).read_text().split()
+    report = analyze(CoefficientTable.load(ROOT / "figures" / "coefficients" / table), bits,
+                     bits, gappa=False, synth=False, **kw)
+    design = report.design
+    files = {**verilog_outputs(report, pipelined=True), **vhdl_outputs(report, pipelined=True)}
+    for k, v in files.items():
+        (tmp_path / k).write_text(v)
     for name in (design.module_name, design.module_name + "_pipe"):
-        assert (out / f"{name}_vhdl_y.hex").read_text().split() == vlog
+        assert simulate(tmp_path, name).passed
+        res = simulate_vhdl(tmp_path, name)
+        assert res.passed and res.vectors == 2 ** bits, res.line
+    vlog = _verilog_dump(tmp_path, design).read_text().split()
+    for name in (design.module_name, design.module_name + "_pipe"):
+        assert (tmp_path / f"{name}_vhdl_y.hex").read_text().split() == vlog
 
 
 @need_ghdl
@@ -532,3 +534,24 @@ def test_json_export_roundtrips(tmp_path):
     out = tmp_path / "t.json"
     assert _cli("export", str(TABLES[0]), "--format", "json", "-o", str(out)).returncode == 0
     assert json.loads(out.read_text()) == json.loads(TABLES[0].read_text())
+
+
+@need_ghdl
+@pytest.mark.parametrize("spec", [
+    ("exp(x)", ("0", "1/8"), 0, 5, 6, "rne"),      # degree 0: no Horner step
+    ("exp(x)", ("-1", "1"), 4, 7, 9, "trunc"),     # negative inputs, four steps
+])
+def test_vhdl_matches_the_model_on_fresh_fits(tmp_path, spec):
+    from chebnorm.hw.report import analyze
+    from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
+
+    expr, iv, deg, wi, wo, rounding = spec
+    t = fit(expr, iv, deg, name=f"f{deg}", frac_bits=20)
+    r = analyze(t, wi, wo, rounding=rounding, gappa=False, synth=False)
+    files = vhdl_outputs(r, pipelined=deg >= 1)
+    for k, v in files.items():
+        (tmp_path / k).write_text(v)
+    names = [r.design.module_name] + ([r.design.module_name + "_pipe"] if deg >= 1 else [])
+    for name in names:
+        res = simulate_vhdl(tmp_path, name)
+        assert res.passed and res.vectors == 2 ** wi, res.line
