@@ -323,6 +323,23 @@ def test_wgsl_on_lavapipe_within_bound(key, wgpu_device):
     assert worst >= t.max_abs_error * 0.5
 
 
+def test_glsl_and_wgsl_interleaved_agree(wgpu_device):
+    """GL after WebGPU in one process (the GL context is made current again)
+    gives the same bits as before; both stay within the bound (the drivers
+    may round differently: fused or not)."""
+    from chebnorm.export.gpu import float32_inputs, glsl_evaluate, wgsl_evaluate
+
+    _gl()
+    t = _table("rsqrt_d3.json")
+    xs = float32_inputs(t, 4096)
+    a = glsl_evaluate(t, xs)
+    b = wgsl_evaluate(t, xs)
+    c = glsl_evaluate(t, xs)
+    assert xs.size == 4096
+    assert np.array_equal(a, c)
+    _check_against_f(t, xs, b, float32_eval_bound(t).total)
+
+
 def test_wgsl_invalid_module_is_rejected(wgpu_device):
     """naga (inside wgpu) validates the WGSL: a type error does not run."""
     from chebnorm.export import gpu

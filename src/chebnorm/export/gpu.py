@@ -45,9 +45,10 @@ class ToolMissing(RuntimeError):
 
 def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     """Every float32 in the table's interval (rounded inward), sorted; when
-    there are more than ``max_samples``, half of them evenly spaced in value
-    and half evenly spaced in float32 order (which reaches the tiny
-    magnitudes near a zero endpoint), both ends kept.
+    there are more than ``max_samples``, that many, taken evenly from the
+    union of ``max_samples`` evenly spaced in value and ``max_samples`` evenly
+    spaced in float32 order (which reaches the tiny magnitudes near a zero
+    endpoint), both ends kept.
 
     >>> from chebnorm.approx import fit
     >>> t = fit("1/x", ("1", "1 + 2**-20"), 1)
@@ -59,11 +60,12 @@ def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> n
     b = _ordered(np.float32(hi))
     if b - a + 1 <= max_samples:
         return _from_ordered(np.arange(a, b + 1, dtype=np.int64))
-    half = max_samples // 2
-    by_order = _from_ordered(np.round(np.linspace(a, b, half)).astype(np.int64))
-    by_value = np.clip(np.linspace(lo, hi, max_samples - half).astype(np.float32),
+    by_order = _from_ordered(np.round(np.linspace(a, b, max_samples)).astype(np.int64))
+    by_value = np.clip(np.linspace(lo, hi, max_samples).astype(np.float32),
                        np.float32(lo), np.float32(hi))
-    return np.unique(np.concatenate([by_order, by_value]))
+    both = np.unique(np.concatenate([by_order, by_value]))
+    pick = np.round(np.linspace(0, both.size - 1, max_samples)).astype(np.int64)
+    return both[np.unique(pick)]
 
 
 def _ordered(f: np.float32) -> int:
@@ -165,19 +167,20 @@ def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
     exported GLSL in an OpenGL compute shader."""
     ctx = gl_context()
     x = np.ascontiguousarray(xs, dtype=np.float32)
-    prog = ctx.compute_shader(compute_shader_source(table, "glsl"))
-    bx = ctx.buffer(x.tobytes())
-    by = ctx.buffer(reserve=max(x.nbytes, 4))
-    try:
-        bx.bind_to_storage_buffer(0)
-        by.bind_to_storage_buffer(1)
-        prog.run(group_x=-(-x.size // _GROUP))
-        ctx.finish()
-        return np.frombuffer(by.read(), dtype=np.float32)[: x.size].copy()
-    finally:
-        bx.release()
-        by.release()
-        prog.release()
+    with ctx:  # make the EGL context current again (another API may have switched it)
+        prog = ctx.compute_shader(compute_shader_source(table, "glsl"))
+        bx = ctx.buffer(x.tobytes())
+        by = ctx.buffer(reserve=max(x.nbytes, 4))
+        try:
+            bx.bind_to_storage_buffer(0)
+            by.bind_to_storage_buffer(1)
+            prog.run(group_x=-(-x.size // _GROUP))
+            ctx.finish()
+            return np.frombuffer(by.read(), dtype=np.float32)[: x.size].copy()
+        finally:
+            bx.release()
+            by.release()
+            prog.release()
 
 
 def wgsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:

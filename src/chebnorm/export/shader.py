@@ -46,8 +46,8 @@ shader analogue of the C header's ``_F_EVAL_ERROR_BOUND``
 What the bound assumes of the driver, from the specifications: float32
 ``+``, ``-``, ``*`` correctly rounded (round to nearest) and ``fma``'s
 accuracy "inherited from" ``a * b + c``, that is fused or two rounded
-operations (GLSL 4.60 section 4.7.1 "Range and Precision", ES 3.20
-section 4.7.3 for ``highp``; WGSL section 15.7 "Floating Point Evaluation";
+operations (GLSL 4.60 section 4.7.1 "Range and Precision"; ES 3.20 section
+4.7 for ``highp``; the WGSL specification's "Floating Point Accuracy" table;
 Direct3D 11's floating-point rules for HLSL), no other reassociation (the
 accumulator is ``precise`` in GLSL 4.x / ES 3.20 and HLSL; WGSL has no such
 qualifier, and a chain in which each step needs the previous one leaves
