@@ -572,3 +572,14 @@ def test_vhdl_matches_the_model_on_fresh_fits(tmp_path, spec):
     for name in names:
         res = simulate_vhdl(tmp_path, name)
         assert res.passed and res.vectors == 2 ** wi, res.line
+
+
+@need_iverilog
+def test_cli_export_verilog(tmp_path):
+    out = tmp_path / "e.v"
+    proc = _cli("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format",
+                "verilog", "--in-bits", "10", "--out-bits", "10", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    text = out.read_text()
+    assert "module chebnorm_rsqrt_d3 #(" in text and "module chebnorm_rsqrt_d3_pipe #(" in text
+    subprocess.run(["iverilog", "-g2005", "-o", str(tmp_path / "a.out"), str(out)], check=True)
