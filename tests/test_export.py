@@ -99,7 +99,7 @@ class TestText:
 
     def test_formats_and_atomic_write(self, tmp_path):
         t = fit_target("eta_term", 1)
-        assert sorted(FORMATS) == ["c", "json"]
+        assert sorted(FORMATS) == ["c", "glsl", "hlsl", "json", "wgsl"]  # vhdl: the CLI asks hw
         out = tmp_path / "t.json"
         export_table(t, "json", out)
         assert out.read_text() == t.to_json()

@@ -1,4 +1,12 @@
-"""``chebnorm export TABLE.json --format c|json -o FILE``."""
+"""``chebnorm export TABLE.json --format c|json|glsl|wgsl|hlsl|vhdl|verilog -o FILE``.
+
+The software formats come from :mod:`chebnorm.export`; ``vhdl`` and
+``verilog`` are fixed-point hardware, which the ``export`` stage does not
+know (``export`` and ``hw`` are sibling stages), so the command dispatches
+them to :mod:`chebnorm.hw` with the widths given by ``--in-bits`` and
+``--out-bits``: FILE then holds the combinational evaluator and, for degree
+>= 1, the pipelined one (``hw verilog --lang vhdl`` writes the benches too).
+"""
 
 from __future__ import annotations
 
@@ -7,18 +15,59 @@ from chebnorm.export import FORMATS, export_table
 
 from ._common import command_line
 
+HW_FORMATS = ("vhdl", "verilog")
+
+
+def _all_formats() -> str:
+    return ", ".join(sorted((*FORMATS, *HW_FORMATS)))
+
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="print a coefficient table as a C header or JSON")
+    p = sub.add_parser("export", help="print a coefficient table as C, JSON, GLSL, WGSL, HLSL, "
+                       "VHDL or Verilog")
     p.add_argument("table", metavar="TABLE.json")
-    p.add_argument("--format", default="c", help=f"one of {', '.join(sorted(FORMATS))} (default c)")
+    p.add_argument("--format", default="c", help=f"one of {_all_formats()} (default c)")
     p.add_argument("-o", "--output", metavar="FILE", required=True)
+    hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
+    hw.add_argument("--in-bits", type=int, default=None, help="input code width, 1..20")
+    hw.add_argument("--out-bits", type=int, default=None, help="output code width, 1..32")
+    hw.add_argument("--coef-bits", type=int, default=None,
+                    help="coefficient fractional bits (default: the table's own)")
+    hw.add_argument("--acc-bits", type=int, default=None,
+                    help="accumulator fractional bits (default: output's + 3)")
+    hw.add_argument("--rounding", default="rne", help="rne (default) or trunc")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    if args.format not in FORMATS:
-        raise ValueError(f"unknown export format {args.format!r}; accepted: {', '.join(sorted(FORMATS))}")
+    if args.format not in FORMATS and args.format not in HW_FORMATS:
+        raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
+    hw_only = [f"--{n.replace('_', '-')}" for n in ("in_bits", "out_bits", "coef_bits", "acc_bits")
+               if getattr(args, n) is not None]
+    if args.format in FORMATS and hw_only:
+        raise ValueError(f"{', '.join(hw_only)} apply to --format vhdl or verilog only, not "
+                         f"{args.format!r}")
     table = CoefficientTable.load(args.table)
-    export_table(table, args.format, args.output, command_line(args))
+    if args.format in FORMATS:
+        export_table(table, args.format, args.output, command_line(args))
+        return 0
+    if args.in_bits is None or args.out_bits is None:
+        raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
+                         f"output code widths); accepted: 1..20 and 1..32")
+    from chebnorm import __version__
+    from chebnorm.approx.files import write_atomic
+    from chebnorm.hw.report import analyze
+
+    report = analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
+                     acc_bits=args.acc_bits, rounding=args.rounding, gappa=False, synth=False)
+    d = report.design
+    kw = dict(version=__version__, command=command_line(args), budget=report.budget)
+    if args.format == "vhdl":
+        from chebnorm.hw.vhdl import vhdl_module as comb, vhdl_pipelined_module as pipe
+    else:
+        from chebnorm.hw.verilog import verilog_module as comb, verilog_pipelined_module as pipe
+    text = comb(d, **kw)
+    if d.degree >= 1:
+        text += "\n" + pipe(d, **kw)
+    write_atomic(args.output, text)
     return 0

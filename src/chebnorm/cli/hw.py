@@ -43,8 +43,12 @@ def register(sub) -> None:
 
     v = hsub.add_parser("verilog", help="write the module, its test bench and vectors")
     _design_args(v)
+    v.add_argument("--lang", choices=("verilog", "vhdl"), default="verilog",
+                   help="HDL of the module and bench: verilog (default; iverilog) or vhdl "
+                   "(VHDL-2008, numeric_std, bit-identical; ghdl)")
     v.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
-    v.add_argument("--simulate", action="store_true", help="also run the test bench in iverilog")
+    v.add_argument("--simulate", action="store_true",
+                   help="also run the test bench in iverilog (ghdl with --lang vhdl)")
     v.add_argument("--pipelined", action="store_true",
                    help="also write the pipelined variant chebnorm_NAME_pipe (clk, one register "
                    "per Horner step, latency = degree) and its bench")
@@ -121,7 +125,10 @@ def run_verilog(args) -> int:
     if args.pipelined and report.design.degree < 1:
         raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
                          f"pipeline; accepted: --pipelined with degree >= 1")
-    files = verilog_outputs(report, version=__version__, command=command_line(args),
+    outputs = verilog_outputs
+    if args.lang == "vhdl":  # the same design as VHDL, simulated by GHDL
+        from chebnorm.hw.vhdl import simulate_vhdl as simulate, vhdl_outputs as outputs
+    files = outputs(report, version=__version__, command=command_line(args),
                             pipelined=args.pipelined)
     files[f"{report.design.module_name}_report.json"] = json.dumps(
         report.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"

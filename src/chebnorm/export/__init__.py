@@ -11,6 +11,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.approx.files import write_atomic
 
 from .c import c_header, horner_rounding_bound
+from .shader import float32_eval_bound, glsl_source, hlsl_source, shader_source, wgsl_source
 
 
 def json_text(table: CoefficientTable, command: str = "") -> str:
@@ -18,9 +19,11 @@ def json_text(table: CoefficientTable, command: str = "") -> str:
     return table.to_json()
 
 
-FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json")}
+FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json"), "glsl": (glsl_source, ".glsl"),
+           "wgsl": (wgsl_source, ".wgsl"), "hlsl": (hlsl_source, ".hlsl")}
 
-__all__ = ["FORMATS", "c_header", "json_text", "export_table", "horner_rounding_bound"]
+__all__ = ["FORMATS", "c_header", "json_text", "export_table", "horner_rounding_bound",
+           "glsl_source", "wgsl_source", "hlsl_source", "shader_source", "float32_eval_bound"]
 
 
 def export_table(table: CoefficientTable, fmt: str, path, command: str = "") -> str:

@@ -1,0 +1,202 @@
+"""Run the exported shader functions on a real driver, and validate them.
+
+Three checks of the text :mod:`chebnorm.export.shader` prints, each through
+an external tool that is optional (the functions raise
+:class:`ToolMissing`, a :class:`RuntimeError`, naming what to install):
+
+* :func:`glslang_validate` -- ``glslangValidator`` (Debian ``glslang-tools``)
+  compiles a GLSL 4.30 or ES 3.10 compute shader around the function, or the
+  HLSL one through glslang's HLSL front end (``-D``);
+* :func:`glsl_evaluate` -- the GLSL function in an OpenGL 4.3 compute shader
+  through ``moderngl`` on a headless EGL context (Mesa's llvmpipe here);
+* :func:`wgsl_evaluate` -- the WGSL function in a compute pipeline through
+  ``wgpu`` (which validates the module with naga first; Mesa's lavapipe
+  here).
+
+The evaluators return float32 arrays: the driver's values, bit for bit.
+:func:`float32_inputs` picks the inputs: every float32 of the table's
+interval, or ``2^20`` of them evenly spread when there are more.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from chebnorm.approx import CoefficientTable
+from chebnorm.approx.textsafe import identifier
+
+from .shader import _interval32, shader_source
+
+__all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
+           "wgsl_evaluate", "gl_context", "compute_shader_source", "MAX_SAMPLES"]
+
+MAX_SAMPLES = 2 ** 20
+_GROUP = 64
+
+
+class ToolMissing(RuntimeError):
+    """An optional tool or driver is not available."""
+
+
+def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> np.ndarray:
+    """Every float32 in the table's interval (rounded inward), sorted; when
+    there are more than ``max_samples``, that many, taken evenly from the
+    union of ``max_samples`` evenly spaced in value and ``max_samples`` evenly
+    spaced in float32 order (which reaches the tiny magnitudes near a zero
+    endpoint), both ends kept.
+
+    >>> from chebnorm.approx import fit
+    >>> t = fit("1/x", ("1", "1 + 2**-20"), 1)
+    >>> float32_inputs(t).size  # 2^-20 / 2^-23 steps, both ends
+    9
+    """
+    lo, hi = _interval32(table)
+    a = _ordered(np.float32(lo))
+    b = _ordered(np.float32(hi))
+    if b - a + 1 <= max_samples:
+        return _from_ordered(np.arange(a, b + 1, dtype=np.int64))
+    by_order = _from_ordered(np.round(np.linspace(a, b, max_samples)).astype(np.int64))
+    by_value = np.clip(np.linspace(lo, hi, max_samples).astype(np.float32),
+                       np.float32(lo), np.float32(hi))
+    both = np.unique(np.concatenate([by_order, by_value]))
+    pick = np.round(np.linspace(0, both.size - 1, max_samples)).astype(np.int64)
+    return both[np.unique(pick)]
+
+
+def _ordered(f: np.float32) -> int:
+    """Integer key monotone in the float32 value (sign-magnitude to two's complement)."""
+    bits = int(np.array(f, dtype=np.float32).view(np.int32))
+    return bits if bits >= 0 else -(bits & 0x7FFFFFFF)
+
+
+def _from_ordered(keys: np.ndarray) -> np.ndarray:
+    keys = np.asarray(keys, dtype=np.int64)
+    bits = np.where(keys >= 0, keys, (-keys) | 0x80000000).astype(np.uint32)
+    return bits.view(np.float32)
+
+
+def compute_shader_source(table: CoefficientTable, language: str, *, es: bool = False) -> str:
+    """A compute shader that maps ``xs[i]`` to ``ys[i] = chebnorm_NAME(xs[i])``
+    around the exported function (GLSL 4.30, or ES 3.10 with ``es``; WGSL; HLSL)."""
+    fn = f"chebnorm_{identifier(table.name, field='table.name')}"
+    body = shader_source(table, language)
+    if language == "glsl":
+        head = ["#version 310 es", "precision highp float;"] if es else ["#version 430"]
+        return "\n".join(head + [
+            f"layout(local_size_x = {_GROUP}) in;",
+            "layout(std430, binding = 0) readonly buffer Xs { float xs[]; };",
+            "layout(std430, binding = 1) writeonly buffer Ys { float ys[]; };",
+            "", body,
+            "void main()", "{",
+            "    uint i = gl_GlobalInvocationID.x;",
+            f"    if (i < uint(xs.length())) ys[i] = {fn}(xs[i]);",
+            "}", ""])
+    if language == "wgsl":
+        return "\n".join([
+            "@group(0) @binding(0) var<storage, read> xs: array<f32>;",
+            "@group(0) @binding(1) var<storage, read_write> ys: array<f32>;",
+            "", body,
+            f"@compute @workgroup_size({_GROUP})",
+            "fn main(@builtin(global_invocation_id) id: vec3<u32>) {",
+            "    let i = id.x;",
+            f"    if (i < arrayLength(&xs)) {{ ys[i] = {fn}(xs[i]); }}",
+            "}", ""])
+    if language == "hlsl":
+        return "\n".join([
+            "StructuredBuffer<float> xs : register(t0);",
+            "RWStructuredBuffer<float> ys : register(u0);",
+            "", body,
+            f"[numthreads({_GROUP}, 1, 1)]",
+            "void main(uint3 id : SV_DispatchThreadID)",
+            "{",
+            f"    ys[id.x] = {fn}(xs[id.x]);",
+            "}", ""])
+    raise ValueError(f"unknown shader language {language!r}; accepted: glsl, wgsl, hlsl")
+
+
+def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
+    """Compile a compute shader with ``glslangValidator``; returns its output,
+    raises :class:`ValueError` with the messages when it does not compile."""
+    exe = shutil.which("glslangValidator")
+    if exe is None:
+        raise ToolMissing("glslangValidator is not installed; accepted: apt-get install "
+                          "glslang-tools")
+    if language not in ("glsl", "hlsl"):
+        raise ValueError(f"glslangValidator checks glsl or hlsl, not {language!r}")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / ("shader.comp" if language == "glsl" else "shader.hlsl")
+        path.write_text(source, encoding="utf-8")
+        cmd = [exe, str(path)] if language == "glsl" else \
+            [exe, "-D", "-e", "main", "-S", "comp", "-V", "-o", str(Path(tmp) / "cs.spv"),
+             str(path)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if proc.returncode != 0:
+        raise ValueError(f"glslangValidator rejected the {language} shader: "
+                         f"{' '.join((proc.stdout + proc.stderr).split())[:600]}")
+    return proc.stdout
+
+
+_CONTEXT = None
+
+
+def gl_context():
+    """A shared headless OpenGL 4.3+ context (moderngl, EGL)."""
+    global _CONTEXT
+    if _CONTEXT is None:
+        try:
+            import moderngl
+        except ImportError as exc:
+            raise ToolMissing("moderngl is not installed; accepted: pip install "
+                              "'chebnorm[gpu]'") from exc
+        try:
+            _CONTEXT = moderngl.create_standalone_context(backend="egl", require=430)
+        except Exception as exc:  # the driver's own error types
+            raise ToolMissing(f"no headless OpenGL 4.3 context ({exc}); accepted: Mesa's "
+                              f"EGL and llvmpipe (apt-get install libegl-mesa0 "
+                              f"libgl1-mesa-dri)") from exc
+    return _CONTEXT
+
+
+def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
+    """``chebnorm_NAME(x)`` for each float32 ``x`` of ``xs``, computed by the
+    exported GLSL in an OpenGL compute shader."""
+    ctx = gl_context()
+    x = np.ascontiguousarray(xs, dtype=np.float32)
+    with ctx:  # make the EGL context current again (another API may have switched it)
+        prog = ctx.compute_shader(compute_shader_source(table, "glsl"))
+        bx = ctx.buffer(x.tobytes())
+        by = ctx.buffer(reserve=max(x.nbytes, 4))
+        try:
+            bx.bind_to_storage_buffer(0)
+            by.bind_to_storage_buffer(1)
+            prog.run(group_x=-(-x.size // _GROUP))
+            ctx.finish()
+            return np.frombuffer(by.read(), dtype=np.float32)[: x.size].copy()
+        finally:
+            bx.release()
+            by.release()
+            prog.release()
+
+
+def wgsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
+    """As :func:`glsl_evaluate`, for the exported WGSL through ``wgpu``."""
+    try:
+        import wgpu
+        from wgpu.utils.compute import compute_with_buffers
+    except ImportError as exc:
+        raise ToolMissing("wgpu is not installed; accepted: pip install 'chebnorm[gpu]'") from exc
+    x = np.ascontiguousarray(xs, dtype=np.float32)
+    try:
+        wgpu.utils.get_default_device()
+    except Exception as exc:  # the driver's own error types
+        raise ToolMissing(f"no WebGPU adapter ({exc}); accepted: Mesa's lavapipe "
+                          f"(apt-get install mesa-vulkan-drivers)") from exc
+    out = compute_with_buffers({0: x}, {1: (x.size, "f")},
+                               compute_shader_source(table, "wgsl"),
+                               n=(-(-x.size // _GROUP), 1, 1))
+    return np.frombuffer(out[1], dtype=np.float32).copy()

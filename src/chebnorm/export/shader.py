@@ -1,0 +1,328 @@
+"""Shader printers (GLSL, WGSL, HLSL) of a :class:`~chebnorm.approx.CoefficientTable`.
+
+One table-driven printer serves the three languages, in the manner of
+sympy's code printers: a :class:`ShaderLanguage` row gives the type name,
+the literal suffix, the multiply-add built-in, the declaration syntax and
+the qualifier that forbids reassociation; :func:`shader_source` prints any
+row. Each output is a function to paste (or ``#include``) into a shader::
+
+    GLSL 4.30 / ES 3.10   float chebnorm_NAME(float x)
+    WGSL                  fn chebnorm_NAME(x: f32) -> f32
+    HLSL (SM 5)           float chebnorm_NAME(float x)
+
+with the coefficients as float32 literals that convert *exactly* (see
+:func:`float32_literal`), Horner's rule through the language's multiply-add
+(``fma`` in GLSL 4.x, ES 3.20 and WGSL; ``a * b + c`` in ES 3.10, which has
+no ``fma``; ``mad`` in HLSL, whose ``fma`` is for double only), the interval and the bounds as constants, and a comment banner.
+
+The float32 evaluation bound
+----------------------------
+``CHEBNORM_NAME_EVAL_ERROR_BOUND`` bounds ``|shader(x) - f(x)|`` for every
+float32 ``x`` in ``[CHEBNORM_NAME_LO, CHEBNORM_NAME_HI]``; it is the
+shader analogue of the C header's ``_F_EVAL_ERROR_BOUND``
+(:func:`float32_eval_bound` gives its parts):
+
+* the certified bound of ``|p - f|`` for the table's (double) coefficients;
+* ``sum_k |c_k - fl32(c_k)| M^k``: rounding the coefficients to float32
+  (``M`` = max |x| on the interval);
+* ``gamma_2n sum_k |fl32(c_k)| M^k`` with ``gamma_k = k u / (1 - k u)``,
+  ``u = 2^-24``: Horner's rounding error (Higham, *Accuracy and Stability of
+  Numerical Algorithms*, 2nd ed., eq. 5.3). The proof writes the computed
+  value as ``sum_k c_k x^k (1 + theta_(k))`` where ``1 + theta_(k)`` is a
+  product of at most ``2n`` factors ``(1 + delta)``, ``|delta| <= u``, one per
+  rounding the term goes through, and ``|theta_j| <= gamma_j``. A fused step
+  ``fl(a x + c)`` rounds once where the unfused ``fl(fl(a x) + c)`` rounds
+  twice, so every term of a fused, unfused or mixed evaluation carries
+  ``j <= 2n`` factors and ``|theta_j| <= gamma_j <= gamma_2n``: the one
+  bound covers the compiler fusing any subset of the steps (GLSL and WGSL
+  allow it; HLSL's ``mad`` may be either);
+* ``2^-124 (sum_{j<n} M^j + sum_k k |c_k| M^(k-1))``: subnormal flushes,
+  which all three languages allow. Each of the ``2n`` operations may flush a
+  subnormal result to zero, an absolute error below ``2^-126`` that later
+  steps multiply by ``|x| <= M`` at most ``n - 1`` times (two per step, and a
+  factor 2 for the roundings the error goes through later); a subnormal input
+  ``x`` flushed to zero moves ``p`` by at most ``2^-126 max |p'|``.
+
+What the bound assumes of the driver, from the specifications: float32
+``+``, ``-``, ``*`` correctly rounded (round to nearest) and ``fma``'s
+accuracy "inherited from" ``a * b + c``, that is fused or two rounded
+operations (GLSL 4.60 section 4.7.1 "Range and Precision"; ES 3.20 section
+4.7 for ``highp``; the WGSL specification's "Floating Point Accuracy" table;
+Direct3D 11's floating-point rules for HLSL), no other reassociation (the
+accumulator is ``precise`` in GLSL 4.x / ES 3.20 and HLSL; WGSL has no such
+qualifier, and a chain in which each step needs the previous one leaves
+nothing to reassociate), and the inputs in ``[LO, HI]``. ``mediump`` (ES)
+is not covered: declare the caller's precision ``highp``. Division, which the
+spec lets be 2.5 ULP, is never used. The tests measure every float32 of the
+interval (or 2^20 evenly spread when there are more) on Mesa's llvmpipe
+(GLSL) and lavapipe (WGSL) against ``f`` and find the error inside the bound.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import Decimal
+from fractions import Fraction
+
+import numpy as np
+
+from chebnorm.approx import CoefficientTable
+from chebnorm.approx.textsafe import comment_text, identifier
+
+from .c import _max_abs_x, _up, horner_rounding_bound
+
+__all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
+           "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source"]
+
+U32 = Fraction(1, 2 ** 24)
+_FLUSH = Fraction(1, 2 ** 126)  # largest magnitude a flushed subnormal float32 loses
+
+
+@dataclass(frozen=True)
+class ShaderLanguage:
+    """One row of the printer's table (see the module docstring).
+
+    ``const``/``function``/``acc`` are format strings with the fields shown in
+    :data:`SHADER_LANGUAGES`; ``prelude``/``postlude`` wrap the function.
+    """
+
+    name: str
+    title: str
+    float_type: str
+    suffix: str
+    madd: str
+    const: str
+    function: str
+    acc: str
+    prelude: tuple[str, ...] = ()
+    postlude: tuple[str, ...] = ()
+
+
+SHADER_LANGUAGES = {
+    "glsl": ShaderLanguage(
+        name="glsl", title="GLSL 4.30 / GLSL ES 3.10", float_type="float", suffix="",
+        madd="{P}_FMA",
+        const="const float {name} = {value};",
+        function="float {fn}(float x)\n{{",
+        acc="    {P}_PRECISE float acc = {value};",
+        prelude=("// fma() and precise (no reassociation) are core in GLSL 4.00 and ES 3.20; ES 3.10",
+                 "// gets a * b + c, which the compiler may fuse or not: the bound covers both.",
+                 "#if defined(GL_ES) && __VERSION__ < 320",
+                 "#define {P}_PRECISE",
+                 "#define {P}_FMA(a, b, c) ((a) * (b) + (c))",
+                 "#else",
+                 "#define {P}_PRECISE precise",
+                 "#define {P}_FMA(a, b, c) fma(a, b, c)",
+                 "#endif"),
+        postlude=("#undef {P}_PRECISE", "#undef {P}_FMA")),
+    "wgsl": ShaderLanguage(
+        name="wgsl", title="WGSL (WebGPU)", float_type="f32", suffix="f", madd="fma",
+        const="const {name}: f32 = {value};",
+        function="fn {fn}(x: f32) -> f32 {{",
+        acc="    var acc: f32 = {value};"),
+    "hlsl": ShaderLanguage(
+        name="hlsl", title="HLSL (Shader Model 5)", float_type="float", suffix="f", madd="mad",
+        const="static const float {name} = {value};",
+        function="float {fn}(float x)\n{{",
+        acc="    precise float acc = {value};"),
+}
+
+
+def _round32(value: Fraction) -> float:
+    """``value`` rounded to the nearest float32 (ties to even), exactly."""
+    f = np.float32(float(value))  # within one float32 step of the answer
+    for _ in range(3):
+        down = np.nextafter(f, np.float32(-np.inf), dtype=np.float32)
+        up = np.nextafter(f, np.float32(np.inf), dtype=np.float32)
+        lo_mid = (Fraction(float(down)) + Fraction(float(f))) / 2
+        hi_mid = (Fraction(float(f)) + Fraction(float(up))) / 2
+        if value < lo_mid:
+            f = down
+        elif value > hi_mid:
+            f = up
+        elif value == lo_mid or value == hi_mid:
+            even = f if (int(np.float32(f).view(np.uint32)) & 1) == 0 else None
+            if even is None:
+                f = down if value == lo_mid else up
+            return float(f)
+        else:
+            return float(f)
+    raise AssertionError("float32 rounding did not settle")  # unreachable: one step suffices
+
+
+def float32_literal(value: float, suffix: str = "") -> str:
+    """A decimal literal that converts exactly to ``float32(value)``.
+
+    GLSL and HLSL have no hexadecimal floats, so the literal is decimal: the
+    shortest that rounds to the float32 both directly (a correctly rounding
+    compiler) and through a double first (a compiler reading ``strtod`` and
+    then narrowing: double rounding); if the shortest fails either way, 9
+    significant digits, then the exact decimal expansion, which always works.
+
+    >>> float32_literal(0.1), float32_literal(-1.5, "f"), float32_literal(0.0)
+    ('1.0e-01', '-1.5e+00f', '0.0e+00')
+    """
+    with np.errstate(over="ignore"):
+        target = np.float32(value)
+    if not np.isfinite(target):
+        raise ValueError(f"coefficient {value!r} is not finite in float32; accepted: "
+                         f"|value| < 3.4e38")
+    if target == 0:
+        return f"0.0e+00{suffix}"
+    tf = float(target)
+    candidates = [np.format_float_scientific(target, unique=True, exp_digits=2),
+                  np.format_float_scientific(target, precision=8, unique=False, exp_digits=2)]
+    for s in candidates:
+        s = s.replace(".e", ".0e")
+        d = Fraction(Decimal(s))
+        if _round32(d) == tf and float(np.float32(float(d))) == tf:
+            return s + suffix
+    exact = Decimal(tf)  # every float32 is a finite decimal
+    s = f"{exact:e}"
+    return s + suffix
+
+
+@dataclass(frozen=True)
+class ShaderBound:
+    """Parts of the float32 bound of ``|shader(x) - f(x)|`` (module docstring).
+
+    ``total`` is rounded up to a double; ``total32`` up to a float32 (the
+    value printed as a shader constant).
+    """
+
+    certified: Fraction
+    coefficients: Fraction
+    rounding: Fraction
+    flush: Fraction
+    total: float
+    total32: float
+
+
+def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
+    """The float32 evaluation bound of the shader printers, fused or not.
+
+    >>> from chebnorm.approx import fit
+    >>> b = float32_eval_bound(fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z", name="d2"))
+    >>> b.certified < b.total <= b.total32 < 2.2e-5
+    True
+    """
+    coeffs = [float(c) for c in table.coefficients]
+    c32 = [float(np.float32(c)) for c in coeffs]
+    m = _max_abs_x(table)
+    coef = sum((abs(Fraction(a) - Fraction(b)) * m ** k
+                for k, (a, b) in enumerate(zip(coeffs, c32))), Fraction(0))
+    rounding = horner_rounding_bound(c32, m, float(U32))
+    n = len(coeffs) - 1
+    flush = 4 * _FLUSH * (sum((m ** j for j in range(n)), Fraction(0))
+                          + sum((k * abs(Fraction(c)) * m ** (k - 1)
+                                 for k, c in enumerate(c32) if k), Fraction(0)))
+    total = Fraction(table.abs_error_bound) + coef + rounding + flush
+    up = _up(total)
+    up32 = float(np.float32(up))
+    if up32 < up:
+        up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
+    return ShaderBound(certified=Fraction(table.abs_error_bound), coefficients=coef,
+                       rounding=rounding, flush=flush, total=up, total32=up32)
+
+
+def _interval32(table: CoefficientTable) -> tuple[float, float]:
+    """The table's interval rounded *inward* to float32: every float32 in it
+    lies in the table's interval."""
+    lo, hi = table.interval_float
+    lo32, hi32 = np.float32(lo), np.float32(hi)
+    if float(lo32) < lo:
+        lo32 = np.nextafter(lo32, np.float32(np.inf), dtype=np.float32)
+    if float(hi32) > hi:
+        hi32 = np.nextafter(hi32, np.float32(-np.inf), dtype=np.float32)
+    return float(lo32), float(hi32)
+
+
+def shader_source(table: CoefficientTable, language: str, command: str = "") -> str:
+    """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl).
+
+    >>> from chebnorm.approx import fit
+    >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="d1")
+    >>> "float chebnorm_d1(float x)" in shader_source(t, "glsl")
+    True
+    >>> "fn chebnorm_d1(x: f32) -> f32 {" in shader_source(t, "wgsl")
+    True
+    """
+    from chebnorm import __version__
+
+    try:
+        lang = SHADER_LANGUAGES[language]
+    except KeyError:
+        raise ValueError(f"unknown shader language {language!r}; accepted: "
+                         f"{', '.join(SHADER_LANGUAGES)}") from None
+    name = identifier(table.name, field="table.name")
+    fn = f"chebnorm_{name}"
+    big = f"CHEBNORM_{name.upper()}"
+    coeffs = [float(c) for c in table.coefficients]
+    bound = float32_eval_bound(table)
+    lo32, hi32 = _interval32(table)
+    var = comment_text(table.variable, max_length=40)
+    lit = lambda v: float32_literal(v, lang.suffix)  # noqa: E731
+    out = []
+    w = out.append
+    w(f"// {fn} -- {lang.title} -- generated by chebnorm {__version__}; do not edit.")
+    if command:
+        w(f"// Command: {comment_text(command)}")
+    w(f"// Table provenance: {comment_text(table.provenance.get('command', 'unknown'))}")
+    w(f"// p({var}) ~ {comment_text(table.expression)} on "
+      f"[{comment_text(table.interval[0], max_length=80)}, "
+      f"{comment_text(table.interval[1], max_length=80)}]"
+      f" = [{table.interval_float[0]!r}, {table.interval_float[1]!r}]")
+    w(f"// {comment_text(table.kind, max_length=40)} fit of degree {table.degree}; coefficients"
+      f" in ascending powers of {var}, rounded to float32 (exact literals).")
+    w(f"// Certified |p - f| <= {table.abs_error_bound!r} (double coefficients, exact arithmetic).")
+    w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
+    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients "
+      f"{float(bound.coefficients):.6e}")
+    w(f"//   + Horner rounding gamma_2n (fused or not) {float(bound.rounding):.6e} + subnormal"
+      f" flushes {float(bound.flush):.3e}.")
+    w("// Assumes float32 (highp) with correctly rounded + and *, and a multiply-add that is fused"
+      " or two roundings.")
+    w("")
+    for line in lang.prelude:
+        w(line.format(P=big))
+    w(lang.const.format(name=f"{big}_LO", value=lit(lo32)))
+    w(lang.const.format(name=f"{big}_HI", value=lit(hi32)))
+    w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND",
+                        value=lit(_up_f32(table.abs_error_bound))))
+    w(lang.const.format(name=f"{big}_EVAL_ERROR_BOUND", value=lit(bound.total32)))
+    w("")
+    w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")
+    w(lang.function.format(fn=fn))
+    w(lang.acc.format(P=big, value=lit(coeffs[-1])) + f"  // x^{len(coeffs) - 1}: "
+      f"{float(np.float32(coeffs[-1])).hex()}")
+    for k in range(len(coeffs) - 2, -1, -1):
+        w(f"    acc = {lang.madd.format(P=big)}(acc, x, {lit(coeffs[k])});  // x^{k}: "
+          f"{float(np.float32(coeffs[k])).hex()}")
+    w("    return acc;")
+    w("}")
+    for line in lang.postlude:
+        w(line.format(P=big))
+    return "\n".join(out) + "\n"
+
+
+def _up_f32(value: float) -> float:
+    """Smallest float32 >= ``value``."""
+    f = np.float32(value)
+    if float(f) < value:
+        f = np.nextafter(f, np.float32(np.inf), dtype=np.float32)
+    return float(f)
+
+
+def glsl_source(table: CoefficientTable, command: str = "") -> str:
+    """:func:`shader_source` in GLSL."""
+    return shader_source(table, "glsl", command)
+
+
+def wgsl_source(table: CoefficientTable, command: str = "") -> str:
+    """:func:`shader_source` in WGSL."""
+    return shader_source(table, "wgsl", command)
+
+
+def hlsl_source(table: CoefficientTable, command: str = "") -> str:
+    """:func:`shader_source` in HLSL."""
+    return shader_source(table, "hlsl", command)
