@@ -203,8 +203,8 @@ def _require_fixed_point(table: CoefficientTable, coef_bits):
         return table
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
-                         f"quantized with `chebnorm fit ... --frac-bits F`, or give "
-                         f"--coef-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
+                         f"quantized with `chebnorm fit ... --coef-frac-bits F`, or give "
+                         f"--coef-frac-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
     return table
 
 
