@@ -116,8 +116,6 @@ def _analyze(args, synth: bool, gappa: bool):
 
 
 def run_verilog(args) -> int:
-    from pathlib import Path
-
     from chebnorm import __version__
     from chebnorm.hw.report import verilog_outputs, write_outputs
     from chebnorm.hw.verilog import simulate
@@ -191,8 +189,6 @@ def argparse_ns(args, **changes):
 
 
 def run_unit(args) -> int:
-    from pathlib import Path
-
     from chebnorm import __version__
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs

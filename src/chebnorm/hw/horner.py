@@ -38,8 +38,8 @@ import sympy as sp
 
 from chebnorm.approx import CoefficientTable, parse_number, quantize
 
-from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, rounding_error_bound,
-                    shift_round, signed_bits, unsigned_bits)
+from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
+                    unsigned_bits)
 
 __all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
            "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]

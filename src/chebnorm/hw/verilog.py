@@ -24,8 +24,6 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from .horner import HornerDesign
 
 __all__ = ["verilog_module", "verilog_testbench", "vector_file", "SimResult", "SynthResult",
