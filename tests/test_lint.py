@@ -17,7 +17,7 @@ FOLDERS = ("src", "paper_repro", "benchmarks", "tests")
 #: files with findings whose owners fix them in other branches (issue 12); when
 #: a file becomes clean the strict xfail below fails: then delete it here
 PENDING = ("src/chebnorm/approx/api.py", "src/chebnorm/approx/expr.py",
-           "src/chebnorm/approx/sollya.py", "src/chebnorm/methods/counting.py")
+           "src/chebnorm/approx/sollya.py")
 
 
 def _ruff() -> list[str]:
