@@ -23,9 +23,7 @@ import sys
 import tempfile
 import time
 
-import sympy as sp
-
-from chebnorm.approx import fit, parse_function, sollya
+from chebnorm.approx import fit, parse_function, parse_number, sollya
 from chebnorm.approx.certify import certify
 
 WORKLOAD = (
@@ -47,7 +45,7 @@ def run_chebnorm(tight: float):
     for (expr, (lo, hi), d), t in zip(WORKLOAD, tables):
         fn = parse_function(expr)
         t0 = time.perf_counter()
-        c = certify(fn, t.coefficients, sp.sympify(lo), sp.sympify(hi), "abs", tol=tight)
+        c = certify(fn, t.coefficients, parse_number(lo), parse_number(hi), "abs", tol=tight)
         certs.append(time.perf_counter() - t0)
         worst_ratio = max(worst_ratio, c.bound / c.maximum - 1)
     return sum(fits), sum(certs), worst_ratio, tables
@@ -56,8 +54,8 @@ def run_chebnorm(tight: float):
 def run_sollya(tight: float):
     lines = ["prec=200!;", "display=decimal!;", "tr=0; ts=0; w=0;"]
     for k, (expr, (lo, hi), d) in enumerate(WORKLOAD):
-        f = sollya._sollya_expr(expr, "x")
-        dom = sollya._interval(lo, hi)
+        f = sollya.function_text(expr, "x")
+        dom = sollya.interval_text(lo, hi)
         lines += [f"f={f};", f"d={dom};",
                   f"t=time(p=remez(f, {d}, d)); tr=tr+t;",
                   f"t=time(r=supnorm(p, f, d, absolute, {tight!r})); ts=ts+t;",

@@ -360,7 +360,7 @@ def verdicts(timing, hardware):
                              "the halving tree replaces the sqrt and three divisions per pixel")
     why7 = (bound() + "; the midpoint alone: one polynomial replaces a sqrt and 3 divisions, "
             "but both are a handful of pipelined instructions. Whole triangles have short spans "
-            f"(median length {{tri_m}}) that leave the quadratic's per-span set-up unamortized; "
+            "(median length {tri_m}) that leave the quadratic's per-span set-up unamortized; "
             "by span length the quadratic reaches " + by_length("quadratic"))
     v["C7"] = _verdict_speed("C7", [
         ("midpoint, polynomial vs classic", per("mesh", "midpoint_poly", "speedup_vs_midpoint_classic"),

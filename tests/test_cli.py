@@ -42,7 +42,7 @@ def test_fit_minimax_acceptance():
 def test_fit_export_targets_round_trip(tmp_path, capsys):
     table = tmp_path / "t.json"
     assert main(["fit", "sqrt(2*(1+x))/2", "--interval", "0", "1", "--degree", "1",
-                 "--name", "eta_d1", "--frac-bits", "16", "-o", str(table)]) == 0
+                 "--name", "eta_d1", "--coef-frac-bits", "16", "-o", str(table)]) == 0
     assert main(["export", str(table), "--format", "c", "-o", str(tmp_path / "eta.h")]) == 0
     h = (tmp_path / "eta.h").read_text()
     assert "chebnorm_eta_d1_q_eval" in h and f"Command: chebnorm export {table}" in h
@@ -61,7 +61,7 @@ def test_fit_export_targets_round_trip(tmp_path, capsys):
     (["fit", "x", "--interval", "0", "1", "--degree", "31"], "accepted: 0 <= degree <= 30"),
     (["fit", "sqrt(", "--interval", "0", "1", "--degree", "2"], "cannot parse expression"),
     (["fit", "x+y", "--interval", "0", "1", "--degree", "2"], "unknown variable"),
-    (["fit", "exp(x)", "--interval", "0", "1", "--degree", "3", "--frac-bits", "40"], "overflows int32"),
+    (["fit", "exp(x)", "--interval", "0", "1", "--degree", "3", "--coef-frac-bits", "40"], "overflows int32"),
     (["fit", "x", "--interval", "0", "1"], "required: --degree"),
     (["export", "missing.json", "-o", "x.h"], "cannot read coefficient table"),
     (["nonsense"], "invalid choice"),
@@ -81,3 +81,58 @@ def test_failed_fit_leaves_no_output(tmp_path):
     out = tmp_path / "t.json"
     assert main(["fit", "1/sqrt(x)", "--interval", "-1", "1", "--degree", "2", "-o", str(out)]) == 2
     assert not out.exists()
+
+
+# --- one name per quantity; the old spellings are deprecated aliases for one release -------
+
+DEPRECATED = "is deprecated and will be removed in the next release; use "
+
+
+def _fit_json(tmp_path, flag):
+    rc, out, err = run("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", flag, "12",
+                       "--json")
+    assert rc == 0, err
+    return json.loads(out), err
+
+
+def test_fit_coef_frac_bits_and_deprecated_frac_bits(tmp_path):
+    new, err_new = _fit_json(tmp_path, "--coef-frac-bits")
+    old, err_old = _fit_json(tmp_path, "--frac-bits")
+    assert err_new == ""
+    assert err_old == f"chebnorm: warning: --frac-bits {DEPRECATED}--coef-frac-bits\n"
+    assert new["fixed_point"]["frac_bits"] == 12
+    new.pop("provenance"), old.pop("provenance")  # the command line differs
+    assert new == old
+
+
+@pytest.mark.parametrize("argv,old,new", [
+    (["hw", "report", "T", "--in-bits", "8", "--out-bits", "8", "--no-gappa", "--no-synth",
+      "--json", "--unit", "classic"], ["--coef-bits", "12"], ["--coef-frac-bits", "12"]),
+    (["hw", "report", "T", "--in-bits", "8", "--out-bits", "8", "--coef-frac-bits", "12",
+      "--no-gappa", "--no-synth", "--json", "--unit", "classic"],
+     ["--frac-bits", "6"], ["--vector-frac-bits", "6"]),
+])
+def test_hw_deprecated_aliases(tmp_path, argv, old, new):
+    from chebnorm.approx import fit_target
+
+    t = tmp_path / "t.json"
+    fit_target("dichotomy", 2).save(t)
+    argv = [str(t) if a == "T" else a for a in argv]
+    rc_new, out_new, err_new = run(*argv, *new)
+    rc_old, out_old, err_old = run(*argv, *old)
+    assert rc_new == rc_old == 0, err_new + err_old
+    assert err_new == ""
+    assert err_old == f"chebnorm: warning: {old[0]} {DEPRECATED}{new[0]}\n"
+    a, b = json.loads(out_new), json.loads(out_old)
+    for d in (a, b):  # timings and the command line differ between runs
+        d.pop("provenance", None)
+    assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+
+
+def test_help_names_each_quantity_once():
+    for argv, flags in ((["fit"], ["--coef-frac-bits"]),
+                        (["hw", "unit"], ["--coef-frac-bits", "--vector-frac-bits"]),
+                        (["hw", "sweep"], ["--coef-frac-bits"])):
+        rc, out, _ = run(*argv, "--help")
+        assert rc == 0 and all(f in out for f in flags)
+        assert "deprecated spelling of" in out

@@ -6,7 +6,6 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
-from fractions import Fraction
 
 import mpmath
 import numpy as np

@@ -298,7 +298,7 @@ class TestCLI:
         import json
 
         code, out, _ = self.run(["hw", "report", str(table_json), "--in-bits", "12",
-                                 "--out-bits", "12", "--coef-bits", "16", "--json",
+                                 "--out-bits", "12", "--coef-frac-bits", "16", "--json",
                                  "--no-synth", "--no-gappa"], capsys)
         assert code == 0
         d = json.loads(out)
@@ -306,12 +306,12 @@ class TestCLI:
         assert d["total_error_bound"] >= d["measured"]["total"]
 
     @pytest.mark.parametrize("extra, msg", [
-        (["--in-bits", "0", "--out-bits", "16", "--coef-bits", "20"], "in-bits = 0"),
+        (["--in-bits", "0", "--out-bits", "16", "--coef-frac-bits", "20"], "in-bits = 0"),
         (["--in-bits", "16", "--out-bits", "16"], "no fixed-point part"),
-        (["--in-bits", "16", "--out-bits", "16", "--coef-bits", "20", "--x-frac-bits", "18"],
+        (["--in-bits", "16", "--out-bits", "16", "--coef-frac-bits", "20", "--x-frac-bits", "18"],
          "does not fit the input format"),
-        (["--in-bits", "16", "--out-bits", "-2", "--coef-bits", "20"], "out-bits = -2"),
-        (["--in-bits", "16", "--out-bits", "16", "--coef-bits", "40"],
+        (["--in-bits", "16", "--out-bits", "-2", "--coef-frac-bits", "20"], "out-bits = -2"),
+        (["--in-bits", "16", "--out-bits", "16", "--coef-frac-bits", "40"],
          "accepted: 1 <= coef-bits <= 31"),
     ])
     def test_errors_leave_nothing(self, table_json, tmp_path, capsys, extra, msg):
@@ -323,7 +323,7 @@ class TestCLI:
 
     def test_verilog_writes(self, table_json, tmp_path, capsys):
         code, out, _ = self.run(["hw", "verilog", str(table_json), "--in-bits", "10",
-                                 "--out-bits", "10", "--coef-bits", "16", "-o", str(tmp_path)],
+                                 "--out-bits", "10", "--coef-frac-bits", "16", "-o", str(tmp_path)],
                                 capsys)
         assert code == 0
         names = sorted(p.name for p in tmp_path.iterdir())

@@ -188,7 +188,7 @@ class TestCLI:
 
     @no_iverilog
     def test_unit_writes_and_passes(self, tmp_path, capsys):
-        code, out, _ = self.run(["hw", "unit", "quadratic", "--frac-bits", "6", "--in-bits", "8",
+        code, out, _ = self.run(["hw", "unit", "quadratic", "--vector-frac-bits", "6", "--in-bits", "8",
                                  "--out-bits", "8", "--vectors", "200", "-o", str(tmp_path),
                                  "--simulate"], capsys)
         assert code == 0 and "PASS:" in out and " 0 mismatches" in out
@@ -200,19 +200,19 @@ class TestCLI:
         t = tmp_path / "t.json"
         fit_target("dichotomy", 2).save(t)
         code, out, _ = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
-                                 "--coef-bits", "12", "--json", "--no-gappa", "--no-synth",
+                                 "--coef-frac-bits", "12", "--json", "--no-gappa", "--no-synth",
                                  "--unit", "dichotomy", "--unit", "classic",
-                                 "--frac-bits", "6"], capsys)
+                                 "--vector-frac-bits", "6"], capsys)
         assert code == 0
         units = json.loads(out)["units"]
         assert [u["unit"] for u in units] == ["dichotomy", "classic"]
         assert all(u["area_fa"] > 0 and "yosys_cells" in u for u in units)
 
     @pytest.mark.parametrize("extra, msg", [
-        (["classic", "--frac-bits", "0"], "frac-bits = 0 is out of range"),
+        (["classic", "--vector-frac-bits", "0"], "frac-bits = 0 is out of range"),
         (["eta", "--comp-bits", "40"], "accepted: 2 <= comp-bits <= 28"),
         (["dichotomy", "--in-bits", "-1"], "in-bits = -1"),
-        (["dichotomy", "--coef-bits", "40"], "accepted: 1 <= coef-bits <= 31"),
+        (["dichotomy", "--coef-frac-bits", "40"], "accepted: 1 <= coef-bits <= 31"),
         (["stepper", "--log-m", "12"], "accepted: 0 <= log-m <= 10"),
     ])
     def test_errors_leave_nothing(self, tmp_path, capsys, extra, msg):
@@ -226,7 +226,7 @@ class TestCLI:
         t = tmp_path / "t.json"
         fit_target("dichotomy", 2).save(t)
         code, _, err = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
-                                 "--coef-bits", "12", "--unit", "cordic"], capsys)
+                                 "--coef-frac-bits", "12", "--unit", "cordic"], capsys)
         assert code == 2 and "unit 'cordic' is unknown" in err
 
 
@@ -267,7 +267,7 @@ class TestPipelined:
         out = tmp_path / "out"
         out.mkdir()
         code = main(["hw", "verilog", str(t), "--in-bits", "10", "--out-bits", "10",
-                     "--coef-bits", "16", "-o", str(out), "--simulate", "--pipelined"])
+                     "--coef-frac-bits", "16", "-o", str(out), "--simulate", "--pipelined"])
         text = capsys.readouterr().out
         assert code == 0 and text.count("PASS:") == 2 and "latency 2" in text
         assert (out / "chebnorm_dichotomy_d2_pipe.v").exists()

@@ -19,7 +19,8 @@ import sympy as sp
 
 from .expr import parse_function, parse_number
 
-__all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm"]
+__all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "function_text",
+           "interval_text"]
 
 
 def available() -> bool:
@@ -54,6 +55,25 @@ def _poly(coefficients) -> str:
 
 def _interval(lo: str, hi: str) -> str:
     return f"[{sp.sstr(parse_number(lo))};{sp.sstr(parse_number(hi))}]".replace("**", "^")
+
+
+def function_text(expr: str, var: str = "x") -> str:
+    """``expr`` (a function of ``var``, parsed by chebnorm's own reader) as a
+    Sollya expression in ``x``, for scripts of one's own.
+
+    >>> function_text("1/sqrt(2+z)", "z")
+    '1/sqrt(x + 2)'
+    """
+    return _sollya_expr(expr, var)
+
+
+def interval_text(lo: str, hi: str) -> str:
+    """The interval ``[lo, hi]`` as a Sollya range with exact endpoints.
+
+    >>> interval_text("sqrt(2)", "2")
+    '[sqrt(2);2]'
+    """
+    return _interval(lo, hi)
 
 
 def _run(script: str, timeout: float = 600) -> str:

@@ -3,8 +3,9 @@
 Each subcommand lives in its own module of this package and exposes
 ``register(subparsers)``, which adds its parser and sets ``func`` to a
 function ``(args) -> int``. Errors the user can fix (``ValueError``,
-``OSError``) end the program with status 2 and one line on stderr, never a
-traceback.
+``OSError``, among them :class:`chebnorm.approx.files.WriteError` for an
+output that cannot be written) end the program with status 2 and one line on
+stderr, never a traceback.
 """
 
 from __future__ import annotations
@@ -37,13 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in SUBCOMMANDS:
-        try:
-            module = importlib.import_module(f"chebnorm.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"chebnorm.cli.{name}":
-                continue  # subcommand not built yet
-            raise
-        module.register(sub)
+        importlib.import_module(f"chebnorm.cli.{name}").register(sub)
     return parser
 
 
@@ -55,7 +50,10 @@ def main(argv: list[str] | None = None) -> int:
         args.argv = ["chebnorm", *argv]
         return int(args.func(args) or 0)
     except (ValueError, OSError) as exc:
-        message = " ".join(str(exc).split()) or type(exc).__name__
+        text = str(exc)
+        if isinstance(exc, OSError) and exc.strerror and exc.filename and "Errno" in text:
+            text = f"{exc.filename}: {exc.strerror}"  # no "[Errno 13]" noise
+        message = " ".join(text.split()) or type(exc).__name__
         print(f"chebnorm: error: {message}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

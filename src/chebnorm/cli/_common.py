@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import shlex
+import sys
 
 
 def command_line(args) -> str:
@@ -14,3 +16,24 @@ def command_line(args) -> str:
 def print_json(obj) -> None:
     """Deterministic JSON on stdout: sorted keys, shortest float repr."""
     print(json.dumps(obj, sort_keys=True, indent=2, allow_nan=False))
+
+
+class _DeprecatedFlag(argparse.Action):
+    """Stores like the flag it stands for, and says once on stderr that the
+    old spelling goes away."""
+
+    def __init__(self, option_strings, dest, new_flag=None, **kwargs):
+        self.new_flag = new_flag
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"chebnorm: warning: {option_string} is deprecated and will be removed in the next "
+              f"release; use {self.new_flag}", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def deprecated_alias(parser, old: str, new: str, dest: str, **kwargs) -> None:
+    """Add ``old`` as a deprecated spelling of option ``new`` (same ``dest``,
+    same type): it still works for one release and prints one warning line."""
+    parser.add_argument(old, dest=dest, action=_DeprecatedFlag, new_flag=new,
+                        help=f"deprecated spelling of {new}", **kwargs)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from chebnorm.approx import MAX_DEGREE, fit
 
-from ._common import command_line, print_json
+from ._common import command_line, deprecated_alias, print_json
 
 
 def register(sub) -> None:
@@ -19,7 +19,9 @@ def register(sub) -> None:
     p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
     p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
     p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
-    p.add_argument("--frac-bits", type=int, default=None, help="also quantize to F fractional bits")
+    p.add_argument("--coef-frac-bits", dest="frac_bits", type=int, default=None, metavar="F",
+                   help="also quantize the coefficients to F fractional bits")
+    deprecated_alias(p, "--frac-bits", "--coef-frac-bits", "frac_bits", type=int, metavar="F")
     p.add_argument("--name", default="table", help="table name (a C identifier)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")

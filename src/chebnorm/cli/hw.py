@@ -6,16 +6,17 @@ import json
 
 from chebnorm.approx import CoefficientTable
 
-from ._common import command_line, print_json
+from ._common import command_line, deprecated_alias, print_json
 
 
 def _design_args(p) -> None:
     p.add_argument("table", metavar="TABLE.json")
     p.add_argument("--in-bits", type=int, required=True, help="input code width, 1..20")
     p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
-    p.add_argument("--coef-bits", type=int, default=None,
+    p.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None, metavar="B",
                    help="coefficient fractional bits, 1..31 or fewer: the table's coefficients "
                    "must fit int32 (re-quantizes; default: the table's own)")
+    deprecated_alias(p, "--coef-bits", "--coef-frac-bits", "coef_bits", type=int, metavar="B")
     p.add_argument("--acc-bits", type=int, default=None,
                    help="accumulator fractional bits (default: output's + 3)")
     p.add_argument("--rounding", default="rne", help="rne (default) or trunc")
@@ -24,8 +25,9 @@ def _design_args(p) -> None:
 
 
 def _unit_width_args(p) -> None:
-    p.add_argument("--frac-bits", type=int, default=14,
+    p.add_argument("--vector-frac-bits", dest="frac_bits", type=int, default=14, metavar="F",
                    help="unit: fractional bits F of the vector components, 1..26 (default 14)")
+    deprecated_alias(p, "--frac-bits", "--vector-frac-bits", "frac_bits", type=int, metavar="F")
     p.add_argument("--comp-bits", type=int, default=None,
                    help="unit: signed component width W, 2..28 (default F + 2)")
     p.add_argument("--log-m", type=int, default=4, help="stepper: m = 2^LOG_M pixels, 0..10")
@@ -75,9 +77,10 @@ def register(sub) -> None:
                    "midpoint or eta_term for psi_max = pi/4)")
     u.add_argument("--in-bits", type=int, default=16, help="evaluator input width, 1..20")
     u.add_argument("--out-bits", type=int, default=16, help="evaluator output width, 1..32")
-    u.add_argument("--coef-bits", type=int, default=None,
+    u.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None, metavar="B",
                    help="coefficient fractional bits (default: the table's own, or out-bits + 4 "
                    "for the default table)")
+    deprecated_alias(u, "--coef-bits", "--coef-frac-bits", "coef_bits", type=int, metavar="B")
     u.add_argument("--rounding", default=None,
                    help="classic: trunc (default) or rne quotient; others: the evaluator's")
     _unit_width_args(u)
@@ -94,7 +97,10 @@ def register(sub) -> None:
     s.add_argument("--target", default="dichotomy", help="registered target (default dichotomy)")
     s.add_argument("--psi-max", default="pi/4", help="largest angle between normals (default pi/4)")
     s.add_argument("--degrees", type=int, nargs="+", default=None, help="1..4 (default 1 2 3 4)")
-    s.add_argument("--coef-bits", type=int, nargs="+", default=None, help="default 10 14 18")
+    s.add_argument("--coef-frac-bits", dest="coef_bits", type=int, nargs="+", default=None,
+                   metavar="B", help="coefficient fractional bits to try (default 10 14 18)")
+    deprecated_alias(s, "--coef-bits", "--coef-frac-bits", "coef_bits", type=int, nargs="+",
+                     metavar="B")
     s.add_argument("--acc-bits", type=int, nargs="+", default=None, help="default 14 18")
     s.add_argument("--in-bits", type=int, default=12, help="default 12")
     s.add_argument("--out-bits", type=int, default=12, help="default 12")
@@ -114,8 +120,6 @@ def _analyze(args, synth: bool, gappa: bool):
 
 
 def run_verilog(args) -> int:
-    from pathlib import Path
-
     from chebnorm import __version__
     from chebnorm.hw.report import verilog_outputs, write_outputs
     from chebnorm.hw.verilog import simulate
@@ -192,8 +196,6 @@ def argparse_ns(args, **changes):
 
 
 def run_unit(args) -> int:
-    from pathlib import Path
-
     from chebnorm import __version__
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs
@@ -220,7 +222,7 @@ def run_unit(args) -> int:
 def run_sweep(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.files import make_folder, write_atomic
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)
@@ -231,7 +233,7 @@ def run_sweep(args) -> int:
                 out_bits=args.out_bits, rounding=args.rounding, psi_max=args.psi_max,
                 synth=not args.no_synth)
     csv, png = res.csv(), res.plot_png()
-    out.mkdir(parents=True, exist_ok=True)  # only now: nothing is created when the sweep fails
+    make_folder(out)  # only now: nothing is created when the sweep fails
     stem = f"sweep_{args.target}"
     write_atomic(out / f"{stem}.csv", csv)
     write_atomic(out / f"{stem}.png", png)

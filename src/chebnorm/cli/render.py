@@ -24,6 +24,10 @@ def register(sub) -> None:
     p.add_argument("--size", nargs=2, type=int, default=(512, 512), metavar=("W", "H"),
                    help="image size in pixels (default 512 512)")
     p.add_argument("--tess", type=int, default=None, help="tessellation level (mesh default)")
+    p.add_argument("--crease-angle", type=float, default=None, metavar="DEG",
+                   help="mesh files: compute vertex normals, kept apart across edges sharper "
+                   f"than DEG degrees ({CREASE_RANGE[0]:g}..{CREASE_RANGE[1]:g}); default: an "
+                   "OBJ file's own vn normals, else 30")
     p.add_argument("--shininess", type=float, default=32.0, help="specular exponent n (default 32)")
     p.add_argument("--half-vector", default="pixel", choices=("pixel", "triangle"),
                    help="H per pixel (default) or constant per triangle")
@@ -36,10 +40,27 @@ def register(sub) -> None:
     p.add_argument("--reference", default=None, metavar="MODE[:METHOD]",
                    help="reference render (default phong:exact; for bump, bump:full — the "
                    "METHOD slot of bump is its variant)")
-    p.add_argument("--out", metavar="IMAGE.png", help="write the 8-bit image")
-    p.add_argument("--error-map", metavar="ERR.png", help="write a heat map of |error|")
+    p.add_argument("--out", metavar="IMAGE.png", help="write the 8-bit image; the extension "
+                   "names the format: .png, .jpg/.jpeg (quality 95), .tif/.tiff, .bmp")
+    p.add_argument("--error-map", metavar="ERR.png", help="write a heat map of |error| "
+                   "(formats as --out)")
     p.add_argument("--json", action="store_true", help="print metrics and mode report as JSON")
     p.set_defaults(func=run)
+
+
+#: accepted --crease-angle, degrees
+CREASE_RANGE = (0.0, 180.0)
+
+
+def _crease_radians(deg):
+    import math
+
+    if deg is None:
+        return None
+    if not (CREASE_RANGE[0] <= deg <= CREASE_RANGE[1]):  # also refuses nan
+        raise ValueError(f"--crease-angle {deg!r}: expected degrees in "
+                         f"[{CREASE_RANGE[0]:g}, {CREASE_RANGE[1]:g}]")
+    return math.radians(deg)
 
 
 def _parse_reference(text, shading):
@@ -60,12 +81,19 @@ def run(args) -> int:
     import numpy as np
 
     from chebnorm.raster import (Lighting, compare, error_map_rgb, get_mesh, render,
-                                 write_png)
+                                 write_image)
+    from chebnorm.raster.metrics import image_format
 
     t_start = time.perf_counter()
     ref_mode, ref_method, ref_bump = _parse_reference(args.reference, args.shading)
+    for option, path in (("--out", args.out), ("--error-map", args.error_map)):
+        if path:
+            try:
+                image_format(path)
+            except ValueError as exc:
+                raise ValueError(f"{option}: {exc}") from None
     lighting = Lighting(shininess=args.shininess, half_vector=args.half_vector)
-    mesh = get_mesh(args.mesh, args.tess)
+    mesh = get_mesh(args.mesh, args.tess, _crease_radians(args.crease_angle))
     common = dict(size=tuple(args.size), lighting=lighting, eta_threshold=args.eta_threshold,
                   q=args.q)
     result = render(mesh, args.shading, args.method, bump=args.bump, **common)
@@ -73,9 +101,9 @@ def run(args) -> int:
     metrics, diff = compare(result, reference)
     # everything validated and computed: now write the outputs (atomically)
     if args.out:
-        write_png(args.out, result.image8)
+        write_image(args.out, result.image8)
     if args.error_map:
-        write_png(args.error_map, error_map_rgb(diff))
+        write_image(args.error_map, error_map_rgb(diff))
     report = metrics.to_dict()
     report.update({
         "seconds": result.seconds,

@@ -38,8 +38,8 @@ import sympy as sp
 
 from chebnorm.approx import CoefficientTable, parse_number, quantize
 
-from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, rounding_error_bound,
-                    shift_round, signed_bits, unsigned_bits)
+from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
+                    unsigned_bits)
 
 __all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
            "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
@@ -203,8 +203,8 @@ def _require_fixed_point(table: CoefficientTable, coef_bits):
         return table
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
-                         f"quantized with `chebnorm fit ... --frac-bits F`, or give "
-                         f"--coef-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
+                         f"quantized with `chebnorm fit ... --coef-frac-bits F`, or give "
+                         f"--coef-frac-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
     return table
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import write_atomic
+from chebnorm.approx.files import make_folder, write_atomic
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -159,11 +159,7 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     """Write every file atomically into ``directory`` (created if missing); the
     caller has checked everything before, so nothing is half-written."""
-    folder = Path(directory)
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"output {str(folder)!r} exists and is not a folder; accepted: a folder "
-                         f"(created if missing)")
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = make_folder(directory)
     paths = []
     for fname, text in files.items():
         write_atomic(folder / fname, text)

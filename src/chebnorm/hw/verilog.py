@@ -24,8 +24,6 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from chebnorm.approx.textsafe import comment_text, identifier
 
 from .horner import HornerDesign

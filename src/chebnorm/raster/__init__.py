@@ -10,15 +10,15 @@ never chebnorm.hw or the CLI.
 0
 
 Public API: :func:`render` (one frame, any mode), :func:`compare` (metrics
-and the signed 8-bit difference), :func:`error_map_rgb`, :func:`write_png`;
-meshes (:func:`get_mesh` and the generators); studies for the paper
-reproduction (:func:`eta_study`, :func:`split_gouraud_study`,
+and the signed 8-bit difference), :func:`error_map_rgb`, :func:`write_image`
+(PNG, JPEG, TIFF or BMP by file extension); meshes (:func:`get_mesh` and the
+generators); studies for the paper reproduction (:func:`eta_study`, :func:`split_gouraud_study`,
 :func:`bump_comparison`, :func:`write_bump_figures`).
 """
 
 from .meshes import (MESH_NAMES, Mesh, crease_normals, get_mesh, icosphere, load_mesh, square,
                      teapot, torus, uv_sphere)
-from .metrics import ImageMetrics, compare, error_map_rgb, write_png
+from .metrics import IMAGE_FORMATS, ImageMetrics, compare, error_map_rgb, write_image, write_png
 from .render import (BUMP_VARIANTS, SHADING_MODES, HeightMap, Lighting, RenderResult,
                      available_methods, get_span_normals, render, to_8bit)
 from .spans import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
@@ -26,7 +26,7 @@ from .studies import (BumpCase, EtaLevel, SplitGouraudStudy, bump_comparison, et
                       split_gouraud_study, write_bump_figures)
 
 __all__ = [
-    "render", "compare", "error_map_rgb", "write_png", "to_8bit",
+    "render", "compare", "error_map_rgb", "write_image", "write_png", "IMAGE_FORMATS", "to_8bit",
     "RenderResult", "ImageMetrics", "Lighting", "HeightMap", "SHADING_MODES", "BUMP_VARIANTS",
     "available_methods", "get_span_normals",
     "Mesh", "MESH_NAMES", "get_mesh", "uv_sphere", "icosphere", "torus", "square", "teapot",

@@ -5,8 +5,9 @@ parametric, the parametrization ``(u, v)`` and its partial derivatives
 Generators: :func:`uv_sphere`, :func:`icosphere`, :func:`torus`,
 :func:`square`, :func:`teapot` (Newell's 32 Bezier patches, normals from
 ``dP/du x dP/dv``, seed 000), and :func:`load_mesh` for OBJ/PLY/STL files
-through trimesh (vertex normals averaged over faces, kept apart across edges
-sharper than a crease angle, seed 000).  :func:`get_mesh` dispatches on a
+through trimesh (an OBJ file's own ``vn`` normals, else vertex normals
+averaged over faces, kept apart across edges sharper than a crease angle,
+seed 000).  :func:`get_mesh` dispatches on a
 name or a path.
 
 Every mesh is validated once, when it is built (:class:`Mesh`): finite
@@ -366,50 +367,151 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     return new_pos, new_nrm, inverse.reshape(-1, 3).astype(np.int64)
 
 
-def load_mesh(path, crease_angle: float = np.radians(30.0)) -> Mesh:
-    """Read an OBJ, PLY or STL file with trimesh (vertices merged), and give
-    it crease-angle vertex normals (:func:`crease_normals`).  Raises
-    ``ValueError`` for a missing or unreadable file and for degenerate
-    triangles."""
+#: default crease angle of :func:`load_mesh` (degrees)
+DEFAULT_CREASE_DEG = 30.0
+
+
+def _check_obj_numbers(path: str) -> None:
+    """Refuse an OBJ file whose ``v`` or ``vn`` lines hold a non-finite
+    number, or whose ``vn`` is the zero vector, naming the vertex / normal by
+    its OBJ index (1-based, as ``f`` lines count) and its line. trimesh would
+    otherwise drop the triangles that use it without a word."""
+    counts = {"v": 0, "vn": 0}
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for lineno, line in enumerate(fh, 1):
+            parts = line.split()
+            if not parts or parts[0] not in counts:
+                continue
+            key = parts[0]
+            counts[key] += 1
+            what = "vertex" if key == "v" else "normal"
+            try:
+                xyz = [float(t) for t in parts[1:4]]
+            except ValueError:
+                raise ValueError(f"mesh file {path!r}: {what} {counts[key]} (line {lineno}) is not "
+                                 f"a number triple: {' '.join(parts[1:4])!r}") from None
+            if len(xyz) != 3 or not all(np.isfinite(xyz)):
+                raise ValueError(f"mesh file {path!r}: {what} {counts[key]} (line {lineno}) is not "
+                                 f"finite: {' '.join(parts[1:4])!r}; every coordinate must be a "
+                                 "finite number")
+            if key == "vn" and not any(xyz):
+                raise ValueError(f"mesh file {path!r}: normal {counts[key]} (line {lineno}) is the "
+                                 "zero vector; a normal needs a direction")
+
+
+def _read_obj(path: str):
+    """Positions, faces and the file's own vertex normals (``None`` unless
+    every triangle carries ``vn`` indices) of an OBJ file, through trimesh's
+    OBJ reader, which splits a vertex that carries different normals in
+    different faces."""
+    from trimesh.exchange.obj import load_obj
+
+    _check_obj_numbers(path)
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        parts = load_obj(fh)["geometry"].values()
+    parts = [g for g in parts if len(g.get("faces", ())) and len(g.get("vertices", ()))]
+    if not parts:
+        return None, None, None
+    pos, faces, normals, offset = [], [], [], 0
+    for g in parts:
+        v = np.asarray(g["vertices"], dtype=np.float64)
+        pos.append(v)
+        faces.append(np.asarray(g["faces"], dtype=np.int64) + offset)
+        vn = g.get("vertex_normals")
+        normals.append(None if vn is None or np.shape(vn) != v.shape
+                       else np.asarray(vn, dtype=np.float64))
+        offset += len(v)
+    nrm = None if any(n is None for n in normals) else np.concatenate(normals)
+    return np.concatenate(pos), np.concatenate(faces), nrm
+
+
+def _read_other(path: str):
+    """Positions and faces of a PLY or STL file (file order, then merged
+    vertices); the file is refused when a vertex is not finite."""
     import trimesh
 
+    tm = trimesh.load(path, force="mesh", process=False)
+    if not isinstance(tm, trimesh.Trimesh) or len(tm.faces) == 0:
+        return None, None, None
+    pos = np.asarray(tm.vertices, dtype=np.float64)
+    bad = ~np.isfinite(pos).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"mesh file {path!r}: vertex {i} (0-based, file order) is not finite: "
+                         f"{pos[i].tolist()}; every coordinate must be a finite number")
+    tm.merge_vertices()
+    return (np.asarray(tm.vertices, dtype=np.float64), np.asarray(tm.faces, dtype=np.int64), None)
+
+
+def load_mesh(path, crease_angle: float | None = None) -> Mesh:
+    """Read an OBJ, PLY or STL file with trimesh.
+
+    Normals: an OBJ file's own ``vn`` normals (normalized) when every
+    triangle carries them and ``crease_angle`` is ``None``; otherwise vertex
+    normals averaged over the faces and kept apart across edges sharper than
+    ``crease_angle`` radians (:func:`crease_normals`; default
+    ``DEFAULT_CREASE_DEG`` degrees). Faces whose winding opposes their
+    vertex normals are re-wound.
+
+    Raises ``ValueError`` for a missing or unreadable file, a vertex or normal
+    that is not finite (naming it: trimesh would silently drop its
+    triangles), a zero normal, and degenerate triangles.
+
+    >>> import tempfile, os
+    >>> p = os.path.join(tempfile.mkdtemp(), "tri.obj")
+    >>> _ = open(p, "w").write("v 0 0 0\\nv 1 0 0\\nv 0 1 0\\nvn 0 0 2\\nf 1//1 2//1 3//1\\n")
+    >>> load_mesh(p).normals.tolist()
+    [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+    """
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise ValueError(f"mesh file {path!r} does not exist")
     ext = os.path.splitext(path)[1].lower()
     if ext not in (".obj", ".ply", ".stl"):
         raise ValueError(f"mesh file {path!r}: unsupported extension {ext!r}; accepted: .obj, .ply, .stl")
+    if crease_angle is not None and not (0 <= crease_angle <= np.pi):
+        raise ValueError(f"crease angle must lie in [0, pi] radians; got {crease_angle!r}")
     try:
-        tm = trimesh.load(path, force="mesh", process=True)
+        pos, faces, nrm = _read_obj(path) if ext == ".obj" else _read_other(path)
+    except ValueError as exc:
+        if str(exc).startswith(f"mesh file {path!r}"):
+            raise
+        raise ValueError(f"cannot read mesh file {path!r}: {exc}") from None
     except Exception as exc:  # trimesh raises many types
         raise ValueError(f"cannot read mesh file {path!r}: {exc}") from None
-    if not isinstance(tm, trimesh.Trimesh) or len(tm.faces) == 0:
+    if faces is None or len(faces) == 0:
         raise ValueError(f"mesh file {path!r} holds no triangles")
-    pos = np.asarray(tm.vertices, dtype=np.float64)
-    faces = np.asarray(tm.faces, dtype=np.int64)
-    if not np.isfinite(pos).all():
-        raise ValueError(f"mesh file {path!r}: non-finite vertex coordinates")
     bad = _degenerate_faces(pos, faces)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"mesh file {path!r}: triangle {i} is degenerate (zero area); "
                          f"{int(bad.sum())} such triangle(s)")
-    p, n, f = crease_normals(pos, faces, crease_angle)
-    return Mesh(os.path.basename(path), p, n, f)
+    name = os.path.basename(path)
+    if nrm is not None and crease_angle is None:
+        nrm = _unit(nrm)
+        return Mesh(name, pos, nrm, _orient(pos, nrm, faces))
+    angle = np.radians(DEFAULT_CREASE_DEG) if crease_angle is None else crease_angle
+    p, n, f = crease_normals(pos, faces, angle)
+    return Mesh(name, p, n, f)
 
 
-def get_mesh(name_or_path, tess: int | None = None) -> Mesh:
+def get_mesh(name_or_path, tess: int | None = None, crease_angle: float | None = None) -> Mesh:
     """A mesh by name (``teapot``, ``sphere``, ``icosphere``, ``torus``,
     ``square``) at tessellation level ``tess`` (generator default if None),
-    or an OBJ/PLY/STL file path."""
+    or an OBJ/PLY/STL file path (:func:`load_mesh`, with ``crease_angle`` in
+    radians). Generated meshes have exact normals: a ``crease_angle`` for one
+    is refused."""
     gens = {"teapot": teapot, "sphere": uv_sphere, "icosphere": icosphere, "torus": torus,
             "square": square}
     if isinstance(name_or_path, Mesh):
         return name_or_path
     name = os.fspath(name_or_path)
     if name in gens:
+        if crease_angle is not None:
+            raise ValueError(f"mesh {name!r} is generated with exact normals; a crease angle "
+                             "applies to mesh files (.obj, .ply, .stl) only")
         return gens[name]() if tess is None else gens[name](tess)
     if os.path.splitext(name)[1].lower() in (".obj", ".ply", ".stl") or os.sep in name:
-        return load_mesh(name)
+        return load_mesh(name, crease_angle)
     raise ValueError(f"unknown mesh {name!r}; accepted: {', '.join(MESH_NAMES)} or a path to an "
                      ".obj, .ply or .stl file")

@@ -1,5 +1,5 @@
 """Image-error metrics against a reference render, error heat maps, and
-atomic PNG writing.
+atomic image writing (PNG, JPEG, TIFF, BMP by file extension).
 
 All metrics are computed on the 8-bit images (``round(255 I)``), so "0
 error" means identical 8-bit output.  Over the *covered* pixels (the union of
@@ -13,12 +13,12 @@ whole image with an explicit ``data_range=255``.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_png"]
+__all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_image", "write_png", "image_bytes",
+           "image_format", "IMAGE_FORMATS"]
 
 
 @dataclass(frozen=True)
@@ -100,24 +100,65 @@ def error_map_rgb(diff, scale: float | None = None) -> np.ndarray:
     return np.round(np.stack([r, g, b], -1) * 255).astype(np.uint8)
 
 
-def write_png(path, array) -> None:
-    """Write a uint8 image (H, W) or (H, W, 3) as PNG atomically: a temporary
-    file in the same directory, then ``os.replace``."""
+#: image formats :func:`write_image` writes, by file extension (Pillow writes
+#: each deterministically: the same array gives the same bytes)
+IMAGE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".tif": "TIFF",
+                 ".tiff": "TIFF", ".bmp": "BMP"}
+#: JPEG is lossy: a fixed quality so that outputs are reproducible
+JPEG_QUALITY = 95
+
+
+def image_bytes(array, fmt: str = "PNG") -> bytes:
+    """Encode a uint8 image ``(H, W)`` or ``(H, W, 3)`` in ``fmt`` (a value of
+    :data:`IMAGE_FORMATS`); JPEG at quality :data:`JPEG_QUALITY`.
+
+    >>> image_bytes(np.zeros((2, 2), np.uint8))[:4]
+    b'\\x89PNG'
+    """
+    import io
+
     from PIL import Image
 
     a = np.asarray(array)
-    if a.dtype != np.uint8 or a.ndim not in (2, 3):
-        raise ValueError(f"write_png needs a uint8 (H, W) or (H, W, 3) array; got {a.dtype} {a.shape}")
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise ValueError(f"cannot write {path!r}: directory {directory!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".png", dir=directory)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            Image.fromarray(a).save(fh, format="PNG")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    if a.dtype != np.uint8 or a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] != 3):
+        raise ValueError(f"an image must be a uint8 (H, W) or (H, W, 3) array; got {a.dtype} {a.shape}")
+    if fmt not in set(IMAGE_FORMATS.values()):
+        raise ValueError(f"unknown image format {fmt!r}; accepted: "
+                         f"{', '.join(sorted(set(IMAGE_FORMATS.values())))}")
+    buf = io.BytesIO()
+    options = {"quality": JPEG_QUALITY} if fmt == "JPEG" else {}
+    Image.fromarray(a).save(buf, format=fmt, **options)
+    return buf.getvalue()
+
+
+def image_format(path) -> str:
+    """The image format a file name asks for, from its extension; refuses an
+    extension outside :data:`IMAGE_FORMATS` (naming the accepted set).
+
+    >>> image_format("out.JPG")
+    'JPEG'
+    """
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext not in IMAGE_FORMATS:
+        raise ValueError(f"cannot write image {os.fspath(path)!r}: unknown extension {ext or '(none)'!r}; "
+                         f"accepted: {', '.join(IMAGE_FORMATS)}")
+    return IMAGE_FORMATS[ext]
+
+
+def write_image(path, array) -> None:
+    """Write a uint8 image ``(H, W)`` or ``(H, W, 3)`` in the format its
+    extension names (:data:`IMAGE_FORMATS`), atomically and with mode 0644
+    (:func:`chebnorm.approx.files.write_atomic`)."""
+    from chebnorm.approx.files import write_atomic
+
+    data = image_bytes(array, image_format(path))
+    write_atomic(path, data)
+
+
+def write_png(path, array) -> None:
+    """:func:`write_image` for a ``.png`` path (refuses any other extension,
+    so a PNG never hides behind another name)."""
+    if image_format(path) != "PNG":
+        raise ValueError(f"write_png writes PNG; {os.fspath(path)!r} names another format "
+                         "(use write_image)")
+    write_image(path, array)

@@ -162,8 +162,9 @@ def write_bump_figures(cases, directory) -> list[str]:
     """For each case write ``bump_<mesh>_{full,square,object}.png`` and the
     error maps ``bump_<mesh>_square_error.png``, ``..._object_error.png``
     (heat maps on a common scale); returns the paths."""
-    directory = os.fspath(directory)
-    os.makedirs(directory, exist_ok=True)
+    from chebnorm.approx.files import make_folder
+
+    directory = os.fspath(make_folder(directory))
     scale = max([1.0] + [float(np.abs(c.images[key]).max()) for c in cases
                          for key in ("square_error", "object_error")])
     paths = []
