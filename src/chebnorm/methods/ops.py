@@ -7,7 +7,10 @@ are 3-tuples of scalars. Two backends implement the interface:
 
 * :class:`NumpyOps` -- scalars are numpy arrays of one dtype (float32 or
   float64), one entry per span (or per pixel); computation stays in that
-  dtype (numpy >= 2 keeps Python-float constants "weak").
+  dtype (numpy >= 2 keeps Python-float constants "weak"). ``sin``, ``cos``
+  and ``arccos`` come from :mod:`.detmath` (float32 correctly rounded, float64
+  by the C library), not from numpy's CPU-dispatched loops, so the float32
+  datapath gives the same bits on every machine.
 * :class:`CountingOps` -- scalars are :class:`Counted` numbers: a float64
   value plus a shared :class:`Counter` that records every operation applied
   to it (add, mul, div, sqrt, trig, cmp), split by the phase the kernel is
@@ -39,6 +42,8 @@ import math
 
 import numpy as np
 
+from . import detmath
+
 __all__ = ["OP_KINDS", "NumpyOps", "CountingOps", "Counted", "Counter"]
 
 #: the operation kinds every count reports, in this order
@@ -67,13 +72,13 @@ class NumpyOps:
         return np.sqrt(x)
 
     def sin(self, x):
-        return np.sin(x)
+        return detmath.sin(x)
 
     def cos(self, x):
-        return np.cos(x)
+        return detmath.cos(x)
 
     def arccos(self, x):
-        return np.arccos(x)
+        return detmath.arccos(x)
 
     def minimum(self, a, b):
         return np.minimum(a, b)

@@ -1,0 +1,147 @@
+"""Elementary functions whose results do not depend on the CPU: the same bits on every x86-64.
+
+numpy >= 2 picks its float32 ``sin``/``cos``/``exp``/``log`` loops by CPU group
+(``X86_V4`` AVX-512, ``X86_V3`` AVX2, baseline), and on AVX-512 machines also
+its float64 ``arccos``, ``arctan2``, ``power``, ``log10``, ... (SVML). Those
+loops are accurate to an ulp or so but not correctly rounded, and they round
+differently from one another, so a float32 figure computed with ``np.sin``
+changes with the machine. The functions here do not:
+
+* **float32** arguments give the *correctly rounded* float32 result (what an
+  ideal float32 datapath computes). The function is evaluated in float64
+  (any numpy loop: all are within a few float64 ulps, i.e. ~2^-50 relative),
+  rounded once to float32; where that float64 value lies within 2^-16 of a
+  float32 ulp from a rounding boundary (a tie between two float32 values;
+  about 3 arguments in 100 000) or the result is a power of two or zero, the
+  value is recomputed with mpmath at 160 bits and rounded once to 24 bits.
+  Both paths give the correctly rounded value, so the result is the same
+  whichever numpy loop ran.
+* **float64** arguments are evaluated element by element with :mod:`math`
+  (the C library's ``sin``, ``cos``, ``acos``, ``atan2``), never with a
+  SIMD-dispatched numpy loop. (On x86-64 machines with or without AVX2 numpy's
+  float64 loops agree with :mod:`math`; on AVX-512 machines they may not.)
+
+Sums and products (``+ - * /``, ``sqrt``) are correctly rounded in every
+numpy loop and need nothing here; :func:`powers` gives ``x, x^2, ..., x^n``
+by multiplications only for the same reason.
+
+>>> import numpy as np
+>>> x = np.float32([0.1, 0.7853982, 3.0])
+>>> sin(x).dtype, bool((sin(x) == np.float32([math.sin(v) for v in x.tolist()])).all())
+(dtype('float32'), True)
+>>> float(arccos(np.float64([0.5]))[0]) == math.acos(0.5)
+True
+>>> powers(np.array([2.0]), 4).tolist()
+[[2.0, 4.0, 8.0, 16.0]]
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+
+__all__ = ["sin", "cos", "arccos", "arctan2", "powers"]
+
+#: float32 results within this fraction of a float32 ulp of a rounding boundary are recomputed
+_TIE_MARGIN = 2.0 ** -16
+#: working precision (bits) of the mpmath recomputation
+_MP_BITS = 160
+_F64 = {"sin": math.sin, "cos": math.cos, "arccos": math.acos}
+_MP = {"sin": mpmath.sin, "cos": mpmath.cos, "arccos": mpmath.acos}
+_NP = {"sin": np.sin, "cos": np.cos, "arccos": np.arccos}
+
+
+def _mp_float32(name: str, x: float) -> np.float32:
+    """``name(x)`` correctly rounded to float32 (x a float32 value, result a normal float32 or 0)."""
+    with mpmath.workprec(_MP_BITS):
+        v = _MP[name](mpmath.mpf(x))
+    if isinstance(v, mpmath.mpc) or not mpmath.isfinite(v):
+        return np.float32(np.nan)
+    with mpmath.workprec(24):
+        v = +v  # one rounding, to nearest (ties to even), to the 24-bit significand
+    return np.float32(float(v))
+
+
+def _float64(name: str, x: np.ndarray) -> np.ndarray:
+    fn = _F64[name]
+
+    def safe(v):
+        try:
+            return fn(v)
+        except ValueError:      # math.acos outside [-1, 1]: numpy's answer, NaN
+            return math.nan
+
+    flat = np.fromiter(map(safe, x.ravel().tolist()), dtype=np.float64, count=x.size)
+    return flat.reshape(x.shape)
+
+
+def _float32(name: str, x: np.ndarray) -> np.ndarray:
+    with np.errstate(invalid="ignore"):
+        y = _NP[name](x.astype(np.float64))
+    r = y.astype(np.float32)
+    r64 = r.astype(np.float64)
+    ulp = np.abs(np.spacing(r)).astype(np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = np.abs(y - r64) / ulp                       # in [0, 1/2] away from powers of two
+    mant = np.frexp(r)[0]
+    hard = np.isfinite(y) & ((np.abs(frac - 0.5) < _TIE_MARGIN) | (np.abs(mant) == 0.5) | (r == 0))
+    if hard.any():
+        idx = np.flatnonzero(hard.ravel())
+        flat = r.ravel().copy()
+        xs = x.ravel()
+        for i in idx:
+            flat[i] = _mp_float32(name, float(xs[i]))
+        r = flat.reshape(r.shape)
+    return r
+
+
+def _apply(name: str, x):
+    arr = np.asarray(x)
+    if arr.dtype == np.float32:
+        out = _float32(name, arr)
+    else:
+        out = _float64(name, arr.astype(np.float64, copy=False))
+    return out if isinstance(x, np.ndarray) or out.ndim else out.dtype.type(out)
+
+
+def sin(x):
+    """``sin(x)``: float32 correctly rounded, float64 by the C library (see the module docstring)."""
+    return _apply("sin", x)
+
+
+def cos(x):
+    """``cos(x)``: float32 correctly rounded, float64 by the C library."""
+    return _apply("cos", x)
+
+
+def arccos(x):
+    """``arccos(x)``: float32 correctly rounded, float64 by the C library; NaN outside [-1, 1]."""
+    return _apply("arccos", x)
+
+
+def arctan2(y, x) -> np.ndarray:
+    """``arctan2(y, x)`` in float64 by the C library's ``atan2``, element by element."""
+    y, x = np.broadcast_arrays(np.asarray(y, dtype=np.float64), np.asarray(x, dtype=np.float64))
+    flat = np.fromiter(map(math.atan2, y.ravel().tolist(), x.ravel().tolist()), dtype=np.float64,
+                       count=y.size)
+    return flat.reshape(y.shape)
+
+
+def powers(x, n: int) -> np.ndarray:
+    """``x^1 .. x^n`` along a new last axis by binary powering: ``x^k`` is the product, in a
+    fixed order, of the squarings ``x^(2^i)`` for the bits of ``k`` (at most ``2 log2 n``
+    correctly rounded multiplications; a rounding of ``x^j`` moves ``x^k`` by ``k/j`` of it,
+    so the result is within ``(k - 1)/2`` ulp of the exact ``x^k``)."""
+    x = np.asarray(x)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n = {n!r}; accepted: an integer n >= 1")
+    k = np.arange(1, int(n) + 1)
+    out = np.ones(x.shape + (int(n),), dtype=np.result_type(x, np.float32))
+    sq = x
+    for bit in range(int(n).bit_length()):
+        sel = (k >> bit) & 1 == 1
+        out[..., sel] *= sq[..., None]
+        sq = sq * sq
+    return out
