@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from chebnorm.approx import fit_target
+from chebnorm.methods import detmath
 from chebnorm.symbolic import delta_d, delta_s, eta, midpoint_normal, norm2_linear_np
 
 from .paths import paper_dir
@@ -66,7 +67,8 @@ def phi_at_delta_s(n, level: float = C2_LEVEL):
     """The angle (radians) at which ``delta_s(phi, n) = level``:
     ``phi = 2 arccos((1 - level)^(1/n))`` (inverse of seed 003's formula)."""
     n = np.asarray(n, dtype=float)
-    return 2.0 * np.arccos((1.0 - level) ** (1.0 / n))
+    base = np.array([math.pow(1.0 - level, 1.0 / v) for v in n.ravel().tolist()]).reshape(n.shape)
+    return 2.0 * detmath.arccos(base)
 
 
 @lru_cache(maxsize=None)
@@ -158,8 +160,8 @@ def _random_cap(rng, axis, half_angle, count):
     e1 = np.cross(axis, helper)
     e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
     e2 = np.cross(axis, e1)
-    v = (cos_t[:, None] * axis + (sin_t * np.cos(az))[:, None] * e1
-         + (sin_t * np.sin(az))[:, None] * e2)
+    v = (cos_t[:, None] * axis + (sin_t * detmath.cos(az))[:, None] * e1
+         + (sin_t * detmath.sin(az))[:, None] * e2)
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
@@ -185,7 +187,7 @@ def measure_eta_tightness() -> dict:
         grid = interior_min_norm_grid(na, nb, nc)
         cos = [np.clip(np.einsum("ij,ij->i", x, y), -1, 1) for x, y in ((na, nb), (nb, nc), (na, nc))]
         max_edge = np.max([1.0 - np.sqrt((1.0 + c) / 2.0) for c in cos], axis=0)
-        max_angle = np.degrees(np.max([np.arccos(c) for c in cos], axis=0))
+        max_angle = np.degrees(np.max([detmath.arccos(c) for c in cos], axis=0))
         for k in range(ETA_PER_CAP):
             rows.append((cap, k, float(max_angle[k]), float(e[k]), float(1.0 - exact[k]),
                          float(1.0 - grid[k]), float(max_edge[k])))

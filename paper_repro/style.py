@@ -5,11 +5,17 @@
   rcParams set (:data:`RC`) applied inside :func:`figure` and
   :func:`save_figure` only.
 * :func:`save_figure` writes ``<stem>.png``, ``<stem>.svg`` and the caption
-  ``<stem>.txt``; PNG and SVG carry no date or software version and the SVG
-  ids come from a fixed hash salt, so two runs give identical bytes.
+  ``<stem>.txt``; PNG and SVG carry no date or software version. matplotlib
+  names clip paths, markers and images by a hash of their full-precision
+  coordinates (a last-bit difference in a layout computation renames them),
+  so :func:`stable_svg_ids` renumbers those ids in order of first use.
 * :func:`write_csv` writes the figure's data with a ``#`` header (caption,
-  producing command, notes), ``%.10g`` floats, rows in the order given (the
-  callers give them sorted).
+  producing command, notes), rows in the order given (the callers give them
+  sorted); :func:`fmt` is the one number format of every CSV cell and JSON
+  value: integers as integers, floats with :data:`FLOAT_FORMAT` (10
+  significant digits, more than any figure reads; the numbers themselves are
+  made machine-independent where they are computed, see
+  :mod:`chebnorm.methods.detmath`).
 
 Every file goes through :func:`chebnorm.approx.files.write_atomic` (temporary
 file, then rename).
@@ -20,6 +26,7 @@ from __future__ import annotations
 import io
 import json
 import math
+import re
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Sequence
@@ -31,8 +38,8 @@ from matplotlib.figure import Figure
 
 from chebnorm.approx.files import write_atomic
 
-__all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "write_csv", "write_json",
-           "write_text", "fmt", "COLORS"]
+__all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "stable_svg_ids", "write_csv",
+           "write_json", "write_text", "fmt", "COLORS"]
 
 #: the float format of every CSV cell
 FLOAT_FORMAT = "%.10g"
@@ -73,6 +80,25 @@ def write_text(path: Path, text: str) -> Path:
     return Path(path)
 
 
+#: the ids matplotlib's SVG writer derives from a hash: clip paths (p), markers (m), images (i)
+_HASHED_ID = re.compile(r"\b[pmi][0-9a-f]{10}\b")
+
+
+def stable_svg_ids(svg: str) -> str:
+    """Rename matplotlib's hashed SVG ids to ``<letter><serial>`` in order of first use.
+
+    >>> stable_svg_ids('<use xlink:href="#m0123abcdef"/><path id="m0123abcdef"/>')
+    '<use xlink:href="#m0000000001"/><path id="m0000000001"/>'
+    """
+    defined = set(re.findall(r'id="([pmi][0-9a-f]{10})"', svg))
+    names: dict[str, str] = {}
+    for match in _HASHED_ID.finditer(svg):
+        tok = match.group(0)
+        if tok in defined and tok not in names:
+            names[tok] = f"{tok[0]}{len(names) + 1:010d}"
+    return _HASHED_ID.sub(lambda m: names.get(m.group(0), m.group(0)), svg)
+
+
 def save_figure(fig, folder: Path, stem: str, caption: str) -> list[Path]:
     """Write ``fig`` as ``folder/stem.png`` and ``.svg`` (deterministic bytes)
     and its caption as ``folder/stem.txt``; return the three paths."""
@@ -83,15 +109,23 @@ def save_figure(fig, folder: Path, stem: str, caption: str) -> list[Path]:
                           ("svg", {"Date": None, "Creator": None})):
             buf = io.BytesIO()
             fig.savefig(buf, format=ext, metadata=meta, bbox_inches="tight")
+            data = buf.getvalue()
+            if ext == "svg":
+                data = stable_svg_ids(data.decode("utf-8")).encode("utf-8")
             path = folder / f"{stem}.{ext}"
-            write_atomic(path, buf.getvalue())
+            write_atomic(path, data)
             written.append(path)
     written.append(write_text(folder / f"{stem}.txt", caption.strip() + "\n"))
     return written
 
 
 def fmt(value) -> str:
-    """One CSV cell: ``%.10g`` for floats, ``str`` for the rest ("nan"/"inf" spelled so)."""
+    """One CSV cell: integers as integers, :data:`FLOAT_FORMAT` for floats, ``str`` for the
+    rest ("nan"/"inf" spelled so).
+
+    >>> fmt(3), fmt(0.1 + 0.2), fmt(float("nan")), fmt("a,b")
+    ('3', '0.3', 'nan', '"a,b"')
+    """
     if isinstance(value, (bool, np.bool_)):
         return "1" if value else "0"
     if isinstance(value, (int, np.integer)):
