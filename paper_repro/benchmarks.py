@@ -1,6 +1,8 @@
-"""Read ``benchmarks/results.json`` (written by ``python benchmarks/run.py``,
-issue 6) for the speed claims; absent file -> ``None``, so a later run
-picks the numbers up without code changes."""
+"""The speed claims' numbers: ``benchmarks/results.json`` (written by
+``python benchmarks/run.py``, issue 6). Which file is read is set per run by
+:func:`use_results` (``chebnorm repro --bench-results``; default
+:func:`~.paths.bench_results`: ``./benchmarks/results.json`` when it exists);
+no file -> ``None``, so a later run picks the numbers up without code changes."""
 
 from __future__ import annotations
 
@@ -8,11 +10,21 @@ import json
 from functools import lru_cache
 from pathlib import Path
 
-from .paths import BENCHMARK_RESULTS
+from .paths import bench_results
 
-__all__ = ["load_results", "MISSING"]
+__all__ = ["load_results", "use_results", "MISSING"]
 
 MISSING = "benchmarks/results.json not generated yet (run: python benchmarks/run.py)"
+
+_current: dict = {"path": None, "set": False}
+
+
+def use_results(path=None) -> Path | None:
+    """Read the results from ``path`` (None: ``./benchmarks/results.json`` if it exists)
+    from now on; returns the file that will be read, or None."""
+    _current["path"] = bench_results(path)
+    _current["set"] = True
+    return _current["path"]
 
 
 @lru_cache(maxsize=None)
@@ -24,5 +36,8 @@ def _load(path: str):
 
 
 def load_results(path: Path | None = None):
-    """The parsed results, or ``None`` when the file does not exist."""
-    return _load(str(path or BENCHMARK_RESULTS))
+    """The parsed results (of ``path``, else of the file set by :func:`use_results`,
+    else of ``./benchmarks/results.json``), or ``None`` when there is no file."""
+    if path is None:
+        path = _current["path"] if _current["set"] else bench_results()
+    return None if path is None else _load(str(Path(path).resolve()))

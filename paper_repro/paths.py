@@ -1,20 +1,38 @@
-"""The one place that knows where the reproduction writes (showyourwork's ``paths.py``).
+"""The one place that knows where the reproduction reads and writes (showyourwork's ``paths.py``).
 
-``chebnorm repro`` hands every job the output root (``figures/`` by default,
-``-o DIR`` otherwise); each paper writes into its own folder under it.
+Nothing here looks at where the code is installed: every location is either
+given (``chebnorm repro -o DIR --ledger-dir DIR --bench-results FILE``) or
+taken from the current directory, so ``pip install .`` and ``pip install -e .``
+behave the same. Run from a checkout of the repository, the defaults are the
+committed locations:
+
+==================  ===================================================================
+what                default
+==================  ===================================================================
+output root         ``./figures`` (each paper in its folder under it, :func:`paper_dir`)
+claims ledger       ``./paper_repro`` when the output root is ``./figures`` and the
+                    current directory has a ``paper_repro/`` folder (a checkout);
+                    otherwise ``<output root>/claims`` (:func:`ledger_dir`)
+benchmark results   ``./benchmarks/results.json`` when that file exists, else none:
+                    the speed figures read "n/a" / "not checkable" (:func:`bench_results`)
+==================  ===================================================================
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["ROOT", "FIGURES", "PAPERS", "CLAIMS_MD", "CLAIMS_JSON", "BENCHMARK_RESULTS",
-           "paper_dir"]
+__all__ = ["PAPERS", "DEFAULT_OUTPUT", "LEDGER_HOME", "DEFAULT_BENCH_RESULTS", "LEDGER_FILES",
+           "paper_dir", "ledger_dir", "bench_results"]
 
-#: the repository (the parent of this package)
-ROOT = Path(__file__).resolve().parent.parent
-#: the default output root of ``chebnorm repro``
-FIGURES = ROOT / "figures"
+#: the default output root, relative to the current directory
+DEFAULT_OUTPUT = Path("figures")
+#: the ledger's home in a checkout, relative to the current directory
+LEDGER_HOME = Path("paper_repro")
+#: the speed measurements written by ``python benchmarks/run.py`` (issue 6), relative to the cwd
+DEFAULT_BENCH_RESULTS = Path("benchmarks") / "results.json"
+#: the ledger's two files
+LEDGER_FILES = ("claims.json", "CLAIMS.md")
 #: paper (seed) -> its folder under the output root, named by topic
 PAPERS = {
     "000": "normalization",  # efficient normalization methods, compared
@@ -22,11 +40,6 @@ PAPERS = {
     "002": "highlight",   # highlight detection for Gouraud shading
     "003": "criterion",   # the normalization criterion eta
 }
-#: the claims ledger (kept beside the code that generates it, not under figures/)
-CLAIMS_MD = Path(__file__).resolve().parent / "CLAIMS.md"
-CLAIMS_JSON = Path(__file__).resolve().parent / "claims.json"
-#: the speed measurements written by ``python benchmarks/run.py`` (issue 6)
-BENCHMARK_RESULTS = ROOT / "benchmarks" / "results.json"
 
 
 def paper_dir(out, seed: str) -> Path:
@@ -39,3 +52,26 @@ def paper_dir(out, seed: str) -> Path:
     folder = Path(out) / name
     folder.mkdir(parents=True, exist_ok=True)
     return folder
+
+
+def ledger_dir(out, given=None) -> Path:
+    """Where the claims ledger goes: ``given`` when not None; ``./paper_repro`` when ``out``
+    is ``./figures`` and ``./paper_repro/`` exists; else ``out/claims``."""
+    if given is not None:
+        return Path(given)
+    cwd = Path.cwd()
+    if Path(out).resolve() == (cwd / DEFAULT_OUTPUT).resolve() and (cwd / LEDGER_HOME).is_dir():
+        return LEDGER_HOME
+    return Path(out) / "claims"
+
+
+def bench_results(given=None) -> Path | None:
+    """The benchmark results file: ``given`` (which must exist), else
+    ``./benchmarks/results.json`` when it exists, else None."""
+    if given is not None:
+        p = Path(given)
+        if not p.is_file():
+            raise ValueError(f"benchmark results {str(p)!r} is not a file; accepted: the "
+                             f"results.json written by `python benchmarks/run.py`")
+        return p
+    return DEFAULT_BENCH_RESULTS if DEFAULT_BENCH_RESULTS.is_file() else None

@@ -1,28 +1,44 @@
 """``chebnorm repro [NAME ...]``: the main job.
 
-Regenerates every output under ``figures/`` (``-o`` to change): the
-coefficient tables and C headers of every registered target (job
-``coefficients``, part of the library), and every job that the paper
-reproduction registers through the ``chebnorm.repro`` entry point (the
+Regenerates every output under the output folder (``-o``, default
+``./figures``): the coefficient tables and C headers of every registered
+target (job ``coefficients``, part of the library), and every job that the
+paper reproduction registers through the ``chebnorm.repro`` entry point (the
 library does not import it by name). Each job writes its files atomically,
 so an interrupted run keeps every file that was finished.
+
+Where things are is given or taken from the current directory, never from
+where chebnorm is installed: ``--ledger-dir`` (default: ``./paper_repro``
+when the output is ``./figures`` and ``./paper_repro/`` exists, else
+``<output>/claims``) and ``--bench-results`` (default
+``./benchmarks/results.json`` when it exists).
+
+``<output>/provenance.json`` records the versions of the numeric dependencies
+that wrote the outputs; when the installed ones differ from those recorded
+there, one line on stderr names them (the bytes may then differ).
 """
 
 from __future__ import annotations
 
+import json
+import sys
 import time
-from importlib.metadata import entry_points
+from importlib.metadata import PackageNotFoundError, entry_points, version
 from pathlib import Path
 
 from chebnorm.approx import TARGETS, fit_target, target_names
-from chebnorm.export import c_header, json_text
 from chebnorm.approx.files import write_atomic
+from chebnorm.export import c_header, json_text
 
 #: fractional bits of the fixed-point part of the exported tables
 EXPORT_FRAC_BITS = 24
+#: the distributions whose versions can change the bytes ``chebnorm repro`` writes
+NUMERIC_DEPENDENCIES = ("numpy", "scipy", "mpmath", "sympy", "python-flint", "matplotlib",
+                        "kiwisolver", "Pillow", "scikit-image", "trimesh", "flip-evaluator")
+PROVENANCE = "provenance.json"
 
 
-def export_coefficients(out: Path) -> list[Path]:
+def export_coefficients(out: Path, **_options) -> list[Path]:
     """Every registered target at each of its degrees: JSON table and C header."""
     folder = out / "coefficients"
     folder.mkdir(parents=True, exist_ok=True)
@@ -50,11 +66,53 @@ def jobs() -> dict:
     return found
 
 
+def installed_versions() -> dict[str, str]:
+    """Installed version of each of :data:`NUMERIC_DEPENDENCIES` ("not installed" when missing).
+
+    >>> v = installed_versions(); v["numpy"] == __import__("numpy").__version__
+    True
+    """
+    out = {}
+    for name in NUMERIC_DEPENDENCIES:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def version_differences(recorded: dict, installed: dict) -> list[str]:
+    """``name installed (recorded X)`` for each name whose versions differ, sorted by name.
+
+    >>> version_differences({"numpy": "2.4.6", "scipy": "1.16.0"}, {"numpy": "2.3.0", "scipy": "1.16.0"})
+    ['numpy 2.3.0 (recorded 2.4.6)']
+    """
+    return [f"{k} {installed.get(k, 'not installed')} (recorded {recorded.get(k, 'nothing')})"
+            for k in sorted(set(recorded) | set(installed), key=str.lower)
+            if recorded.get(k) != installed.get(k)]
+
+
+def _recorded_versions(out: Path) -> dict | None:
+    try:
+        data = json.loads((out / PROVENANCE).read_text(encoding="utf-8"))
+        versions = data["versions"]
+        return versions if isinstance(versions, dict) else None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def register(sub) -> None:
     p = sub.add_parser("repro", help="regenerate every figure, table, ledger and coefficient header",
                        description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", metavar="NAME", help="jobs to run (default: all); see --list")
-    p.add_argument("-o", "--output", default="figures", help="output folder (default figures)")
+    p.add_argument("-o", "--output", default="figures",
+                   help="output folder (default ./figures, in the current directory)")
+    p.add_argument("--ledger-dir", default=None, metavar="DIR",
+                   help="folder of the claims ledger CLAIMS.md / claims.json (default ./paper_repro "
+                        "when the output is ./figures and ./paper_repro exists, else OUTPUT/claims)")
+    p.add_argument("--bench-results", default=None, metavar="FILE",
+                   help="benchmark results read for the speed claims (default "
+                        "./benchmarks/results.json when it exists; without it they read n/a)")
     p.add_argument("--list", action="store_true", help="list the jobs and exit")
     p.set_defaults(func=run)
 
@@ -70,15 +128,29 @@ def run(args) -> int:
     unknown = [n for n in args.names if n not in available]
     if unknown:
         raise ValueError(f"unknown repro job(s) {', '.join(unknown)}; accepted: {', '.join(available)}")
+    bench = args.bench_results
+    if bench is not None and not Path(bench).is_file():
+        raise ValueError(f"--bench-results {bench!r} is not a file; accepted: the results.json "
+                         f"written by `python benchmarks/run.py`")
     selected = args.names or list(available)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
+    installed = installed_versions()
+    recorded = _recorded_versions(out)
+    if recorded is not None:
+        diff = version_differences(recorded, installed)
+        if diff:
+            print(f"chebnorm repro: versions differ from {out / PROVENANCE}, so bytes may differ: "
+                  + ", ".join(diff), file=sys.stderr)
     start = time.perf_counter()
     count = 0
     bar = tqdm(selected, desc="chebnorm repro", unit="job", disable=None)
     for name in bar:
         bar.set_postfix_str(name)
-        count += len(available[name](out) or [])
+        count += len(available[name](out, bench_results=bench, ledger_dir=args.ledger_dir) or [])
+    write_atomic(out / PROVENANCE, json.dumps({"command": "chebnorm repro", "versions": installed},
+                                              sort_keys=True, indent=2) + "\n")
+    count += 1
     print(f"chebnorm repro: {len(selected)} job(s), {count} file(s) under {out}/ "
           f"in {time.perf_counter() - start:.1f} s")
     return 0
