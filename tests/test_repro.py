@@ -19,10 +19,14 @@ import pytest
 
 import paper_repro
 from paper_repro import claims as ledger_mod
-from paper_repro.paths import CLAIMS_JSON, FIGURES, PAPERS
+from paper_repro.paths import PAPERS
+
+#: the checkout these tests run from (the committed outputs live here)
+REPO = Path(__file__).resolve().parents[1]
+FIGURES = REPO / "figures"
+CLAIMS_JSON = REPO / "paper_repro" / "claims.json"
 
 JOBS = sorted(paper_repro.REGISTRY)
-DATA_SUFFIXES = (".csv", ".json", ".txt", ".md")
 
 
 def _run_all(out: Path) -> list[Path]:
@@ -124,8 +128,9 @@ def test_ledger_figures(two_runs):
 
 
 def test_eta_never_below_the_true_interior_error():
-    from paper_repro.criterion import interior_min_norm, interior_min_norm_grid
     import numpy as np
+
+    from paper_repro.criterion import interior_min_norm, interior_min_norm_grid
     rng = np.random.default_rng(0)
     v = rng.normal(size=(3, 50, 3)) * 0.2 + np.array([0.0, 0.0, 1.0])
     v /= np.linalg.norm(v, axis=-1, keepdims=True)
@@ -144,15 +149,19 @@ def test_eta_never_below_the_true_interior_error():
 
 @pytest.mark.skipif(not CLAIMS_JSON.is_file(), reason="no committed ledger")
 def test_committed_outputs_match_a_fresh_run(two_runs):
-    """figures/ and the ledger as committed equal what a fresh run writes (data files)."""
+    """figures/ and the ledger as committed equal what a fresh run writes (every file:
+    data, captions, PNG and SVG)."""
     a, _, _, _ = two_runs
     for folder in PAPERS.values():
         committed = FIGURES / folder
         if not committed.is_dir():
             pytest.skip(f"figures/{folder} not generated")
-        fresh, old = _hashes(a / folder, DATA_SUFFIXES), _hashes(committed, DATA_SUFFIXES)
+        fresh, old = _hashes(a / folder), _hashes(committed)
         stale = sorted(k for k in fresh.keys() | old.keys() if fresh.get(k) != old.get(k))
         assert not stale, f"figures/{folder} is stale; run `chebnorm repro`: {stale}"
     fresh = json.loads((a / "claims" / "claims.json").read_text())
     old = json.loads(CLAIMS_JSON.read_text())
     assert fresh == old, "paper_repro/claims.json is stale; run `chebnorm repro`"
+    md = (a / "claims" / "CLAIMS.md").read_bytes()
+    assert md == (REPO / "paper_repro" / "CLAIMS.md").read_bytes(), \
+        "paper_repro/CLAIMS.md is stale; run `chebnorm repro`"
