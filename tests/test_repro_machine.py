@@ -218,9 +218,11 @@ def test_non_editable_install_writes_the_committed_outputs(tmp_path):
     deps = [p for p in sys.path if p.endswith("site-packages")]
     Path(site, "deps.pth").write_text("\n".join(deps) + "\n")   # the dependencies, not chebnorm
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "NPY_DISABLE_CPU_FEATURES")}
-    pip = subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", "--no-index",
-                          "--no-build-isolation", str(src)], env=env, capture_output=True, text=True,
-                         cwd=tmp_path, check=False)
+    # an ordinary `pip install .` (build isolation: pip fetches setuptools from its index)
+    pip = subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", str(src)], env=env,
+                         capture_output=True, text=True, cwd=tmp_path, check=False, timeout=900)
+    if pip.returncode != 0 and "No matching distribution found for setuptools" in pip.stderr:
+        pytest.skip("pip cannot reach an index with setuptools to build the package")
     assert pip.returncode == 0, pip.stderr[-2000:]
     probe = "import chebnorm, paper_repro; print(chebnorm.__file__); print(paper_repro.__file__)"
     where = subprocess.run([str(py), "-c", probe],
