@@ -20,6 +20,13 @@ method         what it does                                                seed 
 ``angular``    ``N_{j+1} = 2 cos(phi) N_j - N_{j-1}``                      method 6
 =============  ==========================================================  ==========
 
+The methods themselves are entries of the method registry
+(:mod:`chebnorm.approx.method_registry`): :func:`method_names` lists them,
+:func:`register` adds one (an entry plus its kernel), :mod:`.registry` binds
+their kernels and fits their default tables. ``METHODS`` is
+``method_names()`` at the time it is read.
+
+Layer rule: imports numpy, mpmath and :mod:`chebnorm.approx` only.
 
 >>> import numpy as np
 >>> out = span_normals("exact", [[1.0, 0, 0]], [[0, 1.0, 0]], [4])
