@@ -101,9 +101,9 @@ def _show(text: str, limit: int = 60) -> str:
 
 def _accepted(variables: Iterable[str]) -> str:
     names = list(variables)
-    var = ("the variable " + ", ".join(names)) if names else "no variable"
+    var = ("the variable " + ", ".join(names) + ", ") if names else ""
     return ("accepted: numbers (2, 0.1, 1e-3: decimals are exact), " + var +
-            ", the constants pi and E, + - * / ** and ^ (power), parentheses, and the "
+            "the constants pi and E, + - * / ** and ^ (power), parentheses, and the "
             "functions " + ", ".join(FUNCTIONS))
 
 
@@ -307,14 +307,14 @@ def parse_expression(text: str, variables: Iterable[str] = ("x",)) -> sp.Expr:
     >>> parse_expression("x.__class__")
     Traceback (most recent call last):
     ...
-    ValueError: cannot read expression 'x.__class__': 'x.__class__' (attribute access) is not accepted; accepted: ...
+    ValueError: cannot parse expression 'x.__class__': 'x.__class__' (attribute access) is not accepted; accepted: ...
     """
     symbols = _symbols(variables)
     what = _show(text) if isinstance(text, str) else repr(type(text).__name__)
     try:
         return _read(text, symbols)
     except _Refusal as exc:
-        raise ValueError(f"cannot read expression {what}: {exc}; {_accepted(symbols)}") from None
+        raise ValueError(f"cannot parse expression {what}: {exc}; {_accepted(symbols)}") from None
 
 
 def _read(text, symbols: dict[str, sp.Symbol]) -> sp.Expr:
@@ -378,10 +378,18 @@ def parse_number(text: str | float | int) -> sp.Expr:
         value = _exact_floats(text)
     else:
         try:
-            value = parse_expression(text, ())
-        except ValueError as exc:
-            raise ValueError(str(exc).replace("cannot read expression", "cannot read "
-                                              "interval endpoint", 1)) from None
+            value = _read(text, {})
+        except _Refusal as exc:
+            shown = _show(text) if isinstance(text, str) else repr(type(text).__name__)
+            if isinstance(text, str) and text.strip().lower() in ("oo", "inf", "infinity", "nan"):
+                raise ValueError(f"interval endpoint {shown} is not a finite real number; "
+                                 f"accepted: a finite real constant such as 0.1, sqrt(2) or "
+                                 f"2*cos(pi/4)") from None
+            if str(exc).startswith("unknown variable"):
+                raise ValueError(f"interval endpoint {shown} is not a constant ({exc}); "
+                                 f"{_accepted(())}") from None
+            raise ValueError(f"cannot parse interval endpoint {shown}: {exc}; "
+                             f"{_accepted(())}") from None
     if value.free_symbols:
         raise ValueError(f"interval endpoint {_show(str(text))} is not a constant")
     ball = enclose(value)
@@ -666,7 +674,7 @@ def _parse_function(text, var: str) -> Function1D:
         try:
             expr = _read(text, symbols)
         except _Refusal as exc:
-            message = f"cannot read expression {_show(text) if isinstance(text, str) else ''}: {exc}"
+            message = f"cannot parse expression {_show(text) if isinstance(text, str) else ''}: {exc}"
             if str(exc).startswith("unknown variable"):
                 message += f" (the variable is {var!r}: set it with --var)"
             raise ValueError(f"{message}; {_accepted(symbols)}") from None
