@@ -185,10 +185,10 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         coeffs = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
         if not res.converged:
             notes.append(
-                f"the Remez exchange did not converge (after {res.iterations} iterations the "
-                f"levelled error {res.levelled:.3e} and the largest error {res.max_error:.3e} "
-                f"still differ): the coefficients are its best iterate, not the minimax "
-                f"polynomial, and --kind chebyshev may be closer; the certified bounds hold")
+                f"the Remez exchange did not converge: the coefficients are its best iterate "
+                f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
+                f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
+                f"may be closer; the certified bounds hold")
     cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel")
     notes += _certificate_notes(abs_error_bound=cert_abs, rel_error_bound=cert_rel)
     provenance = dict(_versions())

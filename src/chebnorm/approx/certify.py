@@ -283,7 +283,8 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
                 upper = abs(g_point(_ball(a, b, from_right=b is b0)))
             if not upper.is_finite():
                 if (b - a) < min_width or count > max_subintervals:
-                    raise _not_finite(kind, m, a is a0 or b is b0)
+                    end = (a, lo_b) if a is a0 else (b, hi_b) if b is b0 else None
+                    raise _not_finite(kind, m, end, g_point)
                 pending.append((arb("inf"), a, b))
                 continue
             pending.append((upper.upper(), a, b))
@@ -320,17 +321,29 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
                        tight=not reasons, reason="; ".join(sorted(reasons)))
 
 
-def _not_finite(kind: str, m: arb, at_end: bool) -> ValueError:
-    where = float(m.mid())
+def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> ValueError:
+    """The true reason why ``g`` cannot be enclosed near ``m``; ``end`` is the
+    interval's end point and the ball of the exact endpoint, when the piece
+    touches an end."""
     what = "p/f - 1 (f is zero or undefined there)" if kind == "rel" else "f"
-    if at_end:
+    exact = end is not None and end[1].is_exact()
+    if end is not None:
+        end = end[0]
+    if exact and g_point(end).is_finite():
         return ValueError(
-            f"{what} cannot be enclosed near the endpoint x = {where:.17g}: it is not finite "
-            f"and real there, or it is defined only from an endpoint that is not an exact "
-            f"binary number (ball arithmetic needs a margin around it); accepted: a function "
-            f"defined and finite on the whole interval, whose singular endpoint, if any, is "
-            f"a binary number such as 0 or 1")
-    return ValueError(f"{what} is not finite and real near x = {where:.17g}; "
+            f"{what} is finite at the endpoint x = {float(end.mid()):.17g} but its derivatives "
+            f"are not, and ball arithmetic could not enclose it on a piece ending there (the "
+            f"argument of sqrt, log or a power must be computed exactly from that endpoint, "
+            f"as in sqrt(x) or sqrt(1 - x) on [0, 1]); accepted: a function whose Taylor "
+            f"series or ball enclosure is finite on the whole interval")
+    if end is not None and not exact:
+        return ValueError(
+            f"{what} cannot be enclosed near the endpoint x = {float(end.mid()):.17g}: it is "
+            f"not finite and real there, or it is defined only from that endpoint, which is "
+            f"not an exact binary number (ball arithmetic needs a margin around it); "
+            f"accepted: a function defined and finite on the whole interval, whose singular "
+            f"endpoint, if any, is a binary number such as 0 or 1")
+    return ValueError(f"{what} is not finite and real near x = {float(m.mid()):.17g}; "
                       f"accepted: a function defined and finite on the whole interval")
 
 

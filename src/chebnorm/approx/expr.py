@@ -5,7 +5,7 @@ Reading: the one reader of user text
 Every string that becomes a sympy expression -- a CLI argument, the
 ``expression`` and ``interval`` fields of a coefficient table, a target's
 ``psi_max``, an argument of the Python API -- is read by
-:func:`parse_expression`. The text is never run: Python's ``ast`` module
+:func:`read_expression`. The text is never run: Python's ``ast`` module
 parses it (``mode="eval"``), a whitelist of nodes is accepted, and the sympy
 tree is built here, node by node. Accepted:
 
@@ -58,7 +58,7 @@ import numpy as np
 import sympy as sp
 from flint import arb, arb_series, ctx, fmpq
 
-__all__ = ["Function1D", "parse_function", "parse_number", "parse_expression", "FUNCTIONS",
+__all__ = ["Function1D", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
 
 #: the functions an expression may call, by name (one argument each; ``log``
@@ -294,17 +294,17 @@ def _symbols(variables: Iterable[str]) -> dict[str, sp.Symbol]:
     return out
 
 
-def parse_expression(text: str, variables: Iterable[str] = ("x",)) -> sp.Expr:
+def read_expression(text: str, variables: Iterable[str] = ("x",)) -> sp.Expr:
     """Read ``text`` as a real expression in ``variables`` (see module docstring).
 
     Decimals are exact, ``^`` is a power, and nothing in ``text`` is ever run.
     Raises ValueError naming the offending token and the accepted set.
 
-    >>> parse_expression("x^2 + 0.1")
+    >>> read_expression("x^2 + 0.1")
     x**2 + 1/10
-    >>> parse_expression("2*cos(psi_max)", ["psi_max"])
+    >>> read_expression("2*cos(psi_max)", ["psi_max"])
     2*cos(psi_max)
-    >>> parse_expression("x.__class__")
+    >>> read_expression("x.__class__")
     Traceback (most recent call last):
     ...
     ValueError: cannot parse expression 'x.__class__': 'x.__class__' (attribute access) is not accepted; accepted: ...
@@ -356,7 +356,7 @@ def _read(text, symbols: dict[str, sp.Symbol]) -> sp.Expr:
 def parse_number(text: str | float | int) -> sp.Expr:
     """Read an interval endpoint such as ``"sqrt(2)"``, ``"2*cos(pi/4)"`` or ``"0.1"``.
 
-    Text is read by :func:`parse_expression` (no variable; decimals exact).
+    Text is read by :func:`read_expression` (no variable; decimals exact).
     Python floats are taken at their exact binary value, ints and
     ``fractions.Fraction`` exactly. Raises ValueError for anything that is not
     a finite real constant.
@@ -568,6 +568,10 @@ def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
             return constant(node)
         if node.is_Number or node in (sp.pi, sp.E):
             return lambda x: _arb_const(node)
+        if node.is_Mul and node.args[0] == -1:
+            # negation is exact in ball arithmetic; (-1) * x would round the radius up
+            inner = build(sp.Mul(*node.args[1:], evaluate=False), plain_only)
+            return lambda x: -inner(x)
         if node.is_Add or node.is_Mul:
             parts = [build(a, plain_only) for a in node.args]
             if node.is_Add:
@@ -645,7 +649,7 @@ class Function1D:
 def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:
     """Read ``text`` as a real function of the single variable ``var`` (cached).
 
-    Text is read by :func:`parse_expression` (decimals exact, nothing run).
+    Text is read by :func:`read_expression` (decimals exact, nothing run).
     A sympy expression is taken as it is, its Floats at their exact binary
     values.
 

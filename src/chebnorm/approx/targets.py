@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .expr import compare, parse_expression, parse_number
+from .expr import compare, read_expression, parse_number
 
 __all__ = ["Target", "TARGETS", "get_target", "target_names"]
 
@@ -51,7 +51,7 @@ class Target:
         symbol = sp.Symbol("psi_max", real=True)
         out = []
         for text in self.interval_text:
-            value = parse_expression(text, ["psi_max"]).subs(symbol, psi)
+            value = read_expression(text, ["psi_max"]).subs(symbol, psi)
             out.append(sp.sstr(value))
         return (out[0], out[1])
 
