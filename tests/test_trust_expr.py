@@ -411,10 +411,10 @@ def test_hostile_table_fields(text, in_tmp, capsys, table_json):
         assert not (in_tmp / "t.h").exists() and not (in_tmp / "v").exists()
 
 
-@pytest.mark.parametrize("text", [PAYLOAD, f"{PAYLOAD} + x", "().__class__.__bases__",
-                                  "\uff58 + 1", "x+" * 5000 + "x"])
-def test_hostile_in_a_real_process(text, tmp_path):
-    """The console entry point itself: exit 2, one line on stderr, nothing run."""
+def test_hostile_in_a_real_process(tmp_path):
+    """The console entry point itself: exit 2, one line on stderr, nothing run
+    (one payload: the matrix above runs ``main`` in-process, for speed)."""
+    text = f"{PAYLOAD} + x"
     table = json.loads(fit("x", ("0", "1"), 1).to_json())
     table["expression"] = text
     (tmp_path / "t.json").write_text(json.dumps(table))
