@@ -102,7 +102,7 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     x[0], x[-1] = iv.lo_in, iv.hi_in
     with np.errstate(all="ignore"):
         try:
-            y = np.asarray(sp.lambdify(fn.var, fn.expr, "numpy")(x.astype(complex)), dtype=complex)
+            y = np.asarray(sp.lambdify(fn.var, fn.expr, ["scipy", "numpy"])(x.astype(complex)), dtype=complex)
         except (ZeroDivisionError, OverflowError):
             y = np.full(x.shape, np.nan, dtype=complex)
         y = y * np.ones_like(x)
@@ -262,7 +262,6 @@ def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
     frac_bits = int(frac_bits)
     fn = parse_function(table.expression, table.variable)
     iv = Interval(*table.interval)
-    scale = 2 ** frac_bits
     candidates = {"rounded": [round(math.ldexp(c, frac_bits)) for c in table.coefficients]}
     if reoptimize and table.degree >= 1:
         candidates["reoptimized"] = _greedy_integers(fn, iv, table, frac_bits)

@@ -627,7 +627,7 @@ class Function1D:
 
     @functools.cached_property
     def numpy(self) -> Callable[[np.ndarray], np.ndarray]:
-        f = sp.lambdify(self.var, self.expr, "numpy")
+        f = sp.lambdify(self.var, self.expr, ["scipy", "numpy"])
         return lambda x: np.asarray(f(np.asarray(x, dtype=float)), dtype=float) * np.ones_like(x, dtype=float)
 
     @functools.cached_property
