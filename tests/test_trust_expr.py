@@ -425,3 +425,18 @@ def test_hostile_in_a_real_process(tmp_path):
                               capture_output=True, text=True)
         assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
         assert not (tmp_path / MARKER).exists()
+
+
+@pytest.mark.parametrize("expr,interval,f", [
+    ("erf(x)", ("0", "1"), mpmath.erf),
+    ("gamma(x)", ("1", "2"), mpmath.gamma),
+    ("Abs(x)", ("-1", "1"), abs),  # a kink inside: plain ball evaluation there
+])
+def test_reader_functions_are_certified(expr, interval, f):
+    t = fit(expr, interval, 4)
+    lo, hi = (float(v) for v in interval)
+    with mpmath.workdps(40):
+        xs = [mpmath.mpf(lo) + (hi - lo) * mpmath.mpf(k) / 2000 for k in range(2001)]
+        true = max(abs(mpmath.polyval(list(reversed(t.coefficients)), x) - f(x))
+                   for x in xs + [mpmath.mpf(t.max_abs_at)])
+    assert true <= t.abs_error_bound <= 1.01 * true
