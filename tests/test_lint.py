@@ -14,10 +14,6 @@ import pytest
 
 REPO = Path(__file__).resolve().parent.parent
 FOLDERS = ("src", "paper_repro", "benchmarks", "tests")
-#: files with findings whose owners fix them in other branches (issue 12); when
-#: a file becomes clean the strict xfail below fails: then delete it here
-PENDING = ("src/chebnorm/approx/api.py", "src/chebnorm/approx/expr.py",
-           "src/chebnorm/approx/sollya.py")
 
 
 def _ruff() -> list[str]:
@@ -37,18 +33,8 @@ def _check(*args):
 
 
 def test_pyflakes_clean():
-    excludes = [a for p in PENDING if (REPO / p).exists() for a in ("--extend-exclude", p)]
-    proc = _check(*excludes, *FOLDERS)
+    proc = _check(*FOLDERS)
     assert proc.returncode == 0, proc.stdout + proc.stderr
-
-
-@pytest.mark.xfail(strict=True, reason="pending fixes by the owners of these files")
-@pytest.mark.parametrize("path", PENDING)
-def test_pending_files(path):
-    if not (REPO / path).exists():
-        return  # gone: the strict xfail reports it, delete it from PENDING
-    proc = _check(path)
-    assert proc.returncode == 0, proc.stdout
 
 
 def test_lint_rules_match_pyproject():

@@ -6,17 +6,17 @@
 True
 """
 
-from .api import MAX_DEGREE, fit, quantize
+from .api import MAX_DEGREE, fit, quantize, warnings_of
 from .certify import Certificate, certify
-from .expr import Function1D, parse_function, parse_number
+from .expr import Function1D, read_expression, parse_function, parse_number
 from .files import write_atomic
 from . import textsafe
 from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint
 from .targets import TARGETS, Target, get_target, target_names
 
 __all__ = [
-    "CoefficientTable", "FixedPoint", "SCHEMA_VERSION", "fit", "quantize", "MAX_DEGREE",
-    "Certificate", "certify", "Function1D", "parse_function", "parse_number",
+    "CoefficientTable", "FixedPoint", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "MAX_DEGREE",
+    "Certificate", "certify", "Function1D", "read_expression", "parse_function", "parse_number",
     "Target", "TARGETS", "get_target", "target_names", "fit_target",
     "write_atomic", "textsafe",
 ]

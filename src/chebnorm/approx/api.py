@@ -6,16 +6,16 @@ import functools
 import math
 from importlib.metadata import PackageNotFoundError, version as _pkg_version
 
-import mpmath
 import numpy as np
 import sympy as sp
+from flint import arb
 
-from .certify import Certificate, arb_enclose, certify
-from .expr import Function1D, parse_function, parse_number
+from .certify import Certificate, _float_down, _float_up, certify
+from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import chebyshev_interpolant, cheb_to_monomial, remez
 from .table import CoefficientTable, FixedPoint
 
-__all__ = ["fit", "quantize", "MAX_DEGREE", "Interval", "check_interval"]
+__all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval"]
 
 MAX_DEGREE = 30
 KINDS = ("chebyshev", "minimax")
@@ -34,20 +34,62 @@ def _versions() -> dict[str, str]:
 
 
 class Interval:
-    """Exact endpoints (sympy) with their float values. Internal."""
+    """Exact endpoints (sympy) with their float values. Internal.
+
+    ``lo``/``hi`` are exact; ``lo_f``/``hi_f`` the nearest floats (stored in
+    tables as ``interval_float``); ``lo_in``/``hi_in`` the floats nearest
+    *inside* the interval (where it is sampled and its maximum located).
+    ``binary`` names the endpoints given as Python floats, whose exact binary
+    value is used (``0.1`` as a float is 3602879701896397/36028797018963968).
+    """
 
     def __init__(self, lo, hi):
         self.lo = parse_number(lo)
         self.hi = parse_number(hi)
-        self.lo_f = float(sp.N(self.lo, 30))
-        self.hi_f = float(sp.N(self.hi, 30))
-        if not arb_enclose(self.lo) < arb_enclose(self.hi):
+        self.binary = {name: v for name, v in (("LO", lo), ("HI", hi))
+                       if isinstance(v, (float, np.floating))}
+        balls = []
+        for name, value in (("LO", self.lo), ("HI", self.hi)):
+            ball = enclose(value, 128)
+            if ball is None or not abs(ball) < arb(2) ** 1023:
+                raise ValueError(f"interval endpoint {name} = {value} is outside the float64 "
+                                 f"range; accepted: a finite real number below 2^1023 in "
+                                 f"magnitude")
+            balls.append(ball)
+        try:
+            order = compare(self.lo, self.hi)
+        except ValueError:
+            order = 0
+        if order >= 0:
             raise ValueError(f"interval [{self.lo}, {self.hi}] is empty or reversed: "
                              f"LO must be strictly less than HI")
+        self.lo_f, self.hi_f = (_nearest_float(b) for b in balls)
+        self.lo_in, self.hi_in = _float_up(balls[0]), _float_down(balls[1])
+        if not self.lo_in <= self.hi_in:
+            raise ValueError(f"interval [{self.lo}, {self.hi}] holds no float64 number; "
+                             f"accepted: an interval wider than one float64 spacing")
 
     @property
     def strings(self) -> tuple[str, str]:
         return (sp.sstr(self.lo), sp.sstr(self.hi))
+
+    def binary_note(self) -> str | None:
+        """Which endpoints were binary floats, and their exact values (or None)."""
+        if not self.binary:
+            return None
+        parts = [f"{name} = {float(v)!r} was given as a float64, used at its exact binary "
+                 f"value {sp.sstr(self.lo if name == 'LO' else self.hi)}"
+                 for name, v in self.binary.items()]
+        return "; ".join(parts) + " (pass the text '0.1' for the exact decimal)"
+
+
+def _nearest_float(ball: arb) -> float:
+    """The float64 nearest the midpoint of a narrow ball."""
+    mid = ball.mid()
+    f = float(mid)
+    best = min((f, math.nextafter(f, -math.inf), math.nextafter(f, math.inf)),
+               key=lambda c: abs(arb(c) - mid))
+    return best
 
 
 def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndarray:
@@ -56,11 +98,11 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     Returns the samples. The certification later proves finiteness on the
     whole interval; this check only gives an early, precise message.
     """
-    x = np.linspace(iv.lo_f, iv.hi_f, samples)
-    x[0], x[-1] = iv.lo_f, iv.hi_f
+    x = np.linspace(iv.lo_in, iv.hi_in, samples)
+    x[0], x[-1] = iv.lo_in, iv.hi_in
     with np.errstate(all="ignore"):
         try:
-            y = np.asarray(sp.lambdify(fn.var, fn.expr, "numpy")(x.astype(complex)), dtype=complex)
+            y = np.asarray(sp.lambdify(fn.var, fn.expr, ["scipy", "numpy"])(x.astype(complex)), dtype=complex)
         except (ZeroDivisionError, OverflowError):
             y = np.full(x.shape, np.nan, dtype=complex)
         y = y * np.ones_like(x)
@@ -133,6 +175,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         raise ValueError(f"relative error is undefined: {fn.expr} vanishes on [{iv.lo}, {iv.hi}]; "
                          f"accepted for error='rel': an interval where the function has no zero")
 
+    notes = []
     if kind == "chebyshev":
         coeffs = chebyshev_interpolant(fn.mpmath, sp.N(iv.lo, 50), sp.N(iv.hi, 50), degree)
     else:
@@ -140,11 +183,22 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         weight = (lambda x: np.ones_like(x)) if error == "abs" else (lambda x: 1.0 / np.abs(f_np(x)))
         res = remez(f_np, weight, iv.lo_f, iv.hi_f, degree)
         coeffs = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
+        if not res.converged:
+            notes.append(
+                f"the Remez exchange did not converge: the coefficients are its best iterate "
+                f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
+                f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
+                f"may be closer; the certified bounds hold")
     cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel")
+    notes += _certificate_notes(abs_error_bound=cert_abs, rel_error_bound=cert_rel)
     provenance = dict(_versions())
     provenance["command"] = command or (
         f"chebnorm.fit({str(fn.expr)!r}, {iv.strings!r}, {degree}, kind={kind!r}, "
         f"error={error!r}, var={var!r})")
+    if iv.binary_note():
+        provenance["binary_endpoints"] = iv.binary_note()
+    if notes:
+        provenance["warnings"] = " | ".join(notes)
     table = CoefficientTable(
         name=name or "table", expression=sp.sstr(fn.expr), variable=fn.var.name,
         interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
@@ -157,6 +211,23 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     if frac_bits is not None:
         table = quantize(table, frac_bits)
     return table
+
+
+def _certificate_notes(**certs: Certificate | None) -> list[str]:
+    """One warning per certificate that missed its ``(1 + tol)`` tightness."""
+    return [f"{field} is rigorous but not within 1 + 2^-8 of the supremum: {c.reason}"
+            for field, c in certs.items() if c is not None and not c.tight]
+
+
+def warnings_of(table: CoefficientTable) -> list[str]:
+    """The warnings a table's provenance carries (Remez not converged, a
+    certificate that missed its tightness), one string each.
+
+    >>> warnings_of(fit("exp(x)", ("0", "1"), 2))
+    []
+    """
+    text = table.provenance.get("warnings", "")
+    return [w for w in text.split(" | ") if w]
 
 
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
@@ -191,7 +262,6 @@ def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
     frac_bits = int(frac_bits)
     fn = parse_function(table.expression, table.variable)
     iv = Interval(*table.interval)
-    scale = 2 ** frac_bits
     candidates = {"rounded": [round(math.ldexp(c, frac_bits)) for c in table.coefficients]}
     if reoptimize and table.degree >= 1:
         candidates["reoptimized"] = _greedy_integers(fn, iv, table, frac_bits)
@@ -206,12 +276,18 @@ def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
         if best is None or key < best[0]:
             best = (key, method, ints, ca, cr)
     _, method, ints, ca, cr = best
+    notes = _certificate_notes(**{"fixed_point.abs_error_bound": ca,
+                                  "fixed_point.rel_error_bound": cr})
     fixed = FixedPoint(frac_bits=frac_bits, integers=tuple(int(q) for q in ints), word_bits=word_bits,
                        method=method, abs_error_bound=ca.bound,
                        rel_error_bound=None if cr is None else cr.bound,
                        max_abs_error=ca.maximum, max_rel_error=None if cr is None else cr.maximum)
     from dataclasses import replace
-    return replace(table, fixed_point=fixed)
+    provenance = dict(table.provenance)
+    if notes:
+        old = warnings_of(table)
+        provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
+    return replace(table, fixed_point=fixed, provenance=provenance)
 
 
 def _greedy_integers(fn: Function1D, iv: Interval, table: CoefficientTable, frac_bits: int):

@@ -18,7 +18,22 @@ bound is for the very float64 coefficients that are stored and exported.
 
 Subintervals are bisected until each upper bound is within ``(1 + tol)`` of
 the best lower bound found (the largest ``|g|`` at a point), so the returned
-bound is rigorous and at most ``(1 + tol)`` times the true supremum.
+bound is rigorous and at most ``(1 + tol)`` times the true supremum. When a
+cap stops the bisection first (``max_subintervals``, a piece narrower than
+``2**-60`` of the interval, or an error below the working precision) the
+bound is still rigorous but may be looser: ``Certificate.tight`` is then
+False and ``Certificate.reason`` says which cap.
+
+Where the Taylor form is not finite -- a function finite at an endpoint but
+with singular derivatives there, such as ``sqrt(x)`` at 0 -- the piece is
+bounded by plain ball evaluation of ``g`` over it (rigorous, coarser), and
+bisected further if that is not tight enough. For a ball to start exactly at
+the singular endpoint, that endpoint must be an exact binary number (0, 1,
+1/2, ...).
+
+Constants (``1/10``, ``pi``) are evaluated at the working precision (128 bits
+by default), and the interval is enclosed at that precision too: the pieces
+cover the exact interval.
 
 Why Arb and not ``mpmath.iv``: Arb propagates rounding errors in C with
 arbitrary precision and has Taylor-series arithmetic (``arb_series``) built
@@ -34,11 +49,10 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-import numpy as np
 import sympy as sp
 from flint import arb, arb_series, ctx
 
-from .expr import Function1D, _arb_const
+from .expr import Function1D, _compile_arb
 
 __all__ = ["Certificate", "certify", "arb_enclose"]
 
@@ -51,25 +65,25 @@ class Certificate:
     """A certified bound and the located maximum it was compared with.
 
     ``bound`` is a float rounded upward: ``sup |g| <= bound``. ``maximum`` is
-    ``|g(at)|`` at a located point (a lower bound of the supremum), so
-    ``maximum <= sup |g| <= bound``. ``subintervals`` counts the Taylor forms
-    evaluated.
+    ``|g(at)|`` at a located point ``at`` of the interval (a float inside it),
+    so ``maximum <= sup |g| <= bound``. ``subintervals`` counts the pieces
+    evaluated. ``tight`` is True when ``bound <= (1 + tol) * sup`` was
+    reached; when a cap stopped the subdivision first it is False and
+    ``reason`` says which (the bound is rigorous either way).
     """
 
     bound: float
     maximum: float
     at: float
     subintervals: int
+    tight: bool = True
+    reason: str = ""
 
 
 def arb_enclose(value: sp.Expr) -> arb:
-    """A ball enclosing a real sympy constant (``sqrt(2)``, ``2*cos(pi/4)``)."""
-    from .expr import _compile_arb
-
-    dummy = sp.Symbol("_unused")
-    if value.is_Number or value in (sp.pi, sp.E):
-        return _arb_const(value)
-    return _compile_arb(value, dummy, series=False)(arb(0))
+    """A ball enclosing a real sympy constant (``sqrt(2)``, ``2*cos(pi/4)``) at
+    the current ``flint.ctx.prec``."""
+    return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
 
 
 def _float_up(x: arb) -> float:
@@ -102,9 +116,9 @@ def _horner(coeffs: Sequence[arb], x):
     return acc
 
 
-def _error_function(fn: Function1D, coeffs: Sequence[arb], kind: str):
-    f = fn.arb_series
-
+def _error_function(f, coeffs: Sequence[arb], kind: str):
+    """``g = p - f`` or ``p/f - 1`` for ``f`` an arb or arb_series function;
+    nan wherever Arb cannot evaluate it (a division by a ball containing 0)."""
     if kind == "abs":
         def g(s):
             return _horner(coeffs, s) - f(s)
@@ -115,11 +129,12 @@ def _error_function(fn: Function1D, coeffs: Sequence[arb], kind: str):
         raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
 
     def safe(s):
-        # Arb refuses to divide by a ball that contains 0: report "not finite"
         try:
             return g(s)
         except (ValueError, ZeroDivisionError):
-            return arb_series([arb("nan")] * s.prec, prec=s.prec)
+            if isinstance(s, arb_series):
+                return arb_series([arb("nan")] * s.prec, prec=s.prec)
+            return arb("nan")
     return safe
 
 
@@ -139,21 +154,65 @@ def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     return best
 
 
+#: order of the Taylor forms tried when |g| is far below |f| (see _high_order_upper)
+HIGH_ORDER = 8
+
+
+def _high_order_upper(g, a: arb, b: arb, m: arb, r: arb) -> arb:
+    """An order-``HIGH_ORDER`` Taylor form of ``|g|`` on ``[a, b]``.
+
+    ``g = g0 + g1 h + g2 h^2 + sum_{3 <= k <= n} g_k h^k + g_{n+1}(xi) h^{n+1}``:
+    the quadratic's maximum exactly, the middle terms by ``|g_k| r^k`` (point
+    coefficients) and the remainder over the ball. When ``g`` is a tiny
+    difference of large terms (an error at rounding level) the ball
+    enclosure of ``g_3`` is dominated by the width of the ball times ``|f|``;
+    the remainder's ``r^{n+1}`` shrinks that much faster than ``r^3``.
+    """
+    n = HIGH_ORDER
+    c = _coeffs(g(arb_series([m, 1], prec=n + 1)), n + 1)
+    rest = _coeffs(g(arb_series([a.union(b), 1], prec=n + 2)), n + 2)[n + 1]
+    upper = _quadratic_max(c[0], c[1], c[2], r)
+    rk = r * r * r
+    for k in range(3, n + 1):
+        upper = upper + abs(c[k]).upper() * rk
+        rk = rk * r
+    return upper + abs(rest).upper() * rk
+
+
+def _ball(a: arb, b: arb, from_right: bool) -> arb:
+    """A ball containing ``[a, b]`` whose lower end is exactly ``a`` (or, with
+    ``from_right``, whose upper end is exactly ``b``) when that end is an
+    exact binary number: ``a + [0, w]`` with ``[0, w]`` built by
+    ``nonnegative_part``, so a function defined only from ``a`` on (``sqrt``
+    at 0) can be evaluated on it."""
+    width = (b - a).upper()
+    span = arb(0).union(width).nonnegative_part()  # [0, >= b - a], lower end exactly 0
+    return b - span if from_right else a + span
+
+
 def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.Expr,
             kind: str = "abs", tol: float = TOL, max_subintervals: int = 200_000,
             prec: int | None = None) -> Certificate:
     """Certify ``sup_{x in [lo, hi]} |g(x)|`` for ``g = p - f`` or ``p/f - 1``.
 
     ``coefficients`` are the polynomial's float coefficients in ascending
-    powers of ``x``; ``lo`` and ``hi`` are exact sympy constants. Raises
+    powers of ``x``; ``lo`` and ``hi`` are exact sympy constants. Constants
+    and endpoints are evaluated at ``prec`` bits (default 128). Raises
     ValueError when ``g`` is not finite somewhere on the interval (``f`` is
-    undefined, infinite, or -- for ``kind="rel"`` -- zero there).
+    undefined, infinite, or -- for ``kind="rel"`` -- zero there), or when the
+    interval holds no float64 number (the located maximum is reported at one).
 
     >>> from chebnorm.approx.expr import parse_function
     >>> import sympy as sp
     >>> c = certify(parse_function("x**2"), [0.0, 0.0, 1.0], sp.Integer(0), sp.Integer(1))
-    >>> c.bound == 0.0
-    True
+    >>> c.bound == 0.0, c.tight
+    (True, True)
+
+    ``sqrt`` is finite at 0 although its derivatives are not:
+
+    >>> c = certify(parse_function("sqrt(x)"), [0.125, 1.0], sp.Integer(0), sp.Integer(1))
+    >>> c.maximum, c.maximum <= c.bound <= (1 + TOL) * c.maximum
+    (0.125, True)
     """
     old_prec = ctx.prec
     try:
@@ -164,9 +223,29 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
         ctx.prec = old_prec
 
 
+def _scale(fn: Function1D, kind: str, points) -> arb:
+    """The size of ``f`` (abs) or 1 (rel), for the working-precision floor."""
+    if kind == "rel":
+        return arb(1)
+    best = arb(0)
+    for x in points:
+        try:
+            v = abs(fn.arb(x))
+        except (ValueError, ZeroDivisionError):
+            continue
+        if v.is_finite():
+            best = best.max(v.upper())
+    return best if best > 0 else arb(1)
+
+
 def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
-    g = _error_function(fn, coeffs, kind)
+    g = _error_function(fn.arb_series, coeffs, kind)
+    g_point = _error_function(fn.arb, coeffs, kind)
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
+    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
+    if not lo_f <= hi_f:
+        raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
+                         f"interval wider than one float64 spacing")
     a0, b0 = lo_b.lower(), hi_b.upper()
     degree = max(len(coeffs) - 1, 0)
     pieces = 2 * (degree + 2)
@@ -175,11 +254,17 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
     edges = [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
     work = list(zip(edges[:-1], edges[1:]))
     min_width = (b0 - a0) * arb(2) ** -60
+    # below this, |g| is rounding noise of the working precision
+    scale = _scale(fn, kind, (a0, (a0 + b0) / 2, b0))
+    floor = scale * arb(2) ** (24 - ctx.prec)
+    # an error below this is a cancellation: order-3 forms converge too slowly
+    tiny = scale * arb(2) ** -30
 
     best_lower = arb(0)
-    best_at = float(a0.mid())
+    best_at = (a0 + b0) / 2
     accepted_upper = arb(0)
     count = 0
+    reasons: set[str] = set()
     # (upper, a, b) of subintervals bounded above more loosely than the target
     pending: list[tuple[arb, arb, arb]] = []
     while work or pending:
@@ -187,31 +272,41 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
             count += 1
             m = (a + b) / 2
             r = (b - a) / 2
-            sm = g(arb_series([m, 1], prec=3))
-            c0, c1, c2 = _coeffs(sm, 3)
-            sx = g(arb_series([a.union(b), 1], prec=4))
-            c3 = _coeffs(sx, 4)[3]
+            c0, c1, c2 = _coeffs(g(arb_series([m, 1], prec=3)), 3)
+            c3 = _coeffs(g(arb_series([a.union(b), 1], prec=4)), 4)[3]
             upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r)
+            value = c0 if c0.is_finite() else g_point(m)
+            if value.is_finite() and abs(value).lower() > best_lower:
+                best_lower, best_at = abs(value).lower(), m
+            if not upper.is_finite():
+                # no Taylor form (singular derivatives): plain ball evaluation
+                upper = abs(g_point(_ball(a, b, from_right=b is b0)))
             if not upper.is_finite():
                 if (b - a) < min_width or count > max_subintervals:
-                    where = float(m.mid())
-                    what = "p/f - 1 (f is zero or undefined there)" if kind == "rel" else "f"
-                    raise ValueError(f"{what} is not finite and real near x = {where:.17g}; "
-                                     f"accepted: a function defined and finite on the whole interval")
+                    end = (a, lo_b) if a is a0 else (b, hi_b) if b is b0 else None
+                    raise _not_finite(kind, m, end, g_point)
                 pending.append((arb("inf"), a, b))
                 continue
-            if c0.is_finite():
-                low = abs(c0).lower()
-                if low > best_lower:
-                    best_lower, best_at = low, float(m.mid())
             pending.append((upper.upper(), a, b))
         work = []
         target = best_lower * (1 + arb(tol))
         keep = []
         for upper, a, b in pending:
-            if upper.is_finite() and (upper <= target or (b - a) < min_width
-                                       or count > max_subintervals):
+            if upper.is_finite() and upper > target and best_lower < tiny:
+                upper = upper.min(_high_order_upper(g, a, b, (a + b) / 2, (b - a) / 2).upper())
+            if not upper.is_finite():
+                keep.append((upper, a, b))
+            elif upper <= target:
                 accepted_upper = accepted_upper.max(upper)
+            elif upper <= floor:
+                accepted_upper = accepted_upper.max(upper)
+                reasons.add("the error is below the working precision "
+                            f"(2^{24 - ctx.prec} relative to f)")
+            elif (b - a) < min_width or count > max_subintervals:
+                accepted_upper = accepted_upper.max(upper)
+                reasons.add(f"the subdivision cap was reached ({count} pieces, "
+                            f"max_subintervals={max_subintervals}, smallest piece 2^-60 "
+                            f"of the interval)")
             else:
                 keep.append((upper, a, b))
         pending = []
@@ -220,41 +315,61 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
             if not (a < m < b):
                 m = (a + b) / 2
             work.extend([(a, m), (m, b)])
-    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)
-    for end in (lo_f, hi_f):  # the endpoints are often where the error peaks
-        v = abs(_coeffs(g(arb_series([arb(end), 1], prec=1)), 1)[0])
-        if v.is_finite() and v.lower() > best_lower:
-            best_lower, best_at = v.lower(), end
-    maximum, at = _refine_maximum(g, best_lower, best_at, lo_f, hi_f)
+    maximum, at = _locate_maximum(g, g_point, best_at, lo_f, hi_f)
     bound = accepted_upper.max(arb(maximum))
-    return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count)
+    return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
+                       tight=not reasons, reason="; ".join(sorted(reasons)))
 
 
-def _refine_maximum(g, lower: arb, at: float, lo: float, hi: float) -> tuple[float, float]:
-    """Newton steps on g' from the best point found, to locate the extremum."""
-    best, best_at = float(lower), at
-    x = at
-    for _ in range(8):
-        s = _coeffs(g(arb_series([arb(x), 1], prec=3)), 3)
-        v = abs(s[0])
+def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> ValueError:
+    """The true reason why ``g`` cannot be enclosed near ``m``; ``end`` is the
+    interval's end point and the ball of the exact endpoint, when the piece
+    touches an end."""
+    what = "p/f - 1 (f is zero or undefined there)" if kind == "rel" else "f"
+    exact = end is not None and end[1].is_exact()
+    if end is not None:
+        end = end[0]
+    if exact and g_point(end).is_finite():
+        return ValueError(
+            f"{what} is finite at the endpoint x = {float(end.mid()):.17g} but its derivatives "
+            f"are not, and ball arithmetic could not enclose it on a piece ending there (the "
+            f"argument of sqrt, log or a power must be computed exactly from that endpoint, "
+            f"as in sqrt(x) or sqrt(1 - x) on [0, 1]); accepted: a function whose Taylor "
+            f"series or ball enclosure is finite on the whole interval")
+    if end is not None and not exact:
+        return ValueError(
+            f"{what} cannot be enclosed near the endpoint x = {float(end.mid()):.17g}: it is "
+            f"not finite and real there, or it is defined only from that endpoint, which is "
+            f"not an exact binary number (ball arithmetic needs a margin around it); "
+            f"accepted: a function defined and finite on the whole interval, whose singular "
+            f"endpoint, if any, is a binary number such as 0 or 1")
+    return ValueError(f"{what} is not finite and real near x = {float(m.mid()):.17g}; "
+                      f"accepted: a function defined and finite on the whole interval")
+
+
+def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float]:
+    """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
+    the float nearest the best piece midpoint, and Newton steps on ``g'``
+    from the best of these. Returns ``(|g(at)|, at)``."""
+    best, best_at = -1.0, lo
+
+    def visit(x: float) -> None:
+        nonlocal best, best_at
+        v = abs(g_point(arb(x)))
         if v.is_finite() and float(v.mid()) > best:
             best, best_at = float(v.mid()), x
-        if s[2].contains(0) or not s[2].is_finite():
+
+    for x in (min(max(float(start.mid()), lo), hi), lo, hi):
+        visit(x)
+    x = best_at
+    for _ in range(8):
+        s = _coeffs(g(arb_series([arb(x), 1], prec=3)), 3)
+        if not all(c.is_finite() for c in s) or s[2].contains(0):
             break
         step = float((-s[1] / (2 * s[2])).mid())
         nxt = min(max(x + step, lo), hi)
         if nxt == x:
             break
         x = nxt
-    return best, best_at
-
-
-def dense_maximum(fn: Function1D, coefficients: Sequence[float], lo: float, hi: float,
-                  kind: str = "abs", points: int = 20001) -> tuple[float, float]:
-    """Float64 estimate of max |g| on a dense grid (for checks, not a bound)."""
-    x = np.linspace(lo, hi, points)
-    p = np.polynomial.polynomial.polyval(x, coefficients)
-    f = fn.numpy(x)
-    e = p - f if kind == "abs" else p / f - 1
-    i = int(np.argmax(np.abs(e)))
-    return float(abs(e[i])), float(x[i])
+        visit(x)
+    return max(best, 0.0), best_at

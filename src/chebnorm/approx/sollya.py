@@ -13,7 +13,6 @@ import shutil
 import subprocess
 import tempfile
 from dataclasses import dataclass
-from fractions import Fraction
 
 import sympy as sp
 

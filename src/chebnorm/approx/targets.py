@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from .expr import compare, read_expression, parse_number
+
 __all__ = ["Target", "TARGETS", "get_target", "target_names"]
 
 
@@ -28,14 +30,29 @@ class Target:
     meaning: str
 
     def interval(self, psi_max: float | str = "pi/4") -> tuple[str, str]:
-        """Exact endpoint strings with psi_max substituted (sympy syntax)."""
-        psi = sp.sympify(str(psi_max)) if not isinstance(psi_max, float) else sp.Rational(psi_max)
-        if not (0 < float(psi) < float(sp.pi)):
-            raise ValueError(f"psi_max = {psi_max} is out of range; accepted: 0 < psi_max < pi")
+        """Exact endpoint strings with psi_max substituted (sympy syntax).
+
+        ``psi_max`` is read by :func:`~chebnorm.approx.expr.parse_number`:
+        text exactly (``"0.5"`` is 1/2), a float at its exact binary value.
+
+        >>> TARGETS["midpoint"].interval("pi/4")
+        ('sqrt(2)/2', '1')
+        """
+        try:
+            psi = parse_number(psi_max)
+        except ValueError as exc:
+            raise ValueError(f"psi_max: {exc}") from None
+        try:
+            inside = compare(psi, sp.Integer(0)) > 0 and compare(psi, sp.pi) < 0
+        except ValueError:
+            inside = False
+        if not inside:
+            raise ValueError(f"psi_max = {psi} is out of range; accepted: 0 < psi_max < pi")
+        symbol = sp.Symbol("psi_max", real=True)
         out = []
         for text in self.interval_text:
-            value = sp.sympify(text, locals={"psi_max": sp.Symbol("psi_max")}).subs("psi_max", psi)
-            out.append(sp.sstr(sp.nsimplify(value) if value.is_Float else value))
+            value = read_expression(text, ["psi_max"]).subs(symbol, psi)
+            out.append(sp.sstr(value))
         return (out[0], out[1])
 
 

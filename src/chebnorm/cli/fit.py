@@ -3,7 +3,9 @@ in the sibling modules; this one fits and certifies one polynomial."""
 
 from __future__ import annotations
 
-from chebnorm.approx import MAX_DEGREE, fit
+import sys
+
+from chebnorm.approx import MAX_DEGREE, fit, warnings_of
 
 from ._common import command_line, deprecated_alias, print_json
 
@@ -12,10 +14,11 @@ def register(sub) -> None:
     p = sub.add_parser("fit", help="fit and certify a polynomial",
                        description="Fit a polynomial to EXPR on [LO, HI] and certify its "
                        "absolute and relative error bounds.")
-    p.add_argument("expr", metavar="EXPR", help='function in sympy syntax, e.g. "1/sqrt(2+z)"')
+    p.add_argument("expr", metavar="EXPR", help='function of VAR, e.g. "1/sqrt(2+z)": numbers '
+                   '(decimals exact), + - * / ** ^, pi, E, sqrt, exp, log, sin, ... (no other names)')
     p.add_argument("--var", default="x", help="the variable of EXPR (default x)")
     p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
-                   help='endpoints in sympy syntax, e.g. "sqrt(2)" 2')
+                   help='exact endpoints, e.g. "sqrt(2)" 2 or 0.1 0.3 (decimals are exact)')
     p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
     p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
     p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
@@ -32,6 +35,8 @@ def run(args) -> int:
     table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
                 var=args.var, name=args.name, frac_bits=args.frac_bits,
                 command=command_line(args))
+    for warning in warnings_of(table):
+        print(f"chebnorm: warning: {warning}", file=sys.stderr)
     if args.output:
         table.save(args.output)
     if args.json:
@@ -43,6 +48,8 @@ def run(args) -> int:
             table.variable, ", ".join(f"{c:.17g}" for c in table.coefficients)))
         print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
               f"certified bound {table.abs_error_bound:.6e}")
+        if "binary_endpoints" in table.provenance:
+            print(f"note: {table.provenance['binary_endpoints']}")
         if table.rel_error_bound is not None:
             print(f"max |p/f - 1| = {table.max_rel_error:.6e}; certified bound {table.rel_error_bound:.6e}")
         if table.fixed_point is not None:

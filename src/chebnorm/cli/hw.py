@@ -222,11 +222,13 @@ def run_unit(args) -> int:
 def run_sweep(args) -> int:
     from pathlib import Path
 
+    from chebnorm.approx import get_target
     from chebnorm.approx.files import make_folder, write_atomic
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)
     _check_output(out)
+    get_target(args.target).interval(args.psi_max)  # read --psi-max (exactly, safely) up front
     res = sweep(args.target, degrees=args.degrees or DEFAULT_DEGREES,
                 coef_bits=args.coef_bits or DEFAULT_COEF_BITS,
                 acc_bits=args.acc_bits or DEFAULT_ACC_BITS, in_bits=args.in_bits,

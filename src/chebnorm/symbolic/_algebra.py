@@ -23,6 +23,15 @@ def vector(name: str) -> sp.Matrix:
     return sp.Matrix(sp.symbols(f"{name}_x {name}_y {name}_z", real=True))
 
 
+def _as_expr(value) -> sp.Expr:
+    """A relation as a sympy expression (ints allowed); text is refused, never parsed."""
+    if isinstance(value, sp.Basic):
+        return value
+    if isinstance(value, int) and not isinstance(value, bool):
+        return sp.Integer(value)
+    raise TypeError(f"a relation must be a sympy expression, got {type(value).__name__}")
+
+
 def reduce_modulo(
     expr: sp.Expr,
     relations: Sequence[sp.Expr],
@@ -40,7 +49,8 @@ def reduce_modulo(
     """
     eliminate = list(eliminate)
     numer, denom = sp.fraction(sp.together(sp.expand(expr)))
-    symbols = set().union(*(sp.sympify(r).free_symbols for r in relations))
+    relations = [_as_expr(r) for r in relations]
+    symbols = set().union(*(r.free_symbols for r in relations))
     symbols |= numer.free_symbols | denom.free_symbols
     keep = sorted(symbols - set(eliminate), key=lambda s: s.name)
     basis = sp.groebner(list(relations), *eliminate, *keep, order="lex")
