@@ -343,7 +343,7 @@ COMMANDS = {
     "hw report": lambda t, o: ["hw", "report", t, "--in-bits", "8", "--out-bits", "8",
                                "--no-synth", "--no-gappa"],
     "hw unit --table": lambda t, o: ["hw", "unit", "dichotomy", "--table", t, "--in-bits", "8",
-                                     "--out-bits", "8", "--frac-bits", "6", "--vectors", "50",
+                                     "--out-bits", "8", "--vector-frac-bits", "6", "--vectors", "50",
                                      "-o", o],
 }
 
@@ -626,7 +626,7 @@ def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
 def test_unit_banner_keeps_hostile_command_line_inert(tmp_path, capsys):
     def unit_code(table, out):
         code, _, err = run_cli(["hw", "unit", "dichotomy", "--table", table, "--in-bits", "8",
-                                "--out-bits", "8", "--frac-bits", "6", "--vectors", "50",
+                                "--out-bits", "8", "--vector-frac-bits", "6", "--vectors", "50",
                                 "-o", out], capsys)
         assert code == 0, err
         return strip_verilog_comments((out / "chebnorm_dichotomy_unit.v").read_text())
