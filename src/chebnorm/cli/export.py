@@ -13,7 +13,7 @@ from __future__ import annotations
 from chebnorm.approx import CoefficientTable
 from chebnorm.export import FORMATS, export_table
 
-from ._common import command_line
+from ._common import command_line, deprecated_alias
 
 HW_FORMATS = ("vhdl", "verilog")
 
@@ -31,8 +31,9 @@ def register(sub) -> None:
     hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
     hw.add_argument("--in-bits", type=int, default=None, help="input code width, 1..20")
     hw.add_argument("--out-bits", type=int, default=None, help="output code width, 1..32")
-    hw.add_argument("--coef-bits", type=int, default=None,
+    hw.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None,
                     help="coefficient fractional bits (default: the table's own)")
+    deprecated_alias(hw, "--coef-bits", "--coef-frac-bits", "coef_bits", type=int)
     hw.add_argument("--acc-bits", type=int, default=None,
                     help="accumulator fractional bits (default: output's + 3)")
     hw.add_argument("--rounding", default="rne", help="rne (default) or trunc")
@@ -42,8 +43,9 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.format not in FORMATS and args.format not in HW_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
-    hw_only = [f"--{n.replace('_', '-')}" for n in ("in_bits", "out_bits", "coef_bits", "acc_bits")
-               if getattr(args, n) is not None]
+    flags = {"in_bits": "--in-bits", "out_bits": "--out-bits", "coef_bits": "--coef-frac-bits",
+             "acc_bits": "--acc-bits"}
+    hw_only = [flag for dest, flag in flags.items() if getattr(args, dest) is not None]
     if args.format in FORMATS and hw_only:
         raise ValueError(f"{', '.join(hw_only)} apply to --format vhdl or verilog only, not "
                          f"{args.format!r}")
