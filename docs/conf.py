@@ -58,6 +58,9 @@ nb_execution_mode = "off"
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 intersphinx_mapping: dict = {}
+# the CLI page includes a part of README.md, whose in-page links (#targets, ...)
+# point at README sections outside that part: they work on the README itself
+suppress_warnings = ["myst.xref_missing"]
 
 # -- HTML -------------------------------------------------------------------
 html_theme = "alabaster"
