@@ -82,7 +82,7 @@ import ckernels as ck  # noqa: E402
 
 from chebnorm.methods import get_method  # noqa: E402
 
-#: the claims' speed-ups (seed 000, SPEC.md claims ledger)
+#: the claims' speed-ups (seed 000, claims ledger, docs/papers.md)
 CLAIM_C6 = 2.5
 CLAIM_C7_MIDPOINT = 2.5
 CLAIM_C7_TRIANGLE = 2.8

@@ -7,6 +7,7 @@ not installed (``pip install -e ".[test]"`` installs them).
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -46,3 +47,8 @@ def test_notebook_runs(path, tmp_path):
     finally:
         if env_backend is None:
             os.environ.pop("MPLBACKEND", None)
+    # a slider's function runs inside a widget, which shows its exception instead of raising
+    # it: look for errors in the stored widget state too
+    text = json.dumps(nb)
+    assert '"output_type": "error"' not in text and "Traceback" not in text, \
+        f"{path.name}: an error was shown in an output or a widget"

@@ -1,6 +1,6 @@
 """Tests of chebnorm.symbolic: every derived closed form against an independent
 numeric computation on seeded random data, the sympy expressions against the
-formulas of SPEC.md, and every ValueError of the numpy boundary.
+formulas of docs/papers.md, and every ValueError of the numpy boundary.
 
 Tolerances are derived, not tuned: ``EPS`` times the scale of the quantities
 times the number of roundings on the longest path of either computation, or
@@ -71,7 +71,7 @@ def sqrt_error(x, dx):
 
 # ==================================================================== sympy
 class TestDerivations:
-    """The derived expressions equal the formulas stated in SPEC.md."""
+    """The derived expressions equal the formulas stated in docs/papers.md."""
 
     def test_norm2_linear(self):
         assert sp.expand(S.norm2_linear_expr() - (1 - 2 * t * (1 - t) * (1 - c))) == 0

@@ -41,9 +41,45 @@ private (``_name``) modules or names.
 
 ``paper_repro/`` and ``benchmarks/`` use the public API only (no ``_name``
 module or attribute of chebnorm); the library never imports them.
+
+The everyday names, one import away
+-----------------------------------
+``import chebnorm as cn`` gives the facade below. Each name is re-exported
+from its stage (nothing is moved) and imported only when first used
+(PEP 562 module ``__getattr__``), so ``import chebnorm`` stays fast.
+
+* ``cn.fit``, ``cn.quantize``, ``cn.certify``: fit and certify a polynomial,
+  round it to fixed point and re-certify, bound ``sup|p - f|`` of given
+  coefficients (:mod:`chebnorm.approx`).
+* ``cn.CoefficientTable``, ``cn.FixedPoint``: the table contract (JSON,
+  rich display in Jupyter, ``table.plot()``).
+* ``cn.target(name)``, ``cn.target_names()``, ``cn.fit_target(name, degree)``:
+  the registered targets of the papers.
+* ``cn.span_normals(method, ...)``, ``cn.method_names()``: run a
+  normalization method of seed 000 on scan-line spans; the registered
+  methods (:mod:`chebnorm.methods`).
+* ``cn.render(...)``, ``cn.compare(test, reference)``,
+  ``cn.RenderComparison(test, reference)``: render a frame with a shading
+  mode, compare two frames (metrics; shown side by side in Jupyter)
+  (:mod:`chebnorm.raster`).
+* ``cn.export(table, "c")``: the text of a table in a format; the formats
+  are the keys of ``cn.export.FORMATS`` (:mod:`chebnorm.export`).
+* ``cn.hw.report(table, in_bits, out_bits)``: the bit-accurate hardware
+  report of a table (:mod:`chebnorm.hw`).
+* ``cn.symbolic``, ``cn.approx``, ``cn.export``, ``cn.methods``, ``cn.hw``,
+  ``cn.raster``: the stage subpackages themselves.
+
+>>> import chebnorm as cn
+>>> t = cn.fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z")
+>>> t.max_abs_error <= t.abs_error_bound < 2.2e-5
+True
+>>> cn.export(t, "c").startswith("/*")
+True
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib import import_module as _import_module
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("chebnorm")
@@ -62,4 +98,48 @@ LAYERS = {
     "cli": ("symbolic", "approx", "export", "methods", "hw", "raster"),
 }
 
-__all__ = ["__version__", "LAYERS"]
+
+#: the stage subpackages, imported on first attribute access
+_SUBPACKAGES = ("symbolic", "approx", "export", "methods", "hw", "raster")
+
+#: facade name -> (module, attribute); imported on first use
+_LAZY = {
+    "fit": ("chebnorm.approx", "fit"),
+    "quantize": ("chebnorm.approx", "quantize"),
+    "certify": ("chebnorm.approx", "certify"),
+    "fit_target": ("chebnorm.approx", "fit_target"),
+    "CoefficientTable": ("chebnorm.approx", "CoefficientTable"),
+    "FixedPoint": ("chebnorm.approx", "FixedPoint"),
+    "target": ("chebnorm.approx", "get_target"),
+    "target_names": ("chebnorm.approx", "target_names"),
+    "span_normals": ("chebnorm.methods", "span_normals"),
+    "method_names": ("chebnorm.methods", "method_names"),
+    "render": ("chebnorm.raster", "render"),
+    "compare": ("chebnorm.raster", "compare"),
+    "RenderComparison": ("chebnorm.raster", "RenderComparison"),
+}
+
+__all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
+    "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
+    "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
+    "symbolic", "approx", "export", "methods", "hw", "raster",
+]
+assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}
+
+
+def __getattr__(name: str):
+    """Import a facade name or a stage subpackage on first access (PEP 562)."""
+    if name in _SUBPACKAGES:
+        return _import_module(f"chebnorm.{name}")
+    try:
+        module, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'chebnorm' has no attribute {name!r}") from None
+    value = getattr(_import_module(module), attr)
+    globals()[name] = value  # later accesses skip __getattr__
+    return value
+
+
+def __dir__():
+    """The facade names, for tab completion."""
+    return sorted(set(globals()) | set(__all__))

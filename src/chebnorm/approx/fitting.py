@@ -22,6 +22,11 @@ def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) ->
 
     ``f_mp`` takes and returns mpmath numbers; ``lo``/``hi`` are mpmath-able.
     Returns ascending float coefficients.
+
+    A polynomial of degree at most ``degree`` is its own interpolant:
+
+    >>> [round(c, 12) + 0.0 for c in chebyshev_interpolant(lambda x: 3 * x**2 - x, 0, 1, 2)]
+    [0.0, -1.0, 3.0]
     """
     with mpmath.workdps(dps):
         coeffs = mpmath.chebyfit(f_mp, [mpmath.mpf(lo), mpmath.mpf(hi)], degree + 1)
@@ -31,7 +36,14 @@ def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) ->
 def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float) -> list[float]:
     """Convert a Chebyshev series in ``t = (2x - lo - hi)/(hi - lo)`` to
     ascending monomial coefficients in ``x``, exactly in rationals, then
-    rounded once to float."""
+    rounded once to float.
+
+    ``T_2(t) = 2 t^2 - 1``; on ``[0, 2]``, ``t = x - 1`` and
+    ``T_2 = 2 x^2 - 4 x + 1``:
+
+    >>> cheb_to_monomial([0.0, 0.0, 1.0], -1.0, 1.0), cheb_to_monomial([0.0, 0.0, 1.0], 0.0, 2.0)
+    ([-1.0, 0.0, 2.0], [1.0, -4.0, 2.0])
+    """
     n = len(cheb)
     # monomial coefficients in t, exactly: T_0 = 1, T_1 = t, T_k = 2t T_{k-1} - T_{k-2}
     t_polys = [[Fraction(1)], [Fraction(0), Fraction(1)]]
@@ -63,7 +75,10 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float) -> list[float]:
 
 
 class RemezResult:
-    """Chebyshev-basis coefficients (mapped variable), levelled error, iterations."""
+    """Result of :func:`remez`: ``cheb``, the Chebyshev-basis coefficients in
+    the mapped variable ``t in [-1, 1]``; ``levelled``, the equioscillation
+    level; ``max_error``, the largest error on the grid; ``iterations`` and
+    ``converged``."""
 
     def __init__(self, cheb: np.ndarray, levelled: float, max_error: float, iterations: int,
                  converged: bool):
@@ -116,6 +131,15 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     Works in the Chebyshev basis of the mapped variable ``t in [-1, 1]``
     (well conditioned), in float64. Stops when the levelled error and the
     largest error agree to ``rtol`` (de la Vallee Poussin gap).
+
+    The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
+    equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
+    ``3/8 + t/2``:
+
+    >>> import numpy as np
+    >>> r = remez(lambda x: x**2, np.ones_like, 0.0, 1.0, 1)
+    >>> [round(float(c), 9) for c in r.cheb], round(float(r.levelled), 9), r.converged
+    ([0.375, 0.5], 0.125, True)
     """
     n = degree
     to_x = lambda t: 0.5 * (hi - lo) * t + 0.5 * (hi + lo)

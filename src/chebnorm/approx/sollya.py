@@ -95,6 +95,22 @@ _NUM = r"[-+]?[0-9.]+(?:e[-+]?[0-9]+)?"
 
 def script_supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: str = "abs",
                    accuracy: float = 2.0 ** -8) -> str:
+    """The Sollya script that bounds ``sup |p - f|`` (``kind="abs"``) or
+    ``sup |p/f - 1|`` (``"rel"``) on ``[lo, hi]`` with ``supnorm`` and prints
+    ``SUP lower upper``: the independent check of our certified bounds.
+
+    Every coefficient is written exactly, as an integer times a power of two
+    (here ``1 = 2^52 * 2^-52``):
+
+    >>> print(script_supnorm("x**2", "x", [0.0, 0.0, 1.0], "0", "1"))
+    prec=200!;
+    display=decimal!;
+    f=x^2;
+    p=(0*2^(-53))*x^0 + (0*2^(-53))*x^1 + (4503599627370496*2^(-52))*x^2;
+    r=supnorm(p, f, [0;1], absolute, 0.00390625);
+    print("SUP", inf(r), sup(r));
+    <BLANKLINE>
+    """
     mode = "absolute" if kind == "abs" else "relative"
     return (f"prec=200!;\ndisplay=decimal!;\nf={_sollya_expr(expr, var)};\np={_poly(coefficients)};\n"
             f"r=supnorm(p, f, {_interval(lo, hi)}, {mode}, {accuracy!r});\n"

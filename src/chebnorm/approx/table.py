@@ -201,6 +201,152 @@ class CoefficientTable:
 
         write_atomic(path, self.to_json())
 
+    # -- display (Jupyter) ----------------------------------------------------
+    def _display_rows(self) -> list[tuple[str, str]]:
+        """(label, plain text) pairs shown by the HTML and Markdown reprs."""
+        lo, hi = self.interval
+        rows = [
+            ("function", f"{self.expression} of {self.variable}"),
+            ("interval", f"[{lo}, {hi}] = [{self.interval_float[0]!r}, {self.interval_float[1]!r}]"),
+            ("degree, kind", f"{self.degree}, {self.kind} ({self.error_kind} error)"),
+            ("coefficients", ", ".join(repr(c) for c in self.coefficients)
+             + f" (ascending powers of {self.variable})"),
+            ("max |p - f|", f"{self.max_abs_error:.6e} at {self.variable} = {self.max_abs_at!r}; "
+                            f"certified bound {self.abs_error_bound:.6e}"),
+        ]
+        if self.max_rel_error is not None and self.rel_error_bound is not None:
+            rows.append(("max |p/f - 1|", f"{self.max_rel_error:.6e} at {self.variable} = "
+                                          f"{self.max_rel_at!r}; certified bound "
+                                          f"{self.rel_error_bound:.6e}"))
+        fp = self.fixed_point
+        if fp is not None:
+            rows.append(("fixed point", f"{fp.frac_bits} fractional bits, int{fp.word_bits}, "
+                                        f"{fp.method}: " + ", ".join(str(q) for q in fp.integers)))
+            rows.append(("fixed max |p - f|", f"{fp.max_abs_error:.6e}; certified bound "
+                                              f"{fp.abs_error_bound:.6e}"))
+            if fp.max_rel_error is not None and fp.rel_error_bound is not None:
+                rows.append(("fixed max |p/f - 1|", f"{fp.max_rel_error:.6e}; certified bound "
+                                                    f"{fp.rel_error_bound:.6e}"))
+        if self.provenance:
+            rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
+        return rows
+
+    def _repr_html_(self) -> str:
+        """An HTML table of the fit for Jupyter; every field is HTML-escaped
+        (tables may come from untrusted files).
+
+        >>> t = CoefficientTable(name="<script>", expression="x**2", variable="x",
+        ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
+        ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
+        ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
+        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None)
+        >>> "&lt;script&gt;" in t._repr_html_() and "<script>" not in t._repr_html_()
+        True
+        """
+        from html import escape
+
+        body = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th>"
+                       f"<td style='text-align:left'>{escape(v)}</td></tr>"
+                       for k, v in self._display_rows())
+        return (f"<table><caption style='text-align:left'><b>CoefficientTable "
+                f"{escape(self.name)}</b></caption>{body}</table>")
+
+    def _repr_markdown_(self) -> str:
+        """A Markdown table of the fit; user text is escaped for Markdown and HTML.
+
+        >>> t = CoefficientTable(name="a|b", expression="x**2", variable="x",
+        ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
+        ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
+        ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
+        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None)
+        >>> print(t._repr_markdown_().splitlines()[0])
+        **CoefficientTable a\\|b**
+        """
+        lines = [f"**CoefficientTable {_markdown_escape(self.name)}**", "", "| | |", "|---|---|"]
+        lines += [f"| {_markdown_escape(k)} | {_markdown_escape(v)} |" for k, v in self._display_rows()]
+        return "\n".join(lines) + "\n"
+
+    def error_curve(self, points: int = 801, error: str = "abs", fixed: bool = False):
+        """``(x, g)``: the error ``g = p - f`` (``error="abs"``) or
+        ``p/f - 1`` (``"rel"``) at ``points`` equally spaced floats of the
+        interval, evaluated in mpmath at 40 significant digits (the float
+        coefficients exactly, so even an error near zero keeps its digits).
+        ``fixed=True`` uses the fixed-point coefficients.
+
+        >>> from chebnorm.approx import fit
+        >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z")
+        >>> x, g = t.error_curve(201)
+        >>> bool(abs(g).max() <= t.abs_error_bound)
+        True
+        """
+        import mpmath
+
+        from .expr import parse_function
+
+        if error not in ("abs", "rel"):
+            raise ValueError(f"error must be 'abs' or 'rel'; got {error!r}")
+        if not isinstance(points, int) or points < 2:
+            raise ValueError(f"points must be an integer >= 2; got {points!r}")
+        if fixed and self.fixed_point is None:
+            raise ValueError(f"table {self.name!r} has no fixed-point part")
+        coeffs = self.fixed_point.coefficients if fixed else self.coefficients
+        fn = parse_function(self.expression, self.variable)
+        f_mp = fn.mpmath
+        x = np.linspace(self.interval_float[0], self.interval_float[1], points)
+        g = np.empty(points)
+        with mpmath.workdps(40):
+            for i, xi in enumerate(x):
+                xm = mpmath.mpf(float(xi))
+                p = mpmath.mpf(0)
+                for c in reversed(coeffs):
+                    p = p * xm + mpmath.mpf(c)
+                f = f_mp(xm)
+                g[i] = float(p - f) if error == "abs" else float(p / f - 1)
+        return x, g
+
+    def plot(self, ax=None, error: str = "abs", points: int = 801):
+        """Plot the error curve ``p - f`` (``error="rel"``: ``p/f - 1``) over
+        the interval with the certified bound ``+-bound`` and the located
+        maximum; a fixed-point part is drawn too. Returns the matplotlib Axes.
+
+        >>> import matplotlib
+        >>> matplotlib.use("Agg")
+        >>> from chebnorm.approx import fit
+        >>> ax = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z").plot()
+        >>> type(ax).__name__
+        'Axes'
+        """
+        if error == "rel" and self.rel_error_bound is None:
+            raise ValueError(f"table {self.name!r} has no relative error (f vanishes on the interval)")
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            _, ax = plt.subplots(figsize=(6.4, 3.6))
+        x, g = self.error_curve(points, error)
+        bound = self.abs_error_bound if error == "abs" else self.rel_error_bound
+        label = "p - f" if error == "abs" else "p/f - 1"
+        ax.plot(x, g, color="C0", lw=1.2, label=f"{label} (degree {self.degree}, {self.kind})")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {bound:.3e}")
+        ax.axhline(-bound, color="C0", ls="--", lw=0.8)
+        at = self.max_abs_at if error == "abs" else self.max_rel_at
+        if at is not None:
+            _, g_at = _point_error(self, at, error)
+            ax.plot([at], [g_at], "o", color="C0", ms=4, label=f"located maximum at {at:.6g}")
+        fp = self.fixed_point
+        fixed_bound = None if fp is None else (fp.abs_error_bound if error == "abs" else fp.rel_error_bound)
+        if fixed_bound is not None:
+            _, gq = self.error_curve(points, error, fixed=True)
+            ax.plot(x, gq, color="C1", lw=1.0, label=f"fixed point, {fp.frac_bits} fractional bits")
+            ax.axhline(fixed_bound, color="C1", ls=":", lw=0.8, label=f"its bound {fixed_bound:.3e}")
+            ax.axhline(-fixed_bound, color="C1", ls=":", lw=0.8)
+        ax.axhline(0.0, color="0.6", lw=0.5)
+        ax.set_xlabel(self.variable)
+        ax.set_ylabel(label)
+        ax.set_title(f"{self.name}: {self.expression} on [{self.interval[0]}, {self.interval[1]}]",
+                     fontsize="medium")
+        ax.legend(fontsize="small", loc="best")
+        return ax
+
 
 # -- reading: every field checked, each refusal naming its field ---------------
 
@@ -490,3 +636,42 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
                 raise ValueError(f"{prefix}max_{kind}_error: the located maximum {m} exceeds "
                                  f"{prefix}{kind}_error_bound = {s}")
     return t
+
+
+def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float, float]:
+    """``(at, g(at))`` evaluated like :meth:`CoefficientTable.error_curve`."""
+    import mpmath
+
+    from .expr import parse_function
+
+    f_mp = parse_function(table.expression, table.variable).mpmath
+    with mpmath.workdps(40):
+        xm = mpmath.mpf(float(at))
+        p = mpmath.mpf(0)
+        for c in reversed(table.coefficients):
+            p = p * xm + mpmath.mpf(c)
+        f = f_mp(xm)
+        return at, float(p - f) if error == "abs" else float(p / f - 1)
+
+
+_MARKDOWN_SPECIAL = "\\`*_[]|~"
+
+
+def _markdown_escape(text: str) -> str:
+    """Backslash-escape Markdown's inline punctuation (a table cell is
+    inline), so user text is shown, not interpreted (``<`` and ``&`` also become HTML entities)."""
+    out = []
+    for ch in str(text):
+        if ch == "&":
+            out.append("&amp;")
+        elif ch == "<":
+            out.append("&lt;")
+        elif ch == ">":
+            out.append("&gt;")
+        elif ch in _MARKDOWN_SPECIAL:
+            out.append("\\" + ch)
+        elif ch in "\r\n":
+            out.append(" ")
+        else:
+            out.append(ch)
+    return "".join(out)

@@ -30,6 +30,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``chebnorm`` argument parser, one subcommand per task (see the
+    README's CLI reference).
+
+    >>> build_parser().prog
+    'chebnorm'
+    """
     from chebnorm import __version__
 
     parser = _Parser(prog="chebnorm", description="Certified polynomial fits and error analysis "
@@ -43,6 +49,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``) and return
+    the exit status: 0 on success, 2 with one line on stderr on bad input.
+
+    >>> main(["no-such-command"])
+    2
+    """
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         parser = build_parser()

@@ -26,7 +26,11 @@ __all__ = ["Cost", "Block"]
 
 @dataclass(frozen=True)
 class Cost:
-    """Resources of a block (see module docstring). ``+`` composes in series."""
+    """Resources of a block (see module docstring). ``+`` composes in series.
+
+    >>> Cost(multipliers=((8, 8),) * 3, adders=(16, 17), latency=3).area   # a dot product, 8-bit
+    225.0
+    """
 
     multipliers: tuple[tuple[int, int], ...] = ()
     adders: tuple[int, ...] = ()
@@ -38,6 +42,7 @@ class Cost:
 
     @property
     def area(self) -> float:
+        """The area estimate in full-adder equivalents (module docstring)."""
         return float(sum(a * b for a, b in self.multipliers) + sum(self.adders)
                      + sum(w * w / 2 for w in self.sqrts) + sum(w * w for w in self.dividers)
                      + self.mux_bits / 2 + self.rom_bits / 8)
@@ -62,6 +67,7 @@ class Cost:
         return out
 
     def as_dict(self) -> dict:
+        """The cost as a plain dict (for JSON), with the area and the counts."""
         return {"multipliers": [f"{a}x{b}" for a, b in self.multipliers],
                 "adders": list(self.adders), "sqrts": list(self.sqrts),
                 "dividers": list(self.dividers), "mux_bits": self.mux_bits,
@@ -75,6 +81,13 @@ class Block:
 
     ``serial`` children follow each other (latencies add), otherwise they
     work side by side (the larger latency counts).
+
+    >>> dot = Block("dot", Cost(multipliers=((8, 8),) * 3, adders=(16, 17), latency=3))
+    >>> three = Block("3 dots", children=(dot,) * 3, serial=False)
+    >>> three.cost.latency, three.cost.area, len(three.cost.multipliers)
+    (3, 675.0, 9)
+    >>> Block("chain", children=(dot, dot)).cost.latency
+    6
     """
 
     name: str
@@ -85,12 +98,14 @@ class Block:
 
     @property
     def cost(self) -> Cost:
+        """Own cost plus the children's, in series or side by side."""
         inner = Cost()
         for i, c in enumerate(self.children):
             inner = (inner + c.cost) if (self.serial or i == 0) else inner.parallel(c.cost)
         return self.own + inner
 
     def as_dict(self) -> dict:
+        """The block tree as a plain dict (for JSON)."""
         d = {"name": self.name, "cost": self.cost.as_dict()}
         if self.note:
             d["note"] = self.note
@@ -99,6 +114,7 @@ class Block:
         return d
 
     def lines(self, indent: int = 0) -> list[str]:
+        """One text line per block of the tree, indented by depth."""
         c = self.cost
         out = [f"{'  ' * indent}{self.name}: {len(c.multipliers)} mul, {len(c.adders)} add, "
                f"{len(c.sqrts)} sqrt, {len(c.dividers)} div, {c.mux_bits} mux bits, "

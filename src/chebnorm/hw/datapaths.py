@@ -184,7 +184,19 @@ def dichotomy_next_z(z_codes, design: HornerDesign) -> np.ndarray:
     the square root rounded to nearest (no ties: ``sqrt`` of an integer is
     never a half-integer), computed as ``(isqrt(4 X 2^Fx) + 1) >> 1`` with
     ``X = 2^(Fx+1) + K0 + k``; the code ``z' 2^Fx - K0`` saturates to
-    ``0 .. 2^in_bits - 1``. For a valid ``z`` the result is valid (``z' > z``).
+    ``[0, 2^in_bits - 1]``. For a valid ``z`` the result is valid (``z' >= z``, equal only at
+    ``z = 2``, where ``sqrt(2 + z) = z``).
+
+    Every valid code of the 12-bit input on ``[sqrt 2, 2]`` steps to
+    ``sqrt(2 + z)`` within half an LSB (``2^-13``):
+
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 2), 12, 12, coef_bits=16)
+    >>> k = np.arange(d.valid_codes[0], d.valid_codes[1] + 1)
+    >>> z, z_next = d.x_format.values(k), d.x_format.values(dichotomy_next_z(k, d))
+    >>> bool(np.all(np.abs(z_next - np.sqrt(2 + z)) <= 2.0 ** -13)), bool(np.all(z_next >= z))
+    (True, True)
     """
     fx, k0 = design.x_format.frac_bits, design.x_format.offset_code
     x = np.asarray(z_codes, dtype=np.int64) + (2 << fx) + k0
@@ -257,7 +269,13 @@ def forward_difference_setup(G, P, Q, log_m: int, guard: int):
 
 def forward_difference_codes(v0, d1, d2, m: int) -> np.ndarray:
     """``m + 1`` pixel codes ``v_i`` by ``v += d1; d1 += d2`` (additions only);
-    int arrays ``(..., 3)`` in, ``(..., m+1, 3)`` out."""
+    int arrays ``(..., 3)`` in, ``(..., m+1, 3)`` out.
+
+    ``d1 = 1``, ``d2 = 2`` step through the squares (``(i+1)^2 - i^2 = 2i + 1``):
+
+    >>> forward_difference_codes(np.zeros(3, int), np.ones(3, int), np.full(3, 2), 4)[:, 0].tolist()
+    [0, 1, 4, 9, 16]
+    """
     v, d1, d2 = (np.asarray(a, dtype=np.int64) for a in (v0, d1, d2))
     out = [v]
     for _ in range(m):

@@ -102,7 +102,13 @@ class QFormat:
 def shift_round(v, shift: int, mode: str):
     """``v / 2**shift`` rounded to an integer (``shift >= 0``), ints or int64 arrays.
 
-    Does not check its arguments (inner kernel).
+    Does not check its arguments (inner kernel). ``"rne"`` rounds to nearest,
+    ties to even; ``"trunc"`` rounds toward minus infinity (drops the bits):
+
+    >>> shift_round(5, 1, "rne"), shift_round(7, 1, "rne"), shift_round(-5, 1, "rne")
+    (2, 4, -2)
+    >>> shift_round(7, 1, "trunc"), shift_round(-5, 1, "trunc")
+    (3, -3)
     """
     if shift == 0:
         return v
@@ -122,6 +128,12 @@ def fit_bits(v, bits: int, *, signed: bool, overflow: str):
     ``"saturate"`` clamps, ``"wrap"`` keeps the low ``bits`` bits (two's
     complement when ``signed``). ``overflowed`` flags the codes that did
     not fit before the operation.
+
+    >>> [int(c) for c in fit_bits([300, -1], 8, signed=False, overflow="saturate")[0]]
+    [255, 0]
+    >>> codes, over = fit_bits([300, 130], 8, signed=True, overflow="wrap")
+    >>> codes.tolist(), over.tolist()       # 300 - 256 and 130 - 256
+    ([44, -126], [True, True])
     """
     lo = -(1 << (bits - 1)) if signed else 0
     hi = (1 << (bits - 1)) - 1 if signed else (1 << bits) - 1
@@ -151,7 +163,11 @@ def signed_bits(lo: int, hi: int) -> int:
 
 
 def unsigned_bits(hi: int) -> int:
-    """Smallest unsigned width holding ``0..hi`` (at least 1)."""
+    """Smallest unsigned width holding ``0..hi`` (at least 1).
+
+    >>> unsigned_bits(0), unsigned_bits(255), unsigned_bits(256)
+    (1, 8, 9)
+    """
     return max(1, int(hi).bit_length())
 
 
@@ -160,6 +176,9 @@ def rounding_error_bound(frac_bits: int, mode: str, dropped_bits: int | None = N
 
     With ``dropped_bits`` (the exact value has ``frac_bits + dropped_bits``
     fractional bits) truncation errs by at most ``2**-F - 2**-(F + d)``.
+
+    >>> rounding_error_bound(4, "rne"), rounding_error_bound(4, "trunc"), rounding_error_bound(4, "trunc", 2)
+    (Fraction(1, 32), Fraction(1, 16), Fraction(3, 64))
     """
     ulp = Fraction(1, 2 ** frac_bits) if frac_bits >= 0 else Fraction(2 ** -frac_bits)
     if dropped_bits == 0:
@@ -172,7 +191,14 @@ def rounding_error_bound(frac_bits: int, mode: str, dropped_bits: int | None = N
 
 
 def check_int64(bits: int, what: str) -> None:
-    """Boundary check: a value of ``bits`` signed bits fits the int64 model."""
+    """Boundary check: a value of ``bits`` signed bits fits the int64 model.
+
+    >>> check_int64(62, "the accumulator")
+    >>> check_int64(63, "the accumulator")
+    Traceback (most recent call last):
+    ...
+    ValueError: the accumulator needs 63 bits, which overflows the 64-bit bit-accurate model; accepted: at most 62 bits (use fewer input, coefficient or datapath bits)
+    """
     if bits > INT64_BITS:
         raise ValueError(f"{what} needs {bits} bits, which overflows the 64-bit bit-accurate "
                          f"model; accepted: at most {INT64_BITS} bits (use fewer input, "
@@ -180,7 +206,15 @@ def check_int64(bits: int, what: str) -> None:
 
 
 def check_width(value, name: str, lo: int, hi: int) -> int:
-    """Validate a bit width given by the user: an integer in ``[lo, hi]``."""
+    """Validate a bit width given by the user: an integer in ``[lo, hi]``.
+
+    >>> check_width(12, "in_bits", 1, 31)
+    12
+    >>> check_width(40, "in_bits", 1, 31)
+    Traceback (most recent call last):
+    ...
+    ValueError: in_bits = 40 is out of range; accepted: 1 <= in_bits <= 31
+    """
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
     if not lo <= int(value) <= hi:

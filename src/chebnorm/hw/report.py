@@ -1,7 +1,13 @@
 """One call from a table to a checked design: budget, exhaustive
 measurement, gappa, yosys, costs; and the writer of the Verilog outputs.
 
+The module is callable: ``chebnorm.hw.report(table, in_bits, out_bits, ...)``
+is :func:`analyze` (what ``chebnorm hw report`` prints).
+
 >>> from chebnorm.approx import fit_target
+>>> import chebnorm.hw
+>>> chebnorm.hw.report(fit_target("dichotomy", 1), 10, 10, coef_bits=12, synth=False, gappa=False).checks["within_budget"]
+True
 >>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_bits=16, synth=False, gappa=False)
 >>> r.checks["within_budget"], r.checks["budget_within_2x"]
 (True, True)
@@ -9,6 +15,8 @@ measurement, gappa, yosys, costs; and the writer of the Verilog outputs.
 
 from __future__ import annotations
 
+import sys
+import types
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -165,3 +173,13 @@ def write_outputs(directory, files: dict[str, str]) -> list[Path]:
         write_atomic(folder / fname, text)
         paths.append(folder / fname)
     return paths
+
+
+class _CallableModule(types.ModuleType):
+    """``chebnorm.hw.report`` is callable: ``chebnorm.hw.report(table, 12, 12)``."""
+
+    def __call__(self, table: CoefficientTable, in_bits: int, out_bits: int, **options) -> HardwareReport:
+        return analyze(table, in_bits, out_bits, **options)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -37,6 +37,12 @@ COLUMNS = ("degree", "coef_bits", "acc_bits", "in_bits", "out_bits", "y_frac_bit
 
 @dataclass(frozen=True)
 class SweepPoint:
+    """One design of the sweep: its widths, its exhaustively measured error
+    (``max_error``; in output LSBs, ``max_error_lsb``; in 8-bit shading
+    levels, ``shading_levels``), its certified budget and its area (yosys
+    cells when yosys ran, else the full-adder estimate ``area_fa``);
+    ``pareto`` marks the designs no other beats on both error and area."""
+
     degree: int
     coef_bits: int
     acc_bits: int | None
@@ -59,9 +65,11 @@ class SweepPoint:
 
     @property
     def meets_half_level(self) -> bool:
+        """True when the shading error is at most half an 8-bit level."""
         return self.shading_levels <= HALF_LEVEL
 
     def row(self) -> list[str]:
+        """The CSV cells of this point, in the order of ``COLUMNS``."""
         f = lambda v: f"{v:.6e}"
         return [str(self.degree), str(self.coef_bits),
                 "" if self.acc_bits is None else str(self.acc_bits), str(self.in_bits),
@@ -74,6 +82,9 @@ class SweepPoint:
 
 @dataclass(frozen=True)
 class SweepResult:
+    """All points of a sweep of one target (see :func:`sweep`), with
+    ``area_source`` saying whether areas are yosys cells or estimates."""
+
     target: str
     points: tuple[SweepPoint, ...]
     area_source: str
@@ -86,6 +97,7 @@ class SweepResult:
                                       p.acc_bits or 0)) if ok else None
 
     def csv(self) -> str:
+        """The points as CSV text (a header line, then one row per point)."""
         out = io.StringIO()
         out.write(",".join(COLUMNS) + "\n")
         for p in self.points:

@@ -63,13 +63,27 @@ def _check_m(m) -> int:
 
 
 def reference_normals(nl, nr, t) -> np.ndarray:
-    """``R(t)``: linear interpolation then exact normalization, float64, (P, 3)."""
+    """``R(t)``: linear interpolation then exact normalization, float64, (P, 3).
+
+    >>> import numpy as np
+    >>> reference_normals(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.array([0.5])).round(12).tolist()
+    [[0.707106781187, 0.707106781187, 0.0]]
+    """
     n = nl + t[:, None] * (nr - nl)
     return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
 def slerp_normals(nl, nr, psi, t) -> np.ndarray:
-    """``S(t)``: the slerp point at angle fraction ``t``, float64, (P, 3); ``psi`` per pixel."""
+    """``S(t)``: the slerp point at angle fraction ``t``, float64, (P, 3); ``psi`` per pixel.
+
+    Seed 000, method 3: ``[sin((1-t) psi) N_l + sin(t psi) N_r] / sin psi``.
+    A third of the way along a right angle is 30 degrees from ``N_l``:
+
+    >>> import numpy as np
+    >>> s = slerp_normals(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.pi / 2, np.array([1 / 3]))
+    >>> bool(np.allclose(s, [[np.cos(np.pi / 6), np.sin(np.pi / 6), 0.0]]))
+    True
+    """
     psi = np.broadcast_to(psi, t.shape)
     small = psi < 1e-300
     s = np.where(small, 1.0, detmath.sin(psi))

@@ -22,6 +22,7 @@ from .metrics import IMAGE_FORMATS, ImageMetrics, compare, error_map_rgb, write_
 from .render import (BUMP_VARIANTS, SHADING_MODES, HeightMap, Lighting, RenderResult,
                      available_methods, get_span_normals, render, to_8bit)
 from .spans import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
+from .display import RenderComparison, png_data_uri, render_html
 from .studies import (BumpCase, EtaLevel, SplitGouraudStudy, bump_comparison, eta_study,
                       split_gouraud_study, write_bump_figures)
 
@@ -34,4 +35,5 @@ __all__ = [
     "Camera", "Spans", "default_camera", "fit_camera", "project", "setup_spans", "zbuffer",
     "eta_study", "EtaLevel", "split_gouraud_study", "SplitGouraudStudy", "bump_comparison",
     "BumpCase", "write_bump_figures",
+    "RenderComparison", "render_html", "png_data_uri",
 ]

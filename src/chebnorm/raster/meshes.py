@@ -47,6 +47,11 @@ class Mesh:
 
     Construction validates everything and raises ``ValueError`` naming the
     first bad value.
+
+    >>> import numpy as np
+    >>> m = Mesh("tri", np.eye(3), np.tile([0.0, 0.0, 1.0], (3, 1)), np.array([[0, 1, 2]]))
+    >>> m.faces.shape, m.has_parametrization
+    ((1, 3), False)
     """
 
     name: str
@@ -181,6 +186,17 @@ def uv_sphere(tess: int = 16) -> Mesh:
 
     At the poles ``P_u`` vanishes; pole vertices carry ``P_u`` evaluated a
     quarter ring away from the pole so that a tangent frame exists there.
+
+    ``(tess + 1)(2 tess + 1)`` vertices (the seam and the poles repeated) and
+    ``2 (2 tess) tess`` grid triangles less the ``2 (2 tess)`` of zero area at
+    the poles:
+
+    >>> import numpy as np
+    >>> s = uv_sphere(4)
+    >>> len(s.positions), len(s.faces)
+    (45, 48)
+    >>> bool(np.allclose(np.linalg.norm(s.positions, axis=1), 1.0))
+    True
     """
     k = _check_tess(tess, 2, 1024, "uv_sphere")
     nu, nv = 2 * k, k
@@ -203,7 +219,15 @@ def uv_sphere(tess: int = 16) -> Mesh:
 
 def icosphere(tess: int = 3) -> Mesh:
     """Unit icosphere: ``tess`` subdivisions (0..7) of an icosahedron;
-    normals are the positions.  No parametrization (bump mapping needs one)."""
+    normals are the positions.  No parametrization (bump mapping needs one).
+
+    ``20 * 4**tess`` faces and, by Euler's formula, ``10 * 4**tess + 2``
+    vertices:
+
+    >>> m = icosphere(2)
+    >>> len(m.faces), len(m.positions)
+    (320, 162)
+    """
     import trimesh
 
     k = _check_tess(tess, 0, 7, "icosphere")
@@ -215,7 +239,18 @@ def icosphere(tess: int = 3) -> Mesh:
 
 def torus(tess: int = 16, R: float = 1.0, r: float = 0.4) -> Mesh:
     """Torus around z: ``2*tess`` segments around the axis (``u``), ``tess``
-    around the tube (``v``); exact normals and ``P_u, P_v``."""
+    around the tube (``v``); exact normals and ``P_u, P_v``.
+
+    The normal is ``P_u x P_v`` normalized (seed 001):
+
+    >>> import numpy as np
+    >>> t = torus(4)
+    >>> len(t.faces)
+    64
+    >>> n = np.cross(t.P_u, t.P_v)
+    >>> bool(np.allclose(n / np.linalg.norm(n, axis=1, keepdims=True), t.normals))
+    True
+    """
     k = _check_tess(tess, 3, 1024, "torus")
     nu, nv = 2 * k, k
     U, V = np.meshgrid(np.linspace(0, 1, nu + 1), np.linspace(0, 1, nv + 1), indexing="ij")
@@ -233,7 +268,12 @@ def torus(tess: int = 16, R: float = 1.0, r: float = 0.4) -> Mesh:
 
 def square(tess: int = 8) -> Mesh:
     """Flat square ``[-1, 1]^2`` in the plane z = 0, normal +z, ``tess x tess``
-    cells; ``P_u = (2, 0, 0)``, ``P_v = (0, 2, 0)``: a square patch, k = 2."""
+    cells; ``P_u = (2, 0, 0)``, ``P_v = (0, 2, 0)``: a square patch, k = 2.
+
+    >>> s = square(2)
+    >>> len(s.positions), len(s.faces), s.P_u[0].tolist()
+    (9, 8, [2.0, 0.0, 0.0])
+    """
     k = _check_tess(tess, 1, 4096, "square")
     U, V = np.meshgrid(np.linspace(0, 1, k + 1), np.linspace(0, 1, k + 1), indexing="ij")
     pos = np.stack([2 * U - 1, 2 * V - 1, np.zeros_like(U)], -1).reshape(-1, 3)
@@ -280,6 +320,10 @@ def teapot(tess: int = 20) -> Mesh:
     patch.  Zero-area triangles at those poles are dropped.  Patch vertices
     are not welded; ``uv`` is the patch parameter (each patch spans [0,1]^2),
     with ``u`` and ``v`` of the data swapped so that ``P_u x P_v`` is outward.
+
+    >>> t = teapot(4)
+    >>> t.has_parametrization, round(float(t.positions[:, 2].max() - t.positions[:, 2].min()), 2)
+    (True, 3.15)
     """
     k = _check_tess(tess, 1, 256, "teapot")
     ctrl = _teapot_patches()
@@ -326,6 +370,18 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     Returns ``(positions, normals, faces)`` with vertices split where a vertex
     carries more than one normal.  Fully vectorized: one pass over the pairs
     of faces sharing a vertex.
+
+    A cube's faces meet at 90 degrees: each corner splits into three
+    vertices, one per face, each with its face's normal; with a crease angle
+    above 90 degrees nothing splits:
+
+    >>> import numpy as np, trimesh
+    >>> box = trimesh.creation.box()
+    >>> pos, nrm, faces = crease_normals(box.vertices, box.faces)
+    >>> len(box.vertices), len(pos), sorted(np.abs(nrm).sum(axis=1).round(12).tolist()) == [1.0] * 24
+    (8, 24, True)
+    >>> len(crease_normals(box.vertices, box.faces, np.radians(100))[0])
+    8
     """
     pos = np.asarray(positions, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
@@ -500,7 +556,11 @@ def get_mesh(name_or_path, tess: int | None = None, crease_angle: float | None =
     ``square``) at tessellation level ``tess`` (generator default if None),
     or an OBJ/PLY/STL file path (:func:`load_mesh`, with ``crease_angle`` in
     radians). Generated meshes have exact normals: a ``crease_angle`` for one
-    is refused."""
+    is refused.
+
+    >>> get_mesh("sphere", 6).name, len(get_mesh("icosphere", 1).faces)
+    ('sphere', 80)
+    """
     gens = {"teapot": teapot, "sphere": uv_sphere, "icosphere": icosphere, "torus": torus,
             "square": square}
     if isinstance(name_or_path, Mesh):

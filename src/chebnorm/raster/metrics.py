@@ -23,6 +23,11 @@ __all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_image", "write_png
 
 @dataclass(frozen=True)
 class ImageMetrics:
+    """Errors of a frame against a reference, on 8-bit images, over the
+    covered pixels (see the module docstring): largest and mean absolute
+    difference in levels, pixels off by one level or more, PSNR (``None``
+    when identical), SSIM, mean FLIP, and the number of covered pixels."""
+
     max_abs_8bit: int
     pixels_off_1: int
     mean_abs_8bit: float
@@ -32,6 +37,7 @@ class ImageMetrics:
     pixels: int
 
     def to_dict(self) -> dict:
+        """The fields as a plain dict (for JSON)."""
         return asdict(self)
 
 
@@ -90,7 +96,12 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
 def error_map_rgb(diff, scale: float | None = None) -> np.ndarray:
     """A heat map (uint8 RGB) of ``|diff|`` in 8-bit levels: black (0) through
     red and yellow to white at ``scale`` levels (default: the largest error,
-    at least 1)."""
+    at least 1).
+
+    >>> import numpy as np
+    >>> error_map_rgb(np.array([[0, -1, 2, 3, 9]]), scale=3).tolist()
+    [[[0, 0, 0], [255, 0, 0], [255, 255, 0], [255, 255, 255], [255, 255, 255]]]
+    """
     e = np.abs(np.asarray(diff, dtype=float))
     s = float(scale) if scale is not None else max(1.0, float(e.max()))
     x = np.clip(e / s, 0.0, 1.0)

@@ -2,7 +2,7 @@
 normalization method), ``adaptive`` (seed 003), ``split-gouraud`` (seed 002)
 and ``bump`` (seed 001).
 
-Lighting is Blinn-Phong (SPEC.md notation): ``I = I0 (k_a + k_d max(0, L.N)
+Lighting is Blinn-Phong (the notation of docs/papers.md): ``I = I0 (k_a + k_d max(0, L.N)
 + k_s max(0, H.N)^n)`` with a directional light ``L`` and a viewer at the
 camera; ``H = (L+V)/|L+V|`` is computed per pixel (``V`` from the
 interpolated position) or once per triangle at its centroid (seed 002).  The
@@ -56,14 +56,18 @@ def get_span_normals():
 
 
 def available_methods() -> tuple[str, ...]:
-    """The normalization methods ``render`` accepts: every registered method."""
+    """The normalization methods ``render`` accepts: every registered method.
+
+    >>> {"exact", "none", "dichotomy"} <= set(available_methods())
+    True
+    """
     return method_names()
 
 
 # ----------------------------------------------------------------- lighting
 @dataclass(frozen=True)
 class Lighting:
-    """Blinn-Phong parameters (SPEC.md): ``I0, k_a, k_d, k_s``, shininess
+    """Blinn-Phong parameters (docs/papers.md): ``I0, k_a, k_d, k_s``, shininess
     ``n``, unit direction ``light`` *toward* the light (world; default: up and
     to the right of the camera), and where ``H`` is computed: ``"pixel"`` or
     ``"triangle"`` (one ``H`` per triangle, at its centroid, as in seed 002)."""
@@ -134,7 +138,7 @@ class RenderResult:
     stats: dict = field(default_factory=dict)
     #: (H, W) index into mesh.faces of the visible triangle, -1 on background
     triangle: np.ndarray | None = None
-    #: (H, W) |N| of the pixel normal before shading (phong, adaptive), NaN on background
+    #: (H, W) ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background
     normal_length: np.ndarray | None = None
 
     @property
@@ -145,8 +149,21 @@ class RenderResult:
     def pixels(self) -> int:
         return int(self.mask.sum())
 
+    def _repr_html_(self) -> str:
+        """Jupyter: the image beside its length-error map and numbers
+        (:func:`chebnorm.raster.display.render_html`)."""
+        from .display import render_html
+
+        return render_html(self)
+
 
 def to_8bit(image) -> np.ndarray:
+    """Intensities in ``[0, 1]`` to 8-bit levels, ``round(255 I)`` after
+    clipping.
+
+    >>> to_8bit([-0.5, 0.0, 0.5, 1.0, 2.0]).tolist()
+    [0, 0, 128, 255, 255]
+    """
     return np.round(np.clip(image, 0.0, 1.0) * 255.0).astype(np.uint8)
 
 

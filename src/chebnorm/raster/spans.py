@@ -58,7 +58,13 @@ class Camera:
 
 def default_camera(center, radius, direction=(2.0, -3.0, 1.8), fov_y=np.radians(30.0)) -> Camera:
     """A camera looking at ``center`` from ``direction``, far enough for the
-    bounding sphere ``radius`` to fill about 90 % of the view height."""
+    bounding sphere ``radius`` to fill about 90 % of the view height.
+
+    >>> import numpy as np
+    >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
+    >>> bool(np.isclose(np.linalg.norm(cam.eye), 1 / np.sin(np.radians(15)) / 0.9))
+    True
+    """
     d = np.asarray(direction, float)
     d /= np.linalg.norm(d)
     dist = radius / np.sin(fov_y / 2) / 0.9
@@ -69,7 +75,14 @@ def default_camera(center, radius, direction=(2.0, -3.0, 1.8), fov_y=np.radians(
 def fit_camera(points, width: int, height: int, direction=(2.0, -3.0, 1.8),
                fov_y=np.radians(30.0), fill: float = 0.9) -> Camera:
     """:func:`default_camera` re-aimed and zoomed so that the projected
-    ``points`` are centred and fill ``fill`` of the tighter image dimension."""
+    ``points`` are centred and fill ``fill`` of the tighter image dimension.
+
+    >>> import numpy as np
+    >>> pts = np.array([[-1.0, -1, -1], [1, 1, 1]])
+    >>> xy, _ = project(fit_camera(pts, 64, 48), pts, 64, 48)
+    >>> bool(np.all((xy >= 0) & (xy <= [64, 48])))
+    True
+    """
     pts = np.asarray(points, float)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     center, radius = (lo + hi) / 2, float(np.linalg.norm(hi - lo) / 2) or 1.0
@@ -89,7 +102,16 @@ def fit_camera(points, width: int, height: int, direction=(2.0, -3.0, 1.8),
 def project(camera: Camera, points, width: int, height: int):
     """World points ``(..., 3)`` to screen ``(x, y)`` and ``1/w`` (w the
     distance along the view axis).  Raises ``ValueError`` if a point is not
-    in front of the camera."""
+    in front of the camera.
+
+    The target lands on the image centre, at ``1/w = 1/|eye - target|``:
+
+    >>> import numpy as np
+    >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
+    >>> xy, inv_w = project(cam, [[0.0, 0.0, 0.0]], 100, 100)
+    >>> bool(np.allclose(xy, [[50.0, 50.0]])), bool(np.isclose(inv_w[0], 1 / np.linalg.norm(cam.eye)))
+    (True, True)
+    """
     frame = camera.frame()
     pc = (np.asarray(points, float) - np.asarray(camera.eye, float)) @ frame.T
     w = -pc[..., 2]
@@ -134,6 +156,7 @@ class Spans:
 
     @property
     def n_fragments(self) -> int:
+        """The number of covered pixels (fragments) of all spans."""
         return int(self.offsets[-1])
 
     def lerp(self, cols) -> np.ndarray:
@@ -148,7 +171,17 @@ _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 
 def setup_spans(xy, attrs, width: int, height: int) -> Spans:
     """Triangle set-up into spans: ``xy (T,3,2)`` screen corners, ``attrs
-    (T,3,K)`` corner attributes.  Vectorized over triangles, rows and pixels."""
+    (T,3,K)`` corner attributes.  Vectorized over triangles, rows and pixels.
+
+    A right triangle with legs of 8 pixels from the centre of pixel (0, 0):
+    rows 0..7, row ``r`` covering the ``8 - r`` centres left of the
+    hypotenuse ``x + y = 9`` (half-open ranges), 36 pixels in all:
+
+    >>> import numpy as np
+    >>> sp = setup_spans(np.array([[[0.5, 0.5], [8.5, 0.5], [0.5, 8.5]]]), np.zeros((1, 3, 1)), 16, 16)
+    >>> sp.count.tolist(), sp.n_fragments
+    ([8, 7, 6, 5, 4, 3, 2, 1], 36)
+    """
     xy = np.asarray(xy, float)
     attrs = np.asarray(attrs, float)
     T, _, K = attrs.shape
@@ -208,7 +241,12 @@ def setup_spans(xy, attrs, width: int, height: int) -> Spans:
 
 def zbuffer(pixel, inv_w, n_pixels: int):
     """Indices of the visible fragments (largest ``1/w`` per pixel, ties to
-    the earliest fragment), sorted by pixel."""
+    the earliest fragment), sorted by pixel.
+
+    >>> import numpy as np
+    >>> zbuffer(np.array([3, 1, 3]), np.array([0.5, 0.2, 0.9]), 4).tolist()
+    [1, 2]
+    """
     order = np.lexsort((np.arange(len(pixel)), -inv_w, pixel))
     p = pixel[order]
     first = np.ones(len(p), dtype=bool)

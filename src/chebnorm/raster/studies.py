@@ -29,17 +29,20 @@ __all__ = ["EtaLevel", "eta_study", "split_gouraud_study", "SplitGouraudStudy", 
 
 @dataclass
 class EtaLevel:
-    """One tessellation level of :func:`eta_study`."""
+    """One tessellation level of :func:`eta_study`: the metrics of
+    ``phong:none`` against ``phong:exact``, and per visible triangle its eta
+    and its worst relative diffuse error (eta bounds it: ``bound_holds``)."""
 
     tess: int
     triangles: int
     metrics: dict
-    #: per visible triangle: its eta and its worst relative diffuse error 1 - |N|
+    #: per visible triangle: its eta and its worst relative diffuse error ``1 - |N|``
     eta: np.ndarray = field(repr=False)
     worst_rel_diffuse: np.ndarray = field(repr=False)
 
     @property
     def bound_holds(self) -> bool:
+        """Every triangle's worst error is at most its eta (to rounding, 1e-12)."""
         return bool(np.all(self.worst_rel_diffuse <= self.eta + 1e-12))
 
     @property
@@ -49,6 +52,7 @@ class EtaLevel:
         return float(np.max(self.worst_rel_diffuse[ok] / self.eta[ok])) if ok.any() else 0.0
 
     def to_dict(self) -> dict:
+        """The level as a plain dict (for JSON), arrays summarized by their maxima."""
         return {"tess": self.tess, "triangles": self.triangles, "metrics": self.metrics,
                 "bound_holds": self.bound_holds, "tightness": self.tightness,
                 "eta_max": float(self.eta.max()), "worst_rel_diffuse_max":
@@ -62,7 +66,11 @@ def eta_study(tess_levels=(4, 6, 8, 12, 16, 24), size=(128, 128), mesh="sphere",
     The relative diffuse error of skipping normalization is ``1 - |N|``
     exactly (``L.N`` against ``L.N/|N|``), whatever ``L``; per triangle its
     worst value over the triangle's pixels is compared with the triangle's
-    ``eta`` (SPEC.md: eta sums the three edge bounds).
+    ``eta`` (docs/papers.md: eta sums the three edge bounds).
+
+    >>> level = eta_study((4,), size=(48, 48))[0]
+    >>> level.tess, level.bound_holds, level.tightness <= 1.0
+    (4, True, True)
     """
     from chebnorm.symbolic import eta as eta_fn
 
@@ -85,6 +93,11 @@ def eta_study(tess_levels=(4, 6, 8, 12, 16, 24), size=(128, 128), mesh="sphere",
 
 @dataclass
 class SplitGouraudStudy:
+    """Seed 002 (claim C11): plain and split Gouraud against a Phong
+    reference on one mesh; ``gouraud`` and ``split_gouraud`` hold each one's
+    :class:`ImageMetrics` as a dict, ``split_stats`` the extra vertices
+    shaded."""
+
     mesh: str
     tess: int
     shininess: float
@@ -95,10 +108,12 @@ class SplitGouraudStudy:
 
     @property
     def closer_to_phong(self) -> bool:
+        """Split Gouraud has a smaller mean and no larger maximum error."""
         g, s = self.gouraud, self.split_gouraud
         return s["mean_abs_8bit"] < g["mean_abs_8bit"] and s["max_abs_8bit"] <= g["max_abs_8bit"]
 
     def to_dict(self) -> dict:
+        """The study as a plain dict (for JSON), without the images."""
         d = {k: v for k, v in asdict(self).items() if k != "images"}
         d["closer_to_phong"] = self.closer_to_phong
         return d
@@ -107,7 +122,12 @@ class SplitGouraudStudy:
 def split_gouraud_study(tess: int = 6, shininess: float = 64.0, size=(256, 256), q=1.0 / 255.0,
                         mesh="sphere", half_vector: str = "triangle") -> SplitGouraudStudy:
     """Seed 002 (C11): plain and split Gouraud against Phong ``exact`` on a
-    coarse sphere whose highlight falls inside triangles."""
+    coarse sphere whose highlight falls inside triangles.
+
+    >>> s = split_gouraud_study(tess=6, size=(64, 64))
+    >>> s.closer_to_phong, s.split_stats["extra_vertices"] > 0
+    (True, True)
+    """
     light = Lighting(shininess=shininess, half_vector=half_vector)
     m = get_mesh(mesh, tess)
     ref = render(m, "phong", "exact", size=size, lighting=light)
@@ -123,7 +143,9 @@ def split_gouraud_study(tess: int = 6, shininess: float = 64.0, size=(256, 256),
 
 @dataclass
 class BumpCase:
-    """Square-patch (and object-space) against full coefficients on one mesh."""
+    """Square-patch (and object-space) against full coefficients on one mesh
+    (:func:`bump_comparison`): ``k`` is the patch size used, the two dicts
+    hold :class:`ImageMetrics` against the full-coefficient render."""
 
     mesh: str
     k: float
@@ -132,6 +154,7 @@ class BumpCase:
     images: dict = field(repr=False, default_factory=dict)
 
     def to_dict(self) -> dict:
+        """The case as a plain dict (for JSON), without the images."""
         return {k: v for k, v in asdict(self).items() if k != "images"}
 
 
@@ -142,7 +165,14 @@ def bump_comparison(meshes=("square", "sphere", "torus"), size=(256, 256), tess=
     ``[-F_u/k, -F_v/k, 1]`` against the full tangent-space coefficients, on
     surfaces that are square patches (the flat square: they agree) and that
     are not (a sphere, worst near its poles; a torus).  ``images`` holds the
-    three renders and the signed 8-bit differences (the error maps)."""
+    three renders and the signed 8-bit differences (the error maps).
+
+    On the flat square (``k = 2``) the simplification is exact (claim C12):
+
+    >>> case = bump_comparison(("square",), size=(32, 32))[0]
+    >>> case.k, case.square_vs_full["max_abs_8bit"]
+    (2.0, 0)
+    """
     out = []
     for name in meshes:
         m = get_mesh(name, tess)
@@ -161,7 +191,14 @@ def bump_comparison(meshes=("square", "sphere", "torus"), size=(256, 256), tess=
 def write_bump_figures(cases, directory) -> list[str]:
     """For each case write ``bump_<mesh>_{full,square,object}.png`` and the
     error maps ``bump_<mesh>_square_error.png``, ``..._object_error.png``
-    (heat maps on a common scale); returns the paths."""
+    (heat maps on a common scale); returns the paths.
+
+    >>> import os, tempfile
+    >>> cases = bump_comparison(("square",), size=(16, 16))
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     [os.path.basename(p) for p in write_bump_figures(cases, d)]
+    ['bump_square_full.png', 'bump_square_square.png', 'bump_square_object.png', 'bump_square_square_error.png', 'bump_square_object_error.png']
+    """
     from chebnorm.approx.files import make_folder
 
     directory = os.fspath(make_folder(directory))

@@ -16,23 +16,23 @@ accepted range.  Tolerances: :data:`UNIT_RTOL` (unit normals),
 Layer rule: this subpackage imports numpy and sympy only, nothing else from
 chebnorm.
 
-=====================================  ===================================  ========
-sympy expression                       numpy function                       seed
-=====================================  ===================================  ========
-``norm2_linear_expr()``                ``norm2_linear_np(t, c)``            003
-``midpoint_scale_expr()``              ``midpoint_normal(na, nb)``          003, 000
-``delta_d_expr()``                     ``delta_d(phi)``                     003 (C1)
-``delta_s_expr()``                     ``delta_s(phi, n)``                  003 (C2)
-``eta_expr()``                         ``eta(na, nb, nc)``                  003
-``edge_highlight_expr()``              ``edge_highlight(a, b, c)``,         002
+=====================================  =======================================  ========
+sympy expression                       numpy function                           seed
+=====================================  =======================================  ========
+``norm2_linear_expr()``                ``norm2_linear_np(t, c)``                003
+``midpoint_scale_expr()``              ``midpoint_normal(na, nb)``              003, 000
+``delta_d_expr()``                     ``delta_d(phi)``                         003 (C1)
+``delta_s_expr()``                     ``delta_s(phi, n)``                      003 (C2)
+``eta_expr()``                         ``eta(na, nb, nc)``                      003
+``edge_highlight_expr()``              ``edge_highlight(a, b, c)``,             002
                                        ``edge_highlight_unclipped(a, b, c)``
-``quadratic_coefficients_expr()``      ``quadratic_coefficients(nl, nr,     000
+``quadratic_coefficients_expr()``      ``quadratic_coefficients(nl, nr,         000
                                        nc=None)``
-``bump_coefficients_expr()``           ``bump_coefficients(P_u, P_v, F_u,   001
+``bump_coefficients_expr()``           ``bump_coefficients(P_u, P_v, F_u,       001
                                        F_v)``
-``bump_coefficients_square_expr()``    ``bump_coefficients_square(F_u,      001 (C12)
+``bump_coefficients_square_expr()``    ``bump_coefficients_square(F_u,          001 (C12)
                                        F_v, k)``
-=====================================  ===================================  ========
+=====================================  =======================================  ========
 
 Intermediate results of the derivations are exposed too:
 ``midpoint_norm2_expr``, ``linear_argmin_expr``, ``min_norm_linear_expr``

@@ -20,7 +20,7 @@ gives, in terms of the three invariants,
 The seed's forms ``a = -F_u (B.P_v)``, ``b = F_u (T.P_v) - F_v |P_u|``,
 ``c = |P_u x P_v|`` reduce to the same expressions
 (:func:`bump_coefficients_seed_expr`): with these definitions the signs of
-SPEC.md are right.
+docs/papers.md are right.
 
 Square patch (:func:`bump_coefficients_square_expr`): with ``P_u = k e_1``,
 ``P_v = k e_2`` the definitions give ``[a, b, c] = [-F_u k, -F_v k, k^2]``;

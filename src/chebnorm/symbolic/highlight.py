@@ -56,6 +56,16 @@ class EdgeHighlight:
 
     Holds sympy expressions (:func:`edge_highlight_expr`) or numpy arrays
     (:func:`edge_highlight`, :func:`edge_highlight_unclipped`).
+
+    Seed 002: the maximum is at ``t* = (b - a c)/((a + b)(1 - c))``, where it
+    is ``sqrt((a^2 - 2abc + b^2)/(1 - c^2))``. With ``N_A``, ``N_B`` at 45
+    degrees either side of ``H`` (``a = b = cos 45``, ``c = 0``) it is the
+    midpoint, where the normalized normal is ``H`` itself:
+
+    >>> import numpy as np
+    >>> h = edge_highlight(np.cos(np.pi / 4), np.cos(np.pi / 4), 0.0)
+    >>> float(h.t), round(float(h.value), 12)
+    (0.5, 1.0)
     """
 
     t: Any

@@ -346,6 +346,17 @@ class QuadraticCoefficients:
 
     Holds sympy expressions (from :func:`quadratic_coefficients_expr`) or
     ``(..., 3)`` arrays (from :func:`quadratic_coefficients`).
+
+    The quadratic passes through ``N_l`` (t = 0), the normalized midpoint
+    (t = 1/2) and ``N_r`` (t = 1):
+
+    >>> import numpy as np
+    >>> q = quadratic_coefficients(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]))
+    >>> N = lambda t: q.G * t**2 + q.P * t + q.Q
+    >>> bool(np.allclose(N(0), [1, 0, 0]) and np.allclose(N(1), [0, 1, 0]))
+    True
+    >>> bool(np.allclose(N(0.5), [2 ** -0.5, 2 ** -0.5, 0]))
+    True
     """
 
     G: Any

@@ -9,7 +9,7 @@ Interpolation and normalization (seeds 003, 000)
     ``n``      -- the specular (shininess) exponent, ``n >= 0``.
     ``c_ab, c_bc, c_ac`` -- the three edge cosines of a triangle ABC.
     ``N_l, N_c, N_r`` -- one component of the left, centre (t = 1/2) and
-               right normal of a span (quadratic interpolation, seed 000).
+    right normal of a span (quadratic interpolation, seed 000).
 
 Highlight detection (seed 002)
     ``a = H.N_A``, ``b = H.N_B`` (and ``c`` as above).
@@ -18,7 +18,7 @@ Bump mapping (seed 001)
     ``F_u, F_v`` -- partial derivatives of the height map.
     ``k``        -- the common length of ``P_u`` and ``P_v`` on a square patch.
     ``Pu_norm = |P_u|``, ``PuxPv_norm = |P_u x P_v|``, ``Pu_dot_Pv = P_u.P_v``
-                 -- the invariants the tangent-space coefficients depend on.
+    -- the invariants the tangent-space coefficients depend on.
 """
 
 import sympy as sp
