@@ -45,6 +45,11 @@ kernels (seeded random vectors, realistic normals, edge cases; every input
 code when the inputs have at most 16 bits) from ``chebnorm_<kind>_unit.hex``
 and prints one ``PASS:``/``FAIL:`` line.
 
+Adding a kind: one module with a subclass of :class:`UnitKind` (or of
+:class:`~chebnorm.hw.units.evaluator.EvaluatorUnit` when it has a polynomial
+evaluator) passed to :func:`register`, and its import below; the CLI
+(``hw unit``, ``hw report --unit``) lists it from the registry.
+
 >>> u = design_unit("classic", frac_bits=3, comp_bits=5)
 >>> [(p.name, p.bits) for p in u.ports]
 [('n_x', 5), ('n_y', 5), ('n_z', 5), ('u_x', 5), ('u_y', 5), ('u_z', 5)]
