@@ -24,6 +24,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from chebnorm.approx.method_registry import TableSpec, unit_tables
 from chebnorm.approx.textsafe import identifier
 
 from ..cost import Block
@@ -124,10 +125,21 @@ class UnitKind(ABC):
 
     #: registry name, also the ``<kind>`` of the module ``chebnorm_<kind>_unit``
     name: str = ""
-    #: the coefficient-table target its polynomial evaluator approximates, if any
-    target: str | None = None
     #: one rising clock edge per row (else combinational)
     clocked: bool = False
+
+    @property
+    def table_spec(self) -> TableSpec | None:
+        """The table its polynomial evaluator approximates, as the method registry
+        declares it (:func:`chebnorm.approx.method_registry.unit_tables`); None
+        for a unit without an evaluator."""
+        return unit_tables().get(self.name)
+
+    @property
+    def target(self) -> str | None:
+        """The coefficient-table target of its evaluator, if it has one."""
+        spec = self.table_spec
+        return None if spec is None else spec.target
 
     @abstractmethod
     def design(self, f: int, w: int, notes: list[str], *, table, in_bits: int, out_bits: int,

@@ -27,8 +27,9 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
 
     ``table`` (with ``in_bits``, ``out_bits``, ``coef_bits``, ``rounding``)
     makes the polynomial evaluator of the dichotomy, quadratic and eta units;
-    without it the degree-2 table of :data:`~chebnorm.hw.units.UNIT_TARGETS`
-    is fitted (psi_max = pi/4) and quantized to ``out_bits + 4`` bits.
+    without it the unit's table as the method registry declares it
+    (:func:`chebnorm.approx.method_registry.unit_tables`: degree 2, psi_max =
+    pi/4) is fitted and quantized to ``out_bits + 4`` bits.
     ``rounding`` is the classic unit's quotient rounding (``"trunc"``, default,
     or ``"rne"``) or the evaluator's. ``log_m`` and ``guard`` (default
     ``2 log_m``, exact set-up) size the stepper. Raises ValueError naming the

@@ -24,7 +24,6 @@ class DichotomyUnit(EvaluatorUnit):
     """The dichotomy midpoint and next level (see module docstring)."""
 
     name = "dichotomy"
-    target = "dichotomy"
     pair = ("n1", "n2")
 
     def size(self, f, w, notes, d) -> UnitDesign:

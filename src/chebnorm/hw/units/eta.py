@@ -24,7 +24,6 @@ class EtaUnit(EvaluatorUnit):
     """The normalization criterion (see module docstring)."""
 
     name = "eta"
-    target = "eta_term"
     pair = ("na", "nb")
 
     def size(self, f, w, notes, d) -> UnitDesign:

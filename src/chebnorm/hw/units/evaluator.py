@@ -37,9 +37,10 @@ def table_matches(kind: str, table: CoefficientTable) -> bool:
 
 
 def _unit_horner(kind: str, table, in_bits, out_bits, coef_bits, rounding) -> HornerDesign:
-    target_name = get_unit(kind).target
+    spec = get_unit(kind).table_spec
+    target_name = spec.target
     if table is None:
-        table = fit_target(target_name, 2)
+        table = fit_target(spec.target, spec.degree, psi_max=spec.psi_max)
         coef_bits = coef_bits if coef_bits is not None else min(out_bits + 4, 30)
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"table {table!r} is not a CoefficientTable; accepted: a loaded table")
@@ -144,7 +145,8 @@ def _isfloat(s) -> bool:
 
 
 class EvaluatorUnit(UnitKind):
-    """A unit built around the evaluator of a table of :attr:`target`;
+    """A unit built around the evaluator of its table (:attr:`table_spec`, which
+    the method registry declares);
     subclasses size it (:meth:`size`), add their realistic rows
     (:meth:`realistic_extra`) and write the unit module (:meth:`module_lines`)."""
 

@@ -22,7 +22,6 @@ class QuadraticUnit(EvaluatorUnit):
     """The quadratic-interpolation set-up (see module docstring)."""
 
     name = "quadratic"
-    target = "midpoint"
     pair = ("nl", "nr")
 
     def size(self, f, w, notes, d) -> UnitDesign:
