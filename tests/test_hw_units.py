@@ -282,3 +282,84 @@ def test_unit_rejects_a_table_of_another_function():
     assert table_matches("eta", eta) and not table_matches("dichotomy", eta)
     with pytest.raises(ValueError, match="unit 'dichotomy' needs 1/sqrt"):
         design_unit("dichotomy", table=eta)
+
+
+class TestRegistry:
+    def test_names_and_targets(self):
+        from chebnorm.hw.units import UNIT_TARGETS, UNITS, get_unit, unit_names
+
+        assert unit_names() == UNIT_KINDS == ("dichotomy", "classic", "quadratic", "stepper",
+                                              "eta")
+        assert {n: k.target for n, k in UNITS.items() if k.target} == UNIT_TARGETS
+        assert [n for n in unit_names() if get_unit(n).clocked] == ["stepper"]
+        with pytest.raises(ValueError, match="unit 'cordic' is unknown; accepted: dichotomy, "
+                                             "classic, quadratic, stepper, eta"):
+            get_unit("cordic")
+
+    def test_registry_is_read_only_and_names_unique(self):
+        from chebnorm.hw.units import UNITS, get_unit, register
+
+        with pytest.raises(TypeError):
+            UNITS["x"] = get_unit("classic")  # type: ignore[index]
+        with pytest.raises(ValueError, match="already registered"):
+            register(get_unit("classic"))
+
+    @pytest.mark.parametrize("kind", UNIT_KINDS)
+    def test_design_through_the_registry(self, kind):
+        unit = small(kind)
+        assert unit.spec.name == kind and unit.module_name == f"chebnorm_{kind}_unit"
+        assert (unit.horner is not None) == (unit.spec.target is not None)
+
+    def test_default_table_is_the_targets_fit(self):
+        """Without --table a unit fits its target at degree 2, coefficients out_bits + 4."""
+        a = unit_outputs(design_unit("quadratic", frac_bits=6, in_bits=8, out_bits=8), count=20)
+        b = unit_outputs(design_unit("quadratic", frac_bits=6, in_bits=8, out_bits=8,
+                                     table=fit_target("midpoint", 2), coef_bits=12), count=20)
+        assert a == b
+
+
+class TestHostileText:
+    """Text a user controls (paths in the command line, a table's expression or
+    name) reaches the unit's Verilog only as inert comment text."""
+
+    EVIL = 'x\nmodule injected; initial $display("INJECTED"); endmodule\n'
+
+    @no_iverilog
+    def test_no_injected_statement(self, tmp_path, capsys):
+        import re
+
+        from chebnorm.cli import main
+
+        table = fit_target("dichotomy", 2, frac_bits=18).to_dict()
+        # parses as 1/sqrt(2 + z) (the second line is a Python comment)
+        table["expression"] = "1/sqrt(2 + z)\n# */ module injected2; endmodule /*"
+        folder = tmp_path / self.EVIL
+        folder.mkdir()
+        (folder / "t.json").write_text(json.dumps(table))
+        out = f"{tmp_path / self.EVIL}//out"  # '//' so an unescaped newline would comment the rest
+        code = main(["hw", "unit", "dichotomy", "--table", f"{folder}//t.json", "--in-bits", "10",
+                     "--out-bits", "10", "--vectors", "60", "-o", out, "--simulate"])
+        text = capsys.readouterr().out
+        assert code == 0 and "PASS:" in text and "INJECTED" not in text.split("PASS:")[1]
+        for f in (tmp_path / self.EVIL / "out").glob("*.v"):
+            lines = f.read_text().splitlines()
+            assert all(ln.startswith("//") for ln in lines if "injected" in ln), f.name
+            modules = re.findall(r"^\s*module\s+(\w+)", "\n".join(lines), re.M)
+            assert modules and all(m.startswith(("chebnorm_", "tb_chebnorm_")) for m in modules)
+        banner = (tmp_path / self.EVIL / "out" / "chebnorm_dichotomy_unit.v").read_text()
+        assert '// Command: chebnorm hw unit dichotomy --table ' in banner
+        assert '_module injected; initial $display("INJECTED"); endmodule_' in banner
+
+    @pytest.mark.parametrize("name", ["d2; initial $finish", "a\nb", "x" * 64])
+    def test_hostile_table_name_refused(self, tmp_path, capsys, name):
+        from chebnorm.cli import main
+
+        table = fit_target("dichotomy", 2, frac_bits=18).to_dict()
+        table["name"] = name
+        (tmp_path / "t.json").write_text(json.dumps(table))
+        out = tmp_path / "out"
+        code = main(["hw", "unit", "dichotomy", "--table", str(tmp_path / "t.json"), "-o",
+                     str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1 and "identifier" in err
+        assert not out.exists()

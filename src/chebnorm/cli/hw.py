@@ -36,6 +36,8 @@ def _unit_width_args(p) -> None:
 
 
 def register(sub) -> None:
+    from chebnorm.hw.units import UNIT_TARGETS, unit_names
+
     hw = sub.add_parser("hw", help="bit-accurate hardware: Verilog, error budget, sweep",
                         description="Fixed-point Horner evaluators of a coefficient table: "
                         "Verilog checked in Icarus Verilog, sized by Yosys; error budgets "
@@ -62,8 +64,8 @@ def register(sub) -> None:
     r.add_argument("--no-synth", action="store_true", help="skip yosys")
     r.add_argument("--no-gappa", action="store_true", help="skip gappa")
     r.add_argument("--unit", action="append", default=[], metavar="KIND",
-                   help="also cost a normalization unit (dichotomy, classic, quadratic, stepper, "
-                   "eta; repeatable): model area beside yosys cells; units with an evaluator "
+                   help=f"also cost a normalization unit ({', '.join(unit_names())}; "
+                   "repeatable): model area beside yosys cells; units with an evaluator "
                    "use TABLE and its widths")
     _unit_width_args(r)
     r.set_defaults(func=run_report)
@@ -71,10 +73,11 @@ def register(sub) -> None:
     u = hsub.add_parser("unit", help="Verilog of a normalization unit, its test bench, vectors",
                         description="A normalization unit as synthesizable Verilog, bit-for-bit "
                         "equal to the Python kernels, with a self-checking test bench.")
-    u.add_argument("kind", choices=("dichotomy", "classic", "quadratic", "stepper", "eta"))
+    u.add_argument("kind", choices=unit_names())
+    targets = list(dict.fromkeys(UNIT_TARGETS.values()))
     u.add_argument("--table", metavar="TABLE.json", default=None,
-                   help="table of the unit's evaluator (default: the degree-2 fit of dichotomy, "
-                   "midpoint or eta_term for psi_max = pi/4)")
+                   help="table of the unit's evaluator (default: the degree-2 fit of "
+                   f"{', '.join(targets[:-1])} or {targets[-1]} for psi_max = pi/4)")
     u.add_argument("--in-bits", type=int, default=16, help="evaluator input width, 1..20")
     u.add_argument("--out-bits", type=int, default=16, help="evaluator output width, 1..32")
     u.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None, metavar="B",
@@ -161,18 +164,19 @@ def _unit(args, kind, table=None):
 
 
 def run_report(args) -> int:
-    from chebnorm.hw.units import UNIT_KINDS, UNIT_TARGETS, analyze_unit, table_matches
+    from chebnorm.hw.units import analyze_unit, get_unit, table_matches
 
     for kind in args.unit:
-        if kind not in UNIT_KINDS:
-            raise ValueError(f"unit {kind!r} is unknown; accepted: {', '.join(UNIT_KINDS)}")
+        get_unit(kind)  # refuses an unknown name, listing the registered ones
     report = _analyze(args, synth=not args.no_synth, gappa=not args.no_gappa)
     units = []
     for kind in dict.fromkeys(args.unit):
-        rounding = args.rounding if kind != "classic" else None
+        has_evaluator = get_unit(kind).target is not None
+        # --rounding is the evaluator's; the classic unit keeps its own default quotient
+        rounding = args.rounding if has_evaluator else None
         # a unit whose function is not the report's table gets its own target's table
         table = report.design.table
-        if kind in UNIT_TARGETS and not table_matches(kind, table):
+        if has_evaluator and not table_matches(kind, table):
             table = None
         unit = _unit(argparse_ns(args, rounding=rounding), kind, table=table)
         units.append(analyze_unit(unit, synth=not args.no_synth))

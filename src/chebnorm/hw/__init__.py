@@ -16,8 +16,8 @@ from .datapaths import (bump_pipeline, classic_normalize, classic_unit, dichotom
                         forward_difference, forward_difference_codes, forward_difference_setup,
                         forward_difference_stepper, horner_block, phong_pipeline,
                         quadratic_midpoint, quadratic_midpoint_unit)
-from .units import (UNIT_KINDS, UnitDesign, UnitReport, analyze_unit, design_unit, unit_outputs,
-                    unit_verilog)
+from .units import (UNIT_KINDS, UNITS, UnitDesign, UnitKind, UnitReport, analyze_unit, design_unit,
+                    get_unit, unit_names, unit_outputs, unit_verilog)
 from .report import HardwareReport, analyze, verilog_outputs, write_outputs
 from .sweep import SweepPoint, SweepResult, sweep
 from .verilog import (SimResult, SynthResult, simulate, synthesize, verilog_module,
@@ -34,7 +34,7 @@ __all__ = [
     "classic_normalize", "dichotomy_midpoint", "dichotomy_next_z", "quadratic_midpoint",
     "eta_criterion", "forward_difference", "forward_difference_setup", "forward_difference_codes",
     "UNIT_KINDS", "UnitDesign", "UnitReport", "design_unit", "unit_outputs", "unit_verilog",
-    "analyze_unit",
+    "analyze_unit", "UNITS", "UnitKind", "get_unit", "unit_names",
     "HardwareReport", "analyze", "verilog_outputs", "write_outputs",
     "SweepPoint", "SweepResult", "sweep",
 ]

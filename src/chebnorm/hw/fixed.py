@@ -31,7 +31,6 @@ that int64 does not overflow; :func:`check_int64` is the boundary check.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -220,17 +219,3 @@ def check_width(value, name: str, lo: int, hi: int) -> int:
     if not lo <= int(value) <= hi:
         raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
     return int(value)
-
-
-def _exact_log2_floor(x: Fraction) -> int:
-    """floor(log2(x)) for x > 0, exactly."""
-    e = x.numerator.bit_length() - x.denominator.bit_length()
-    while Fraction(2) ** e > x:
-        e -= 1
-    while Fraction(2) ** (e + 1) <= x:
-        e += 1
-    return e
-
-
-def _ceil_div_pow2(x: Fraction, f: int) -> int:
-    return math.ceil(x * Fraction(2) ** f)

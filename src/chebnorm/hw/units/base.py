@@ -1,0 +1,193 @@
+"""What every normalization unit shares: ports, the sized design, the
+:class:`UnitKind` interface each kind implements, and the registry of kinds
+by name.
+
+A kind is one object registered under its name (``"classic"``, ...): it
+sizes a design (:meth:`UnitKind.design`), evaluates it bit-accurately
+(:meth:`UnitKind.evaluate`), prices it (:meth:`UnitKind.block`), makes its
+test rows (:meth:`UnitKind.vector_rows`) and writes its Verilog
+(:meth:`UnitKind.verilog`). Everything else (test bench, vector file, report)
+is the same for every kind and dispatches through :func:`get_unit`.
+
+>>> from chebnorm.hw.units import get_unit, unit_names
+>>> unit_names()
+('dichotomy', 'classic', 'quadratic', 'stepper', 'eta')
+>>> get_unit("quadratic").target
+'midpoint'
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+from chebnorm.approx.method_registry import TableSpec, unit_tables
+from chebnorm.approx.textsafe import identifier
+
+from ..cost import Block
+from ..horner import HornerDesign
+
+__all__ = ["Port", "UnitDesign", "UnitKind", "UNITS", "register", "get_unit", "unit_names",
+           "vec_ports", "MAX_COMP_BITS", "MAX_UNIT_FRAC_BITS", "MAX_LOG_M", "MAX_GUARD",
+           "EXHAUSTIVE_BITS"]
+
+MAX_COMP_BITS = 28
+MAX_UNIT_FRAC_BITS = 26
+MAX_LOG_M = 10
+MAX_GUARD = 24
+#: input spaces up to this many bits are tested exhaustively
+EXHAUSTIVE_BITS = 16
+
+
+@dataclass(frozen=True)
+class Port:
+    """One port: ``bits`` wide, two's complement when ``signed``."""
+
+    name: str
+    bits: int
+    signed: bool = True
+    output: bool = False
+
+
+def vec_ports(name: str, bits: int, output: bool = False,
+              signed: bool = True) -> tuple[Port, ...]:
+    """The three ports ``<name>_x``, ``<name>_y``, ``<name>_z``."""
+    return tuple(Port(f"{name}_{c}", bits, signed, output) for c in "xyz")
+
+
+@dataclass(frozen=True)
+class UnitDesign:
+    """A sized normalization unit (see :mod:`chebnorm.hw.units`); ``evaluate``
+    is the bit-accurate model, :func:`~chebnorm.hw.units.unit_verilog` its circuit."""
+
+    kind: str
+    ports: tuple[Port, ...]
+    frac_bits: int
+    comp_bits: int
+    horner: HornerDesign | None = None
+    rounding: str = "rne"
+    log_m: int = 0
+    guard: int = 0
+    sizes: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def spec(self) -> UnitKind:
+        """The registered kind of this unit."""
+        return get_unit(self.kind)
+
+    @property
+    def module_name(self) -> str:
+        return f"chebnorm_{self.kind}_unit"
+
+    @property
+    def clocked(self) -> bool:
+        return self.spec.clocked
+
+    @property
+    def inputs(self) -> tuple[Port, ...]:
+        return tuple(p for p in self.ports if not p.output)
+
+    @property
+    def outputs(self) -> tuple[Port, ...]:
+        return tuple(p for p in self.ports if p.output)
+
+    @property
+    def block(self) -> Block:
+        """The cost model of the unit (:mod:`chebnorm.hw.datapaths`)."""
+        return self.spec.block(self)
+
+    def evaluate(self, inputs: dict) -> dict:
+        """Outputs (name -> int64 array) for input arrays (name -> codes); for the
+        clocked stepper, one row per cycle, outputs as seen after each edge."""
+        g = {k: np.asarray(v, dtype=np.int64) for k, v in inputs.items()}
+        return self.spec.evaluate(self, g)
+
+
+def vec(g: dict, name: str) -> np.ndarray:
+    """The ``(..., 3)`` array of ports ``<name>_x``, ``_y``, ``_z`` of ``g``."""
+    return np.stack([g[f"{name}_{c}"] for c in "xyz"], axis=-1)
+
+
+def put(out: dict, name: str, arr: np.ndarray) -> None:
+    """Store the ``(..., 3)`` array ``arr`` as ports ``<name>_x``, ``_y``, ``_z``."""
+    for i, c in enumerate("xyz"):
+        out[f"{name}_{c}"] = arr[..., i]
+
+
+class UnitKind(ABC):
+    """One kind of normalization unit; subclasses fill in the methods and are
+    registered once with :func:`register`. The methods take valid designs
+    (made by their own :meth:`design`) and do not check them again."""
+
+    #: registry name, also the ``<kind>`` of the module ``chebnorm_<kind>_unit``
+    name: str = ""
+    #: one rising clock edge per row (else combinational)
+    clocked: bool = False
+
+    @property
+    def table_spec(self) -> TableSpec | None:
+        """The table its polynomial evaluator approximates, as the method registry
+        declares it (:func:`chebnorm.approx.method_registry.unit_tables`); None
+        for a unit without an evaluator."""
+        return unit_tables().get(self.name)
+
+    @property
+    def target(self) -> str | None:
+        """The coefficient-table target of its evaluator, if it has one."""
+        spec = self.table_spec
+        return None if spec is None else spec.target
+
+    @abstractmethod
+    def design(self, f: int, w: int, notes: list[str], *, table, in_bits: int, out_bits: int,
+               coef_bits: int | None, rounding: str | None, log_m: int,
+               guard: int | None) -> UnitDesign:
+        """Size the unit for ``F = f``, ``W = w`` (both already checked)."""
+
+    @abstractmethod
+    def evaluate(self, unit: UnitDesign, g: dict) -> dict:
+        """Bit-accurate outputs for int64 input arrays ``g`` (name -> codes)."""
+
+    @abstractmethod
+    def block(self, unit: UnitDesign) -> Block:
+        """The cost model (:mod:`chebnorm.hw.datapaths`)."""
+
+    @abstractmethod
+    def vector_rows(self, unit: UnitDesign, rng, count: int) -> dict:
+        """Input rows (name -> int64 array) of the test bench, drawn from ``rng``
+        (``count`` checked); combinational kinds use
+        :func:`~chebnorm.hw.units.bench.combinational_rows`."""
+
+    @abstractmethod
+    def verilog(self, unit: UnitDesign, *, version: str, command: str | None) -> str:
+        """The unit module and its helper modules."""
+
+
+_UNITS: dict[str, UnitKind] = {}
+#: name -> registered :class:`UnitKind`, in registration order (read-only)
+UNITS = MappingProxyType(_UNITS)
+
+
+def register(kind: UnitKind) -> UnitKind:
+    """Add ``kind`` to the registry under ``kind.name`` (a new identifier)."""
+    name = identifier(kind.name, field="unit name")
+    if name in _UNITS:
+        raise ValueError(f"unit {name!r} is already registered")
+    _UNITS[name] = kind
+    return kind
+
+
+def unit_names() -> tuple[str, ...]:
+    """The registered unit names, in registration order."""
+    return tuple(_UNITS)
+
+
+def get_unit(name: str) -> UnitKind:
+    """The registered unit ``name``; ValueError naming the accepted names."""
+    try:
+        return _UNITS[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"unit {name!r} is unknown; accepted: {', '.join(_UNITS)}") from None

@@ -1,0 +1,171 @@
+"""Test vectors, vector files and self-checking test benches of every unit."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fixed import check_width
+from .base import EXHAUSTIVE_BITS, Port, UnitDesign
+
+__all__ = ["unit_vectors", "combinational_rows", "unit_vector_file", "unit_testbench",
+           "unit_normals", "near", "codes", "edges"]
+
+
+def unit_normals(rng, n: int) -> np.ndarray:
+    """``n`` random unit vectors ``(n, 3)``."""
+    v = rng.normal(size=(n, 3))
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def near(rng, a: np.ndarray, psi: float) -> np.ndarray:
+    """Unit vectors at angles in [0, psi] from the rows of ``a``."""
+    t = rng.normal(size=a.shape)
+    t -= np.sum(t * a, axis=1, keepdims=True) * a
+    t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
+    th = rng.uniform(0, psi, (len(a), 1))
+    th[:4, 0] = [0.0, psi, psi / 2, 1e-3][:len(a)]
+    return a * np.cos(th) + t * np.sin(th)
+
+
+def codes(v: np.ndarray, f: int, w: int) -> np.ndarray:
+    """``w``-bit codes with ``f`` fractional bits of the values ``v`` (nearest, saturated)."""
+    return np.clip(np.rint(v * 2.0 ** f), -(1 << (w - 1)), (1 << (w - 1)) - 1).astype(np.int64)
+
+
+def _rand(rng, n: int, port: Port) -> np.ndarray:
+    lo = -(1 << (port.bits - 1)) if port.signed else 0
+    hi = (1 << (port.bits - 1)) if port.signed else (1 << port.bits)
+    return rng.integers(lo, hi, n, dtype=np.int64)
+
+
+def edges(port: Port) -> list[int]:
+    """The extreme codes of ``port``: min, -1, 0, 1, max (those it has)."""
+    if port.signed:
+        b = port.bits
+        return sorted({-(1 << (b - 1)), -1, 0, 1, (1 << (b - 1)) - 1})
+    return sorted({0, 1, (1 << port.bits) - 1})
+
+
+def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
+    """Input rows (name -> int64 array) for the test bench of ``unit``: every
+    input code when the inputs have at most 16 bits; else edge cases (each
+    input takes each of its extreme codes -- min, -1, 0, 1, max -- while the
+    others cycle through theirs), ``count`` realistic rows
+    (quantized unit normals at angles inside the table's interval, and
+    their ``z``/threshold) and ``count`` rows of uniformly random codes."""
+    count = check_width(count, "vectors", 1, 10 ** 6)
+    return unit.spec.vector_rows(unit, np.random.default_rng(seed), count)
+
+
+def combinational_rows(unit: UnitDesign, rng, count: int, realistic) -> dict:
+    """The rows of :func:`unit_vectors` of a combinational unit;
+    ``realistic(rng, a)`` makes its realistic rows from the unit normals ``a``."""
+    ins = unit.inputs
+    if sum(p.bits for p in ins) <= EXHAUSTIVE_BITS:
+        grids = np.meshgrid(*[np.arange(edges(p)[0], edges(p)[-1] + 1) for p in ins],
+                            indexing="ij")
+        return {p.name: g.ravel().astype(np.int64) for p, g in zip(ins, grids)}
+    rows = {p.name: [] for p in ins}
+
+    def add(d):
+        for k in rows:
+            rows[k].append(np.asarray(d[k], dtype=np.int64))
+    # edge cases: each input takes each of its extreme codes, the others cycle through theirs
+    ends = [edges(p) for p in ins]
+    n_edge = max(len(e) for e in ends) * 8
+    for j in range(n_edge):
+        add({p.name: [e[(j + i * (j // len(e) + 1)) % len(e)]] for i, (p, e) in
+             enumerate(zip(ins, ends))})
+    add(realistic(rng, unit_normals(rng, count)))
+    add({p.name: _rand(rng, count, p) for p in ins})
+    return {k: np.concatenate(v) for k, v in rows.items()}
+
+
+def _layout(unit: UnitDesign) -> tuple[list[tuple[Port, int, int]], int]:
+    """Each port's ``[hi:lo]`` in a vector row, inputs first from the MSB."""
+    total = sum(p.bits for p in unit.ports)
+    pos, out = total, []
+    for p in unit.ports:
+        out.append((p, pos - 1, pos - p.bits))
+        pos -= p.bits
+    return out, total
+
+
+def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
+    """Rows ``{inputs, expected outputs}`` in hex (``$readmemh``)."""
+    outs = unit.evaluate(inputs)
+    layout, total = _layout(unit)
+    vals = {**inputs, **outs}
+    n = len(next(iter(inputs.values())))
+    row = [0] * n
+    for p, _, lo in layout:
+        v = np.asarray(vals[p.name], dtype=np.int64)
+        vmin = -(1 << (p.bits - 1)) if p.signed else 0
+        vmax = (1 << (p.bits - 1)) - 1 if p.signed else (1 << p.bits) - 1
+        if v.min() < vmin or v.max() > vmax:
+            raise ValueError(f"{unit.module_name}: {p.name} takes {int(v.min())}..{int(v.max())}, "
+                             f"outside its {p.bits}-bit port (internal sizing error)")
+        mask = (1 << p.bits) - 1
+        for i, x in enumerate(v.tolist()):
+            row[i] |= (x & mask) << lo
+    digits = (total + 3) // 4
+    return "".join(f"{r:0{digits}x}\n" for r in row)
+
+
+def _declarations(unit: UnitDesign, layout) -> list[str]:
+    lines = ["    reg clk;"] if unit.clocked else []
+    for p, _, _ in layout:
+        lines.append(f"    {'wire' if p.output else 'reg'} "
+                     f"{'signed ' if p.signed and p.bits > 1 else ''}[{p.bits - 1}:0] {p.name};")
+    return lines
+
+
+def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> str:
+    """A self-checking test bench of ``count`` rows read from ``vectors``."""
+    name = unit.module_name
+    vectors = vectors or f"{name}.hex"
+    layout, total = _layout(unit)
+    ins = [(p, hi, lo) for p, hi, lo in layout if not p.output]
+    outs = [(p, hi, lo) for p, hi, lo in layout if p.output]
+    ohi, olo = outs[0][1], outs[-1][2]
+    lines = [f"// tb_{name}: self-checking test bench of {name}.",
+             f"// Rows {{inputs, expected outputs}} come from the chebnorm bit-accurate model "
+             f"({vectors}).",
+             "`timescale 1ns/1ps",
+             f"module tb_{name};",
+             f"    localparam COUNT = {count};",
+             f"    reg [{total - 1}:0] vec [0:COUNT-1];",
+             f"    reg [{total - 1}:0] row;"]
+    lines += _declarations(unit, ins + outs)
+    conns = ([".clk(clk)"] if unit.clocked else []) + [f".{p.name}({p.name})" for p in unit.ports]
+    got = "{" + ", ".join(p.name for p, _, _ in outs) + "}"
+    lines += [f"    {name} dut ({', '.join(conns)});",
+              "    integer i, errors;",
+              "    initial begin",
+              f"        $readmemh(\"{vectors}\", vec);",
+              "        errors = 0;"]
+    if unit.clocked:
+        lines.append("        clk = 0;")
+    lines.append("        for (i = 0; i < COUNT; i = i + 1) begin")
+    lines.append("            row = vec[i];")
+    for p, hi, lo in ins:
+        lines.append(f"            {p.name} = row[{hi}:{lo}];")
+    lines += (["            #1 clk = 1;", "            #1;"] if unit.clocked
+              else ["            #1;"])
+    lines += [f"            if ({got} !== row[{ohi}:{olo}]) begin",
+              "                errors = errors + 1;",
+              "                if (errors <= 10)",
+              f"                    $display(\"MISMATCH row %0d: got %h expected %h\", i, {got}, "
+              f"row[{ohi}:{olo}]);",
+              "            end"]
+    if unit.clocked:
+        lines.append("            clk = 0;")
+    lines += ["        end",
+              "        if (errors == 0)",
+              f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
+              "        else",
+              f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
+              "        $finish;",
+              "    end",
+              "endmodule", ""]
+    return "\n".join(lines)

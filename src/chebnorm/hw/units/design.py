@@ -1,0 +1,101 @@
+"""The public entry points: size a unit of any registered kind, write its
+files, report its cost."""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass
+
+from chebnorm.approx import CoefficientTable
+
+from ..cost import Block
+from ..fixed import check_width
+from ..verilog import SynthResult, synthesize_text
+from .base import MAX_COMP_BITS, MAX_UNIT_FRAC_BITS, UnitDesign, get_unit
+from .bench import unit_testbench, unit_vector_file, unit_vectors
+
+__all__ = ["design_unit", "unit_verilog", "unit_outputs", "UnitReport", "analyze_unit"]
+
+
+def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
+                table: CoefficientTable | None = None, in_bits: int = 16,
+                out_bits: int = 16, coef_bits: int | None = None, rounding: str | None = None,
+                log_m: int = 4, guard: int | None = None) -> UnitDesign:
+    """Size unit ``kind`` (a name of :func:`~chebnorm.hw.units.unit_names`) for
+    ``F = frac_bits`` fractional bits and ``W = comp_bits`` (default ``F + 2``)
+    bit components.
+
+    ``table`` (with ``in_bits``, ``out_bits``, ``coef_bits``, ``rounding``)
+    makes the polynomial evaluator of the dichotomy, quadratic and eta units;
+    without it the unit's table as the method registry declares it
+    (:func:`chebnorm.approx.method_registry.unit_tables`: degree 2, psi_max =
+    pi/4) is fitted and quantized to ``out_bits + 4`` bits.
+    ``rounding`` is the classic unit's quotient rounding (``"trunc"``, default,
+    or ``"rne"``) or the evaluator's. ``log_m`` and ``guard`` (default
+    ``2 log_m``, exact set-up) size the stepper. Raises ValueError naming the
+    accepted range.
+
+    >>> u = design_unit("stepper", frac_bits=6, log_m=2)
+    >>> u.clocked, [p.name for p in u.outputs], u.sizes["v_bits"]
+    (True, ['v_x', 'v_y', 'v_z'], 15)
+    """
+    spec = get_unit(kind)
+    f = check_width(frac_bits, "frac-bits", 1, MAX_UNIT_FRAC_BITS)
+    w = check_width(comp_bits if comp_bits is not None else f + 2, "comp-bits", 2, MAX_COMP_BITS)
+    notes = []
+    if w < f + 2:
+        notes.append(f"comp-bits {w} < frac-bits + 2 = {f + 2}: +1.0 is not representable")
+    return spec.design(f, w, notes, table=table, in_bits=in_bits, out_bits=out_bits,
+                       coef_bits=coef_bits, rounding=rounding, log_m=log_m, guard=guard)
+
+
+def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = None) -> str:
+    """The synthesizable Verilog-2005 text of ``unit``: the unit module, then
+    its helper modules (square root, divider, polynomial evaluator)."""
+    return unit.spec.verilog(unit, version=version, command=command)
+
+
+def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version: str = "",
+                 command: str | None = None) -> dict[str, str]:
+    """File name -> text: the unit's Verilog, its test bench and its vectors."""
+    rows = unit_vectors(unit, count, seed)
+    n = len(next(iter(rows.values())))
+    name = unit.module_name
+    return {f"{name}.v": unit_verilog(unit, version=version, command=command),
+            f"tb_{name}.v": unit_testbench(unit, n),
+            f"{name}.hex": unit_vector_file(unit, rows)}
+
+
+@dataclass(frozen=True)
+class UnitReport:
+    """A unit with its cost model and (when yosys ran) its cell count."""
+
+    unit: UnitDesign
+    block: Block
+    synth: SynthResult | None
+
+    def as_dict(self) -> dict:
+        u = self.unit
+        return {"unit": u.kind, "module": u.module_name, "frac_bits": u.frac_bits,
+                "comp_bits": u.comp_bits,
+                "evaluator": None if u.horner is None else u.horner.module_name,
+                "ports": {p.name: {"bits": p.bits, "signed": p.signed,
+                                   "dir": "output" if p.output else "input"} for p in u.ports},
+                "area_fa": self.block.cost.area, "cost": self.block.as_dict(),
+                "yosys_cells": None if self.synth is None else self.synth.cells,
+                "notes": list(u.notes)}
+
+    def lines(self) -> list[str]:
+        u = self.unit
+        cells = "yosys not run" if self.synth is None else f"{self.synth.cells} yosys cells"
+        return [f"{u.module_name}: W = {u.comp_bits}, F = {u.frac_bits}: area ~"
+                f"{self.block.cost.area:.0f} FA (model), {cells}"] + \
+            ["  " + ln for ln in self.block.lines()]
+
+
+def analyze_unit(unit: UnitDesign, *, synth: bool = True) -> UnitReport:
+    """The unit's cost model and, with yosys installed and ``synth``, its cell count."""
+    syn = None
+    if synth and shutil.which("yosys") is not None:
+        syn = synthesize_text(unit_verilog(unit), unit.module_name)
+    return UnitReport(unit, unit.block, syn)

@@ -1,0 +1,95 @@
+"""``"eta"``: ``eta = 3 - sum g(N_i.N_j)`` and ``skip = eta < thr`` (seed 003;
+:func:`~chebnorm.hw.datapaths.eta_criterion`), ``g`` the evaluator of a
+``sqrt(2(1+x))/2`` table, instantiated three times."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..cost import Block
+from ..datapaths import eta_criterion, eta_unit
+from ..fixed import check_int64, signed_bits
+from ..verilog import _lit
+from .base import Port, UnitDesign, register, vec, vec_ports
+from .bench import codes, edges, near
+from .evaluator import EvaluatorUnit, check_dot, dot_code
+from .hdl import banner, ports_decl
+
+__all__ = ["EtaUnit"]
+
+
+class EtaUnit(EvaluatorUnit):
+    """The normalization criterion (see module docstring)."""
+
+    name = "eta"
+    pair = ("na", "nb")
+
+    def size(self, f, w, notes, d) -> UnitDesign:
+        check_dot(w, f, d)
+        fy, ky, ymax = d.y_format.frac_bits, d.y_format.offset_code, d.y_format.max_code
+        check_int64(fy + 3, "eta")
+        elo, ehi = (3 << fy) - 3 * (ky + ymax), (3 << fy) - 3 * ky
+        ew = signed_bits(min(elo, 0), max(ehi, 0))
+        ports = (vec_ports("na", w) + vec_ports("nb", w) + vec_ports("nc", w)
+                 + (Port("thr", ew, True),)
+                 + (Port("eta", ew, True, True), Port("skip", 1, False, True)))
+        return UnitDesign(self.name, ports, f, w, horner=d, sizes={"eta_bits": ew},
+                          notes=tuple(notes))
+
+    def evaluate(self, unit, g) -> dict:
+        eta = eta_criterion(vec(g, "na"), vec(g, "nb"), vec(g, "nc"), unit.horner,
+                            unit.frac_bits)
+        return {"eta": eta, "skip": (eta < g["thr"]).astype(np.int64)}
+
+    def block(self, unit) -> Block:
+        return eta_unit(unit.horner, unit.comp_bits)
+
+    def psi(self, lo: float) -> float:
+        return math.acos(min(1.0, max(lo, 0.0)))
+
+    def realistic_extra(self, unit, rng, a, b, psi, real, count) -> None:
+        """A third normal ``nc`` near ``na``, and thresholds within 2 codes of eta."""
+        c3 = near(rng, a, psi / 2)
+        for i, c in enumerate("xyz"):
+            real[f"nc_{c}"] = codes(c3[:, i], unit.frac_bits, unit.comp_bits)
+        real["thr"] = np.zeros(count, dtype=np.int64)
+        eta = unit.evaluate(real)["eta"]
+        thr_port = [p for p in unit.inputs if p.name == "thr"][0]
+        real["thr"] = np.clip(eta + rng.integers(-2, 3, count),
+                              edges(thr_port)[0], edges(thr_port)[-1])
+
+    def module_lines(self, unit, version, command) -> list[str]:
+        d, w, name = unit.horner, unit.comp_bits, unit.module_name
+        ew = unit.sizes["eta_bits"]
+        fy, ky = d.y_format.frac_bits, d.y_format.offset_code
+        out = banner(unit, version, command, [
+            "normalization criterion eta = 3 - g(Na.Nb) - g(Nb.Nc) - g(Na.Nc) (seed 003)",
+            "and skip = eta < thr, bit-for-bit chebnorm.hw.datapaths.eta_criterion: each dot",
+            "product exact, to the evaluator's input code (nearest-even, saturated), three",
+            f"evaluators, the sum exact; eta and thr have {fy} fractional bits (value code / "
+            f"2^{fy}).",
+            "The eta width and the constants were sized for the generated widths."])
+        widths = {f"{n}_{c}": "W-1" for n in ("na", "nb", "nc") for c in "xyz"}
+        out += ["// Combinational.", f"module {name} #(", f"    parameter W = {w}", ") ("]
+        out += ports_decl(unit, widths)
+        out += [");"]
+        sw = ew + 2
+        terms = []
+        for a, b in (("na", "nb"), ("nb", "nc"), ("na", "nc")):
+            tag = a[1] + b[1]
+            out += dot_code(unit, a, b, tag)
+            out += [f"    wire [{d.out_bits - 1}:0] y_{tag};",
+                    f"    {d.module_name} poly_{tag} (.x(k_{tag}), .y(y_{tag}));"]
+            terms.append(f"$signed({{1'b0, y_{tag}}})")
+        out += [f"    localparam signed [{sw - 1}:0] THREE_MINUS_KY = "
+                f"{_lit((3 << fy) - 3 * ky, sw)};",
+                f"    wire signed [{sw - 1}:0] e = THREE_MINUS_KY - {' - '.join(terms)};",
+                f"    assign eta = e[{ew - 1}:0];",
+                "    assign skip = eta < thr;",
+                "endmodule", ""]
+        return out
+
+
+register(EtaUnit())

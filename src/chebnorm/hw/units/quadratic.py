@@ -1,0 +1,78 @@
+"""``"quadratic"``: ``x = N_l.N_r``, ``N_c = (N_l + N_r) p(x)`` and the
+coefficients ``G, P, Q`` (seed 000, method 5;
+:func:`~chebnorm.hw.datapaths.quadratic_midpoint`), ``p`` the evaluator of a
+``1/sqrt(2(1+x))`` table."""
+
+from __future__ import annotations
+
+import math
+
+from ..cost import Block
+from ..datapaths import quadratic_midpoint, quadratic_midpoint_unit
+from ..fixed import signed_bits
+from .base import UnitDesign, put, register, vec, vec_ports
+from .evaluator import (EvaluatorUnit, check_dot, dot_code, ky_localparam, scale_lines,
+                        scaled_range)
+from .hdl import banner, ports_decl
+
+__all__ = ["QuadraticUnit"]
+
+
+class QuadraticUnit(EvaluatorUnit):
+    """The quadratic-interpolation set-up (see module docstring)."""
+
+    name = "quadratic"
+    pair = ("nl", "nr")
+
+    def size(self, f, w, notes, d) -> UnitDesign:
+        check_dot(w, f, d)
+        lo, hi, yw = scaled_range(w, d)
+        mw = signed_bits(lo, hi)
+        a, b = -(1 << (w - 1)), (1 << (w - 1)) - 1
+        gw = signed_bits(min(4 * a - 4 * hi, 4 * lo - 4 * b), max(4 * b - 4 * lo, 4 * hi - 4 * a))
+        ports = (vec_ports("nl", w) + vec_ports("nr", w) + vec_ports("g", gw, True)
+                 + vec_ports("p", gw, True) + vec_ports("q", w, True) + vec_ports("nc", mw, True))
+        return UnitDesign(self.name, ports, f, w, horner=d,
+                          sizes={"m_bits": mw, "yv_bits": yw, "g_bits": gw}, notes=tuple(notes))
+
+    def evaluate(self, unit, g) -> dict:
+        G, P, Q, nc = quadratic_midpoint(vec(g, "nl"), vec(g, "nr"), unit.horner, unit.frac_bits)
+        out = {}
+        put(out, "g", G), put(out, "p", P), put(out, "q", Q), put(out, "nc", nc)
+        return out
+
+    def block(self, unit) -> Block:
+        return quadratic_midpoint_unit(unit.horner, unit.comp_bits)
+
+    def psi(self, lo: float) -> float:
+        return math.acos(min(1.0, lo))
+
+    def module_lines(self, unit, version, command) -> list[str]:
+        d, w, name = unit.horner, unit.comp_bits, unit.module_name
+        mw, gw = unit.sizes["m_bits"], unit.sizes["g_bits"]
+        out = banner(unit, version, command, [
+            "quadratic-interpolation set-up (seed 000, method 5), bit-for-bit",
+            "chebnorm.hw.datapaths.quadratic_midpoint: x = Nl.Nr (exact) to the evaluator's",
+            "input code (nearest-even, saturated), Nc = (Nl + Nr) p(x) (nearest-even),",
+            "G = 2Nl + 2Nr - 4Nc, P = 4Nc - 3Nl - Nr, Q = Nl (exact), all F fractional bits.",
+            "Output widths W+c and the constants were sized for the generated widths."])
+        widths = {f"{n}_{c}": "W-1" for n in ("nl", "nr", "q") for c in "xyz"}
+        widths.update({f"nc_{c}": f"W+{mw - w - 1}" for c in "xyz"})
+        widths.update({f"{n}_{c}": f"W+{gw - w - 1}" for n in "gp" for c in "xyz"})
+        out += ["// Combinational.", f"module {name} #(", f"    parameter W = {w}", ") ("]
+        out += ports_decl(unit, widths)
+        out += [");"]
+        out += dot_code(unit, "nl", "nr", "lr")
+        out += [f"    wire [{d.out_bits - 1}:0] y;",
+                f"    {d.module_name} poly (.x(k_lr), .y(y));",
+                ky_localparam(unit)]
+        out += scale_lines(unit, "nl", "nr", "nc", "y")
+        for c in "xyz":
+            out += [f"    assign g_{c} = ((nl_{c} + nr_{c}) <<< 1) - (nc_{c} <<< 2);",
+                    f"    assign p_{c} = (nc_{c} <<< 2) - 3 * nl_{c} - nr_{c};",
+                    f"    assign q_{c} = nl_{c};"]
+        out += ["endmodule", ""]
+        return out
+
+
+register(QuadraticUnit())
