@@ -84,6 +84,7 @@ FIGURE_TOPICS = {
     "normalization": "Seed 000: fast normalization methods",
     "highlight": "Seed 002: highlights for Gouraud shading",
     "bump": "Seed 001: bump mapping on Phong hardware",
+    "shaders": "Exported shaders on a real driver (written by figures/shaders/shader_demo.py)",
 }
 
 
