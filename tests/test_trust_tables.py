@@ -620,9 +620,6 @@ def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
 
 
 @needs_iverilog
-@pytest.mark.xfail(strict=True, reason="hw/units.py prints the command line, the version and "
-                   "the table's expression and interval into its banner raw; the lead applies "
-                   "chebnorm.approx.textsafe there after the units split (then drop this mark)")
 def test_unit_banner_keeps_hostile_command_line_inert(tmp_path, capsys):
     def unit_code(table, out):
         code, _, err = run_cli(["hw", "unit", "dichotomy", "--table", table, "--in-bits", "8",

@@ -216,8 +216,9 @@ def cli_cases(synth: bool) -> dict:
         with tempfile.TemporaryDirectory() as tmp:
             code, out, err = _cli(["hw", "unit", *argv, "-o", tmp], tmp)
             entry = {"exit": code, "stdout": _sha(out), "stderr": err}
-            # the banner's command names the (temporary) output folder
-            entry.update({p.name: _sha(p.read_text().replace(tmp, "OUT"))
+            # the banner's command names the (temporary) output folder and the
+            # table's path, which depends on where the repository is checked out
+            entry.update({p.name: _sha(p.read_text().replace(tmp, "OUT").replace(str(TABLES), "TABLES"))
                           for p in sorted(Path(tmp).iterdir())})
         res["hw unit " + " ".join(argv).replace(str(TABLES), "TABLES")] = entry
     for argv in CLI_REPORT:

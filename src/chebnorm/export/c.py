@@ -126,6 +126,33 @@ def _check_fixed_ranges(table: CoefficientTable, max_abs_x: Fraction) -> None:
         acc = acc * max_abs_x + 1 + abs(q)
 
 
+def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
+    """Lines of the integer coefficient array and the integer Horner evaluator."""
+    out = []
+    w = out.append
+    w("")
+    w(f"/* Coefficients * 2^{fp.frac_bits} ({comment_text(fp.method)}), ascending powers. */")
+    w(f"static const int32_t {fn}_q[{len(fp.integers)}] = {{")
+    w("    " + ", ".join(f"INT32_C({q})" for q in fp.integers))
+    w("};")
+    w("")
+    w(f"/* Integer Horner's rule. x_q = x * 2^{fp.frac_bits} (x in [{macro}_LO, {macro}_HI]);")
+    w(f" * returns p(x) * 2^{fp.frac_bits}, each step rounded to nearest (ties up) by an")
+    w(" * arithmetic right shift (implementation-defined for negative values in C99;")
+    w(f" * arithmetic on gcc and clang). |result / 2^{fp.frac_bits} - f(x)| <= {macro}_Q_EVAL_ERROR_BOUND. */")
+    w(f"static inline int64_t {fn}_q_eval(int64_t x_q)")
+    w("{")
+    w(f"    int64_t acc = {fn}_q[{len(fp.integers) - 1}];")
+    for k in range(len(fp.integers) - 2, -1, -1):
+        w(f"    acc = ((acc * x_q + (INT64_C(1) << {max(fp.frac_bits - 1, 0)})) >> {fp.frac_bits})"
+          f" + {fn}_q[{k}];" if fp.frac_bits > 0 else f"    acc = acc * x_q + {fn}_q[{k}];")
+    if len(fp.integers) == 1:
+        w("    (void)x_q;")
+    w("    return acc;")
+    w("}")
+    return out
+
+
 def c_header(table: CoefficientTable, command: str = "") -> str:
     """The C99 header text for ``table`` (see the module docstring).
 
@@ -210,27 +237,7 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
         w("    return acc;")
         w("}")
     if table.fixed_point is not None:
-        fp = table.fixed_point
-        w("")
-        w(f"/* Coefficients * 2^{fp.frac_bits} ({comment_text(fp.method)}), ascending powers. */")
-        w(f"static const int32_t {fn}_q[{len(fp.integers)}] = {{")
-        w("    " + ", ".join(f"INT32_C({q})" for q in fp.integers))
-        w("};")
-        w("")
-        w(f"/* Integer Horner's rule. x_q = x * 2^{fp.frac_bits} (x in [{macro}_LO, {macro}_HI]);")
-        w(f" * returns p(x) * 2^{fp.frac_bits}, each step rounded to nearest (ties up) by an")
-        w(" * arithmetic right shift (implementation-defined for negative values in C99;")
-        w(f" * arithmetic on gcc and clang). |result / 2^{fp.frac_bits} - f(x)| <= {macro}_Q_EVAL_ERROR_BOUND. */")
-        w(f"static inline int64_t {fn}_q_eval(int64_t x_q)")
-        w("{")
-        w(f"    int64_t acc = {fn}_q[{len(fp.integers) - 1}];")
-        for k in range(len(fp.integers) - 2, -1, -1):
-            w(f"    acc = ((acc * x_q + (INT64_C(1) << {max(fp.frac_bits - 1, 0)})) >> {fp.frac_bits})"
-              f" + {fn}_q[{k}];" if fp.frac_bits > 0 else f"    acc = acc * x_q + {fn}_q[{k}];")
-        if len(fp.integers) == 1:
-            w("    (void)x_q;")
-        w("    return acc;")
-        w("}")
+        out += _fixed_evaluator(table.fixed_point, fn, macro)
     w("")
     w(f"#endif /* {macro}_H */")
     return "\n".join(out) + "\n"

@@ -37,6 +37,7 @@ import numpy as np
 import sympy as sp
 
 from chebnorm.approx import CoefficientTable, parse_number, quantize
+from chebnorm.approx.textsafe import identifier
 
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
@@ -326,9 +327,7 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         y_frac_bits = check_width(y_frac_bits, "y-frac-bits", -MAX_FRAC_BITS, MAX_FRAC_BITS + 20)
     guard_bits = check_width(guard_bits, "guard-bits", 0, 32)
     name = name or table.name
-    if not name.isidentifier() or not name.isascii():
-        raise ValueError(f"table name {name!r} is not a Verilog identifier; accepted: letters, "
-                         f"digits and underscores, not starting with a digit")
+    identifier(name, field="table name")
     table = _require_fixed_point(table, coef_bits)
     fp = table.fixed_point
     integers, fc = tuple(int(q) for q in fp.integers), fp.frac_bits
