@@ -235,3 +235,12 @@ def test_missing_gcc_is_a_clear_message(monkeypatch, tmp_path):
     monkeypatch.setenv("CC", "no-such-compiler-chebnorm")
     with pytest.raises(ck.ToolMissing, match="not found on PATH"):
         ck.build(tmp_path, ck.STRICT)
+
+
+def test_portable_dichotomy_matches_python(tmp_path_factory):
+    """The dichotomy without SSE (plain C nodes, as on a non-x86 machine): same pixels."""
+    binary = _build(tmp_path_factory, "gcc", [*ck.STRICT, "-U__SSE__"])
+    assert "sse_rsqrt" not in ck.kernel_names(binary)
+    for seed in (4, 5):
+        _check_against_python(binary, "dichotomy", _grid_spans(np.random.default_rng(seed)))
+    _check_against_python(binary, "dichotomy", _spans(np.random.default_rng(0), offset=True))

@@ -241,7 +241,10 @@ static inline void k_quadratic(const span_t *s, float *restrict out)
  *   ka..kb, and a level of half-stride h computes only the midpoints in
  *   [ka rounded down, kb rounded up] to multiples of h (their ancestors);
  * - a pixel is snapped to its node by u = t0 2^L + j (dt 2^L) (exact power-of-two
- *   scalings of the Python kernel's t 2^L), k = (int)u, f = u - k: no division. */
+ *   scalings of the Python kernel's t 2^L), k = (int)u, f = u - k: no division;
+ *   node n + 1 repeats N_r, so the pixel at t = 1 needs no clamp of k + 1;
+ * - on x86 a node is one SSE register (below), so a node is stored and read back
+ *   with one instruction of the same width (store forwarding never stalls). */
 #define BENCH_PICK_TOL 0x1p-12
 
 #define DICH_COS0 (2.0 * (1.0 - BENCH_PICK_TOL) * (1.0 - BENCH_PICK_TOL) - 1.0)
@@ -296,9 +299,56 @@ static inline int dichotomy_levels(const span_t *s, int *on_grid)
     return L;
 }
 
+#if BENCH_HAVE_SSE
+/* x86: a node is one __m128 (x, y, z, 0), so the tree's stores and the picks'
+ * loads have the same width (a store read back by a wider load stalls the
+ * store forwarding); the same operations, one rounding each, as the portable
+ * version below. The pixel is stored as 2 + 1 floats (no write past the span). */
+typedef __m128 dnode_t;
+#define DNODE_SET(v) _mm_setr_ps((v)[0], (v)[1], (v)[2], 0.0f)
+#define DNODE_MID(a, b, r) _mm_mul_ps(_mm_add_ps(a, b), _mm_set1_ps(r))
+#define DNODE_PICK(a, b, f) _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(f), _mm_sub_ps(b, a)))
+static inline void dnode_store(float *out, dnode_t v)
+{
+    _mm_storel_pi((__m64 *)out, v);
+    _mm_store_ss(out + 2, _mm_movehl_ps(v, v));
+}
+/* a pixel followed by another one of the span: 4 floats, the 4th overwritten next */
+#define DNODE_STORE_INNER(out, v) _mm_storeu_ps(out, v)
+#else
+typedef struct { float v[3]; } dnode_t;
+static inline dnode_t dnode_set(const float *v)
+{
+    dnode_t d = {{v[0], v[1], v[2]}};
+    return d;
+}
+static inline dnode_t dnode_mid(dnode_t a, dnode_t b, float r)
+{
+    dnode_t d = {{(a.v[0] + b.v[0]) * r, (a.v[1] + b.v[1]) * r, (a.v[2] + b.v[2]) * r}};
+    return d;
+}
+static inline dnode_t dnode_pick(dnode_t a, dnode_t b, float f)
+{
+    dnode_t d = {{a.v[0] + f * (b.v[0] - a.v[0]), a.v[1] + f * (b.v[1] - a.v[1]),
+                  a.v[2] + f * (b.v[2] - a.v[2])}};
+    return d;
+}
+static inline void dnode_store(float *out, dnode_t d)
+{
+    out[0] = d.v[0];
+    out[1] = d.v[1];
+    out[2] = d.v[2];
+}
+#define DNODE_SET(v) dnode_set(v)
+#define DNODE_MID(a, b, r) dnode_mid(a, b, r)
+#define DNODE_PICK(a, b, f) dnode_pick(a, b, f)
+#define DNODE_STORE_INNER(out, v) dnode_store(out, v)
+#endif
+
 static inline void k_dichotomy(const span_t *s, float *restrict out)
 {
-    static float node[((1 << BENCH_MAX_LEVELS) + 1) * 3];
+    /* nodes 0 .. n, and node n + 1 = N_r so that a pixel at u = n needs no clamp */
+    static dnode_t node[(1 << BENCH_MAX_LEVELS) + 2];
     int on_grid;
     const int L = dichotomy_levels(s, &on_grid);
     const int n = 1 << L;
@@ -312,13 +362,35 @@ static inline void k_dichotomy(const span_t *s, float *restrict out)
         kb = (int)(g0 + (float)(s->count - 1) * g1) + 2; /* one node of slack for rounding */
     if (ka > n) ka = n;
     if (kb > n) kb = n;
-    for (int k = 0; k < 3; ++k) {
-        node[k] = s->nl[k];
-        node[3 * n + k] = s->nr[k];
-    }
+    node[0] = DNODE_SET(s->nl);
+    node[n] = node[n + 1] = DNODE_SET(s->nr);
     /* each level: r = p(z) ~ 1/sqrt(2 + z), midpoints (N1 + N2) r, z' = (2 + z) r */
     float z = dot3(s->nl, s->nr) * 2.0f;
-    for (int h = n >> 1; h >= 1; h >>= 1) {
+    if (L <= 3) { /* the short spans of a mesh: the whole tree, unrolled (no loop branches) */
+        const dnode_t a = node[0], b = node[n];
+        const float r0 = chebnorm_dichotomy_d2_f(z);
+        if (L == 1) {
+            node[1] = DNODE_MID(a, b, r0);
+        } else if (L >= 2) {
+            const float z1 = (z + 2.0f) * r0, r1 = chebnorm_dichotomy_d2_f(z1);
+            const dnode_t m = DNODE_MID(a, b, r0);
+            if (L == 2) {
+                node[1] = DNODE_MID(a, m, r1);
+                node[2] = m;
+                node[3] = DNODE_MID(m, b, r1);
+            } else {
+                const float z2 = (z1 + 2.0f) * r1, r2 = chebnorm_dichotomy_d2_f(z2);
+                const dnode_t q1 = DNODE_MID(a, m, r1), q3 = DNODE_MID(m, b, r1);
+                node[1] = DNODE_MID(a, q1, r2);
+                node[2] = q1;
+                node[3] = DNODE_MID(q1, m, r2);
+                node[4] = m;
+                node[5] = DNODE_MID(m, q3, r2);
+                node[6] = q3;
+                node[7] = DNODE_MID(q3, b, r2);
+            }
+        }
+    } else for (int h = n >> 1; h >= 1; h >>= 1) {
         const float sz = z + 2.0f;
         const float r = chebnorm_dichotomy_d2_f(z);
         if (h > 1)
@@ -326,30 +398,29 @@ static inline void k_dichotomy(const span_t *s, float *restrict out)
         const int lo = ka & ~(h - 1);
         int hi = (kb + h - 1) & ~(h - 1);
         if (hi > n) hi = n;
-        for (int i = (lo & h) ? lo : lo + h; i <= hi; i += 2 * h) {
-            const float *A = node + 3 * (i - h), *B = node + 3 * (i + h);
-            float *M = node + 3 * i;
-            M[0] = (A[0] + B[0]) * r;
-            M[1] = (A[1] + B[1]) * r;
-            M[2] = (A[2] + B[2]) * r;
-        }
+        for (int i = (lo & h) ? lo : lo + h; i <= hi; i += 2 * h)
+            node[i] = DNODE_MID(node[i - h], node[i + h], r);
     }
+    const int last = s->count - 1;
     if (on_grid) { /* pixel j is node ka + j */
-        memcpy(out, node + 3 * ka, (size_t)s->count * 3 * sizeof(float));
+        for (int j = 0; j < last; ++j)
+            DNODE_STORE_INNER(out + 3 * j, node[ka + j]);
+        dnode_store(out + 3 * last, node[ka + last]);
         return;
     }
     /* off the grid: a linear pick between the two nodes around the pixel
-     * (u >= 0, so truncation is floor) */
-    for (int j = 0; j < s->count; ++j) {
-        const float u = g0 + (float)j * g1;
+     * (u >= 0, so truncation is floor; u <= n up to rounding, so k0 <= n) */
+    float jf = 0.0f;
+    for (int j = 0; j <= last; ++j, jf += 1.0f) {
+        const float u = g0 + jf * g1;
         int k0 = (int)u;
         const float f = u - (float)k0;
         if (k0 > n) k0 = n;
-        const int k1 = k0 + 1 > n ? n : k0 + 1;
-        const float *A = node + 3 * k0, *B = node + 3 * k1;
-        out[3 * j] = A[0] + f * (B[0] - A[0]);
-        out[3 * j + 1] = A[1] + f * (B[1] - A[1]);
-        out[3 * j + 2] = A[2] + f * (B[2] - A[2]);
+        const dnode_t p = DNODE_PICK(node[k0], node[k0 + 1], f);
+        if (j < last)
+            DNODE_STORE_INNER(out + 3 * j, p);
+        else
+            dnode_store(out + 3 * j, p);
     }
 }
 
@@ -622,7 +693,7 @@ static inline void k_avx2_quadratic(const span_t *s, float *restrict out)
  * (k = (int)u, f = u - k, both nodes of 8 pixels by vgatherdps). Small trees and
  * spans that read few of their nodes (the restricted node range pays there)
  * take the scalar kernel: this is the kernel "at its best" on every span. */
-#define AVX2_DICH_MIN_NODES 16
+#define AVX2_DICH_MIN_NODES 64
 static inline void k_avx2_dichotomy(const span_t *s, float *restrict out)
 {
     enum { CAP = (1 << BENCH_MAX_LEVELS) + 1 + 24 };
