@@ -313,8 +313,6 @@ static inline void dnode_store(float *out, dnode_t v)
     _mm_storel_pi((__m64 *)out, v);
     _mm_store_ss(out + 2, _mm_movehl_ps(v, v));
 }
-/* a pixel followed by another one of the span: 4 floats, the 4th overwritten next */
-#define DNODE_STORE_INNER(out, v) _mm_storeu_ps(out, v)
 #else
 typedef struct { float v[3]; } dnode_t;
 static inline dnode_t dnode_set(const float *v)
@@ -342,7 +340,6 @@ static inline void dnode_store(float *out, dnode_t d)
 #define DNODE_SET(v) dnode_set(v)
 #define DNODE_MID(a, b, r) dnode_mid(a, b, r)
 #define DNODE_PICK(a, b, f) dnode_pick(a, b, f)
-#define DNODE_STORE_INNER(out, v) dnode_store(out, v)
 #endif
 
 static inline void k_dichotomy(const span_t *s, float *restrict out)
@@ -401,26 +398,20 @@ static inline void k_dichotomy(const span_t *s, float *restrict out)
         for (int i = (lo & h) ? lo : lo + h; i <= hi; i += 2 * h)
             node[i] = DNODE_MID(node[i - h], node[i + h], r);
     }
-    const int last = s->count - 1;
     if (on_grid) { /* pixel j is node ka + j */
-        for (int j = 0; j < last; ++j)
-            DNODE_STORE_INNER(out + 3 * j, node[ka + j]);
-        dnode_store(out + 3 * last, node[ka + last]);
+        for (int j = 0; j < s->count; ++j)
+            dnode_store(out + 3 * j, node[ka + j]);
         return;
     }
     /* off the grid: a linear pick between the two nodes around the pixel
      * (u >= 0, so truncation is floor; u <= n up to rounding, so k0 <= n) */
     float jf = 0.0f;
-    for (int j = 0; j <= last; ++j, jf += 1.0f) {
+    for (int j = 0; j < s->count; ++j, jf += 1.0f) {
         const float u = g0 + jf * g1;
         int k0 = (int)u;
         const float f = u - (float)k0;
         if (k0 > n) k0 = n;
-        const dnode_t p = DNODE_PICK(node[k0], node[k0 + 1], f);
-        if (j < last)
-            DNODE_STORE_INNER(out + 3 * j, p);
-        else
-            dnode_store(out + 3 * j, p);
+        dnode_store(out + 3 * j, DNODE_PICK(node[k0], node[k0 + 1], f));
     }
 }
 
@@ -718,6 +709,24 @@ static inline void k_avx2_dichotomy(const span_t *s, float *restrict out)
         if (h > 1)
             z = sz * r;
         const __m256 rv = _mm256_set1_ps(r);
+        if (h == 1 && on_grid && s->t0 == 0.0f && s->count == n + 1) {
+            /* a whole span on the grid: the last level goes straight to the pixels */
+            for (int i = 0; i < c - 1; i += 8) {
+                __m256 lo8[3], hi8[3];
+                for (int k = 0; k < 3; ++k) {
+                    const __m256 a = _mm256_loadu_ps(P[k] + i), b = _mm256_loadu_ps(P[k] + i + 1);
+                    const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), rv);
+                    const __m256 lo = _mm256_unpacklo_ps(a, m), hi = _mm256_unpackhi_ps(a, m);
+                    lo8[k] = _mm256_permute2f128_ps(lo, hi, 0x20);
+                    hi8[k] = _mm256_permute2f128_ps(lo, hi, 0x31);
+                }
+                store3x8(out + 6 * i, lo8[0], lo8[1], lo8[2]);
+                store3x8(out + 6 * i + 24, hi8[0], hi8[1], hi8[2]);
+            }
+            for (int k = 0; k < 3; ++k) /* pixel n (c - 1 = n / 2 is a multiple of 8) */
+                out[3 * n + k] = s->nr[k];
+            return;
+        }
         for (int k = 0; k < 3; ++k) {
             const float *p = P[k];
             float *q = Q[k];
