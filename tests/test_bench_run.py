@@ -119,3 +119,11 @@ def test_verdict_changes_name_what_moved(tmp_path):
     assert lines[1].startswith("C8: verdict unchanged")
     assert len(lines) == 2
     assert bench_run.verdict_changes(tmp_path / "missing.json", new) == []
+
+
+def test_c8_reports_other_frame_sizes():
+    kernels = _timing(2.0)
+    kernels["frame_2048"] = {"angular": {"ns_per_pixel": 1.0, "speedup_vs_classic": _s(1.0),
+                                         "speedup_vs_angular_direct": _s(2.5)}}
+    v = bench_run.verdicts({"O2": {"kernels": kernels}}, bench_run.hardware_costs())
+    assert "2048x2048 frame: O2 2.50x" in v["C8"]["why"]
