@@ -127,3 +127,30 @@ def test_c8_reports_other_frame_sizes():
                                          "speedup_vs_angular_direct": _s(2.5)}}
     v = bench_run.verdicts({"O2": {"kernels": kernels}}, bench_run.hardware_costs())
     assert "2048x2048 frame: O2 2.50x" in v["C8"]["why"]
+
+
+def test_verdict_changes_name_a_changed_condition(tmp_path):
+    old = tmp_path / "results.json"
+    old.write_text('{"verdicts": {"C8": {"verdict": "reproduced with a stated condition", '
+                   '"why": "holds only with O3-native. more"}}}')
+    new = {"C8": {"verdict": "reproduced with a stated condition", "why": "holds on big frames. x"}}
+    (line,) = bench_run.verdict_changes(old, new)
+    assert "condition was: holds only with O3-native; now: holds on big frames" in line
+
+
+def test_rerender_settles_from_the_measurements_alone(tmp_path):
+    """--from-json: the verdicts come from the stored timings, no timing run."""
+    res = {"configs": {"O2": {"kernels": _timing(3.0), "command": "gcc -O2", "rounds": 5}},
+           "accuracy": {}, "quick": False,
+           "hardware": bench_run.hardware_costs(), "skipped": [], "seconds": 1.0,
+           "machine": {"cpu": "x", "cores": 2}, "fit_vs_sollya": {"skipped": "t"},
+           "raster": {"skipped": "t"}, "main_job": {"skipped": "t"},
+           "workloads": {w: {"description": w, "spans": 1, "pixels": 1, "m_min": 1, "m_max": 1,
+                             "m_median": 1.0, "psi_deg": {"p10": 1, "p50": 1, "p90": 1, "max": 1}}
+                         for w in ["mesh", "triangles"] + [f"length_{n}" for n in bench_run.LENGTHS]}}
+    src = tmp_path / "in.json"
+    src.write_text(bench_run.json.dumps(res))
+    out = bench_run.rerender(src, tmp_path)
+    assert out["verdicts"]["C6"]["verdict"] == "reproduced"
+    assert (tmp_path / "RESULTS.md").read_text().startswith("# Benchmark results")
+    assert bench_run.json.loads((tmp_path / "results.json").read_text())["verdicts"]["C8"]
