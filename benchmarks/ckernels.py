@@ -3,7 +3,7 @@
 :func:`build` writes the two fitted polynomials as C headers with
 :func:`chebnorm.export.c.c_header` (``chebnorm_dichotomy_d2.h``,
 ``chebnorm_midpoint_d2.h``; nothing typed in by hand) and compiles the harness
-with gcc. :func:`evaluate` runs one kernel on spans and returns its outputs;
+with gcc or clang. :func:`evaluate` runs one kernel on spans and returns its outputs;
 :func:`bench` times kernels side by side (interleaved rounds) and returns
 nanoseconds per pixel per round.
 
@@ -16,7 +16,10 @@ Kernels (C name -> what it computes; ``PY_METHOD`` names the Python
 * ``none``, ``newton``, ``lyon``, ``slerp``, ``dichotomy``, ``quadratic``, ``angular`` as in Python;
 * ``angular_direct`` ``N_a cos(t psi) + N_k sin(t psi)`` per pixel (C8's reference; the slerp points);
 * ``midpoint_classic`` / ``midpoint_poly``: the span midpoint alone, per span (C7, part 1);
-* ``phong_n``, ``phong_nlh``, ``bump``: per-pixel shading, one float per pixel (C13).
+* ``phong_n``, ``phong_nlh``, ``bump``: per-pixel shading, one float per pixel (C13);
+* ``avx2_<name>``: explicit 8-lane AVX2 versions of classic, rsqrt + Newton, none, newton,
+  lyon, quadratic and dichotomy (built where the compiler targets AVX2, see :data:`AVX2`);
+* ``store_floor``: no kernel, a memset of the bytes the normal kernels store (the floor).
 
 Used by ``benchmarks/run.py`` and ``tests/test_bench_kernels.py``; it is not a
 library module (chebnorm never imports it).
@@ -35,8 +38,14 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 C_DIR = HERE / "c"
 
-#: the two timing configurations of the issue
-CONFIGS = {"O2": ["-O2"], "O3-native": ["-O3", "-march=native"]}
+#: the timing configurations: the AVX2 kernels are built in the two native ones and
+#: reported, from the no-errno build, as a fourth configuration "AVX2"
+CONFIGS = {"O2": ["-O2"], "O3-native": ["-O3", "-march=native"],
+           "O3-native-no-errno": ["-O3", "-march=native", "-fno-math-errno"]}
+#: the build whose avx2_* kernels make the "AVX2" configuration
+AVX2_BUILD = "O3-native-no-errno"
+#: the compilers every configuration is built with (a compiler artifact must not settle a claim)
+COMPILERS = ("gcc", "clang")
 #: the strict flags of the smoke test
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"]
 
@@ -52,13 +61,21 @@ def method_kernels() -> dict:
 #: method whose output each approximates
 BASELINES = {"rsqrt_mul": "exact", "sse_rsqrt": "exact", "angular_direct": "slerp"}
 _METHODS_C = method_kernels()
+#: AVX2 kernel -> the scalar kernel it vectorizes (same method, same operations per pixel)
+AVX2 = {"avx2_classic": "classic", "avx2_rsqrt_newton": "sse_rsqrt", "avx2_none": "none",
+        "avx2_newton": "newton", "avx2_lyon": "lyon", "avx2_quadratic": "quadratic",
+        "avx2_dichotomy": "dichotomy"}
 #: C kernel -> Python span_normals method it mirrors (None: no Python twin)
 PY_METHOD = {**_METHODS_C, **BASELINES, "midpoint_classic": None, "midpoint_poly": None,
-             "phong_n": None, "phong_nlh": None, "bump": None}
+             "phong_n": None, "phong_nlh": None, "bump": None, "store_floor": None}
+PY_METHOD.update({k: PY_METHOD[v] for k, v in AVX2.items()})
+#: the pseudo-kernel timing a memset of the normals' bytes
+FLOOR = "store_floor"
 #: kernels writing a unit-ish normal per pixel (accuracy is measured on these): the
 #: classic one first, its baselines, the other methods' kernels, direct angular last
 NORMAL_KERNELS = ("classic", "rsqrt_mul", "sse_rsqrt",
                   *[k for k in _METHODS_C if k != "classic"], "angular_direct")
+AVX2_KERNELS = tuple(AVX2)
 SHADING_KERNELS = ("phong_n", "phong_nlh", "bump")
 MIDPOINT_KERNELS = ("midpoint_classic", "midpoint_poly")
 
@@ -68,11 +85,18 @@ class ToolMissing(RuntimeError):
 
 
 def gcc() -> str:
-    """Path of gcc, or raise :class:`ToolMissing` with what to do."""
-    path = shutil.which(os.environ.get("CC", "gcc"))
+    """Path of gcc (``$CC`` if set), or raise :class:`ToolMissing` with what to do."""
+    return compiler("gcc")
+
+
+def compiler(name="gcc") -> str:
+    """Path of compiler ``name`` (``"gcc"`` honours ``$CC``), or raise
+    :class:`ToolMissing` with what to do."""
+    exe = os.environ.get("CC", "gcc") if name == "gcc" else name
+    path = shutil.which(exe)
     if path is None:
-        raise ToolMissing("gcc not found on PATH: apt-get install gcc (or set CC) to build "
-                          "the C kernels; the C part of the benchmark is skipped")
+        raise ToolMissing(f"{exe} not found on PATH: apt-get install {name} (or set CC) to build "
+                          f"the C kernels with it; that part of the benchmark is skipped")
     return path
 
 
@@ -97,32 +121,41 @@ def write_headers(directory: Path, psi_max="pi/4") -> list[Path]:
     return out
 
 
-def build(build_dir, flags, *, psi_max="pi/4", name="harness") -> dict:
-    """Write the headers and compile the harness with ``gcc flags``.
+def build(build_dir, flags, *, psi_max="pi/4", name="harness", cc="gcc") -> dict:
+    """Write the headers and compile the harness with ``cc flags`` (``cc``: gcc or clang).
 
-    Returns ``{"binary": Path, "command": str, "vectorized": [...], "gcc": version}``;
-    ``vectorized`` lists the kernel source lines gcc reports as vectorized
-    (``-fopt-info-vec-optimized``). Raises :class:`ToolMissing` without gcc and
-    ``RuntimeError`` with gcc's message when compilation fails."""
-    cc = gcc()
+    Returns ``{"binary": Path, "command": str, "vectorized": [...], "gcc": version,
+    "compiler": name, "version": version}`` (``"gcc"`` holds the version of whichever
+    compiler built it, kept for readers of older results); ``vectorized`` lists the
+    kernel source lines the compiler reports as loop-vectorized (gcc
+    ``-fopt-info-vec-optimized``, clang ``-Rpass=loop-vectorize``), also written to
+    ``<name>.vec.txt``. Raises :class:`ToolMissing` without the compiler and
+    ``RuntimeError`` with its message when compilation fails."""
+    exe = compiler(cc)
     build_dir = Path(build_dir)
     build_dir.mkdir(parents=True, exist_ok=True)
     write_headers(build_dir, psi_max)
     binary = build_dir / name
-    cmd = [cc, *flags, f"-I{build_dir}", f"-I{C_DIR}", str(C_DIR / "harness.c"), "-o",
+    cmd = [exe, *flags, f"-I{build_dir}", f"-I{C_DIR}", str(C_DIR / "harness.c"), "-o",
            str(binary), "-lm"]
     info = build_dir / f"{name}.vec.txt"
-    res = subprocess.run(cmd + [f"-fopt-info-vec-optimized={info}"], capture_output=True,
-                         text=True)
+    is_clang = "clang" in Path(exe).name
+    extra = ["-Rpass=loop-vectorize"] if is_clang else [f"-fopt-info-vec-optimized={info}"]
+    res = subprocess.run(cmd + extra, capture_output=True, text=True)
     if res.returncode != 0:
-        raise RuntimeError(f"gcc failed ({' '.join(cmd)}):\n{res.stderr}")
+        raise RuntimeError(f"{cc} failed ({' '.join(cmd)}):\n{res.stderr}")
+    if is_clang:  # remarks "file:line:col: remark: vectorized loop ..." on stderr
+        info.write_text("\n".join(line.replace("vectorized loop", "loop vectorized")
+                                   for line in res.stderr.splitlines() if "vectorized loop" in line))
     vec = []
     if info.exists():
         vec = sorted({line.split(": ")[0].rsplit("/", 1)[-1] for line in info.read_text().splitlines()
                       if "vectorized" in line and "kernels.h" in line})
-    version = subprocess.run([cc, "-dumpfullversion"], capture_output=True, text=True).stdout.strip()
-    return {"binary": binary, "command": " ".join([Path(cc).name, *flags, "harness.c", "-lm"]),
-            "vectorized": vec, "gcc": version}
+    flag = "--version" if is_clang else "-dumpfullversion"
+    version = subprocess.run([exe, flag], capture_output=True, text=True).stdout.strip()
+    version = version.splitlines()[0] if version else ""
+    return {"binary": binary, "command": " ".join([Path(exe).name, *flags, "harness.c", "-lm"]),
+            "vectorized": vec, "gcc": version, "compiler": cc, "version": version}
 
 
 def kernel_names(binary) -> list[str]:
@@ -159,21 +192,26 @@ def evaluate(binary, kernel, nl, nr, t0, dt, count, width=3, per_span=False) -> 
         return np.fromfile(out, np.float32).reshape(-1, width)
 
 
-def bench(binary, spans_file, kernels, *, reps=15, warmup=2, target_ms=4.0) -> dict:
-    """Time ``kernels`` side by side over the span file.
+def bench(binary, spans_file, kernels, *, reps=15, warmup=2, target_ms=50.0) -> dict:
+    """Time ``kernels`` side by side over the span file, each in windows of about
+    ``target_ms`` of CPU time.
 
-    Returns ``{"passes": n, "pixels": P, "ns": {kernel: [ns per pixel (or per
-    span for the midpoint kernels), one per round]}}``."""
+    Returns ``{"passes": n, "pixels": P, "floor_bytes": B, "ns": {kernel: [ns per pixel
+    (or per span for the midpoint kernels), thread CPU time, one per round]},
+    "wall_ns": {kernel: [the same, wall-clock]}}``."""
     res = subprocess.run([str(binary), "bench", str(spans_file), str(reps), str(warmup),
                           str(target_ms), *kernels], capture_output=True, text=True)
     if res.returncode != 0:
         raise RuntimeError(f"harness bench failed: {res.stderr.strip()}")
     ns: dict[str, list[float]] = {k: [] for k in kernels}
+    wall: dict[str, list[float]] = {k: [] for k in kernels}
     head = {}
     for line in res.stdout.splitlines():
         parts = line.split()
         if parts and parts[0] == "time":
-            ns[parts[2]].append(float(parts[3]) / float(parts[4]))
+            ns[parts[2]].append(float(parts[3]) / float(parts[5]))
+            wall[parts[2]].append(float(parts[4]) / float(parts[5]))
         elif parts and parts[0] == "spans":
-            head = {"spans": int(parts[1]), "pixels": int(parts[3]), "passes": int(parts[5])}
-    return {**head, "ns": ns}
+            head = {"spans": int(parts[1]), "pixels": int(parts[3]), "passes": int(parts[5]),
+                    "floor_bytes": int(parts[7])}
+    return {**head, "ns": ns, "wall_ns": wall}

@@ -3,20 +3,28 @@
  * span file and writes its outputs (for the accuracy figures and the tests).
  *
  *   harness list
- *       one line per kernel: name, floats per pixel
+ *       one line per kernel: name, floats per pixel, per-span flag
  *   harness eval KERNEL SPANS.bin OUT.bin
  *       run KERNEL on every span, write the float32 outputs
  *   harness bench SPANS.bin REPS WARMUP TARGET_MS KERNEL...
  *       WARMUP + REPS rounds; in each round every kernel runs PASSES times
  *       over all spans, the kernels in an order rotated every round
  *       (interleaved, so slow drifts of the machine hit every kernel alike).
- *       PASSES is set once so that the first kernel takes about TARGET_MS.
- *       Prints "time ROUND KERNEL NANOSECONDS PIXELS" per round and kernel
+ *       Each kernel's PASSES is set so that its window takes about TARGET_MS.
+ *       Prints "time ROUND KERNEL CPU_NS WALL_NS ITEMS" per round and kernel
  *       (warm-up rounds are not printed) and "checksum VALUE".
+ *       The kernel "store_floor" is no kernel: it stores the same bytes the
+ *       normal kernels write (3 floats per pixel) with memset, the machine's
+ *       store-bandwidth floor for them.
  *
  * Span file: int64 S, then S records of 8 float32 (nl, nr, t0, dt) and
- * S int32 counts. Timing: clock_gettime(CLOCK_MONOTONIC). The checksum reads
- * an output of every span so that no kernel's work can be optimized away.
+ * S int32 counts. Each kernel writes the whole frame: span s at its pixel
+ * offset in one output array (as a renderer fills its buffer), so every
+ * kernel stores the same bytes as store_floor. Timing: CPU time of the thread
+ * (CLOCK_THREAD_CPUTIME_ID: time the thread was descheduled on the shared
+ * machine does not count) and wall time (CLOCK_MONOTONIC). Nothing but the
+ * kernel calls is inside a timed window; the checksum reads the outputs
+ * after each window so that no kernel's work can be optimized away.
  */
 #define _POSIX_C_SOURCE 199309L
 
@@ -29,51 +37,77 @@
 #include "kernels.h"
 
 typedef void (*kernel_fn)(const span_t *, float *restrict);
-typedef double (*bench_fn)(const span_t *, long, int, float *, double *);
+typedef void (*bench_fn)(const span_t *, long, const long *, int, float *);
 
-static double now_ns(void)
+static double clock_ns(clockid_t id)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(id, &ts);
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-/* one timing function per kernel, so the kernel is called directly (and may be
- * inlined) rather than through a pointer */
-#define BENCH(NAME, OUTS)                                                             \
-    static double bench_##NAME(const span_t *sp, long S, int passes, float *buf,    \
-                               double *chk)                                          \
-    {                                                                                \
-        double acc = 0.0;                                                            \
-        const double start = now_ns();                                               \
-        for (int p = 0; p < passes; ++p)                                             \
-            for (long s = 0; s < S; ++s) {                                           \
-                k_##NAME(&sp[s], buf);                                               \
-                acc += buf[(unsigned long)(s * 7 + p) % (unsigned long)(OUTS)];             \
-            }                                                                        \
-        const double stop = now_ns();                                                \
-        *chk += acc;                                                                 \
-        return stop - start;                                                         \
+#if defined(__GNUC__)
+#define BARRIER() __asm__ __volatile__("" ::: "memory")
+#else
+#define BARRIER() ((void)0)
+#endif
+
+/* one function per kernel, so the kernel is called directly (and may be
+ * inlined) rather than through a pointer; off[s] is where span s writes, in
+ * floats (the barrier keeps one pass from being merged with the next) */
+#define BENCH(NAME)                                                                \
+    static void bench_##NAME(const span_t *sp, long S, const long *off, int passes, \
+                             float *out)                                           \
+    {                                                                              \
+        for (int p = 0; p < passes; ++p) {                                         \
+            for (long s = 0; s < S; ++s)                                           \
+                k_##NAME(&sp[s], out + off[s]);                                    \
+            BARRIER();                                                             \
+        }                                                                          \
     }
 
-BENCH(classic, 3 * sp[s].count)
-BENCH(rsqrt_mul, 3 * sp[s].count)
+BENCH(classic)
+BENCH(rsqrt_mul)
 #if BENCH_HAVE_SSE
-BENCH(sse_rsqrt, 3 * sp[s].count)
+BENCH(sse_rsqrt)
 #endif
-BENCH(none, 3 * sp[s].count)
-BENCH(newton, 3 * sp[s].count)
-BENCH(lyon, 3 * sp[s].count)
-BENCH(slerp, 3 * sp[s].count)
-BENCH(dichotomy, 3 * sp[s].count)
-BENCH(quadratic, 3 * sp[s].count)
-BENCH(angular, 3 * sp[s].count)
-BENCH(angular_direct, 3 * sp[s].count)
-BENCH(midpoint_classic, 3)
-BENCH(midpoint_poly, 3)
-BENCH(phong_n, sp[s].count)
-BENCH(phong_nlh, sp[s].count)
-BENCH(bump, sp[s].count)
+BENCH(none)
+BENCH(newton)
+BENCH(lyon)
+BENCH(slerp)
+BENCH(dichotomy)
+BENCH(quadratic)
+BENCH(angular)
+BENCH(angular_direct)
+BENCH(midpoint_classic)
+BENCH(midpoint_poly)
+BENCH(phong_n)
+BENCH(phong_nlh)
+BENCH(bump)
+#if BENCH_HAVE_AVX2
+BENCH(avx2_classic)
+BENCH(avx2_rsqrt_newton)
+BENCH(avx2_none)
+BENCH(avx2_newton)
+BENCH(avx2_lyon)
+BENCH(avx2_quadratic)
+BENCH(avx2_dichotomy)
+#endif
+
+/* the store floor: the bytes of the whole frame's normals, stored by memset */
+static size_t floor_bytes;
+static void k_store_floor(const span_t *s, float *restrict out)
+{
+    memset(out, 0x3f, (size_t)s->count * 3 * sizeof(float));
+}
+static void bench_store_floor(const span_t *sp, long S, const long *off, int passes, float *out)
+{
+    (void)sp; (void)S; (void)off;
+    for (int p = 0; p < passes; ++p) {
+        memset(out, 0x3f + (p & 1), floor_bytes);
+        BARRIER();
+    }
+}
 
 typedef struct {
     const char *name;
@@ -104,6 +138,16 @@ static const entry_t KERNELS[] = {
     ENTRY(phong_n, 1, 0),
     ENTRY(phong_nlh, 1, 0),
     ENTRY(bump, 1, 0),
+#if BENCH_HAVE_AVX2
+    ENTRY(avx2_classic, 3, 0),
+    ENTRY(avx2_rsqrt_newton, 3, 0),
+    ENTRY(avx2_none, 3, 0),
+    ENTRY(avx2_newton, 3, 0),
+    ENTRY(avx2_lyon, 3, 0),
+    ENTRY(avx2_quadratic, 3, 0),
+    ENTRY(avx2_dichotomy, 3, 0),
+#endif
+    ENTRY(store_floor, 3, 0),
 };
 #define N_KERNELS ((int)(sizeof KERNELS / sizeof KERNELS[0]))
 
@@ -170,7 +214,8 @@ static int cmd_eval(const char *name, const char *in, const char *outp)
     span_t *sp = read_spans(in, &S, &maxc, &pixels);
     if (!sp)
         return 2;
-    float *buf = malloc((size_t)maxc * 3 * sizeof(float));
+    /* 8 pixels of slack: the AVX2 kernels store whole groups of 8 */
+    float *buf = malloc((size_t)(maxc + 8) * 3 * sizeof(float));
     FILE *f = fopen(outp, "wb");
     if (!buf || !f) {
         fprintf(stderr, "harness: cannot write %s\n", outp);
@@ -193,6 +238,30 @@ static int cmd_eval(const char *name, const char *in, const char *outp)
     return 0;
 }
 
+/* floats of the frame before each span's output, for a kernel of this width */
+static long *offsets(const span_t *sp, long S, const entry_t *e)
+{
+    long *off = malloc((size_t)S * sizeof *off);
+    long acc = 0;
+    if (!off)
+        return NULL;
+    for (long s = 0; s < S; ++s) {
+        off[s] = acc;
+        acc += (long)e->width * (e->per_span ? 1 : sp[s].count);
+    }
+    return off;
+}
+
+static double window(const entry_t *e, const span_t *sp, long S, const long *off, int passes,
+                     float *out, double *wall)
+{
+    const double w0 = clock_ns(CLOCK_MONOTONIC), c0 = clock_ns(CLOCK_THREAD_CPUTIME_ID);
+    e->bench(sp, S, off, passes, out);
+    const double c1 = clock_ns(CLOCK_THREAD_CPUTIME_ID), w1 = clock_ns(CLOCK_MONOTONIC);
+    *wall = w1 - w0;
+    return c1 - c0;
+}
+
 static int cmd_bench(int argc, char **argv)
 {
     const char *in = argv[0];
@@ -200,46 +269,61 @@ static int cmd_bench(int argc, char **argv)
     const double target_ns = atof(argv[3]) * 1e6;
     const int nk = argc - 4;
     const entry_t **ks = malloc((size_t)nk * sizeof *ks);
-    if (!ks || reps < 1 || warmup < 0 || nk < 1) {
+    long **offs = calloc((size_t)nk, sizeof *offs);
+    int *passes = calloc((size_t)nk, sizeof *passes);
+    if (!ks || !offs || !passes || reps < 1 || warmup < 0 || nk < 1) {
         fprintf(stderr, "harness: bench needs SPANS REPS WARMUP TARGET_MS KERNEL...\n");
-        free(ks);
+        free(ks); free(offs); free(passes);
         return 2;
     }
     for (int i = 0; i < nk; ++i) {
         ks[i] = find(argv[4 + i]);
         if (!ks[i]) {
             fprintf(stderr, "harness: unknown kernel %s\n", argv[4 + i]);
-            free(ks);
+            free(ks); free(offs); free(passes);
             return 2;
         }
     }
     long S, maxc, pixels;
     span_t *sp = read_spans(in, &S, &maxc, &pixels);
     if (!sp) {
-        free(ks);
+        free(ks); free(offs); free(passes);
         return 2;
     }
-    float *buf = malloc((size_t)maxc * 3 * sizeof(float));
-    double chk = 0.0;
-    /* calibrate: passes so that the first kernel takes about target_ns */
-    double one = ks[0]->bench(sp, S, 1, buf, &chk);
-    int passes = one > 0 ? (int)(target_ns / one + 0.5) : 1;
-    if (passes < 1)
-        passes = 1;
-    printf("spans %ld pixels %ld passes %d\n", S, pixels, passes);
+    /* the frame: 3 floats per pixel, plus 24 floats of slack for 8-lane stores */
+    const size_t frame = (size_t)pixels * 3 + (size_t)S * 3 + 24;
+    float *out = malloc(frame * sizeof(float));
+    floor_bytes = (size_t)pixels * 3 * sizeof(float);
+    double chk = 0.0, wall;
+    for (int i = 0; i < nk; ++i)
+        offs[i] = offsets(sp, S, ks[i]);
+    memset(out, 0, frame * sizeof(float));
+    /* calibrate each kernel: passes so that its window takes about target_ns */
+    for (int i = 0; i < nk; ++i) {
+        double one = window(ks[i], sp, S, offs[i], 1, out, &wall);
+        if (one < target_ns / 64) /* too short to calibrate on: time 16 passes */
+            one = window(ks[i], sp, S, offs[i], 16, out, &wall) / 16;
+        passes[i] = one > 0 ? (int)(target_ns / one + 0.5) : 1;
+        if (passes[i] < 1)
+            passes[i] = 1;
+    }
+    printf("spans %ld pixels %ld passes %d floor_bytes %zu\n", S, pixels, passes[0], floor_bytes);
     for (int r = 0; r < warmup + reps; ++r) {
-        for (int i = 0; i < nk; ++i) {
-            const entry_t *e = ks[(i + r) % nk];
-            const double ns = e->bench(sp, S, passes, buf, &chk);
+        for (int q = 0; q < nk; ++q) {
+            const int i = (q + r) % nk;
+            const entry_t *e = ks[i];
+            const double ns = window(e, sp, S, offs[i], passes[i], out, &wall);
+            for (size_t x = 0; x < frame; x += 97)
+                chk += out[x];
             if (r >= warmup)
-                printf("time %d %s %.0f %ld\n", r - warmup, e->name, ns,
-                       (long)passes * (e->per_span ? S : pixels));
+                printf("time %d %s %.0f %.0f %ld\n", r - warmup, e->name, ns, wall,
+                       (long)passes[i] * (e->per_span ? S : pixels));
         }
     }
     printf("checksum %.9g\n", chk);
-    free(buf);
-    free(sp);
-    free(ks);
+    for (int i = 0; i < nk; ++i)
+        free(offs[i]);
+    free(out); free(sp); free(ks); free(offs); free(passes);
     return 0;
 }
 

@@ -23,6 +23,8 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "chebnorm_dichotomy_d2.h"
 #include "chebnorm_midpoint_d2.h"
@@ -222,81 +224,194 @@ static inline void k_quadratic(const span_t *s, float *restrict out)
 }
 
 /* ------------------------------------------------------ dichotomy, method 4 */
-/* largest length error 1 - cos(theta/2) accepted from the linear pick between
- * two nodes theta apart (span_normals' PICK_TOL = 2^-12) */
-#define BENCH_PICK_TOL 0x1p-12f
+/* Written as a performance engineer would, with the nodes and pixels
+ * span_normals' float32 kernel computes (same midpoints, same depth, same picks):
+ *
+ * - depth from the float's bits: the smallest L >= 0 with 2^-L <= dt is minus the
+ *   binary exponent of dt (dt in [2^e, 2^(e+1)) gives L = -e); the pixels are on
+ *   the dyadic grid of depth L exactly when dt's mantissa bits are zero (dt 2^L = 1)
+ *   and t0 2^L is an integer;
+ * - off the grid the depth is raised until the node angle psi / 2^L is at most
+ *   theta_max = 2 acos(1 - PICK_TOL) (span_normals' _levels). Instead of psi = acos c
+ *   the kernel compares c = N_l.N_r with the constants cos(2^n theta_max),
+ *   n = 0..6, evaluated at compile time by the double-angle formula from
+ *   cos(theta_max) = 2 (1 - PICK_TOL)^2 - 1 (2^7 theta_max > pi: 7 levels always do);
+ * - 2^L is built from its bits: no acosf, no ldexpf, no other libm call per span;
+ * - only the nodes the pixels need are computed: the pixels cover node indices
+ *   ka..kb, and a level of half-stride h computes only the midpoints in
+ *   [ka rounded down, kb rounded up] to multiples of h (their ancestors);
+ * - a pixel is snapped to its node by u = t0 2^L + j (dt 2^L) (exact power-of-two
+ *   scalings of the Python kernel's t 2^L), k = (int)u, f = u - k: no division;
+ *   node n + 1 repeats N_r, so the pixel at t = 1 needs no clamp of k + 1;
+ * - on x86 a node is one SSE register (below), so a node is stored and read back
+ *   with one instruction of the same width (store forwarding never stalls). */
+#define BENCH_PICK_TOL 0x1p-12
 
-/* depth L, as span_normals' _levels: the smallest L >= 0 with 2^-L <= dt; a span
- * with a pixel off that dyadic grid is halved deeper, until the node angle
- * psi / 2^L is at most theta_max = 2 acos(1 - PICK_TOL) */
-static inline int dichotomy_levels(const span_t *s)
+#define DICH_COS0 (2.0 * (1.0 - BENCH_PICK_TOL) * (1.0 - BENCH_PICK_TOL) - 1.0)
+#define DICH_DBL(c) (2.0 * (c) * (c) - 1.0)
+#define DICH_COS1 DICH_DBL(DICH_COS0)
+#define DICH_COS2 DICH_DBL(DICH_COS1)
+#define DICH_COS3 DICH_DBL(DICH_COS2)
+#define DICH_COS4 DICH_DBL(DICH_COS3)
+#define DICH_COS5 DICH_DBL(DICH_COS4)
+#define DICH_COS6 DICH_DBL(DICH_COS5)
+/* cos(2^n theta_max): a span needs n + 1 levels when N_l.N_r is below entry n */
+static const float DICH_NEED_COS[7] = {
+    (float)DICH_COS0, (float)DICH_COS1, (float)DICH_COS2, (float)DICH_COS3,
+    (float)DICH_COS4, (float)DICH_COS5, (float)DICH_COS6};
+
+static inline uint32_t float_bits(float x)
 {
-    int L = 0;
-    while (L < BENCH_MAX_LEVELS && ldexpf(s->dt, L) < 1.0f - 1e-6f)
-        ++L;
-    const float g0 = ldexpf(s->t0, L), g1 = ldexpf(s->dt, L);
-    if (g0 != floorf(g0) || (s->count > 1 && g1 != floorf(g1))) {
-        const float psi = acosf(fmaxf(fminf(dot3(s->nl, s->nr), 1.0f), -1.0f));
-        const float theta_max = 2.0f * acosf(1.0f - BENCH_PICK_TOL);
+    uint32_t u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+
+/* 2^k for 0 <= k <= 127, from its bits */
+static inline float pow2f(int k)
+{
+    const uint32_t u = (uint32_t)(127 + k) << 23;
+    float x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+/* depth L as span_normals' _levels (dt > 0, pixels in [0, 1]) and whether the
+ * pixels lie on the dyadic grid of depth L */
+static inline int dichotomy_levels(const span_t *s, int *on_grid)
+{
+    const uint32_t b = float_bits(s->dt);
+    const int e = (int)((b >> 23) & 0xffu) - 127;
+    int L = e < 0 ? -e : 0;
+    if (L > BENCH_MAX_LEVELS)
+        L = BENCH_MAX_LEVELS;
+    const float g0 = s->t0 * pow2f(L);
+    *on_grid = g0 == (float)(int32_t)g0
+               && (s->count < 2 || ((b & 0x7fffffu) == 0 && e <= 0 && -e <= BENCH_MAX_LEVELS));
+    if (!*on_grid) {
+        const float c = dot3(s->nl, s->nr);
         int need = 0;
-        while (need < BENCH_MAX_LEVELS && ldexpf(theta_max, need) < psi)
-            ++need;
+        for (int n = 0; n < 7; ++n)
+            need += c < DICH_NEED_COS[n];
         if (need > L)
             L = need;
     }
     return L;
 }
 
+#if BENCH_HAVE_SSE
+/* x86: a node is one __m128 (x, y, z, 0), so the tree's stores and the picks'
+ * loads have the same width (a store read back by a wider load stalls the
+ * store forwarding); the same operations, one rounding each, as the portable
+ * version below. The pixel is stored as 2 + 1 floats (no write past the span). */
+typedef __m128 dnode_t;
+#define DNODE_SET(v) _mm_setr_ps((v)[0], (v)[1], (v)[2], 0.0f)
+#define DNODE_MID(a, b, r) _mm_mul_ps(_mm_add_ps(a, b), _mm_set1_ps(r))
+#define DNODE_PICK(a, b, f) _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(f), _mm_sub_ps(b, a)))
+static inline void dnode_store(float *out, dnode_t v)
+{
+    _mm_storel_pi((__m64 *)out, v);
+    _mm_store_ss(out + 2, _mm_movehl_ps(v, v));
+}
+#else
+typedef struct { float v[3]; } dnode_t;
+static inline dnode_t dnode_set(const float *v)
+{
+    dnode_t d = {{v[0], v[1], v[2]}};
+    return d;
+}
+static inline dnode_t dnode_mid(dnode_t a, dnode_t b, float r)
+{
+    dnode_t d = {{(a.v[0] + b.v[0]) * r, (a.v[1] + b.v[1]) * r, (a.v[2] + b.v[2]) * r}};
+    return d;
+}
+static inline dnode_t dnode_pick(dnode_t a, dnode_t b, float f)
+{
+    dnode_t d = {{a.v[0] + f * (b.v[0] - a.v[0]), a.v[1] + f * (b.v[1] - a.v[1]),
+                  a.v[2] + f * (b.v[2] - a.v[2])}};
+    return d;
+}
+static inline void dnode_store(float *out, dnode_t d)
+{
+    out[0] = d.v[0];
+    out[1] = d.v[1];
+    out[2] = d.v[2];
+}
+#define DNODE_SET(v) dnode_set(v)
+#define DNODE_MID(a, b, r) dnode_mid(a, b, r)
+#define DNODE_PICK(a, b, f) dnode_pick(a, b, f)
+#endif
+
 static inline void k_dichotomy(const span_t *s, float *restrict out)
 {
-    static float node[((1 << BENCH_MAX_LEVELS) + 1) * 3];
-    const int L = dichotomy_levels(s);
+    /* nodes 0 .. n, and node n + 1 = N_r so that a pixel at u = n needs no clamp */
+    static dnode_t node[(1 << BENCH_MAX_LEVELS) + 2];
+    int on_grid;
+    const int L = dichotomy_levels(s, &on_grid);
     const int n = 1 << L;
-    for (int k = 0; k < 3; ++k) {
-        node[k] = s->nl[k];
-        node[3 * n + k] = s->nr[k];
-    }
+    const float scale = pow2f(L);
+    const float g0 = s->t0 * scale, g1 = s->dt * scale;
+    /* node indices the pixels read: ka .. kb */
+    int ka = (int)g0, kb;
+    if (on_grid)
+        kb = ka + s->count - 1;
+    else
+        kb = (int)(g0 + (float)(s->count - 1) * g1) + 2; /* one node of slack for rounding */
+    if (ka > n) ka = n;
+    if (kb > n) kb = n;
+    node[0] = DNODE_SET(s->nl);
+    node[n] = node[n + 1] = DNODE_SET(s->nr);
     /* each level: r = p(z) ~ 1/sqrt(2 + z), midpoints (N1 + N2) r, z' = (2 + z) r */
     float z = dot3(s->nl, s->nr) * 2.0f;
-    for (int level = 0, stride = n; level < L; ++level, stride >>= 1) {
+    if (L <= 3) { /* the short spans of a mesh: the whole tree, unrolled (no loop branches) */
+        const dnode_t a = node[0], b = node[n];
+        const float r0 = chebnorm_dichotomy_d2_f(z);
+        if (L == 1) {
+            node[1] = DNODE_MID(a, b, r0);
+        } else if (L >= 2) {
+            const float z1 = (z + 2.0f) * r0, r1 = chebnorm_dichotomy_d2_f(z1);
+            const dnode_t m = DNODE_MID(a, b, r0);
+            if (L == 2) {
+                node[1] = DNODE_MID(a, m, r1);
+                node[2] = m;
+                node[3] = DNODE_MID(m, b, r1);
+            } else {
+                const float z2 = (z1 + 2.0f) * r1, r2 = chebnorm_dichotomy_d2_f(z2);
+                const dnode_t q1 = DNODE_MID(a, m, r1), q3 = DNODE_MID(m, b, r1);
+                node[1] = DNODE_MID(a, q1, r2);
+                node[2] = q1;
+                node[3] = DNODE_MID(q1, m, r2);
+                node[4] = m;
+                node[5] = DNODE_MID(m, q3, r2);
+                node[6] = q3;
+                node[7] = DNODE_MID(q3, b, r2);
+            }
+        }
+    } else for (int h = n >> 1; h >= 1; h >>= 1) {
         const float sz = z + 2.0f;
         const float r = chebnorm_dichotomy_d2_f(z);
-        if (level < L - 1)
+        if (h > 1)
             z = sz * r;
-        const int h = stride >> 1;
-        for (int i = h; i < n; i += stride) {
-            const float *A = node + 3 * (i - h), *B = node + 3 * (i + h);
-            float *M = node + 3 * i;
-            M[0] = (A[0] + B[0]) * r;
-            M[1] = (A[1] + B[1]) * r;
-            M[2] = (A[2] + B[2]) * r;
-        }
+        const int lo = ka & ~(h - 1);
+        int hi = (kb + h - 1) & ~(h - 1);
+        if (hi > n) hi = n;
+        for (int i = (lo & h) ? lo : lo + h; i <= hi; i += 2 * h)
+            node[i] = DNODE_MID(node[i - h], node[i + h], r);
     }
-    /* pixels on the dyadic grid (t0 2^L and dt 2^L integers) take their node */
-    const float g0 = ldexpf(s->t0, L), g1 = ldexpf(s->dt, L);
-    if (g0 == floorf(g0) && (s->count < 2 || g1 == floorf(g1))) {
-        const int k0 = (int)g0, step = (int)g1;
-        for (int j = 0; j < s->count; ++j) {
-            const float *A = node + 3 * (k0 + j * step);
-            out[3 * j] = A[0];
-            out[3 * j + 1] = A[1];
-            out[3 * j + 2] = A[2];
-        }
+    if (on_grid) { /* pixel j is node ka + j */
+        for (int j = 0; j < s->count; ++j)
+            dnode_store(out + 3 * j, node[ka + j]);
         return;
     }
     /* off the grid: a linear pick between the two nodes around the pixel
-     * (u >= 0, so truncation is floor) */
-    const float scale = (float)n;
-    for (int j = 0; j < s->count; ++j) {
-        const float u = pixel_t(s, j) * scale;
-        int ka = (int)u;
-        const float f = u - (float)ka;
-        if (ka > n) ka = n;
-        const int kb = ka + 1 > n ? n : ka + 1;
-        const float *A = node + 3 * ka, *B = node + 3 * kb;
-        out[3 * j] = A[0] + f * (B[0] - A[0]);
-        out[3 * j + 1] = A[1] + f * (B[1] - A[1]);
-        out[3 * j + 2] = A[2] + f * (B[2] - A[2]);
+     * (u >= 0, so truncation is floor; u <= n up to rounding, so k0 <= n) */
+    float jf = 0.0f;
+    for (int j = 0; j < s->count; ++j, jf += 1.0f) {
+        const float u = g0 + jf * g1;
+        int k0 = (int)u;
+        const float f = u - (float)k0;
+        if (k0 > n) k0 = n;
+        dnode_store(out + 3 * j, DNODE_PICK(node[k0], node[k0 + 1], f));
     }
 }
 
@@ -435,5 +550,226 @@ static inline void k_bump(const span_t *s, float *restrict out)
         out[j] = shade(T[0], T[1], T[2], L, H);
     }
 }
+
+/* ---------------------------------------------------- AVX2 variants (8 lanes) */
+/* Explicit 8-lane versions of classic, rsqrt + Newton, none and the paper's
+ * Newton, Lyon, quadratic and dichotomy methods, lanes = 8 consecutive pixels of a span.
+ * Built where the compiler targets AVX2 (-march=native on an AVX2 CPU). Same
+ * operations per pixel as the scalar kernels; the quadratic steps its forward
+ * differences 8 pixels at a time (lane l starts at pixel l: same 6 add per pixel,
+ * fewer accumulated roundings). The three component vectors are interleaved
+ * to x y z x y z ... with in-lane permutes and blends. A span's last group
+ * is stored whole (8 pixels): OUT MUST HAVE ROOM FOR 7 PIXELS PAST THE SPAN,
+ * as a SIMD renderer pads its scan-line buffer; those slots hold scratch (the
+ * harness writes the spans of a frame in order, so the next span overwrites
+ * them). Masked stores (vmaskmovps) would keep the strict bound but cost more
+ * than the whole kernel on short spans (measured on AMD Zen 3). */
+#if defined(__AVX2__)
+#include <immintrin.h>
+#define BENCH_HAVE_AVX2 1
+
+/* store 8 pixels of the components x, y, z, interleaved x y z x y z ... */
+static inline void store3x8(float *out, __m256 x, __m256 y, __m256 z)
+{
+    const __m256 xr = _mm256_permute_ps(x, _MM_SHUFFLE(1, 2, 3, 0)); /* x0 x3 x2 x1 */
+    const __m256 yr = _mm256_permute_ps(y, _MM_SHUFFLE(2, 3, 0, 1)); /* y1 y0 y3 y2 */
+    const __m256 zr = _mm256_permute_ps(z, _MM_SHUFFLE(3, 0, 1, 2)); /* z2 z1 z0 z3 */
+    const __m256 a = _mm256_blend_ps(_mm256_blend_ps(xr, yr, 0x22), zr, 0x44); /* x0 y0 z0 x1 */
+    const __m256 b = _mm256_blend_ps(_mm256_blend_ps(yr, zr, 0x22), xr, 0x44); /* y1 z1 x2 y2 */
+    const __m256 c = _mm256_blend_ps(_mm256_blend_ps(zr, xr, 0x22), yr, 0x44); /* z2 x3 y3 z3 */
+    _mm256_storeu_ps(out, _mm256_permute2f128_ps(a, b, 0x20));
+    _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(c, a, 0x30));
+    _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(b, c, 0x31));
+}
+
+#define AVX2_LINEAR_KERNEL(NAME, NORMALIZE)                                           \
+    static inline void NAME(const span_t *s, float *restrict out)                    \
+    {                                                                                 \
+        const __m256 a0 = _mm256_set1_ps(s->nl[0]), a1 = _mm256_set1_ps(s->nl[1]);   \
+        const __m256 a2 = _mm256_set1_ps(s->nl[2]);                                   \
+        const __m256 d0 = _mm256_set1_ps(s->nr[0] - s->nl[0]);                        \
+        const __m256 d1 = _mm256_set1_ps(s->nr[1] - s->nl[1]);                        \
+        const __m256 d2 = _mm256_set1_ps(s->nr[2] - s->nl[2]);                        \
+        const __m256 iota = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);                   \
+        const __m256 t0 = _mm256_set1_ps(s->t0), dt = _mm256_set1_ps(s->dt);         \
+        for (int j = 0; j < s->count; j += 8) {                                       \
+            const __m256 jj = _mm256_add_ps(_mm256_set1_ps((float)j), iota);          \
+            const __m256 t = _mm256_add_ps(t0, _mm256_mul_ps(jj, dt));                \
+            __m256 n0 = _mm256_add_ps(a0, _mm256_mul_ps(t, d0));                      \
+            __m256 n1 = _mm256_add_ps(a1, _mm256_mul_ps(t, d1));                      \
+            __m256 n2 = _mm256_add_ps(a2, _mm256_mul_ps(t, d2));                      \
+            NORMALIZE                                                                 \
+            store3x8(out + 3 * j, n0, n1, n2);                                         \
+        }                                                                             \
+    }
+
+#define AVX2_DOT(n0, n1, n2) \
+    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0, n0), _mm256_mul_ps(n1, n1)), _mm256_mul_ps(n2, n2))
+#define AVX2_SCALE(sc) \
+    { n0 = _mm256_mul_ps(n0, sc); n1 = _mm256_mul_ps(n1, sc); n2 = _mm256_mul_ps(n2, sc); }
+#define AVX2_NORM_CLASSIC                                        \
+    {                                                            \
+        const __m256 r = _mm256_sqrt_ps(AVX2_DOT(n0, n1, n2));   \
+        n0 = _mm256_div_ps(n0, r);                               \
+        n1 = _mm256_div_ps(n1, r);                               \
+        n2 = _mm256_div_ps(n2, r);                               \
+    }
+#define AVX2_NORM_RSQRT_NEWTON                                                        \
+    {                                                                                 \
+        const __m256 x = AVX2_DOT(n0, n1, n2);                                        \
+        __m256 r = _mm256_rsqrt_ps(x);                                                \
+        const __m256 hx = _mm256_mul_ps(_mm256_set1_ps(0.5f), x);                     \
+        r = _mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f),                      \
+                                           _mm256_mul_ps(_mm256_mul_ps(hx, r), r)));  \
+        AVX2_SCALE(r)                                                                 \
+    }
+#define AVX2_NORM_NEWTON                                                                    \
+    {                                                                                       \
+        const __m256 sc = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(3.0f), AVX2_DOT(n0, n1, n2)), \
+                                        _mm256_set1_ps(0.5f));                              \
+        AVX2_SCALE(sc)                                                                      \
+    }
+#define AVX2_NORM_LYON                                                                      \
+    {                                                                                       \
+        const __m256 x = AVX2_DOT(n0, n1, n2);                                              \
+        const __m256 sc = _mm256_add_ps(                                                    \
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_mul_ps(x, _mm256_set1_ps(0.375f)),           \
+                                        _mm256_set1_ps(1.25f)), x),                          \
+            _mm256_set1_ps(1.875f));                                                        \
+        AVX2_SCALE(sc)                                                                      \
+    }
+
+AVX2_LINEAR_KERNEL(k_avx2_classic, AVX2_NORM_CLASSIC)
+AVX2_LINEAR_KERNEL(k_avx2_rsqrt_newton, AVX2_NORM_RSQRT_NEWTON)
+AVX2_LINEAR_KERNEL(k_avx2_none, {})
+AVX2_LINEAR_KERNEL(k_avx2_newton, AVX2_NORM_NEWTON)
+AVX2_LINEAR_KERNEL(k_avx2_lyon, AVX2_NORM_LYON)
+
+/* method 5 with forward differences of step 8 dt, lane l at pixel j + l:
+ * v_l = N_l + (P + G t_l) t_l, e_l = P H + G (2 t_l H + H^2), f = 2 G H^2 (H = 8 dt) */
+static inline void k_avx2_quadratic(const span_t *s, float *restrict out)
+{
+    const float x = dot3(s->nl, s->nr);
+    const float r = chebnorm_midpoint_d2_f(x);
+    const __m256 iota = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 t = _mm256_add_ps(_mm256_set1_ps(s->t0), _mm256_mul_ps(iota, _mm256_set1_ps(s->dt)));
+    const float H = 8.0f * s->dt;
+    const __m256 Hv = _mm256_set1_ps(H), H2 = _mm256_set1_ps(H * H);
+    const __m256 tH2 = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(t, Hv), _mm256_set1_ps(2.0f)), H2);
+    __m256 v[3], e[3], f[3];
+    for (int k = 0; k < 3; ++k) {
+        const float sk = s->nl[k] + s->nr[k];
+        const float nc4 = (sk * r) * 4.0f;
+        const __m256 g = _mm256_set1_ps(sk * 2.0f - nc4);
+        const __m256 p = _mm256_set1_ps((nc4 - s->nl[k] * 2.0f) - sk);
+        f[k] = _mm256_mul_ps(g, _mm256_set1_ps(H * H * 2.0f));
+        v[k] = _mm256_add_ps(_mm256_set1_ps(s->nl[k]),
+                             _mm256_mul_ps(_mm256_add_ps(p, _mm256_mul_ps(g, t)), t));
+        e[k] = _mm256_add_ps(_mm256_mul_ps(p, Hv), _mm256_mul_ps(g, tH2));
+    }
+    for (int j = 0; j < s->count; j += 8) {
+        store3x8(out + 3 * j, v[0], v[1], v[2]);
+        for (int k = 0; k < 3; ++k) {
+            v[k] = _mm256_add_ps(v[k], e[k]);
+            e[k] = _mm256_add_ps(e[k], f[k]);
+        }
+    }
+}
+/* method 4, 8 lanes: the same tree level by level in structure-of-arrays form.
+ * A level's new midpoints (N_k + N_{k+1}) r are 8 consecutive pairs of the
+ * previous level's nodes (two overlapping loads), interleaved with those nodes
+ * by unpack and permute into the next level; the nodes, their depth, the z
+ * recurrence and the picks are those of k_dichotomy (identical roundings).
+ * Pixels on the grid are loaded 8 at a time, pixels off it are gathered
+ * (k = (int)u, f = u - k, both nodes of 8 pixels by vgatherdps). Small trees and
+ * spans that read few of their nodes (the restricted node range pays there)
+ * take the scalar kernel: this is the kernel "at its best" on every span. */
+#define AVX2_DICH_MIN_NODES 64
+static inline void k_avx2_dichotomy(const span_t *s, float *restrict out)
+{
+    enum { CAP = (1 << BENCH_MAX_LEVELS) + 1 + 24 };
+    static float buf[2][3][CAP];
+    int on_grid;
+    const int L = dichotomy_levels(s, &on_grid);
+    const int n = 1 << L;
+    if (n < AVX2_DICH_MIN_NODES || 2 * s->count < n) {
+        k_dichotomy(s, out);
+        return;
+    }
+    float *P[3] = {buf[0][0], buf[0][1], buf[0][2]};
+    float *Q[3] = {buf[1][0], buf[1][1], buf[1][2]};
+    for (int k = 0; k < 3; ++k) {
+        P[k][0] = s->nl[k];
+        P[k][1] = s->nr[k];
+    }
+    float z = dot3(s->nl, s->nr) * 2.0f;
+    for (int c = 2, h = n >> 1; h >= 1; c = 2 * c - 1, h >>= 1) { /* c nodes -> 2c - 1 */
+        const float sz = z + 2.0f;
+        const float r = chebnorm_dichotomy_d2_f(z);
+        if (h > 1)
+            z = sz * r;
+        const __m256 rv = _mm256_set1_ps(r);
+        if (h == 1 && on_grid && s->t0 == 0.0f && s->count == n + 1) {
+            /* a whole span on the grid: the last level goes straight to the pixels */
+            for (int i = 0; i < c - 1; i += 8) {
+                __m256 lo8[3], hi8[3];
+                for (int k = 0; k < 3; ++k) {
+                    const __m256 a = _mm256_loadu_ps(P[k] + i), b = _mm256_loadu_ps(P[k] + i + 1);
+                    const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), rv);
+                    const __m256 lo = _mm256_unpacklo_ps(a, m), hi = _mm256_unpackhi_ps(a, m);
+                    lo8[k] = _mm256_permute2f128_ps(lo, hi, 0x20);
+                    hi8[k] = _mm256_permute2f128_ps(lo, hi, 0x31);
+                }
+                store3x8(out + 6 * i, lo8[0], lo8[1], lo8[2]);
+                store3x8(out + 6 * i + 24, hi8[0], hi8[1], hi8[2]);
+            }
+            for (int k = 0; k < 3; ++k) /* pixel n (c - 1 = n / 2 is a multiple of 8) */
+                out[3 * n + k] = s->nr[k];
+            return;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const float *p = P[k];
+            float *q = Q[k];
+            for (int i = 0; i < c - 1; i += 8) {
+                const __m256 a = _mm256_loadu_ps(p + i), b = _mm256_loadu_ps(p + i + 1);
+                const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), rv);
+                const __m256 lo = _mm256_unpacklo_ps(a, m), hi = _mm256_unpackhi_ps(a, m);
+                _mm256_storeu_ps(q + 2 * i, _mm256_permute2f128_ps(lo, hi, 0x20));
+                _mm256_storeu_ps(q + 2 * i + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+            }
+            q[2 * (c - 1)] = p[c - 1];
+            Q[k] = P[k];
+            P[k] = q;
+        }
+    }
+    const float scale = pow2f(L);
+    const float g0 = s->t0 * scale, g1 = s->dt * scale;
+    if (on_grid) { /* pixel j is node ka + j */
+        const int ka = (int)g0;
+        for (int j = 0; j < s->count; j += 8)
+            store3x8(out + 3 * j, _mm256_loadu_ps(P[0] + ka + j), _mm256_loadu_ps(P[1] + ka + j),
+                     _mm256_loadu_ps(P[2] + ka + j));
+        return;
+    }
+    const __m256 iota = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 g0v = _mm256_set1_ps(g0), g1v = _mm256_set1_ps(g1);
+    const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1);
+    for (int j = 0; j < s->count; j += 8) {
+        const __m256 u = _mm256_add_ps(g0v, _mm256_mul_ps(_mm256_add_ps(_mm256_set1_ps((float)j), iota), g1v));
+        const __m256i k0 = _mm256_cvttps_epi32(u);
+        const __m256 f = _mm256_sub_ps(u, _mm256_cvtepi32_ps(k0));
+        const __m256i ka = _mm256_min_epi32(k0, nv);
+        const __m256i kb = _mm256_min_epi32(_mm256_add_epi32(ka, one), nv);
+        __m256 o[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m256 A = _mm256_i32gather_ps(P[k], ka, 4), B = _mm256_i32gather_ps(P[k], kb, 4);
+            o[k] = _mm256_add_ps(A, _mm256_mul_ps(f, _mm256_sub_ps(B, A)));
+        }
+        store3x8(out + 3 * j, o[0], o[1], o[2]);
+    }
+}
+#else
+#define BENCH_HAVE_AVX2 0
+#endif
 
 #endif /* CHEBNORM_BENCH_KERNELS_H */
