@@ -1,0 +1,660 @@
+"""Piecewise polynomial tables: fit, quantize and certify one polynomial per segment.
+
+A :class:`PiecewiseTable` splits ``[lo, hi]`` into segments and stores, for
+each, a polynomial in a *local* variable, with integer coefficients in one
+common fixed-point format (``coef_frac_bits`` fractional bits):
+
+* ``segment_by="uniform"``: ``2**k`` equal segments, the hardware way -- the
+  input code's top ``k`` bits select the segment, its low bits are the local
+  variable (FloPoCo's ``FixFunctionByPiecewisePoly``).
+* ``segment_by="exponent"``: ``[lo, hi] = [2**e0, 2**e1]``, each binade split
+  into ``2**m`` segments by the top ``m`` bits of the mantissa (a float's
+  exponent and leading mantissa bits select the segment, as normalization
+  units index ``1/sqrt`` tables).
+
+Segment ``s`` covers ``[a_s, b_s]``; its polynomial is evaluated in
+``t = (x - a_s) / (b_s - a_s)`` in ``[0, 1]``, or with ``centered=True`` in
+``u = t - 1/2`` in ``[-1/2, 1/2]`` (smaller coefficients and a smaller Horner
+rounding error). Coefficient ``j`` of segment ``s`` is exactly
+``integers[s][j] / 2**coef_frac_bits``.
+
+Every segment's error ``sup |p_s - f|`` (and ``sup |p_s/f - 1|`` for
+``error="rel"``) is certified by :func:`chebnorm.approx.certify` for exactly
+the stored integers, on the composed function ``t -> f(a_s + (b_s - a_s) t)``
+(the endpoints are exact rationals, enclosed in Arb balls); the table's bound
+is the maximum over the segments. Reading a table (:meth:`PiecewiseTable.load`,
+``from_dict``) checks every field (a refusal names it) and re-certifies every
+stated bound, as :class:`chebnorm.approx.CoefficientTable` does.
+
+>>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+>>> t.segment_count, t.degree, t.abs_error_bound < 2e-3
+(4, 1, True)
+>>> [str(e) for e in t.segment_bounds(0)]
+['1', '7/4']
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from .certify import arb_enclose, certify
+from .expr import Function1D, parse_function, parse_number
+from .fitting import cheb_to_monomial, remez
+
+__all__ = ["PiecewiseTable", "PiecewiseSegment", "fit_piecewise", "PIECEWISE_KIND",
+           "PIECEWISE_SCHEMA", "MAX_INDEX_BITS", "MAX_PIECEWISE_DEGREE", "MAX_COEF_FRAC_BITS",
+           "SEGMENT_BY", "parse_segments"]
+
+PIECEWISE_KIND = "chebnorm.piecewise_table"
+PIECEWISE_SCHEMA = 1
+#: at most 2**12 segments (a ROM of 4096 words)
+MAX_INDEX_BITS = 12
+MAX_PIECEWISE_DEGREE = 8
+#: coefficients are integers / 2**F; |integer| < 2**52 keeps them exact doubles
+MAX_COEF_FRAC_BITS = 48
+MAX_COEF_INT_BITS = 52
+SEGMENT_BY = ("uniform", "exponent")
+FITS = ("minimax", "chebyshev")
+ERRORS = ("abs", "rel")
+MAX_EXPONENT_SPAN = 64
+MAX_PIECEWISE_BYTES = 8 << 20
+_DENSE = 257
+
+
+@dataclass(frozen=True)
+class PiecewiseSegment:
+    """One segment: integer coefficients and the certified claims about them."""
+
+    integers: tuple[int, ...]
+    abs_error_bound: float
+    max_abs_error: float
+    rel_error_bound: float | None = None
+    max_rel_error: float | None = None
+
+
+@dataclass(frozen=True)
+class PiecewiseTable:
+    """The piecewise-table contract (see the module docstring)."""
+
+    name: str
+    expression: str
+    variable: str
+    interval: tuple[str, str]
+    segment_by: str
+    index_bits: int
+    degree: int
+    centered: bool
+    fit: str
+    error_kind: str
+    coef_frac_bits: int
+    segments: tuple[PiecewiseSegment, ...]
+    abs_error_bound: float
+    rel_error_bound: float | None
+    provenance: dict = field(default_factory=dict)
+
+    # -- geometry ------------------------------------------------------------
+    @property
+    def segment_count(self) -> int:
+        return len(self.segments)
+
+    @property
+    def lo(self) -> sp.Expr:
+        return parse_number(self.interval[0])
+
+    @property
+    def hi(self) -> sp.Expr:
+        return parse_number(self.interval[1])
+
+    @property
+    def local_range(self) -> tuple[Fraction, Fraction]:
+        """Range of the local variable: ``[0, 1]`` or ``[-1/2, 1/2]`` (centred)."""
+        return (Fraction(-1, 2), Fraction(1, 2)) if self.centered else (Fraction(0), Fraction(1))
+
+    def segment_bounds(self, s: int) -> tuple[sp.Expr, sp.Expr]:
+        """Exact endpoints ``(a_s, b_s)`` of segment ``s``."""
+        return _segment_bounds(self.segment_by, self.lo, self.hi, self.index_bits, s)
+
+    def coefficients(self, s: int) -> tuple[float, ...]:
+        """Coefficients of segment ``s`` in its local variable (exact doubles)."""
+        return tuple(math.ldexp(q, -self.coef_frac_bits) for q in self.segments[s].integers)
+
+    def coefficient_word_bits(self) -> tuple[int, ...]:
+        """Signed width of coefficient ``j`` over all segments (the ROM's word layout)."""
+        out = []
+        for j in range(self.degree + 1):
+            vals = [seg.integers[j] for seg in self.segments]
+            out.append(_signed_bits(min(vals), max(vals)))
+        return tuple(out)
+
+    def __call__(self, x) -> np.ndarray:
+        """Float64 evaluation at ``x`` (inside ``[lo, hi]``), for plots and checks."""
+        x = np.asarray(x, dtype=float)
+        lo_f, hi_f = float(self.lo), float(self.hi)
+        if self.segment_by == "uniform":
+            n = self.segment_count
+            pos = (x - lo_f) / (hi_f - lo_f) * n
+            s = np.clip(np.floor(pos), 0, n - 1).astype(int)
+            t = pos - s
+        else:
+            m, e = np.frexp(x)
+            e0 = int(math.log2(lo_f))
+            per = 2 ** self.index_bits
+            scaled = (2 * m - 1) * per
+            j = np.clip(np.floor(scaled), 0, per - 1).astype(int)
+            s = np.clip((e - 1 - e0) * per + j, 0, self.segment_count - 1)
+            t = scaled - j
+        if self.centered:
+            t = t - 0.5
+        coeffs = np.array([self.coefficients(i) for i in range(self.segment_count)])
+        acc = coeffs[s, self.degree]
+        for j in range(self.degree - 1, -1, -1):
+            acc = acc * t + coeffs[s, j]
+        return acc
+
+    # -- serialization -------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        d = {"kind": PIECEWISE_KIND, "schema": PIECEWISE_SCHEMA, "name": self.name,
+             "expression": self.expression, "variable": self.variable,
+             "interval": list(self.interval), "segment_by": self.segment_by,
+             "index_bits": self.index_bits, "degree": self.degree, "centered": self.centered,
+             "fit": self.fit, "error_kind": self.error_kind,
+             "coef_frac_bits": self.coef_frac_bits,
+             "abs_error_bound": self.abs_error_bound, "rel_error_bound": self.rel_error_bound,
+             "segments": [{"integers": list(seg.integers),
+                           "abs_error_bound": seg.abs_error_bound,
+                           "max_abs_error": seg.max_abs_error,
+                           "rel_error_bound": seg.rel_error_bound,
+                           "max_rel_error": seg.max_rel_error} for seg in self.segments],
+             "provenance": dict(self.provenance)}
+        return d
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, indent=1, allow_nan=False) + "\n"
+
+    def save(self, path) -> None:
+        """Write the JSON atomically."""
+        from .files import write_atomic
+
+        write_atomic(path, self.to_json())
+
+    @classmethod
+    def from_dict(cls, d: Any, *, verify: bool = True) -> "PiecewiseTable":
+        """Read a table: every field checked, then (``verify``) every bound re-certified."""
+        t = _read(d)
+        return t.verify() if verify else t
+
+    @classmethod
+    def from_json(cls, text: str, *, verify: bool = True) -> "PiecewiseTable":
+        try:
+            d = json.loads(text)
+        except (ValueError, RecursionError) as exc:
+            raise ValueError(f"piecewise table is not valid JSON: "
+                             f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
+        return cls.from_dict(d, verify=verify)
+
+    @classmethod
+    def load(cls, path, *, verify: bool = True) -> "PiecewiseTable":
+        """Read and verify the table in ``path``; refusals start with the file name."""
+        try:
+            with open(path, "rb") as fh:
+                raw = fh.read(MAX_PIECEWISE_BYTES + 1)
+        except OSError as exc:
+            raise ValueError(f"cannot read piecewise table {str(path)!r}: {exc.strerror}") from None
+        if len(raw) > MAX_PIECEWISE_BYTES:
+            raise ValueError(f"piecewise table {str(path)!r} is larger than "
+                             f"{MAX_PIECEWISE_BYTES} bytes")
+        try:
+            return cls.from_json(raw.decode("utf-8"), verify=verify)
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"piecewise table {str(path)!r} is not UTF-8 text (byte "
+                             f"{exc.start})") from None
+        except ValueError as exc:
+            raise ValueError(f"piecewise table {str(path)!r}: {exc}") from None
+
+    def verify(self) -> "PiecewiseTable":
+        """Re-certify every segment's stated bounds and the table's maxima; return self or raise.
+
+        >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
+        >>> t.verify() is t
+        True
+        >>> bad = replace(t, segments=(replace(t.segments[0], abs_error_bound=1e-9),) + t.segments[1:])
+        >>> bad.verify()
+        Traceback (most recent call last):
+        ...
+        ValueError: segments[0].abs_error_bound: stated 1.00e-09 but the certified error of segment 0 is ...
+        """
+        fn = parse_function(self.expression, self.variable)
+        loc = self.local_range
+        for s, seg in enumerate(self.segments):
+            g = _local_function(fn, *self.segment_bounds(s), centered=self.centered)
+            coeffs = self.coefficients(s)
+            for kind, bound, maximum in (("abs", seg.abs_error_bound, seg.max_abs_error),
+                                         ("rel", seg.rel_error_bound, seg.max_rel_error)):
+                if bound is None:
+                    continue
+                cert = None
+                for tol in (None, 2.0 ** -14):
+                    cert = certify(g, coeffs, sp.Rational(loc[0]), sp.Rational(loc[1]), kind,
+                                   **({} if tol is None else {"tol": tol}))
+                    if bound >= cert.bound:
+                        break
+                if bound < cert.bound:
+                    raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
+                                     f"the certified error of segment {s} is {cert.bound:.2e}")
+                if maximum > bound:
+                    raise ValueError(f"segments[{s}].max_{kind}_error: {maximum!r} exceeds the "
+                                     f"segment's bound {bound!r}")
+        top = max(seg.abs_error_bound for seg in self.segments)
+        if self.abs_error_bound < top:
+            raise ValueError(f"abs_error_bound: stated {self.abs_error_bound!r} is below the "
+                             f"largest segment bound {top!r}")
+        if self.error_kind == "rel":
+            top_r = max(seg.rel_error_bound for seg in self.segments)
+            if self.rel_error_bound is None or self.rel_error_bound < top_r:
+                raise ValueError(f"rel_error_bound: stated {self.rel_error_bound!r} is below "
+                                 f"the largest segment bound {top_r!r}")
+        return self
+
+
+# -- geometry ------------------------------------------------------------------
+
+def _signed_bits(lo: int, hi: int) -> int:
+    n = 1
+    while not (-(1 << (n - 1)) <= lo and hi <= (1 << (n - 1)) - 1):
+        n += 1
+    return n
+
+
+def _exact_log2(value: sp.Expr) -> int | None:
+    """``e`` when ``value == 2**e`` exactly, else None."""
+    r = sp.nsimplify(value) if not value.is_Rational else value
+    if not r.is_Rational or r <= 0:
+        return None
+    p, q = int(r.p), int(r.q)
+    if p & (p - 1) == 0 and q == 1:
+        return p.bit_length() - 1
+    if p == 1 and q & (q - 1) == 0:
+        return -(q.bit_length() - 1)
+    return None
+
+
+def _segment_bounds(segment_by, lo, hi, index_bits, s):
+    if segment_by == "uniform":
+        n = 2 ** index_bits
+        h = (hi - lo) / n
+        return (lo + s * h, lo + (s + 1) * h)
+    per = 2 ** index_bits
+    e0 = _exact_log2(lo)
+    e, j = divmod(s, per)
+    base = sp.Integer(2) ** (e0 + e)
+    return (base * (1 + sp.Rational(j, per)), base * (1 + sp.Rational(j + 1, per)))
+
+
+def _segment_count(segment_by, lo, hi, index_bits) -> int:
+    if segment_by == "uniform":
+        return 2 ** index_bits
+    return (_exact_log2(hi) - _exact_log2(lo)) * 2 ** index_bits
+
+
+class _LocalFunction:
+    """``t -> f(a + (b - a) t)`` (``t + 1/2`` when centred) for the certifier:
+    the Arb evaluators compose ``f``'s with the exact affine map (endpoints as
+    balls), the numpy one composes in float64 (fitting only)."""
+
+    def __init__(self, fn: Function1D, a, b, centered: bool):
+        self.fn = fn
+        self.var = sp.Symbol("t", real=True)
+        self.expr = fn.expr
+        self._a, self._w = arb_enclose(sp.sympify(a)), arb_enclose(sp.sympify(b - a))
+        self._shift = 0.5 if centered else 0.0
+        self._af, self._wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
+        f_series, f_np = fn.arb_series, fn.numpy
+        a_b, w_b, sh = self._a, self._w, self._shift
+
+        def series(s):
+            return f_series(a_b + w_b * (s + sh))
+
+        def numpy_(t):
+            return f_np(self._af + self._wf * (np.asarray(t, dtype=float) + sh))
+
+        self.arb_series = series
+        self.numpy = numpy_
+
+    def __str__(self) -> str:
+        return f"{self.fn.expr} on a segment"
+
+
+def _local_function(fn: Function1D, a, b, *, centered: bool) -> _LocalFunction:
+    return _LocalFunction(fn, a, b, centered)
+
+
+def parse_segments(text) -> int:
+    """``"2^k"``, ``"2**k"`` or a power of two ``N`` -> ``k`` (index bits).
+
+    >>> parse_segments("2^8"), parse_segments("16"), parse_segments(1)
+    (8, 4, 0)
+    """
+    s = str(text).strip().replace("**", "^")
+    try:
+        if s.startswith("2^"):
+            k = int(s[2:])
+        else:
+            n = int(s)
+            if n < 1 or n & (n - 1):
+                raise ValueError
+            k = n.bit_length() - 1
+    except ValueError:
+        raise ValueError(f"segments {text!r} is not a power of two; accepted: 2^k or N = 2^k "
+                         f"with 0 <= k <= {MAX_INDEX_BITS}") from None
+    if not 0 <= k <= MAX_INDEX_BITS:
+        raise ValueError(f"segments 2^{k}: k = {k} is out of range; accepted: 0 <= k <= "
+                         f"{MAX_INDEX_BITS}")
+    return k
+
+
+# -- fitting -------------------------------------------------------------------
+
+def _check_int(value, name: str, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
+    if not lo <= int(value) <= hi:
+        raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
+    return int(value)
+
+
+def _fit_segment(g: Function1D, degree: int, lo: float, hi: float, fit: str, error: str):
+    """Float coefficients in the local variable on ``[lo, hi]``."""
+    f_np = g.numpy
+    if degree == 0 or fit == "chebyshev":
+        nodes = np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))
+        x = 0.5 * (hi - lo) * nodes + 0.5 * (hi + lo)
+        cheb = np.polynomial.chebyshev.chebfit(nodes, f_np(x), degree)
+        if degree == 0 and fit == "minimax":
+            grid = f_np(np.linspace(lo, hi, _DENSE))
+            cheb = np.array([0.5 * (grid.max() + grid.min())])
+    else:
+        weight = (lambda v: np.ones_like(v)) if error == "abs" else (lambda v: 1 / np.abs(f_np(v)))
+        # a few exchanges reach the minimax error to 1e-4; the rounding to the
+        # common format dominates past that
+        cheb = remez(f_np, weight, lo, hi, degree, max_iter=12, rtol=1e-4).cheb
+    return cheb_to_monomial(cheb, lo, hi)
+
+
+def _quantize_segment(g: Function1D, coeffs, frac_bits: int, lo: float, hi: float, error: str):
+    """Integers: plain rounding, and rounding with the constant term re-centred
+    on the dense error of the rounded higher terms; the better on a grid."""
+    scale = 2.0 ** frac_bits
+    plain = [int(round(c * scale)) for c in coeffs]
+    v = np.linspace(lo, hi, _DENSE)
+    f = g.numpy(v)
+
+    def err(ints):
+        p = np.polynomial.polynomial.polyval(v, np.array(ints, dtype=float) / scale)
+        e = p - f if error == "abs" else p / f - 1
+        return float(np.max(np.abs(e)))
+
+    best = plain
+    if len(coeffs) > 1:
+        high = np.polynomial.polynomial.polyval(v, np.array([0] + plain[1:], dtype=float) / scale)
+        if error == "abs":
+            r = f - high
+            c0 = 0.5 * (r.max() + r.min())
+        else:  # minimise max |(c0 + high)/f - 1|: c0 levels (f - high)/f weighted by 1/f
+            c0 = _level_rel(f, high)
+        recentred = [int(round(c0 * scale))] + plain[1:]
+        if err(recentred) < err(plain):
+            best = recentred
+    return best
+
+
+def _level_rel(f, high) -> float:
+    """The constant ``c`` minimising ``max |(c + high)/f - 1|`` (bisection on the level)."""
+    lo_c, hi_c = float(np.min(f - high)) - 1.0, float(np.max(f - high)) + 1.0
+    for _ in range(80):
+        mid = 0.5 * (lo_c + hi_c)
+        e = (mid + high) / f - 1
+        if e.max() + e.min() > 0:
+            hi_c = mid
+        else:
+            lo_c = mid
+    return 0.5 * (lo_c + hi_c)
+
+
+def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = "uniform",
+                  coef_frac_bits: int = 24, centered: bool = False, fit: str = "minimax",
+                  error: str = "abs", var: str = "x", name: str = "table",
+                  command: str | None = None, progress=None) -> PiecewiseTable:
+    """Fit, quantize and certify a piecewise polynomial table (module docstring).
+
+    ``segments``: ``2**k`` (an int or ``"2^k"``) -- the whole interval's
+    count for ``segment_by="uniform"``, the count per binade for
+    ``"exponent"`` (then ``interval`` must be ``[2**e0, 2**e1]``).
+    ``coef_frac_bits``: the common fixed-point format of all coefficients.
+    ``progress``: optional callable run once per certified segment.
+
+    >>> t = fit_piecewise("1/sqrt(x)", ("1/4", "4"), 2, segments=2, segment_by="exponent",
+    ...                   coef_frac_bits=20, error="rel")
+    >>> t.segment_count, t.rel_error_bound < 1e-3
+    (8, True)
+    """
+    index_bits = parse_segments(segments)
+    degree = _check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
+    frac_bits = _check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
+    if segment_by not in SEGMENT_BY:
+        raise ValueError(f"segment-by {segment_by!r} is unknown; accepted: {', '.join(SEGMENT_BY)}")
+    if fit not in FITS:
+        raise ValueError(f"fit kind {fit!r} is unknown; accepted: {', '.join(FITS)}")
+    if error not in ERRORS:
+        raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERRORS)}")
+    if not isinstance(centered, bool):
+        raise ValueError(f"centered {centered!r} is not a boolean")
+    try:
+        lo_t, hi_t = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    fn = expr if isinstance(expr, Function1D) else parse_function(expr, var)
+    lo, hi = parse_number(lo_t), parse_number(hi_t)
+    if not arb_enclose(lo) < arb_enclose(hi):
+        raise ValueError(f"interval [{lo}, {hi}] is empty or reversed; accepted: LO < HI")
+    if segment_by == "exponent":
+        e0, e1 = _exact_log2(lo), _exact_log2(hi)
+        if e0 is None or e1 is None:
+            raise ValueError(f"segment-by exponent needs an interval [2^e0, 2^e1] of powers of "
+                             f"two, got [{lo}, {hi}]; accepted: e.g. --interval 1/4 4")
+        if not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
+            raise ValueError(f"segment-by exponent: {e1 - e0} binades; accepted: 1 to "
+                             f"{MAX_EXPONENT_SPAN}")
+        if (e1 - e0) * 2 ** index_bits > 2 ** MAX_INDEX_BITS:
+            raise ValueError(f"segment-by exponent: {e1 - e0} binades x 2^{index_bits} = "
+                             f"{(e1 - e0) * 2 ** index_bits} segments; accepted: at most "
+                             f"2^{MAX_INDEX_BITS}")
+    count = _segment_count(segment_by, lo, hi, index_bits)
+    loc = (-0.5, 0.5) if centered else (0.0, 1.0)
+    limit = 2 ** MAX_COEF_INT_BITS
+    out, bad_seg = [], None
+    for s in range(count):
+        a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
+        g = _local_function(fn, a, b, centered=centered)
+        with np.errstate(all="ignore"):
+            try:
+                probe = g.numpy(np.linspace(*loc, 65))
+            except (ZeroDivisionError, OverflowError, TypeError):
+                probe = np.array([np.nan])
+        if not np.all(np.isfinite(probe)) or (error == "rel" and np.any(probe == 0)):
+            bad_seg = (s, a, b)
+            break
+        with np.errstate(all="ignore"):
+            coeffs = _fit_segment(g, degree, *loc, fit, error)
+        big = max(abs(c) for c in coeffs)
+        if big * 2.0 ** frac_bits >= limit:
+            max_f = max(0, math.floor(math.log2(limit / big)) - 1)
+            raise ValueError(f"coef-frac-bits {frac_bits} overflows the {MAX_COEF_INT_BITS}-bit "
+                             f"coefficient integers (segment {s}: |c| = {big:.6g}); accepted: "
+                             f"coef-frac-bits <= {max_f}")
+        with np.errstate(all="ignore"):
+            ints = _quantize_segment(g, coeffs, frac_bits, *loc, error)
+        q = [math.ldexp(i, -frac_bits) for i in ints]
+        try:
+            ca = certify(g, q, sp.Rational(loc[0]), sp.Rational(loc[1]), "abs")
+            cr = certify(g, q, sp.Rational(loc[0]), sp.Rational(loc[1]), "rel") \
+                if error == "rel" else None
+        except ValueError:
+            bad_seg = (s, a, b)
+            break
+        out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
+                                    None if cr is None else cr.bound,
+                                    None if cr is None else cr.maximum))
+        if progress is not None:
+            progress()
+    if bad_seg is not None:
+        s, a, b = bad_seg
+        what = "finite, real and nonzero" if error == "rel" else "finite and real"
+        raise ValueError(f"{fn.expr} is not {what} on segment {s} = [{a}, {b}] of "
+                         f"[{lo}, {hi}]; accepted: an interval where the function is {what}")
+    from .api import _versions
+
+    prov = dict(_versions())
+    prov["command"] = command or (f"chebnorm.approx.fit_piecewise({str(fn.expr)!r}, "
+                                  f"({sp.sstr(lo)!r}, {sp.sstr(hi)!r}), {degree}, "
+                                  f"segments={2 ** index_bits}, segment_by={segment_by!r}, "
+                                  f"coef_frac_bits={frac_bits}, centered={centered})")
+    return PiecewiseTable(
+        name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+        interval=(sp.sstr(lo), sp.sstr(hi)), segment_by=segment_by, index_bits=index_bits,
+        degree=degree, centered=centered, fit=fit, error_kind=error, coef_frac_bits=frac_bits,
+        segments=tuple(out), abs_error_bound=max(sg.abs_error_bound for sg in out),
+        rel_error_bound=max(sg.rel_error_bound for sg in out) if error == "rel" else None,
+        provenance=prov)
+
+
+# -- reading ---------------------------------------------------------------------
+
+_FIELDS = {"kind", "schema", "name", "expression", "variable", "interval", "segment_by",
+           "index_bits", "degree", "centered", "fit", "error_kind", "coef_frac_bits",
+           "abs_error_bound", "rel_error_bound", "segments", "provenance"}
+_SEG_FIELDS = {"integers", "abs_error_bound", "max_abs_error", "rel_error_bound", "max_rel_error"}
+
+
+def _bad(fieldname: str, expected: str, value) -> ValueError:
+    shown = repr(value)
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    return ValueError(f"{fieldname}: expected {expected}, got {shown}")
+
+
+def _num(value, fieldname: str, *, optional: bool = False) -> float | None:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            or value < 0:
+        raise _bad(fieldname, "a finite number >= 0", value)
+    return float(value)
+
+
+def _int(value, fieldname: str, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+        raise _bad(fieldname, f"an integer in [{lo}, {hi}]", value)
+    return value
+
+
+def _str(value, fieldname: str, max_length: int = 1000) -> str:
+    if not isinstance(value, str) or not value or len(value) > max_length:
+        raise _bad(fieldname, f"a non-empty string of at most {max_length} characters", value)
+    return value
+
+
+def _read(d) -> PiecewiseTable:
+    from . import textsafe
+
+    if not isinstance(d, dict):
+        raise _bad("table", "a JSON object", d)
+    if d.get("kind") != PIECEWISE_KIND:
+        raise _bad("kind", repr(PIECEWISE_KIND), d.get("kind"))
+    if d.get("schema") != PIECEWISE_SCHEMA:
+        raise _bad("schema", str(PIECEWISE_SCHEMA), d.get("schema"))
+    missing = sorted(_FIELDS - set(d))
+    extra = sorted(set(d) - _FIELDS)
+    if missing:
+        raise ValueError(f"{missing[0]}: missing field")
+    if extra:
+        raise ValueError(f"{extra[0]}: unknown field; accepted: {', '.join(sorted(_FIELDS))}")
+    name = textsafe.identifier(_str(d["name"], "name", 64), field="name")
+    expression = _str(d["expression"], "expression")
+    variable = _str(d["variable"], "variable", 64)
+    if not variable.isidentifier():
+        raise _bad("variable", "an identifier", variable)
+    iv = d["interval"]
+    if not isinstance(iv, list) or len(iv) != 2:
+        raise _bad("interval", "an array of 2 strings", iv)
+    interval = (_str(iv[0], "interval[0]"), _str(iv[1], "interval[1]"))
+    segment_by = d["segment_by"]
+    if segment_by not in SEGMENT_BY:
+        raise _bad("segment_by", " or ".join(map(repr, SEGMENT_BY)), segment_by)
+    index_bits = _int(d["index_bits"], "index_bits", 0, MAX_INDEX_BITS)
+    degree = _int(d["degree"], "degree", 0, MAX_PIECEWISE_DEGREE)
+    if not isinstance(d["centered"], bool):
+        raise _bad("centered", "true or false", d["centered"])
+    if d["fit"] not in FITS:
+        raise _bad("fit", " or ".join(map(repr, FITS)), d["fit"])
+    if d["error_kind"] not in ERRORS:
+        raise _bad("error_kind", " or ".join(map(repr, ERRORS)), d["error_kind"])
+    frac_bits = _int(d["coef_frac_bits"], "coef_frac_bits", 0, MAX_COEF_FRAC_BITS)
+    try:
+        fn = parse_function(expression, variable)
+        del fn
+    except ValueError as exc:
+        raise ValueError(f"expression: {exc}") from None
+    ends = []
+    for i, text in enumerate(interval):
+        try:
+            ends.append(parse_number(text))
+        except ValueError as exc:
+            raise ValueError(f"interval[{i}]: {exc}") from None
+    if not arb_enclose(ends[0]) < arb_enclose(ends[1]):
+        raise ValueError(f"interval: [{interval[0]}, {interval[1]}] is empty or reversed")
+    if segment_by == "exponent":
+        e0, e1 = _exact_log2(ends[0]), _exact_log2(ends[1])
+        if e0 is None or e1 is None or not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
+            raise _bad("interval", "powers of two [2^e0, 2^e1] for segment_by 'exponent'", iv)
+    count = _segment_count(segment_by, ends[0], ends[1], index_bits)
+    segs = d["segments"]
+    if not isinstance(segs, list) or len(segs) != count:
+        raise _bad("segments", f"an array of {count} segments", segs)
+    out = []
+    for s, seg in enumerate(segs):
+        where = f"segments[{s}]"
+        if not isinstance(seg, dict) or set(seg) != _SEG_FIELDS:
+            raise _bad(where, f"an object with fields {', '.join(sorted(_SEG_FIELDS))}", seg)
+        ints = seg["integers"]
+        if not isinstance(ints, list) or len(ints) != degree + 1:
+            raise _bad(f"{where}.integers", f"an array of {degree + 1} integers", ints)
+        for j, q in enumerate(ints):
+            if isinstance(q, bool) or not isinstance(q, int) or abs(q) >= 2 ** MAX_COEF_INT_BITS:
+                raise _bad(f"{where}.integers[{j}]",
+                           f"an integer of magnitude below 2^{MAX_COEF_INT_BITS}", q)
+        rel = d["error_kind"] == "rel"
+        out.append(PiecewiseSegment(
+            tuple(ints), _num(seg["abs_error_bound"], f"{where}.abs_error_bound"),
+            _num(seg["max_abs_error"], f"{where}.max_abs_error"),
+            _num(seg["rel_error_bound"], f"{where}.rel_error_bound", optional=not rel),
+            _num(seg["max_rel_error"], f"{where}.max_rel_error", optional=not rel)))
+        if rel and (out[-1].rel_error_bound is None):
+            raise _bad(f"{where}.rel_error_bound", "a number (error_kind is 'rel')", None)
+    prov = d["provenance"]
+    if not isinstance(prov, dict) or len(prov) > 32 or not all(
+            isinstance(k, str) and isinstance(v, str) and len(k) <= 64 and len(v) <= 1000
+            for k, v in prov.items()):
+        raise _bad("provenance", "an object of at most 32 short strings", prov)
+    return PiecewiseTable(
+        name=name, expression=expression, variable=variable, interval=interval,
+        segment_by=segment_by, index_bits=index_bits, degree=degree, centered=d["centered"],
+        fit=d["fit"], error_kind=d["error_kind"], coef_frac_bits=frac_bits, segments=tuple(out),
+        abs_error_bound=_num(d["abs_error_bound"], "abs_error_bound"),
+        rel_error_bound=_num(d["rel_error_bound"], "rel_error_bound", optional=True),
+        provenance=dict(prov))

@@ -1,0 +1,359 @@
+"""Hardware of a uniform piecewise table: a coefficient ROM and one shared Horner datapath.
+
+The input is an unsigned ``W``-bit code ``k`` standing for
+``x = lo + (hi - lo) * k / 2**W`` (so ``[lo, hi)`` is covered exactly, as in
+FloPoCo's ``FixFunctionByPiecewisePoly``). With ``2**K`` segments the top
+``K`` bits of ``k`` address the ROM, the low ``L = W - K`` bits are the local
+variable ``t = low / 2**L`` in ``[0, 1)`` (``t - 1/2`` when the table is
+centred): exactly the variable each segment's polynomial was certified in.
+The datapath, for coefficients ``q_j`` (``Fc`` fractional bits) read from
+the ROM::
+
+    a_n = q_n
+    a_j = R_Fa(a_{j+1} * t + q_j),        j = n-1 .. 1
+    y   = sat(R_Fy(a_1 * t + q_0) - Oy)
+
+each multiply-add exact, then one rounding (round to nearest even); every wire
+is sized from its exact range over all ``2**W`` codes. The error of ``y``
+against ``f(x)`` is bounded by the table's certified bound plus
+``sum_{j=1}^{n-1} 2**-(Fa+1) |t|_max^j`` plus ``2**-(Fy+1)`` (a rounding of
+``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
+compares it, code by code and in 40-digit arithmetic, with ``f``.
+
+>>> from chebnorm.approx.piecewise import fit_piecewise
+>>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+>>> d = design_piecewise(t, 8, 8)
+>>> d.y_format.frac_bits, d.budget()["total"] >= d.measure()["max_error"]
+(9, True)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+
+from chebnorm.approx.expr import parse_function, parse_number
+from chebnorm.approx.piecewise import PiecewiseTable
+from chebnorm.approx.textsafe import comment_text, identifier
+
+from .fixed import QFormat, check_int64, check_width, rounding_error_bound, shift_round, signed_bits
+from .verilog import _lit, _round, simulate, synthesize_text, vector_file, verilog_testbench
+
+__all__ = ["PiecewiseDesign", "design_piecewise", "piecewise_verilog", "piecewise_testbench",
+           "piecewise_outputs", "piecewise_cells", "simulate_piecewise", "MAX_PW_IN_BITS"]
+
+MAX_PW_IN_BITS = 20
+MAX_PW_OUT_BITS = 32
+ROUNDING = "rne"
+
+
+@dataclass(frozen=True)
+class PiecewiseDesign:
+    """A sized ROM + Horner evaluator of a uniform :class:`PiecewiseTable`."""
+
+    name: str
+    table: PiecewiseTable
+    in_bits: int
+    out_bits: int
+    local_bits: int
+    acc_frac_bits: int
+    y_format: QFormat
+    rom_bits: tuple[int, ...]
+    t_bits: int
+    widths: tuple[tuple[int, int, int], ...]   # per step j=n-1..0: (product, sum, out)
+    top_frac_bits: int
+    rounding: str = ROUNDING
+
+    @property
+    def module_name(self) -> str:
+        return f"chebnorm_{self.name}"
+
+    @property
+    def degree(self) -> int:
+        return self.table.degree
+
+    @property
+    def index_bits(self) -> int:
+        return self.table.index_bits
+
+    def _rom(self, dtype=np.int64) -> np.ndarray:
+        return np.array([seg.integers for seg in self.table.segments], dtype=dtype)
+
+    def _t(self, k: np.ndarray) -> np.ndarray:
+        low = k & ((1 << self.local_bits) - 1)
+        return low - (1 << (self.local_bits - 1)) if self.table.centered else low
+
+    def evaluate(self, codes=None, *, wires: bool = False):
+        """Output codes for input ``codes`` (default: all ``2**in_bits``)."""
+        k = np.arange(2 ** self.in_bits, dtype=np.int64) if codes is None \
+            else np.asarray(codes, dtype=np.int64)
+        w = _run(self, k, self.acc_frac_bits, self.y_format.frac_bits)
+        raw = w["rounded"] - self.y_format.offset_code
+        w["raw"] = raw
+        w["y"] = np.clip(raw, 0, self.y_format.max_code)
+        return w if wires else w["y"]
+
+    def x_values(self, codes) -> list[Fraction]:
+        lo, hi = (_exact(v) for v in self.table.interval)
+        return [lo + (hi - lo) * Fraction(int(c), 2 ** self.in_bits) for c in codes]
+
+    def budget(self) -> dict:
+        """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up)."""
+        tmax = Fraction(1, 2) if self.table.centered else Fraction(1)
+        fa = self.acc_frac_bits
+        steps = [rounding_error_bound(fa, self.rounding) * tmax ** j
+                 for j in range(1, self.degree)]
+        out = rounding_error_bound(self.y_format.frac_bits, self.rounding)
+        approx = Fraction(self.table.abs_error_bound)
+        total = approx + sum(steps, Fraction(0)) + out
+        return {"approximation": self.table.abs_error_bound,
+                "horner_rounding": _up(sum(steps, Fraction(0))), "output_rounding": _up(out),
+                "total": _up(total), "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
+
+    def measure(self, codes=None) -> dict:
+        """Exact ``max |y - f(x)|`` over ``codes`` (default all), f at 40 digits."""
+        k = np.arange(2 ** self.in_bits) if codes is None else np.asarray(codes)
+        y = self.evaluate(k)
+        fn = parse_function(self.table.expression, self.table.variable)
+        f = fn.mpmath
+        yf = self.y_format
+        worst, at = mpmath.mpf(0), 0
+        with mpmath.workdps(40):
+            for code, x, yc in zip(k, self.x_values(k), y):
+                v = mpmath.mpf(yf.offset_code + int(yc)) / 2 ** yf.frac_bits
+                e = abs(v - f(mpmath.mpf(x.numerator) / x.denominator))
+                if e > worst:
+                    worst, at = e, int(code)
+        return {"max_error": float(worst), "at_code": at, "codes": len(k),
+                "saturated": int(((self.evaluate(k, wires=True)["raw"] < 0)
+                                  | (self.evaluate(k, wires=True)["raw"] > yf.max_code)).sum())}
+
+
+def _exact(text: str) -> Fraction:
+    v = parse_number(text)
+    if not v.is_Rational:
+        raise ValueError(f"interval endpoint {text!r} is not rational; accepted for hardware: "
+                         f"a rational endpoint (the input code maps onto [lo, hi) exactly)")
+    return Fraction(int(v.p), int(v.q))
+
+
+def _up(x: Fraction) -> float:
+    f = float(x)
+    while Fraction(f) < x:
+        f = math.nextafter(f, math.inf)
+    return f
+
+
+def _run(d, k, fa, fy) -> dict:
+    rom = d._rom(k.dtype)
+    s = (k >> d.local_bits).astype(np.int64)
+    t = d._t(k)
+    fc = d.table.coef_frac_bits
+    n = d.table.degree
+    acc, accf = rom[s, n], fc
+    w = {"t": t, "s": s}
+    for j in range(n - 1, -1, -1):
+        prod = acc * t
+        pf = accf + d.local_bits
+        sf = max(pf, fc)
+        total = (prod << (sf - pf)) + (rom[s, j] << (sf - fc))
+        w[f"p{j}"], w[f"s{j}"] = prod, total
+        if j > 0:
+            f_out = min(fa, sf)
+            acc = shift_round(total, sf - f_out, ROUNDING)
+            accf = f_out
+            w[f"a{j}"] = acc
+        else:
+            acc, accf = total, sf
+    if n == 0:
+        acc = rom[s, 0]
+    w["top"], w["top_frac"] = acc, accf
+    shift = accf - fy
+    w["rounded"] = shift_round(acc, shift, ROUNDING) if shift >= 0 else acc << -shift
+    return w
+
+
+def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
+                     guard_bits: int = 2, name: str | None = None) -> PiecewiseDesign:
+    """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
+
+    ``in_bits`` must exceed the table's index bits (the rest is the local
+    variable); the accumulators carry ``y_frac_bits + guard_bits`` fractional
+    bits. Raises ValueError naming the value and the accepted range.
+    """
+    if not isinstance(table, PiecewiseTable):
+        raise ValueError("design_piecewise needs a PiecewiseTable")
+    if table.segment_by != "uniform":
+        raise ValueError(f"table {table.name!r} is segmented by {table.segment_by}; accepted "
+                         f"for hardware: a uniform table (the input code's top bits index it)")
+    in_bits = check_width(in_bits, "in-bits", table.index_bits + 1, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    guard_bits = check_width(guard_bits, "guard-bits", 0, 16)
+    name = identifier(name or table.name, field="name")
+    for v in table.interval:
+        _exact(v)
+    L = in_bits - table.index_bits
+    fc = table.coef_frac_bits
+    rom_bits = table.coefficient_word_bits()
+    proto = PiecewiseDesign(name, table, in_bits, out_bits, L, 0, QFormat(out_bits, 0), rom_bits,
+                            L + 2, (), 0)
+    k = np.arange(2 ** in_bits, dtype=np.int64)
+    # exact range of the polynomial values (no rounding, Python integers) fixes
+    # y's format, and bounds every wire of the rounded datapath
+    exact = _run(proto, k.astype(object), 10 ** 6, 0)
+    for key, v in exact.items():
+        if key.startswith(("p", "s")) and key != "s":
+            check_int64(signed_bits(int(v.min()), int(v.max())) + 2,
+                        f"wire {key} of the Horner datapath ({table.coef_frac_bits} coefficient "
+                        f"fractional bits, {L} local bits)")
+    top, tf = exact["top"], exact["top_frac"]
+    span = Fraction(int(top.max()) - int(top.min()), 2 ** tf)
+    fy = out_bits - (math.floor(math.log2(span)) if span > 0 else -8)
+    for fy in range(min(fy, 60), -60, -1):
+        fa = fy + guard_bits
+        w = _run(proto, k, fa, fy)
+        r = w["rounded"]
+        y_off = int(r.min())
+        if int(r.max()) - y_off <= 2 ** out_bits - 1:
+            break
+    widths = []
+    n = table.degree
+    for j in range(n - 1, -1, -1):
+        p, s = w[f"p{j}"], w[f"s{j}"]
+        out = w.get(f"a{j}", s)
+        widths.append((max(signed_bits(int(p.min()), int(p.max())), 2),
+                       max(signed_bits(int(s.min()), int(s.max())), 2),
+                       max(signed_bits(int(out.min()), int(out.max())), 2)))
+        check_int64(widths[-1][1], f"the sum of Horner step {j}")
+    return PiecewiseDesign(name, table, in_bits, out_bits, L, fa,
+                           QFormat(out_bits, fy, offset_code=y_off), rom_bits, L + 2,
+                           tuple(widths), int(w["top_frac"]))
+
+
+# -- Verilog -------------------------------------------------------------------
+
+def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | None = None) -> str:
+    """The synthesizable Verilog-2005 module: ROM (a case on the index) + Horner."""
+    t = d.table
+    n, L, K, fc = t.degree, d.local_bits, t.index_bits, t.coef_frac_bits
+    yf = d.y_format
+    b = d.budget()
+    mod = d.module_name
+    lo, hi = t.interval
+    out = [f"// {mod}: piecewise degree-{n} evaluator of {comment_text(t.expression)} on "
+           f"[{comment_text(lo)}, {comment_text(hi)}),",
+           f"//   2^{K} uniform segments (table {identifier(t.name, field='name')!r}), "
+           f"{'centred' if t.centered else 'uncentred'} local variable.",
+           f"// Generated by chebnorm {comment_text(version)}; do not edit."]
+    if command:
+        out.append(f"// Command: {comment_text(command)}")
+    out += [f"// x: unsigned {d.in_bits}-bit code k, value = lo + (hi - lo) * k / 2^{d.in_bits};"
+            f" segment = k[{d.in_bits - 1}:{L}], t = k[{L - 1}:0] / 2^{L}"
+            + (" - 1/2" if t.centered else ""),
+            f"// y: unsigned {d.out_bits}-bit code k, value = ({yf.offset_code} + k) / 2^{yf.frac_bits}",
+            f"// ROM: coefficients q_j / 2^{fc}, widths {list(d.rom_bits)} bits (j ascending).",
+            f"// Rounding: {d.rounding} after each multiply-add; accumulators with "
+            f"{d.acc_frac_bits} fractional bits.",
+            f"// Error budget |y - f(x)| <= {b['total']:.6e} = approximation "
+            f"{b['approximation']:.6e} + Horner rounding {b['horner_rounding']:.6e} + output "
+            f"rounding {b['output_rounding']:.6e}",
+            f"module {mod} #(",
+            f"    parameter IN_BITS = {d.in_bits},",
+            f"    parameter OUT_BITS = {d.out_bits}",
+            ") (",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");",
+            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
+    tw = d.t_bits
+    if t.centered:
+        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}) - "
+                   f"{_lit(1 << (L - 1), tw)};")
+    else:
+        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
+    regs = [f"c{j}" for j in range(n + 1)]
+    for j in range(n + 1):
+        out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
+    if K == 0:
+        out.append("    always @(*) begin")
+        for j in range(n + 1):
+            out.append(f"        c{j} = {_lit(t.segments[0].integers[j], d.rom_bits[j])};")
+        out.append("    end")
+    else:
+        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
+                "    always @(*) begin",
+                "        case (idx)"]
+        for s, seg in enumerate(t.segments):
+            body = " ".join(f"{regs[j]} = {_lit(q, d.rom_bits[j])};"
+                            for j, q in enumerate(seg.integers))
+            out.append(f"            {K}'d{s}: begin {body} end")
+        out += ["        endcase", "    end"]
+    prev, prev_frac = f"c{n}", fc
+    for i, j in enumerate(range(n - 1, -1, -1)):
+        pw, sw, ow = d.widths[i]
+        pf = prev_frac + L
+        sf = max(pf, fc)
+        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
+        out.append(f"    wire signed [{pw - 1}:0] p{j} = {prev} * t;")
+        sh_p = f" <<< {sf - pf}" if sf > pf else ""
+        sh_c = f" <<< {sf - fc}" if sf > fc else ""
+        out.append(f"    wire signed [{sw - 1}:0] s{j} = (p{j}{sh_p}) + (c{j}{sh_c});")
+        if j > 0:
+            f_out = min(d.acc_frac_bits, sf)
+            if sf > f_out:
+                out += _round(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
+            else:
+                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
+            prev, prev_frac = f"a{j}", f_out
+        else:
+            prev, prev_frac = f"s{j}", sf
+    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
+    top = prev
+    shift = prev_frac - yf.frac_bits
+    rw = max(top_bits + max(0, -shift) + 1, d.out_bits + 2, yf.offset_code.bit_length() + 2)
+    if shift > 0:
+        out += _round(top, "r", top_bits, shift, rw, d.rounding)
+    elif shift == 0:
+        out.append(f"    wire signed [{rw - 1}:0] r = {top};")
+    else:
+        out.append(f"    wire signed [{rw - 1}:0] r = {top} <<< {-shift};")
+    out += [f"    localparam signed [{rw - 1}:0] KY = {_lit(yf.offset_code, rw)};",
+            f"    localparam signed [{rw - 1}:0] YMAX = {_lit(yf.max_code, rw)};",
+            f"    wire signed [{rw - 1}:0] raw = r - KY;",
+            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
+            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
+            "endmodule", ""]
+    return "\n".join(out)
+
+
+def piecewise_testbench(d: PiecewiseDesign) -> str:
+    """The exhaustive self-checking bench (expected codes from :meth:`evaluate`)."""
+    return verilog_testbench(d)
+
+
+def piecewise_outputs(d: PiecewiseDesign, *, version: str = "",
+                      command: str | None = None) -> dict[str, str]:
+    """``{file name: text}``: the module, its bench and the expected-output vectors."""
+    m = d.module_name
+    return {f"{m}.v": piecewise_verilog(d, version=version, command=command),
+            f"tb_{m}.v": piecewise_testbench(d), f"{m}.hex": vector_file(d)}
+
+
+def piecewise_cells(d: PiecewiseDesign):
+    """Yosys ``synth; stat`` of the module (a :class:`~chebnorm.hw.verilog.SynthResult`)."""
+    return synthesize_text(piecewise_verilog(d), d.module_name)
+
+
+def simulate_piecewise(d: PiecewiseDesign, directory):
+    """Write the outputs into ``directory`` and run the bench in Icarus Verilog."""
+    from pathlib import Path
+
+    from chebnorm.approx.files import write_atomic
+
+    for fname, text in piecewise_outputs(d).items():
+        write_atomic(Path(directory) / fname, text)
+    return simulate(directory, d)
