@@ -50,7 +50,7 @@ from .fitting import cheb_to_monomial, remez
 
 __all__ = ["PiecewiseTable", "PiecewiseSegment", "fit_piecewise", "PIECEWISE_KIND",
            "PIECEWISE_SCHEMA", "MAX_INDEX_BITS", "MAX_PIECEWISE_DEGREE", "MAX_COEF_FRAC_BITS",
-           "SEGMENT_BY", "parse_segments"]
+           "SEGMENT_BY", "parse_segments", "is_piecewise_file"]
 
 PIECEWISE_KIND = "chebnorm.piecewise_table"
 PIECEWISE_SCHEMA = 1
@@ -111,6 +111,13 @@ class PiecewiseTable:
     @property
     def hi(self) -> sp.Expr:
         return parse_number(self.interval[1])
+
+    @property
+    def exponent_range(self) -> tuple[int, int] | None:
+        """``(e0, e1)`` with ``[lo, hi] = [2**e0, 2**e1]`` for exponent tables, else None."""
+        if self.segment_by != "exponent":
+            return None
+        return _exact_log2(self.lo), _exact_log2(self.hi)
 
     @property
     def local_range(self) -> tuple[Fraction, Fraction]:
@@ -357,6 +364,18 @@ def parse_segments(text) -> int:
         raise ValueError(f"segments 2^{k}: k = {k} is out of range; accepted: 0 <= k <= "
                          f"{MAX_INDEX_BITS}")
     return k
+
+
+def is_piecewise_file(path) -> bool:
+    """True when the JSON file ``path`` declares ``kind`` = :data:`PIECEWISE_KIND`
+    (so a consumer reads it with :meth:`PiecewiseTable.load`)."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_PIECEWISE_BYTES + 1)
+        d = json.loads(raw.decode("utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return False
+    return isinstance(d, dict) and d.get("kind") == PIECEWISE_KIND
 
 
 # -- fitting -------------------------------------------------------------------

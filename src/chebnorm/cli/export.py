@@ -29,7 +29,9 @@ def register(sub) -> None:
     p.add_argument("--format", default="c", help=f"one of {_all_formats()} (default c)")
     p.add_argument("-o", "--output", metavar="FILE", required=True)
     hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
-    hw.add_argument("--in-bits", type=int, default=None, help="input code width, 1..20")
+    hw.add_argument("--in-bits", type=int, default=None,
+                    help="input code width, 1..20 (a piecewise table's C export: 1..32, "
+                    "default 24)")
     hw.add_argument("--out-bits", type=int, default=None, help="output code width, 1..32")
     hw.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None,
                     help="coefficient fractional bits (default: the table's own)")
@@ -43,6 +45,10 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.format not in FORMATS and args.format not in HW_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
+    from chebnorm.approx.piecewise import is_piecewise_file
+
+    if is_piecewise_file(args.table):
+        return _run_piecewise(args)
     flags = {"in_bits": "--in-bits", "out_bits": "--out-bits", "coef_bits": "--coef-frac-bits",
              "acc_bits": "--acc-bits"}
     hw_only = [flag for dest, flag in flags.items() if getattr(args, dest) is not None]
@@ -71,5 +77,32 @@ def run(args) -> int:
     text = comb(d, **kw)
     if d.degree >= 1:
         text += "\n" + pipe(d, **kw)
+    write_atomic(args.output, text)
+    return 0
+
+
+def _run_piecewise(args) -> int:
+    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.piecewise import PiecewiseTable
+    from chebnorm.export.c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
+
+    table = PiecewiseTable.load(args.table)
+    if args.format == "c":
+        in_bits = DEFAULT_C_IN_BITS if args.in_bits is None else args.in_bits
+        text = piecewise_c_header(table, command_line(args), in_bits=in_bits)
+    elif args.format == "json":
+        text = table.to_json()
+    elif args.format == "verilog":
+        from chebnorm import __version__
+        from chebnorm.hw.piecewise import design_piecewise, piecewise_verilog
+
+        if args.in_bits is None or args.out_bits is None:
+            raise ValueError("--format verilog needs --in-bits and --out-bits (input and output "
+                             "code widths)")
+        text = piecewise_verilog(design_piecewise(table, args.in_bits, args.out_bits),
+                                 version=__version__, command=command_line(args))
+    else:
+        raise ValueError(f"format {args.format!r} is not available for a piecewise table; "
+                         f"accepted: c, json, verilog")
     write_atomic(args.output, text)
     return 0

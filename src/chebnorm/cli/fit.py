@@ -25,13 +25,46 @@ def register(sub) -> None:
     p.add_argument("--coef-frac-bits", dest="frac_bits", type=int, default=None, metavar="F",
                    help="also quantize the coefficients to F fractional bits")
     deprecated_alias(p, "--frac-bits", "--coef-frac-bits", "frac_bits", type=int, metavar="F")
+    p.add_argument("--segments", default=None, metavar="2^k",
+                   help="piecewise table of 2^k segments, 0 <= k <= 12 (per binade with "
+                   "--segment-by exponent); coefficients in one fixed-point format "
+                   "(--coef-frac-bits, default 24)")
+    p.add_argument("--segment-by", default=None, choices=("uniform", "exponent"),
+                   help="uniform (default: top k bits of the input) or exponent (a float's "
+                   "exponent and top mantissa bits; interval [2^e0, 2^e1])")
+    p.add_argument("--centered", action="store_true",
+                   help="piecewise: evaluate each segment in t - 1/2 (smaller coefficients)")
     p.add_argument("--name", default="table", help="table name (a C identifier)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
     p.set_defaults(func=run)
 
 
+def _run_piecewise(args) -> int:
+    from chebnorm.approx.piecewise import fit_piecewise
+
+    table = fit_piecewise(args.expr, tuple(args.interval), args.degree,
+                          segments=args.segments or 1, segment_by=args.segment_by or "uniform",
+                          coef_frac_bits=24 if args.frac_bits is None else args.frac_bits,
+                          centered=args.centered, fit=args.kind, error=args.error,
+                          var=args.var, name=args.name, command=command_line(args))
+    if args.output:
+        table.save(args.output)
+    if args.json:
+        print_json(table.to_dict())
+    elif not args.output:
+        print(f"{table.name}: {table.segment_count} {table.segment_by} segments, {table.fit} "
+              f"degree {table.degree} of {table.expression} on [{table.interval[0]}, "
+              f"{table.interval[1]}], coefficients * 2^-{table.coef_frac_bits}")
+        print(f"certified max over segments |p_s - f| <= {table.abs_error_bound:.6e}"
+              + ("" if table.rel_error_bound is None
+                 else f", |p_s/f - 1| <= {table.rel_error_bound:.6e}"))
+    return 0
+
+
 def run(args) -> int:
+    if args.segments is not None or args.segment_by is not None or args.centered:
+        return _run_piecewise(args)
     table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
                 var=args.var, name=args.name, frac_bits=args.frac_bits,
                 command=command_line(args))

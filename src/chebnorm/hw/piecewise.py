@@ -276,14 +276,13 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
     else:
         out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
     regs = [f"c{j}" for j in range(n + 1)]
-    for j in range(n + 1):
-        out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
-    if K == 0:
-        out.append("    always @(*) begin")
+    if K == 0:  # one segment: constants (an always block with no input would never run)
         for j in range(n + 1):
-            out.append(f"        c{j} = {_lit(t.segments[0].integers[j], d.rom_bits[j])};")
-        out.append("    end")
+            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
+                       f"{_lit(t.segments[0].integers[j], d.rom_bits[j])};")
     else:
+        for j in range(n + 1):
+            out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
         out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
                 "    always @(*) begin",
                 "        case (idx)"]

@@ -1,0 +1,180 @@
+"""Piecewise tables (issue 13): every segment certified, bounds re-proved on load,
+the C export and the ROM + Horner hardware checked against independent computations
+(mpmath at 40 digits, gcc, Icarus Verilog)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+
+from chebnorm.approx.certify import dense_maximum
+from chebnorm.approx.expr import parse_function
+from chebnorm.approx.piecewise import PiecewiseTable, fit_piecewise, parse_segments
+from chebnorm.export.c_piecewise import piecewise_c_header, piecewise_eval_bound
+from chebnorm.hw.piecewise import design_piecewise, simulate_piecewise
+
+RSQRT = parse_function("1/sqrt(x)")
+
+
+def _dense_check(table, points=2001):
+    """Every segment's stated bound covers a dense float64 sample of |p_s - f|
+    (evaluated independently of the certifier: f through numpy on x)."""
+    for s in range(table.segment_count):
+        a, b = (float(v) for v in table.segment_bounds(s))
+        t = np.linspace(*[float(v) for v in table.local_range], points)
+        x = a + (b - a) * (t - float(table.local_range[0]))
+        p = np.polynomial.polynomial.polyval(t, table.coefficients(s))
+        err = np.max(np.abs(p - RSQRT.numpy(x)))
+        seg = table.segments[s]
+        assert seg.max_abs_error <= seg.abs_error_bound
+        assert err <= seg.abs_error_bound * (1 + 1e-9) + 1e-15, (s, err, seg.abs_error_bound)
+
+
+@pytest.mark.parametrize("k", range(9))
+@pytest.mark.parametrize("degree", [1, 2, 3])
+def test_rsqrt_every_segment_certified(k, degree):
+    t = fit_piecewise("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=24)
+    assert t.segment_count == 2 ** k
+    assert t.abs_error_bound == max(s.abs_error_bound for s in t.segments)
+    if k in (0, 4, 8):
+        _dense_check(t, 201 if k == 8 else 2001)
+
+
+def test_more_segments_tighter():
+    bounds = [fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=2 ** k,
+                            coef_frac_bits=34).abs_error_bound for k in (0, 2, 4, 6)]
+    # degree 2: the error falls like h^3 (64x per 4x segments) once h is small
+    assert bounds[0] > bounds[1] > bounds[2] > 40 * bounds[3]
+
+
+def test_centered_and_exponent_rel():
+    t = fit_piecewise("1/sqrt(x)", ("1/4", "4"), 2, segments=4, segment_by="exponent",
+                      centered=True, error="rel", coef_frac_bits=24)
+    assert t.segment_count == 16 and t.rel_error_bound is not None
+    x = np.linspace(0.25, 4, 5001, endpoint=False)
+    rel = np.abs(t(x) * np.sqrt(x) - 1)
+    assert rel.max() <= t.rel_error_bound * (1 + 1e-9)
+
+
+def test_load_reproves_and_names_fields(tmp_path):
+    t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="r")
+    path = tmp_path / "r.json"
+    t.save(path)
+    assert PiecewiseTable.load(path) == t
+    d = json.loads(path.read_text())
+    d["segments"][2]["abs_error_bound"] = d["segments"][2]["max_abs_error"] / 2
+    path.write_text(json.dumps(d))
+    with pytest.raises(ValueError, match=r"segments\[2\]\.abs_error_bound"):
+        PiecewiseTable.load(path)
+    d = json.loads(t.to_json())
+    d["segments"][1]["integers"][0] += 1000
+    with pytest.raises(ValueError, match=r"segments\[1\]\.abs_error_bound"):
+        PiecewiseTable.from_dict(d)
+    d = json.loads(t.to_json())
+    d["index_bits"] = 40
+    with pytest.raises(ValueError, match=r"index_bits: expected an integer in \[0, 12\]"):
+        PiecewiseTable.from_dict(d)
+    d = json.loads(t.to_json())
+    d["name"] = "x */ evil"
+    with pytest.raises(ValueError, match="name"):
+        PiecewiseTable.from_dict(d)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"segments": "2^13"}, r"k = 13 is out of range; accepted: 0 <= k <= 12"),
+    ({"segments": 3}, "not a power of two"),
+    ({"degree": -1}, r"degree = -1 is out of range; accepted: 0 <= degree <= 8"),
+    ({"coef_frac_bits": 60}, r"coef-frac-bits = 60 is out of range"),
+    ({"interval": ("-1", "4")}, r"not finite and real on segment 0"),
+    ({"segment_by": "exponent", "interval": ("1", "3")}, "powers of two"),
+])
+def test_bad_input(kwargs, match):
+    args = {"interval": ("1", "4"), "degree": 2, "segments": 4}
+    args.update(kwargs)
+    interval, degree = args.pop("interval"), args.pop("degree")
+    with pytest.raises(ValueError, match=match):
+        fit_piecewise("1/sqrt(x)", interval, degree, **args)
+
+
+def test_cli_errors_one_line(tmp_path):
+    for extra in (["--segments", "2^13"], ["--segments", "4", "--degree", "-1"],
+                  ["--segments", "4", "--interval", "-1", "4"]):
+        argv = ["fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", *extra]
+        r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
+                           text=True, cwd=tmp_path)
+        assert r.returncode == 2, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and "accepted" in r.stderr
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.parametrize("segment_by", ["uniform", "exponent"])
+def test_c_export_within_eval_bound(tmp_path, segment_by):
+    interval = ("1", "4") if segment_by == "uniform" else ("1/4", "4")
+    t = fit_piecewise("1/sqrt(x)", interval, 2, segments=8, segment_by=segment_by,
+                      coef_frac_bits=30, name="pw", centered=segment_by == "exponent")
+    (tmp_path / "chebnorm_pw.h").write_text(piecewise_c_header(t, in_bits=12))
+    if segment_by == "uniform":
+        xs = [Fraction(1) + 3 * Fraction(k, 4096) for k in range(4096)]
+        body = "for (uint32_t k = 0; k < 4096; k++) printf(\"%a\\n\", chebnorm_pw(k));"
+    else:
+        xs = [Fraction(np.ldexp(1.0, -2)) + Fraction(k, 2048) * Fraction(15, 4) for k in range(2048)]
+        xs_text = ",".join(float(x).hex() for x in xs)
+        body = (f"static const double xs[] = {{{xs_text}}}; for (int i = 0; i < 2048; i++) "
+                "printf(\"%a\\n\", chebnorm_pw(xs[i]));")
+    (tmp_path / "m.c").write_text("#include <stdio.h>\n#include \"chebnorm_pw.h\"\n"
+                                  f"int main(void) {{ {body} return 0; }}\n")
+    subprocess.run(["gcc", "-std=c99", "-O2", "-Wall", "-Werror", "m.c", "-o", "m", "-lm"],
+                   cwd=tmp_path, check=True)
+    out = subprocess.run(["./m"], cwd=tmp_path, check=True, capture_output=True, text=True).stdout
+    ys = [float.fromhex(v) for v in out.split()]
+    bound = piecewise_eval_bound(t)
+    worst = 0
+    with mpmath.workdps(40):
+        for x, y in zip(xs, ys):
+            xf = mpmath.mpf(float(x)) if segment_by == "exponent" else \
+                mpmath.mpf(x.numerator) / x.denominator
+            worst = max(worst, abs(mpmath.mpf(y) - 1 / mpmath.sqrt(xf)))
+    assert worst <= bound, (float(worst), bound)
+    assert bound < 2 * t.abs_error_bound
+
+
+@pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
+def test_rsqrt_256_segments_hardware_bit_exact(tmp_path):
+    """Acceptance: 8-bit index, degree 2, 16-bit in / 16-bit out: iverilog matches the
+    model on all 65,536 inputs and the measured error stays within the stated bound."""
+    t = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=256, coef_frac_bits=24, name="rs")
+    d = design_piecewise(t, 16, 16)
+    sim = simulate_piecewise(d, tmp_path)
+    assert sim.passed and sim.vectors == 65536 and sim.mismatches == 0, sim.line
+    m = d.measure()
+    b = d.budget()
+    assert m["saturated"] == 0
+    assert m["max_error"] <= b["total"]
+    # the budget is tight: rounding dominates, measured within a factor 2
+    assert b["total"] <= 2 * m["max_error"]
+    print(f"measured max error {m['max_error']:.4e} <= stated bound {b['total']:.4e}")
+
+
+@pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
+@pytest.mark.parametrize("k, degree, centered", [(0, 3, False), (3, 1, True), (5, 2, True)])
+def test_small_designs_bit_exact(tmp_path, k, degree, centered):
+    t = fit_piecewise("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=18,
+                      centered=centered, name="sm")
+    d = design_piecewise(t, 10, 12)
+    sim = simulate_piecewise(d, tmp_path)
+    assert sim.passed, sim.line
+    assert d.measure()["max_error"] <= d.budget()["total"]
+
+
+def test_parse_segments():
+    assert parse_segments("2**3") == 3
+    with pytest.raises(ValueError, match="k = -1"):
+        parse_segments("2^-1")
