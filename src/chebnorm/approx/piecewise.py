@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
@@ -48,9 +48,19 @@ from .certify import arb_enclose, certify
 from .expr import Function1D, parse_function, parse_number
 from .fitting import cheb_to_monomial, remez
 
-__all__ = ["PiecewiseTable", "PiecewiseSegment", "fit_piecewise", "PIECEWISE_KIND",
-           "PIECEWISE_SCHEMA", "MAX_INDEX_BITS", "MAX_PIECEWISE_DEGREE", "MAX_COEF_FRAC_BITS",
-           "SEGMENT_BY", "parse_segments", "is_piecewise_file"]
+__all__ = [
+    "MAX_COEF_FRAC_BITS",
+    "MAX_INDEX_BITS",
+    "MAX_PIECEWISE_DEGREE",
+    "PIECEWISE_KIND",
+    "PIECEWISE_SCHEMA",
+    "SEGMENT_BY",
+    "PiecewiseSegment",
+    "PiecewiseTable",
+    "fit_piecewise",
+    "is_piecewise_file",
+    "parse_segments",
+]
 
 PIECEWISE_KIND = "chebnorm.piecewise_table"
 PIECEWISE_SCHEMA = 1
@@ -192,13 +202,13 @@ class PiecewiseTable:
         write_atomic(path, self.to_json())
 
     @classmethod
-    def from_dict(cls, d: Any, *, verify: bool = True) -> "PiecewiseTable":
+    def from_dict(cls, d: Any, *, verify: bool = True) -> PiecewiseTable:
         """Read a table: every field checked, then (``verify``) every bound re-certified."""
         t = _read(d)
         return t.verify() if verify else t
 
     @classmethod
-    def from_json(cls, text: str, *, verify: bool = True) -> "PiecewiseTable":
+    def from_json(cls, text: str, *, verify: bool = True) -> PiecewiseTable:
         try:
             d = json.loads(text)
         except (ValueError, RecursionError) as exc:
@@ -207,7 +217,7 @@ class PiecewiseTable:
         return cls.from_dict(d, verify=verify)
 
     @classmethod
-    def load(cls, path, *, verify: bool = True) -> "PiecewiseTable":
+    def load(cls, path, *, verify: bool = True) -> PiecewiseTable:
         """Read and verify the table in ``path``; refusals start with the file name."""
         try:
             with open(path, "rb") as fh:
@@ -225,7 +235,7 @@ class PiecewiseTable:
         except ValueError as exc:
             raise ValueError(f"piecewise table {str(path)!r}: {exc}") from None
 
-    def verify(self) -> "PiecewiseTable":
+    def verify(self) -> PiecewiseTable:
         """Re-certify every segment's stated bounds and the table's maxima; return self or raise.
 
         >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)

@@ -36,7 +36,7 @@ from chebnorm.approx.textsafe import comment_text, identifier
 
 from .c import horner_rounding_bound
 
-__all__ = ["piecewise_c_header", "piecewise_eval_bound", "DEFAULT_C_IN_BITS"]
+__all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound"]
 
 DEFAULT_C_IN_BITS = 24
 MAX_C_IN_BITS = 32
@@ -139,9 +139,9 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
         w("    int e;")
         w("    double m = frexp(x, &e);              /* x = m 2^e, m in [1/2, 1) */")
         w(f"    double u = (2.0 * m - 1.0) * {float(per)!r};  /* exact */")
-        w(f"    long j = (long)u;")
+        w("    long j = (long)u;")
         w(f"    long s = (long)(e - 1 - ({e0})) * {per} + j;")
-        w(f"    if (s < 0) s = 0;")
+        w("    if (s < 0) s = 0;")
         w(f"    if (s > {N - 1}) s = {N - 1};")
         w(f"    const double *c = {fn}_coeffs[s];")
         w(f"    double t = (u - (double)j){half};")

@@ -40,11 +40,33 @@ from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise import PiecewiseTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-from .fixed import QFormat, check_int64, check_width, rounding_error_bound, shift_round, signed_bits
-from .verilog import _lit, _round, simulate, synthesize_text, vector_file, verilog_testbench
+from .fixed import (
+    QFormat,
+    check_int64,
+    check_width,
+    rounding_error_bound,
+    shift_round,
+    signed_bits,
+)
+from .verilog import (
+    _lit,
+    _round,
+    simulate,
+    synthesize_text,
+    vector_file,
+    verilog_testbench,
+)
 
-__all__ = ["PiecewiseDesign", "design_piecewise", "piecewise_verilog", "piecewise_testbench",
-           "piecewise_outputs", "piecewise_cells", "simulate_piecewise", "MAX_PW_IN_BITS"]
+__all__ = [
+    "MAX_PW_IN_BITS",
+    "PiecewiseDesign",
+    "design_piecewise",
+    "piecewise_cells",
+    "piecewise_outputs",
+    "piecewise_testbench",
+    "piecewise_verilog",
+    "simulate_piecewise",
+]
 
 MAX_PW_IN_BITS = 20
 MAX_PW_OUT_BITS = 32
@@ -197,7 +219,6 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     for v in table.interval:
         _exact(v)
     L = in_bits - table.index_bits
-    fc = table.coef_frac_bits
     rom_bits = table.coefficient_word_bits()
     proto = PiecewiseDesign(name, table, in_bits, out_bits, L, 0, QFormat(out_bits, 0), rom_bits,
                             L + 2, (), 0)
@@ -212,8 +233,8 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                         f"fractional bits, {L} local bits)")
     top, tf = exact["top"], exact["top_frac"]
     span = Fraction(int(top.max()) - int(top.min()), 2 ** tf)
-    fy = out_bits - (math.floor(math.log2(span)) if span > 0 else -8)
-    for fy in range(min(fy, 60), -60, -1):
+    fy_max = out_bits - (math.floor(math.log2(span)) if span > 0 else -8)
+    for fy in range(min(fy_max, 60), -60, -1):
         fa = fy + guard_bits
         w = _run(proto, k, fa, fy)
         r = w["rounded"]
