@@ -17,7 +17,7 @@ import sys
 __all__ = ["main", "build_parser", "UsageError"]
 
 #: subcommand modules, in the order ``chebnorm --help`` lists them
-SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "hw", "repro")
+SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "hw", "design", "repro")
 
 
 class UsageError(ValueError):

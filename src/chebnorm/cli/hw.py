@@ -128,6 +128,11 @@ def run_verilog(args) -> int:
     from chebnorm.hw.verilog import simulate
 
     _check_output(args.output)
+    from chebnorm.approx.piecewise import is_piecewise_file
+
+    if is_piecewise_file(args.table):
+        from .design import hw_verilog
+        return hw_verilog(args)
     report = _analyze(args, synth=False, gappa=False)
     if args.pipelined and report.design.degree < 1:
         raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
@@ -168,6 +173,11 @@ def run_report(args) -> int:
 
     for kind in args.unit:
         get_unit(kind)  # refuses an unknown name, listing the registered ones
+    from chebnorm.approx.piecewise import is_piecewise_file
+
+    if is_piecewise_file(args.table) and not args.unit:
+        from .design import hw_report
+        return hw_report(args)
     report = _analyze(args, synth=not args.no_synth, gappa=not args.no_gappa)
     units = []
     for kind in dict.fromkeys(args.unit):

@@ -1,0 +1,133 @@
+"""``chebnorm design``: the cheapest certified piecewise hardware meeting an error bound;
+also the piecewise-table paths of ``chebnorm hw verilog`` and ``hw report``."""
+
+from __future__ import annotations
+
+import json
+
+from ._common import command_line, print_json
+
+
+def register(sub) -> None:
+    p = sub.add_parser("design", help="cheapest certified piecewise evaluator meeting --max-error",
+                       description="Search segments x degree x coefficient bits for the "
+                       "cheapest piecewise ROM + Horner evaluator (yosys cells, or the model "
+                       "estimate without yosys) whose certified error meets --max-error; write "
+                       "the Pareto front as CSV and PNG and say why the winner wins.")
+    p.add_argument("expr", metavar="EXPR", help='function in sympy syntax, e.g. "1/sqrt(x)"')
+    p.add_argument("--var", default="x", help="the variable of EXPR (default x)")
+    p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
+                   help="rational endpoints: the input code maps onto [LO, HI)")
+    p.add_argument("--in-bits", type=int, required=True, help="input code width, 2..20")
+    p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
+    p.add_argument("--max-error", type=float, required=True, help="bound on |y - f(x)|, > 0")
+    p.add_argument("--degrees", type=int, nargs="+", default=[1, 2, 3], help="default 1 2 3")
+    p.add_argument("--max-segments", default="2^8", metavar="2^k",
+                   help="largest segment count tried (default 2^8)")
+    p.add_argument("--no-synth", action="store_true", help="model estimate instead of yosys")
+    p.add_argument("--name", default="design", help="module name (an identifier)")
+    p.add_argument("-o", "--output", metavar="DIR", required=True,
+                   help="folder for design_NAME.csv/.png (created if missing)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.piecewise import parse_segments
+    from chebnorm.approx.textsafe import identifier
+    from chebnorm.hw.piecewise_search import search
+
+    name = identifier(args.name, field="name")
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
+    res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, args.max_error,
+                 degrees=args.degrees, max_index_bits=parse_segments(args.max_segments),
+                 var=args.var, synth=not args.no_synth, name=name)
+    csv, png = res.csv(), res.plot_png()
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / f"design_{name}.csv", csv)
+    write_atomic(out / f"design_{name}.png", png)
+    print(out / f"design_{name}.csv")
+    print(out / f"design_{name}.png")
+    print("\n".join(res.explain()))
+    if res.winner is None:
+        return 1
+    w = res.winner
+    print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
+          f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
+          f"--kind minimax --frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
+          f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
+    return 0
+
+
+def _piecewise_design(args):
+    from chebnorm.approx.piecewise import PiecewiseTable
+    from chebnorm.hw.piecewise import design_piecewise
+
+    for opt in ("coef_bits", "acc_bits", "x_frac_bits", "y_frac_bits"):
+        if getattr(args, opt, None) is not None:
+            raise ValueError(f"--{opt.replace('_', '-')} is not available for a piecewise table "
+                             f"(its coefficient format is the table's; the widths are sized "
+                             f"exactly); accepted: --in-bits and --out-bits")
+    if getattr(args, "rounding", "rne") != "rne":
+        raise ValueError(f"rounding {args.rounding!r}: a piecewise evaluator rounds to nearest "
+                         f"even; accepted: rne")
+    return design_piecewise(PiecewiseTable.load(args.table), args.in_bits, args.out_bits)
+
+
+def hw_verilog(args) -> int:
+    """``chebnorm hw verilog`` of a piecewise table (called by :mod:`chebnorm.cli.hw`)."""
+    from pathlib import Path
+
+    from chebnorm import __version__
+    from chebnorm.approx.files import write_atomic
+    from chebnorm.hw.piecewise import piecewise_outputs
+    from chebnorm.hw.verilog import simulate
+
+    if getattr(args, "pipelined", False):
+        raise ValueError("--pipelined is not available for a piecewise table; accepted: the "
+                         "combinational evaluator")
+    d = _piecewise_design(args)
+    files = piecewise_outputs(d, version=__version__, command=command_line(args))
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    for fname, text in sorted(files.items()):
+        write_atomic(out / fname, text)
+        print(out / fname)
+    if args.simulate:
+        res = simulate(out, d)
+        print(res.line)
+        return 0 if res.passed else 1
+    return 0
+
+
+def hw_report(args) -> int:
+    """``chebnorm hw report`` of a piecewise table: error budget by part, measured error, cells."""
+    from chebnorm.hw.piecewise import piecewise_cells
+    from chebnorm.hw.piecewise_search import model_cost
+
+    d = _piecewise_design(args)
+    b, m = d.budget(), d.measure()
+    cells = None if args.no_synth else piecewise_cells(d).cells
+    rep = {"module": d.module_name, "segments": d.table.segment_count, "degree": d.degree,
+           "in_bits": d.in_bits, "out_bits": d.out_bits,
+           "coef_frac_bits": d.table.coef_frac_bits, "rom_word_bits": list(d.rom_bits),
+           "acc_frac_bits": d.acc_frac_bits, "y_format": d.y_format.as_dict(), "budget": b,
+           "measured": m, "within_budget": m["max_error"] <= b["total"],
+           "model_cost": model_cost(d), "yosys_cells": cells}
+    if args.json:
+        rep["y_format"]["offset"] = float(rep["y_format"]["offset"])
+        print_json(rep)
+        return 0
+    print(f"{d.module_name}: {d.table.segment_count} segments x degree {d.degree}, "
+          f"{d.in_bits}-bit in / {d.out_bits}-bit out, ROM words {list(d.rom_bits)} bits")
+    print(f"error budget |y - f(x)| <= {b['total']:.4e} = approximation "
+          f"{b['approximation']:.4e} + Horner rounding {b['horner_rounding']:.4e} + output "
+          f"rounding {b['output_rounding']:.4e} ({b['total'] / b['y_lsb']:.3f} LSB)")
+    print(f"measured over all {m['codes']} codes: max |y - f(x)| = {m['max_error']:.4e} at code "
+          f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
+    print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
+    return 0

@@ -1,0 +1,268 @@
+"""Design search over piecewise hardware: segments x degree x coefficient bits.
+
+FloPoCo chooses a piecewise evaluator's parameters automatically; this does
+the same, certified and explained. For each degree ``d`` the search walks
+the segment count ``2**k`` up from 1; at each ``(k, d)`` it fits the table
+with generous coefficient bits (``F_hi``) and sizes the hardware
+(:func:`chebnorm.hw.piecewise.design_piecewise`): the total certified bound
+(approximation + Horner rounding + output rounding) says whether the maximum
+error ``E`` is met. At the first ``k`` that meets it (and at ``k + 1``, whose
+smaller coefficients may need fewer bits) the coefficient bits are lowered
+while ``E`` still holds. Every evaluated point becomes a CSV row; the cost is
+first the model estimate (:func:`model_cost`), and Yosys counts cells only on
+the Pareto front's points that meet ``E`` (so the search stays bounded: at
+most ``len(degrees) * (max_index_bits + 1) + 2 * len(degrees) * 16`` fits).
+
+>>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
+...            progress=False)
+>>> w = r.winner
+>>> (w.degree, w.segments, w.total_bound <= 2e-3)
+(1, 32, True)
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass, replace
+
+from chebnorm.approx.piecewise import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE, fit_piecewise
+from chebnorm.approx.textsafe import csv_cell
+
+from .fixed import check_width
+from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
+
+__all__ = ["DesignPoint", "SearchResult", "search", "model_cost", "COLUMNS"]
+
+COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
+           "rom_bits", "approx_bound", "total_bound", "meets", "model_cost", "yosys_cells",
+           "pareto", "winner")
+#: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
+ROM_CELLS_PER_BIT = 0.15
+MAX_SYNTH = 6
+
+
+def model_cost(d: PiecewiseDesign) -> float:
+    """Area estimate in Yosys-cell units: ROM bits x :data:`ROM_CELLS_PER_BIT`,
+    plus ``a * b`` per ``a x b``-bit multiplier and the width of each adder.
+
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=12)
+    >>> round(model_cost(design_piecewise(t, 8, 8)))
+    136
+    """
+    rom = d.table.segment_count * sum(d.rom_bits) * ROM_CELLS_PER_BIT
+    n = d.degree
+    total, acc_w = rom, d.rom_bits[n] if n > 0 else 0
+    for i, (_pw, sw, ow) in enumerate(d.widths):
+        total += acc_w * d.t_bits + sw
+        acc_w = ow
+    return float(total)
+
+
+@dataclass(frozen=True)
+class DesignPoint:
+    degree: int
+    segments: int
+    coef_frac_bits: int
+    acc_frac_bits: int
+    y_frac_bits: int
+    rom_bits: int
+    approx_bound: float
+    total_bound: float
+    meets: bool
+    model_cost: float
+    yosys_cells: int | None = None
+    pareto: bool = False
+
+    @property
+    def cost(self) -> float:
+        return float(self.yosys_cells) if self.yosys_cells is not None else self.model_cost
+
+    def describe(self) -> str:
+        cells = (f"{self.yosys_cells} yosys cells" if self.yosys_cells is not None
+                 else f"~{self.model_cost:.0f} cells (model)")
+        return (f"degree {self.degree}, {self.segments} segments, {self.coef_frac_bits} "
+                f"coefficient bits (ROM {self.rom_bits} bits): {cells}, certified error "
+                f"<= {self.total_bound:.4e}")
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    expression: str
+    interval: tuple[str, str]
+    in_bits: int
+    out_bits: int
+    max_error: float
+    points: tuple[DesignPoint, ...]
+    winner: DesignPoint | None
+    cost_source: str
+    designs: dict
+
+    def csv(self) -> str:
+        out = io.StringIO()
+        out.write(",".join(COLUMNS) + "\n")
+        for p in self.points:
+            row = [p.degree, p.segments, p.coef_frac_bits, p.acc_frac_bits, p.y_frac_bits,
+                   p.rom_bits, f"{p.approx_bound:.6e}", f"{p.total_bound:.6e}", int(p.meets),
+                   f"{p.model_cost:.1f}", "" if p.yosys_cells is None else p.yosys_cells,
+                   int(p.pareto), int(p is self.winner)]
+            out.write(",".join(csv_cell(str(v)) for v in row) + "\n")
+        return out.getvalue()
+
+    def explain(self) -> list[str]:
+        """Why the winner wins: its cost and bound, and the best alternative per degree."""
+        if self.winner is None:
+            return [f"no design meets max error {self.max_error:.4e}; closest: "
+                    + min(self.points, key=lambda p: p.total_bound).describe()]
+        w = self.winner
+        lines = [f"winner: {w.describe()} <= max error {self.max_error:.4e} "
+                 f"(cost by {self.cost_source})"]
+        for deg in sorted({p.degree for p in self.points}):
+            ok = [p for p in self.points if p.degree == deg and p.meets]
+            if not ok:
+                best = min((p for p in self.points if p.degree == deg),
+                           key=lambda p: p.total_bound)
+                lines.append(f"  degree {deg}: no design meets the bound up to {best.segments} "
+                             f"segments (best {best.total_bound:.4e})")
+                continue
+            b = min(ok, key=lambda p: (p.cost, p.total_bound))
+            if b is w:
+                continue
+            lines.append(f"  degree {deg}: best is {b.describe()} -- costlier by "
+                         f"{b.cost - w.cost:.0f}: ROM {b.rom_bits} vs {w.rom_bits} bits, "
+                         f"{b.degree} vs {w.degree} multiply-adds")
+        return lines
+
+    def plot_png(self) -> bytes:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(7, 4.5), dpi=120)
+        for deg in sorted({p.degree for p in self.points}):
+            pts = [p for p in self.points if p.degree == deg]
+            ax.scatter([p.model_cost for p in pts], [p.total_bound for p in pts], s=18,
+                       label=f"degree {deg}")
+        front = sorted((p for p in self.points if p.pareto), key=lambda p: p.model_cost)
+        ax.step([p.model_cost for p in front], [p.total_bound for p in front], where="post",
+                color="k", lw=1, label="Pareto front")
+        ax.axhline(self.max_error, color="r", ls="--", lw=1, label="max error")
+        if self.winner is not None:
+            ax.scatter([self.winner.model_cost], [self.winner.total_bound], s=90,
+                       facecolors="none", edgecolors="r", label="winner")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("model cost (Yosys-cell units)")
+        ax.set_ylabel("certified max |y - f(x)|")
+        ax.set_title(f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", metadata={"Software": None})
+        plt.close(fig)
+        return buf.getvalue()
+
+
+def _point(d: PiecewiseDesign) -> DesignPoint:
+    b = d.budget()
+    return DesignPoint(d.degree, d.table.segment_count, d.table.coef_frac_bits,
+                       d.acc_frac_bits, d.y_format.frac_bits,
+                       d.table.segment_count * sum(d.rom_bits), d.table.abs_error_bound,
+                       b["total"], False, model_cost(d))
+
+
+def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
+           degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
+           progress: bool = True, name: str = "design") -> SearchResult:
+    """Cheapest certified piecewise design meeting ``max_error`` (module docstring)."""
+    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) or \
+            not math.isfinite(max_error) or max_error <= 0:
+        raise ValueError(f"max-error {max_error!r} is not a positive number; accepted: E > 0")
+    degrees = tuple(sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees}))
+    if not degrees:
+        raise ValueError("degrees: empty; accepted: one or more of 0..8")
+    kmax = check_width(max_index_bits, "max-index-bits", 0, min(12, in_bits - 1))
+    f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(degrees) * (kmax + 1), desc="design search", unit="fit",
+                   leave=False)
+    designs: dict[tuple[int, int, int], PiecewiseDesign] = {}
+
+    def evaluate(d, k, f):
+        key = (d, k, f)
+        if key not in designs:
+            t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
+                              name=name)
+            designs[key] = design_piecewise(t, in_bits, out_bits)
+        return designs[key]
+
+    points: dict[tuple[int, int, int], DesignPoint] = {}
+    for d in degrees:
+        first = None
+        for k in range(kmax + 1):
+            des = evaluate(d, k, f_hi)
+            p = _point(des)
+            points[(d, k, f_hi)] = replace(p, meets=p.total_bound <= max_error)
+            if bar is not None:
+                bar.update(1)
+            if points[(d, k, f_hi)].meets:
+                first = k
+                break
+        if bar is not None and first is not None:
+            bar.update(kmax - first)
+        if first is None:
+            continue
+        for k in (first, first + 1):
+            if k > kmax:
+                continue
+            for f in range(f_hi - 1, 0, -1):
+                des = evaluate(d, k, f)
+                p = _point(des)
+                p = replace(p, meets=p.total_bound <= max_error)
+                points[(d, k, f)] = p
+                if not p.meets:
+                    break
+            if (d, k, f_hi) not in points:
+                p = _point(evaluate(d, k, f_hi))
+                points[(d, k, f_hi)] = replace(p, meets=p.total_bound <= max_error)
+    if bar is not None:
+        bar.close()
+    keys = sorted(points)
+    # Pareto front over (model cost, total bound)
+    front = set()
+    for key in keys:
+        p = points[key]
+        dominated = any(q.model_cost <= p.model_cost and q.total_bound <= p.total_bound
+                        and (q.model_cost, q.total_bound) != (p.model_cost, p.total_bound)
+                        for q in points.values())
+        if not dominated:
+            front.add(key)
+    for key in front:
+        points[key] = replace(points[key], pareto=True)
+    cost_source = "model estimate"
+    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: points[k].model_cost)
+    if synth and meeting:
+        import shutil
+
+        if shutil.which("yosys") is not None:
+            from .piecewise import piecewise_cells
+
+            cost_source = "yosys cells"
+            chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
+            for key in chosen:
+                points[key] = replace(points[key], yosys_cells=piecewise_cells(designs[key]).cells)
+    ordered = tuple(points[k] for k in keys)
+    winner = None
+    if meeting:
+        pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
+                                                   or cost_source == "model estimate")]
+        winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
+    return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
+                        float(max_error), ordered, winner, cost_source,
+                        {k: designs[k] for k in keys})
