@@ -7,7 +7,12 @@ Runs, in one process and one sitting:
   on the same cases, in one sollya process, each part timed by Sollya's own
   ``time()``; so the ratio compares certification with certification.
 
-Usage: python benchmarks/bench_fit.py [--json] [--repeat N] [--tight T ...]
+Piecewise workload (issue 13): certify every segment of the 256-segment
+degree-2 table of ``1/sqrt(x)`` on [1, 4) (24-bit fixed-point coefficients),
+against one Sollya process running ``supnorm`` on each segment's composed
+function ``f(a_s + h t)``, t in [0, 1], same coefficients, same tightness.
+
+Usage: python benchmarks/bench_fit.py [--json] [--repeat N] [--tight T ...] [--piecewise-only]
 Not a test: timings are printed, nothing is asserted.
 """
 
@@ -76,15 +81,84 @@ def run_sollya(tight: float):
     return float(m.group(1)), float(m.group(2)), float(m.group(3)), wall
 
 
+PIECEWISE = ("1/sqrt(x)", ("1", "4"), 2, 256, 24)
+
+
+def run_piecewise_chebnorm(table, tight: float):
+    from chebnorm.approx.piecewise import certify_segments
+
+    t0 = time.perf_counter()
+    certs = certify_segments(table, tol=tight)
+    elapsed = time.perf_counter() - t0
+    return elapsed, max(c.bound / c.maximum - 1 for c in certs), max(c.bound for c in certs)
+
+
+def run_piecewise_sollya(table, tight: float):
+    expr = sollya._sollya_expr(table.expression, table.variable)
+    lines = ["prec=200!;", "display=decimal!;", f"f={expr};", "ts=0; w=0; b=0;"]
+    for s in range(table.segment_count):
+        a, b = table.segment_bounds(s)
+        ints = table.segments[s].integers
+        poly = " + ".join(f"({q})*2^(-{table.coef_frac_bits})*x^{j}" for j, q in enumerate(ints))
+        lines += [f"g=f(({sp.sstr(a)}) + ({sp.sstr(b - a)})*x);", f"p={poly};",
+                  f"t=time(r=supnorm(p, g, [0;1], absolute, {tight!r})); ts=ts+t;",
+                  "w=max(w, sup(r)/inf(r)-1); b=max(b, sup(r));"]
+    lines += ['print("TIMES", ts, w, b);', "quit;"]
+    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
+        fh.write("\n".join(lines) + "\n")
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
+                             stdin=subprocess.DEVNULL).stdout
+    finally:
+        os.unlink(fh.name)
+    wall = time.perf_counter() - t0
+    m = re.search(r"TIMES\s+(\S+)\s+(\S+)\s+(\S+)", out)
+    if m is None:
+        raise RuntimeError(f"sollya printed no timing line; its output began: {out[:200]!r}")
+    return float(m.group(1)), float(m.group(2)), float(m.group(3)), wall
+
+
+def piecewise_rows(tights, repeat: int) -> list[dict]:
+    from chebnorm.approx.piecewise import fit_piecewise
+
+    expr, interval, degree, segments, frac = PIECEWISE
+    table = fit_piecewise(expr, interval, degree, segments=segments, coef_frac_bits=frac)
+    rows = []
+    for tight in tights:
+        ours = [run_piecewise_chebnorm(table, tight) for _ in range(repeat)]
+        row = {"workload": f"piecewise {segments} x degree {degree} {expr} on [{interval[0]}, "
+                           f"{interval[1]})", "tightness": tight,
+               "chebnorm_certify_s": statistics.median(o[0] for o in ours),
+               "chebnorm_worst_bound_over_max": max(o[1] for o in ours),
+               "chebnorm_bound": ours[0][2], "load_average_1min": os.getloadavg()[0]}
+        if sollya.available():
+            try:
+                theirs = [run_piecewise_sollya(table, tight) for _ in range(repeat)]
+                row.update({"sollya_supnorm_s": statistics.median(t[0] for t in theirs),
+                            "sollya_worst_upper_over_lower": max(t[1] for t in theirs),
+                            "sollya_bound": theirs[0][2],
+                            "sollya_wall_s": statistics.median(t[3] for t in theirs)})
+                row["certify_speedup"] = row["sollya_supnorm_s"] / row["chebnorm_certify_s"]
+            except (RuntimeError, OSError) as exc:
+                row["sollya"] = f"sollya run failed: {exc}"
+        else:
+            row["sollya"] = "not installed: apt-get install sollya to compare"
+        rows.append(row)
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--tight", type=float, nargs="+", default=[2.0 ** -8, 2.0 ** -20])
+    ap.add_argument("--piecewise-only", action="store_true",
+                    help="run only the piecewise workload")
     args = ap.parse_args(argv)
     fit(*WORKLOAD[0][:2], 1)  # warm-up: imports, lambdify caches
     results = []
-    for tight in args.tight:
+    for tight in ([] if args.piecewise_only else args.tight):
         ours = [run_chebnorm(tight) for _ in range(args.repeat)]
         row = {"tightness": tight, "cases": len(WORKLOAD),
                "chebnorm_fit_s": statistics.median(o[0] for o in ours),
@@ -107,8 +181,9 @@ def main(argv=None) -> int:
         elif "sollya" not in row:
             row["sollya"] = "not installed: apt-get install sollya to compare"
         results.append(row)
+    pw = piecewise_rows(args.tight, args.repeat)
     if args.json:
-        print(json.dumps(results, indent=2, sort_keys=True))
+        print(json.dumps(results + pw, indent=2, sort_keys=True))
     else:
         for r in results:
             print(f"tightness {r['tightness']:.3g}: chebnorm fit {r['chebnorm_fit_s']:.3f} s, "
@@ -119,6 +194,17 @@ def main(argv=None) -> int:
                       f"(worst upper/lower - 1 = {r['sollya_worst_upper_over_lower']:.2e})")
                 print(f"  certification speed-up {r['certify_speedup']:.1f}x; "
                       f"fit + certify {r['fit_and_certify_speedup']:.1f}x")
+            else:
+                print(f"  {r['sollya']}")
+        for r in pw:
+            print(f"{r['workload']}, tightness {r['tightness']:.3g}: chebnorm certify "
+                  f"{r['chebnorm_certify_s']:.3f} s (worst bound/max - 1 = "
+                  f"{r['chebnorm_worst_bound_over_max']:.2e}, bound {r['chebnorm_bound']:.6e}); "
+                  f"load average {r['load_average_1min']:.2f}")
+            if "sollya_supnorm_s" in r:
+                print(f"  sollya supnorm {r['sollya_supnorm_s']:.3f} s (worst upper/lower - 1 = "
+                      f"{r['sollya_worst_upper_over_lower']:.2e}, bound {r['sollya_bound']:.6e}); "
+                      f"speed-up {r['certify_speedup']:.1f}x")
             else:
                 print(f"  {r['sollya']}")
     return 0

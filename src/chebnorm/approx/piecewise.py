@@ -376,6 +376,23 @@ def parse_segments(text) -> int:
     return k
 
 
+def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None = None):
+    """A :class:`~chebnorm.approx.Certificate` of ``sup |p_s - f|`` (or ``p_s/f - 1``)
+    for every segment of ``table``, at relative tightness ``tol`` (default the
+    certifier's).
+
+    >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
+    >>> [c.bound <= s.abs_error_bound for c, s in zip(certify_segments(t), t.segments)]
+    [True, True]
+    """
+    fn = parse_function(table.expression, table.variable)
+    lo, hi = (sp.Rational(v) for v in table.local_range)
+    opts = {} if tol is None else {"tol": tol}
+    return [certify(_local_function(fn, *table.segment_bounds(s), centered=table.centered),
+                    table.coefficients(s), lo, hi, kind, **opts)
+            for s in range(table.segment_count)]
+
+
 def is_piecewise_file(path) -> bool:
     """True when the JSON file ``path`` declares ``kind`` = :data:`PIECEWISE_KIND`
     (so a consumer reads it with :meth:`PiecewiseTable.load`)."""

@@ -222,15 +222,10 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     rom_bits = table.coefficient_word_bits()
     proto = PiecewiseDesign(name, table, in_bits, out_bits, L, 0, QFormat(out_bits, 0), rom_bits,
                             L + 2, (), 0)
-    k = np.arange(2 ** in_bits, dtype=np.int64)
-    # exact range of the polynomial values (no rounding, Python integers) fixes
-    # y's format, and bounds every wire of the rounded datapath
-    exact = _run(proto, k.astype(object), 10 ** 6, 0)
-    for key, v in exact.items():
-        if key.startswith(("p", "s")) and key != "s":
-            check_int64(signed_bits(int(v.min()), int(v.max())) + 2,
-                        f"wire {key} of the Horner datapath ({table.coef_frac_bits} coefficient "
-                        f"fractional bits, {L} local bits)")
+    # sized with Python integers (no overflow possible), then checked to fit the
+    # int64 model: first the exact polynomial values (no rounding) fix y's format
+    k = np.arange(2 ** in_bits, dtype=np.int64).astype(object)
+    exact = _run(proto, k, 10 ** 6, 0)
     top, tf = exact["top"], exact["top_frac"]
     span = Fraction(int(top.max()) - int(top.min()), 2 ** tf)
     fy_max = out_bits - (math.floor(math.log2(span)) if span > 0 else -8)
@@ -241,6 +236,11 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         y_off = int(r.min())
         if int(r.max()) - y_off <= 2 ** out_bits - 1:
             break
+    for key, v in w.items():
+        if key[0] in "psa" and key != "s":
+            check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
+                        f"wire {key} of the Horner datapath ({table.coef_frac_bits} coefficient "
+                        f"fractional bits, {L} local bits)")
     widths = []
     n = table.degree
     for j in range(n - 1, -1, -1):

@@ -202,6 +202,9 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
             designs[key] = design_piecewise(t, in_bits, out_bits)
         return designs[key]
 
+    # the first fit reports a bad expression or interval as it is (one clear error)
+    evaluate(degrees[0], 0, f_hi)
+
     points: dict[tuple[int, int, int], DesignPoint] = {}
     for d in degrees:
         first = None
