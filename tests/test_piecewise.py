@@ -176,3 +176,64 @@ def test_parse_segments():
     assert parse_segments("2**3") == 3
     with pytest.raises(ValueError, match="k = -1"):
         parse_segments("2^-1")
+
+
+def test_design_search_model_only():
+    """The winner meets E with a certified bound, no cheaper meeting point exists,
+    and the CSV and front are deterministic."""
+    from chebnorm.hw.piecewise_search import search
+
+    kw = dict(degrees=(1, 2), synth=False, progress=False, max_index_bits=6)
+    r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, **kw)
+    w = r.winner
+    assert w is not None and w.meets and w.total_bound <= 2e-3
+    assert all(p.model_cost >= w.model_cost for p in r.points if p.meets)
+    # the winner's design really meets the bound: measure it over every code
+    d = r.designs[(w.degree, w.segments.bit_length() - 1, w.coef_frac_bits)]
+    assert d.measure()["max_error"] <= w.total_bound
+    assert any(p.pareto for p in r.points)
+    assert r.csv() == search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, **kw).csv()
+    assert "winner:" in r.explain()[0]
+
+
+def test_design_cli(tmp_path):
+    argv = ["design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "10", "--out-bits",
+            "10", "--max-error", "2e-3", "--degrees", "1", "2", "--max-segments", "2^6",
+            "--no-synth", "-o", str(tmp_path / "out")]
+    r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
+                       text=True, check=False)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "out" / "design_design.csv").read_text().startswith("degree,segments")
+    assert (tmp_path / "out" / "design_design.png").stat().st_size > 1000
+    assert "winner: degree" in r.stdout
+    bad = argv[:]
+    bad[bad.index("2e-3")] = "-1"
+    r = subprocess.run([sys.executable, "-m", "chebnorm", *bad], capture_output=True,
+                       text=True, check=False)
+    assert r.returncode == 2 and "max-error" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_cli_fit_export_hw(tmp_path):
+    def cli(*argv, code=0):
+        r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
+                           text=True, cwd=tmp_path, check=False)
+        assert r.returncode == code, r.stderr
+        return r
+
+    cli("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^3",
+        "--kind", "minimax", "--frac-bits", "20", "--name", "rs", "-o", "rs.json")
+    t = PiecewiseTable.load(tmp_path / "rs.json")
+    assert t.segment_count == 8
+    cli("export", "rs.json", "-o", "rs.h", "--in-bits", "12")
+    assert "chebnorm_rs_coeffs[8][3]" in (tmp_path / "rs.h").read_text()
+    if shutil.which("iverilog"):
+        r = cli("hw", "verilog", "rs.json", "--in-bits", "10", "--out-bits", "10", "-o", "hw",
+                "--simulate")
+        assert "PASS: 1024 vectors, 0 mismatches" in r.stdout
+    r = cli("hw", "report", "rs.json", "--in-bits", "10", "--out-bits", "10", "--no-synth",
+            "--json")
+    rep = json.loads(r.stdout)
+    assert rep["within_budget"] and rep["measured"]["max_error"] <= rep["budget"]["total"]
+    r = cli("hw", "verilog", "rs.json", "--in-bits", "3", "--out-bits", "10", "-o", "hw", code=2)
+    assert "in-bits = 3 is out of range; accepted: 4 <= in-bits <= 20" in r.stderr

@@ -129,8 +129,13 @@ class SearchResult:
             b = min(ok, key=lambda p: (p.cost, p.total_bound))
             if b is w:
                 continue
+            # compare like with like: yosys cells when both were synthesized, else the model
+            if b.yosys_cells is not None and w.yosys_cells is not None:
+                diff, unit = b.yosys_cells - w.yosys_cells, "yosys cells"
+            else:
+                diff, unit = b.model_cost - w.model_cost, "model cells"
             lines.append(f"  degree {deg}: best is {b.describe()} -- costlier by "
-                         f"{b.cost - w.cost:.0f}: ROM {b.rom_bits} vs {w.rom_bits} bits, "
+                         f"{diff:.0f} {unit}: ROM {b.rom_bits} vs {w.rom_bits} bits, "
                          f"{b.degree} vs {w.degree} multiply-adds")
         return lines
 
