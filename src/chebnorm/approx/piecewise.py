@@ -333,16 +333,20 @@ class _LocalFunction:
         self._a, self._w = arb_enclose(sp.sympify(a)), arb_enclose(sp.sympify(b - a))
         self._shift = 0.5 if centered else 0.0
         self._af, self._wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
-        f_series, f_np = fn.arb_series, fn.numpy
+        f_series, f_point, f_np = fn.arb_series, fn.arb, fn.numpy
         a_b, w_b, sh = self._a, self._w, self._shift
 
         def series(s):
             return f_series(a_b + w_b * (s + sh))
 
+        def point(x):
+            return f_point(a_b + w_b * (x + sh))
+
         def numpy_(t):
             return f_np(self._af + self._wf * (np.asarray(t, dtype=float) + sh))
 
         self.arb_series = series
+        self.arb = point
         self.numpy = numpy_
 
     def __str__(self) -> str:
