@@ -94,6 +94,8 @@ def run_piecewise_chebnorm(table, tight: float):
 
 
 def run_piecewise_sollya(table, tight: float):
+    import sympy as sp
+
     expr = sollya._sollya_expr(table.expression, table.variable)
     lines = ["prec=200!;", "display=decimal!;", f"f={expr};", "ts=0; w=0; b=0;"]
     for s in range(table.segment_count):

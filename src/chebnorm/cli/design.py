@@ -58,7 +58,7 @@ def run(args) -> int:
     w = res.winner
     print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
           f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
-          f"--kind minimax --frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
+          f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
           f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
     return 0
 
