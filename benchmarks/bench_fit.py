@@ -96,13 +96,13 @@ def run_piecewise_chebnorm(table, tight: float):
 def run_piecewise_sollya(table, tight: float):
     import sympy as sp
 
-    expr = sollya._sollya_expr(table.expression, table.variable)
+    expr = sollya.function_text(table.expression, table.variable)
     lines = ["prec=200!;", "display=decimal!;", f"f={expr};", "ts=0; w=0; b=0;"]
     for s in range(table.segment_count):
         a, b = table.segment_bounds(s)
         ints = table.segments[s].integers
         poly = " + ".join(f"({q})*2^(-{table.coef_frac_bits})*x^{j}" for j, q in enumerate(ints))
-        lines += [f"g=f(({sp.sstr(a)}) + ({sp.sstr(b - a)})*x);", f"p={poly};",
+        lines += [f"g=f(({sp.sstr(a)}) + ({sp.sstr(b - a)})*x);".replace("**", "^"), f"p={poly};",
                   f"t=time(r=supnorm(p, g, [0;1], absolute, {tight!r})); ts=ts+t;",
                   "w=max(w, sup(r)/inf(r)-1); b=max(b, sup(r));"]
     lines += ['print("TIMES", ts, w, b);', "quit;"]

@@ -34,7 +34,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.files import make_folder, write_atomic
     from chebnorm.approx.piecewise import parse_segments
     from chebnorm.approx.textsafe import identifier
     from chebnorm.hw.piecewise_search import search
@@ -47,7 +47,7 @@ def run(args) -> int:
                  degrees=args.degrees, max_index_bits=parse_segments(args.max_segments),
                  var=args.var, synth=not args.no_synth, name=name)
     csv, png = res.csv(), res.plot_png()
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     write_atomic(out / f"design_{name}.csv", csv)
     write_atomic(out / f"design_{name}.png", png)
     print(out / f"design_{name}.csv")
@@ -83,7 +83,7 @@ def hw_verilog(args) -> int:
     from pathlib import Path
 
     from chebnorm import __version__
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.files import make_folder, write_atomic
     from chebnorm.hw.piecewise import piecewise_outputs
     from chebnorm.hw.verilog import simulate
 
@@ -93,7 +93,7 @@ def hw_verilog(args) -> int:
     d = _piecewise_design(args)
     files = piecewise_outputs(d, version=__version__, command=command_line(args))
     out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     for fname, text in sorted(files.items()):
         write_atomic(out / fname, text)
         print(out / fname)
@@ -130,4 +130,24 @@ def hw_report(args) -> int:
     print(f"measured over all {m['codes']} codes: max |y - f(x)| = {m['max_error']:.4e} at code "
           f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
     print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
+    return 0
+
+
+def hw_sweep_piecewise(args) -> int:
+    """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot."""
+    from pathlib import Path
+
+    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.approx.piecewise import parse_segments
+    from chebnorm.hw.piecewise_search import grid
+
+    res = grid(args.expr or "1/sqrt(x)", tuple(args.interval or ("1", "4")), args.in_bits,
+               args.out_bits, index_bits=[parse_segments(v) for v in args.segments],
+               degrees=args.degrees or (1, 2, 3), coef_frac_bits=args.coef_bits or (12, 16, 20),
+               synth=not args.no_synth)
+    out = make_folder(Path(args.output))
+    write_atomic(out / "sweep_piecewise.csv", res.csv())
+    write_atomic(out / "sweep_piecewise.png", res.plot_png())
+    print(out / "sweep_piecewise.csv")
+    print(out / "sweep_piecewise.png")
     return 0

@@ -109,6 +109,12 @@ def register(sub) -> None:
     s.add_argument("--out-bits", type=int, default=12, help="default 12")
     s.add_argument("--rounding", default="rne")
     s.add_argument("--no-synth", action="store_true", help="area estimate instead of yosys cells")
+    s.add_argument("--segments", nargs="+", default=None, metavar="2^k",
+                   help="piecewise sweep of EXPR (--expr, --interval): segment counts x "
+                   "--degrees x --coef-frac-bits (see chebnorm design)")
+    s.add_argument("--expr", default=None, help="piecewise sweep: the function (default 1/sqrt(x))")
+    s.add_argument("--interval", nargs=2, default=None, metavar=("LO", "HI"),
+                   help="piecewise sweep: rational endpoints (default 1 4)")
     s.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
     s.set_defaults(func=run_sweep)
 
@@ -242,6 +248,9 @@ def run_sweep(args) -> int:
 
     out = Path(args.output)
     _check_output(out)
+    if args.segments is not None:
+        from .design import hw_sweep_piecewise
+        return hw_sweep_piecewise(args)
     get_target(args.target).interval(args.psi_max)  # read --psi-max (exactly, safely) up front
     res = sweep(args.target, degrees=args.degrees or DEFAULT_DEGREES,
                 coef_bits=args.coef_bits or DEFAULT_COEF_BITS,

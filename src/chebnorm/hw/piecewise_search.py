@@ -32,7 +32,7 @@ from chebnorm.approx.textsafe import csv_cell
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
 
-__all__ = ["DesignPoint", "SearchResult", "search", "model_cost", "COLUMNS"]
+__all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS"]
 
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
            "rom_bits", "approx_bound", "total_bound", "meets", "model_cost", "yosys_cells",
@@ -274,3 +274,55 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
                         float(max_error), ordered, winner, cost_source,
                         {k: designs[k] for k in keys})
+
+
+def grid(expr, interval, in_bits: int, out_bits: int, *, index_bits=(0, 2, 4, 6, 8),
+         degrees=(1, 2, 3), coef_frac_bits=(12, 16, 20), max_error: float | None = None,
+         var: str = "x", synth: bool = False, progress: bool = True,
+         name: str = "sweep") -> SearchResult:
+    """Every ``(2**k segments, degree, coefficient bits)`` of the grid, fitted,
+    certified and sized: the piecewise ``hw sweep`` (no search, no pruning).
+    With ``synth`` Yosys counts the cells of every point. ``max_error``
+    (optional) marks the points that meet it and picks the cheapest.
+
+    >>> r = grid("1/sqrt(x)", ("1", "4"), 8, 8, index_bits=(1, 2), degrees=(1,),
+    ...          coef_frac_bits=(10,), progress=False)
+    >>> [(p.segments, p.degree) for p in r.points]
+    [(2, 1), (4, 1)]
+    """
+    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    ks = sorted({check_width(k, "index bits k", 0, min(12, in_bits - 1)) for k in index_bits})
+    ds = sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees})
+    fs = sorted({check_width(f, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS) for f in coef_frac_bits})
+    if not ks or not ds or not fs:
+        raise ValueError("empty sweep list; accepted: at least one segment count, degree and "
+                         "coefficient width")
+    limit = math.inf if max_error is None else float(max_error)
+    items = [(d, k, f) for d in ds for k in ks for f in fs]
+    it = items
+    if progress:
+        from tqdm import tqdm
+        it = tqdm(items, desc="piecewise sweep", unit="design", leave=False)
+    points, designs = [], {}
+    for d, k, f in it:
+        t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
+                          name=name)
+        des = design_piecewise(t, in_bits, out_bits)
+        p = _point(des)
+        p = replace(p, meets=max_error is not None and p.total_bound <= limit)
+        if synth:
+            from .piecewise import piecewise_cells
+            p = replace(p, yosys_cells=piecewise_cells(des).cells)
+        points.append(p)
+        designs[(d, k, f)] = des
+    front = [p for p in points if not any(
+        q.cost <= p.cost and q.total_bound <= p.total_bound
+        and (q.cost, q.total_bound) != (p.cost, p.total_bound) for q in points)]
+    points = [replace(p, pareto=p in front) for p in points]
+    ok = [p for p in points if p.meets]
+    winner = min(ok, key=lambda p: (p.cost, p.total_bound)) if ok else None
+    return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
+                        limit if max_error is not None else max(p.total_bound for p in points),
+                        tuple(points), winner, "yosys cells" if synth else "model estimate",
+                        designs)
