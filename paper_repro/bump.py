@@ -22,11 +22,11 @@ from pathlib import Path
 import numpy as np
 
 from chebnorm.hw.datapaths import bump_pipeline, phong_pipeline
-from chebnorm.raster import bump_comparison, error_map_rgb
+from chebnorm.raster import bump_comparison
 from chebnorm.symbolic import bump_coefficients_square_expr
 
 from .paths import paper_dir
-from .style import figure, save_figure, write_csv, write_json
+from .style import error_map, figure, save_figure, write_csv, write_json
 
 __all__ = ["JOB", "run", "fig_bump_renders", "fig_pipeline_costs", "measure_c12", "measure_c13"]
 
@@ -87,7 +87,8 @@ def fig_bump_renders(out) -> list[Path]:
                "[a, b, c] = [-F_u (B.P_v), F_u (T.P_v) - F_v |P_u|, |P_u x P_v|] (reference), the "
                "square-patch simplification [-F_u/k, -F_v/k, 1] and the object-space variant, on a "
                f"flat square (a square patch: they agree), a sphere and a torus ({SIZE[0]}x{SIZE[1]} "
-               "px); error maps |difference to full| in 8-bit levels on one scale per row.")
+               "px); error maps |difference to full| in 8-bit levels on one scale for the whole figure, "
+               "with its colour bar beside each map.")
     rows = []
     for c in cases:
         for variant, d in (("square", c.square_vs_full), ("object", c.object_vs_full)):
@@ -95,22 +96,24 @@ def fig_bump_renders(out) -> list[Path]:
     paths = [write_csv(folder, "bump_renders", ("mesh", "variant", "k", *_METRICS), rows, caption, CMD,
                        ["k: the patch scale |P_u| used by the square-patch coefficients; "
                         "psnr nan = identical images"])]
-    with figure(len(cases), 5, figsize=(11.0, 2.4 * len(cases))) as (fig, axes):
+    # one scale for every error map of the figure, so a 3-level and a 62-level error look different
+    scale = max([1.0] + [float(np.abs(c.images[k]).max()) for c in cases
+                         for k in ("square_error", "object_error")])
+    with figure(len(cases), 5, figsize=(12.0, 2.5 * len(cases))) as (fig, axes):
         for r, c in enumerate(cases):
-            scale = max(1.0, float(np.abs(c.images["square_error"]).max()),
-                        float(np.abs(c.images["object_error"]).max()))
-            panels = ((c.images["full"], f"{c.mesh}: full"), (c.images["square"], "square patch"),
-                      (c.images["object"], "object space"),
-                      (error_map_rgb(c.images["square_error"], scale),
-                       f"|square - full| (max {c.square_vs_full['max_abs_8bit']})"),
-                      (error_map_rgb(c.images["object_error"], scale),
-                       f"|object - full| (max {c.object_vs_full['max_abs_8bit']})"))
+            panels = ((c.images["full"], f"{c.mesh}: full (reference)"),
+                      (c.images["square"], "square patch"), (c.images["object"], "object space"))
             for ax, (im, title) in zip(axes[r], panels):
                 ax.imshow(im, interpolation="nearest", cmap="gray", vmin=0, vmax=255)
                 ax.set_title(title, fontsize=8)
                 ax.set_axis_off()
-        fig.suptitle("Seed 001: square-patch bump coefficients against the full formula "
-                     "(error maps: black 0 to white = row max, 8-bit levels)")
+            error_map(fig, axes[r][3], c.images["square_error"], scale,
+                      f"|square - full|, max {c.square_vs_full['max_abs_8bit']} levels")
+            error_map(fig, axes[r][4], c.images["object_error"], scale,
+                      f"|object - full|, max {c.object_vs_full['max_abs_8bit']} levels")
+        fig.suptitle("Seed 001: the square-patch coefficients are exact on the square and err on the "
+                     "sphere and torus; the object-space variant stays near 0 "
+                     f"(error maps: one scale, 0-{scale:g} 8-bit levels)")
         paths += save_figure(fig, folder, "bump_renders", caption)
     paths.append(write_json(folder / "c12_summary.json", {**measure_c12(), "command": CMD}))
     return paths
@@ -131,21 +134,34 @@ def fig_pipeline_costs(out) -> list[Path]:
             "latency", "area_fa")
     rows = [("phong", *r) for r in m["rows_phong"]] + [("bump", *r) for r in m["rows_bump"]]
     paths = [write_csv(folder, "pipeline_costs", cols, rows, caption, CMD)]
-    with figure(figsize=(7.0, 3.6)) as (fig, ax):
+    with figure(figsize=(8.0, 3.4)) as (fig, ax):
         depth = [(r, r[0].count(" > ")) for r in m["rows_bump"]]
         # the Phong pipeline's top-level blocks, then the bump pipeline's own addition
-        tops = [r for r, k in depth if k == 2] + [r for r, k in depth if k == 1 and "Phong" not in r[0]]
-        names = [r[0].split(" > ")[-1] for r in tops]
-        areas = [r[8] for r in tops]
-        y = np.arange(len(names))
-        ax.barh(y, areas, color=["C0"] * (len(names) - 1) + ["C1"])
-        ax.set_yticks(y, names)
-        ax.set_xscale("log")
-        ax.set_xlabel("area (full-adder equivalents, log scale)")
-        ax.set_title(f"Seed 001: bump pipeline = Phong pipeline + {m['extra_mux_bits']}-bit mux "
-                     f"(+{100 * m['extra_area_fraction']:.2f} % area)")
-        for yy, a in zip(y, areas):
-            ax.text(a, yy, f" {a:.0f}", va="center", fontsize=7)
+        tops = [r for r, k in depth if k == 2]
+        extra = [r for r, k in depth if k == 1 and "Phong" not in r[0]]
+        total_b = sum(r[8] for r in tops + extra)
+        colors = ["#0072B2", "#56B4E9", "#009E73", "#CC79A7", "#999999", "#000000"]
+        for yy, (label, blocks) in enumerate((("Phong", tops), ("bump", tops + extra))):
+            left = 0.0
+            for i, r in enumerate(blocks):
+                is_extra = r in extra
+                ax.barh(yy, r[8], left=left, height=0.55, edgecolor="white", lw=0.5,
+                        color="#D55E00" if is_extra else colors[i % len(colors)],
+                        label=(r[0].split(" > ")[-1] if yy == 1 else None))
+                left += r[8]
+            ax.text(left, yy, f" {left:.0f} FA", va="center", fontsize=8)
+        mux = sum(r[8] for r in extra)
+        ax.annotate(f"multiplexer: {mux:.0f} FA = {100 * mux / total_b:.2f} % of the bump pipeline",
+                    xy=(total_b - mux / 2, 1.3), xytext=(0.45 * total_b, 1.75), fontsize=8,
+                    color="#D55E00", arrowprops={"arrowstyle": "->", "color": "#D55E00"})
+        ax.set_yticks([0, 1], ["Phong pipeline", "bump pipeline"])
+        ax.set_ylim(-0.5, 2.1)
+        ax.set_xlim(0, 1.12 * total_b)
+        ax.set_xlabel("area (full-adder equivalents, linear scale)")
+        ax.legend(fontsize=7, ncol=3, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False)
+        ax.set_title(f"Seed 001: the bump pipeline is the Phong pipeline plus a {m['extra_mux_bits']}-bit "
+                     f"multiplexer (+{100 * m['extra_area_fraction']:.2f} % area; model, not synthesis)",
+                     pad=40)
         paths += save_figure(fig, folder, "pipeline_costs", caption)
     return paths
 

@@ -24,8 +24,12 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullLocator
 
-from chebnorm.approx import fit_target
+import mpmath
+import sympy as sp
+
+from chebnorm.approx import certify, fit_target, parse_function
 from chebnorm.methods import detmath
 from chebnorm.symbolic import delta_d, delta_s, eta, midpoint_normal, norm2_linear_np
 
@@ -35,7 +39,8 @@ from .style import figure, save_figure, write_csv, write_json
 __all__ = ["JOB", "run", "fig1_chord_arc", "fig2_delta_d", "fig3_linear_fit",
            "fig4_quadratic_fit", "fig5_delta_s", "eta_tightness", "measure_c1",
            "phi_at_delta_s", "measure_eta_fits", "measure_eta_tightness",
-           "interior_min_norm", "interior_min_norm_grid"]
+           "interior_min_norm", "interior_min_norm_grid", "measure_eta_readings",
+           "eta_readings_table", "truncated_chebyshev_series", "READINGS"]
 
 JOB = "seed003_criterion"
 CMD = f"chebnorm repro {JOB}"
@@ -88,6 +93,100 @@ def measure_eta_fits() -> dict:
             "command": f"chebnorm fit \"sqrt(2*(1+x))/2\" --var x --interval 0 1 --degree {degree}",
         }
     return out
+
+
+ETA_EXPR = "sqrt(2*(1+x))/2"
+#: the three readings of seed 003's "expand each term of (1) in a Chebyshev polynomial"
+READINGS = ("series", "interpolation", "minimax")
+
+
+def truncated_chebyshev_series(degree: int, dps: int = 40) -> list[float]:
+    """The degree-``degree`` truncation of the Chebyshev series of ``g(x) = sqrt(2(1+x))/2`` on
+    [0, 1] (``x = (t + 1)/2``), ``sum_k c_k T_k(t)`` with
+    ``c_k = (2/pi) int_0^pi g((cos u + 1)/2) cos(k u) du`` (``c_0`` halved), as coefficients
+    in ascending powers of ``x`` (mpmath quadrature at ``dps`` digits).
+
+    >>> [round(c, 6) for c in truncated_chebyshev_series(1)]
+    [0.713941, 0.291811]
+    """
+    with mpmath.workdps(dps):
+        g = lambda u: mpmath.sqrt(2 * (1 + (mpmath.cos(u) + 1) / 2)) / 2  # noqa: E731
+        ck = [2 / mpmath.pi * mpmath.quad(lambda u, k=k: g(u) * mpmath.cos(k * u), [0, mpmath.pi])
+              for k in range(degree + 1)]
+        ck[0] /= 2
+        # T_k(t) in powers of t, then t = 2x - 1
+        t_pows = [[mpmath.mpf(0)] * (degree + 1) for _ in range(degree + 1)]
+        t_pows[0][0] = mpmath.mpf(1)
+        if degree >= 1:
+            t_pows[1][1] = mpmath.mpf(1)
+        for k in range(2, degree + 1):
+            for j in range(degree + 1):
+                t_pows[k][j] = (2 * t_pows[k - 1][j - 1] if j else 0) - t_pows[k - 2][j]
+        in_t = [sum(ck[k] * t_pows[k][j] for k in range(degree + 1)) for j in range(degree + 1)]
+        in_x = [mpmath.mpf(0)] * (degree + 1)
+        for j, a in enumerate(in_t):          # a (2x - 1)^j
+            for i in range(j + 1):
+                in_x[i] += a * mpmath.binomial(j, i) * mpmath.mpf(2) ** i * (-1) ** (j - i)
+        return [float(c) for c in in_x]
+
+
+def _error_shape(coeffs) -> dict:
+    """Where p - g has its extrema and zeros on [0, 1] (a dense grid): what a plotted error
+    curve of the reading looks like."""
+    x = np.linspace(0.0, 1.0, 20001)
+    e = np.polynomial.polynomial.polyval(x, coeffs) - np.sqrt(2.0 * (1.0 + x)) / 2.0
+    pos = e > 0
+    zeros = x[:-1][pos[:-1] != pos[1:]]
+    return {"error_at_0": float(e[0]), "error_at_1": float(e[-1]),
+            "zeros": [float(z) for z in zeros],
+            "endpoint_over_max": max(abs(e[0]), abs(e[-1])) / float(np.abs(e).max())}
+
+
+@lru_cache(maxsize=None)
+def measure_eta_readings() -> dict:
+    """Claim C3: for degrees 1 and 2, the three readings of "a Chebyshev polynomial" of
+    ``g(x) = sqrt(2(1+x))/2`` on [0, 1] - the truncated Chebyshev series, interpolation at the
+    Chebyshev nodes (chebnorm's ``eta_term`` target) and the minimax (Remez) fit - with their
+    coefficients, certified abs and rel errors and the shape of their error curves."""
+    fn = parse_function(ETA_EXPR, "x")
+    out = {}
+    for degree in (1, 2):
+        for reading in READINGS:
+            if reading == "series":
+                c = truncated_chebyshev_series(degree)
+            else:
+                t = fit_target("eta_term", degree, kind="chebyshev" if reading == "interpolation"
+                               else "minimax")
+                c = [float(v) for v in t.coefficients]
+            ca = certify(fn, c, sp.Integer(0), sp.Integer(1), "abs")
+            cr = certify(fn, c, sp.Integer(0), sp.Integer(1), "rel")
+            out[f"d{degree}_{reading}"] = {"degree": degree, "reading": reading, "coefficients": c,
+                                           "max_abs_error": ca.maximum, "abs_error_bound": ca.bound,
+                                           "max_rel_error": cr.maximum, "rel_error_bound": cr.bound,
+                                           **_error_shape(c)}
+    return out
+
+
+def eta_readings_table(out) -> list[Path]:
+    """The three readings of claim C3 side by side (one CSV)."""
+    folder = _dir(out)
+    r = measure_eta_readings()
+    caption = ("Seed 003, Figs. 3-4 (claim C3): three readings of 'a Chebyshev polynomial' of "
+               "g(x) = sqrt(2(1+x))/2 on [0, 1] - the truncated Chebyshev series, interpolation at "
+               "the Chebyshev nodes (the eta_term table) and the minimax fit - with certified errors "
+               "and where each error curve crosses zero.")
+    rows = []
+    for key in sorted(r, key=lambda k: (r[k]["degree"], READINGS.index(r[k]["reading"]))):
+        e = r[key]
+        c = list(e["coefficients"]) + [float("nan")] * (3 - len(e["coefficients"]))
+        rows.append((e["degree"], e["reading"], *c, e["max_abs_error"], e["abs_error_bound"],
+                     e["max_rel_error"], e["rel_error_bound"], e["error_at_0"], e["error_at_1"],
+                     " ".join(f"{z:.4f}" for z in e["zeros"])))
+    return [write_csv(folder, "eta_readings",
+                      ("degree", "reading", "c0", "c1", "c2", "max_abs_error", "abs_error_bound",
+                       "max_rel_error", "rel_error_bound", "error_at_0", "error_at_1", "zeros"),
+                      rows, caption, CMD, ["coefficients in ascending powers of x; nan = absent; "
+                                           "error = p - g"])]
 
 
 def _table(degree: int):
@@ -379,21 +478,38 @@ def fig5_delta_s(out) -> list[Path]:
     paths.append(write_csv(folder, "fig5_phi_at_1_percent", ("n", "phi_rad", "phi_deg"),
                            [(int(n), float(p), math.degrees(p)) for n, p in zip(nn, p1)],
                            caption, CMD, ["phi at which delta_s(phi, n) = 1 %"]))
-    with figure(1, 2, figsize=(8.6, 3.6)) as (fig, (a1, a2)):
+    with figure(1, 2, figsize=(9.0, 3.8)) as (fig, (a1, a2)):
+        phi_deg = np.degrees(phi)
         for n, line in zip(ns, grid):
-            a1.plot(phi, 100 * line, label=f"n = {n}")
-        a1.axhline(1.0, color="0.5", ls="--", lw=1)
+            a1.plot(phi_deg, 100 * line, label=f"n = {n}")
+        a1.axhline(1.0, color="0.5", ls="--", lw=1, label="1 %")
         a1.set_yscale("log")
         a1.set_ylim(1e-3, 100)
-        a1.set_xlabel("angle phi between N_A and N_B (rad)")
+        a1.set_xlim(0, float(phi_deg[-1]))
+        a1.set_xlabel("angle phi between N_A and N_B (deg)")
         a1.set_ylabel("largest relative specular error delta_s (%)")
-        a1.legend(ncol=2, fontsize=7)
-        a2.plot(nn, np.degrees(p1))
+        a1.legend(ncol=3, fontsize=7)
+        a2.plot(nn, np.degrees(p1), color="C0", label="phi_1%(n) = 2 arccos(0.99^(1/n))")
+        pts = [i for i, n in enumerate(nn) if n in ns]
+        a2.plot(nn[pts], np.degrees(p1[pts]), "o", color="#D55E00", ms=4,
+                label="computed points (n = 1, 2, 4, ..., 128)")
+        for i in pts:
+            a2.annotate(f"{math.degrees(p1[i]):.2f}", (nn[i], math.degrees(p1[i])), fontsize=6,
+                        textcoords="offset points", xytext=(4, 3))
         a2.set_xscale("log", base=2)
         a2.set_yscale("log")
+        a2.xaxis.set_major_locator(FixedLocator([1, 2, 4, 8, 16, 32, 64, 128]))
+        a2.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        a2.xaxis.set_minor_locator(NullLocator())
+        a2.yaxis.set_major_locator(FixedLocator([1, 1.5, 2, 3, 4, 6, 10, 16]))
+        a2.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+        a2.yaxis.set_minor_locator(NullLocator())
+        a2.set_ylim(1.2, 20)
         a2.set_xlabel("specular exponent n")
         a2.set_ylabel("phi where delta_s = 1 % (deg)")
-        fig.suptitle("Seed 003 Fig. 5: relative specular error without normalization")
+        a2.legend(fontsize=7)
+        fig.suptitle("Seed 003 Fig. 5: without normalization the specular error passes 1 % at "
+                     "16 deg for n = 1 but below 3 deg for n >= 32")
         paths += save_figure(fig, folder, "fig5_delta_s", caption)
     return paths
 
@@ -443,6 +559,7 @@ def eta_tightness(out) -> list[Path]:
 
 
 FIGURES = (fig1_chord_arc, fig2_delta_d, fig3_linear_fit, fig4_quadratic_fit, eta_fit_table,
+           eta_readings_table,
            fig5_delta_s, eta_tightness)
 
 

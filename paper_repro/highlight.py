@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from chebnorm.raster import error_map_rgb, split_gouraud_study
+from chebnorm.raster import split_gouraud_study
 from chebnorm.symbolic import edge_highlight
 
 from .paths import paper_dir
-from .style import figure, save_figure, write_csv, write_json
+from .style import error_map, figure, save_figure, write_csv, write_json
 
 __all__ = ["JOB", "run", "fig_triangulation", "fig_render_comparison", "fig_split_sweep",
            "measure_c11", "measure_split_sweep", "triangulation_cases"]
@@ -84,6 +84,16 @@ def triangulation_cases() -> list[dict]:
     return out
 
 
+def _label(ax, text, anchor, direction, offset_pt, **kw):
+    """Annotate ``text`` ``offset_pt`` points from ``anchor`` along the unit ``direction``,
+    aligned so that the text extends away from the anchor."""
+    dx, dy = float(direction[0]), float(direction[1])
+    ha = "left" if dx > 0.35 else "right" if dx < -0.35 else "center"
+    va = "bottom" if dy > 0.35 else "top" if dy < -0.35 else "center"
+    return ax.annotate(text, tuple(anchor), textcoords="offset points",
+                       xytext=(offset_pt * dx, offset_pt * dy), ha=ha, va=va, **kw)
+
+
 def fig_triangulation(out) -> list[Path]:
     """Seed 002, Fig. 4: one, two and three highlighted edges give 2, 3 and 4 sub-triangles."""
     folder = _dir(out)
@@ -104,7 +114,8 @@ def fig_triangulation(out) -> list[Path]:
                         "split"), rows, caption, CMD,
                        ["vertex normals (unnormalized): " + str(_NRM.tolist()),
                         "triangle (2D): " + str(_POS.tolist())])]
-    with figure(1, 3, figsize=(9.0, 3.3)) as (fig, axes):
+    centroid = _POS.mean(axis=0)
+    with figure(1, 3, figsize=(10.5, 3.9)) as (fig, axes):
         for ax, c, k in zip(axes, cases, range(3)):
             for tri in c["sub_triangles"]:
                 p = np.array(tri + [tri[0]])
@@ -114,17 +125,24 @@ def fig_triangulation(out) -> list[Path]:
                 if c["split"][e]:
                     q = _POS[i] + c["t"][e] * (_POS[j] - _POS[i])
                     ax.plot(*q, "o", color="C1", ms=5)
-                    ax.annotate(f"t*={c['t'][e]:.2f}", q, textcoords="offset points",
-                                xytext=(4, -10 if e == 0 else 4), fontsize=7)
+                    # outside the triangle, along the edge's outward normal
+                    tang = _unit(_POS[j] - _POS[i])
+                    nrm = np.array([tang[1], -tang[0]])
+                    if nrm @ (q - centroid) < 0:
+                        nrm = -nrm
+                    _label(ax, f"t*={c['t'][e]:.2f}", q, nrm, 9, fontsize=7, color="#D55E00")
             for name, p in zip("ABC", _POS):
-                ax.annotate(name, p, textcoords="offset points", xytext=(-8, 2))
+                _label(ax, name, p, _unit(p - centroid), 6, fontsize=9)
             nsplit = sum(c["split"])
             ax.set_title(f"{nsplit} edge{'s' if nsplit > 1 else ''} -> "
                          f"{len(c['sub_triangles'])} sub-triangles (n = {c['n']})")
             ax.set_aspect("equal")
+            ax.set_xlim(-0.3, 1.3)
+            ax.set_ylim(-0.22, 1.05)
             ax.set_xlabel("x (triangle units)")
             ax.set_ylabel("y (triangle units)")
-        fig.suptitle("Seed 002 Fig. 4: triangulation at the edge highlight points")
+        fig.suptitle("Seed 002 Fig. 4: each highlighted edge (orange t*, where the specular peak "
+                     "exceeds q) adds a vertex; 1, 2, 3 edges give 2, 3, 4 sub-triangles")
         paths += save_figure(fig, folder, "fig4_triangulation", caption)
     return paths
 
@@ -173,21 +191,24 @@ def fig_render_comparison(out) -> list[Path]:
                                                          else f"{k}={st[k]}" for k in sorted(st))])]
     img = s.images
     scale = max(1.0, float(np.abs(img["gouraud_error"]).max()), float(np.abs(img["split_gouraud_error"]).max()))
-    with figure(2, 3, figsize=(9.0, 6.2)) as (fig, axes):
+    with figure(2, 3, figsize=(10.0, 6.4)) as (fig, axes):
         panels = ((img["phong"], "Phong (reference)"), (img["gouraud"], "Gouraud"),
-                  (img["split_gouraud"], "split Gouraud"),
-                  (None, ""), (error_map_rgb(img["gouraud_error"], scale), "|Gouraud - Phong|"),
-                  (error_map_rgb(img["split_gouraud_error"], scale), "|split Gouraud - Phong|"))
-        for ax, (im, title) in zip(axes.flat, panels):
+                  (img["split_gouraud"], "split Gouraud"))
+        for ax, (im, title) in zip(axes[0], panels):
             ax.set_axis_off()
-            if im is not None:
-                ax.imshow(im, interpolation="nearest", cmap="gray", vmin=0, vmax=255)
-                ax.set_title(title)
-        axes[1, 0].text(0.0, 0.5, f"error maps: black 0 to white {scale:g}\n8-bit levels\n\n"
+            ax.imshow(im, interpolation="nearest", cmap="gray", vmin=0, vmax=255)
+            ax.set_title(title)
+        axes[1, 0].set_axis_off()
+        error_map(fig, axes[1, 1], img["gouraud_error"], scale,
+                  f"|Gouraud - Phong|, max {rows[0][1]} levels")
+        error_map(fig, axes[1, 2], img["split_gouraud_error"], scale,
+                  f"|split Gouraud - Phong|, max {rows[1][1]} levels")
+        axes[1, 0].text(0.0, 0.5, f"error maps: one scale,\n0 to {scale:g} 8-bit levels\n\n"
                         + "\n".join(f"{m}: max {r[1]}, mean {r[2]:.2f}" for m, r in
-                                    zip(("Gouraud", "split"), rows)),
+                                     zip(("Gouraud", "split"), rows)),
                         transform=axes[1, 0].transAxes, va="center", fontsize=8)
-        fig.suptitle("Seed 002 Fig. 5: Gouraud vs split Gouraud vs Phong")
+        fig.suptitle("Seed 002 Fig. 5: split Gouraud brings the highlight closer to Phong "
+                     "(smaller, dimmer error maps)")
         paths += save_figure(fig, folder, "fig5_render_comparison", caption)
     return paths
 

@@ -34,12 +34,12 @@ from chebnorm.methods import (METHODS, analyze, angular_drift, count_ops, error_
 
 from .benchmarks import load_results
 from .paths import paper_dir
-from .style import figure, save_figure, write_csv, write_json, write_text
+from .style import METHOD_STYLE, figure, save_figure, write_csv, write_json, write_text
 
 __all__ = ["JOB", "run", "methods_table", "fig_op_counts", "fig_error_vs_angle",
            "fig_error_vs_length", "fig_dichotomy_interval", "fig_angular_drift",
            "measure_dichotomy", "measure_op_counts", "measure_method_errors",
-           "measure_inaccuracy_thresholds", "measure_drift"]
+           "measure_inaccuracy_thresholds", "measure_drift", "measure_midpoint_cost"]
 
 JOB = "seed000_normalization"
 CMD = f"chebnorm repro {JOB}"
@@ -273,46 +273,94 @@ def fig_op_counts(out) -> list[Path]:
     return paths
 
 
+#: the lowest error drawn by the error figures (8-bit levels); smaller values sit on it, clipped
+PLOT_FLOOR = 1e-7
+#: the quadratic method with the exact midpoint normal (N_l + N_r)/|N_l + N_r| instead of the
+#: midpoint polynomial: what the polynomial costs
+QUAD_EXACT = "quadratic_exact_midpoint"
+
+
+@lru_cache(maxsize=None)
+def measure_midpoint_cost(psi: float = 0.1) -> dict:
+    """The quadratic method (64 px, float64) with the midpoint polynomial against the exact
+    midpoint normal at span angle ``psi`` (rad): length and vector errors and their ratios."""
+    poly = analyze("quadratic", psi, SPAN_M)
+    exact = analyze("quadratic", psi, SPAN_M, tables={"quadratic": None})
+    return {"psi_rad": psi, "span_pixels": SPAN_M,
+            "length_error_polynomial": poly.max_length_error,
+            "length_error_exact_midpoint": exact.max_length_error,
+            "length_ratio": poly.max_length_error / exact.max_length_error,
+            "vector_error_polynomial": poly.max_vector_error,
+            "vector_error_exact_midpoint": exact.max_vector_error,
+            "vector_ratio": poly.max_vector_error / exact.max_vector_error}
+
+
 def fig_error_vs_angle(out) -> list[Path]:
-    """Each method's largest error against the span angle (0..45 deg, 64 pixels)."""
+    """Each method's largest error against the span angle (0..45 deg, 64 pixels), with the
+    quadratic method's exact-midpoint variant beside it."""
     folder = _dir(out)
     psis = np.radians(np.linspace(1.0, 45.0, 45))
     methods = tuple(m for m in METHODS if m != "exact")
     s = error_sweep(methods, psis, (SPAN_M,), (np.float64, np.float32))
+    sx = error_sweep(("quadratic",), psis, (SPAN_M,), (np.float64, np.float32),
+                     tables={"quadratic": None})
+    mc = measure_midpoint_cost()
+
+    def get(q, m, dt):
+        return sx.get(q, "quadratic", dt, m=SPAN_M) if m == QUAD_EXACT else s.get(q, m, dt, m=SPAN_M)
+    shown = methods[:methods.index("quadratic") + 1] + (QUAD_EXACT,) + methods[methods.index("quadratic") + 1:]
     caption = (f"Seed 000: each method's largest error on a span of {SPAN_M} pixels against the "
                "angle between its end normals, in 8-bit levels. Left: 255 |N - R| against Phong's "
                "exactly normalized linear interpolant R (the largest diffuse error over all lights; "
                "the slerp family - slerp, dichotomy, angular - spaces normals evenly in angle and so "
                "differs from R by a parametrization term ~psi^3/40 even when exact). Right: the "
-               "length error 255 | |N| - 1 |. float64 solid, float32 dotted; the table methods use "
-               "the degree-2 tables fitted for psi_max = pi/4. Dashed: half a level.")
+               "length error 255 | |N| - 1 |. float64 solid, float32 dotted; colour and marker "
+               "name the method; the table methods use the degree-2 tables fitted for "
+               "psi_max = pi/4. The quadratic method's midpoint normal comes from a polynomial "
+               "fitted on [cos(max(psi, pi/4)), 1]; quadratic_exact_midpoint uses the exact "
+               f"(N_l + N_r)/|N_l + N_r| instead: at psi = {mc['psi_rad']:g} rad the polynomial's "
+               f"length error is {mc['length_ratio']:.0f}x the exact midpoint's. Dashed: half a "
+               f"level. Values below {PLOT_FLOOR:g} levels are drawn on the shaded floor (clipped).")
     rows = []
-    for m in methods:
+    for m in shown:
         for dt in ("float64", "float32"):
-            v = s.get("vector_error", m, dt, m=SPAN_M)
-            sp = s.get("specular_error", m, dt, m=SPAN_M)[:, SPEC_N - 1]
-            ln = s.get("length_error", m, dt, m=SPAN_M)
+            v = get("vector_error", m, dt)
+            sp = get("specular_error", m, dt)[:, SPEC_N - 1]
+            ln = get("length_error", m, dt)
             rows += [(m, dt, float(p), math.degrees(p), float(a), float(c), float(b))
                      for p, a, c, b in zip(psis, v, ln, sp)]
     paths = [write_csv(folder, "error_vs_angle", ("method", "dtype", "psi_rad", "psi_deg",
                                                   "vector_error", "length_error",
                                                   f"specular_n{SPEC_N}_error"),
                        rows, caption, CMD)]
-    with figure(1, 2, figsize=(9.0, 4.0)) as (fig, (a1, a2)):
+    from matplotlib.lines import Line2D
+    with figure(1, 2, figsize=(10.0, 4.6)) as (fig, (a1, a2)):
         for ax, q in ((a1, "vector_error"), (a2, "length_error")):
-            for i, m in enumerate(methods):
+            for m in shown:
+                color, marker = METHOD_STYLE[m]
                 for dt, ls in (("float64", "-"), ("float32", ":")):
-                    v = np.maximum(LEVELS * s.get(q, m, dt, m=SPAN_M), 1e-7)
-                    ax.plot(np.degrees(psis), v, ls, color=f"C{i}",
-                            label=m if dt == "float64" else None)
+                    v = np.maximum(LEVELS * get(q, m, dt), PLOT_FLOOR)
+                    ax.plot(np.degrees(psis), v, ls=ls, color=color, marker=marker, ms=4,
+                            markevery=(3 if dt == "float64" else 6, 8),
+                            mfc=color if dt == "float64" else "none", label=None)
             ax.axhline(0.5, color="0.4", ls="--", lw=1)
+            ax.axhspan(PLOT_FLOOR / 3, PLOT_FLOOR, color="0.85", lw=0)
+            ax.text(44.5, PLOT_FLOOR * 0.55, f"floor: below {PLOT_FLOOR:g}, clipped", ha="right",
+                    va="center", fontsize=7, color="0.3")
             ax.set_yscale("log")
-            ax.set_ylim(1e-7, 100)
-            ax.set_xlabel("angle between the span's end normals (deg)")
+            ax.set_ylim(PLOT_FLOOR / 3, 100)
+            ax.set_xlim(0, 46)
+            ax.set_xlabel("angle psi between the span's end normals (deg)")
         a1.set_ylabel("255 |N - R|, against Phong (8-bit levels)")
         a2.set_ylabel("255 | |N| - 1 |, length error (8-bit levels)")
-        a1.legend(ncol=2)
-        fig.suptitle(f"Seed 000: error against span angle ({SPAN_M} px)")
+        keys = [Line2D([], [], color=METHOD_STYLE[m][0], marker=METHOD_STYLE[m][1], ms=5, label=m)
+                for m in shown]
+        keys += [Line2D([], [], color="0.2", ls="-", label="float64"),
+                 Line2D([], [], color="0.2", ls=":", mfc="none", label="float32"),
+                 Line2D([], [], color="0.4", ls="--", lw=1, label="half a level")]
+        fig.legend(handles=keys, loc="outside right center", fontsize=7)
+        fig.suptitle(f"Seed 000: error against span angle ({SPAN_M} px): which methods stay under "
+                     "half an 8-bit level (dashed), in float64 and float32")
         paths += save_figure(fig, folder, "error_vs_angle", caption)
     return paths
 

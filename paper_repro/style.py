@@ -39,12 +39,24 @@ from matplotlib.figure import Figure
 from chebnorm.approx.files import write_atomic
 
 __all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "stable_svg_ids", "write_csv",
-           "write_json", "write_text", "fmt", "COLORS"]
+           "write_json", "write_text", "fmt", "COLORS", "METHOD_STYLE", "ERROR_MAP", "ERROR_CMAP",
+           "error_map", "error_maps_of"]
 
 #: the float format of every CSV cell
 FLOAT_FORMAT = "%.10g"
 #: a colour-blind-safe cycle (Okabe-Ito)
 COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
+#: per span method: (colour, marker), distinct in colour for colour-blind readers and, through
+#: the marker, in greyscale (Okabe-Ito colours; the line style is left to encode the number format)
+METHOD_STYLE = {
+    "none": ("#000000", "o"), "newton": ("#0072B2", "s"), "lyon": ("#D55E00", "^"),
+    "slerp": ("#009E73", "D"), "dichotomy": ("#CC79A7", "v"), "quadratic": ("#E69F00", "P"),
+    "quadratic_exact_midpoint": ("#7F7F7F", "X"), "angular": ("#56B4E9", "*"),
+}
+#: the label of every axes that shows an error map (the tests find them by it)
+ERROR_MAP = "error map"
+#: error maps: perceptually uniform, dark = no error, readable in greyscale
+ERROR_CMAP = "magma"
 RC = {
     "figure.figsize": (6.4, 4.2),
     "figure.dpi": 100,
@@ -73,6 +85,25 @@ def figure(nrows: int = 1, ncols: int = 1, **kwargs):
         FigureCanvasAgg(fig)
         axes = fig.subplots(nrows, ncols, **kwargs)
         yield fig, axes
+
+
+def error_map(fig, ax, diff, vmax: float, title: str):
+    """Draw ``|diff|`` (8-bit levels) on ``ax`` from 0 to ``vmax`` (one scale for the whole
+    figure) with its own colour bar in 8-bit levels; the axes is labelled :data:`ERROR_MAP`."""
+    im = ax.imshow(np.abs(np.asarray(diff, dtype=float)), interpolation="nearest", cmap=ERROR_CMAP,
+                   vmin=0.0, vmax=float(vmax))
+    ax.set_title(title, fontsize=8)
+    ax.set_axis_off()
+    ax.set_label(ERROR_MAP)
+    bar = fig.colorbar(im, ax=ax, shrink=0.85, pad=0.02)
+    bar.set_label("8-bit levels", fontsize=7)
+    bar.ax.tick_params(labelsize=7)
+    return im
+
+
+def error_maps_of(fig) -> list:
+    """The axes of ``fig`` drawn by :func:`error_map`, each with its image (``(ax, image)``)."""
+    return [(ax, ax.images[0]) for ax in fig.axes if ax.get_label() == ERROR_MAP and ax.images]
 
 
 def write_text(path: Path, text: str) -> Path:
