@@ -478,6 +478,21 @@ def _level_rel(f, high) -> float:
     return 0.5 * (lo_c + hi_c)
 
 
+def _check_binades(lo, hi, index_bits: int) -> None:
+    """Refuse an exponent-indexed interval that is not [2^e0, 2^e1] of a few binades."""
+    e0, e1 = _exact_log2(lo), _exact_log2(hi)
+    if e0 is None or e1 is None:
+        raise ValueError(f"segment-by exponent needs an interval [2^e0, 2^e1] of powers of "
+                         f"two, got [{lo}, {hi}]; accepted: e.g. --interval 1/4 4")
+    if not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
+        raise ValueError(f"segment-by exponent: {e1 - e0} binades; accepted: 1 to "
+                         f"{MAX_EXPONENT_SPAN}")
+    if (e1 - e0) * 2 ** index_bits > 2 ** MAX_INDEX_BITS:
+        raise ValueError(f"segment-by exponent: {e1 - e0} binades x 2^{index_bits} = "
+                         f"{(e1 - e0) * 2 ** index_bits} segments; accepted: at most "
+                         f"2^{MAX_INDEX_BITS}")
+
+
 def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = "uniform",
                   coef_frac_bits: int = 24, centered: bool = False, fit: str = "minimax",
                   error: str = "abs", var: str = "x", name: str = "table",
@@ -515,17 +530,7 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
     if not arb_enclose(lo) < arb_enclose(hi):
         raise ValueError(f"interval [{lo}, {hi}] is empty or reversed; accepted: LO < HI")
     if segment_by == "exponent":
-        e0, e1 = _exact_log2(lo), _exact_log2(hi)
-        if e0 is None or e1 is None:
-            raise ValueError(f"segment-by exponent needs an interval [2^e0, 2^e1] of powers of "
-                             f"two, got [{lo}, {hi}]; accepted: e.g. --interval 1/4 4")
-        if not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
-            raise ValueError(f"segment-by exponent: {e1 - e0} binades; accepted: 1 to "
-                             f"{MAX_EXPONENT_SPAN}")
-        if (e1 - e0) * 2 ** index_bits > 2 ** MAX_INDEX_BITS:
-            raise ValueError(f"segment-by exponent: {e1 - e0} binades x 2^{index_bits} = "
-                             f"{(e1 - e0) * 2 ** index_bits} segments; accepted: at most "
-                             f"2^{MAX_INDEX_BITS}")
+        _check_binades(lo, hi, index_bits)
     count = _segment_count(segment_by, lo, hi, index_bits)
     loc = (-0.5, 0.5) if centered else (0.0, 1.0)
     limit = 2 ** MAX_COEF_INT_BITS
