@@ -95,3 +95,14 @@ def test_engine_names():
     assert fast.resolve_engine("auto") == "numba"
     with pytest.raises(ValueError, match="accepted: auto, numpy, numba"):
         render("sphere", size=(8, 8), tess=4, engine="gpu")
+
+
+def test_render_identical_other_lighting():
+    from chebnorm.raster import Lighting
+
+    for light in (Lighting(half_vector="triangle", shininess=7.3, ka=0.0),
+                  Lighting(I0=3.0, light=(0.2, -1.0, 0.5), kd=0.9, ks=0.8)):
+        ref = render("teapot", "phong", "lyon", size=SIZE, lighting=light, engine="numpy")
+        got = render("teapot", "phong", "lyon", size=SIZE, lighting=light, engine="numba")
+        assert _same(got.image, ref.image) and _same(got.normal_length, ref.normal_length)
+        assert _same(got.triangle, ref.triangle)

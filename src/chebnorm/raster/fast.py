@@ -561,3 +561,75 @@ def _angular_setup(ops, nl, nr, t0, dt, n, start_at_left):
     c = ops.minimum(K.dot(nl, nr), 1.0)
     k2 = ops.cos(ops.arccos(c) * dt) * 2.0
     return _stack(p0), _stack(p1), np.ascontiguousarray(k2)
+
+
+# ---------------------------------------------------------------- shading
+@_njit
+def _half_vectors_kernel(frag_span, frag_t, left, right, c0, sel, L, eye):
+    """``_unit(L + _unit(eye - P))`` at the fragments ``sel``, ``P`` interpolated from
+    attribute columns ``c0 .. c0+2`` (the reference's operation order)."""
+    n = sel.shape[0]
+    H = np.empty((n, 3), np.float64)
+    for i in range(n):
+        f = sel[i]
+        s = frag_span[f]
+        t = frag_t[f]
+        lo0, lo1, lo2 = left[s, c0], left[s, c0 + 1], left[s, c0 + 2]
+        p0 = lo0 + t * (right[s, c0] - lo0)
+        p1 = lo1 + t * (right[s, c0 + 1] - lo1)
+        p2 = lo2 + t * (right[s, c0 + 2] - lo2)
+        v0, v1, v2 = eye[0] - p0, eye[1] - p1, eye[2] - p2
+        r = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        v0, v1, v2 = v0 / r, v1 / r, v2 / r
+        h0, h1, h2 = L[0] + v0, L[1] + v1, L[2] + v2
+        r = np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+        H[i, 0] = h0 / r
+        H[i, 1] = h1 / r
+        H[i, 2] = h2 / r
+    return H
+
+
+def fast_half_vectors(sp: Spans, col: int, vis, L, eye) -> np.ndarray:
+    """Per-pixel Blinn half vectors at the visible fragments (positions in attribute
+    columns ``col .. col+2``), as :mod:`.render` computes them."""
+    return _half_vectors_kernel(sp.frag_span, sp.frag_t, np.ascontiguousarray(sp.left),
+                                np.ascontiguousarray(sp.right), int(col),
+                                np.asarray(vis, np.int64), np.asarray(L, np.float64),
+                                np.asarray(eye, np.float64))
+
+
+@_njit
+def _shade_kernel(ndotl, ndoth, N, pixel, tri_of, light, n_pixels):
+    # light: I0, ka, kd, ks, shininess
+    img = np.zeros(n_pixels, np.float64)
+    mask = np.zeros(n_pixels, np.bool_)
+    tri = np.full(n_pixels, -1, np.int64)
+    nlen = np.full(n_pixels, np.nan, np.float64)
+    I0, ka, kd, ks, sh = light[0], light[1], light[2], light[3], light[4]
+    for i in range(pixel.shape[0]):
+        a = ndotl[i]
+        b = ndoth[i]
+        a = a if (a >= 0.0 or a != a) else 0.0      # np.maximum(a, 0.0)
+        b = b if (b >= 0.0 or b != b) else 0.0
+        v = I0 * (ka + kd * a + ks * b ** sh)
+        if v < 0.0:
+            v = 0.0
+        elif v > 1.0:
+            v = 1.0
+        p = pixel[i]
+        img[p] = v
+        mask[p] = True
+        tri[p] = tri_of[i]
+        nlen[p] = np.sqrt(N[i, 0] * N[i, 0] + N[i, 1] * N[i, 1] + N[i, 2] * N[i, 2])
+    return img, mask, tri, nlen
+
+
+def fast_shade(ndotl, ndoth, N, pixel, tri_of, lighting, n_pixels):
+    """Blinn-Phong intensities clipped to [0, 1] scattered into the image, with the
+    coverage mask, the triangle map (-1 off the mesh) and ``|N|`` (NaN off the mesh)."""
+    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess],
+                     np.float64)
+    return _shade_kernel(np.ascontiguousarray(ndotl, np.float64),
+                         np.ascontiguousarray(ndoth, np.float64),
+                         np.ascontiguousarray(N, np.float64), np.asarray(pixel, np.int64),
+                         np.asarray(tri_of, np.int64), light, int(n_pixels))

@@ -442,6 +442,19 @@ def _phong(st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None):
             "eta_max": float(eta.max()) if len(eta) else 0.0,
         })
     N = N[vis]
+    if st.engine == "numba":
+        # the same operations as below, compiled; dot products stay numpy's (their
+        # summation order is numpy's and BLAS's)
+        if per_pixel_h:
+            H = fast.fast_half_vectors(sp, 4, vis, st.L, st.camera.eye)
+        else:
+            H = _tri_half(st)[sp.tri[sp.frag_span[vis]]]
+        img, mask, tri, nlen = fast.fast_shade(N @ st.L, _dot(N, H), N, sp.frag_pixel[vis],
+                                               st.tri[sp.tri[sp.frag_span[vis]]], lighting,
+                                               st.width * st.height)
+        shape = (st.height, st.width)
+        return _ModeResult(img.reshape(shape), mask.reshape(shape), sp.n_fragments, stats,
+                           triangle=tri.reshape(shape), normal_length=nlen.reshape(shape))
     if per_pixel_h:
         H = _half_vectors(st.L, st.camera.eye, st.lerp_visible(sp, [4, 5, 6], vis))
     else:
