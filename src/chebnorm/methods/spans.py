@@ -243,7 +243,7 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     """
     inp = check_span_input(method, n_left, n_right, m, t0=t0, dt=dt, count=count, tables=tables,
                            dtype=dtype)
-    spec, dtype, kern, nl, nr = inp.spec, inp.dtype, inp.kernel, inp.n_left, inp.n_right
+    dtype, kern, nl, nr = inp.dtype, inp.kernel, inp.n_left, inp.n_right
     dt_arr, t0_arr, cnt, levels, coeffs = inp.dt, inp.t0, inp.count, inp.levels, inp.coefficients
     if angular_reanchor is not None and (not isinstance(angular_reanchor, (int, np.integer))
                                          or isinstance(angular_reanchor, bool)
