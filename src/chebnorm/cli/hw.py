@@ -7,6 +7,7 @@ import json
 from chebnorm.approx import CoefficientTable
 
 from ._common import command_line, deprecated_alias, print_json
+from ._parallel import add_parallel_args
 
 
 def _design_args(p) -> None:
@@ -116,6 +117,7 @@ def register(sub) -> None:
     s.add_argument("--interval", nargs=2, default=None, metavar=("LO", "HI"),
                    help="piecewise sweep: rational endpoints (default 1 4)")
     s.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
+    add_parallel_args(s)
     s.set_defaults(func=run_sweep)
 
 
@@ -256,7 +258,7 @@ def run_sweep(args) -> int:
                 coef_bits=args.coef_bits or DEFAULT_COEF_BITS,
                 acc_bits=args.acc_bits or DEFAULT_ACC_BITS, in_bits=args.in_bits,
                 out_bits=args.out_bits, rounding=args.rounding, psi_max=args.psi_max,
-                synth=not args.no_synth)
+                synth=not args.no_synth, workers=args.workers, scheduler=args.scheduler)
     csv, png = res.csv(), res.plot_png()
     make_folder(out)  # only now: nothing is created when the sweep fails
     stem = f"sweep_{args.target}"

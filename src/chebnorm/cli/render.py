@@ -45,6 +45,9 @@ def register(sub) -> None:
     p.add_argument("--error-map", metavar="ERR.png", help="write a heat map of |error| "
                    "(formats as --out)")
     p.add_argument("--json", action="store_true", help="print metrics and mode report as JSON")
+    p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
+                   help="numba: the compiled path (same image bytes); numpy: the reference; "
+                        "auto (default): numba when installed")
     p.set_defaults(func=run)
 
 
@@ -94,8 +97,8 @@ def run(args) -> int:
                 raise ValueError(f"{option}: {exc}") from None
     lighting = Lighting(shininess=args.shininess, half_vector=args.half_vector)
     mesh = get_mesh(args.mesh, args.tess, _crease_radians(args.crease_angle))
-    common = dict(size=tuple(args.size), lighting=lighting, eta_threshold=args.eta_threshold,
-                  q=args.q)
+    common = dict(size=tuple(args.size), lighting=lighting, engine=args.engine,
+                  eta_threshold=args.eta_threshold, q=args.q)
     result = render(mesh, args.shading, args.method, bump=args.bump, **common)
     reference = render(mesh, ref_mode, ref_method, bump=ref_bump, dtype=np.float64, **common)
     metrics, diff = compare(result, reference)

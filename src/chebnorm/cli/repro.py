@@ -5,7 +5,10 @@ Regenerates every output under the output folder (``-o``, default
 target (job ``coefficients``, part of the library), and every job that the
 paper reproduction registers through the ``chebnorm.repro`` entry point (the
 library does not import it by name). Each job writes its files atomically,
-so an interrupted run keeps every file that was finished.
+so an interrupted run keeps every file that was finished. The jobs are
+independent: ``--workers N`` runs them on local processes (default: the core
+count), ``--scheduler ADDRESS`` on a Dask scheduler; each job writes the same
+files whatever runs it.
 
 Where things are is given or taken from the current directory, never from
 where chebnorm is installed: ``--ledger-dir`` (default: ``./paper_repro``
@@ -29,6 +32,9 @@ from pathlib import Path
 from chebnorm.approx import TARGETS, fit_target, target_names
 from chebnorm.approx.files import write_atomic
 from chebnorm.export import c_header, json_text
+from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
+
+from ._parallel import add_parallel_args, parallel_kwargs
 
 #: fractional bits of the fixed-point part of the exported tables
 EXPORT_FRAC_BITS = 24
@@ -114,12 +120,17 @@ def register(sub) -> None:
                    help="benchmark results read for the speed claims (default "
                         "./benchmarks/results.json when it exists; without it they read n/a)")
     p.add_argument("--list", action="store_true", help="list the jobs and exit")
+    add_parallel_args(p)
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from tqdm import tqdm
+def _run_job(item) -> int:
+    """Run the repro job ``name`` into ``out`` (on a worker); the number of files written."""
+    name, out, bench, ledger_dir = item
+    return len(jobs()[name](Path(out), bench_results=bench, ledger_dir=ledger_dir) or [])
 
+
+def run(args) -> int:
     available = jobs()
     if args.list:
         for name in available:
@@ -133,6 +144,8 @@ def run(args) -> int:
         raise ValueError(f"--bench-results {bench!r} is not a file; accepted: the results.json "
                          f"written by `python benchmarks/run.py`")
     selected = args.names or list(available)
+    check_workers(args.workers)
+    check_scheduler(args.scheduler)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     installed = installed_versions()
@@ -143,11 +156,9 @@ def run(args) -> int:
             print(f"chebnorm repro: versions differ from {out / PROVENANCE}, so bytes may differ: "
                   + ", ".join(diff), file=sys.stderr)
     start = time.perf_counter()
-    count = 0
-    bar = tqdm(selected, desc="chebnorm repro", unit="job", disable=None)
-    for name in bar:
-        bar.set_postfix_str(name)
-        count += len(available[name](out, bench_results=bench, ledger_dir=args.ledger_dir) or [])
+    count = sum(map_ordered(_run_job, [(name, str(out), bench, args.ledger_dir)
+                                       for name in selected],
+                            progress=True, desc="chebnorm repro", **parallel_kwargs(args)))
     write_atomic(out / PROVENANCE, json.dumps({"command": "chebnorm repro", "versions": installed},
                                               sort_keys=True, indent=2) + "\n")
     count += 1

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import io
 import shutil
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from chebnorm.approx import fit_target, get_target
+from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -143,16 +143,37 @@ def _validate_list(values, name, lo, hi) -> tuple[int, ...]:
     return vals
 
 
+def _design_point(item) -> SweepPoint:
+    """One design of the grid: built, measured over every input code, synthesized
+    (run by :func:`map_ordered` on a worker)."""
+    target, table, d, c, a, in_bits, out_bits, rounding, use_yosys = item
+    design = design_horner(table, in_bits, out_bits, coef_bits=c, acc_bits=a,
+                           rounding=rounding, name=f"{target}_d{d}_c{c}_a{a or 0}")
+    b, m = error_budget(design), measure(design)
+    cells = synthesize_text(verilog_module(design), design.module_name).cells if use_yosys \
+        else None
+    return SweepPoint(degree=d, coef_bits=c, acc_bits=a, in_bits=in_bits, out_bits=out_bits,
+                      y_frac_bits=design.y_format.frac_bits, max_error=m.total,
+                      max_error_lsb=m.total_lsb, budget=b.total, budget_lsb=b.total / b.y_lsb,
+                      shading_levels=m.shading_levels, yosys_cells=cells,
+                      area_fa=horner_block(design).cost.area)
+
+
 def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAULT_COEF_BITS,
           acc_bits=DEFAULT_ACC_BITS, in_bits: int = 12, out_bits: int = 12,
-          rounding: str = "rne", psi_max="pi/4", synth: bool = True, jobs: int = 4,
-          progress: bool = True) -> SweepResult:
+          rounding: str = "rne", psi_max="pi/4", synth: bool = True, workers: int | None = None,
+          scheduler=None, progress: bool = True) -> SweepResult:
     """Evaluate every design of the grid exhaustively and (with yosys) synthesize it.
 
     Degree-1 designs have no intermediate accumulator, so ``acc_bits`` does
-    not apply to them (one point per coefficient width).
+    not apply to them (one point per coefficient width).  The designs run on
+    ``workers`` local processes (default: the core count) or on a Dask
+    ``scheduler`` (:func:`chebnorm.approx.parallel.map_ordered`); the result is
+    the same whatever runs it.
     """
     get_target(target)
+    workers = check_workers(workers)
+    check_scheduler(scheduler)
     degrees = _validate_list(degrees, "degree", 1, 4)
     coef_bits = _validate_list(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
     acc_bits = _validate_list(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
@@ -163,29 +184,10 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     grid = [(d, c, a if d >= 2 else None) for d in degrees for c in coef_bits
             for a in (acc_bits if d >= 2 else (None,))]
     use_yosys = synth and shutil.which("yosys") is not None
-    from tqdm import tqdm
-
-    designs = []
-    for d, c, a in tqdm(grid, desc=f"sweep {target}", unit="design", disable=not progress,
-                        leave=False):
-        design = design_horner(tables[d], in_bits, out_bits, coef_bits=c, acc_bits=a,
-                               rounding=rounding, name=f"{target}_d{d}_c{c}_a{a or 0}")
-        designs.append((d, c, a, design, error_budget(design), measure(design)))
-    cells = [None] * len(designs)
-    if use_yosys:
-        def run(item):
-            design = item[3]
-            return synthesize_text(verilog_module(design), design.module_name).cells
-        with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-            cells = list(tqdm(pool.map(run, designs), total=len(designs), desc="yosys",
-                              unit="design", disable=not progress, leave=False))
-    points = []
-    for (d, c, a, design, b, m), n_cells in zip(designs, cells):
-        points.append(SweepPoint(degree=d, coef_bits=c, acc_bits=a, in_bits=in_bits,
-                                 out_bits=out_bits, y_frac_bits=design.y_format.frac_bits,
-                                 max_error=m.total, max_error_lsb=m.total_lsb, budget=b.total,
-                                 budget_lsb=b.total / b.y_lsb, shading_levels=m.shading_levels,
-                                 yosys_cells=n_cells, area_fa=horner_block(design).cost.area))
+    items = [(target, tables[d], d, c, a, in_bits, out_bits, rounding, use_yosys)
+             for d, c, a in grid]
+    points = map_ordered(_design_point, items, workers=workers, scheduler=scheduler,
+                         progress=progress, desc=f"sweep {target}")
     # Pareto front: no other point is at most as large and at most as wrong, one strictly
     marked = []
     for p in points:

@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from chebnorm.approx.parallel import map_ordered
+
 from . import detmath
 from .counting import OpCounts, _generic_pair, count_ops
 from .registry import default_tables, method_names
@@ -198,13 +200,28 @@ class ErrorSweep:
         return out if m is None else out[:, self.ms.index(m)]
 
 
+def _sweep_cell(item):
+    """Per-angle maxima of the errors of one (method, dtype, m) cell of :func:`error_sweep`."""
+    name, dt, m, nl, nr, psis, tab = item
+    res = span_normals(name, nl, nr, np.full(len(psis), m), dtype=dt, tables=tab)
+    sid = np.repeat(np.arange(len(psis)), np.diff(res.offsets))
+    err, spec = _pixel_errors(res.normals.astype(np.float64), nl[sid], nr[sid], psis[sid], res.t)
+    starts = res.offsets[:-1]
+    return ({key: np.maximum.reduceat(v, starts) for key, v in err.items()},
+            np.maximum.reduceat(spec, starts, axis=0))
+
+
 def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np.float32), *,
-                tables=None) -> ErrorSweep:
+                tables=None, workers: int = 1, scheduler=None) -> ErrorSweep:
     """Errors of ``methods`` (None: every registered method) over span angles ``psis`` (default 33 points on [0, pi/2]),
     span lengths ``ms`` and dtypes; vectorized over the angles (one span per angle).
 
     ``tables=None``: the default degree-2 tables for pi/4 when they cover
     ``max(psis)``, else the degree-2 tables fitted for ``psi_max = max(psis)``.
+
+    ``workers``, ``scheduler``: the (method, dtype, m) cells run on local processes or
+    a Dask scheduler (:func:`chebnorm.approx.parallel.map_ordered`; default: here);
+    the result is the same.
 
     >>> s = error_sweep(("none",), [0.2], (4,), (np.float64,))
     >>> round(float(s.get("diffuse_error", "none", m=4)[0]), 7)   # delta_d(0.2), claim C1
@@ -222,18 +239,14 @@ def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np
     pairs = [_generic_pair(p) for p in psis]
     nl = np.array([a for a, _ in pairs])
     nr = np.array([b for _, b in pairs])
-    for i, entry in enumerate(specs):
-        for d, dt in enumerate(dts):
-            for k, m in enumerate(ms):
-                res = span_normals(entry, nl, nr, np.full(len(psis), m), dtype=dt,
-                                   tables=tab if entry.table is not None else None)
-                sid = np.repeat(np.arange(len(psis)), np.diff(res.offsets))
-                err, spec = _pixel_errors(res.normals.astype(np.float64), nl[sid], nr[sid],
-                                          psis[sid], res.t)
-                starts = res.offsets[:-1]
-                for key, v in err.items():
-                    out[key][i, d, :, k] = np.maximum.reduceat(v, starts)
-                spec_out[i, d, :, k, :] = np.maximum.reduceat(spec, starts, axis=0)
+    cells = [(i, d, k) for i in range(len(specs)) for d in range(len(dts)) for k in range(len(ms))]
+    items = [(specs[i], dts[d], ms[k], nl, nr, psis,
+              tab if specs[i].table is not None else None) for i, d, k in cells]
+    for (i, d, k), (err, spec) in zip(cells, map_ordered(_sweep_cell, items, workers=workers,
+                                                         scheduler=scheduler)):
+        for key, v in err.items():
+            out[key][i, d, :, k] = v
+        spec_out[i, d, :, k, :] = spec
     return ErrorSweep(methods=methods, dtypes=tuple(np.dtype(d).name for d in dts), psis=psis, ms=ms,
                       length_error=out["length"], angle_error=out["angle"],
                       angle_error_slerp=out["angle_slerp"], vector_error=out["vector"],

@@ -17,7 +17,8 @@ from chebnorm.approx.method_registry import MethodSpec, get_method
 from .ops import NumpyOps
 from .registry import default_tables, method_kernel
 
-__all__ = ["SpanNormals", "span_normals", "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES"]
+__all__ = ["SpanNormals", "span_normals", "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES",
+           "SpanInput", "check_span_input"]
 
 #: accepted | |N| - 1 | of an end normal
 UNIT_TOL = 1e-5
@@ -240,11 +241,10 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     >>> np.linalg.norm(span_normals("slerp", nl, nr, [4]).normals, axis=1).round(15).tolist()
     [1.0, 1.0, 1.0, 1.0, 1.0]
     """
-    spec = _check_method(method)
-    dtype = _check_dtype(dtype)
-    kern = method_kernel(spec)
-    nl, nr, cos = _end_normals(n_left, n_right)
-    m_arr, dt_arr, t0_arr, cnt = _positions(nl.shape[0], m, dt, t0, count)
+    inp = check_span_input(method, n_left, n_right, m, t0=t0, dt=dt, count=count, tables=tables,
+                           dtype=dtype)
+    dtype, kern, nl, nr = inp.dtype, inp.kernel, inp.n_left, inp.n_right
+    dt_arr, t0_arr, cnt, levels, coeffs = inp.dt, inp.t0, inp.count, inp.levels, inp.coefficients
     if angular_reanchor is not None and (not isinstance(angular_reanchor, (int, np.integer))
                                          or isinstance(angular_reanchor, bool)
                                          or angular_reanchor < 2):
@@ -254,13 +254,6 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     np.cumsum(cnt, out=offsets[1:])
     sid = np.repeat(np.arange(nl.shape[0]), cnt)
     t = t0_arr[sid] + (np.arange(int(offsets[-1])) - offsets[sid]) * dt_arr[sid]
-
-    levels = _levels(dt_arr, t0_arr, cnt, cos) if kern.shape == "tree" else None
-    if levels is not None and (levels > MAX_LEVELS).any():
-        raise ValueError(f"{spec.name} step dt = {float(dt_arr.min()):.3g} needs more than "
-                         f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
-    table = _resolve_table(spec, tables, cos, levels) if spec.table is not None else None
-    coeffs = None if table is None else table.coefficients
 
     ops = NumpyOps(dtype)
     a = tuple(nl.astype(dtype).T)
@@ -283,6 +276,50 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     else:
         _tree(kern, ops, a, b, levels, coeffs, t, sid, out, dtype)
     return SpanNormals(normals=out, offsets=offsets, t=t)
+
+
+@dataclass(frozen=True)
+class SpanInput:
+    """The checked input of :func:`span_normals` (what a compiled twin of it starts from):
+    the registry entry ``spec``, its ``kernel``, ``dtype``, the (S, 3) float64 end normals,
+    their ``cosines``, per-span ``m``, ``dt``, ``t0``, ``count``, the dichotomy depth
+    ``levels`` (None for the other kernels) and the table's ``coefficients`` (None: exact)."""
+
+    spec: MethodSpec
+    kernel: object
+    dtype: type
+    n_left: np.ndarray
+    n_right: np.ndarray
+    cosines: np.ndarray
+    m: np.ndarray
+    dt: np.ndarray
+    t0: np.ndarray
+    count: np.ndarray
+    levels: np.ndarray | None
+    coefficients: tuple | None
+
+
+def check_span_input(method, n_left, n_right, m, *, t0=None, dt=None, count=None, tables=None,
+                     dtype=np.float64) -> SpanInput:
+    """Every check :func:`span_normals` makes, and the values it derives before computing
+    (same arguments, same errors).
+
+    >>> inp = check_span_input("dichotomy", [[1.0, 0, 0]], [[0.8, 0.6, 0]], [4])
+    >>> inp.levels.tolist(), inp.count.tolist()
+    ([2], [5])
+    """
+    spec = _check_method(method)
+    dtype = _check_dtype(dtype)
+    kern = method_kernel(spec)
+    nl, nr, cos = _end_normals(n_left, n_right)
+    m_arr, dt_arr, t0_arr, cnt = _positions(nl.shape[0], m, dt, t0, count)
+    levels = _levels(dt_arr, t0_arr, cnt, cos) if kern.shape == "tree" else None
+    if levels is not None and (levels > MAX_LEVELS).any():
+        raise ValueError(f"{spec.name} step dt = {float(dt_arr.min()):.3g} needs more than "
+                         f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
+    table = _resolve_table(spec, tables, cos, levels) if spec.table is not None else None
+    coeffs = None if table is None else table.coefficients
+    return SpanInput(spec, kern, dtype, nl, nr, cos, m_arr, dt_arr, t0_arr, cnt, levels, coeffs)
 
 
 def _end_normals(n_left, n_right):

@@ -33,6 +33,7 @@ from chebnorm.methods import default_tables, get_method, method_names
 from chebnorm.methods import span_normals as _span_normals
 from chebnorm.symbolic import eta as _eta_criterion
 
+from . import fast
 from .meshes import Mesh, _unit, get_mesh
 from .spans import Camera, fit_camera, project, setup_spans, zbuffer
 
@@ -180,13 +181,21 @@ class _Setup:
     inv_w: np.ndarray          # (T,3)
     pos: np.ndarray            # (T,3,3)
     nrm: np.ndarray            # (T,3,3)
+    engine: str = "numpy"      # "numpy" (the reference) or "numba" (compiled, same bytes)
 
     def rasterize(self, extra):
         """Spans and visible fragments with attributes [1/w, *extra] (extra (T,3,K))."""
         attrs = np.concatenate([self.inv_w[..., None], extra], axis=2)
+        if self.engine == "numba":
+            sp = fast.fast_setup_spans(self.xy, attrs, self.width, self.height)
+            return sp, fast.fast_zbuffer(sp, self.width * self.height)
         sp = setup_spans(self.xy, attrs, self.width, self.height)
         vis = zbuffer(sp.frag_pixel, sp.lerp([0])[:, 0], self.width * self.height)
         return sp, vis
+
+    def lerp_visible(self, sp, cols, vis):
+        """``sp.lerp(cols)[vis]``."""
+        return fast.fast_lerp(sp, cols, vis) if self.engine == "numba" else sp.lerp(cols)[vis]
 
 
 def _setup(mesh, camera, size, cull=True):
@@ -229,7 +238,7 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
            camera: Camera | None = None, tables=None, dtype=np.float64,
            eta_threshold: float = 0.005, q: float = 1.0 / 255.0, bump: str = "full",
            height_map: HeightMap | None = None, k: float | None = None, cull: bool = True,
-           span_normals=None) -> RenderResult:
+           span_normals=None, engine: str | None = "auto") -> RenderResult:
     """Render ``mesh`` (a :class:`Mesh`, a name or a file path) with one
     shading mode.
 
@@ -246,6 +255,9 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     over the vertices) or ``object`` (Blinn's perturbed normal in object space,
     L and H in object space).  ``span_normals``: a replacement span
     interpolator (same signature as :func:`chebnorm.methods.span_normals`).
+    ``engine``: ``"numpy"`` (the reference), ``"numba"`` (the compiled fast path of
+    :mod:`chebnorm.raster.fast`: the same image bytes) or ``"auto"`` (numba when
+    installed).
 
     >>> r = render("sphere", "phong", "exact", size=(32, 32), tess=8)
     >>> r.image.shape, r.pixels > 300
@@ -255,6 +267,7 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     if shading not in SHADING_MODES:
         raise ValueError(f"unknown shading mode {shading!r}; accepted: {', '.join(SHADING_MODES)}")
     w, h = _validate_size(size)
+    engine = fast.resolve_engine(engine)
     lighting = lighting or Lighting()
     lighting.validate()
     spec = None
@@ -270,8 +283,9 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
     st = _setup(mesh, camera, (w, h), cull)
+    st.engine = engine
     st.L = lighting.direction(st.camera)
-    kw = dict(lighting=lighting, interp=_interpolator(spec, span_normals), tables=tables,
+    kw = dict(lighting=lighting, interp=_interpolator(spec, span_normals, engine), tables=tables,
               dtype=dtype)
     if shading == "gouraud":
         out = _gouraud(st, lighting)
@@ -297,11 +311,13 @@ def _check_options(shading, bump, eta_threshold, q):
         raise ValueError(f"q must be a finite number >= 0; got {q!r}")
 
 
-def _interpolator(spec, span_normals):
+def _interpolator(spec, span_normals, engine="numpy"):
     """The span interpolator ``render`` calls: a given one gets the method's name,
     the built-in one the registry entry ``render`` already looked up."""
     if span_normals is not None:
         return span_normals
+    if engine == "numba" and spec is not None and fast.supports(spec):
+        return lambda _name, *args, **kw: fast.fast_span_normals(spec, *args, **kw)
     return lambda _name, *args, **kw: _span_normals(spec, *args, **kw)
 
 
@@ -345,18 +361,21 @@ def _vertex_intensity(st, lighting, pos, nrm, tri_local):
 def _gouraud(st, lighting):
     I = _vertex_intensity(st, lighting, st.pos, st.nrm, np.arange(len(st.tri)))
     sp, vis = st.rasterize(I[..., None])
-    vals = sp.lerp([1])[vis, 0]
+    vals = st.lerp_visible(sp, [1], vis)[:, 0]
     img, mask = _to_image(st, sp, vis, vals)
     return _ModeResult(img, mask, sp.n_fragments, {"vertices_shaded": int(3 * len(st.tri))})
 
 
 # ------------------------------------------------------------------ phong
-def _interpolated_normals(sp, cols, method, interp, tables, dtype, sel=None):
+def _interpolated_normals(sp, cols, method, interp, tables, dtype, sel=None, engine="numpy"):
     """Pixel normals of the spans ``sel`` (all if None), in fragment order."""
     idx = np.arange(len(sp.count)) if sel is None else np.flatnonzero(sel)
     if len(idx) == 0:
         return np.zeros((0, 3))
     nl, nr = sp.left[idx][:, cols], sp.right[idx][:, cols]
+    if method == "none" and engine == "numba":
+        frags = np.arange(sp.n_fragments) if sel is None else np.flatnonzero(sel[sp.frag_span])
+        return fast.fast_lerp(sp, cols, frags)
     if method == "none":
         # normalization skipped altogether (seed 003): plain linear interpolation
         fs = np.repeat(idx, sp.count[idx])
@@ -400,15 +419,17 @@ def _phong(st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None):
     stats = {}
     tables = _auto_tables(spec, sp, [ncols], tables, stats)
     if skip_eta is None:
-        N = _interpolated_normals(sp, ncols, method, interp, tables, dtype)
+        N = _interpolated_normals(sp, ncols, method, interp, tables, dtype, engine=st.engine)
     else:
         eta = np.asarray(_eta_criterion(st.nrm[:, 0], st.nrm[:, 1], st.nrm[:, 2]), dtype=float)
         skip_tri = eta < skip_eta
         skip_span = skip_tri[sp.tri]
         skip_frag = skip_span[sp.frag_span]
         N = np.empty((sp.n_fragments, 3))
-        N[skip_frag] = _interpolated_normals(sp, ncols, "none", interp, tables, dtype, skip_span)
-        N[~skip_frag] = _interpolated_normals(sp, ncols, method, interp, tables, dtype, ~skip_span)
+        N[skip_frag] = _interpolated_normals(sp, ncols, "none", interp, tables, dtype, skip_span,
+                                             engine=st.engine)
+        N[~skip_frag] = _interpolated_normals(sp, ncols, method, interp, tables, dtype, ~skip_span,
+                                              engine=st.engine)
         drawn = np.unique(sp.tri)
         stats.update({
             "eta_threshold": float(skip_eta),
@@ -421,8 +442,21 @@ def _phong(st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None):
             "eta_max": float(eta.max()) if len(eta) else 0.0,
         })
     N = N[vis]
+    if st.engine == "numba":
+        # the same operations as below, compiled; dot products stay numpy's (their
+        # summation order is numpy's and BLAS's)
+        if per_pixel_h:
+            H = fast.fast_half_vectors(sp, 4, vis, st.L, st.camera.eye)
+        else:
+            H = _tri_half(st)[sp.tri[sp.frag_span[vis]]]
+        img, mask, tri, nlen = fast.fast_shade(N @ st.L, _dot(N, H), N, sp.frag_pixel[vis],
+                                               st.tri[sp.tri[sp.frag_span[vis]]], lighting,
+                                               st.width * st.height)
+        shape = (st.height, st.width)
+        return _ModeResult(img.reshape(shape), mask.reshape(shape), sp.n_fragments, stats,
+                           triangle=tri.reshape(shape), normal_length=nlen.reshape(shape))
     if per_pixel_h:
-        H = _half_vectors(st.L, st.camera.eye, sp.lerp([4, 5, 6])[vis])
+        H = _half_vectors(st.L, st.camera.eye, st.lerp_visible(sp, [4, 5, 6], vis))
     else:
         H = _tri_half(st)[sp.tri[sp.frag_span[vis]]]
     vals = lighting.intensity(N @ st.L, _dot(N, H))
@@ -490,9 +524,13 @@ def _split_gouraud(st, lighting, q):
     sub_tri, sub_slots = sub_tri[order], sub_slots[order]
     rows = sub_tri[:, None]
     attrs = np.stack([inv_w6[rows, sub_slots], I6[rows, sub_slots]], axis=2)
-    sp = setup_spans(xy6[rows, sub_slots], attrs, st.width, st.height)
-    vis = zbuffer(sp.frag_pixel, sp.lerp([0])[:, 0], st.width * st.height)
-    img, mask = _to_image(st, sp, vis, sp.lerp([1])[vis, 0])
+    if st.engine == "numba":
+        sp = fast.fast_setup_spans(xy6[rows, sub_slots], attrs, st.width, st.height)
+        vis = fast.fast_zbuffer(sp, st.width * st.height)
+    else:
+        sp = setup_spans(xy6[rows, sub_slots], attrs, st.width, st.height)
+        vis = zbuffer(sp.frag_pixel, sp.lerp([0])[:, 0], st.width * st.height)
+    img, mask = _to_image(st, sp, vis, st.lerp_visible(sp, [1], vis)[:, 0])
     n_split = split.sum(axis=1)
     stats = {
         "q": float(q),
@@ -534,11 +572,13 @@ def _bump(st, method, spec, variant, height_map, k, *, lighting, interp, tables,
     sp, vis = st.rasterize(extra)
     tables = _auto_tables(spec, sp, [[9, 10, 11], [12, 13, 14]], tables, stats)
     # L and H: interpolated along spans, normalized per pixel by the method
-    Lp = _interpolated_normals(sp, [9, 10, 11], method, interp, tables, dtype)[vis]
-    Hp = _interpolated_normals(sp, [12, 13, 14], method, interp, tables, dtype)[vis]
-    uvp = sp.lerp([1, 2])[vis]
+    Lp = _interpolated_normals(sp, [9, 10, 11], method, interp, tables, dtype,
+                               engine=st.engine)[vis]
+    Hp = _interpolated_normals(sp, [12, 13, 14], method, interp, tables, dtype,
+                               engine=st.engine)[vis]
+    uvp = st.lerp_visible(sp, [1, 2], vis)
     F_u, F_v = height_map.derivatives(uvp)
-    pu, pv = sp.lerp([3, 4, 5])[vis], sp.lerp([6, 7, 8])[vis]
+    pu, pv = st.lerp_visible(sp, [3, 4, 5], vis), st.lerp_visible(sp, [6, 7, 8], vis)
     if variant == "object":
         N = np.cross(pu, pv)
         nlen = np.linalg.norm(N, axis=1, keepdims=True)

@@ -1,0 +1,18 @@
+"""``--workers N`` and ``--scheduler ADDRESS``: the options of every parallel command
+(they map onto :func:`chebnorm.approx.parallel.map_ordered`)."""
+
+from __future__ import annotations
+
+
+def add_parallel_args(p) -> None:
+    """Add ``--workers`` and ``--scheduler`` to the argparse parser ``p``."""
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="local worker processes (default: the core count; 1: in this process)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a Dask distributed scheduler, e.g. tcp://host:8786 "
+                        "(needs pip install 'chebnorm[cluster]'); overrides --workers")
+
+
+def parallel_kwargs(args) -> dict:
+    """``workers=`` and ``scheduler=`` for the library call, from parsed ``args``."""
+    return {"workers": args.workers, "scheduler": args.scheduler}
