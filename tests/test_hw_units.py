@@ -331,10 +331,15 @@ class TestHostileText:
         from chebnorm.cli import main
 
         table = fit_target("dichotomy", 2, frac_bits=18).to_dict()
-        # parses as 1/sqrt(2 + z) (the second line is a Python comment)
-        table["expression"] = "1/sqrt(2 + z)\n# */ module injected2; endmodule /*"
         folder = tmp_path / self.EVIL
         folder.mkdir()
+        # an expression carrying a comment-closer is refused when the table is read
+        hostile = dict(table, expression="1/sqrt(2 + z)\n# */ module injected2; endmodule /*")
+        (folder / "h.json").write_text(json.dumps(hostile))
+        assert main(["hw", "unit", "dichotomy", "--table", str(folder / "h.json"), "--in-bits",
+                     "10", "--out-bits", "10", "-o", str(tmp_path / "h")]) == 2
+        assert "expression" in capsys.readouterr().err
+        # the hostile folder name reaches the banner through the command line
         (folder / "t.json").write_text(json.dumps(table))
         out = f"{tmp_path / self.EVIL}//out"  # '//' so an unescaped newline would comment the rest
         code = main(["hw", "unit", "dichotomy", "--table", f"{folder}//t.json", "--in-bits", "10",
