@@ -12,7 +12,7 @@ from flint import arb
 
 from .certify import Certificate, _float_down, _float_up, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
-from .fitting import chebyshev_interpolant, cheb_to_monomial, remez
+from .fitting import chebyshev_interpolant, cheb_to_monomial, polish, remez, shift_for
 from .table import CoefficientTable, FixedPoint
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval"]
@@ -20,6 +20,7 @@ __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_in
 MAX_DEGREE = 30
 KINDS = ("chebyshev", "minimax")
 ERROR_KINDS = ("abs", "rel")
+BASES = ("monomial", "shifted")
 
 
 @functools.lru_cache(maxsize=1)
@@ -115,10 +116,10 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     return y.real
 
 
-def _certify_both(fn, coeffs, iv, need_rel: bool):
-    cert_abs = certify(fn, coeffs, iv.lo, iv.hi, "abs")
+def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None):
+    cert_abs = certify(fn, coeffs, iv.lo, iv.hi, "abs", shift=shift)
     try:
-        cert_rel = certify(fn, coeffs, iv.lo, iv.hi, "rel")
+        cert_rel = certify(fn, coeffs, iv.lo, iv.hi, "rel", shift=shift)
     except ValueError:
         if need_rel:
             raise ValueError(f"relative error is undefined: {fn.expr} vanishes on "
@@ -130,7 +131,7 @@ def _certify_both(fn, coeffs, iv, need_rel: bool):
 
 def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs", *,
         var: str = "x", name: str | None = None, frac_bits: int | None = None,
-        command: str | None = None) -> CoefficientTable:
+        command: str | None = None, basis: str = "monomial") -> CoefficientTable:
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
@@ -138,6 +139,15 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     (``error="abs"``) or relative (``error="rel"``) error. Every table carries
     rigorous bounds of both errors (see :mod:`chebnorm.approx.certify`).
     With ``frac_bits`` the table also gets a re-certified fixed-point part.
+    ``basis="shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c``
+    the midpoint, ``s`` a power of two at least the half-width; recorded in
+    ``table.shift``), well conditioned on narrow or offset intervals where
+    plain powers of ``x`` (``basis="monomial"``, the default) lose accuracy:
+
+    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
+    >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
+    >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
+    ((100.5, 0.5), True, True)
 
     Seed 000, method 4 (claim C5): the degree-2 Chebyshev fit of
     ``1/sqrt(2+z)`` on ``[sqrt(2), 2]``:
@@ -164,6 +174,11 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
     if error not in ERROR_KINDS:
         raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
+    if basis not in BASES:
+        raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
+    if basis != "monomial" and frac_bits is not None:
+        raise ValueError("frac-bits with basis shifted is not supported; accepted: "
+                         "basis monomial for fixed-point tables")
     try:
         lo, hi = interval
     except (TypeError, ValueError):
@@ -175,21 +190,9 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         raise ValueError(f"relative error is undefined: {fn.expr} vanishes on [{iv.lo}, {iv.hi}]; "
                          f"accepted for error='rel': an interval where the function has no zero")
 
-    notes = []
-    if kind == "chebyshev":
-        coeffs = chebyshev_interpolant(fn.mpmath, sp.N(iv.lo, 50), sp.N(iv.hi, 50), degree)
-    else:
-        f_np = fn.numpy
-        weight = (lambda x: np.ones_like(x)) if error == "abs" else (lambda x: 1.0 / np.abs(f_np(x)))
-        res = remez(f_np, weight, iv.lo_f, iv.hi_f, degree)
-        coeffs = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
-        if not res.converged:
-            notes.append(
-                f"the Remez exchange did not converge: the coefficients are its best iterate "
-                f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
-                f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
-                f"may be closer; the certified bounds hold")
-    cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel")
+    shift = shift_for(iv.lo_f, iv.hi_f) if basis == "shifted" else None
+    coeffs, notes = _fit_coefficients(fn, iv, degree, kind, error, shift)
+    cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel", shift)
     notes += _certificate_notes(abs_error_bound=cert_abs, rel_error_bound=cert_rel)
     provenance = dict(_versions())
     provenance["command"] = command or (
@@ -207,10 +210,41 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         max_abs_error=cert_abs.maximum, max_abs_at=cert_abs.at,
         max_rel_error=None if cert_rel is None else cert_rel.maximum,
         max_rel_at=None if cert_rel is None else cert_rel.at,
-        provenance=provenance)
+        provenance=provenance, shift=shift)
     if frac_bits is not None:
         table = quantize(table, frac_bits)
     return table
+
+
+def _fit_coefficients(fn: Function1D, iv: Interval, degree: int, kind: str, error: str,
+                      shift: tuple[float, float] | None) -> tuple[list[float], list[str]]:
+    """The fitted float coefficients (in ``t = (x - c)/s`` with ``shift``)
+    and the notes on how the fit went."""
+    notes = []
+    if kind == "chebyshev" and shift is not None:
+        c, s = (sp.Float(v, 60) for v in shift)
+        f_mp = fn.mpmath
+        coeffs = chebyshev_interpolant(lambda t: f_mp(c + s * t), sp.N((iv.lo - c) / s, 50),
+                                       sp.N((iv.hi - c) / s, 50), degree)
+    elif kind == "chebyshev":
+        coeffs = chebyshev_interpolant(fn.mpmath, sp.N(iv.lo, 50), sp.N(iv.hi, 50), degree)
+    else:
+        f_np = fn.numpy
+        weight = None if error == "abs" else (lambda x: 1.0 / np.abs(f_np(x)))
+        res = remez(f_np, weight, iv.lo_f, iv.hi_f, degree)
+        cheb = res.cheb
+        polished = res.noise_limited and res.ref is not None and len(res.ref) == degree + 2
+        if polished:
+            # the float64 solve limits the error: re-solve the same reference in 50 digits
+            cheb = polish(fn.mpmath, iv.lo_f, iv.hi_f, res.ref, degree, relative=error == "rel")
+        coeffs = cheb_to_monomial(cheb, iv.lo_f, iv.hi_f, *(shift or (0.0, 1.0)))
+        if not res.converged and not polished:
+            notes.append(
+                f"the Remez exchange did not converge: the coefficients are its best iterate "
+                f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
+                f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
+                f"may be closer; the certified bounds hold")
+    return coeffs, notes
 
 
 def _certificate_notes(**certs: Certificate | None) -> list[str]:
@@ -258,6 +292,7 @@ def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
     >>> t.fixed_point.method, t.fixed_point.abs_error_bound < 1.01 * t.abs_error_bound
     ('reoptimized', True)
     """
+    table.require_monomial("quantize")
     _check_frac_bits(frac_bits, table.coefficients, word_bits)
     frac_bits = int(frac_bits)
     fn = parse_function(table.expression, table.variable)

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import sympy as sp
-from flint import arb, arb_series, ctx
+from flint import arb, arb_poly, arb_series, ctx
 
 from .expr import Function1D, _compile_arb
 
@@ -116,15 +116,57 @@ def _horner(coeffs: Sequence[arb], x):
     return acc
 
 
-def _error_function(f, coeffs: Sequence[arb], kind: str):
+class _PolyTaylor:
+    """``p`` and its Taylor expansions ``p(x0 + h)``, by Horner in C.
+
+    The k-th Taylor coefficient at ``x0`` is ``q_k(x0)`` with ``q_k =
+    p^(k)/k!``, an arb_poly whose coefficients ``binomial(j, k) c_j`` are
+    exact (a float times an integer below 2^28, at 128 bits); each is one
+    ``arb_poly`` evaluation instead of a Python loop of series operations.
+    """
+
+    def __init__(self, coeffs: Sequence[arb], shift: tuple[float, float] | None = None):
+        self.coeffs = list(coeffs)
+        self.polys: list[arb_poly] = []
+        # p(x) = q((x - c)/s): the k-th Taylor coefficient in x is q_k(t0) / s^k
+        self.c, self.s = (arb(0), arb(1)) if shift is None else (arb(shift[0]), arb(shift[1]))
+        self.shifted = shift is not None
+
+    def _t(self, x):
+        return (x - self.c) / self.s if self.shifted else x
+
+    def _q(self, k: int) -> arb_poly:
+        while len(self.polys) <= k:
+            j = len(self.polys)
+            c = self.coeffs
+            self.polys.append(arb_poly([c[i] * math.comb(i, j) for i in range(j, len(c))]
+                                       or [arb(0)]))
+        return self.polys[k]
+
+    def __call__(self, s):
+        if isinstance(s, arb_series):
+            c = s.coeffs()
+            if len(c) == 2 and c[1] == 1:  # s = x0 + h, the only form certify builds
+                t0 = self._t(c[0])
+                if not self.shifted:
+                    return arb_series([self._q(k)(t0) for k in range(s.prec)], prec=s.prec)
+                return arb_series([self._q(k)(t0) / self.s ** k for k in range(s.prec)],
+                                  prec=s.prec)
+            return _horner(self.coeffs, self._t(s))
+        return self._q(0)(self._t(s))
+
+
+def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     """``g = p - f`` or ``p/f - 1`` for ``f`` an arb or arb_series function;
-    nan wherever Arb cannot evaluate it (a division by a ball containing 0)."""
+    nan wherever Arb cannot evaluate it (a division by a ball containing 0).
+    With ``shift = (c, s)``, ``p(x) = sum coeffs[k] ((x - c)/s)^k``."""
+    p = _PolyTaylor(coeffs, shift)
     if kind == "abs":
         def g(s):
-            return _horner(coeffs, s) - f(s)
+            return p(s) - f(s)
     elif kind == "rel":
         def g(s):
-            return _horner(coeffs, s) / f(s) - 1
+            return p(s) / f(s) - 1
     else:
         raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
 
@@ -192,7 +234,7 @@ def _ball(a: arb, b: arb, from_right: bool) -> arb:
 
 def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.Expr,
             kind: str = "abs", tol: float = TOL, max_subintervals: int = 200_000,
-            prec: int | None = None) -> Certificate:
+            prec: int | None = None, shift: tuple[float, float] | None = None) -> Certificate:
     """Certify ``sup_{x in [lo, hi]} |g(x)|`` for ``g = p - f`` or ``p/f - 1``.
 
     ``coefficients`` are the polynomial's float coefficients in ascending
@@ -201,6 +243,9 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     ValueError when ``g`` is not finite somewhere on the interval (``f`` is
     undefined, infinite, or -- for ``kind="rel"`` -- zero there), or when the
     interval holds no float64 number (the located maximum is reported at one).
+    With ``shift = (c, s)`` (floats, ``s > 0``) the coefficients are in the
+    shifted variable: ``p(x) = sum_k coefficients[k] ((x - c)/s)^k``, the
+    quotient taken exactly.
 
     >>> from chebnorm.approx.expr import parse_function
     >>> import sympy as sp
@@ -217,8 +262,13 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     old_prec = ctx.prec
     try:
         ctx.prec = prec or 128
+        if shift is not None:
+            shift = (float(shift[0]), float(shift[1]))
+            if not (math.isfinite(shift[0]) and math.isfinite(shift[1]) and shift[1] > 0):
+                raise ValueError(f"shift {shift!r}: accepted: a finite center and a finite "
+                                 f"positive scale")
         return _certify(fn, [arb(float(c)) for c in coefficients], lo, hi, kind, tol,
-                        max_subintervals)
+                        max_subintervals, shift)
     finally:
         ctx.prec = old_prec
 
@@ -238,9 +288,9 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
     return best if best > 0 else arb(1)
 
 
-def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals) -> Certificate:
-    g = _error_function(fn.arb_series, coeffs, kind)
-    g_point = _error_function(fn.arb, coeffs, kind)
+def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
+    g = _error_function(fn.arb_series, coeffs, kind, shift)
+    g_point = _error_function(fn.arb, coeffs, kind, shift)
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
     lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
     if not lo_f <= hi_f:

@@ -6,7 +6,10 @@ with rigorous bounds of its absolute and relative error there, the located
 maxima, an optional fixed-point version, and where it came from.
 
 JSON schema (version 1): every field of the dataclasses below, floats written
-with Python's shortest round-trip repr, keys sorted.
+with Python's shortest round-trip repr, keys sorted. The optional ``shift``
+``[c, s]`` stores the polynomial in ``t = (x - c)/s`` instead (well
+conditioned on narrow or offset intervals); tables without it read and write
+exactly as before.
 
 Tables are files people exchange, so reading one (:meth:`CoefficientTable.load`,
 ``from_json``, ``from_dict``) trusts nothing in it: every field is checked for
@@ -100,11 +103,39 @@ class CoefficientTable:
     fixed_point: FixedPoint | None = None
     provenance: dict[str, str] = field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
+    #: ``(c, s)``: the coefficients are in ``t = (x - c)/s`` (basis "shifted");
+    #: None (the default, absent from the JSON): plain monomials in ``x``
+    shift: tuple[float, float] | None = None
+
+    @property
+    def basis(self) -> str:
+        """``"monomial"`` (powers of ``x``) or ``"shifted"`` (powers of ``(x - c)/s``)."""
+        return "monomial" if self.shift is None else "shifted"
+
+    def require_monomial(self, consumer: str) -> None:
+        """Raise a ValueError naming ``consumer`` when the table is not in
+        plain monomials of ``x`` (what that consumer evaluates).
+
+        >>> from chebnorm.approx import fit
+        >>> fit("exp(x)", ("0", "1"), 2, basis="shifted").require_monomial("hw")
+        Traceback (most recent call last):
+        ...
+        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with --basis monomial
+        """
+        if self.shift is not None:
+            c, s = self.shift
+            raise ValueError(f"table {self.name!r} is stored in the shifted variable "
+                             f"t = ({self.variable} - {c!r})/{s!r}; {consumer}: plain "
+                             f"powers of {self.variable} only; accepted: a table fitted with "
+                             f"--basis monomial")
 
     # -- evaluation -------------------------------------------------------
     def __call__(self, x, dtype=np.float64):
-        """Horner evaluation of the float coefficients in ``dtype``."""
+        """Horner evaluation of the float coefficients in ``dtype`` (in the
+        shifted variable ``(x - c) * (1/s)`` for a shifted table)."""
         x = np.asarray(x, dtype=dtype)
+        if self.shift is not None:
+            x = (x - dtype(self.shift[0])) * dtype(1 / self.shift[1])
         acc = np.full_like(x, self.coefficients[-1])
         for c in reversed(self.coefficients[:-1]):
             acc = acc * x + dtype(c)
@@ -120,6 +151,10 @@ class CoefficientTable:
         d["interval"] = list(self.interval)
         d["interval_float"] = list(self.interval_float)
         d["coefficients"] = list(self.coefficients)
+        if self.shift is None:
+            del d["shift"]  # plain monomials: the JSON of schema 1 as it always was
+        else:
+            d["shift"] = list(self.shift)
         if self.fixed_point is not None:
             d["fixed_point"]["integers"] = list(self.fixed_point.integers)
         return d
@@ -363,7 +398,7 @@ _MAX_KEY = 64
 MAX_WORD_BITS = 53
 MAX_FRAC_BITS = 1074
 FIXED_METHODS = ("rounded", "reoptimized")
-_OPTIONAL = {"fixed_point": None, "provenance": {}}
+_OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None}
 
 
 def _show(value) -> str:
@@ -517,6 +552,14 @@ def _read(cls, d) -> "CoefficientTable":
     if (rel is None) != (max_rel is None) or (rel is None) != (max_rel_at is None):
         raise ValueError("max_rel_error, max_rel_at: must be null exactly when "
                          "rel_error_bound is null")
+    shift = None
+    if d["shift"] is not None:
+        pair = _array(d["shift"], "shift", "2 numbers [center, scale]")
+        if len(pair) != 2:
+            raise _bad("shift", "an array of 2 numbers [center, scale]", pair)
+        shift = (_number(pair[0], "shift[0]"), _number(pair[1], "shift[1]", nonneg=True))
+        if not shift[1] > 0:
+            raise _bad("shift[1]", "a positive number (the scale s of t = (x - c)/s)", pair[1])
     return cls(
         name=identifier(d["name"], field="name"),
         expression=_text(d["expression"], "expression"),
@@ -533,7 +576,7 @@ def _read(cls, d) -> "CoefficientTable":
         max_abs_at=_number(d["max_abs_at"], "max_abs_at"),
         max_rel_error=max_rel, max_rel_at=max_rel_at,
         fixed_point=_read_fixed(d["fixed_point"], degree),
-        provenance=dict(provenance), schema_version=SCHEMA_VERSION)
+        provenance=dict(provenance), schema_version=SCHEMA_VERSION, shift=shift)
 
 
 # -- verifying: every stated bound re-proved for exactly the stored numbers -----
@@ -555,7 +598,8 @@ def _fmt2(a: float, b: float) -> tuple[str, str]:
     return repr(a), repr(b)
 
 
-def _prove(field: str, stated: float, fn, coefficients, lo, hi, kind: str, what: str):
+def _prove(field: str, stated: float, fn, coefficients, lo, hi, kind: str, what: str,
+           shift=None):
     """Certify ``sup |g|`` (``g = p - f`` or ``p/f - 1``) until ``stated`` is
     shown to bound it; raise naming ``field`` when it cannot be."""
     from .certify import certify
@@ -564,7 +608,7 @@ def _prove(field: str, stated: float, fn, coefficients, lo, hi, kind: str, what:
     for tol in _TOLS:
         opts = {} if tol is None else {"tol": tol, "max_subintervals": _RETRY_SUBINTERVALS}
         try:
-            cert = certify(fn, coefficients, lo, hi, kind, **opts)
+            cert = certify(fn, coefficients, lo, hi, kind, shift=shift, **opts)
         except ValueError as exc:
             raise ValueError(f"{field}: {what} cannot be certified: {exc}") from None
         if stated >= cert.bound:
@@ -630,7 +674,8 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
             if bound is None:
                 continue
             what = f"{whose} certified {'relative ' if kind == 'rel' else ''}error"
-            _prove(f"{prefix}{kind}_error_bound", bound, fn, coeffs, lo, hi, kind, what)
+            _prove(f"{prefix}{kind}_error_bound", bound, fn, coeffs, lo, hi, kind, what,
+                   t.shift)
             if maximum > bound:
                 s, m = _fmt2(bound, maximum)
                 raise ValueError(f"{prefix}max_{kind}_error: the located maximum {m} exceeds "

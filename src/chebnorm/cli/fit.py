@@ -34,6 +34,10 @@ def register(sub) -> None:
                    "exponent and top mantissa bits; interval [2^e0, 2^e1])")
     p.add_argument("--centered", action="store_true",
                    help="piecewise: evaluate each segment in t - 1/2 (smaller coefficients)")
+    p.add_argument("--basis", default="monomial", choices=("monomial", "shifted"),
+                   help="monomial (default): powers of VAR; shifted: powers of t = (VAR - c)/s, "
+                   "c the midpoint, s a power of two (well conditioned on narrow or offset "
+                   "intervals, where monomials lose accuracy; exported to C, not to hw/shaders)")
     p.add_argument("--name", default="table", help="table name (a C identifier)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
@@ -43,6 +47,10 @@ def register(sub) -> None:
 def _run_piecewise(args) -> int:
     from chebnorm.approx.piecewise import fit_piecewise
 
+    if args.basis != "monomial":
+        raise ValueError(f"--basis {args.basis} applies to one polynomial; accepted with "
+                         f"--segments/--segment-by/--centered: --basis monomial (use --centered "
+                         f"for segments evaluated about their middle)")
     table = fit_piecewise(args.expr, tuple(args.interval), args.degree,
                           segments=args.segments or 1, segment_by=args.segment_by or "uniform",
                           coef_frac_bits=24 if args.frac_bits is None else args.frac_bits,
@@ -67,7 +75,7 @@ def run(args) -> int:
         return _run_piecewise(args)
     table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
                 var=args.var, name=args.name, frac_bits=args.frac_bits,
-                command=command_line(args))
+                command=command_line(args), basis=args.basis)
     for warning in warnings_of(table):
         print(f"chebnorm: warning: {warning}", file=sys.stderr)
     if args.output:
@@ -77,8 +85,10 @@ def run(args) -> int:
     elif not args.output:
         print(f"{table.name}: {table.kind} degree {table.degree} fit of {table.expression} "
               f"on [{table.interval[0]}, {table.interval[1]}]")
+        powers_of = table.variable if table.shift is None else (
+            f"t = ({table.variable} - {table.shift[0]!r})/{table.shift[1]!r}")
         print("coefficients (ascending powers of {}): {}".format(
-            table.variable, ", ".join(f"{c:.17g}" for c in table.coefficients)))
+            powers_of, ", ".join(f"{c:.17g}" for c in table.coefficients)))
         print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
               f"certified bound {table.abs_error_bound:.6e}")
         if "binary_endpoints" in table.provenance:

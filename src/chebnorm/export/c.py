@@ -21,6 +21,12 @@ decimal value in a comment, Horner evaluators, and the bounds:
     for a quantized table, the bound of the integer evaluator: the fixed-point
     certified bound plus half an LSB per Horner step, amplified by ``|x|``.
 
+A table in the shifted basis (``table.shift = (c, s)``) gets ``<P>_CENTER``
+and ``<P>_SCALE`` and evaluators that first form ``t = (x - c) * (1/s)`` (a
+multiply by a power of two, exact; a division when ``s`` is not one); the
+evaluation bounds then add the error of ``t`` (``c`` rounded to the type, the
+subtraction unless Sterbenz's lemma makes it exact) times ``max |p'|``.
+
 Text from the table or the command line never reaches the header raw: the
 name must be an identifier (:func:`chebnorm.approx.textsafe.identifier`, it
 makes every symbol and macro), every other text goes through
@@ -115,6 +121,40 @@ def _fixed_rounding_bound(degree: int, frac_bits: int, max_abs_x: Fraction) -> F
     return half * sum(max_abs_x ** j for j in range(degree))
 
 
+def _is_power_of_two(s: float) -> bool:
+    return s > 0 and math.frexp(s)[0] == 0.5
+
+
+def _to_type(value: float, suffix: str) -> float:
+    return float(np.float32(value)) if suffix == "f" else float(value)
+
+
+def _shift_error(table: CoefficientTable, coeffs, suffix: str, u: float):
+    """For a shifted table evaluated in the type of ``suffix`` as
+    ``t~ = (x - c_T) * (1/s)`` (or ``/ s``): a bound ``M`` of ``|t~|`` and the
+    bound of ``|p(t~) - p(t)|`` from computing ``t`` (mean value theorem:
+    ``max |p'| |t~ - t|``, ``|p'| <= sum k |a_k| M^(k-1)``)."""
+    c, s = (Fraction(v) for v in table.shift)
+    c_t = Fraction(_to_type(table.shift[0], suffix))
+    lo, hi = (Fraction(v) for v in table.interval_float)
+    pad = max(abs(lo), abs(hi)) * Fraction(2) ** -52  # the float endpoints within an ulp
+    lo, hi = lo - pad, hi + pad
+    reach = max(abs(lo - c_t), abs(hi - c_t))
+    uf = Fraction(u)
+    # x - c_T is exact (Sterbenz) when every x lies in [c_T/2, 2 c_T]
+    sterbenz = (c_t > 0 and c_t / 2 <= lo and hi <= 2 * c_t) or (
+        c_t < 0 and 2 * c_t <= lo and hi <= c_t / 2) or c_t == 0
+    err = abs(c - c_t) / s + (0 if sterbenz else uf * reach / s)
+    t_max = max(abs(lo - c), abs(hi - c)) / s
+    if not _is_power_of_two(float(table.shift[1])):
+        err += uf * (reach / s) * (1 + uf)  # the rounded division
+    # an underflowing product: at most the smallest subnormal's half-spacing
+    err += Fraction(2) ** (-150 if suffix == "f" else -1075)
+    m = t_max + err
+    slope = sum(k * abs(Fraction(a)) * m ** (k - 1) for k, a in enumerate(coeffs) if k > 0)
+    return m, slope * err
+
+
 def _check_fixed_ranges(table: CoefficientTable, max_abs_x: Fraction) -> None:
     fp = table.fixed_point
     x_q = max_abs_x * 2 ** fp.frac_bits
@@ -153,6 +193,44 @@ def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
     return out
 
 
+def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: Fraction
+                ) -> Fraction:
+    """Bound of ``|evaluator(x) - f(x)|`` in the type of ``suffix`` (module docstring)."""
+    cs = [float(np.float32(c)) for c in coeffs] if suffix == "f" else list(coeffs)
+    if table.shift is not None:
+        max_t, t_err = _shift_error(table, cs, suffix, u)
+    else:
+        max_t, t_err = max_x, Fraction(0)
+    coef_err = sum(abs(Fraction(a) - Fraction(b)) * max_t ** k
+                   for k, (a, b) in enumerate(zip(coeffs, cs)))
+    return (Fraction(table.abs_error_bound) + coef_err + t_err
+            + horner_rounding_bound(cs, max_t, u))
+
+
+def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, name: str,
+                     macro: str) -> list[str]:
+    """Horner's rule in ``ctype`` (in ``t = (x - c) * (1/s)`` for a shifted table)."""
+    out = ["", f"/* Horner's rule in {ctype}; x must lie in [{macro}_LO, {macro}_HI]. */",
+           f"static inline {ctype} {name}({ctype} x)", "{"]
+    arg = "x"
+    if table.shift is not None:
+        arg = "t"
+        center = _literal(_to_type(table.shift[0], suffix), suffix)
+        scale = float(table.shift[1])
+        if _is_power_of_two(scale):
+            out.append(f"    {ctype} t = (x - {center}) * {_literal(1 / scale, suffix)};"
+                       f"  /* exact scaling by 2^{-(math.frexp(scale)[1] - 1)} */")
+        else:
+            out.append(f"    {ctype} t = (x - {center}) / "
+                       f"{_literal(_to_type(scale, suffix), suffix)};")
+    out.append(f"    {ctype} acc = {_literal(coeffs[-1], suffix)};")
+    for c in reversed(coeffs[:-1]):
+        out.append(f"    acc = acc * {arg} + {_literal(c, suffix)};")
+    if len(coeffs) == 1:
+        out.append(f"    (void){arg};")
+    return out + ["    return acc;", "}"]
+
+
 def c_header(table: CoefficientTable, command: str = "") -> str:
     """The C99 header text for ``table`` (see the module docstring).
 
@@ -172,6 +250,10 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
         raise ValueError(f"coefficients: {len(coeffs)} numbers for degree {degree}; expected "
                          f"degree + 1 = {degree + 1}")
     max_x = _max_abs_x(table)
+    shifted = table.shift is not None
+    if shifted and table.fixed_point is not None:
+        raise ValueError(f"table {table.name!r}: a fixed-point part in the shifted basis has no "
+                         f"C evaluator; accepted: a shifted table without fixed_point")
     var, expr = comment_text(table.variable), comment_text(table.expression)
     lo_s, hi_s = (comment_text(v) for v in table.interval)
     lo_f, hi_f = (float(v) for v in table.interval_float)
@@ -183,8 +265,10 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
         w(f" * Command: {comment_text(command)}")
     w(f" * Table provenance: {comment_text(table.provenance.get('command', 'unknown'))}")
     w(f" * p({var}) ~ {expr} on [{lo_s}, {hi_s}] = [{lo_f!r}, {hi_f!r}]")
+    powers = var if not shifted else (
+        f"t = ({var} - {float(table.shift[0])!r})/{float(table.shift[1])!r}")
     w(f" * kind: {comment_text(table.kind)}, error kind: {comment_text(table.error_kind)}, "
-      f"degree {degree}; coefficients in ascending powers of {var}.")
+      f"degree {degree}; coefficients in ascending powers of {powers}.")
     w(f" * Certified: |p - f| <= {float(table.abs_error_bound)!r}"
       + ("" if table.rel_error_bound is None else f", |p/f - 1| <= {float(table.rel_error_bound)!r}")
       + f"; located max |p - f| = {float(table.max_abs_error)!r} at {var} = "
@@ -202,15 +286,11 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     w(f"#define {macro}_ABS_ERROR_BOUND {_literal(table.abs_error_bound, '')}")
     if table.rel_error_bound is not None:
         w(f"#define {macro}_REL_ERROR_BOUND {_literal(table.rel_error_bound, '')}")
+    if shifted:
+        w(f"#define {macro}_CENTER {_literal(float(table.shift[0]), '')}")
+        w(f"#define {macro}_SCALE {_literal(float(table.shift[1]), '')}")
     for ctype, suffix, fsuffix, u in FLOAT_TYPES:
-        if suffix == "f":
-            cs = [float(np.float32(c)) for c in coeffs]
-            coef_err = sum(abs(Fraction(a) - Fraction(b)) * max_x ** k
-                           for k, (a, b) in enumerate(zip(coeffs, cs)))
-        else:
-            cs, coef_err = coeffs, Fraction(0)
-        bound = (Fraction(table.abs_error_bound) + coef_err
-                 + horner_rounding_bound(cs, max_x, u))
+        bound = _eval_bound(table, coeffs, suffix, u, max_x)
         w(f"#define {macro}{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
     if table.fixed_point is not None:
         fp = _checked_fixed(table)
@@ -222,20 +302,10 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     w("")
     w(f"static const double {fn}_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
-        w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* x^{k} */")
+        w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* {'t' if shifted else 'x'}^{k} */")
     w("};")
     for ctype, suffix, fsuffix, _ in FLOAT_TYPES:
-        w("")
-        w(f"/* Horner's rule in {ctype}; x must lie in [{macro}_LO, {macro}_HI]. */")
-        w(f"static inline {ctype} {fn}{fsuffix}({ctype} x)")
-        w("{")
-        w(f"    {ctype} acc = {_literal(coeffs[-1], suffix)};")
-        for c in reversed(coeffs[:-1]):
-            w(f"    acc = acc * x + {_literal(c, suffix)};")
-        if len(coeffs) == 1:
-            w("    (void)x;")
-        w("    return acc;")
-        w("}")
+        out += _float_evaluator(table, coeffs, ctype, suffix, f"{fn}{fsuffix}", macro)
     if table.fixed_point is not None:
         out += _fixed_evaluator(table.fixed_point, fn, macro)
     w("")

@@ -206,6 +206,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     >>> b.certified < b.total <= b.total32 < 2.2e-5
     True
     """
+    table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
     coeffs = [float(c) for c in table.coefficients]
     c32 = [float(np.float32(c)) for c in coeffs]
     m = _max_abs_x(table)
@@ -247,6 +248,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
     >>> "fn chebnorm_d1(x: f32) -> f32 {" in shader_source(t, "wgsl")
     True
     """
+    table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
     from chebnorm import __version__
 
     try:
