@@ -62,6 +62,11 @@ def model_cost(d: PiecewiseDesign) -> float:
 
 @dataclass(frozen=True)
 class DesignPoint:
+    """One candidate of the design search: a uniform piecewise table's degree,
+    segment count and widths, its certified error (approximation and total,
+    rounding included), whether it meets the requested error, and its cost
+    (yosys cells when synthesized, else the model's estimate)."""
+
     degree: int
     segments: int
     coef_frac_bits: int
@@ -89,6 +94,11 @@ class DesignPoint:
 
 @dataclass(frozen=True)
 class SearchResult:
+    """What ``chebnorm design`` found: every candidate evaluated (``points``),
+    the cheapest one that meets ``max_error`` (``winner``, or None), and where
+    the costs came from (``cost_source``: yosys or the model); ``csv()`` gives
+    the Pareto table that the command writes."""
+
     expression: str
     interval: tuple[str, str]
     in_bits: int
