@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('rsqrt', 3, psi_max='pi/4', kind='minimax', error='abs', frac_bits=24)
  * p(x) ~ 1/sqrt(x) on [sqrt(2)/4 + 1/2, 1] = [0.8535533905932737, 1.0]
  * kind: minimax, error kind: abs, degree 3; coefficients in ascending powers of x.
- * Certified: |p - f| <= 1.4007558930662257e-06, |p/f - 1| <= 1.3960203634758236e-06; located max |p - f| = 1.3960203642606937e-06 at x = 0.9779062049812176.
+ * Certified: |p - f| <= 1.4007558928290687e-06, |p/f - 1| <= 1.3960203631982679e-06; located max |p - f| = 1.3960203644663984e-06 at x = 0.8743433918582022.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_RSQRT_D3_H
@@ -15,28 +15,28 @@
 #define CHEBNORM_RSQRT_D3_DEGREE 3
 #define CHEBNORM_RSQRT_D3_LO 0x1.b504f333f9de6p-1 /* 0.8535533905932737 */
 #define CHEBNORM_RSQRT_D3_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_RSQRT_D3_ABS_ERROR_BOUND 0x1.780336460cd21p-20 /* 1.4007558930662257e-06 */
-#define CHEBNORM_RSQRT_D3_REL_ERROR_BOUND 0x1.76bdc9f4c0581p-20 /* 1.3960203634758236e-06 */
-#define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.7803365a4bad8p-20 /* 1.4007558975616377e-06 */
-#define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.04483a2c1c6f2p-18 /* 3.878506088837837e-06 */
+#define CHEBNORM_RSQRT_D3_ABS_ERROR_BOUND 0x1.78033644fb65bp-20 /* 1.4007558928290687e-06 */
+#define CHEBNORM_RSQRT_D3_REL_ERROR_BOUND 0x1.76bdc9f380581p-20 /* 1.3960203631982679e-06 */
+#define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.780336593a412p-20 /* 1.4007558973244807e-06 */
+#define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.04483a2c28141p-18 /* 3.878506088878236e-06 */
 #define CHEBNORM_RSQRT_D3_FRAC_BITS 24
 #define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.7d8508e7e24e5p-20 /* 1.4212715146753058e-06 */
 #define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.958508e7e24e6p-20 /* 1.510678481838392e-06 */
 
 static const double chebnorm_rsqrt_d3_coeffs[4] = {
-    0x1.2362f4010de4cp+1 /* 2.276457310213834 */,  /* x^0 */
-    -0x1.3b51fdccec74ep+1 /* -2.463439679203396 */,  /* x^1 */
-    0x1.99094872a859cp+0 /* 1.5977978973317937 */,  /* x^2 */
-    -0x1.a4ad311b1f633p-2 /* -0.41081692436259515 */  /* x^3 */
+    0x1.2362f4010dbe7p+1 /* 2.2764573102135617 */,  /* x^0 */
+    -0x1.3b51fdccebf88p+1 /* -2.463439679202512 */,  /* x^1 */
+    0x1.99094872a74d5p+0 /* 1.59779789733084 */,  /* x^2 */
+    -0x1.a4ad311b1de1ap-2 /* -0.4108169243622527 */  /* x^3 */
 };
 
 /* Horner's rule in double; x must lie in [CHEBNORM_RSQRT_D3_LO, CHEBNORM_RSQRT_D3_HI]. */
 static inline double chebnorm_rsqrt_d3(double x)
 {
-    double acc = -0x1.a4ad311b1f633p-2 /* -0.41081692436259515 */;
-    acc = acc * x + 0x1.99094872a859cp+0 /* 1.5977978973317937 */;
-    acc = acc * x + -0x1.3b51fdccec74ep+1 /* -2.463439679203396 */;
-    acc = acc * x + 0x1.2362f4010de4cp+1 /* 2.276457310213834 */;
+    double acc = -0x1.a4ad311b1de1ap-2 /* -0.4108169243622527 */;
+    acc = acc * x + 0x1.99094872a74d5p+0 /* 1.59779789733084 */;
+    acc = acc * x + -0x1.3b51fdccebf88p+1 /* -2.463439679202512 */;
+    acc = acc * x + 0x1.2362f4010dbe7p+1 /* 2.2764573102135617 */;
     return acc;
 }
 
