@@ -330,7 +330,8 @@ class _LocalFunction:
         self.fn = fn
         self.var = sp.Symbol("t", real=True)
         self.expr = fn.expr
-        self._a, self._w = arb_enclose(sp.sympify(a)), arb_enclose(sp.sympify(b - a))
+        a, b = (v if isinstance(v, sp.Basic) else sp.Rational(v) for v in (a, b))
+        self._a, self._w = arb_enclose(a), arb_enclose(b - a)
         self._shift = 0.5 if centered else 0.0
         self._af, self._wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
         f_series, f_point, f_np = fn.arb_series, fn.arb, fn.numpy
