@@ -28,26 +28,18 @@ True
 
 from __future__ import annotations
 
-import math
 from fractions import Fraction
 
 from chebnorm.approx.piecewise import PiecewiseTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-from .c import horner_rounding_bound
+from .c import _up, horner_rounding_bound
 
 __all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound"]
 
 DEFAULT_C_IN_BITS = 24
 MAX_C_IN_BITS = 32
 _U = 2.0 ** -53
-
-
-def _up(x: Fraction) -> float:
-    f = float(x)
-    while Fraction(f) < x:
-        f = math.nextafter(f, math.inf)
-    return f
 
 
 def _lit(x: float) -> str:
