@@ -300,8 +300,8 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     (lattice reduction and a closest vector at Chebyshev points, see
     :mod:`chebnorm.approx.rounding`); plain rounding and, with
     ``reoptimize``, the greedy refit (rounded from the highest power down,
-    the lower ones refitted by Remez) compete, and the candidate with the
-    smallest certified bound wins. Fixed formats are monotone in the bits:
+    the lower ones refitted at Chebyshev nodes) compete, and the candidate with the
+    smallest certified bound wins (``method`` names it). Fixed formats are monotone in the bits:
     more fractional bits never certify a worse error.
 
     The result is the table with ``quantized`` (always) and ``fixed_point``
@@ -316,7 +316,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     """
     from dataclasses import replace
 
-    from .rounding import FORMATS, _Problem, round_coefficients, round_to_float
+    from .rounding import FORMATS, _Problem, greedy as greedy_integers, round_coefficients, round_to_float
 
     if coef_format not in FORMATS:
         raise ValueError(f"coefficient format {coef_format!r} is unknown; accepted: "
@@ -353,9 +353,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                     error_kind=table.error_kind, degree=n, powers=mons, fixed=fixed,
                     word_limit=2 ** (word_bits - 1) - 1 if coef_format == "fixed" else None)
     greedy = None
-    if reoptimize and n >= 1 and full_basis and not fix_constant:
+    if reoptimize and n >= 1 and mons == tuple(range(n + 1)):
         def greedy(quanta):
-            return _greedy_integers(fn, iv, table, quanta)
+            return greedy_integers(prob, real, quanta)
     best = round_coefficients(prob, real, coef_format, fracs if coef_format == "fixed" else None,
                               greedy)
     if best is None:
@@ -421,29 +421,3 @@ def _constrained_fit(fn, iv, degree, powers, fixed, error_kind):
     for k, (mm, e) in fixed.items():
         real[k] = math.ldexp(mm, e)
     return real
-
-
-def _greedy_integers(fn: Function1D, iv: Interval, table: CoefficientTable, quanta):
-    """Greedy rounding: coefficient ``k`` (quantum ``2**quanta[k]``) rounded from
-    the highest power down, the lower ones refitted by Remez after each."""
-    f_np = fn.numpy
-    n = table.degree
-    fixed: dict[int, int] = {}
-    current = list(table.coefficients)
-    for k in range(n, -1, -1):
-        fixed[k] = round(math.ldexp(current[k], -quanta[k]))
-        if k == 0:
-            break
-        high = {j: math.ldexp(q, quanta[j]) for j, q in fixed.items()}
-
-        def residual(x, high=high):
-            return f_np(x) - sum(c * x ** j for j, c in high.items())
-
-        if table.error_kind == "rel":
-            weight = lambda x: 1.0 / np.abs(f_np(x))
-        else:
-            weight = lambda x: np.ones_like(x)
-        res = remez(residual, weight, iv.lo_f, iv.hi_f, k - 1)
-        low = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
-        current = low + [math.ldexp(fixed[j], quanta[j]) for j in range(k, n + 1)]
-    return [fixed[k] for k in range(n + 1)]

@@ -42,6 +42,8 @@ FLOAT_FORMATS = {
     "binary64": (53, -1022, 1023),
 }
 FORMATS = ("fixed",) + tuple(FLOAT_FORMATS)
+#: most lattice rounds (sets of binades) tried for a floating format
+FLOAT_ROUNDS = 10
 
 
 @dataclass(frozen=True)
@@ -220,8 +222,17 @@ class _Sampler:
         return float(np.max(err)) if err.size else 0.0
 
 
+#: tolerance of the certificates that rank candidates: candidates often differ
+#: by less than the certifier's default 2^-8, and a looser bound would misrank
+SELECT_TOL = 2.0 ** -20
+
+
 def _certify_key(prob: _Problem, coeffs):
-    return certify(prob.fn, list(coeffs), prob.lo, prob.hi, prob.error_kind)
+    try:
+        return certify(prob.fn, list(coeffs), prob.lo, prob.hi, prob.error_kind, tol=SELECT_TOL,
+                       max_subintervals=20_000)
+    except ValueError:
+        return certify(prob.fn, list(coeffs), prob.lo, prob.hi, prob.error_kind)
 
 
 def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
@@ -313,6 +324,35 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt) -> dict:
     return out
 
 
+def greedy(prob: _Problem, real, quanta) -> list[int] | None:
+    """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
+    ``2**quanta[k]`` from the highest power down, the lower ones refitted after
+    each rounding (interpolation of the residual at Chebyshev nodes)."""
+    from .fitting import cheb_to_monomial
+
+    f_np = prob.fn.numpy
+    lo, hi = prob.lo_f, prob.hi_f
+    n = prob.degree
+    current = list(real)
+    ints: dict[int, int] = {}
+    for k in range(n, -1, -1):
+        ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        if k == 0:
+            break
+        high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
+
+        def residual(t, high=high):
+            x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+            return f_np(x) - sum(c * x ** j for j, c in high.items())
+
+        with np.errstate(all="ignore"):
+            cheb = np.polynomial.chebyshev.chebinterpolate(residual, k - 1)
+        if not np.all(np.isfinite(cheb)):
+            return None
+        current = cheb_to_monomial(cheb, lo, hi) + [high[j] for j in range(k, n + 1)]
+    return [ints[k] for k in range(n + 1)]
+
+
 def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None) -> Candidate:
     """The best certified rounding of ``real`` (coefficients of all powers)."""
     sampler = _Sampler(prob)
@@ -338,16 +378,24 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
                                     best.abs_cert, best.rel_cert)
             best = new if new is not None else best
         return best
-    # floating: quanta from the real coefficients, then once more from the answer
-    quanta = [float_quantum(real[k], fmt) for k in range(prob.degree + 1)]
+    # floating: quanta from the real coefficients, then from the best few
+    # candidates' own binades (a lattice answer may leave a binade), a few rounds
+    todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
+    tried = set()
     best = None
-    for _ in range(2):
-        cands = _candidates(prob, sampler, real, quanta, greedy, fmt)
+    for _ in range(FLOAT_ROUNDS):
+        todo = [q for q in todo if q not in tried]
+        if not todo:
+            break
+        quanta = todo.pop(0)
+        tried.add(quanta)
+        cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
         best = _select(prob, sampler, cands, best)
-        if best is None:
-            break
-        again = [float_quantum(c, fmt) for c in best.coefficients]
-        if again == quanta:
-            break
-        quanta = again
+        ranked = sorted(cands.values(), key=lambda c: sampler.error(
+            [math.ldexp(m, e) for m, e in zip(*c)]))
+        for ms, es in ranked[:8]:
+            q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers else quanta[k]
+                      for k, (m, e) in enumerate(zip(ms, es)))
+            if q not in tried and q not in todo:
+                todo.append(q)
     return best
