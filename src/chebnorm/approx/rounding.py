@@ -227,12 +227,13 @@ class _Sampler:
 SELECT_TOL = 2.0 ** -20
 
 
+def certify_tight(fn, coeffs, lo, hi, kind):
+    """:func:`certify` at :data:`SELECT_TOL` (at most 20,000 subintervals)."""
+    return certify(fn, list(coeffs), lo, hi, kind, tol=SELECT_TOL, max_subintervals=20_000)
+
+
 def _certify_key(prob: _Problem, coeffs):
-    try:
-        return certify(prob.fn, list(coeffs), prob.lo, prob.hi, prob.error_kind, tol=SELECT_TOL,
-                       max_subintervals=20_000)
-    except ValueError:
-        return certify(prob.fn, list(coeffs), prob.lo, prob.hi, prob.error_kind)
+    return certify_tight(prob.fn, coeffs, prob.lo, prob.hi, prob.error_kind)
 
 
 def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
