@@ -317,10 +317,8 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
     ((0, 0, 0), True)
     """
-    from dataclasses import replace
 
-    from .rounding import (FORMATS, _normal, _Problem, greedy as greedy_integers,
-                           round_coefficients, round_to_float)
+    from .rounding import FORMATS, _Problem, greedy as greedy_integers, round_coefficients
 
     if coef_format not in FORMATS:
         raise ValueError(f"coefficient format {coef_format!r} is unknown; accepted: "
@@ -336,17 +334,10 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
     elif frac_bits is not None:
         raise ValueError(f"frac-bits applies to coefficient format fixed, not {coef_format}")
-    fixed = {}
-    if fix_constant:
-        f0 = enclose(fn.expr.subs(fn.var, 0), 128)
-        if f0 is None or not f0.is_finite():
-            raise ValueError(f"fix_constant: {fn.expr} has no finite value at "
-                             f"{fn.var} = 0; accepted only where f(0) is defined")
-        c0 = float(f0.mid())
-        if coef_format == "fixed":
-            fixed[0] = (round(math.ldexp(c0, fracs[0])), -fracs[0])
-        else:
-            fixed[0] = round_to_float(c0, coef_format)
+    else:
+        fracs = None
+    fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \
+        if fix_constant else {}
     if not mons:
         raise ValueError("monomials: no free coefficient left (only the fixed constant)")
     real = list(table.coefficients)
@@ -369,6 +360,17 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     # the certificates that ranked the candidates (tight), so the stated bound
     # is the one the monotone chain compared
     ca, cr = _certify_both(fn, list(coeffs), iv, table.error_kind == "rel", tight=True)
+    return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
+                           fix_constant, full_basis)
+
+
+def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fix_constant,
+                    full_basis) -> CoefficientTable:
+    """The table with its ``quantized`` (and, where it fits, ``fixed_point``) part."""
+    from dataclasses import replace
+
+    from .rounding import _normal
+
     method = "lattice" if best.method.startswith("lattice") else best.method
     # tight=False there means missing 2^-20; warn only when 1 + 2^-8 is missed
     notes = _certificate_notes(**{
@@ -397,6 +399,20 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         old = warnings_of(table)
         provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
     return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
+
+
+def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:
+    """``{0: (mantissa, exponent)}``: ``f(0)`` rounded to the constant's format."""
+    from .rounding import round_to_float
+
+    f0 = enclose(fn.expr.subs(fn.var, 0), 128)
+    if f0 is None or not f0.is_finite():
+        raise ValueError(f"fix_constant: {fn.expr} has no finite value at "
+                         f"{fn.var} = 0; accepted only where f(0) is defined")
+    c0 = float(f0.mid())
+    if coef_format == "fixed":
+        return {0: (round(math.ldexp(c0, frac0)), -frac0)}
+    return {0: round_to_float(c0, coef_format)}
 
 
 def _constrained_fit(fn, iv, degree, powers, fixed, error_kind):
