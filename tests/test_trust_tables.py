@@ -181,7 +181,7 @@ FIELD_CASES = [
                                        r"0\.\.1074, got -1$"),
     (("fixed_point", "frac_bits"), 24.0, r"^fixed_point\.frac_bits: expected an integer"),
     (("fixed_point", "method"), "magic", r"^fixed_point\.method: expected one of 'rounded', "
-                                         r"'reoptimized', got 'magic'$"),
+                                         r"'reoptimized', 'lattice', got 'magic'$"),
     (("fixed_point", "abs_error_bound"), -1, r"^fixed_point\.abs_error_bound: expected a "
                                              r"finite number >= 0, got -1$"),
     (("fixed_point", "max_rel_error"), None, r"^fixed_point\.max_rel_error: must be null exactly "

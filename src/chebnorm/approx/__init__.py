@@ -11,11 +11,12 @@ from .certify import Certificate, certify
 from .expr import Function1D, read_expression, parse_function, parse_number
 from .files import write_atomic
 from . import textsafe
-from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint
+from .rounding import FORMATS as COEF_FORMATS
+from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint, Quantized
 from .targets import TARGETS, Target, get_target, target_names
 
 __all__ = [
-    "CoefficientTable", "FixedPoint", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "MAX_DEGREE",
+    "CoefficientTable", "FixedPoint", "Quantized", "COEF_FORMATS", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "MAX_DEGREE",
     "Certificate", "certify", "Function1D", "read_expression", "parse_function", "parse_number",
     "Target", "TARGETS", "get_target", "target_names", "fit_target",
     "write_atomic", "textsafe",

@@ -13,7 +13,7 @@ from flint import arb
 from .certify import Certificate, _float_down, _float_up, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import chebyshev_interpolant, cheb_to_monomial, polish, remez, shift_for
-from .table import CoefficientTable, FixedPoint
+from .table import CoefficientTable, FixedPoint, Quantized
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval"]
 
@@ -116,10 +116,18 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     return y.real
 
 
-def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None):
-    cert_abs = certify(fn, coeffs, iv.lo, iv.hi, "abs", shift=shift)
+def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = False):
+    if tight:  # monomial tables only (quantize refuses the shifted basis)
+        from .rounding import certify_tight
+
+        def cert(*a):
+            return certify_tight(*a)
+    else:
+        def cert(*a):
+            return certify(*a, shift=shift)
+    cert_abs = cert(fn, coeffs, iv.lo, iv.hi, "abs")
     try:
-        cert_rel = certify(fn, coeffs, iv.lo, iv.hi, "rel", shift=shift)
+        cert_rel = cert(fn, coeffs, iv.lo, iv.hi, "rel")
     except ValueError:
         if need_rel:
             raise ValueError(f"relative error is undefined: {fn.expr} vanishes on "
@@ -130,15 +138,19 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None):
 
 
 def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs", *,
-        var: str = "x", name: str | None = None, frac_bits: int | None = None,
-        command: str | None = None, basis: str = "monomial") -> CoefficientTable:
+        var: str = "x", name: str | None = None, frac_bits=None,
+        command: str | None = None, basis: str = "monomial", coef_format: str | None = None,
+        monomials=None, fix_constant: bool = False) -> CoefficientTable:
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
     ``kind="minimax"``: the Remez exchange, minimizing the absolute
     (``error="abs"``) or relative (``error="rel"``) error. Every table carries
     rigorous bounds of both errors (see :mod:`chebnorm.approx.certify`).
-    With ``frac_bits`` the table also gets a re-certified fixed-point part.
+    With ``frac_bits`` (one integer or one per power), ``coef_format``
+    (``"fixed"``, ``"binary16"``, ``"bfloat16"``, ``"binary32"``,
+    ``"binary64"``), ``monomials`` or ``fix_constant`` the table also gets
+    re-certified quantized coefficients: see :func:`quantize`.
     ``basis="shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c``
     the midpoint, ``s`` a power of two at least the half-width; recorded in
     ``table.shift``), well conditioned on narrow or offset intervals where
@@ -176,9 +188,11 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
     if basis not in BASES:
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
-    if basis != "monomial" and frac_bits is not None:
-        raise ValueError("frac-bits with basis shifted is not supported; accepted: "
-                         "basis monomial for fixed-point tables")
+    if basis != "monomial" and (frac_bits is not None or coef_format is not None
+                                or monomials is not None or fix_constant):
+        raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
+                         "fix-constant) with basis shifted are not supported; accepted: "
+                         "basis monomial for quantized tables")
     try:
         lo, hi = interval
     except (TypeError, ValueError):
@@ -211,8 +225,9 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         max_rel_error=None if cert_rel is None else cert_rel.maximum,
         max_rel_at=None if cert_rel is None else cert_rel.at,
         provenance=provenance, shift=shift)
-    if frac_bits is not None:
-        table = quantize(table, frac_bits)
+    if frac_bits is not None or coef_format is not None or monomials is not None or fix_constant:
+        table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
+                         monomials=monomials, fix_constant=fix_constant)
     return table
 
 
@@ -279,71 +294,196 @@ def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
                              f"accepted: frac-bits <= {max_f}")
 
 
-def quantize(table: CoefficientTable, frac_bits: int, *, word_bits: int = 32,
-             reoptimize: bool = True) -> CoefficientTable:
-    """Round the coefficients to ``frac_bits`` fractional bits and re-certify.
+def _frac_list(frac_bits, degree: int, coeffs, word_bits: int) -> list[int]:
+    """``frac_bits`` (an integer or one per power 0..degree) as a list, checked."""
+    if isinstance(frac_bits, (list, tuple)):
+        if len(frac_bits) != degree + 1:
+            raise ValueError(f"frac-bits list {list(frac_bits)} has {len(frac_bits)} entries; "
+                             f"accepted: one integer, or degree + 1 = {degree + 1} integers "
+                             f"(one per power 0..{degree})")
+        for k, f in enumerate(frac_bits):
+            _check_frac_bits(f, [coeffs[k]], word_bits)
+        return [int(f) for f in frac_bits]
+    _check_frac_bits(frac_bits, coeffs, word_bits)
+    return [int(frac_bits)] * (degree + 1)
 
-    With ``reoptimize`` the coefficients are rounded from the highest power
-    down, the lower ones refitted (Remez, same error kind) after each
-    rounding -- a greedy version of Sollya's ``fpminimax`` -- and the result
-    is kept only when its certified error beats plain rounding.
 
-    >>> t = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 20)
-    >>> t.fixed_point.method, t.fixed_point.abs_error_bound < 1.01 * t.abs_error_bound
-    ('reoptimized', True)
+def _monomials(monomials, degree: int, fix_constant: bool) -> tuple[int, ...]:
+    if monomials is None:
+        monomials = range(degree + 1)
+    try:
+        mons = sorted({int(k) for k in monomials})
+        ok = all(not isinstance(k, bool) and float(k) == int(k) for k in monomials)
+    except (TypeError, ValueError):
+        ok, mons = False, []
+    if not ok or not mons or mons[0] < 0 or mons[-1] > degree:
+        raise ValueError(f"monomials {monomials!r} are not powers of the variable in "
+                         f"0..{degree}; accepted: a non-empty list such as 1,3,5 (at most the "
+                         f"degree {degree})")
+    if fix_constant and 0 in mons:
+        mons.remove(0)
+    return tuple(mons)
+
+
+def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
+             reoptimize: bool = True, coef_format: str = "fixed", monomials=None,
+             fix_constant: bool = False) -> CoefficientTable:
+    """Round the coefficients to a fixed or floating format and re-certify.
+
+    ``coef_format="fixed"`` (the default) stores coefficient ``k`` with
+    ``frac_bits`` fractional bits (one integer, or one per power
+    ``0..degree``) as a ``word_bits``-bit integer; ``"binary16"``,
+    ``"bfloat16"``, ``"binary32"``, ``"binary64"`` store each coefficient as a
+    number of that floating format. ``monomials`` (e.g. ``(1, 3, 5)``) keeps
+    only those powers; ``fix_constant`` holds the constant coefficient at
+    ``f(0)`` rounded to its format (so ``p(0) = f(0)`` when that is
+    representable). The error minimized is the table's ``error_kind``.
+
+    With ``reoptimize=False`` each coefficient is only rounded to nearest.
+    Otherwise the coefficients are chosen as Sollya's ``fpminimax`` chooses them
+    (lattice reduction and a closest vector at Chebyshev points, see
+    :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
+    the lower ones refitted at Chebyshev nodes) compete, and the candidate with the
+    smallest certified bound wins (``method`` names it). Fixed formats are monotone in the bits:
+    more fractional bits never certify a worse error.
+
+    The result is the table with ``quantized`` (always) and ``fixed_point``
+    (fixed format with one ``frac_bits``, all powers, free constant) set.
+
+    >>> t = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 14)
+    >>> t.fixed_point.integers, f"{t.fixed_point.abs_error_bound:.3e}"
+    ((11152, -1944, 232), '2.781e-05')
+    >>> s = quantize(fit("sin(x)", ("0", "1"), 5), coef_format="binary32", monomials=(1, 3, 5))
+    >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
+    ((0, 0, 0), True)
     """
     table.require_monomial("quantize")
-    _check_frac_bits(frac_bits, table.coefficients, word_bits)
-    frac_bits = int(frac_bits)
+
+    from .rounding import FORMATS, _Problem, greedy as greedy_integers, round_coefficients
+
+    if coef_format not in FORMATS:
+        raise ValueError(f"coefficient format {coef_format!r} is unknown; accepted: "
+                         f"{', '.join(FORMATS)}")
+    n = table.degree
     fn = parse_function(table.expression, table.variable)
     iv = Interval(*table.interval)
-    candidates = {"rounded": [round(math.ldexp(c, frac_bits)) for c in table.coefficients]}
-    if reoptimize and table.degree >= 1:
-        candidates["reoptimized"] = _greedy_integers(fn, iv, table, frac_bits)
-    best = None
-    limit = 2 ** (word_bits - 1) - 1
-    for method, ints in candidates.items():
-        if max(abs(q) for q in ints) > limit:
-            continue
-        coeffs = [math.ldexp(q, -frac_bits) for q in ints]
-        ca, cr = _certify_both(fn, coeffs, iv, table.error_kind == "rel")
-        key = ca.bound if table.error_kind == "abs" else (cr.bound if cr else math.inf)
-        if best is None or key < best[0]:
-            best = (key, method, ints, ca, cr)
-    _, method, ints, ca, cr = best
-    notes = _certificate_notes(**{"fixed_point.abs_error_bound": ca,
-                                  "fixed_point.rel_error_bound": cr})
-    fixed = FixedPoint(frac_bits=frac_bits, integers=tuple(int(q) for q in ints), word_bits=word_bits,
-                       method=method, abs_error_bound=ca.bound,
-                       rel_error_bound=None if cr is None else cr.bound,
-                       max_abs_error=ca.maximum, max_rel_error=None if cr is None else cr.maximum)
+    mons = _monomials(monomials, n, fix_constant)
+    if coef_format == "fixed":
+        if frac_bits is None:
+            raise ValueError("coefficient format fixed needs frac-bits (an integer, or one per "
+                             "power); accepted: e.g. 14 or 14,16,18")
+        fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
+    elif frac_bits is not None:
+        raise ValueError(f"frac-bits applies to coefficient format fixed, not {coef_format}")
+    else:
+        fracs = None
+    fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \
+        if fix_constant else {}
+    if not mons:
+        raise ValueError("monomials: no free coefficient left (only the fixed constant)")
+    real = list(table.coefficients)
+    full_basis = mons == tuple(range(n + 1)) or (fix_constant and mons == tuple(range(1, n + 1)))
+    if not full_basis or fix_constant:
+        real = _constrained_fit(fn, iv, n, mons, fixed, table.error_kind)
+    prob = _Problem(fn=fn, lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,
+                    error_kind=table.error_kind, degree=n, powers=mons, fixed=fixed,
+                    word_limit=2 ** (word_bits - 1) - 1 if coef_format == "fixed" else None)
+    greedy = None
+    if reoptimize and n >= 1 and mons == tuple(range(n + 1)):
+        def greedy(quanta):
+            return greedy_integers(prob, real, quanta)
+    best = round_coefficients(prob, real, coef_format, fracs if coef_format == "fixed" else None,
+                              greedy, plain=not reoptimize)
+    if best is None:
+        raise ValueError(f"no rounding of the coefficients to {coef_format} could be certified "
+                         f"(every candidate overflowed word_bits = {word_bits} or failed)")
+    coeffs = best.coefficients
+    # the certificates that ranked the candidates (tight), so the stated bound
+    # is the one the monotone chain compared
+    ca, cr = _certify_both(fn, list(coeffs), iv, table.error_kind == "rel", tight=True)
+    return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
+                           fix_constant, full_basis)
+
+
+def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fix_constant,
+                    full_basis) -> CoefficientTable:
+    """The table with its ``quantized`` (and, where it fits, ``fixed_point``) part."""
     from dataclasses import replace
+
+    from .rounding import _normal
+
+    method = "lattice" if best.method.startswith("lattice") else best.method
+    # tight=False there means missing 2^-20; warn only when 1 + 2^-8 is missed
+    notes = _certificate_notes(**{
+        k: c for k, c in (("quantized.abs_error_bound", ca), ("quantized.rel_error_bound", cr))
+        if c is not None and c.bound > (1 + 2.0 ** -8) * c.maximum})
+    quant = Quantized(
+        format=coef_format, monomials=mons, mantissas=tuple(best.mantissas),
+        exponents=tuple(best.exponents if coef_format != "fixed" else [-f for f in fracs]),
+        frac_bits=tuple(fracs) if coef_format == "fixed" else None,
+        word_bits=word_bits if coef_format == "fixed" else None, fixed_constant=fix_constant,
+        method=method, abs_error_bound=ca.bound, rel_error_bound=None if cr is None else cr.bound,
+        max_abs_error=ca.maximum, max_rel_error=None if cr is None else cr.maximum)
+    if coef_format != "fixed":
+        # odd mantissas (zero: 0 * 2^0): one spelling per number, within 2^53
+        pairs = [_normal(m, e) for m, e in zip(quant.mantissas, quant.exponents)]
+        quant = replace(quant, mantissas=tuple(m for m, _ in pairs),
+                        exponents=tuple(e for _, e in pairs))
+    fixed_point = None
+    if coef_format == "fixed" and len(set(fracs)) == 1 and full_basis and not fix_constant:
+        fixed_point = FixedPoint(frac_bits=fracs[0], integers=quant.mantissas,
+                                 word_bits=word_bits, method=method, abs_error_bound=ca.bound,
+                                 rel_error_bound=quant.rel_error_bound, max_abs_error=ca.maximum,
+                                 max_rel_error=quant.max_rel_error)
     provenance = dict(table.provenance)
     if notes:
         old = warnings_of(table)
         provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
-    return replace(table, fixed_point=fixed, provenance=provenance)
+    return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
 
 
-def _greedy_integers(fn: Function1D, iv: Interval, table: CoefficientTable, frac_bits: int):
-    f_np = fn.numpy
-    n = table.degree
-    fixed: dict[int, int] = {}
-    current = list(table.coefficients)
-    for k in range(n, -1, -1):
-        fixed[k] = round(math.ldexp(current[k], frac_bits))
-        if k == 0:
-            break
-        high = {j: math.ldexp(q, -frac_bits) for j, q in fixed.items()}
+def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:
+    """``{0: (mantissa, exponent)}``: ``f(0)`` rounded to the constant's format."""
+    from .rounding import round_to_float
 
-        def residual(x, high=high):
-            return f_np(x) - sum(c * x ** j for j, c in high.items())
+    f0 = enclose(fn.expr.subs(fn.var, 0), 128)
+    if f0 is None or not f0.is_finite():
+        raise ValueError(f"fix_constant: {fn.expr} has no finite value at "
+                         f"{fn.var} = 0; accepted only where f(0) is defined")
+    c0 = float(f0.mid())
+    if coef_format == "fixed":
+        return {0: (round(math.ldexp(c0, frac0)), -frac0)}
+    return {0: round_to_float(c0, coef_format)}
 
-        if table.error_kind == "rel":
-            weight = lambda x: 1.0 / np.abs(f_np(x))
-        else:
-            weight = lambda x: np.ones_like(x)
-        res = remez(residual, weight, iv.lo_f, iv.hi_f, k - 1)
-        low = cheb_to_monomial(res.cheb, iv.lo_f, iv.hi_f)
-        current = low + [math.ldexp(fixed[j], -frac_bits) for j in range(k, n + 1)]
-    return [fixed[k] for k in range(n + 1)]
+
+def _constrained_fit(fn, iv, degree, powers, fixed, error_kind):
+    """Real coefficients (all powers) of the discrete minimax fit in the given
+    powers, the fixed ones held (linear programming on a dense grid)."""
+    from scipy.optimize import linprog
+
+    x = np.linspace(iv.lo_f, iv.hi_f, 1500)
+    x = np.concatenate([x, 0.5 * (iv.lo_f + iv.hi_f) + 0.5 * (iv.hi_f - iv.lo_f)
+                        * np.cos(np.pi * (np.arange(500) + 0.5) / 500)])
+    f = np.asarray(fn.numpy(x), dtype=float) * np.ones_like(x)
+    w = 1.0 / np.abs(f) if error_kind == "rel" else np.ones_like(f)
+    y = f - sum(math.ldexp(m, e) * x ** k for k, (m, e) in fixed.items())
+    cols = np.stack([x ** k for k in powers], axis=1)
+    scale = np.max(np.abs(cols), axis=0)
+    scale[scale == 0] = 1.0
+    a = cols / scale * w[:, None]
+    b = y * w
+    m = len(powers)
+    # minimise t subject to |a c - b| <= t
+    A = np.block([[a, -np.ones((len(x), 1))], [-a, -np.ones((len(x), 1))]])
+    rhs = np.concatenate([b, -b])
+    cost = np.zeros(m + 1)
+    cost[-1] = 1.0
+    res = linprog(cost, A_ub=A, b_ub=rhs, bounds=[(None, None)] * m + [(0, None)],
+                  method="highs")
+    sol = res.x[:m] / scale if res.success else np.linalg.lstsq(a, b, rcond=None)[0] / scale
+    real = [0.0] * (degree + 1)
+    for k, c in zip(powers, sol):
+        real[k] = float(c)
+    for k, (mm, e) in fixed.items():
+        real[k] = math.ldexp(mm, e)
+    return real

@@ -19,7 +19,7 @@ import sympy as sp
 from .expr import parse_function, parse_number
 
 __all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "function_text",
-           "interval_text"]
+           "interval_text", "FpminimaxCase", "fpminimax"]
 
 
 def available() -> bool:
@@ -129,12 +129,17 @@ def supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: str = "ab
 
 def remez(expr: str, var: str, lo: str, hi: str, degree: int, kind: str = "abs",
           accuracy: float = 2.0 ** -8) -> tuple[list[float], SollyaSupnorm]:
-    """Sollya's ``remez`` fit (abs: weight 1; rel: weight 1/f) and its supnorm."""
+    """Sollya's ``remez`` fit and the ``supnorm`` of its error.
+
+    Sollya's ``remez(g, n, d, w)`` minimises ``sup |p*w - g|``: the absolute
+    fit is ``remez(f, n, d)``, the relative one (``sup |p/f - 1|``)
+    ``remez(1, n, d, 1/f)``.
+    """
     f = _sollya_expr(expr, var)
-    weight = "1" if kind == "abs" else f"1/({f})"
+    target, weight = ("f", "1") if kind == "abs" else ("1", "1/f")
     mode = "absolute" if kind == "abs" else "relative"
     script = (f"prec=200!;\ndisplay=decimal!;\nf={f};\nd={_interval(lo, hi)};\n"
-              f"p=remez(f, {degree}, d, {weight});\n"
+              f"p=remez({target}, {degree}, d, {weight});\n"
               + "".join(f"print(\"C{k}\", coeff(p, {k}));\n" for k in range(degree + 1))
               + f"r=supnorm(p, f, d, {mode}, {accuracy!r});\nprint(\"SUP\", inf(r), sup(r));\n")
     out = _run(script)
@@ -146,3 +151,97 @@ def remez(expr: str, var: str, lo: str, hi: str, degree: int, kind: str = "abs",
     if not m:
         raise RuntimeError(f"unexpected sollya output: {out[:300]!r}")
     return coeffs, SollyaSupnorm(float(m.group(1)), float(m.group(2)))
+
+
+#: Sollya's precision (floating) for chebnorm's floating formats; Sollya's
+#: ``floating`` formats have an unbounded exponent range, which none of the
+#: compared coefficients approach
+_SOLLYA_PRECISION = {"binary16": 11, "bfloat16": 8, "binary32": 24, "binary64": 53}
+
+
+@dataclass(frozen=True)
+class FpminimaxCase:
+    """One ``fpminimax`` problem: ``expr`` of ``var`` on ``[lo, hi]`` with the
+    powers ``monomials``, ``coef_format`` (``"fixed"`` with ``frac_bits`` per
+    power, or a floating format), ``kind`` abs or rel, ``constant`` (a float
+    held as the constant coefficient) or None; ``check`` optional coefficients
+    (all powers) whose supnorm Sollya also computes."""
+
+    expr: str
+    var: str
+    lo: str
+    hi: str
+    monomials: tuple[int, ...]
+    coef_format: str
+    frac_bits: tuple[int, ...] | None = None
+    kind: str = "abs"
+    constant: float | None = None
+    check: tuple[float, ...] | None = None
+
+
+def _dyadic(text: str):
+    from fractions import Fraction
+
+    text = text.strip()
+    m = re.fullmatch(r"([-+]?[0-9]+)(?:b([-+]?[0-9]+))?", text)
+    if not m:
+        raise RuntimeError(f"unexpected sollya number {text!r}")
+    return Fraction(int(m.group(1))) * Fraction(2) ** int(m.group(2) or 0)
+
+
+def fpminimax(cases, accuracy: float = 2.0 ** -20, timeout: float = 1200):
+    """Run Sollya's ``fpminimax`` on every case in one Sollya process.
+
+    Returns one dict per case: ``coefficients`` (exact Fractions, all powers
+    up to the largest monomial), ``sup`` (:class:`SollyaSupnorm` of its error,
+    absolute or relative as the case's ``kind``) and ``check_sup`` (the
+    supnorm of the case's ``check`` coefficients, or None); a case Sollya
+    fails on gives ``None``.
+    """
+    parts = ["prec=300!;", "display=dyadic!;", "verbosity=0!;"]
+    for i, c in enumerate(cases):
+        mode = "absolute" if c.kind == "abs" else "relative"
+        mons = list(c.monomials)
+        if c.coef_format == "fixed":
+            fmts = [c.frac_bits[k] for k in mons]
+            kind = "fixed"
+        else:
+            fmts = [_SOLLYA_PRECISION[c.coef_format]] * len(mons)
+            kind = "floating"
+        constrained = "" if c.constant is None else f", {_exact(c.constant)}"
+        parts.append(f"f={_sollya_expr(c.expr, c.var)};\nd={_interval(c.lo, c.hi)};")
+        parts.append(f"p=fpminimax(f, [|{','.join(map(str, mons))}|], "
+                     f"[|{','.join(map(str, fmts))}|], d, {kind}, {mode}{constrained});")
+        parts.append("".join(f"print(\"C{i}_{k}\", coeff(p, {k}));\n"
+                             for k in range(max(mons) + 1))
+                     + f"r=supnorm(p, f, d, {mode}, {accuracy!r});\n"
+                     f"print(\"S{i}\", inf(r), sup(r));")
+        if c.check is not None:
+            parts.append(f"q={_poly(c.check)};\nr=supnorm(q, f, d, {mode}, {accuracy!r});\n"
+                         f"print(\"K{i}\", inf(r), sup(r));")
+    out = _run("\n".join(parts) + "\n", timeout=timeout)
+    num = r"[-+]?[0-9]+(?:b[-+]?[0-9]+)?"
+    results = []
+    for i, c in enumerate(cases):
+        found = [re.search(rf"^C{i}_{k}\s+({num})\s*$", out, re.M)
+                 for k in range(max(c.monomials) + 1)]
+        sup = re.search(rf"^S{i}\s+({num})\s+({num})\s*$", out, re.M)
+        check = re.search(rf"^K{i}\s+({num})\s+({num})\s*$", out, re.M)
+        if sup is None or not all(found):     # Sollya failed on this case
+            results.append(None)
+            continue
+        coeffs = [_dyadic(m.group(1)) for m in found]
+        if c.check is not None and check is None:
+            # Sollya's supnorm occasionally fails at the tight accuracy: a looser one
+            try:
+                checked = supnorm(c.expr, c.var, c.check, c.lo, c.hi, c.kind, 2.0 ** -12)
+            except RuntimeError:
+                checked = None
+        else:
+            checked = None if check is None else SollyaSupnorm(
+                float(_dyadic(check.group(1))), float(_dyadic(check.group(2))))
+        results.append({
+            "coefficients": coeffs,
+            "sup": SollyaSupnorm(float(_dyadic(sup.group(1))), float(_dyadic(sup.group(2)))),
+            "check_sup": checked})
+    return results

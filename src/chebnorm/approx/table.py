@@ -26,12 +26,14 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from fractions import Fraction
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint"]
+__all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint",
+           "Quantized"]
 
 SCHEMA_VERSION = 1
 
@@ -62,6 +64,41 @@ class FixedPoint:
     def coefficients(self) -> tuple[float, ...]:
         """The quantized coefficients as floats (exact)."""
         return tuple(math.ldexp(q, -self.frac_bits) for q in self.integers)
+
+
+@dataclass(frozen=True)
+class Quantized:
+    """Coefficients stored in a fixed or floating format (``chebnorm.approx.quantize``).
+
+    The coefficient of ``x**k`` is ``mantissas[k] * 2**exponents[k]`` exactly
+    (zero for the powers not in ``monomials``). ``format`` is ``"fixed"``
+    (then ``frac_bits[k]`` fractional bits per power, ``exponents[k] ==
+    -frac_bits[k]``, and each mantissa fits a ``word_bits``-bit two's
+    complement integer) or a floating format (``binary16``, ``bfloat16``,
+    ``binary32``, ``binary64``: each coefficient a finite number of it).
+    ``fixed_constant``: the constant coefficient is ``f(0)`` rounded to its
+    format, not chosen by the fit. Bounds are re-certified for exactly these
+    numbers. ``method`` names the candidate that won: ``"lattice"`` (LLL and
+    nearest plane), ``"rounded"`` or ``"reoptimized"`` (greedy refit).
+    """
+
+    format: str
+    monomials: tuple[int, ...]
+    mantissas: tuple[int, ...]
+    exponents: tuple[int, ...]
+    frac_bits: tuple[int, ...] | None
+    word_bits: int | None
+    fixed_constant: bool
+    method: str
+    abs_error_bound: float
+    rel_error_bound: float | None
+    max_abs_error: float
+    max_rel_error: float | None
+
+    @property
+    def coefficients(self) -> tuple[float, ...]:
+        """The stored coefficients as floats (exact)."""
+        return tuple(math.ldexp(m, e) for m, e in zip(self.mantissas, self.exponents))
 
 
 @dataclass(frozen=True)
@@ -106,6 +143,7 @@ class CoefficientTable:
     #: ``(c, s)``: the coefficients are in ``t = (x - c)/s`` (basis "shifted");
     #: None (the default, absent from the JSON): plain monomials in ``x``
     shift: tuple[float, float] | None = None
+    quantized: Quantized | None = None
 
     @property
     def basis(self) -> str:
@@ -157,6 +195,12 @@ class CoefficientTable:
             d["shift"] = list(self.shift)
         if self.fixed_point is not None:
             d["fixed_point"]["integers"] = list(self.fixed_point.integers)
+        if self.quantized is not None:
+            for key in ("monomials", "mantissas", "exponents", "frac_bits"):
+                if d["quantized"][key] is not None:
+                    d["quantized"][key] = list(d["quantized"][key])
+        else:
+            del d["quantized"]
         return d
 
     def to_json(self) -> str:
@@ -397,8 +441,9 @@ _MAX_KEY = 64
 #: (``word_bits <= 53``) and ``frac_bits <= 1074`` (the smallest subnormal)
 MAX_WORD_BITS = 53
 MAX_FRAC_BITS = 1074
-FIXED_METHODS = ("rounded", "reoptimized")
-_OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None}
+FIXED_METHODS = ("rounded", "reoptimized", "lattice")
+QUANT_FORMATS = ("fixed", "binary16", "bfloat16", "binary32", "binary64")
+_OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None, "quantized": None}
 
 
 def _show(value) -> str:
@@ -511,6 +556,80 @@ def _read_fixed(fp, degree: int) -> FixedPoint | None:
         max_rel_error=max_rel)
 
 
+def _read_quantized(q, degree: int) -> Quantized | None:
+    if q is None:
+        return None
+    from .rounding import representable
+
+    allowed = [f.name for f in dataclasses.fields(Quantized)]
+    _object(q, "quantized", allowed)
+    fmt = _choice(q["format"], "quantized.format", QUANT_FORMATS)
+    mon = _array(q["monomials"], "quantized.monomials", "integers")
+    monomials = tuple(_integer(k, f"quantized.monomials[{i}]", 0, degree) for i, k in enumerate(mon))
+    if not monomials or list(monomials) != sorted(set(monomials)):
+        raise _bad("quantized.monomials", f"increasing distinct powers in 0..{degree}", list(mon))
+    lists = {}
+    for key in ("mantissas", "exponents"):
+        arr = _array(q[key], f"quantized.{key}", "integers")
+        if len(arr) != degree + 1:
+            raise ValueError(f"quantized.{key}: {len(arr)} integers for degree {degree}; "
+                             f"expected degree + 1 = {degree + 1}")
+        lim = (1 << 53) - 1 if key == "mantissas" else 1100
+        lists[key] = tuple(_integer(v, f"quantized.{key}[{k}]", -lim, lim)
+                           for k, v in enumerate(arr))
+    mants, exps = lists["mantissas"], lists["exponents"]
+    for k, (m, e) in enumerate(zip(mants, exps)):
+        c = math.ldexp(m, e) if e < 1024 else math.inf
+        if m and (not math.isfinite(c) or Fraction(c) != Fraction(m) * Fraction(2) ** e):
+            raise ValueError(f"quantized.mantissas[{k}]: {m} * 2^{e} is not a double; accepted: "
+                             f"a finite double (the certifier evaluates it exactly)")
+    fixed_constant = q["fixed_constant"]
+    if not isinstance(fixed_constant, bool):
+        raise _bad("quantized.fixed_constant", "true or false", fixed_constant)
+    for k in range(degree + 1):
+        if k not in monomials and mants[k] != 0 and not (k == 0 and fixed_constant):
+            raise ValueError(f"quantized.mantissas[{k}]: x^{k} is not among quantized.monomials "
+                             f"{list(monomials)}, so its mantissa must be 0")
+    frac_bits, word_bits = None, None
+    if fmt == "fixed":
+        fb = _array(q["frac_bits"], "quantized.frac_bits", "integers")
+        if len(fb) != degree + 1:
+            raise ValueError(f"quantized.frac_bits: {len(fb)} integers for degree {degree}; "
+                             f"expected degree + 1 = {degree + 1}")
+        frac_bits = tuple(_integer(v, f"quantized.frac_bits[{k}]", 0, MAX_FRAC_BITS)
+                          for k, v in enumerate(fb))
+        word_bits = _integer(q["word_bits"], "quantized.word_bits", 2, MAX_WORD_BITS)
+        for k in range(degree + 1):
+            if mants[k] and exps[k] != -frac_bits[k]:
+                raise ValueError(f"quantized.exponents[{k}]: {exps[k]} for a fixed-point "
+                                 f"coefficient with {frac_bits[k]} fractional bits; expected "
+                                 f"{-frac_bits[k]}")
+            if not -(1 << (word_bits - 1)) <= mants[k] < (1 << (word_bits - 1)):
+                raise ValueError(f"quantized.word_bits: {word_bits} bits cannot hold "
+                                 f"quantized.mantissas[{k}] = {mants[k]}")
+    else:
+        if q["frac_bits"] is not None or q["word_bits"] is not None:
+            raise ValueError(f"quantized.frac_bits, quantized.word_bits: must be null for "
+                             f"format {fmt}")
+        for k in range(degree + 1):
+            if not representable(mants[k], exps[k], fmt):
+                raise ValueError(f"quantized.mantissas[{k}]: {mants[k]} * 2^{exps[k]} is not "
+                                 f"a finite {fmt} number")
+    rel = _number(q["rel_error_bound"], "quantized.rel_error_bound", optional=True, nonneg=True)
+    max_rel = _number(q["max_rel_error"], "quantized.max_rel_error", optional=True, nonneg=True)
+    if (rel is None) != (max_rel is None):
+        raise ValueError("quantized.max_rel_error: must be null exactly when "
+                         "quantized.rel_error_bound is null")
+    return Quantized(
+        format=fmt, monomials=monomials, mantissas=mants, exponents=exps, frac_bits=frac_bits,
+        word_bits=word_bits, fixed_constant=fixed_constant,
+        method=_choice(q["method"], "quantized.method", FIXED_METHODS),
+        abs_error_bound=_number(q["abs_error_bound"], "quantized.abs_error_bound", nonneg=True),
+        rel_error_bound=rel,
+        max_abs_error=_number(q["max_abs_error"], "quantized.max_abs_error", nonneg=True),
+        max_rel_error=max_rel)
+
+
 def _read(cls, d) -> "CoefficientTable":
     """Build a table from a JSON object, every field checked (no certification)."""
     from .api import ERROR_KINDS, KINDS, MAX_DEGREE
@@ -576,7 +695,8 @@ def _read(cls, d) -> "CoefficientTable":
         max_abs_at=_number(d["max_abs_at"], "max_abs_at"),
         max_rel_error=max_rel, max_rel_at=max_rel_at,
         fixed_point=_read_fixed(d["fixed_point"], degree),
-        provenance=dict(provenance), schema_version=SCHEMA_VERSION, shift=shift)
+        provenance=dict(provenance), schema_version=SCHEMA_VERSION, shift=shift,
+        quantized=_read_quantized(d["quantized"], degree))
 
 
 # -- verifying: every stated bound re-proved for exactly the stored numbers -----
@@ -668,6 +788,9 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
     if t.fixed_point is not None:
         parts.append(("fixed_point.", t.fixed_point.coefficients, t.fixed_point,
                       "the fixed-point coefficients'"))
+    if t.quantized is not None:
+        parts.append(("quantized.", t.quantized.coefficients, t.quantized,
+                      f"the {t.quantized.format} coefficients'"))
     for prefix, coeffs, claims, whose in parts:
         for kind, bound, maximum in (("abs", claims.abs_error_bound, claims.max_abs_error),
                                      ("rel", claims.rel_error_bound, claims.max_rel_error)):

@@ -3,9 +3,10 @@ in the sibling modules; this one fits and certifies one polynomial."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 
-from chebnorm.approx import MAX_DEGREE, fit, warnings_of
+from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, fit, warnings_of
 
 from ._common import command_line, deprecated_alias, print_json
 
@@ -22,9 +23,19 @@ def register(sub) -> None:
     p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
     p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
     p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
-    p.add_argument("--coef-frac-bits", dest="frac_bits", type=int, default=None, metavar="F",
-                   help="also quantize the coefficients to F fractional bits")
-    deprecated_alias(p, "--frac-bits", "--coef-frac-bits", "frac_bits", type=int, metavar="F")
+    p.add_argument("--coef-frac-bits", dest="frac_bits", type=_int_list, default=None,
+                   metavar="F", help="also quantize the coefficients to F fractional bits "
+                   "(fixed point), or F0,F1,...,Fn one per power 0..degree")
+    deprecated_alias(p, "--frac-bits", "--coef-frac-bits", "frac_bits", type=_int_list,
+                     metavar="F")
+    p.add_argument("--coef-format", default=None, choices=FORMATS,
+                   help="coefficient format: fixed (with --coef-frac-bits) or a floating format "
+                   "binary16, bfloat16, binary32, binary64; coefficients chosen by lattice "
+                   "reduction (as Sollya's fpminimax) and re-certified")
+    p.add_argument("--monomials", type=_int_list, default=None, metavar="K,K,...",
+                   help="keep only these powers, e.g. 1,3,5 (odd) or 0,2,4 (even)")
+    p.add_argument("--fix-constant", action="store_true",
+                   help="hold the constant coefficient at f(0) rounded to its format")
     p.add_argument("--segments", default=None, metavar="2^k",
                    help="piecewise table of 2^k segments, 0 <= k <= 12 (per binade with "
                    "--segment-by exponent); coefficients in one fixed-point format "
@@ -44,6 +55,16 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _int_list(text: str):
+    """``14`` -> 14; ``1,3,5`` -> [1, 3, 5] (argparse type)."""
+    try:
+        parts = [int(p) for p in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer or a comma-separated "
+                                         f"list of integers, e.g. 14 or 1,3,5") from None
+    return parts[0] if len(parts) == 1 and "," not in text else parts
+
+
 def _run_piecewise(args) -> int:
     from chebnorm.approx.piecewise import fit_piecewise
 
@@ -51,6 +72,13 @@ def _run_piecewise(args) -> int:
         raise ValueError(f"--basis {args.basis} applies to one polynomial; accepted with "
                          f"--segments/--segment-by/--centered: --basis monomial (use --centered "
                          f"for segments evaluated about their middle)")
+    if args.coef_format not in (None, "fixed") or args.monomials is not None or args.fix_constant:
+        raise ValueError("--coef-format/--monomials/--fix-constant apply to one polynomial; "
+                         "accepted with --segments/--segment-by/--centered: fixed-point "
+                         "coefficients (--coef-frac-bits F, one integer)")
+    if isinstance(args.frac_bits, list):
+        raise ValueError(f"--coef-frac-bits {','.join(map(str, args.frac_bits))}: piecewise "
+                         f"tables share one format; accepted: one integer")
     table = fit_piecewise(args.expr, tuple(args.interval), args.degree,
                           segments=args.segments or 1, segment_by=args.segment_by or "uniform",
                           coef_frac_bits=24 if args.frac_bits is None else args.frac_bits,
@@ -73,9 +101,14 @@ def _run_piecewise(args) -> int:
 def run(args) -> int:
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)
+    mon = args.monomials
+    if isinstance(mon, int):
+        mon = [mon]
     table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
                 var=args.var, name=args.name, frac_bits=args.frac_bits,
-                command=command_line(args), basis=args.basis)
+                command=command_line(args), basis=args.basis,
+                coef_format=args.coef_format, monomials=mon,
+                fix_constant=args.fix_constant)
     for warning in warnings_of(table):
         print(f"chebnorm: warning: {warning}", file=sys.stderr)
     if args.output:
@@ -99,4 +132,14 @@ def run(args) -> int:
             fp = table.fixed_point
             print(f"fixed point ({fp.frac_bits} fractional bits, {fp.method}): {list(fp.integers)}; "
                   f"certified |p_q - f| <= {fp.abs_error_bound:.6e}")
+        elif table.quantized is not None:
+            q = table.quantized
+            what = (f"fixed point ({','.join(map(str, q.frac_bits))} fractional bits"
+                    if q.format == "fixed" else f"{q.format} (coefficients")
+            print(f"{what}, {q.method}): " + ", ".join(
+                f"{m}*2^{e}" for k, (m, e) in enumerate(zip(q.mantissas, q.exponents))
+                if k in q.monomials or (k == 0 and q.fixed_constant)))
+            print(f"quantized: certified |p_q - f| <= {q.abs_error_bound:.6e}"
+                  + ("" if q.rel_error_bound is None
+                     else f", |p_q/f - 1| <= {q.rel_error_bound:.6e}"))
     return 0

@@ -24,7 +24,7 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 (16, 20, (1, 38391))
 >>> y = d.evaluate([1, 38391])
 >>> [round(float(d.y_format.value(c)), 6) for c in y]
-[0.541175, 0.500016]
+[0.541176, 0.50002]
 """
 
 from __future__ import annotations

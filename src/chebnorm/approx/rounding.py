@@ -1,0 +1,409 @@
+"""Coefficient rounding to fixed or floating formats by lattice reduction.
+
+The approach of Sollya's ``fpminimax`` (Brisebarre and Chevillard, "Efficient
+polynomial L-infinity approximations", ARITH 18, 2007): at a set of points
+``x_i`` (Chebyshev nodes of the interval) the values of a polynomial whose
+``k``-th coefficient is ``n_k * 2^(s_k)`` (``n_k`` an integer, ``2^(s_k)``
+the coefficient's quantum in its format) form a lattice point
+``sum_k n_k * b_k`` with ``b_k = (w_i x_i^(e_k) 2^(s_k))_i``; the point closest
+to the function's (weighted) values is found approximately by LLL reduction
+(python-flint) and Babai's nearest plane. Every candidate -- the lattice
+answers for several point sets and their neighbours, each coefficient rounded
+to nearest, and the greedy refit of :func:`chebnorm.approx.quantize` -- is
+ranked by its sampled error and the best ones are certified
+(:func:`chebnorm.approx.certify.certify`); the smallest certified bound wins.
+
+Fixed formats are monotone in the bits: the answer at ``F`` fractional bits
+is chosen among the candidates at ``F`` and the (shifted) answer at ``F - 1``,
+computed by the same chain from zero bits, so more bits never certify worse.
+
+Internal: the public entry point is :func:`chebnorm.approx.quantize`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from flint import fmpz_mat
+
+from .certify import certify
+
+__all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
+
+#: floating formats: (precision p including the hidden bit, emin, emax);
+#: representable: m * 2^(e - p + 1) with |m| < 2^p and emin <= e <= emax
+#: (subnormals: e = emin with |m| < 2^(p-1))
+FLOAT_FORMATS = {
+    "binary16": (11, -14, 15),
+    "bfloat16": (8, -126, 127),
+    "binary32": (24, -126, 127),
+    "binary64": (53, -1022, 1023),
+}
+FORMATS = ("fixed",) + tuple(FLOAT_FORMATS)
+#: most lattice rounds (sets of binades) tried for a floating format
+FLOAT_ROUNDS = 10
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One rounded polynomial: coefficient of ``x**k`` is ``mantissas[k] * 2**exponents[k]``."""
+
+    mantissas: tuple[int, ...]
+    exponents: tuple[int, ...]
+    method: str
+    bound: float
+    abs_cert: object
+    rel_cert: object | None
+
+    @property
+    def coefficients(self) -> tuple[float, ...]:
+        return tuple(math.ldexp(m, e) for m, e in zip(self.mantissas, self.exponents))
+
+
+def float_quantum(value: float, fmt: str) -> int:
+    """The exponent ``s`` of the quantum ``2^s`` of ``value`` in float format ``fmt``."""
+    p, emin, _ = FLOAT_FORMATS[fmt]
+    if value == 0 or not math.isfinite(value):
+        return emin - p + 1
+    e = math.frexp(value)[1] - 1          # 2^e <= |value| < 2^(e+1)
+    return max(e, emin) - p + 1
+
+
+def round_to_float(value: float, fmt: str) -> tuple[int, int]:
+    """``value`` rounded to nearest (ties to even) in ``fmt``, as ``(m, s)``, value = m 2^s.
+
+    Raises ValueError on overflow.
+    """
+    p, emin, emax = FLOAT_FORMATS[fmt]
+    if value == 0:
+        return 0, 0
+    s = float_quantum(value, fmt)
+    m = round(math.ldexp(value, -s))
+    if abs(m) >= 1 << p:                  # rounding carried into the next binade
+        m, s = round(m / 2), s + 1
+    if s > emax - p + 1:
+        raise ValueError(f"coefficient {value:.6g} overflows {fmt}; accepted: |c| below "
+                         f"{math.ldexp(2 - 2.0 ** (1 - p), emax):.6g}")
+    return _normal(m, s)
+
+
+def _normal(m: int, s: int) -> tuple[int, int]:
+    if m == 0:
+        return 0, 0
+    while m % 2 == 0:
+        m //= 2
+        s += 1
+    return m, s
+
+
+def representable(m: int, s: int, fmt: str) -> bool:
+    """True when ``m * 2^s`` is a finite number of ``fmt``."""
+    if m == 0:
+        return True
+    p, emin, emax = FLOAT_FORMATS[fmt]
+    m, s = _normal(m, s)
+    bits = abs(m).bit_length()
+    top = s + bits - 1                    # exponent of the leading bit
+    return bits <= p and top <= emax and s >= emin - p + 1
+
+
+def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
+    k = np.arange(count)
+    t = np.cos(np.pi * (2 * k + 1) / (2 * count))[::-1]
+    return 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+
+
+def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list[int]]:
+    """LLL-reduce ``basis`` (integer rows) and return the integer coordinates
+    (in ``basis``) of Babai's nearest-plane point to ``target`` and, with
+    ``spread``, of its neighbours ``+- one reduced vector``."""
+    mat = fmpz_mat(basis)
+    red, trans = mat.lll(transform=True)
+    n = red.nrows()
+    rows = np.array([[float(int(red[i, j])) for j in range(red.ncols())] for i in range(n)])
+    tr = [[int(trans[i, j]) for j in range(n)] for i in range(n)]
+    # Gram-Schmidt of the reduced rows, in floats (scaled to avoid overflow)
+    scale = max(np.max(np.abs(rows)), 1.0)
+    b = rows / scale
+    t = np.array([float(v) for v in target]) / scale
+    q, r = np.linalg.qr(b.T)              # b.T = q r: row i of b has GS vector r[i,i] q[:, i]
+    coords = [0] * n
+    resid = t.copy()
+    for i in range(n - 1, -1, -1):
+        if r[i, i] == 0:
+            continue
+        c = round(float(q[:, i] @ resid) / r[i, i])
+        coords[i] = c
+        resid = resid - c * b[i]
+    def to_basis(cs):
+        return [sum(cs[i] * tr[i][k] for i in range(n)) for k in range(n)]
+    out = [to_basis(coords)]
+    if spread:
+        for i in range(n):
+            for d in (-1, 1):
+                cs = list(coords)
+                cs[i] += d
+                out.append(to_basis(cs))
+    return out
+
+
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly):
+    """Integer vectors ``n`` (one per free power) near the weighted function values."""
+    x = np.asarray(points, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x))
+    vecs = [w * x ** e * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
+    big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
+    shift = 62 - math.frexp(big)[1]
+    def ints(v):
+        return [int(round(math.ldexp(float(a), shift))) for a in v]
+    basis = [ints(v) for v in vecs]
+    if any(all(a == 0 for a in row) for row in basis):
+        return []
+    try:
+        return _babai(basis, ints(y), spread=True)
+    except (ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+        return []
+
+
+@dataclass
+class _Problem:
+    fn: object
+    lo: object                    # exact sympy endpoints
+    hi: object
+    lo_f: float
+    hi_f: float
+    error_kind: str
+    degree: int
+    powers: tuple[int, ...]       # free powers (fixed c0 excluded)
+    fixed: dict                   # power -> (mantissa, exponent) held fixed
+    word_limit: int | None        # fixed point: |integer| <= word_limit
+
+
+class _Sampler:
+    """Sampled weighted error of candidate polynomials (a lower bound of the
+    supremum up to the float evaluation error, which is accounted for)."""
+
+    def __init__(self, prob: _Problem, samples: int = 4097):
+        lo, hi = prob.lo_f, prob.hi_f
+        x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
+        x = np.clip(x, lo, hi)
+        with np.errstate(all="ignore"):
+            fx = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
+        ok = np.isfinite(fx) & (x > lo) & (x < hi)
+        if prob.error_kind == "rel":
+            ok &= fx != 0
+        self.x, self.f = x[ok], fx[ok]
+        self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
+        self.xp = {k: self.x ** k for k in range(prob.degree + 1)}
+
+    def zeros(self, coeffs) -> np.ndarray:
+        """Where the error of the real polynomial ``coeffs`` changes sign (its
+        interpolation points, linearly interpolated between samples)."""
+        order = np.argsort(self.x)
+        x, f = self.x[order], self.f[order]
+        p = sum(c * x ** k for k, c in enumerate(coeffs))
+        g = p - f
+        idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
+        t = g[idx] / (g[idx] - g[idx + 1])
+        return x[idx] + t * (x[idx + 1] - x[idx])
+
+    def error(self, coeffs) -> float:
+        p = np.zeros_like(self.x)
+        mag = np.zeros_like(self.x)
+        for k, c in enumerate(coeffs):
+            if c:
+                term = c * self.xp[k]
+                p += term
+                mag += np.abs(term)
+        err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
+        return float(np.max(err)) if err.size else 0.0
+
+
+#: tolerance of the certificates that rank candidates: candidates often differ
+#: by less than the certifier's default 2^-8, and a looser bound would misrank
+SELECT_TOL = 2.0 ** -20
+
+
+def certify_tight(fn, coeffs, lo, hi, kind):
+    """:func:`certify` at :data:`SELECT_TOL` (at most 20,000 subintervals)."""
+    return certify(fn, list(coeffs), lo, hi, kind, tol=SELECT_TOL, max_subintervals=20_000)
+
+
+def _certify_key(prob: _Problem, coeffs):
+    return certify_tight(prob.fn, coeffs, prob.lo, prob.hi, prob.error_kind)
+
+
+def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
+    """The candidate (among ``cands``: method -> (mantissas, exponents)) with the
+    smallest certified bound, or ``best`` when none beats it."""
+    ranked = []
+    seen = set()
+    for method, (ms, es) in cands.items():
+        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
+        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+            continue
+        seen.add(coeffs)
+        ranked.append((sampler.error(coeffs), method, ms, es, coeffs))
+    ranked.sort(key=lambda r: (r[0], r[1]))
+    for low, method, ms, es, coeffs in ranked:
+        if best is not None and low >= best.bound:
+            break
+        try:
+            cert = _certify_key(prob, coeffs)
+        except ValueError:
+            continue
+        if best is None or cert.bound < best.bound:
+            best = Candidate(tuple(ms), tuple(es), method, cert.bound,
+                             cert if prob.error_kind == "abs" else None,
+                             cert if prob.error_kind == "rel" else None)
+    return best
+
+
+def _full(prob: _Problem, free: dict) -> tuple[list[int], list[int]]:
+    """Mantissas/exponents of all powers 0..degree from the free and fixed ones."""
+    ms, es = [0] * (prob.degree + 1), [0] * (prob.degree + 1)
+    for k, (m, e) in {**free, **prob.fixed}.items():
+        ms[k], es[k] = int(m), int(e)
+    return ms, es
+
+
+def _fixed_poly(prob: _Problem):
+    def poly(x):
+        out = np.zeros_like(x)
+        for k, (m, e) in prob.fixed.items():
+            out += math.ldexp(m, e) * x ** k
+        return out
+    return poly
+
+
+def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) -> dict:
+    """Candidate (mantissas, exponents) at one set of quanta (power -> s)."""
+    cands = {}
+    free_exps = [quanta[k] for k in prob.powers]
+    # each free coefficient rounded to nearest
+    cands["rounded"] = _full(prob, {k: (round(math.ldexp(real[k], -quanta[k])), quanta[k])
+                                    for k in prob.powers})
+    n_free = len(prob.powers)
+    f_np = prob.fn.numpy
+    point_sets = [chebyshev_nodes(prob.lo_f, prob.hi_f, count)
+                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})] if lattice else []
+    zeros = sampler.zeros(real)
+    if lattice and len(zeros) >= n_free:
+        point_sets.append(zeros)
+    for pts in point_sets:
+        count = len(pts)
+        with np.errstate(all="ignore"):
+            fv = np.asarray(f_np(pts), dtype=float) * np.ones_like(pts)
+        if not np.all(np.isfinite(fv)) or (prob.error_kind == "rel" and np.any(fv == 0)):
+            continue
+        w = 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv)
+        vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob))
+        for j, ints in enumerate(vecs):
+            cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
+                prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
+    if greedy is not None:
+        ints = greedy([quanta[k] for k in range(prob.degree + 1)])
+        if ints is not None:
+            cands["reoptimized"] = (list(ints), [quanta[k] for k in range(prob.degree + 1)])
+    out = {}
+    for method, (ms, es) in cands.items():
+        if fmt == "fixed":
+            if prob.word_limit is not None and max(abs(m) for m in ms) > prob.word_limit:
+                continue
+            out[method] = (ms, es)
+        else:
+            # lattice answers may leave a coefficient's binade: round it into the format
+            try:
+                pairs = [(m, e) if representable(m, e, fmt) else
+                         round_to_float(math.ldexp(m, e), fmt) for m, e in zip(ms, es)]
+            except (ValueError, OverflowError):
+                continue
+            out[method] = ([m for m, _ in pairs], [e for _, e in pairs])
+    return out
+
+
+def greedy(prob: _Problem, real, quanta) -> list[int] | None:
+    """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
+    ``2**quanta[k]`` from the highest power down, the lower ones refitted after
+    each rounding (interpolation of the residual at Chebyshev nodes)."""
+    from .fitting import cheb_to_monomial
+
+    f_np = prob.fn.numpy
+    lo, hi = prob.lo_f, prob.hi_f
+    n = prob.degree
+    current = list(real)
+    ints: dict[int, int] = {}
+    for k in range(n, -1, -1):
+        ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        if k == 0:
+            break
+        high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
+
+        def residual(t, high=high):
+            x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+            return f_np(x) - sum(c * x ** j for j, c in high.items())
+
+        with np.errstate(all="ignore"):
+            cheb = np.polynomial.chebyshev.chebinterpolate(residual, k - 1)
+        if not np.all(np.isfinite(cheb)):
+            return None
+        current = cheb_to_monomial(cheb, lo, hi) + [high[j] for j in range(k, n + 1)]
+    return [ints[k] for k in range(n + 1)]
+
+
+def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
+                       plain: bool = False) -> Candidate:
+    """The best certified rounding of ``real`` (coefficients of all powers);
+    with ``plain``, each coefficient rounded to nearest and nothing else."""
+    sampler = _Sampler(prob)
+    if plain:
+        quanta = ([-f for f in frac_bits] if fmt == "fixed" else
+                  [float_quantum(real[k], fmt) for k in range(prob.degree + 1)])
+        cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
+        return _select(prob, sampler, cands, None)
+    if fmt == "fixed":
+        fracs = list(frac_bits)
+        best = None
+        for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
+            quanta = [-(f - level) for f in fracs]
+            cands = _candidates(prob, sampler, real, quanta, greedy, fmt)
+            if best is not None:
+                # the answer at one bit fewer, exactly representable here
+                cands["fewer-bits"] = _full(prob, {
+                    k: (best.mantissas[k] << (best.exponents[k] - quanta[k])
+                        if best.mantissas[k] else 0, quanta[k]) for k in prob.powers})
+                if prob.word_limit is not None and max(abs(m) for m in cands["fewer-bits"][0]) \
+                        > prob.word_limit:
+                    del cands["fewer-bits"]
+            new = _select(prob, sampler, cands, None)
+            if new is not None and best is not None and not new.bound < best.bound:
+                m, e = cands["fewer-bits"] if "fewer-bits" in cands else (None, None)
+                if m is not None:
+                    new = Candidate(tuple(m), tuple(e), best.method, best.bound,
+                                    best.abs_cert, best.rel_cert)
+            best = new if new is not None else best
+        return best
+    # floating: quanta from the real coefficients, then from the best few
+    # candidates' own binades (a lattice answer may leave a binade), a few rounds
+    todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
+    tried = set()
+    best = None
+    for _ in range(FLOAT_ROUNDS):
+        todo = [q for q in todo if q not in tried]
+        if not todo:
+            break
+        quanta = todo.pop(0)
+        tried.add(quanta)
+        cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
+        best = _select(prob, sampler, cands, best)
+        ranked = sorted(cands.values(), key=lambda c: sampler.error(
+            [math.ldexp(m, e) for m, e in zip(*c)]))
+        for ms, es in ranked[:8]:
+            q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers else quanta[k]
+                      for k, (m, e) in enumerate(zip(ms, es)))
+            if q not in tried and q not in todo:
+                todo.append(q)
+    return best
