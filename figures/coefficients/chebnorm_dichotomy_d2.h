@@ -20,8 +20,8 @@
 #define CHEBNORM_DICHOTOMY_D2_EVAL_ERROR_BOUND 0x1.6a1474c6819c7p-16 /* 2.1581644228185913e-05 */
 #define CHEBNORM_DICHOTOMY_D2_F_EVAL_ERROR_BOUND 0x1.6e4ea50a67131p-16 /* 2.1833610881581345e-05 */
 #define CHEBNORM_DICHOTOMY_D2_FRAC_BITS 24
-#define CHEBNORM_DICHOTOMY_D2_Q_ABS_ERROR_BOUND 0x1.5ddfb95e5719dp-16 /* 2.085411085182982e-05 */
-#define CHEBNORM_DICHOTOMY_D2_Q_EVAL_ERROR_BOUND 0x1.5f5fb95e5719ep-16 /* 2.094351781899291e-05 */
+#define CHEBNORM_DICHOTOMY_D2_Q_ABS_ERROR_BOUND 0x1.584d0767f0942p-16 /* 2.0521932498026843e-05 */
+#define CHEBNORM_DICHOTOMY_D2_Q_EVAL_ERROR_BOUND 0x1.59cd0767f0943p-16 /* 2.0611339465189933e-05 */
 
 static const double chebnorm_dichotomy_d2_coeffs[3] = {
     0x1.5c8c146ff8a2cp-1 /* 0.6807562243159899 */,  /* x^0 */
@@ -47,9 +47,9 @@ static inline float chebnorm_dichotomy_d2_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_dichotomy_d2_q[3] = {
-    INT32_C(11421323), INT32_C(-1993394), INT32_C(238588)
+    INT32_C(11422256), INT32_C(-1994576), INT32_C(238960)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_DICHOTOMY_D2_LO, CHEBNORM_DICHOTOMY_D2_HI]);

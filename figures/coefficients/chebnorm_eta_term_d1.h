@@ -20,8 +20,8 @@
 #define CHEBNORM_ETA_TERM_D1_EVAL_ERROR_BOUND 0x1.e70e5a5170fa6p-8 /* 0.007431885767292734 */
 #define CHEBNORM_ETA_TERM_D1_F_EVAL_ERROR_BOUND 0x1.e710d8c1aa77bp-8 /* 0.007432034415311035 */
 #define CHEBNORM_ETA_TERM_D1_FRAC_BITS 24
-#define CHEBNORM_ETA_TERM_D1_Q_ABS_ERROR_BOUND 0x1.bceafd39630e9p-8 /* 0.006788908788973405 */
-#define CHEBNORM_ETA_TERM_D1_Q_EVAL_ERROR_BOUND 0x1.bceb7d39630e9p-8 /* 0.006788938591295792 */
+#define CHEBNORM_ETA_TERM_D1_Q_ABS_ERROR_BOUND 0x1.a8b536ba6dcb8p-8 /* 0.0064805277456151875 */
+#define CHEBNORM_ETA_TERM_D1_Q_EVAL_ERROR_BOUND 0x1.a8b5b6ba6dcb8p-8 /* 0.006480557547937575 */
 
 static const double chebnorm_eta_term_d1_coeffs[2] = {
     0x1.6dd8031c969ddp-1 /* 0.7145386669538386 */,  /* x^0 */
@@ -44,9 +44,9 @@ static inline float chebnorm_eta_term_d1_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_eta_term_d1_q[2] = {
-    INT32_C(11977161), INT32_C(4877643)
+    INT32_C(11968512), INT32_C(4907008)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_ETA_TERM_D1_LO, CHEBNORM_ETA_TERM_D1_HI]);

@@ -20,8 +20,8 @@
 #define CHEBNORM_ETA_TERM_D2_EVAL_ERROR_BOUND 0x1.5c2444816a457p-11 /* 0.0006640275388935063 */
 #define CHEBNORM_ETA_TERM_D2_F_EVAL_ERROR_BOUND 0x1.5c4b3d059a391p-11 /* 0.0006643178937341001 */
 #define CHEBNORM_ETA_TERM_D2_FRAC_BITS 24
-#define CHEBNORM_ETA_TERM_D2_Q_ABS_ERROR_BOUND 0x1.374b7b3f426ffp-11 /* 0.0005937478053123778 */
-#define CHEBNORM_ETA_TERM_D2_Q_EVAL_ERROR_BOUND 0x1.37537b3f42700p-11 /* 0.0005938074099571533 */
+#define CHEBNORM_ETA_TERM_D2_Q_ABS_ERROR_BOUND 0x1.2b8a07f9f4178p-11 /* 0.0005713256534765473 */
+#define CHEBNORM_ETA_TERM_D2_Q_EVAL_ERROR_BOUND 0x1.2b9207f9f4179p-11 /* 0.0005713852581213228 */
 
 static const double chebnorm_eta_term_d2_coeffs[3] = {
     0x1.6a60ef7914171p-1 /* 0.7077708087254405 */,  /* x^0 */
@@ -47,9 +47,9 @@ static inline float chebnorm_eta_term_d2_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_eta_term_d2_q[3] = {
-    INT32_C(11873243), INT32_C(5729041), INT32_C(-829187)
+    INT32_C(11872768), INT32_C(5734912), INT32_C(-838656)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_ETA_TERM_D2_LO, CHEBNORM_ETA_TERM_D2_HI]);

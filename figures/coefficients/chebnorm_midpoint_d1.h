@@ -20,8 +20,8 @@
 #define CHEBNORM_MIDPOINT_D1_EVAL_ERROR_BOUND 0x1.560b3e31f89b4p-11 /* 0.000652396998926988 */
 #define CHEBNORM_MIDPOINT_D1_F_EVAL_ERROR_BOUND 0x1.56182d2aec0ebp-11 /* 0.0006524933609082494 */
 #define CHEBNORM_MIDPOINT_D1_FRAC_BITS 24
-#define CHEBNORM_MIDPOINT_D1_Q_ABS_ERROR_BOUND 0x1.4ad926df6dcd1p-11 /* 0.0006310429561641411 */
-#define CHEBNORM_MIDPOINT_D1_Q_EVAL_ERROR_BOUND 0x1.4add26df6dcd1p-11 /* 0.0006310727584865288 */
+#define CHEBNORM_MIDPOINT_D1_Q_ABS_ERROR_BOUND 0x1.43b8b0bb534f3p-11 /* 0.0006174496587988673 */
+#define CHEBNORM_MIDPOINT_D1_Q_EVAL_ERROR_BOUND 0x1.43bcb0bb534f3p-11 /* 0.000617479461121255 */
 
 static const double chebnorm_midpoint_d1_coeffs[2] = {
     0x1.47948c01869c6p-1 /* 0.6398051978933885 */,  /* x^0 */
@@ -44,9 +44,9 @@ static inline float chebnorm_midpoint_d1_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_midpoint_d1_q[2] = {
-    INT32_C(10734509), INT32_C(-2355134)
+    INT32_C(10738688), INT32_C(-2360320)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_MIDPOINT_D1_LO, CHEBNORM_MIDPOINT_D1_HI]);

@@ -20,8 +20,8 @@
 #define CHEBNORM_MIDPOINT_D2_EVAL_ERROR_BOUND 0x1.6a1474c6819c7p-16 /* 2.1581644228185913e-05 */
 #define CHEBNORM_MIDPOINT_D2_F_EVAL_ERROR_BOUND 0x1.6e4ea50a67131p-16 /* 2.1833610881581345e-05 */
 #define CHEBNORM_MIDPOINT_D2_FRAC_BITS 24
-#define CHEBNORM_MIDPOINT_D2_Q_ABS_ERROR_BOUND 0x1.5df118bff09a9p-16 /* 2.0858155721512114e-05 */
-#define CHEBNORM_MIDPOINT_D2_Q_EVAL_ERROR_BOUND 0x1.5ef118bff09aap-16 /* 2.0917760366287508e-05 */
+#define CHEBNORM_MIDPOINT_D2_Q_ABS_ERROR_BOUND 0x1.5a6145cc7f23fp-16 /* 2.064585514637202e-05 */
+#define CHEBNORM_MIDPOINT_D2_Q_EVAL_ERROR_BOUND 0x1.5b6145cc7f240p-16 /* 2.0705459791147416e-05 */
 
 static const double chebnorm_midpoint_d2_coeffs[3] = {
     0x1.5c8c146ff8a2cp-1 /* 0.6807562243159899 */,  /* x^0 */
@@ -47,9 +47,9 @@ static inline float chebnorm_midpoint_d2_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_midpoint_d2_q[3] = {
-    INT32_C(11421323), INT32_C(-3986789), INT32_C(954353)
+    INT32_C(11422016), INT32_C(-3988544), INT32_C(955456)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_MIDPOINT_D2_LO, CHEBNORM_MIDPOINT_D2_HI]);

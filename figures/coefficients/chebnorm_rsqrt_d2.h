@@ -20,8 +20,8 @@
 #define CHEBNORM_RSQRT_D2_EVAL_ERROR_BOUND 0x1.5245f8a1e70efp-15 /* 4.032532275674734e-05 */
 #define CHEBNORM_RSQRT_D2_F_EVAL_ERROR_BOUND 0x1.5aa1fb10d32acp-15 /* 4.132184233771505e-05 */
 #define CHEBNORM_RSQRT_D2_FRAC_BITS 24
-#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.527f1e6ac899ep-15 /* 4.035193418007735e-05 */
-#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52ff1e6ac899fp-15 /* 4.041153882485275e-05 */
+#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.5246b9d0f0bd1p-15 /* 4.032567415592599e-05 */
+#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52c6b9d0f0bd2p-15 /* 4.0385278800701384e-05 */
 
 static const double chebnorm_rsqrt_d2_coeffs[3] = {
     0x1.f38fea70e0934p+0 /* 1.951414730604097 */,  /* x^0 */
@@ -47,9 +47,9 @@ static inline float chebnorm_rsqrt_d2_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (rounded), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_rsqrt_d2_q[3] = {
-    INT32_C(32739306), INT32_C(-23613703), INT32_C(7652289)
+    INT32_C(32739253), INT32_C(-23613585), INT32_C(7652224)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_RSQRT_D2_LO, CHEBNORM_RSQRT_D2_HI]);

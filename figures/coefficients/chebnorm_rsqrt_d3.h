@@ -20,8 +20,8 @@
 #define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.780336593a412p-20 /* 1.4007558973244807e-06 */
 #define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.04483a2c28141p-18 /* 3.878506088878236e-06 */
 #define CHEBNORM_RSQRT_D3_FRAC_BITS 24
-#define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.7d8508e7e24e5p-20 /* 1.4212715146753058e-06 */
-#define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.958508e7e24e6p-20 /* 1.510678481838392e-06 */
+#define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.77b0e3c7ec8f5p-20 /* 1.399557946851551e-06 */
+#define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.8fb0e3c7ec8f6p-20 /* 1.4889649140146372e-06 */
 
 static const double chebnorm_rsqrt_d3_coeffs[4] = {
     0x1.2362f4010dbe7p+1 /* 2.2764573102135617 */,  /* x^0 */
@@ -50,9 +50,9 @@ static inline float chebnorm_rsqrt_d3_f(float x)
     return acc;
 }
 
-/* Coefficients * 2^24 (reoptimized), ascending powers. */
+/* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_rsqrt_d3_q[4] = {
-    INT32_C(38192616), INT32_C(-41329659), INT32_C(26806600), INT32_C(-6892364)
+    INT32_C(38191725), INT32_C(-41326727), INT32_C(26803387), INT32_C(-6891192)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_RSQRT_D3_LO, CHEBNORM_RSQRT_D3_HI]);
