@@ -47,8 +47,9 @@ class FixedPoint:
     (two's complement). Bounds and maxima are those of the quantized
     polynomial, re-certified (evaluated exactly, without rounding inside
     Horner's rule). ``method`` is ``"rounded"`` (each coefficient rounded to
-    nearest) or ``"reoptimized"`` (coefficients rounded from the highest power
-    down, the lower ones refitted by Remez after each rounding).
+    nearest), ``"reoptimized"`` (coefficients rounded from the highest power
+    down, the lower ones refitted after each rounding) or ``"lattice"``
+    (lattice reduction and a closest vector, as Sollya's ``fpminimax``).
     """
 
     frac_bits: int

@@ -20,6 +20,14 @@ decimal value in a comment, Horner evaluators, and the bounds:
 ``<P>_Q_EVAL_ERROR_BOUND``
     for a quantized table, the bound of the integer evaluator: the fixed-point
     certified bound plus half an LSB per Horner step, amplified by ``|x|``.
+``<P>_QUANT_ABS_ERROR_BOUND``, ``<P>_QUANT_EVAL_ERROR_BOUND`` (and ``_F_``)
+    for a table whose ``quantized`` part is not a plain ``fixed_point`` (a
+    floating format, one fractional width per power, chosen monomials or a
+    fixed constant): ``<p>_quant_coeffs`` holds those coefficients exactly
+    (zero for the powers left out) and ``<p>_quant`` / ``<p>_quant_f``
+    evaluate them by Horner's rule; the float evaluator is emitted only when
+    every coefficient is a float exactly, so its bound adds no coefficient
+    rounding.
 
 A table in the shifted basis (``table.shift = (c, s)``) gets ``<P>_CENTER``
 and ``<P>_SCALE`` and evaluators that first form ``t = (x - c) * (1/s)`` (a
@@ -231,6 +239,84 @@ def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, n
     return out + ["    return acc;", "}"]
 
 
+def _parity(q, degree: int) -> int | None:
+    """1 when only odd powers are used, 0 when only even ones, else None."""
+    powers = set(q.monomials) | ({0} if q.fixed_constant else set())
+    for parity in (1, 0):
+        if degree >= 2 and all(k % 2 == parity for k in powers):
+            return parity
+    return None
+
+
+def _parity_rounding_bound(coeffs, parity: int, max_abs_x: Fraction, u: float) -> Fraction:
+    """Bound of the rounding error of ``x^parity * q(x*x)`` by Horner's rule in
+    ``t = fl(x*x)``: each term ``b_j t^j`` carries at most ``2m`` roundings of
+    Horner's rule, ``j`` from ``t``'s own rounding and one from the final
+    multiply by ``x`` (odd), so ``gamma_(3m + parity) * sum |b_j| M^(2j + parity)``."""
+    b = coeffs[parity::2]
+    m = len(b) - 1
+    n = 3 * m + parity
+    if n == 0:
+        return Fraction(0)
+    uf = Fraction(u)
+    gamma = n * uf / (1 - n * uf)
+    return gamma * sum(abs(Fraction(c)) * max_abs_x ** (2 * j + parity) for j, c in enumerate(b))
+
+
+def _parity_evaluator(coeffs, parity: int, ctype: str, suffix: str, name: str,
+                      macro: str) -> list[str]:
+    """Horner's rule in ``t = x*x`` over the odd (times ``x``) or even coefficients."""
+    b = coeffs[parity::2]
+    kind = "odd" if parity else "even"
+    out = ["", f"/* Horner's rule in {ctype} over the {kind} powers, in t = x*x; x must lie in",
+           f" * [{macro}_LO, {macro}_HI]. */", f"static inline {ctype} {name}({ctype} x)", "{",
+           f"    {ctype} t = x * x;", f"    {ctype} acc = {_literal(b[-1], suffix)};"]
+    for c in reversed(b[:-1]):
+        out.append(f"    acc = acc * t + {_literal(c, suffix)};")
+    if len(b) == 1:
+        out.append("    (void)t;")
+    return out + [f"    return acc{' * x' if parity else ''};", "}"]
+
+
+def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fraction) -> list[str]:
+    """Bounds, exact coefficient array and Horner evaluators of ``table.quantized``
+    (in ``x*x`` when only odd or only even powers are used)."""
+    q = table.quantized
+    coeffs = [float(c) for c in q.coefficients]
+    if len(coeffs) != table.degree + 1 or not all(math.isfinite(c) for c in coeffs):
+        raise ValueError(f"quantized: {len(coeffs)} finite coefficients expected for degree "
+                         f"{table.degree}")
+    if table.shift is not None:
+        raise ValueError(f"table {table.name!r}: a quantized part in the shifted basis has no "
+                         f"C evaluator; accepted: a shifted table without quantized")
+    parity = _parity(q, table.degree)
+    fmt = comment_text(q.format, max_length=20)
+    out = ["", f"/* Quantized coefficients ({fmt}, {comment_text(q.method, max_length=20)}), "
+           f"ascending powers of x (exact): certified |p_q - f| <= {float(q.abs_error_bound)!r}"
+           + ("" if q.rel_error_bound is None else f", |p_q/f - 1| <= {float(q.rel_error_bound)!r}")
+           + ". */"]
+    w = out.append
+    w(f"#define {macro}_QUANT_ABS_ERROR_BOUND {_literal(q.abs_error_bound, '')}")
+    if q.rel_error_bound is not None:
+        w(f"#define {macro}_QUANT_REL_ERROR_BOUND {_literal(q.rel_error_bound, '')}")
+    emitted = [row for row in FLOAT_TYPES
+               if row[1] == "" or all(_to_type(c, row[1]) == c for c in coeffs)]
+    for ctype, suffix, fsuffix, u in emitted:
+        rounding = (horner_rounding_bound(coeffs, max_x, u) if parity is None
+                    else _parity_rounding_bound(coeffs, parity, max_x, u))
+        bound = Fraction(q.abs_error_bound) + rounding
+        w(f"#define {macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
+    w(f"static const double {fn}_quant_coeffs[{len(coeffs)}] = {{")
+    for k, c in enumerate(coeffs):
+        w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* x^{k} */")
+    w("};")
+    for ctype, suffix, fsuffix, _ in emitted:
+        name = f"{fn}_quant{fsuffix}"
+        out += (_float_evaluator(table, coeffs, ctype, suffix, name, macro) if parity is None
+                else _parity_evaluator(coeffs, parity, ctype, suffix, name, macro))
+    return out
+
+
 def c_header(table: CoefficientTable, command: str = "") -> str:
     """The C99 header text for ``table`` (see the module docstring).
 
@@ -308,6 +394,8 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
         out += _float_evaluator(table, coeffs, ctype, suffix, f"{fn}{fsuffix}", macro)
     if table.fixed_point is not None:
         out += _fixed_evaluator(table.fixed_point, fn, macro)
+    elif table.quantized is not None:
+        out += _quantized_part(table, fn, macro, max_x)
     w("")
     w(f"#endif /* {macro}_H */")
     return "\n".join(out) + "\n"

@@ -22,7 +22,9 @@ float32 ``x`` in ``[CHEBNORM_NAME_LO, CHEBNORM_NAME_HI]``; it is the
 shader analogue of the C header's ``_F_EVAL_ERROR_BOUND``
 (:func:`float32_eval_bound` gives its parts):
 
-* the certified bound of ``|p - f|`` for the table's (double) coefficients;
+* the certified bound of ``|p - f|`` for the coefficients evaluated: the
+  table's double coefficients, or its ``quantized`` ones when their format is
+  binary16, bfloat16 or binary32 (each a float32 exactly, so the next term is 0);
 * ``sum_k |c_k - fl32(c_k)| M^k``: rounding the coefficients to float32
   (``M`` = max |x| on the interval);
 * ``gamma_2n sum_k |fl32(c_k)| M^k`` with ``gamma_k = k u / (1 - k u)``,
@@ -198,6 +200,25 @@ class ShaderBound:
     total32: float
 
 
+#: quantized formats whose every number is a float32 (used as they are)
+_FLOAT32_FORMATS = ("binary16", "bfloat16", "binary32")
+
+
+def _coefficients(table: CoefficientTable) -> tuple[list[float], Fraction, str]:
+    """The coefficients a shader evaluates, their certified ``|p - f|`` bound
+    and how they were chosen: a table quantized to a floating format a float32
+    holds exactly gives those coefficients and their certified bound (nothing
+    lost rounding them); any other table its double coefficients, rounded to
+    float32 below."""
+    q = table.quantized
+    if q is not None and q.format in _FLOAT32_FORMATS:
+        coeffs = [float(c) for c in q.coefficients]
+        if all(float(np.float32(c)) == c for c in coeffs):
+            return coeffs, Fraction(q.abs_error_bound), f"{q.format} coefficients ({q.method})"
+    return ([float(c) for c in table.coefficients], Fraction(table.abs_error_bound),
+            "double coefficients")
+
+
 def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     """The float32 evaluation bound of the shader printers, fused or not.
 
@@ -207,7 +228,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     True
     """
     table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
-    coeffs = [float(c) for c in table.coefficients]
+    coeffs, certified, _ = _coefficients(table)
     c32 = [float(np.float32(c)) for c in coeffs]
     m = _max_abs_x(table)
     coef = sum((abs(Fraction(a) - Fraction(b)) * m ** k
@@ -217,12 +238,12 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     flush = 4 * _FLUSH * (sum((m ** j for j in range(n)), Fraction(0))
                           + sum((k * abs(Fraction(c)) * m ** (k - 1)
                                  for k, c in enumerate(c32) if k), Fraction(0)))
-    total = Fraction(table.abs_error_bound) + coef + rounding + flush
+    total = certified + coef + rounding + flush
     up = _up(total)
     up32 = float(np.float32(up))
     if up32 < up:
         up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
-    return ShaderBound(certified=Fraction(table.abs_error_bound), coefficients=coef,
+    return ShaderBound(certified=certified, coefficients=coef,
                        rounding=rounding, flush=flush, total=up, total32=up32)
 
 
@@ -259,7 +280,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
     name = identifier(table.name, field="table.name")
     fn = f"chebnorm_{name}"
     big = f"CHEBNORM_{name.upper()}"
-    coeffs = [float(c) for c in table.coefficients]
+    coeffs, certified, source = _coefficients(table)
     bound = float32_eval_bound(table)
     lo32, hi32 = _interval32(table)
     var = comment_text(table.variable, max_length=40)
@@ -276,7 +297,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
       f" = [{table.interval_float[0]!r}, {table.interval_float[1]!r}]")
     w(f"// {comment_text(table.kind, max_length=40)} fit of degree {table.degree}; coefficients"
       f" in ascending powers of {var}, rounded to float32 (exact literals).")
-    w(f"// Certified |p - f| <= {table.abs_error_bound!r} (double coefficients, exact arithmetic).")
+    w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
     w(f"//   certified {float(bound.certified):.6e} + float32 coefficients "
       f"{float(bound.coefficients):.6e}")
@@ -289,8 +310,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
         w(line.format(P=big))
     w(lang.const.format(name=f"{big}_LO", value=lit(lo32)))
     w(lang.const.format(name=f"{big}_HI", value=lit(hi32)))
-    w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND",
-                        value=lit(_up_f32(table.abs_error_bound))))
+    w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND", value=lit(_up_f32(_up(certified)))))
     w(lang.const.format(name=f"{big}_EVAL_ERROR_BOUND", value=lit(bound.total32)))
     w("")
     w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")
