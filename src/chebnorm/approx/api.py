@@ -140,7 +140,8 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
 def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs", *,
         var: str = "x", name: str | None = None, frac_bits=None,
         command: str | None = None, basis: str = "monomial", coef_format: str | None = None,
-        monomials=None, fix_constant: bool = False) -> CoefficientTable:
+        monomials=None, fix_constant: bool = False, segments=None, segment_by: str | None = None,
+        centered: bool = False):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
@@ -161,6 +162,16 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
     ((100.5, 0.5), True, True)
 
+    ``segments`` (``2**k``), ``segment_by`` (``"uniform"`` or ``"exponent"``)
+    or ``centered`` make a piecewise table instead (a
+    :class:`~chebnorm.approx.piecewise.PiecewiseTable`, coefficients in one
+    fixed-point format of ``frac_bits``, default 24, see
+    :func:`~chebnorm.approx.piecewise.fit_piecewise`):
+
+    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
+    >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
+    (16, True)
+
     Seed 000, method 4 (claim C5): the degree-2 Chebyshev fit of
     ``1/sqrt(2+z)`` on ``[sqrt(2), 2]``:
 
@@ -171,28 +182,18 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     (2.16e-05, True)
 
     Choice of degree: each extra degree buys roughly a factor
-    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy.
-    Possible issues: coefficients are stored in the original variable's
-    monomial basis, which is ill-conditioned on intervals far from 0 at high
-    degree; the certified bound is that of the stored floats, so it stays
-    honest, but it may then sit above the minimax error.
+    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
+    from 0 at high degree prefer ``basis="shifted"``.
     """
-    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
-        raise ValueError(f"degree {degree!r} is not an integer; accepted: 0 <= degree <= {MAX_DEGREE}")
-    degree = int(degree)
-    if not 0 <= degree <= MAX_DEGREE:
-        raise ValueError(f"degree {degree} is out of range; accepted: 0 <= degree <= {MAX_DEGREE}")
-    if kind not in KINDS:
-        raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
-    if error not in ERROR_KINDS:
-        raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
-    if basis not in BASES:
-        raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
-    if basis != "monomial" and (frac_bits is not None or coef_format is not None
-                                or monomials is not None or fix_constant):
-        raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
-                         "fix-constant) with basis shifted are not supported; accepted: "
-                         "basis monomial for quantized tables")
+    if segments is not None or segment_by is not None or centered:
+        return _fit_segments(expr, interval, degree, kind, error, var=var, name=name,
+                             frac_bits=frac_bits, command=command, basis=basis,
+                             coef_format=coef_format, monomials=monomials,
+                             fix_constant=fix_constant, segments=segments,
+                             segment_by=segment_by, centered=centered)
+    quantized = (frac_bits is not None or coef_format is not None or monomials is not None
+                 or fix_constant)
+    degree = _check_fit_args(degree, kind, error, basis, quantized)
     try:
         lo, hi = interval
     except (TypeError, ValueError):
@@ -229,6 +230,49 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
                          monomials=monomials, fix_constant=fix_constant)
     return table
+
+
+def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool) -> int:
+    """``degree`` as an int, after checking :func:`fit`'s arguments."""
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
+        raise ValueError(f"degree {degree!r} is not an integer; accepted: 0 <= degree <= {MAX_DEGREE}")
+    degree = int(degree)
+    if not 0 <= degree <= MAX_DEGREE:
+        raise ValueError(f"degree {degree} is out of range; accepted: 0 <= degree <= {MAX_DEGREE}")
+    if kind not in KINDS:
+        raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
+    if error not in ERROR_KINDS:
+        raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
+    if basis not in BASES:
+        raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
+    if basis != "monomial" and quantized:
+        raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
+                         "fix-constant) with basis shifted are not supported; accepted: "
+                         "basis monomial for quantized tables")
+    return degree
+
+
+def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, command, basis,
+                  coef_format, monomials, fix_constant, segments, segment_by, centered):
+    """:func:`fit` with ``segments``/``segment_by``/``centered``: a piecewise table."""
+    from .piecewise import fit_piecewise
+
+    if basis != "monomial":
+        raise ValueError(f"basis {basis} applies to one polynomial; accepted with segments, "
+                         f"segment-by or centered: basis monomial (centered evaluates each "
+                         f"segment about its middle)")
+    if coef_format not in (None, "fixed") or monomials is not None or fix_constant:
+        raise ValueError("coef-format, monomials and fix-constant apply to one polynomial; "
+                         "accepted with segments, segment-by or centered: fixed-point "
+                         "coefficients (frac-bits F, one integer)")
+    if isinstance(frac_bits, (list, tuple)):
+        raise ValueError(f"frac-bits {','.join(map(str, frac_bits))}: piecewise tables share "
+                         f"one format; accepted: one integer")
+    return fit_piecewise(expr, tuple(interval), degree, segments=segments or 1,
+                         segment_by=segment_by or "uniform",
+                         coef_frac_bits=24 if frac_bits is None else frac_bits,
+                         centered=centered, fit=kind, error=error, var=var,
+                         name=name or "table", command=command)
 
 
 def _fit_coefficients(fn: Function1D, iv: Interval, degree: int, kind: str, error: str,

@@ -66,24 +66,12 @@ def _int_list(text: str):
 
 
 def _run_piecewise(args) -> int:
-    from chebnorm.approx.piecewise import fit_piecewise
-
-    if args.basis != "monomial":
-        raise ValueError(f"--basis {args.basis} applies to one polynomial; accepted with "
-                         f"--segments/--segment-by/--centered: --basis monomial (use --centered "
-                         f"for segments evaluated about their middle)")
-    if args.coef_format not in (None, "fixed") or args.monomials is not None or args.fix_constant:
-        raise ValueError("--coef-format/--monomials/--fix-constant apply to one polynomial; "
-                         "accepted with --segments/--segment-by/--centered: fixed-point "
-                         "coefficients (--coef-frac-bits F, one integer)")
-    if isinstance(args.frac_bits, list):
-        raise ValueError(f"--coef-frac-bits {','.join(map(str, args.frac_bits))}: piecewise "
-                         f"tables share one format; accepted: one integer")
-    table = fit_piecewise(args.expr, tuple(args.interval), args.degree,
-                          segments=args.segments or 1, segment_by=args.segment_by or "uniform",
-                          coef_frac_bits=24 if args.frac_bits is None else args.frac_bits,
-                          centered=args.centered, fit=args.kind, error=args.error,
-                          var=args.var, name=args.name, command=command_line(args))
+    table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
+                var=args.var, name=args.name, frac_bits=args.frac_bits,
+                command=command_line(args), basis=args.basis, coef_format=args.coef_format,
+                monomials=args.monomials, fix_constant=args.fix_constant,
+                segments=args.segments or 1, segment_by=args.segment_by or "uniform",
+                centered=args.centered)
     if args.output:
         table.save(args.output)
     if args.json:
