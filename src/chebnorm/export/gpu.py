@@ -80,43 +80,53 @@ def _from_ordered(keys: np.ndarray) -> np.ndarray:
     return bits.view(np.float32)
 
 
+#: per language: the buffers before the exported function and the entry point
+#: after it (``$FN``: the function's name, ``$GROUP``: the work-group size)
+_KERNELS = {
+    "glsl": (["layout(local_size_x = $GROUP) in;",
+              "layout(std430, binding = 0) readonly buffer Xs { float xs[]; };",
+              "layout(std430, binding = 1) writeonly buffer Ys { float ys[]; };"],
+             ["void main()", "{",
+              "    uint i = gl_GlobalInvocationID.x;",
+              "    if (i < uint(xs.length())) ys[i] = $FN(xs[i]);",
+              "}"]),
+    "wgsl": (["@group(0) @binding(0) var<storage, read> xs: array<f32>;",
+              "@group(0) @binding(1) var<storage, read_write> ys: array<f32>;"],
+             ["@compute @workgroup_size($GROUP)",
+              "fn main(@builtin(global_invocation_id) id: vec3<u32>) {",
+              "    let i = id.x;",
+              "    if (i < arrayLength(&xs)) { ys[i] = $FN(xs[i]); }",
+              "}"]),
+    "hlsl": (["StructuredBuffer<float> xs : register(t0);",
+              "RWStructuredBuffer<float> ys : register(u0);"],
+             ["[numthreads($GROUP, 1, 1)]",
+              "void main(uint3 id : SV_DispatchThreadID)",
+              "{",
+              "    ys[id.x] = $FN(xs[id.x]);",
+              "}"]),
+}
+
+
 def compute_shader_source(table: CoefficientTable, language: str, *, es: bool = False) -> str:
     """A compute shader that maps ``xs[i]`` to ``ys[i] = chebnorm_NAME(xs[i])``
-    around the exported function (GLSL 4.30, or ES 3.10 with ``es``; WGSL; HLSL)."""
+    around the exported function (GLSL 4.30, or ES 3.10 with ``es``; WGSL; HLSL).
+
+    >>> from chebnorm.approx import fit_target
+    >>> src = compute_shader_source(fit_target("dichotomy", 1), "wgsl")
+    >>> print(src.splitlines()[-3])
+        if (i < arrayLength(&xs)) { ys[i] = chebnorm_dichotomy_d1(xs[i]); }
+    >>> compute_shader_source(fit_target("dichotomy", 1), "glsl", es=True).splitlines()[0]
+    '#version 310 es'
+    """
     fn = f"chebnorm_{identifier(table.name, field='table.name')}"
     body = shader_source(table, language)
-    if language == "glsl":
-        head = ["#version 310 es", "precision highp float;"] if es else ["#version 430"]
-        return "\n".join(head + [
-            f"layout(local_size_x = {_GROUP}) in;",
-            "layout(std430, binding = 0) readonly buffer Xs { float xs[]; };",
-            "layout(std430, binding = 1) writeonly buffer Ys { float ys[]; };",
-            "", body,
-            "void main()", "{",
-            "    uint i = gl_GlobalInvocationID.x;",
-            f"    if (i < uint(xs.length())) ys[i] = {fn}(xs[i]);",
-            "}", ""])
-    if language == "wgsl":
-        return "\n".join([
-            "@group(0) @binding(0) var<storage, read> xs: array<f32>;",
-            "@group(0) @binding(1) var<storage, read_write> ys: array<f32>;",
-            "", body,
-            f"@compute @workgroup_size({_GROUP})",
-            "fn main(@builtin(global_invocation_id) id: vec3<u32>) {",
-            "    let i = id.x;",
-            f"    if (i < arrayLength(&xs)) {{ ys[i] = {fn}(xs[i]); }}",
-            "}", ""])
-    if language == "hlsl":
-        return "\n".join([
-            "StructuredBuffer<float> xs : register(t0);",
-            "RWStructuredBuffer<float> ys : register(u0);",
-            "", body,
-            f"[numthreads({_GROUP}, 1, 1)]",
-            "void main(uint3 id : SV_DispatchThreadID)",
-            "{",
-            f"    ys[id.x] = {fn}(xs[id.x]);",
-            "}", ""])
-    raise ValueError(f"unknown shader language {language!r}; accepted: glsl, wgsl, hlsl")
+    if language not in _KERNELS:
+        raise ValueError(f"unknown shader language {language!r}; accepted: glsl, wgsl, hlsl")
+    head = (["#version 310 es", "precision highp float;"] if es else ["#version 430"]) \
+        if language == "glsl" else []
+    buffers, main = ([line.replace("$FN", fn).replace("$GROUP", str(_GROUP)) for line in part]
+                     for part in _KERNELS[language])
+    return "\n".join(head + buffers + ["", body] + main + [""])
 
 
 def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
@@ -162,11 +172,22 @@ def gl_context():
     return _CONTEXT
 
 
+def _inputs(xs) -> tuple[np.ndarray, int]:
+    """``xs`` as contiguous float32, and the work groups that cover it."""
+    x = np.ascontiguousarray(xs, dtype=np.float32)
+    return x, -(-x.size // _GROUP)
+
+
+def _outputs(raw: bytes, count: int) -> np.ndarray:
+    """The first ``count`` float32 of a read-back buffer, as an owned array."""
+    return np.frombuffer(raw, dtype=np.float32)[:count].copy()
+
+
 def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
     """``chebnorm_NAME(x)`` for each float32 ``x`` of ``xs``, computed by the
     exported GLSL in an OpenGL compute shader."""
     ctx = gl_context()
-    x = np.ascontiguousarray(xs, dtype=np.float32)
+    x, groups = _inputs(xs)
     with ctx:  # make the EGL context current again (another API may have switched it)
         prog = ctx.compute_shader(compute_shader_source(table, "glsl"))
         bx = ctx.buffer(x.tobytes())
@@ -174,9 +195,9 @@ def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
         try:
             bx.bind_to_storage_buffer(0)
             by.bind_to_storage_buffer(1)
-            prog.run(group_x=-(-x.size // _GROUP))
+            prog.run(group_x=groups)
             ctx.finish()
-            return np.frombuffer(by.read(), dtype=np.float32)[: x.size].copy()
+            return _outputs(by.read(), x.size)
         finally:
             bx.release()
             by.release()
@@ -190,13 +211,12 @@ def wgsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
         from wgpu.utils.compute import compute_with_buffers
     except ImportError as exc:
         raise ToolMissing("wgpu is not installed; accepted: pip install 'chebnorm[gpu]'") from exc
-    x = np.ascontiguousarray(xs, dtype=np.float32)
+    x, groups = _inputs(xs)
     try:
         wgpu.utils.get_default_device()
     except Exception as exc:  # the driver's own error types
         raise ToolMissing(f"no WebGPU adapter ({exc}); accepted: Mesa's lavapipe "
                           f"(apt-get install mesa-vulkan-drivers)") from exc
     out = compute_with_buffers({0: x}, {1: (x.size, "f")},
-                               compute_shader_source(table, "wgsl"),
-                               n=(-(-x.size // _GROUP), 1, 1))
-    return np.frombuffer(out[1], dtype=np.float32).copy()
+                               compute_shader_source(table, "wgsl"), n=(groups, 1, 1))
+    return _outputs(out[1], x.size)

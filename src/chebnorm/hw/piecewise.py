@@ -48,9 +48,8 @@ from .fixed import (
     shift_round,
     signed_bits,
 )
+from .hdltext import round_lines, saturating_output, signed_literal
 from .verilog import (
-    _lit,
-    _round,
     simulate,
     synthesize_text,
     vector_file,
@@ -293,14 +292,14 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
     tw = d.t_bits
     if t.centered:
         out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}) - "
-                   f"{_lit(1 << (L - 1), tw)};")
+                   f"{signed_literal(1 << (L - 1), tw)};")
     else:
         out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
     regs = [f"c{j}" for j in range(n + 1)]
     if K == 0:  # one segment: constants (an always block with no input would never run)
         for j in range(n + 1):
             out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{_lit(t.segments[0].integers[j], d.rom_bits[j])};")
+                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
     else:
         for j in range(n + 1):
             out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
@@ -308,7 +307,7 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
                 "    always @(*) begin",
                 "        case (idx)"]
         for s, seg in enumerate(t.segments):
-            body = " ".join(f"{regs[j]} = {_lit(q, d.rom_bits[j])};"
+            body = " ".join(f"{regs[j]} = {signed_literal(q, d.rom_bits[j])};"
                             for j, q in enumerate(seg.integers))
             out.append(f"            {K}'d{s}: begin {body} end")
         out += ["        endcase", "    end"]
@@ -325,28 +324,14 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
         if j > 0:
             f_out = min(d.acc_frac_bits, sf)
             if sf > f_out:
-                out += _round(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
+                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
             else:
                 out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
             prev, prev_frac = f"a{j}", f_out
         else:
             prev, prev_frac = f"s{j}", sf
     top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
-    top = prev
-    shift = prev_frac - yf.frac_bits
-    rw = max(top_bits + max(0, -shift) + 1, d.out_bits + 2, yf.offset_code.bit_length() + 2)
-    if shift > 0:
-        out += _round(top, "r", top_bits, shift, rw, d.rounding)
-    elif shift == 0:
-        out.append(f"    wire signed [{rw - 1}:0] r = {top};")
-    else:
-        out.append(f"    wire signed [{rw - 1}:0] r = {top} <<< {-shift};")
-    out += [f"    localparam signed [{rw - 1}:0] KY = {_lit(yf.offset_code, rw)};",
-            f"    localparam signed [{rw - 1}:0] YMAX = {_lit(yf.max_code, rw)};",
-            f"    wire signed [{rw - 1}:0] raw = r - KY;",
-            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
-            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
-            "endmodule", ""]
+    out += saturating_output(prev, top_bits, prev_frac, yf, d.out_bits, d.rounding)
     return "\n".join(out)
 
 

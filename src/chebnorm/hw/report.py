@@ -31,7 +31,7 @@ from .verilog import (SynthResult, pipelined_name, synthesize_text, vector_file,
                       verilog_module, verilog_pipelined_module, verilog_pipelined_testbench,
                       verilog_testbench)
 
-__all__ = ["HardwareReport", "analyze", "verilog_outputs", "write_outputs"]
+__all__ = ["HardwareReport", "analyze", "hdl_outputs", "verilog_outputs", "write_outputs"]
 
 
 @dataclass(frozen=True)
@@ -145,23 +145,62 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     return HardwareReport(design, budget, meas, horner_block(design), syn)
 
 
-def verilog_outputs(report: HardwareReport, *, version: str = "", command: str | None = None,
-                    pipelined: bool = False) -> dict[str, str]:
-    """File name -> text of the module, its test bench and its vector file; with
-    ``pipelined`` also those of the pipelined variant ``chebnorm_NAME_pipe``."""
+def _printers(language: str):
+    """Suffix and the four printers of one HDL (module, bench, pipelined module
+    and bench), each taking the design."""
+    if language == "verilog":
+        return (".v", verilog_module, verilog_testbench, verilog_pipelined_module,
+                verilog_pipelined_testbench)
+    if language == "vhdl":
+        from .vhdl import (vhdl_module, vhdl_pipelined_module, vhdl_pipelined_testbench,
+                           vhdl_testbench)
+        return ".vhd", vhdl_module, vhdl_testbench, vhdl_pipelined_module, vhdl_pipelined_testbench
+    raise ValueError(f"unknown HDL {language!r}; accepted: verilog, vhdl")
+
+
+def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: str = "",
+                command: str | None = None, pipelined: bool = False) -> dict[str, str]:
+    """File name -> text of the module, its test bench and its vector file in
+    ``language`` (``"verilog"``: ``NAME.v``; ``"vhdl"``: ``NAME.vhd``); with
+    ``pipelined`` also those of the pipelined variant ``chebnorm_NAME_pipe``.
+    Both languages' benches read the same vector file ``NAME.hex``.
+
+    >>> from chebnorm.approx import fit_target
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> sorted(hdl_outputs(r, "vhdl", pipelined=True))  # doctest: +NORMALIZE_WHITESPACE
+    ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'chebnorm_dichotomy_d1_pipe.hex',
+     'chebnorm_dichotomy_d1_pipe.vhd', 'tb_chebnorm_dichotomy_d1.vhd',
+     'tb_chebnorm_dichotomy_d1_pipe.vhd']
+    >>> hdl_outputs(r, "vhdl")["chebnorm_dichotomy_d1.hex"] == hdl_outputs(r)["chebnorm_dichotomy_d1.hex"]
+    True
+    """
+    ext, module, bench, pipe_module, pipe_bench = _printers(language)
     d = report.design
     name = d.module_name
-    files = {f"{name}.v": verilog_module(d, version=version, command=command,
-                                         budget=report.budget),
-             f"tb_{name}.v": verilog_testbench(d),
+    files = {f"{name}{ext}": module(d, version=version, command=command, budget=report.budget),
+             f"tb_{name}{ext}": bench(d),
              f"{name}.hex": vector_file(d)}
     if pipelined:
         pipe = pipelined_name(d)
-        files[f"{pipe}.v"] = verilog_pipelined_module(d, version=version, command=command,
-                                                      budget=report.budget)
-        files[f"tb_{pipe}.v"] = verilog_pipelined_testbench(d)
+        files[f"{pipe}{ext}"] = pipe_module(d, version=version, command=command,
+                                            budget=report.budget)
+        files[f"tb_{pipe}{ext}"] = pipe_bench(d)
         files[f"{pipe}.hex"] = files[f"{name}.hex"]
     return files
+
+
+def verilog_outputs(report: HardwareReport, *, version: str = "", command: str | None = None,
+                    pipelined: bool = False) -> dict[str, str]:
+    """File name -> text of the module, its test bench and its vector file; with
+    ``pipelined`` also those of the pipelined variant ``chebnorm_NAME_pipe``
+    (:func:`hdl_outputs` in Verilog).
+
+    >>> from chebnorm.approx import fit_target
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> sorted(verilog_outputs(r))
+    ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v']
+    """
+    return hdl_outputs(report, "verilog", version=version, command=command, pipelined=pipelined)
 
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:

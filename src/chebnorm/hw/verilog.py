@@ -26,18 +26,12 @@ from pathlib import Path
 
 from chebnorm.approx.textsafe import comment_text, identifier
 
+from .hdltext import bench_verdict, round_lines, saturating_output, signed_literal
 from .horner import HornerDesign
 
 __all__ = ["verilog_module", "verilog_testbench", "vector_file", "SimResult", "SynthResult",
            "simulate", "synthesize", "synthesize_text", "verilog_pipelined_module",
            "verilog_pipelined_testbench", "pipelined_name"]
-
-
-def _lit(value: int, bits: int) -> str:
-    """A sized signed decimal literal (range-checked)."""
-    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
-        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
-    return f"{'-' if value < 0 else ''}{bits}'sd{abs(value)}"
 
 
 def _vectors_name(name: str, vectors: str | None) -> str:
@@ -107,15 +101,15 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
             ");"]
     xw = design.xs_bits
     out += [f"    // x value times 2^{xf.frac_bits}",
-            f"    localparam signed [{xw - 1}:0] K0 = {_lit(xf.offset_code, xw)};",
+            f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
             f"    wire signed [{xw - 1}:0] xs = $signed({{1'b0, x}}) + K0;"]
     if n == 0:
         top_bits = max(design.top_bits, 2)
-        out.append(f"    wire signed [{top_bits - 1}:0] top = {_lit(design.integers[0], top_bits)};")
+        out.append(f"    wire signed [{top_bits - 1}:0] top = {signed_literal(design.integers[0], top_bits)};")
         top_frac = design.coef_frac_bits
     else:
         aw = max(design.stages[0].acc_bits, 2)
-        out.append(f"    localparam signed [{aw - 1}:0] A{n} = {_lit(design.integers[n], aw)};")
+        out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
         prev = f"A{n}"
         for st in design.stages:
             j = st.power
@@ -137,33 +131,18 @@ def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
     j = st.power
     shift = f" <<< {st.product_shift}" if st.product_shift else ""
     out = [f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * {xs};",
-           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {_lit(st.coef_shifted, st.sum_bits)};",
+           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {signed_literal(st.coef_shifted, st.sum_bits)};",
            f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};"]
     if j > 0:
-        out += _round(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
+        out += round_lines(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
     return out
 
 def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
     """The evaluator's last lines, shared by the combinational and pipelined
     modules: round ``top`` to y's fractional bits, remove y's offset, saturate."""
-    out = []
-    shift = top_frac - yf.frac_bits
-    rw = max(design.raw_bits, top_bits + max(0, -shift) + 1, design.out_bits + 2,
-             yf.offset_code.bit_length() + 2)
-    out.append(f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate")
-    if shift > 0:
-        out += _round("top", "r", top_bits, shift, rw, design.rounding)
-    elif shift == 0:
-        out.append(f"    wire signed [{rw - 1}:0] r = top;")
-    else:
-        out.append(f"    wire signed [{rw - 1}:0] r = top <<< {-shift};")
-    out += [f"    localparam signed [{rw - 1}:0] KY = {_lit(yf.offset_code, rw)};",
-            f"    localparam signed [{rw - 1}:0] YMAX = {_lit(yf.max_code, rw)};",
-            f"    wire signed [{rw - 1}:0] raw = r - KY;",
-            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
-            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
-            "endmodule", ""]
-    return out
+    return ([f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate"]
+            + saturating_output("top", top_bits, top_frac, yf, design.out_bits, design.rounding,
+                                min_bits=design.raw_bits))
 
 
 def _module_name(design: HornerDesign) -> str:
@@ -205,10 +184,10 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
             "    output wire [OUT_BITS-1:0] y",
             ");"]
     xw = design.xs_bits
-    out += [f"    localparam signed [{xw - 1}:0] K0 = {_lit(xf.offset_code, xw)};",
+    out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
             f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
     aw = max(design.stages[0].acc_bits, 2)
-    out.append(f"    localparam signed [{aw - 1}:0] A{n} = {_lit(design.integers[n], aw)};")
+    out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
     prev = f"A{n}"
     for s, st in enumerate(design.stages):
         j = st.power
@@ -284,18 +263,6 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
         "endmodule", ""])
 
 
-def _round(src: str, dst: str, src_bits: int, shift: int, dst_bits: int, mode: str) -> list[str]:
-    """Verilog lines: ``dst = round(src / 2^shift)`` (floor, or nearest-even)."""
-    lines = [f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};"]
-    if mode == "trunc":
-        lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q;")
-        return lines
-    sticky = f"(|{src}[{shift - 2}:0]) | " if shift >= 2 else ""
-    lines.append(f"    wire {dst}_inc = {src}[{shift - 1}] & ({sticky}{dst}_q[0]);")
-    lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q + $signed({{1'b0, {dst}_inc}});")
-    return lines
-
-
 def vector_file(design: HornerDesign) -> str:
     """Expected ``y`` of every input code, one hex word a line (``$readmemh``)."""
     y = design.evaluate()
@@ -333,13 +300,7 @@ def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
         "                    $display(\"MISMATCH x=%h y=%h expected=%h\", x, y, expected[i]);",
         "            end",
         "        end",
-        "        if (errors == 0)",
-        f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
-        "        else",
-        f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
-        "        $finish;",
-        "    end",
-        "endmodule", ""])
+        *bench_verdict(name)])
 
 
 @dataclass(frozen=True)

@@ -102,7 +102,7 @@ class _Body:
 
 def _round(b: _Body, src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
            mode: str) -> None:
-    """``dst = round(src / 2^shift)`` as in the Verilog ``_round``."""
+    """``dst = round(src / 2^shift)`` as in the Verilog :func:`~chebnorm.hw.hdltext.round_lines`."""
     b.wire(f"{dst}_q", src_bits, f"shift_right({src}, {shift})")
     if mode == "trunc":
         b.wire(dst, dst_bits, f"wrap({dst}_q, {dst_bits})")
@@ -411,19 +411,14 @@ def vhdl_outputs(report, *, version: str = "", command: str | None = None,
     """File name -> text of the VHDL entity, its bench and the vector file of a
     :class:`~chebnorm.hw.report.HardwareReport` (the VHDL twin of
     :func:`~chebnorm.hw.report.verilog_outputs`); with ``pipelined`` also the
-    pipelined entity and its bench."""
-    from .verilog import vector_file
+    pipelined entity and its bench (:func:`~chebnorm.hw.report.hdl_outputs` in VHDL).
 
-    d = report.design
-    name = d.module_name
-    files = {f"{name}.vhd": vhdl_module(d, version=version, command=command,
-                                       budget=report.budget),
-             f"tb_{name}.vhd": vhdl_testbench(d),
-             f"{name}.hex": vector_file(d)}
-    if pipelined:
-        pipe = pipelined_name(d)
-        files[f"{pipe}.vhd"] = vhdl_pipelined_module(d, version=version, command=command,
-                                                     budget=report.budget)
-        files[f"tb_{pipe}.vhd"] = vhdl_pipelined_testbench(d)
-        files[f"{pipe}.hex"] = files[f"{name}.hex"]
-    return files
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.report import analyze
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> sorted(vhdl_outputs(r))
+    ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'tb_chebnorm_dichotomy_d1.vhd']
+    """
+    from .report import hdl_outputs
+
+    return hdl_outputs(report, "vhdl", version=version, command=command, pipelined=pipelined)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fixed import check_width
+from ..hdltext import bench_verdict
 from .base import EXHAUSTIVE_BITS, Port, UnitDesign
 
 __all__ = ["unit_vectors", "combinational_rows", "unit_vector_file", "unit_testbench",
@@ -160,12 +161,5 @@ def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> 
               "            end"]
     if unit.clocked:
         lines.append("            clk = 0;")
-    lines += ["        end",
-              "        if (errors == 0)",
-              f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
-              "        else",
-              f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
-              "        $finish;",
-              "    end",
-              "endmodule", ""]
+    lines += ["        end", *bench_verdict(name)]
     return "\n".join(lines)

@@ -12,7 +12,7 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import dichotomy_midpoint, dichotomy_next_z, dichotomy_unit
 from ..fixed import signed_bits, unsigned_bits
-from ..verilog import _lit
+from ..hdltext import signed_literal
 from .base import Port, UnitDesign, put, register, vec, vec_ports
 from .evaluator import EvaluatorUnit, ky_localparam, scale_lines, scaled_range
 from .hdl import banner, isqrt_module, ports_decl
@@ -97,8 +97,8 @@ def _next_z_lines(unit: UnitDesign) -> list[str]:
             f"    wire [{rw - 1}:0] r2;",
             f"    {name}_isqrt #(.RW({rw})) sq (.v(rad), .r(r2));",
             f"    wire [{rw}:0] zr = ({{1'b0, r2}} + 1'b1) >> 1;",
-            f"    wire signed [{zw - 1}:0] zd = $signed({{1'b0, zr}}) - {_lit(k0, zw)};",
-            f"    assign z_next = zd[{zw - 1}] ? {d.in_bits}'d0 : (zd > {_lit(kmax, zw)}) ? "
+            f"    wire signed [{zw - 1}:0] zd = $signed({{1'b0, zr}}) - {signed_literal(k0, zw)};",
+            f"    assign z_next = zd[{zw - 1}] ? {d.in_bits}'d0 : (zd > {signed_literal(kmax, zw)}) ? "
             f"{d.in_bits}'d{kmax} : zd[{d.in_bits - 1}:0];"]
 
 

@@ -11,7 +11,7 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import eta_criterion, eta_unit
 from ..fixed import check_int64, signed_bits
-from ..verilog import _lit
+from ..hdltext import signed_literal
 from .base import Port, UnitDesign, register, vec, vec_ports
 from .bench import codes, edges, near
 from .evaluator import EvaluatorUnit, check_dot, dot_code
@@ -84,7 +84,7 @@ class EtaUnit(EvaluatorUnit):
                     f"    {d.module_name} poly_{tag} (.x(k_{tag}), .y(y_{tag}));"]
             terms.append(f"$signed({{1'b0, y_{tag}}})")
         out += [f"    localparam signed [{sw - 1}:0] THREE_MINUS_KY = "
-                f"{_lit((3 << fy) - 3 * ky, sw)};",
+                f"{signed_literal((3 << fy) - 3 * ky, sw)};",
                 f"    wire signed [{sw - 1}:0] e = THREE_MINUS_KY - {' - '.join(terms)};",
                 f"    assign eta = e[{ew - 1}:0];",
                 "    assign skip = eta < thr;",

@@ -15,7 +15,8 @@ from chebnorm.approx.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
 from ..horner import HornerDesign, design_horner
-from ..verilog import _lit, _round, verilog_module
+from ..hdltext import round_lines, signed_literal
+from ..verilog import verilog_module
 from .base import UnitDesign, UnitKind, get_unit
 from .bench import codes, combinational_rows, near
 
@@ -104,15 +105,15 @@ def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
     if sh > 0:
         rlo, rhi = _rne_range(dlo, dhi, sh)
         rw = signed_bits(rlo, rhi)
-        lines += _round(f"dot_{tag}", f"dr_{tag}", dw, sh, rw, "rne")
+        lines += round_lines(f"dot_{tag}", f"dr_{tag}", dw, sh, rw, "rne")
     else:
         rlo, rhi = dlo << -sh, dhi << -sh
         rw = signed_bits(rlo, rhi)
         lines.append(f"    wire signed [{rw - 1}:0] dr_{tag} = dot_{tag} <<< {-sh};")
     cw = signed_bits(min(rlo - k0, 0), max(rhi - k0, kmax)) + 1
-    lines += [f"    wire signed [{cw - 1}:0] dc_{tag} = dr_{tag} - {_lit(k0, cw)};",
+    lines += [f"    wire signed [{cw - 1}:0] dc_{tag} = dr_{tag} - {signed_literal(k0, cw)};",
               f"    wire [{d.in_bits - 1}:0] k_{tag} = dc_{tag}[{cw - 1}] ? {d.in_bits}'d0 : "
-              f"(dc_{tag} > {_lit(kmax, cw)}) ? {d.in_bits}'d{kmax} : dc_{tag}[{d.in_bits - 1}:0];"]
+              f"(dc_{tag} > {signed_literal(kmax, cw)}) ? {d.in_bits}'d{kmax} : dc_{tag}[{d.in_bits - 1}:0];"]
     return lines
 
 
@@ -124,7 +125,7 @@ def scale_lines(unit: UnitDesign, a: str, b: str, out: str, ycode: str) -> list[
     for c in "xyz":
         lines += [f"    wire signed [W:0] s_{c} = {a}_{c} + {b}_{c};",
                   f"    wire signed [W+{yw}:0] t_{c} = s_{c} * yv;"]
-        lines += _round(f"t_{c}", f"{out}_{c}_r", w + 1 + yw, fy, mw, "rne")
+        lines += round_lines(f"t_{c}", f"{out}_{c}_r", w + 1 + yw, fy, mw, "rne")
         lines.append(f"    assign {out}_{c} = {out}_{c}_r;")
     return lines
 
@@ -133,7 +134,7 @@ def ky_localparam(unit: UnitDesign) -> str:
     """Line: the evaluator's output offset ``KY`` as a signed constant."""
     yw = unit.sizes["yv_bits"]
     return (f"    localparam signed [{yw - 1}:0] KY = "
-            f"{_lit(unit.horner.y_format.offset_code, yw)};")
+            f"{signed_literal(unit.horner.y_format.offset_code, yw)};")
 
 
 def _isfloat(s) -> bool:

@@ -12,7 +12,7 @@ from ..cost import Block
 from ..datapaths import (forward_difference_codes, forward_difference_setup,
                          forward_difference_stepper)
 from ..fixed import check_int64, check_width, signed_bits
-from ..verilog import _round
+from ..hdltext import round_lines
 from .base import MAX_GUARD, MAX_LOG_M, Port, UnitDesign, UnitKind, put, register, vec, vec_ports
 from .hdl import banner, ports_decl
 
@@ -129,7 +129,7 @@ def _component_lines(c: str, vb: int, db: int, aw: int, sh1: int) -> list[str]:
 
 def _setup_shift(src: str, dst: str, bits: int, sh: int, dst_bits: int) -> list[str]:
     if sh > 0:
-        return _round(src, dst, bits, sh, dst_bits, "rne")
+        return round_lines(src, dst, bits, sh, dst_bits, "rne")
     return [f"    wire signed [{dst_bits - 1}:0] {dst} = {src} <<< {-sh};"]
 
 
