@@ -620,6 +620,12 @@ class Function1D:
 
     ``expr`` is the sympy expression, ``var`` its variable. The evaluators are
     compiled on first use. Internal: no input checking.
+
+    Examples
+    --------
+    >>> f = parse_function("1/sqrt(x)")
+    >>> f.numpy([1.0, 4.0]).tolist(), float(f.mpmath(16))
+    ([1.0, 0.5], 0.25)
     """
 
     expr: sp.Expr

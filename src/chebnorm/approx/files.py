@@ -27,7 +27,18 @@ class WriteError(OSError, ValueError):
     """A destination chebnorm cannot write: the message names the path the
     caller gave (never a temporary file) and the reason. It is an ``OSError``
     and a ``ValueError``, so the command line reports it as a user error
-    (exit status 2, one line)."""
+    (exit status 2, one line).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     try:
+    ...         write_atomic(pathlib.Path(tmp) / "missing" / "t.txt", "x")
+    ...     except WriteError as exc:
+    ...         print(isinstance(exc, ValueError), isinstance(exc, OSError))
+    True True
+    """
 
 
 _REASONS = {
@@ -59,6 +70,14 @@ def write_atomic(path, data: str | bytes) -> None:
         folder, or the system refuses the write (permissions, read-only file
         system, full disk, ``/proc``...). The message names ``path`` as given
         and the reason; no temporary file is left behind.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     write_atomic(pathlib.Path(tmp) / "t.csv", "a,b\\n1,2\\n")
+    ...     print(repr((pathlib.Path(tmp) / "t.csv").read_bytes()))
+    b'a,b\\n1,2\\n'
     """
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")

@@ -48,7 +48,13 @@ _DOTTED = re.compile(r"[A-Za-z_][\w.]*:[A-Za-z_]\w*\Z")
 
 @dataclass(frozen=True)
 class TableSpec:
-    """The coefficient table a kernel reads: ``fit_target(target, degree, psi_max=psi_max)``."""
+    """The coefficient table a kernel reads: ``fit_target(target, degree, psi_max=psi_max)``.
+
+    Examples
+    --------
+    >>> TableSpec("rsqrt", 3)
+    TableSpec(target='rsqrt', degree=3, psi_max='pi/4')
+    """
 
     target: str
     degree: int = 2
@@ -67,6 +73,12 @@ class MethodSpec:
     unit names implementing it, the first one evaluating ``table``;
     ``c_kernel``: its kernel in ``benchmarks/c/kernels.h`` (None: none);
     ``ideal``: ``"linear"`` or ``"slerp"`` (see :data:`IDEALS`).
+
+    Examples
+    --------
+    >>> s = get_method("quadratic")
+    >>> s.seed, s.table.target, s.units
+    ('seed 000, method 5', 'midpoint', ('quadratic', 'stepper'))
     """
 
     name: str
@@ -146,7 +158,19 @@ def register(spec: MethodSpec, *, replace: bool = False) -> MethodSpec:
 
 
 def unregister(name: str) -> None:
-    """Remove a method registered at run time (the built-in eight stay)."""
+    """Remove a method registered at run time (the built-in eight stay).
+
+    Examples
+    --------
+    >>> s = register(MethodSpec("toy_unreg", "copy N_l", "none", "mymodule:KERNEL"))
+    >>> unregister("toy_unreg")
+    >>> "toy_unreg" in method_names()
+    False
+    >>> unregister("dichotomy")
+    Traceback (most recent call last):
+    ...
+    ValueError: method 'dichotomy' is built in and cannot be removed
+    """
     if name in {s.name for s in _BUILTIN}:
         raise ValueError(f"method {name!r} is built in and cannot be removed")
     get_method(name)
@@ -168,19 +192,39 @@ def get_method(name) -> MethodSpec:
 
 
 def method_names() -> tuple[str, ...]:
-    """The registered methods, in the order the papers and the CLI list them."""
+    """The registered methods, in the order the papers and the CLI list them.
+
+    Examples
+    --------
+    >>> method_names()
+    ('exact', 'none', 'newton', 'lyon', 'slerp', 'dichotomy', 'quadratic', 'angular')
+    """
     return tuple(_REGISTRY)
 
 
 def registered_methods() -> tuple[MethodSpec, ...]:
-    """Every registry entry, in :func:`method_names` order."""
+    """Every registry entry, in :func:`method_names` order.
+
+    Examples
+    --------
+    >>> [s.name for s in registered_methods() if s.table is not None]
+    ['dichotomy', 'quadratic']
+    """
     return tuple(_REGISTRY.values())
 
 
 def unit_tables() -> dict[str, TableSpec]:
     """Hardware unit name -> the table its polynomial evaluator approximates (units
     without an evaluator are absent): the first unit of every method with a table,
-    and the units that belong to no method (``eta``)."""
+    and the units that belong to no method (``eta``).
+
+    Examples
+    --------
+    >>> sorted(unit_tables())
+    ['dichotomy', 'eta', 'quadratic']
+    >>> unit_tables()["eta"]
+    TableSpec(target='eta_term', degree=2, psi_max='pi/4')
+    """
     out = {s.units[0]: s.table for s in _REGISTRY.values() if s.units and s.table is not None}
     out.update(_UNIT_ONLY_TABLES)
     return out

@@ -19,7 +19,14 @@ __all__ = ["Target", "TARGETS", "get_target", "target_names"]
 @dataclass(frozen=True)
 class Target:
     """A named function, its variable, its interval as a function of psi_max,
-    the degrees and kind the main job exports, and what it is for."""
+    the degrees and kind the main job exports, and what it is for.
+
+    Examples
+    --------
+    >>> t = get_target("dichotomy")
+    >>> t.expression, t.variable, t.interval("pi/4")
+    ('1/sqrt(2+z)', 'z', ('sqrt(2)', '2'))
+    """
 
     name: str
     expression: str

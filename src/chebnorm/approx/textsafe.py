@@ -60,6 +60,11 @@ def comment_text(text, *, max_length: int = 400) -> str:
     backslashes become ``_`` (line continuation); ``*/`` and ``/*`` get a space
     between their characters, ``??`` too (trigraphs), repeatedly until none is
     left. Longer texts are cut to ``max_length`` characters and end in ``...``.
+
+    Examples
+    --------
+    >>> comment_text("a */ b\\nc")
+    'a * / b_c'
     """
     text = str(text)
     out = "".join(ch if " " <= ch <= "~" and ch != "\\" else "_" for ch in text)
@@ -81,6 +86,11 @@ def csv_cell(text) -> str:
     is not a plain number gets a leading apostrophe (the OWASP advice for CSV
     injection); a cell holding a comma, quote or line break is quoted with
     doubled quotes.
+
+    Examples
+    --------
+    >>> csv_cell("=1+2"), csv_cell("-0.5"), csv_cell('say "hi", twice')
+    ("'=1+2", '-0.5', '"say ""hi"", twice"')
     """
     text = str(text)
     if text[:1] in ("=", "+", "-", "@", "\t", "\r"):

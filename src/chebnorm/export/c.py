@@ -112,7 +112,14 @@ def _max_abs_x(table: CoefficientTable) -> Fraction:
 
 def horner_rounding_bound(coefficients, max_abs_x: Fraction, unit_roundoff: float) -> Fraction:
     """Rigorous bound of ``|fl(p(x)) - p(x)|`` for ``|x| <= max_abs_x``
-    (``gamma_2n * sum |c_k| M^k``, ``gamma_k = k u / (1 - k u)``)."""
+    (``gamma_2n * sum |c_k| M^k``, ``gamma_k = k u / (1 - k u)``).
+
+    Examples
+    --------
+    >>> b = horner_rounding_bound([1.0, 2.0, 3.0], Fraction(1), 2.0 ** -53)
+    >>> b == 6 * Fraction(4, 2 ** 53 - 4)   # gamma_4 * (1 + 2 + 3)
+    True
+    """
     n = len(coefficients) - 1
     if n <= 0:
         return Fraction(0)

@@ -40,7 +40,13 @@ _GROUP = 64
 
 
 class ToolMissing(RuntimeError):
-    """An optional tool or driver is not available."""
+    """An optional tool or driver is not available.
+
+    Examples
+    --------
+    >>> issubclass(ToolMissing, RuntimeError)
+    True
+    """
 
 
 def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> np.ndarray:
@@ -113,7 +119,7 @@ def compute_shader_source(table: CoefficientTable, language: str, *, es: bool = 
 
     >>> from chebnorm.approx import fit_target
     >>> src = compute_shader_source(fit_target("dichotomy", 1), "wgsl")
-    >>> print(src.splitlines()[-3])
+    >>> print(src.splitlines()[-2])
         if (i < arrayLength(&xs)) { ys[i] = chebnorm_dichotomy_d1(xs[i]); }
     >>> compute_shader_source(fit_target("dichotomy", 1), "glsl", es=True).splitlines()[0]
     '#version 310 es'

@@ -86,6 +86,12 @@ class ShaderLanguage:
 
     ``const``/``function``/``acc`` are format strings with the fields shown in
     :data:`SHADER_LANGUAGES`; ``prelude``/``postlude`` wrap the function.
+
+    Examples
+    --------
+    >>> g = SHADER_LANGUAGES["wgsl"]
+    >>> g.float_type, g.const.format(name="C0", value="1.0")
+    ('f32', 'const C0: f32 = 1.0;')
     """
 
     name: str
@@ -190,6 +196,13 @@ class ShaderBound:
 
     ``total`` is rounded up to a double; ``total32`` up to a float32 (the
     value printed as a shader constant).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> b = float32_eval_bound(fit("1/x", ("1", "2"), 1, name="inv"))
+    >>> b.certified + b.coefficients + b.rounding + b.flush <= Fraction(b.total) <= Fraction(b.total32)
+    True
     """
 
     certified: Fraction
@@ -336,15 +349,37 @@ def _up_f32(value: float) -> float:
 
 
 def glsl_source(table: CoefficientTable, command: str = "") -> str:
-    """:func:`shader_source` in GLSL."""
+    """:func:`shader_source` in GLSL.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> t = fit("1/x", ("1", "2"), 1, name="inv")
+    >>> glsl_source(t) == shader_source(t, "glsl"), "float chebnorm_inv(float x)" in glsl_source(t)
+    (True, True)
+    """
     return shader_source(table, "glsl", command)
 
 
 def wgsl_source(table: CoefficientTable, command: str = "") -> str:
-    """:func:`shader_source` in WGSL."""
+    """:func:`shader_source` in WGSL.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> "fn chebnorm_inv(x: f32) -> f32" in wgsl_source(fit("1/x", ("1", "2"), 1, name="inv"))
+    True
+    """
     return shader_source(table, "wgsl", command)
 
 
 def hlsl_source(table: CoefficientTable, command: str = "") -> str:
-    """:func:`shader_source` in HLSL."""
+    """:func:`shader_source` in HLSL.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> "float chebnorm_inv(float x)" in hlsl_source(fit("1/x", ("1", "2"), 1, name="inv"))
+    True
+    """
     return shader_source(table, "hlsl", command)
