@@ -90,7 +90,7 @@ def bench_verdict(name: str) -> list[str]:
     ``errors`` over ``COUNT`` vectors: print the one ``PASS:``/``FAIL:`` line
     the simulation runners read, then ``$finish``.
 
-    >>> print("\n".join(bench_verdict("chebnorm_f")[:2]))
+    >>> print("\\n".join(bench_verdict("chebnorm_f")[:2]))
             if (errors == 0)
                 $display("PASS: %0d vectors, 0 mismatches (chebnorm_f)", COUNT);
     """
