@@ -54,7 +54,17 @@ def _up(x: Fraction) -> float:
 @dataclass(frozen=True)
 class ErrorBudget:
     """Certified parts of the error (see module docstring); ``total`` is
-    ``min(approximation + quantization, quantized) + rounding``."""
+    ``min(approximation + quantization, quantized) + rounding``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> b = error_budget(design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14), gappa=False)
+    >>> parts = min(b.approximation + b.quantization, b.quantized) + b.rounding
+    >>> f"{parts / b.total:.12f}"   # total: the same sum, in exact arithmetic rounded up
+    '1.000000000000'
+    """
 
     approximation: float
     quantization: float
@@ -86,6 +96,15 @@ class Measurement:
     ``rel_total`` is ``max |y / f - 1|``, ``shading_levels`` is
     ``255 * rel_total``: the largest change of an 8-bit intensity
     ``I <= 1`` when the normal is scaled by ``y`` instead of ``f``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14)
+    >>> m = measure(d)
+    >>> m.codes == d.valid_codes[1] - d.valid_codes[0] + 1, m.total <= error_budget(d, gappa=False).total
+    (True, True)
     """
 
     codes: int

@@ -39,7 +39,17 @@ __all__ = ["horner_block", "dot_block", "classic_unit", "dichotomy_unit",
 
 def horner_block(design: HornerDesign) -> Block:
     """The polynomial evaluator: one multiplier and adder per degree, the
-    input-offset adder, rounding incrementers, the output offset and clamp."""
+    input-offset adder, rounding incrementers, the output offset and clamp.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14)
+    >>> c = horner_block(d).cost
+    >>> len(c.multipliers) == d.degree, c.latency
+    (True, 5)
+    """
     mults = tuple((st.acc_bits, design.xs_bits) for st in design.stages)
     adders = [design.xs_bits] + [st.sum_bits for st in design.stages]
     adders += [st.out_bits for st in design.stages[:-1] if st.round_shift]
@@ -52,7 +62,14 @@ def horner_block(design: HornerDesign) -> Block:
 
 
 def dot_block(w: int) -> Block:
-    """``A.B`` of two 3-vectors of ``w``-bit components."""
+    """``A.B`` of two 3-vectors of ``w``-bit components.
+
+    Examples
+    --------
+    >>> c = dot_block(8).cost
+    >>> c.multipliers, len(c.adders)
+    (((8, 8), (8, 8), (8, 8)), 2)
+    """
     return Block("dot product", Cost(multipliers=((w, w),) * 3, adders=(2 * w, 2 * w + 1),
                                      latency=3))
 
@@ -62,6 +79,12 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
 
     With ``frac_bits = F`` the dividers are priced as in :func:`classic_normalize`:
     a ``W + F``-bit quotient of ``N << F`` (without it, a ``W``-bit quotient).
+
+    Examples
+    --------
+    >>> c = classic_unit(12).cost
+    >>> len(c.multipliers), len(c.adders), len(c.sqrts), len(c.dividers)
+    (3, 2, 1, 3)
     """
     q = w if frac_bits is None else w + frac_bits
     return Block("classic normalization", children=(
@@ -72,7 +95,16 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
 
 
 def dichotomy_unit(design: HornerDesign, w: int) -> Block:
-    """Dichotomy midpoint ``(N1 + N2) p(z)`` and next level ``z' = sqrt(2 + z)``."""
+    """Dichotomy midpoint ``(N1 + N2) p(z)`` and next level ``z' = sqrt(2 + z)``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> b = dichotomy_unit(design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14), 12)
+    >>> [c.name for c in b.children]
+    ['N1 + N2', 'horner chebnorm_dichotomy_d2', 'scale', "next level z' = sqrt(2 + z)"]
+    """
     return Block("dichotomy midpoint", children=(
         Block("N1 + N2", Cost(adders=(w + 1,) * 3, latency=1)),
         horner_block(design),
@@ -84,7 +116,16 @@ def dichotomy_unit(design: HornerDesign, w: int) -> Block:
 
 
 def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
-    """Midpoint ``N_c = (N_l + N_r) p(N_l.N_r)`` and ``G, P, Q`` (seed 000, method 5)."""
+    """Midpoint ``N_c = (N_l + N_r) p(N_l.N_r)`` and ``G, P, Q`` (seed 000, method 5).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> b = quadratic_midpoint_unit(design_horner(fit_target("midpoint", 2), 10, 10, coef_bits=14), 12)
+    >>> len(b.cost.sqrts), len(b.cost.dividers)   # no square root, no division
+    (0, 0)
+    """
     return Block("quadratic-interpolation midpoint", children=(
         dot_block(w),
         horner_block(design),
@@ -97,13 +138,29 @@ def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
 
 
 def forward_difference_stepper(w: int, guard: int = 8) -> Block:
-    """Per pixel ``N += D1; D1 += D2`` for each component: 6 adders, no multiplier."""
+    """Per pixel ``N += D1; D1 += D2`` for each component: 6 adders, no multiplier.
+
+    Examples
+    --------
+    >>> c = forward_difference_stepper(12).cost
+    >>> len(c.adders), len(c.multipliers)
+    (6, 0)
+    """
     return Block("forward-difference stepper", Cost(adders=(w + guard,) * 6, latency=1),
                  note="seed 000, method 5: additions only")
 
 
 def eta_unit(design: HornerDesign, w: int) -> Block:
-    """eta = 3 - sum of three g(N_i.N_j) (seed 003) and the threshold compare."""
+    """eta = 3 - sum of three g(N_i.N_j) (seed 003) and the threshold compare.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> b = eta_unit(design_horner(fit_target("eta_term", 2), 10, 10, coef_bits=14), 12)
+    >>> len(b.cost.sqrts), b.cost.latency > 0
+    (0, True)
+    """
     return Block("eta criterion", children=(
         Block("3 dot products", children=(dot_block(w),) * 3, serial=False),
         Block("3 evaluators", children=(horner_block(design),) * 3, serial=False),
@@ -122,7 +179,14 @@ def _intensity(w: int, shininess_bits: int = 7) -> Block:
 
 
 def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
-    """Phong pipeline (seed 001): interpolate N, L, H; normalize each; intensity."""
+    """Phong pipeline (seed 001): interpolate N, L, H; normalize each; intensity.
+
+    Examples
+    --------
+    >>> p = phong_pipeline(12)
+    >>> p.cost.area > classic_unit(12).cost.area, len(p.cost.sqrts)
+    (True, 3)
+    """
     norm = normalizer or classic_unit(w)
     return Block("Phong pipeline", children=(
         Block("interpolation of N, L, H", Cost(adders=(w + 8,) * 9, latency=1)),
@@ -134,7 +198,13 @@ def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
 def bump_pipeline(w: int, normalizer: Block | None = None) -> Block:
     """Bump mapping on the Phong pipeline (seed 001): the perturbed normal comes
     from a texture; one added 3w-bit 2:1 multiplexer selects it over the
-    interpolated normal."""
+    interpolated normal.
+
+    Examples
+    --------
+    >>> bump_pipeline(12).cost.mux_bits - phong_pipeline(12).cost.mux_bits   # one 3w-bit multiplexer
+    36
+    """
     base = phong_pipeline(w, normalizer)
     return Block("bump-mapping pipeline", children=(
         base, Block("multiplexer N / texture normal", Cost(mux_bits=3 * w)),
@@ -172,7 +242,23 @@ def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
 
 def dichotomy_midpoint(n1, n2, z_codes, design: HornerDesign, frac_bits: int) -> np.ndarray:
     """Bit-accurate dichotomy midpoint ``(N1 + N2) * p(z)`` (seed 000, method 4),
-    the product rounded to nearest-even back to ``frac_bits``."""
+    the product rounded to nearest-even back to ``frac_bits``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 2), 12, 12, coef_bits=16)
+    >>> F = 12
+    >>> n1 = np.array([1 << F, 0, 0])
+    >>> n2 = np.rint(2.0 ** F * np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0]))
+    >>> z = 2 * np.cos(np.pi / 4)
+    >>> k = int(np.rint((z - float(d.x_format.offset)) * 2 ** d.x_format.frac_bits))
+    >>> m = dichotomy_midpoint(n1, n2, k, d, F)
+    >>> exact = np.rint(2.0 ** F * np.array([np.cos(np.pi / 8), np.sin(np.pi / 8), 0]))  # 22.5 degrees
+    >>> m.tolist(), exact.astype(int).tolist()
+    ([3784, 1567, 0], [3784, 1567, 0])
+    """
     s = np.asarray(n1, dtype=np.int64) + np.asarray(n2, dtype=np.int64)
     y = design.evaluate(z_codes)[..., None] + design.y_format.offset_code
     return shift_round(s * y, design.y_format.frac_bits, "rne")
@@ -207,7 +293,18 @@ def dichotomy_next_z(z_codes, design: HornerDesign) -> np.ndarray:
 def dot_to_code(dot, dot_frac_bits: int, design: HornerDesign) -> np.ndarray:
     """Input code of ``design`` for a dot product ``dot / 2**dot_frac_bits``:
     rounded to nearest-even to the ``Fx`` fractional bits of the input, less
-    the offset, saturated to ``0 .. 2^in_bits - 1``."""
+    the offset, saturated to ``0 .. 2^in_bits - 1``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("midpoint", 2), 10, 10, coef_bits=14)
+    >>> F = 8
+    >>> one = np.array([1 << F, 0, 0])
+    >>> int(dot_to_code(one @ one, 2 * F, d)) == d.valid_codes[1]   # x = 1, the top of [cos(pi/4), 1]
+    True
+    """
     fx, k0 = design.x_format.frac_bits, design.x_format.offset_code
     dot = np.asarray(dot, dtype=np.int64)
     v = shift_round(dot, dot_frac_bits - fx, "rne") if dot_frac_bits >= fx else \
@@ -231,6 +328,16 @@ def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
     ``F`` bits; ``G = 2N_l + 2N_r - 4N_c``, ``P = 4N_c - 3N_l - N_r``,
     ``Q = N_l`` are exact. Returns ``(G, P, Q, N_c)``, int codes ``(..., 3)``
     with ``F`` fractional bits.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("midpoint", 2), 12, 12, coef_bits=16)
+    >>> nl, nr = np.array([1 << 10, 0, 0]), np.array([0, 1 << 10, 0])
+    >>> G, P, Q, nc = quadratic_midpoint(nl, nr, d, 10)
+    >>> bool(np.all(Q == nl)), bool(np.all(G + P + Q == nr))   # the curve starts at N_l and ends at N_r
+    (True, True)
     """
     nl, nr = np.asarray(nl, dtype=np.int64), np.asarray(nr, dtype=np.int64)
     k = dot_to_code(np.sum(nl * nr, axis=-1), 2 * frac_bits, design)
@@ -243,7 +350,19 @@ def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarra
     with ``g ~ sqrt(2(1+x))/2`` the polynomial of ``design``: each dot product
     exact, converted by :func:`dot_to_code`; the sum exact. Returns the codes of
     eta with the ``Fy`` fractional bits of ``design``'s output (value
-    ``code / 2**Fy``, no offset)."""
+    ``code / 2**Fy``, no offset).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("eta_term", 2), 10, 10, coef_bits=14)
+    >>> n = np.array([[1 << 8, 0, 0]])
+    >>> eta = eta_criterion(n, n, n, d, 8)   # three equal normals: eta = 3 - 3 g(1) = 0
+    >>> from chebnorm.hw.budget import error_budget
+    >>> abs(int(eta[0])) * 2.0 ** -d.y_format.frac_bits <= 3 * error_budget(d, gappa=False).total
+    True
+    """
     na, nb, nc = (np.asarray(a, dtype=np.int64) for a in (na, nb, nc))
     fy, ky = design.y_format.frac_bits, design.y_format.offset_code
     total = np.zeros(na.shape[:-1], dtype=np.int64)
@@ -258,7 +377,15 @@ def forward_difference_setup(G, P, Q, log_m: int, guard: int):
     ``v0 = Q 2^g``, ``d1 = R((G + m P) 2^g / m^2)``, ``d2 = R(2 G 2^g / m^2)``
     (``R``: nearest-even, exact when ``g >= 2 log_m``), the shifts being wiring.
     ``G, P, Q``: int codes ``(..., 3)``; the results have ``g`` more fractional
-    bits. Equal to what :func:`forward_difference` computes from the values."""
+    bits. Equal to what :func:`forward_difference` computes from the values.
+
+    Examples
+    --------
+    >>> G, P, Q = np.array([1 << 8, 0, 0]), np.zeros(3, int), np.zeros(3, int)   # G = 1, F = 8
+    >>> v = forward_difference_codes(*forward_difference_setup(G, P, Q, 2, 4), 4)
+    >>> (v[:, 0] / 2 ** (8 + 4)).tolist()   # t^2 at t = i/4, exact
+    [0.0, 0.0625, 0.25, 0.5625, 1.0]
+    """
     G, P, Q = (np.asarray(a, dtype=np.int64) for a in (G, P, Q))
 
     def scale(v, up):
@@ -290,6 +417,11 @@ def forward_difference(G, P, Q, m: int, frac_bits: int, guard: int = 8) -> np.nd
     differences in fixed point (``frac_bits + guard`` fractional bits inside,
     the start values rounded once): additions only, as the hardware does it.
     ``G, P, Q``: float arrays ``(..., 3)``. Returns float values ``(..., m+1, 3)``.
+
+    Examples
+    --------
+    >>> forward_difference(np.array([1.0, 0, 0]), np.zeros(3), np.zeros(3), 4, 8)[:, 0].tolist()   # t^2
+    [0.0, 0.0625, 0.25, 0.5625, 1.0]
     """
     scale = 2.0 ** (frac_bits + guard)
     G, P, Q = (np.asarray(a, dtype=np.float64) for a in (G, P, Q))

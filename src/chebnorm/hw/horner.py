@@ -58,6 +58,13 @@ class Stage:
     aligned sum (``sum_frac_bits`` fractional bits); ``out_bits``: width of
     the rounded result with ``out_frac_bits`` fractional bits;
     ``coef_shifted``: the integer added, ``q_j`` aligned to the sum.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> d = design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14)
+    >>> [(s.power, s.sum_bits, s.out_frac_bits) for s in d.stages]
+    [(1, 22, 17), (0, 28, 27)]
     """
 
     power: int
@@ -74,7 +81,17 @@ class Stage:
 
 @dataclass(frozen=True)
 class HornerDesign:
-    """A fully sized fixed-point polynomial evaluator (see module docstring)."""
+    """A fully sized fixed-point polynomial evaluator (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> d = design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14)
+    >>> d.module_name, d.x_format.q_name(), d.valid_codes
+    ('chebnorm_dichotomy_d2', 'UQ0.10', (1, 600))
+    >>> bool(np.all(d.evaluate() <= d.y_format.max_code))
+    True
+    """
 
     name: str
     table: CoefficientTable
@@ -181,7 +198,19 @@ def max_coef_bits(table: CoefficientTable) -> int:
 
 
 def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
-    """Boundary check of ``coef-bits`` against the table's int32 coefficient limit."""
+    """Boundary check of ``coef-bits`` against the table's int32 coefficient limit.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> t = fit_target("dichotomy", 2)
+    >>> check_coef_bits(t, 14)
+    14
+    >>> check_coef_bits(t, 40)
+    Traceback (most recent call last):
+    ...
+    ValueError: coef-bits = 40 is out of range; accepted: 1 <= coef-bits <= 31 (quantized coefficients are signed 32-bit integers and the largest of table 'dichotomy_d2' is 0.680756)
+    """
     hi = max_coef_bits(table)
     if hi < 1:
         raise ValueError(f"table {table.name!r}: its largest coefficient does not fit a signed "

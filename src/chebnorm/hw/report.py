@@ -37,7 +37,15 @@ __all__ = ["HardwareReport", "analyze", "hdl_outputs", "verilog_outputs", "write
 @dataclass(frozen=True)
 class HardwareReport:
     """A sized design with its certified budget, its exhaustive measurement,
-    its cost block and (when yosys ran) its cell count."""
+    its cost block and (when yosys ran) its cell count.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> all(r.checks.values()), r.as_dict()["module"]
+    (True, 'chebnorm_dichotomy_d1')
+    """
 
     design: HornerDesign
     budget: ErrorBudget
@@ -133,7 +141,15 @@ def _local(stage, design) -> float:
 def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=None,
             acc_bits=None, rounding: str = "rne", x_frac_bits=None, y_frac_bits=None,
             gappa: bool = True, synth: bool = True) -> HardwareReport:
-    """Design, budget, measure (exhaustively) and optionally synthesize."""
+    """Design, budget, measure (exhaustively) and optionally synthesize.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> r = analyze(fit_target("dichotomy", 2), 10, 10, coef_bits=14, synth=False, gappa=False)
+    >>> r.measurement.total <= r.budget.total, r.synth is None
+    (True, True)
+    """
     design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
                            rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits)
     import shutil
@@ -205,7 +221,17 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     """Write every file atomically into ``directory`` (created if missing); the
-    caller has checked everything before, so nothing is half-written."""
+    caller has checked everything before, so nothing is half-written.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> import tempfile
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     print([p.name for p in write_outputs(tmp, verilog_outputs(r))])
+    ['chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v', 'chebnorm_dichotomy_d1.hex']
+    """
     folder = make_folder(directory)
     paths = []
     for fname, text in files.items():

@@ -41,7 +41,16 @@ class SweepPoint:
     (``max_error``; in output LSBs, ``max_error_lsb``; in 8-bit shading
     levels, ``shading_levels``), its certified budget and its area (yosys
     cells when yosys ran, else the full-adder estimate ``area_fa``);
-    ``pareto`` marks the designs no other beats on both error and area."""
+    ``pareto`` marks the designs no other beats on both error and area.
+
+    Examples
+    --------
+    >>> s = sweep("dichotomy", degrees=(1,), coef_bits=(10,), in_bits=8, out_bits=8, synth=False,
+    ...           workers=1, progress=False)
+    >>> p = s.points[0]
+    >>> p.degree, p.coef_bits, p.max_error <= p.budget, p.area == p.area_fa
+    (1, 10, True, True)
+    """
 
     degree: int
     coef_bits: int
@@ -83,7 +92,15 @@ class SweepPoint:
 @dataclass(frozen=True)
 class SweepResult:
     """All points of a sweep of one target (see :func:`sweep`), with
-    ``area_source`` saying whether areas are yosys cells or estimates."""
+    ``area_source`` saying whether areas are yosys cells or estimates.
+
+    Examples
+    --------
+    >>> s = sweep("dichotomy", degrees=(1, 2), coef_bits=(10, 14), acc_bits=(14,), in_bits=8,
+    ...           out_bits=8, synth=False, workers=1, progress=False)
+    >>> len(s.points), s.area_source, s.csv().splitlines()[0].split(",")[:3]
+    (4, 'estimate', ['degree', 'coef_bits', 'acc_bits'])
+    """
 
     target: str
     points: tuple[SweepPoint, ...]
@@ -170,6 +187,13 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     ``workers`` local processes (default: the core count) or on a Dask
     ``scheduler`` (:func:`chebnorm.approx.parallel.map_ordered`); the result is
     the same whatever runs it.
+
+    Examples
+    --------
+    >>> s = sweep("dichotomy", degrees=(1, 2), coef_bits=(10, 14), acc_bits=(14,), in_bits=8,
+    ...           out_bits=8, synth=False, workers=1, progress=False)
+    >>> all(p.max_error <= p.budget for p in s.points), any(p.pareto for p in s.points)
+    (True, True)
     """
     get_target(target)
     workers = check_workers(workers)
