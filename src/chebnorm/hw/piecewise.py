@@ -74,7 +74,23 @@ ROUNDING = "rne"
 
 @dataclass(frozen=True)
 class PiecewiseDesign:
-    """A sized ROM + Horner evaluator of a uniform :class:`PiecewiseTable`."""
+    """A sized ROM + Horner evaluator of a uniform :class:`PiecewiseTable`.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> d.index_bits, d.local_bits, d.module_name
+    (2, 6, 'chebnorm_rs')
+    >>> [float(x) for x in d.x_values([0, 255])]
+    [1.0, 3.98828125]
+    >>> y = [float(d.y_format.value(c)) for c in d.evaluate([0, 255])]
+    >>> [round(v, 3) for v in y]   # 1/sqrt(x), degree 1 on 4 segments: 1e-2 off
+    [0.986, 0.5]
+    >>> abs(y[0] - 1) <= d.budget()["total"], abs(y[1] - 3.98828125 ** -0.5) <= d.budget()["total"]
+    (True, True)
+    """
 
     name: str
     table: PiecewiseTable
@@ -205,6 +221,18 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     ``in_bits`` must exceed the table's index bits (the rest is the local
     variable); the accumulators carry ``y_frac_bits + guard_bits`` fractional
     bits. Raises ValueError naming the value and the accepted range.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> d.measure()["max_error"] <= d.budget()["total"]
+    True
+    >>> design_piecewise(t, 2, 8)
+    Traceback (most recent call last):
+    ...
+    ValueError: in-bits = 2 is out of range; accepted: 3 <= in-bits <= 20
     """
     if not isinstance(table, PiecewiseTable):
         raise ValueError("design_piecewise needs a PiecewiseTable")
@@ -257,7 +285,17 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
 # -- Verilog -------------------------------------------------------------------
 
 def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | None = None) -> str:
-    """The synthesizable Verilog-2005 module: ROM (a case on the index) + Horner."""
+    """The synthesizable Verilog-2005 module: ROM (a case on the index) + Horner.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> v = piecewise_verilog(d)
+    >>> v.count("2'd"), "module chebnorm_rs" in v   # one ROM row per segment
+    (4, True)
+    """
     t = d.table
     n, L, K, fc = t.degree, d.local_bits, t.index_bits, t.coef_frac_bits
     yf = d.y_format
@@ -336,13 +374,32 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
 
 
 def piecewise_testbench(d: PiecewiseDesign) -> str:
-    """The exhaustive self-checking bench (expected codes from :meth:`evaluate`)."""
+    """The exhaustive self-checking bench (expected codes from :meth:`evaluate`).
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> piecewise_testbench(d).splitlines()[0]
+    '// tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs.'
+    """
     return verilog_testbench(d)
 
 
 def piecewise_outputs(d: PiecewiseDesign, *, version: str = "",
                       command: str | None = None) -> dict[str, str]:
-    """``{file name: text}``: the module, its bench and the expected-output vectors."""
+    """``{file name: text}``: the module, its bench and the expected-output vectors.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> files = piecewise_outputs(d)
+    >>> sorted(files), len(files["chebnorm_rs.hex"].split()) == 2 ** 8
+    (['chebnorm_rs.hex', 'chebnorm_rs.v', 'tb_chebnorm_rs.v'], True)
+    """
     m = d.module_name
     return {f"{m}.v": piecewise_verilog(d, version=version, command=command),
             f"tb_{m}.v": piecewise_testbench(d), f"{m}.hex": vector_file(d)}

@@ -88,7 +88,17 @@ def _banner(design: HornerDesign, version: str, command: str | None, budget=None
 
 def verilog_module(design: HornerDesign, *, version: str = "", command: str | None = None,
                    budget=None) -> str:
-    """The synthesizable Verilog-2005 module of ``design``."""
+    """The synthesizable Verilog-2005 module of ``design``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = verilog_module(d)
+    >>> [line for line in v.splitlines() if line.startswith(("module", "    input", "    output"))]
+    ['module chebnorm_dichotomy_d1 #(', '    input  wire [IN_BITS-1:0]  x,', '    output wire [OUT_BITS-1:0] y']
+    """
     xf, yf = design.x_format, design.y_format
     n = design.degree
     out = _banner(design, version, command, budget)
@@ -153,7 +163,16 @@ def _module_name(design: HornerDesign) -> str:
 
 
 def pipelined_name(design: HornerDesign) -> str:
-    """Module name of the pipelined variant: ``chebnorm_NAME_pipe``."""
+    """Module name of the pipelined variant: ``chebnorm_NAME_pipe``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> pipelined_name(d)
+    'chebnorm_dichotomy_d1_pipe'
+    """
     return f"{_module_name(design)}_pipe"
 
 
@@ -163,7 +182,17 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     for bit, with ``clk`` and one register stage after each Horner step (the
     delayed ``x`` travels beside the accumulator). Latency: ``degree`` cycles
     -- ``y`` after the ``degree``-th rising edge belongs to the ``x`` applied
-    before the first; a new ``x`` can be applied every cycle."""
+    before the first; a new ``x`` can be applied every cycle.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = verilog_pipelined_module(d)
+    >>> [line.strip() for line in v.splitlines() if "LATENCY =" in line or "posedge" in line]
+    ['parameter LATENCY = 1', 'always @(posedge clk) top <= t0;']
+    """
     n = design.degree
     if n < 1:
         raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
@@ -212,7 +241,16 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     """Exhaustive self-checking bench of the pipelined variant: one new input
     code per cycle; the output after edge ``i`` is checked against the model's
     answer for code ``i - LATENCY + 1`` (the first ``LATENCY - 1`` edges are
-    the pipeline filling and are not checked)."""
+    the pipeline filling and are not checked).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> verilog_pipelined_testbench(d).splitlines()[0]
+    '// tb_chebnorm_dichotomy_d1_pipe: exhaustive self-checking test bench of chebnorm_dichotomy_d1_pipe, latency 1.'
+    """
     name = pipelined_name(design)
     vectors = _vectors_name(name, vectors)
     count = 2 ** design.in_bits
@@ -264,14 +302,36 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
 
 
 def vector_file(design: HornerDesign) -> str:
-    """Expected ``y`` of every input code, one hex word a line (``$readmemh``)."""
+    """Expected ``y`` of every input code, one hex word a line (``$readmemh``).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = vector_file(d).split()
+    >>> len(v) == 2 ** 6, [int(w, 16) for w in v[:3]] == d.evaluate()[:3].tolist()
+    (True, True)
+    """
     y = design.evaluate()
     digits = (design.out_bits + 3) // 4
     return "".join(f"{int(v):0{digits}x}\n" for v in y)
 
 
 def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
-    """A self-checking test bench comparing every input code with the model."""
+    """A self-checking test bench comparing every input code with the model.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> tb = verilog_testbench(d)
+    >>> tb.splitlines()[0]
+    '// tb_chebnorm_dichotomy_d1: exhaustive self-checking test bench of chebnorm_dichotomy_d1.'
+    >>> '$readmemh("chebnorm_dichotomy_d1.hex", expected);' in tb
+    True
+    """
     name = _module_name(design)
     vectors = _vectors_name(name, vectors)
     count = 2 ** design.in_bits

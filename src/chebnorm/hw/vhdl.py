@@ -222,7 +222,17 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
                           command: str | None = None, budget=None) -> str:
     """The pipelined VHDL evaluator ``chebnorm_NAME_pipe``: the datapath of
     :func:`vhdl_module` with one register stage after each Horner step, as
-    :func:`~chebnorm.hw.verilog.verilog_pipelined_module` (latency ``degree``)."""
+    :func:`~chebnorm.hw.verilog.verilog_pipelined_module` (latency ``degree``).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = vhdl_pipelined_module(d)
+    >>> [line.strip() for line in v.splitlines() if line.startswith("entity")]
+    ['entity chebnorm_dichotomy_d1_pipe is']
+    """
     n = design.degree
     if n < 1:
         raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
@@ -366,14 +376,33 @@ def _bench(design: HornerDesign, name: str, vectors: str, clocked: bool) -> str:
 
 
 def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
-    """Exhaustive self-checking bench of :func:`vhdl_module` (every input code)."""
+    """Exhaustive self-checking bench of :func:`vhdl_module` (every input code).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> tb = vhdl_testbench(d)
+    >>> "chebnorm_dichotomy_d1.hex" in tb, "chebnorm_dichotomy_d1_vhdl_y.hex" in tb
+    (True, True)
+    """
     name = design.module_name
     return _bench(design, name, vectors or f"{name}.hex", clocked=False)
 
 
 def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive bench of the pipelined entity: one code per cycle, the output
-    after edge ``i`` checked against code ``i - LATENCY + 1``."""
+    after edge ``i`` checked against code ``i - LATENCY + 1``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> [line.strip() for line in vhdl_pipelined_testbench(d).splitlines() if "LATENCY" in line][:1]
+    ['constant LATENCY  : natural := 1;']
+    """
     name = pipelined_name(design)
     return _bench(design, name, vectors or f"{name}.hex", clocked=True)
 
