@@ -44,7 +44,13 @@ EXHAUSTIVE_BITS = 16
 
 @dataclass(frozen=True)
 class Port:
-    """One port: ``bits`` wide, two's complement when ``signed``."""
+    """One port: ``bits`` wide, two's complement when ``signed``.
+
+    Examples
+    --------
+    >>> Port("n_x", 8), Port("skip", 1, signed=False, output=True).output
+    (Port(name='n_x', bits=8, signed=True, output=False), True)
+    """
 
     name: str
     bits: int
@@ -54,14 +60,31 @@ class Port:
 
 def vec_ports(name: str, bits: int, output: bool = False,
               signed: bool = True) -> tuple[Port, ...]:
-    """The three ports ``<name>_x``, ``<name>_y``, ``<name>_z``."""
+    """The three ports ``<name>_x``, ``<name>_y``, ``<name>_z``.
+
+    Examples
+    --------
+    >>> [(p.name, p.bits, p.output) for p in vec_ports("m", 9, output=True)]
+    [('m_x', 9, True), ('m_y', 9, True), ('m_z', 9, True)]
+    """
     return tuple(Port(f"{name}_{c}", bits, signed, output) for c in "xyz")
 
 
 @dataclass(frozen=True)
 class UnitDesign:
     """A sized normalization unit (see :mod:`chebnorm.hw.units`); ``evaluate``
-    is the bit-accurate model, :func:`~chebnorm.hw.units.unit_verilog` its circuit."""
+    is the bit-accurate model, :func:`~chebnorm.hw.units.unit_verilog` its circuit.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("classic", frac_bits=6)
+    >>> u.module_name, [p.name for p in u.inputs], u.comp_bits
+    ('chebnorm_classic_unit', ['n_x', 'n_y', 'n_z'], 8)
+    >>> out = u.evaluate({"n_x": [3 << 4], "n_y": [4 << 4], "n_z": [0]})   # (0.75, 1, 0): length 1.25
+    >>> int(out["u_x"][0]), int(out["u_y"][0]), int(0.6 * 64), int(0.8 * 64)   # floor quotients
+    (38, 51, 38, 51)
+    """
 
     kind: str
     ports: tuple[Port, ...]
@@ -121,7 +144,14 @@ def put(out: dict, name: str, arr: np.ndarray) -> None:
 class UnitKind(ABC):
     """One kind of normalization unit; subclasses fill in the methods and are
     registered once with :func:`register`. The methods take valid designs
-    (made by their own :meth:`design`) and do not check them again."""
+    (made by their own :meth:`design`) and do not check them again.
+
+    Examples
+    --------
+    >>> k = get_unit("dichotomy")
+    >>> isinstance(k, UnitKind), k.clocked, k.table_spec
+    (True, False, TableSpec(target='dichotomy', degree=2, psi_max='pi/4'))
+    """
 
     #: registry name, also the ``<kind>`` of the module ``chebnorm_<kind>_unit``
     name: str = ""
@@ -172,7 +202,15 @@ UNITS = MappingProxyType(_UNITS)
 
 
 def register(kind: UnitKind) -> UnitKind:
-    """Add ``kind`` to the registry under ``kind.name`` (a new identifier)."""
+    """Add ``kind`` to the registry under ``kind.name`` (a new identifier).
+
+    Examples
+    --------
+    >>> register(get_unit("classic"))
+    Traceback (most recent call last):
+    ...
+    ValueError: unit 'classic' is already registered
+    """
     name = identifier(kind.name, field="unit name")
     if name in _UNITS:
         raise ValueError(f"unit {name!r} is already registered")
@@ -181,12 +219,28 @@ def register(kind: UnitKind) -> UnitKind:
 
 
 def unit_names() -> tuple[str, ...]:
-    """The registered unit names, in registration order."""
+    """The registered unit names, in registration order.
+
+    Examples
+    --------
+    >>> unit_names()
+    ('dichotomy', 'classic', 'quadratic', 'stepper', 'eta')
+    """
     return tuple(_UNITS)
 
 
 def get_unit(name: str) -> UnitKind:
-    """The registered unit ``name``; ValueError naming the accepted names."""
+    """The registered unit ``name``; ValueError naming the accepted names.
+
+    Examples
+    --------
+    >>> get_unit("eta").target
+    'eta_term'
+    >>> get_unit("nope")
+    Traceback (most recent call last):
+    ...
+    ValueError: unit 'nope' is unknown; accepted: dichotomy, classic, quadratic, stepper, eta
+    """
     try:
         return _UNITS[name]
     except (KeyError, TypeError):

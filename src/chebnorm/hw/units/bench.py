@@ -13,13 +13,29 @@ __all__ = ["unit_vectors", "combinational_rows", "unit_vector_file", "unit_testb
 
 
 def unit_normals(rng, n: int) -> np.ndarray:
-    """``n`` random unit vectors ``(n, 3)``."""
+    """``n`` random unit vectors ``(n, 3)``.
+
+    Examples
+    --------
+    >>> v = unit_normals(np.random.default_rng(0), 4)
+    >>> v.shape, bool(np.allclose(np.linalg.norm(v, axis=1), 1))
+    ((4, 3), True)
+    """
     v = rng.normal(size=(n, 3))
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
 def near(rng, a: np.ndarray, psi: float) -> np.ndarray:
-    """Unit vectors at angles in [0, psi] from the rows of ``a``."""
+    """Unit vectors at angles in [0, psi] from the rows of ``a``.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> a = unit_normals(rng, 100)
+    >>> b = near(rng, a, 0.5)
+    >>> bool(np.all(np.arccos(np.clip(np.sum(a * b, axis=1), -1, 1)) <= 0.5 + 1e-12))
+    True
+    """
     t = rng.normal(size=a.shape)
     t -= np.sum(t * a, axis=1, keepdims=True) * a
     t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
@@ -29,7 +45,13 @@ def near(rng, a: np.ndarray, psi: float) -> np.ndarray:
 
 
 def codes(v: np.ndarray, f: int, w: int) -> np.ndarray:
-    """``w``-bit codes with ``f`` fractional bits of the values ``v`` (nearest, saturated)."""
+    """``w``-bit codes with ``f`` fractional bits of the values ``v`` (nearest, saturated).
+
+    Examples
+    --------
+    >>> codes(np.array([0.5, -1.0, 3.0]), 4, 6).tolist()   # 3.0 saturates to 31/16
+    [8, -16, 31]
+    """
     return np.clip(np.rint(v * 2.0 ** f), -(1 << (w - 1)), (1 << (w - 1)) - 1).astype(np.int64)
 
 
@@ -40,7 +62,13 @@ def _rand(rng, n: int, port: Port) -> np.ndarray:
 
 
 def edges(port: Port) -> list[int]:
-    """The extreme codes of ``port``: min, -1, 0, 1, max (those it has)."""
+    """The extreme codes of ``port``: min, -1, 0, 1, max (those it has).
+
+    Examples
+    --------
+    >>> edges(Port("n_x", 5)), edges(Port("thr", 4, signed=False))
+    ([-16, -1, 0, 1, 15], [0, 1, 15])
+    """
     if port.signed:
         b = port.bits
         return sorted({-(1 << (b - 1)), -1, 0, 1, (1 << (b - 1)) - 1})
@@ -53,14 +81,32 @@ def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
     input takes each of its extreme codes -- min, -1, 0, 1, max -- while the
     others cycle through theirs), ``count`` realistic rows
     (quantized unit normals at angles inside the table's interval, and
-    their ``z``/threshold) and ``count`` rows of uniformly random codes."""
+    their ``z``/threshold) and ``count`` rows of uniformly random codes.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> rows = unit_vectors(design_unit("classic", frac_bits=3, comp_bits=5))
+    >>> sorted(rows), len(rows["n_x"]) == 2 ** 15   # 15 input bits: every code
+    (['n_x', 'n_y', 'n_z'], True)
+    """
     count = check_width(count, "vectors", 1, 10 ** 6)
     return unit.spec.vector_rows(unit, np.random.default_rng(seed), count)
 
 
 def combinational_rows(unit: UnitDesign, rng, count: int, realistic) -> dict:
     """The rows of :func:`unit_vectors` of a combinational unit;
-    ``realistic(rng, a)`` makes its realistic rows from the unit normals ``a``."""
+    ``realistic(rng, a)`` makes its realistic rows from the unit normals ``a``.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("classic", frac_bits=6)
+    >>> rows = combinational_rows(u, np.random.default_rng(0), 10, lambda rng, a: {
+    ...     f"n_{c}": codes(a[:, i], 6, 8) for i, c in enumerate("xyz")})
+    >>> len(rows["n_x"])   # 40 edge rows, 10 realistic, 10 random
+    60
+    """
     ins = unit.inputs
     if sum(p.bits for p in ins) <= EXHAUSTIVE_BITS:
         grids = np.meshgrid(*[np.arange(edges(p)[0], edges(p)[-1] + 1) for p in ins],
@@ -93,7 +139,15 @@ def _layout(unit: UnitDesign) -> tuple[list[tuple[Port, int, int]], int]:
 
 
 def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
-    """Rows ``{inputs, expected outputs}`` in hex (``$readmemh``)."""
+    """Rows ``{inputs, expected outputs}`` in hex (``$readmemh``).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("classic", frac_bits=3, comp_bits=5)
+    >>> unit_vector_file(u, {"n_x": [6], "n_y": [8], "n_z": [0]})   # n = (6, 8, 0) -> u = (4, 6, 0)
+    '0c8010c0\\n'
+    """
     outs = unit.evaluate(inputs)
     layout, total = _layout(unit)
     vals = {**inputs, **outs}
@@ -122,7 +176,15 @@ def _declarations(unit: UnitDesign, layout) -> list[str]:
 
 
 def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> str:
-    """A self-checking test bench of ``count`` rows read from ``vectors``."""
+    """A self-checking test bench of ``count`` rows read from ``vectors``.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> tb = unit_testbench(design_unit("classic", frac_bits=6), 100)
+    >>> tb.splitlines()[0][:40], "localparam COUNT = 100;" in tb
+    ('// tb_chebnorm_classic_unit: self-checki', True)
+    """
     name = unit.module_name
     vectors = vectors or f"{name}.hex"
     layout, total = _layout(unit)

@@ -20,7 +20,17 @@ ROUNDINGS = ("trunc", "rne")
 
 
 class ClassicUnit(UnitKind):
-    """The classic unit (see module docstring)."""
+    """The classic unit (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("classic", frac_bits=12)
+    >>> n = np.array([3 << 10, 4 << 10, 0])   # (0.75, 1, 0): length 1.25
+    >>> out = u.evaluate({"n_x": n[:1], "n_y": n[1:2], "n_z": n[2:]})
+    >>> [int(out[f"u_{c}"][0]) for c in "xy"], [int(0.6 * 4096), int(0.8 * 4096)]
+    ([2457, 3276], [2457, 3276])
+    """
 
     name = "classic"
 

@@ -51,13 +51,26 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
 
 def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = None) -> str:
     """The synthesizable Verilog-2005 text of ``unit``: the unit module, then
-    its helper modules (square root, divider, polynomial evaluator)."""
+    its helper modules (square root, divider, polynomial evaluator).
+
+    Examples
+    --------
+    >>> v = unit_verilog(design_unit("classic", frac_bits=6))
+    >>> [line.split()[1] for line in v.splitlines() if line.startswith("module")]
+    ['chebnorm_classic_unit', 'chebnorm_classic_unit_comp', 'chebnorm_classic_unit_isqrt', 'chebnorm_classic_unit_div']
+    """
     return unit.spec.verilog(unit, version=version, command=command)
 
 
 def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version: str = "",
                  command: str | None = None) -> dict[str, str]:
-    """File name -> text: the unit's Verilog, its test bench and its vectors."""
+    """File name -> text: the unit's Verilog, its test bench and its vectors.
+
+    Examples
+    --------
+    >>> sorted(unit_outputs(design_unit("classic", frac_bits=3, comp_bits=5)))
+    ['chebnorm_classic_unit.hex', 'chebnorm_classic_unit.v', 'tb_chebnorm_classic_unit.v']
+    """
     rows = unit_vectors(unit, count, seed)
     n = len(next(iter(rows.values())))
     name = unit.module_name
@@ -68,7 +81,14 @@ def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version:
 
 @dataclass(frozen=True)
 class UnitReport:
-    """A unit with its cost model and (when yosys ran) its cell count."""
+    """A unit with its cost model and (when yosys ran) its cell count.
+
+    Examples
+    --------
+    >>> r = analyze_unit(design_unit("classic", frac_bits=6), synth=False)
+    >>> r.as_dict()["module"], r.synth is None, r.lines()[0]
+    ('chebnorm_classic_unit', True, 'chebnorm_classic_unit: W = 8, F = 6: area ~845 FA (model), yosys not run')
+    """
 
     unit: UnitDesign
     block: Block
@@ -94,7 +114,14 @@ class UnitReport:
 
 
 def analyze_unit(unit: UnitDesign, *, synth: bool = True) -> UnitReport:
-    """The unit's cost model and, with yosys installed and ``synth``, its cell count."""
+    """The unit's cost model and, with yosys installed and ``synth``, its cell count.
+
+    Examples
+    --------
+    >>> r = analyze_unit(design_unit("stepper", frac_bits=6, log_m=2), synth=False)
+    >>> len(r.block.cost.adders), len(r.block.cost.multipliers)
+    (6, 0)
+    """
     syn = None
     if synth and shutil.which("yosys") is not None:
         syn = synthesize_text(unit_verilog(unit), unit.module_name)

@@ -21,7 +21,23 @@ __all__ = ["DichotomyUnit"]
 
 
 class DichotomyUnit(EvaluatorUnit):
-    """The dichotomy midpoint and next level (see module docstring)."""
+    """The dichotomy midpoint and next level (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("dichotomy", frac_bits=12, in_bits=12, out_bits=12)
+    >>> d = u.horner
+    >>> c = np.cos(np.pi / 4)
+    >>> n2 = np.rint(4096 * np.array([c, c, 0])).astype(int)
+    >>> k = int(np.rint((2 * c - float(d.x_format.offset)) * 2 ** d.x_format.frac_bits))
+    >>> g = {"n1_x": [4096], "n1_y": [0], "n1_z": [0], "z": [k],
+    ...      "n2_x": [n2[0]], "n2_y": [n2[1]], "n2_z": [0]}
+    >>> out = u.evaluate(g)   # the normal half-way, at 22.5 degrees
+    >>> exact = np.rint(4096 * np.array([np.cos(np.pi / 8), np.sin(np.pi / 8)])).astype(int)
+    >>> [int(out["m_x"][0]), int(out["m_y"][0])], exact.tolist()
+    ([3784, 1567], [3784, 1567])
+    """
 
     name = "dichotomy"
     pair = ("n1", "n2")

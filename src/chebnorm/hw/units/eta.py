@@ -21,7 +21,17 @@ __all__ = ["EtaUnit"]
 
 
 class EtaUnit(EvaluatorUnit):
-    """The normalization criterion (see module docstring)."""
+    """The normalization criterion (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("eta", frac_bits=8, in_bits=10, out_bits=10)
+    >>> n = {f"n{v}_{c}": [256 if c == "x" else 0] for v in "abc" for c in "xyz"}
+    >>> out = u.evaluate({**n, "thr": [4]})   # three equal normals: eta ~ 0 < thr (codes), skip
+    >>> int(out["skip"][0])
+    1
+    """
 
     name = "eta"
     pair = ("na", "nb")

@@ -26,7 +26,16 @@ __all__ = ["EvaluatorUnit", "table_matches", "dot_range", "scaled_range", "dot_c
 
 def table_matches(kind: str, table: CoefficientTable) -> bool:
     """True when ``table`` approximates the function of unit ``kind``'s target
-    (:data:`~chebnorm.hw.units.UNIT_TARGETS`), whatever its variable is called."""
+    (:data:`~chebnorm.hw.units.UNIT_TARGETS`), whatever its variable is called.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> table_matches("dichotomy", fit("1/sqrt(2 + t)", ("sqrt(2)", "2"), 1, var="t"))
+    True
+    >>> table_matches("dichotomy", fit("1/sqrt(x)", ("1", "2"), 1))
+    False
+    """
     import sympy as sp
 
     from chebnorm.approx import get_target, parse_function
@@ -71,7 +80,15 @@ def _rne_range(lo: int, hi: int, shift: int) -> tuple[int, int]:
 
 
 def scaled_range(w: int, d: HornerDesign) -> tuple[int, int, int]:
-    """Range of ``R((N1 + N2) (y + KY))`` over every code, and the width of ``y + KY``."""
+    """Range of ``R((N1 + N2) (y + KY))`` over every code, and the width of ``y + KY``.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("dichotomy", frac_bits=6, in_bits=8, out_bits=8)
+    >>> scaled_range(u.comp_bits, u.horner)[2] == u.sizes["yv_bits"]
+    True
+    """
     ky, ymax, fy = d.y_format.offset_code, d.y_format.max_code, d.y_format.frac_bits
     yv = (ky, ky + ymax)
     s = (-(1 << w), (1 << w) - 2)
@@ -82,7 +99,13 @@ def scaled_range(w: int, d: HornerDesign) -> tuple[int, int, int]:
 
 
 def dot_range(w: int) -> tuple[int, int]:
-    """Range of the dot product of two 3-vectors of ``w``-bit codes."""
+    """Range of the dot product of two 3-vectors of ``w``-bit codes.
+
+    Examples
+    --------
+    >>> dot_range(4)   # codes -8..7: 3 * (-8) * 7 .. 3 * (-8) * (-8)
+    (-168, 192)
+    """
     a, b = -(1 << (w - 1)), (1 << (w - 1)) - 1
     return 3 * a * b, 3 * a * a
 
@@ -94,7 +117,15 @@ def check_dot(w: int, f: int, d: HornerDesign) -> None:
 
 
 def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
-    """Lines: the exact dot product of vectors ``a``, ``b`` and its input code ``k_tag``."""
+    """Lines: the exact dot product of vectors ``a``, ``b`` and its input code ``k_tag``.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("eta", frac_bits=6, in_bits=8, out_bits=8)
+    >>> dot_code(u, "na", "nb", "ab")[0]
+    '    wire signed [16:0] dot_ab = na_x * nb_x + na_y * nb_y + na_z * nb_z;'
+    """
     d, f, w = unit.horner, unit.frac_bits, unit.comp_bits
     fx, k0, kmax = d.x_format.frac_bits, d.x_format.offset_code, 2 ** d.in_bits - 1
     dlo, dhi = dot_range(w)
@@ -118,7 +149,15 @@ def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
 
 
 def scale_lines(unit: UnitDesign, a: str, b: str, out: str, ycode: str) -> list[str]:
-    """Lines: ``out_c = R((a_c + b_c) * (ycode + KY))`` for c in x, y, z."""
+    """Lines: ``out_c = R((a_c + b_c) * (ycode + KY))`` for c in x, y, z.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("dichotomy", frac_bits=6, in_bits=8, out_bits=8)
+    >>> scale_lines(u, "n1", "n2", "m", "y")[-1]
+    '    assign m_z = m_z_r;'
+    """
     d, w = unit.horner, unit.comp_bits
     yw, mw, fy = unit.sizes["yv_bits"], unit.sizes["m_bits"], d.y_format.frac_bits
     lines = [f"    wire signed [{yw - 1}:0] yv = $signed({{1'b0, {ycode}}}) + KY;"]
@@ -149,7 +188,15 @@ class EvaluatorUnit(UnitKind):
     """A unit built around the evaluator of its table (:attr:`table_spec`, which
     the method registry declares);
     subclasses size it (:meth:`size`), add their realistic rows
-    (:meth:`realistic_extra`) and write the unit module (:meth:`module_lines`)."""
+    (:meth:`realistic_extra`) and write the unit module (:meth:`module_lines`).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import get_unit
+    >>> sorted(k for k in ("dichotomy", "classic", "quadratic", "stepper", "eta")
+    ...        if isinstance(get_unit(k), EvaluatorUnit))
+    ['dichotomy', 'eta', 'quadratic']
+    """
 
     #: the two vector inputs of the realistic rows: unit normals at angles <= psi
     pair: tuple[str, str] = ("", "")

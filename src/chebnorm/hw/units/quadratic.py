@@ -19,7 +19,17 @@ __all__ = ["QuadraticUnit"]
 
 
 class QuadraticUnit(EvaluatorUnit):
-    """The quadratic-interpolation set-up (see module docstring)."""
+    """The quadratic-interpolation set-up (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("quadratic", frac_bits=10, in_bits=10, out_bits=10)
+    >>> g = {"nl_x": [1024], "nl_y": [0], "nl_z": [0], "nr_x": [0], "nr_y": [1024], "nr_z": [0]}
+    >>> out = u.evaluate(g)
+    >>> [int(out[f"g_{c}"][0] + out[f"p_{c}"][0] + out[f"q_{c}"][0]) for c in "xyz"]   # = N_r
+    [0, 1024, 0]
+    """
 
     name = "quadratic"
     pair = ("nl", "nr")

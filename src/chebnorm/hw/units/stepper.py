@@ -20,7 +20,18 @@ __all__ = ["StepperUnit"]
 
 
 class StepperUnit(UnitKind):
-    """The forward-difference stepper (see module docstring)."""
+    """The forward-difference stepper (see module docstring).
+
+    Examples
+    --------
+    >>> from chebnorm.hw.units import design_unit
+    >>> u = design_unit("stepper", frac_bits=6, log_m=2)
+    >>> z = [0] * 5
+    >>> rows = {"load": [1, 0, 0, 0, 0], "g_x": [64] * 5, "g_y": z, "g_z": z, "p_x": z, "p_y": z,
+    ...         "p_z": z, "q_x": z, "q_y": z, "q_z": z}
+    >>> (u.evaluate(rows)["v_x"] / 2 ** (6 + u.guard)).tolist()   # G t^2 at t = 0, 1/4, ..., 1
+    [0.0, 0.0625, 0.25, 0.5625, 1.0]
+    """
 
     name = "stepper"
     clocked = True
