@@ -111,7 +111,16 @@ def _pixel_errors(n, nl, nr, psi, t):
 
 @dataclass(frozen=True)
 class MethodReport:
-    """Errors and operation counts of one method on one span (see the module docstring)."""
+    """Errors and operation counts of one method on one span (see the module docstring).
+
+    Examples
+    --------
+    >>> r = analyze("none", 0.2, 8)   # linear interpolation, not normalized
+    >>> round(r.max_length_error, 7), round(1 - math.cos(0.1), 7)   # shortest at the middle
+    (0.0049958, 0.0049958)
+    >>> r.specular_error(1) == r.diffuse_error, r.ops.per_pixel["mul"]
+    (True, 3)
+    """
 
     method: str
     psi: float
@@ -179,7 +188,16 @@ def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
 
 @dataclass(frozen=True)
 class ErrorSweep:
-    """Errors over a grid: arrays indexed ``[method, dtype, psi, m]`` (specular: ``[..., n-1]``)."""
+    """Errors over a grid: arrays indexed ``[method, dtype, psi, m]`` (specular: ``[..., n-1]``).
+
+    Examples
+    --------
+    >>> s = error_sweep(("none", "exact"), [0.2, 0.4], (8,), (np.float64,))
+    >>> s.length_error.shape
+    (2, 1, 2, 1)
+    >>> float(s.get("length_error", "exact", m=8).max()) < 1e-15
+    True
+    """
 
     methods: tuple[str, ...]
     dtypes: tuple[str, ...]
@@ -327,7 +345,14 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
 
 @dataclass(frozen=True)
 class DriftReport:
-    """Per-pixel errors of the ``angular`` recurrence against its ideal, slerp (float64)."""
+    """Per-pixel errors of the ``angular`` recurrence against its ideal, slerp (float64).
+
+    Examples
+    --------
+    >>> d = angular_drift(math.pi / 4, 64, np.float64)
+    >>> d.t.shape, d.final_angle_error <= d.max_angle_error < 1e-12
+    ((65,), True)
+    """
 
     psi: float
     m: int

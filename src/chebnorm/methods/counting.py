@@ -70,7 +70,14 @@ def _clean(v):
 
 @dataclass(frozen=True)
 class OpCounts:
-    """Counts of one method on one span (see the module docstring)."""
+    """Counts of one method on one span (see the module docstring).
+
+    Examples
+    --------
+    >>> c = count_ops("none", 8)   # N_l + t (N_r - N_l): 3 mul, 3 add per pixel
+    >>> c.per_pixel["mul"], c.per_pixel["add"], c.per_span["add"]
+    (3, 3, 3)
+    """
 
     method: str
     m: int
@@ -93,7 +100,14 @@ class OpCounts:
 class NormalizationCounts:
     """Counts of a normalization step alone (claim C9): ``ops`` maps each
     operation kind to its count, ``pow2`` counts the multiplications by a
-    power of two among them (see :func:`normalization_ops`)."""
+    power of two among them (see :func:`normalization_ops`).
+
+    Examples
+    --------
+    >>> c = normalization_ops("lyon")
+    >>> c.method, c.ops["sqrt"], c.ops["div"]
+    ('lyon', 0, 0)
+    """
 
     method: str
     ops: dict

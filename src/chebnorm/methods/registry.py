@@ -58,18 +58,39 @@ def _kernel_of(spec: MethodSpec):
 
 
 def method_kernel(method: str | MethodSpec):
-    """The span kernel object of ``method`` (a name or a registry entry)."""
+    """The span kernel object of ``method`` (a name or a registry entry).
+
+    Examples
+    --------
+    >>> k = method_kernel("dichotomy")
+    >>> k.shape, k.table_scale
+    ('tree', 2.0)
+    >>> method_kernel("quadratic").shape
+    'steps'
+    """
     spec = method if isinstance(method, MethodSpec) else get_method(method)
     return _kernel_of(spec)
 
 
 def method_kernels() -> dict:
-    """Every registered method's span kernel: ``{name: kernel}``."""
+    """Every registered method's span kernel: ``{name: kernel}``.
+
+    Examples
+    --------
+    >>> sorted({k.shape for k in method_kernels().values()})
+    ['direct', 'steps', 'tree']
+    """
     return {s.name: _kernel_of(s) for s in registered_methods()}
 
 
 def table_methods() -> dict[str, TableSpec]:
-    """The methods that read a coefficient table, and the table each reads."""
+    """The methods that read a coefficient table, and the table each reads.
+
+    Examples
+    --------
+    >>> {m: t.target for m, t in table_methods().items()}
+    {'dichotomy': 'dichotomy', 'quadratic': 'midpoint'}
+    """
     return {s.name: s.table for s in registered_methods() if s.table is not None}
 
 

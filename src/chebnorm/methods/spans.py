@@ -35,7 +35,16 @@ _COVER_SLACK = 1e-9
 @dataclass(frozen=True)
 class SpanNormals:
     """Pixel normals of S spans: span i's pixels are ``normals[offsets[i]:offsets[i+1]]``,
-    at positions ``t[offsets[i]:offsets[i+1]]`` (0 at ``N_l``, 1 at ``N_r``)."""
+    at positions ``t[offsets[i]:offsets[i+1]]`` (0 at ``N_l``, 1 at ``N_r``).
+
+    Examples
+    --------
+    >>> r = span_normals("exact", [[1.0, 0, 0]], [[0.0, 1, 0]], [4])
+    >>> r.offsets.tolist(), r.t.tolist()
+    ([0, 5], [0.0, 0.25, 0.5, 0.75, 1.0])
+    >>> np.round(r.span(0)[2], 6).tolist()   # t = 1/2: the normal at 45 degrees
+    [0.707107, 0.707107, 0.0]
+    """
 
     normals: np.ndarray   # (P, 3), dtype of the computation
     offsets: np.ndarray   # (S + 1,) int64
@@ -283,7 +292,14 @@ class SpanInput:
     """The checked input of :func:`span_normals` (what a compiled twin of it starts from):
     the registry entry ``spec``, its ``kernel``, ``dtype``, the (S, 3) float64 end normals,
     their ``cosines``, per-span ``m``, ``dt``, ``t0``, ``count``, the dichotomy depth
-    ``levels`` (None for the other kernels) and the table's ``coefficients`` (None: exact)."""
+    ``levels`` (None for the other kernels) and the table's ``coefficients`` (None: exact).
+
+    Examples
+    --------
+    >>> inp = check_span_input("quadratic", [[1.0, 0, 0]], [[0.8, 0.6, 0]], [4])
+    >>> inp.kernel.shape, inp.cosines.tolist(), inp.levels, len(inp.coefficients)
+    ('steps', [0.8], None, 3)
+    """
 
     spec: MethodSpec
     kernel: object
