@@ -19,10 +19,13 @@ rounding error). Coefficient ``j`` of segment ``s`` is exactly
 ``integers[s][j] / 2**coef_frac_bits``.
 
 Every segment's error ``sup |p_s - f|`` (and ``sup |p_s/f - 1|`` for
-``error="rel"``) is certified by :func:`chebnorm.approx.certify` for exactly
-the stored integers, on the composed function ``t -> f(a_s + (b_s - a_s) t)``
-(the endpoints are exact rationals, enclosed in Arb balls); the table's bound
-is the maximum over the segments. Reading a table (:meth:`PiecewiseTable.load`,
+``error="rel"``) is certified for exactly the stored integers, on the composed
+function ``t -> f(a_s + (b_s - a_s) t)`` (the endpoints are exact rationals,
+enclosed in Arb balls), all segments together by
+:func:`chebnorm.approx.certify_batch.certify_batch` (one Taylor model per
+segment in Arb, a vectorised branch and bound in float64 with every rounding
+error accounted for; :func:`chebnorm.approx.certify` for a segment it cannot
+settle); the table's bound is the maximum over the segments. Reading a table (:meth:`PiecewiseTable.load`,
 ``from_dict``) checks every field (a refusal names it) and re-certifies every
 stated bound, as :class:`chebnorm.approx.CoefficientTable` does.
 
@@ -44,7 +47,10 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from .certify import arb_enclose, certify
+from flint import arb, ctx
+
+from .certify import arb_enclose
+from .certify_batch import SegmentError, certify_batch
 from .expr import Function1D, parse_function, parse_number
 from .fitting import cheb_to_monomial, remez
 
@@ -248,24 +254,22 @@ class PiecewiseTable:
         ...
         ValueError: segments[0].abs_error_bound: stated 1.00e-09 but the certified error of segment 0 is 2.42e-02
         """
-        fn = parse_function(self.expression, self.variable)
-        loc = self.local_range
-        for s, seg in enumerate(self.segments):
-            g = _local_function(fn, *self.segment_bounds(s), centered=self.centered)
-            coeffs = self.coefficients(s)
-            for kind, bound, maximum in (("abs", seg.abs_error_bound, seg.max_abs_error),
-                                         ("rel", seg.rel_error_bound, seg.max_rel_error)):
-                if bound is None:
-                    continue
-                cert = None
-                for tol in (None, 2.0 ** -14):
-                    cert = certify(g, coeffs, sp.Rational(loc[0]), sp.Rational(loc[1]), kind,
-                                   **({} if tol is None else {"tol": tol}))
-                    if bound >= cert.bound:
-                        break
-                if bound < cert.bound:
+        for kind in ("abs", "rel"):
+            stated = [getattr(seg, f"{kind}_error_bound") for seg in self.segments]
+            todo = [s for s, b in enumerate(stated) if b is not None]
+            if not todo:
+                continue
+            certs = dict(zip(todo, certify_segments(self, kind, segments=todo)))
+            # a bound certified more tightly than the default may need a tighter proof
+            redo = [s for s in todo if stated[s] < certs[s].bound]
+            if redo:
+                certs.update(zip(redo, certify_segments(self, kind, 2.0 ** -14, segments=redo)))
+            for s in todo:
+                bound, maximum = stated[s], getattr(self.segments[s], f"max_{kind}_error")
+                if bound < certs[s].bound:
                     raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
-                                     f"the certified error of segment {s} is {cert.bound:.2e}")
+                                     f"the certified error of segment {s} is "
+                                     f"{certs[s].bound:.2e}")
                 if maximum > bound:
                     raise ValueError(f"segments[{s}].max_{kind}_error: {maximum!r} exceeds the "
                                      f"segment's bound {bound!r}")
@@ -322,33 +326,17 @@ def _segment_count(segment_by, lo, hi, index_bits) -> int:
 
 
 class _LocalFunction:
-    """``t -> f(a + (b - a) t)`` (``t + 1/2`` when centred) for the certifier:
-    the Arb evaluators compose ``f``'s with the exact affine map (endpoints as
-    balls), the numpy one composes in float64 (fitting only)."""
+    """``t -> f(a + (b - a) t)`` (``t + 1/2`` when centred) in float64, for
+    fitting and quantizing (certification composes in Arb, see
+    :func:`_segment_balls`)."""
 
     def __init__(self, fn: Function1D, a, b, centered: bool):
         self.fn = fn
-        self.var = sp.Symbol("t", real=True)
         self.expr = fn.expr
-        a, b = (v if isinstance(v, sp.Basic) else sp.Rational(v) for v in (a, b))
-        self._a, self._w = arb_enclose(a), arb_enclose(b - a)
-        self._shift = 0.5 if centered else 0.0
-        self._af, self._wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
-        f_series, f_point, f_np = fn.arb_series, fn.arb, fn.numpy
-        a_b, w_b, sh = self._a, self._w, self._shift
-
-        def series(s):
-            return f_series(a_b + w_b * (s + sh))
-
-        def point(x):
-            return f_point(a_b + w_b * (x + sh))
-
-        def numpy_(t):
-            return f_np(self._af + self._wf * (np.asarray(t, dtype=float) + sh))
-
-        self.arb_series = series
-        self.arb = point
-        self.numpy = numpy_
+        sh = 0.5 if centered else 0.0
+        af, wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
+        f_np = fn.numpy
+        self.numpy = lambda t: f_np(af + wf * (np.asarray(t, dtype=float) + sh))
 
     def __str__(self) -> str:
         return f"{self.fn.expr} on a segment"
@@ -382,21 +370,53 @@ def parse_segments(text) -> int:
     return k
 
 
-def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None = None):
+def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None = None,
+                     segments=None):
     """A :class:`~chebnorm.approx.Certificate` of ``sup |p_s - f|`` (or ``p_s/f - 1``)
-    for every segment of ``table``, at relative tightness ``tol`` (default the
-    certifier's).
+    for every segment of ``table`` (or the indices ``segments``), at relative
+    tightness ``tol`` (default the certifier's), all segments in one batch
+    (:func:`chebnorm.approx.certify_batch.certify_batch`).
 
     >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
     >>> [c.bound <= s.abs_error_bound for c, s in zip(certify_segments(t), t.segments)]
     [True, True]
     """
     fn = parse_function(table.expression, table.variable)
-    lo, hi = (sp.Rational(v) for v in table.local_range)
+    idx = list(range(table.segment_count)) if segments is None else [int(s) for s in segments]
+    origins, widths = _segment_balls(table.segment_by, table.lo, table.hi, table.index_bits,
+                                     table.centered, idx)
     opts = {} if tol is None else {"tol": tol}
-    return [certify(_local_function(fn, *table.segment_bounds(s), centered=table.centered),
-                    table.coefficients(s), lo, hi, kind, **opts)
-            for s in range(table.segment_count)]
+    return certify_batch(fn, origins, widths, [table.coefficients(s) for s in idx],
+                         tuple(float(v) for v in table.local_range), kind, **opts)
+
+
+def _segment_balls(segment_by, lo, hi, index_bits, centered, segments):
+    """Arb balls ``(o_s, w_s)`` with segment ``s`` = ``o_s + w_s t``, ``t`` in
+    the local range (128 bits; exact for binary ends), without sympy per segment."""
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        origins, widths = [], []
+        if segment_by == "uniform":
+            n = 2 ** index_bits
+            lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
+            w = (hi_b - lo_b) / n
+            for s in segments:
+                origins.append(lo_b + (hi_b - lo_b) * s / n)
+                widths.append(w)
+        else:
+            per = 2 ** index_bits
+            e0 = _exact_log2(lo)
+            for s in segments:
+                e, j = divmod(s, per)
+                base = arb(2) ** (e0 + e)
+                origins.append(base * (per + j) / per)
+                widths.append(base / per)
+        if centered:
+            origins = [o + w / 2 for o, w in zip(origins, widths)]
+        return origins, widths
+    finally:
+        ctx.prec = old
 
 
 def is_piecewise_file(path) -> bool:
@@ -504,7 +524,8 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
     count for ``segment_by="uniform"``, the count per binade for
     ``"exponent"`` (then ``interval`` must be ``[2**e0, 2**e1]``).
     ``coef_frac_bits``: the common fixed-point format of all coefficients.
-    ``progress``: optional callable run once per certified segment.
+    ``progress``: optional callable run once per fitted segment (the
+    certification of all segments together follows).
 
     >>> t = fit_piecewise("1/sqrt(x)", ("1/4", "4"), 2, segments=2, segment_by="exponent",
     ...                   coef_frac_bits=20, error="rel")
@@ -535,7 +556,7 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
     count = _segment_count(segment_by, lo, hi, index_bits)
     loc = (-0.5, 0.5) if centered else (0.0, 1.0)
     limit = 2 ** MAX_COEF_INT_BITS
-    out, bad_seg = [], None
+    ints_all, bad_seg = [], None
     for s in range(count):
         a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
         g = _local_function(fn, a, b, centered=centered)
@@ -545,7 +566,7 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
             except (ZeroDivisionError, OverflowError, TypeError):
                 probe = np.array([np.nan])
         if not np.all(np.isfinite(probe)) or (error == "rel" and np.any(probe == 0)):
-            bad_seg = (s, a, b)
+            bad_seg = s
             break
         with np.errstate(all="ignore"):
             coeffs = _fit_segment(g, degree, *loc, fit, error)
@@ -556,22 +577,30 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
                              f"coefficient integers (segment {s}: |c| = {big:.6g}); accepted: "
                              f"coef-frac-bits <= {max_f}")
         with np.errstate(all="ignore"):
-            ints = _quantize_segment(g, coeffs, frac_bits, *loc, error)
-        q = [math.ldexp(i, -frac_bits) for i in ints]
-        try:
-            ca = certify(g, q, sp.Rational(loc[0]), sp.Rational(loc[1]), "abs")
-            cr = certify(g, q, sp.Rational(loc[0]), sp.Rational(loc[1]), "rel") \
-                if error == "rel" else None
-        except ValueError:
-            bad_seg = (s, a, b)
-            break
-        out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
-                                    None if cr is None else cr.bound,
-                                    None if cr is None else cr.maximum))
+            ints_all.append(_quantize_segment(g, coeffs, frac_bits, *loc, error))
         if progress is not None:
             progress()
+    # certify the segments fitted so far, all at once; the first that fails
+    # (or the first the probe refused) is reported
+    certs = {}
+    origins, widths = _segment_balls(segment_by, lo, hi, index_bits, centered,
+                                     range(len(ints_all)))
+    qs = [[math.ldexp(i, -frac_bits) for i in ints] for ints in ints_all]
+    for kind in ("abs", "rel") if error == "rel" else ("abs",):
+        try:
+            certs[kind] = certify_batch(fn, origins, widths, qs, loc, kind)
+        except SegmentError as exc:
+            bad_seg = exc.segment if bad_seg is None else min(bad_seg, exc.segment)
+    out = []
+    if bad_seg is None:
+        for s, ints in enumerate(ints_all):
+            ca, cr = certs["abs"][s], certs["rel"][s] if error == "rel" else None
+            out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
+                                        None if cr is None else cr.bound,
+                                        None if cr is None else cr.maximum))
     if bad_seg is not None:
-        s, a, b = bad_seg
+        s = bad_seg
+        a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
         what = "finite, real and nonzero" if error == "rel" else "finite and real"
         raise ValueError(f"{fn.expr} is not {what} on segment {s} = [{a}, {b}] of "
                          f"[{lo}, {hi}]; accepted: an interval where the function is {what}")
