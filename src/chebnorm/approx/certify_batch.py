@@ -157,14 +157,16 @@ def certify_batch(fn: Function1D, origins: Sequence, widths: Sequence,
     coeffs = [[float(c) for c in cs] or [0.0] for cs in coefficients]
     if any(not math.isfinite(c) for cs in coeffs for c in cs):
         raise ValueError("coefficients: accepted: finite floats")
-    old = ctx.prec
+    old, old_cap = ctx.prec, ctx.cap
     try:
         ctx.prec = 128
+        # series of the highest order tried (python-flint truncates at ctx.cap terms)
+        ctx.cap = max(old_cap, max(map(len, coeffs), default=1) + EXTRA_ORDERS[-1] + 2)
         o = [_ball(v) for v in origins]
         w = [_ball(v) for v in widths]
         return _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, float(tol))
     finally:
-        ctx.prec = old
+        ctx.prec, ctx.cap = old, old_cap
 
 
 class SegmentError(ValueError):
@@ -187,9 +189,8 @@ def _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, tol) -> list[Certificate]:
         model = _models(fn, o, w, coeffs, todo, t0, rho, n, kind, tol)
         done = _branch_and_bound(model.mids, model.slack, t0, rho, tol)
         for i, s in enumerate(model.keep):
-            cert = done[i]
-            if cert is not None and cert.maximum < 0:  # `at` not exact: evaluate in Arb
-                cert = _arb_maximum(fn, o[s], w[s], coeffs[s], kind, cert)
+            cert = None if done[i] is None else _certificate(fn, o[s], w[s], coeffs[s], kind,
+                                                            *done[i])
             if cert is None:
                 alone.append(s)
             else:
@@ -216,6 +217,10 @@ class _Model:
 
 
 def _padded(series: arb_series, n: int) -> list[arb]:
+    """The first ``n`` Taylor coefficients; ValueError when the series is shorter
+    (python-flint truncates series at ``ctx.cap`` terms)."""
+    if series.prec < n:
+        raise ValueError(f"series of {series.prec} terms, {n} needed")
     c = series.coeffs()  # flint drops trailing zeros
     return c + [arb(0)] * (n - len(c)) if len(c) < n else c[:n]
 
@@ -356,11 +361,12 @@ _MAX_LIVE = 4096
 
 
 def _branch_and_bound(mids: np.ndarray, slack: np.ndarray, t0: float, rho: float,
-                      tol: float) -> list[Certificate | None]:
+                      tol: float) -> list[tuple[float, float, int] | None]:
     """Bound ``sup |g_s|`` for every row ``s`` of ``mids`` (the coefficients of
     ``D_s`` in ``u``, ``|g_s - D_s| <= slack[s]``), bisecting pieces of
-    ``[-rho, rho]`` until ``upper <= (1 + tol) * lower``; None for a segment
-    a cap stopped. ``maximum`` is -1 when ``at`` could not be made exact."""
+    ``[-rho, rho]`` until ``upper <= (1 + tol) * lower``: ``(upper, at,
+    pieces)`` with ``at = t0 + u`` where ``|D_s|`` was largest; None for a
+    segment a cap stopped."""
     count = mids.shape[0]
     if count == 0:
         return []
@@ -426,7 +432,9 @@ def _branch_and_bound(mids: np.ndarray, slack: np.ndarray, t0: float, rho: float
         top = top[low[top] > best[seg[top]]]
         best[seg[top]] = low[top]
         best_u[seg[top]] = where[top]
-        ok = upper <= scale * (best[seg] - slack[seg])
+        # |g| at the best point found is at least best - 2 slack (the slack of
+        # D there and of D at the vertex): so bound <= (1 + tol) * maximum
+        ok = upper <= scale * (best[seg] - 2 * slack[seg])
         np.maximum.at(accepted, seg[ok], upper[ok])
         live = ~ok
         failed[seg[live & (r < min_r)]] = True
@@ -443,29 +451,14 @@ def _branch_and_bound(mids: np.ndarray, slack: np.ndarray, t0: float, rho: float
         r = np.concatenate([h, h])
     if seg.size:
         failed[seg] = True
-    # the located maximum: a lower bound of |g| at a float `at` = t0 + u, u exact
-    u = np.clip(np.round(best_u / rho * 2.0 ** 50) * (rho * 2.0 ** -50), -rho, rho)
-    at = t0 + u
-    back = at - t0
-    exact = ((t0 - (at - back)) + (u - back)) == 0  # TwoSum: the rounding error of t0 + u
-    val = mids[:, n].copy()
-    for k in range(n - 1, -1, -1):
-        val = val * u + mids[:, k]
-    maximum = np.maximum((np.abs(val) - err - slack) * (1 - 2.0 ** -50), 0.0)
-    out: list[Certificate | None] = []
-    for s in range(count):
-        if failed[s]:
-            out.append(None)
-            continue
-        mx = float(maximum[s]) if exact[s] else -1.0
-        out.append(Certificate(bound=max(float(accepted[s]), mx), maximum=mx, at=float(at[s]),
-                               subintervals=int(pieces[s])))
-    return out
+    at = np.clip(t0 + best_u, t0 - rho, t0 + rho)
+    return [None if failed[s] else (float(accepted[s]), float(at[s]), int(pieces[s]))
+            for s in range(count)]
 
 
-def _arb_maximum(fn, o, w, cs, kind, cert: Certificate) -> Certificate | None:
-    """``cert`` with ``maximum = |g(at)|`` evaluated in Arb (rounded down)."""
-    ta = arb(cert.at)
+def _certificate(fn, o, w, cs, kind, bound, at, pieces) -> Certificate | None:
+    """The certificate, with ``maximum = |g(at)|`` evaluated in Arb (rounded down)."""
+    ta = arb(at)
     p = arb(cs[-1])
     for c in reversed(cs[:-1]):
         p = p * ta + c
@@ -477,5 +470,4 @@ def _arb_maximum(fn, o, w, cs, kind, cert: Certificate) -> Certificate | None:
     if not v.is_finite():
         return None
     maximum = max(-_up(-abs(v)), 0.0)
-    return Certificate(bound=max(cert.bound, maximum), maximum=maximum, at=cert.at,
-                       subintervals=cert.subintervals)
+    return Certificate(bound=max(bound, maximum), maximum=maximum, at=at, subintervals=pieces)
