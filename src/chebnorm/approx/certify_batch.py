@@ -273,13 +273,13 @@ def _models(fn, o, w, coeffs, todo, t0, rho, n, kind, tol) -> _Model:
                 for c in reversed(p[:-1]):
                     p_b = p_b * sb + c
                 g_b = p_b / f_series(xc + w[s] * sb)
-                rem = _up(abs(_padded(g_b, n + 2)[n + 1])) * rho ** (n + 1)
+                rem = _up(abs(_padded(g_b, n + 2)[n + 1])) * rho ** (n + 1) * (1 + 2.0 ** -40)
         except (ValueError, ZeroDivisionError):
             bad.append(s)
             continue
         keep.append(s)
         rows.append([float(c) for c in g])
-        rads.append([float(c.rad()) if c.is_finite() else math.inf for c in g])
+        rads.append([float(c.rad()) for c in g])  # inf or nan where not finite
         rems.append(rem)
     k = len(keep)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -290,8 +290,9 @@ def _models(fn, o, w, coeffs, todo, t0, rho, n, kind, tol) -> _Model:
         finite = np.all(np.isfinite(mids), axis=1) & np.all(np.isfinite(rad), axis=1)
         # |g - D| <= sum_k (rad_k + |mid_k| 2^-52) rho^k + remainder, rounded up
         powers = rho ** np.arange(n + 1)
-        coef_slack = ((rad * (1 + 2.0 ** -50) + np.abs(mids) * 2.0 ** -52) @ powers) \
-            * (1 + 2.0 ** -45)
+        # (2^-1000 per coefficient: a float that underflowed)
+        coef_slack = ((rad * (1 + 2.0 ** -50) + np.abs(mids) * 2.0 ** -52 + 2.0 ** -1000)
+                      @ powers) * (1 + 2.0 ** -45)
         size = _grid_max(np.where(np.isfinite(mids), mids, 0.0), rho)
     # the slack is spent twice (upper and lower bound): keep it well inside tol
     budget = tol * size / 16
