@@ -176,3 +176,26 @@ def test_against_sollya_supnorm():
         # as tight as what Sollya is asked for
         assert certs[s].bound <= (1 + tol) * theirs.upper
         assert math.isfinite(theirs.upper)
+
+
+def test_tables_certified_one_segment_at_a_time_still_load():
+    """Bounds written by the per-segment certifier (tables saved before the
+    batch) can be tighter than the batch's at its default: verify escalates."""
+    from dataclasses import replace
+
+    table = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=16, coef_frac_bits=24)
+    fn = parse_function(table.expression)
+    segs = []
+    for s, seg in enumerate(table.segments):
+        c = certify(_Composed(fn, *_ends(table, s)), table.coefficients(s), sp.Integer(0),
+                    sp.Integer(1), "abs")
+        segs.append(replace(seg, abs_error_bound=c.bound, max_abs_error=c.maximum))
+    old = replace(table, segments=tuple(segs),
+                  abs_error_bound=max(s.abs_error_bound for s in segs))
+    assert old.verify() is old
+
+
+def test_below_float_resolution_goes_to_certify():
+    fn = parse_function("exp(x)")
+    c, = certify_batch(fn, [0], [Fraction(1, 8)], [[1.0, 0.125, 0.0078125]], tol=2.0 ** -45)
+    assert c.tight and c.maximum <= c.bound <= (1 + 2.0 ** -45) * c.maximum

@@ -46,10 +46,11 @@ Method
 
 A segment the batch cannot settle -- ``g_s`` not finite on it (a singular
 endpoint), a remainder too large at the highest order tried, an error at the
-working-precision floor (an exact fit), or a piece narrower than
-``2**-40`` of the segment -- is certified by :func:`~chebnorm.approx.certify`
-on its own, so the result is never less rigorous, nor less tight, than the
-per-segment certifier's.
+working-precision floor, or a piece narrower than ``2**-40`` of the segment;
+and every segment when ``tol < MIN_TOL`` (``2**-40``, near float64's
+resolution) -- is certified by :func:`~chebnorm.approx.certify` on its own,
+so the result is never less rigorous, nor less tight, than the per-segment
+certifier's.
 
 Two segments of ``1/sqrt(x)``, ``[1, 2]`` and ``[2, 4]`` (``x = o + w t``):
 the first error peaks inside, at 0.011960..., the second at ``x = 4``,
@@ -83,6 +84,9 @@ __all__ = ["certify_batch"]
 #: Taylor orders tried in turn, above the polynomial's degree (the first whose
 #: remainder is small enough for the segment)
 EXTRA_ORDERS = (5, 12, 24)
+#: tightness below which float64 cannot settle a segment: every segment then
+#: goes to the per-segment certifier (working at 128 bits)
+MIN_TOL = 2.0 ** -40
 #: initial pieces per segment (a power of two keeps every piece end exact)
 _START_PIECES = 8
 #: bisection rounds before a segment is handed to the per-segment certifier
@@ -186,7 +190,7 @@ class SegmentError(ValueError):
 def _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, tol) -> list[Certificate]:
     count = len(coeffs)
     out: list[Certificate | None] = [None] * count
-    todo, alone = list(range(count)), []
+    todo, alone = ([], list(range(count))) if tol < MIN_TOL else (list(range(count)), [])
     for extra in EXTRA_ORDERS:
         if not todo:
             break
@@ -388,8 +392,9 @@ def _branch_and_bound(mids: np.ndarray, slack: np.ndarray, t0: float, rho: float
     # a bound of every float64 rounding error in a piece's bounds (module docstring, 4.)
     err = (8 * n + 32) * _U * size * (1 + 2.0 ** -40)
     grow = 1 + 2.0 ** -48
-    # accept within (1 + tol), less a margin for rounding `at` to a float
-    scale = (1 + tol) * (1 - 2.0 ** -40)
+    # accept within (1 + tol), less a margin (far above float64 rounding: tol >=
+    # MIN_TOL) for rounding `at` to a float and this product
+    scale = 1 + tol * (1 - 2.0 ** -8)
     r0 = rho / _START_PIECES
     seg = np.repeat(np.arange(count), _START_PIECES)
     m = np.tile(-rho + r0 * (2 * np.arange(_START_PIECES) + 1), count)
