@@ -179,7 +179,8 @@ def piecewise_rows(tights, repeat: int) -> list[dict]:
     table = fit_piecewise(expr, interval, degree, segments=segments, coef_frac_bits=frac)
     rows = []
     for tight in tights:
-        ours = [run_piecewise_chebnorm(table, tight) for _ in range(repeat)]
+        # ours takes tens of milliseconds: more repeats steady the median on a loaded machine
+        ours = [run_piecewise_chebnorm(table, tight) for _ in range(max(repeat, 7))]
         single = run_piecewise_per_segment(table, tight)
         row = {"workload": f"piecewise {segments} x degree {degree} {expr} on [{interval[0]}, "
                            f"{interval[1]})", "tightness": tight,

@@ -601,6 +601,22 @@ def _capture_json(fn, argv):
     return json.loads(buf.getvalue())
 
 
+def _piecewise_line(r: dict) -> str:
+    """RESULTS.md's line for a piecewise row of bench_fit.py."""
+    line = (f"- {r['workload']}, tightness {r['tightness']:.3g}: chebnorm certifies every segment "
+            f"in {r['chebnorm_certify_s']:.3f} s (bound {r['chebnorm_bound']:.6e}, worst "
+            f"bound/max - 1 {r['chebnorm_worst_bound_over_max']:.2e})")
+    if "chebnorm_per_segment_certify_s" in r:
+        line += f", one segment at a time {r['chebnorm_per_segment_certify_s']:.3f} s"
+    if "sollya_supnorm_s" in r:
+        line += (f"; Sollya supnorm {r['sollya_supnorm_s']:.3f} s (bound {r['sollya_bound']:.6e}, "
+                 f"worst upper/lower - 1 {r['sollya_worst_upper_over_lower']:.2e}); "
+                 f"{r['certify_speedup']:.1f}x faster than Sollya")
+    else:
+        line += f"; {r.get('sollya', 'sollya not run')}"
+    return line + f" (load average {r['load_average_1min']:.1f})"
+
+
 def fit_vs_sollya(quick):
     import bench_fit
     from chebnorm.approx import sollya
@@ -777,6 +793,9 @@ def markdown(res):
     fs = res["fit_vs_sollya"]
     if "rows" in fs:
         for r in fs["rows"]:
+            if "workload" in r:  # the piecewise table (issue 13)
+                L.append(_piecewise_line(r))
+                continue
             line = (f"- fit and certify, {r['cases']} cases, tightness {r['tightness']:.3g}: chebnorm "
                     f"fit {r['chebnorm_fit_s']:.3f} s + certify {r['chebnorm_certify_s']:.3f} s")
             if "sollya_supnorm_s" in r:

@@ -108,7 +108,10 @@ def _ball(value) -> arb:
         return arb(int(value.numerator)) / int(value.denominator)
     if isinstance(value, sp.Basic) and value.is_Rational:
         return arb(int(value.p)) / int(value.q)
-    return arb_enclose(sp.sympify(value))
+    if isinstance(value, sp.Basic):
+        return arb_enclose(value)
+    raise ValueError(f"segment end {value!r}: accepted: an int, Fraction, float, sympy "
+                     f"constant or Arb ball")
 
 
 class _Affine:
