@@ -535,6 +535,28 @@ def _level_rel(f, high) -> float:
     return 0.5 * (lo_c + hi_c)
 
 
+def _certify_fitted(fn, ints_all, frac_bits: int, error: str, balls, loc):
+    """The segments fitted (integers ``ints_all``), certified all at once:
+    ``(segments, None)``, or ``(None, s)`` with ``s`` the first segment where
+    the error is not finite."""
+    certs, bad_seg = {}, None
+    qs = [[math.ldexp(i, -frac_bits) for i in ints] for ints in ints_all]
+    for kind in ("abs", "rel") if error == "rel" else ("abs",):
+        try:
+            certs[kind] = certify_batch(fn, *balls, qs, loc, kind)
+        except SegmentError as exc:
+            bad_seg = exc.segment if bad_seg is None else min(bad_seg, exc.segment)
+    if bad_seg is not None:
+        return None, bad_seg
+    out = []
+    for s, ints in enumerate(ints_all):
+        ca, cr = certs["abs"][s], certs["rel"][s] if error == "rel" else None
+        out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
+                                    None if cr is None else cr.bound,
+                                    None if cr is None else cr.maximum))
+    return out, None
+
+
 def _check_binades(lo, hi, index_bits: int) -> None:
     """Refuse an exponent-indexed interval that is not [2^e0, 2^e1] of a few binades."""
     e0, e1 = _exact_log2(lo), _exact_log2(hi)
@@ -616,24 +638,13 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
             ints_all.append(_quantize_segment(g, coeffs, frac_bits, *loc, error))
         if progress is not None:
             progress()
-    # certify the segments fitted so far, all at once; the first that fails
-    # (or the first the probe refused) is reported
-    certs = {}
-    origins, widths = _segment_balls(segment_by, lo, hi, index_bits, centered,
-                                     range(len(ints_all)))
-    qs = [[math.ldexp(i, -frac_bits) for i in ints] for ints in ints_all]
-    for kind in ("abs", "rel") if error == "rel" else ("abs",):
-        try:
-            certs[kind] = certify_batch(fn, origins, widths, qs, loc, kind)
-        except SegmentError as exc:
-            bad_seg = exc.segment if bad_seg is None else min(bad_seg, exc.segment)
-    out = []
-    if bad_seg is None:
-        for s, ints in enumerate(ints_all):
-            ca, cr = certs["abs"][s], certs["rel"][s] if error == "rel" else None
-            out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
-                                        None if cr is None else cr.bound,
-                                        None if cr is None else cr.maximum))
+    # the segments fitted so far, certified together; the first segment that
+    # fails (or that the probe refused) is reported
+    out, failed = _certify_fitted(fn, ints_all, frac_bits, error,
+                                  _segment_balls(segment_by, lo, hi, index_bits, centered,
+                                                 range(len(ints_all))), loc)
+    if failed is not None and (bad_seg is None or failed < bad_seg):
+        bad_seg = failed
     if bad_seg is not None:
         s = bad_seg
         a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
