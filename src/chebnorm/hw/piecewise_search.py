@@ -266,7 +266,9 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     check_scheduler(scheduler)
     f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
     # the first fit reports a bad expression or interval as it is (one clear error), here
-    fit_piecewise(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var, name=name)
+    with _FIT_LOCK:
+        fit_piecewise(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var,
+                      name=name)
     items = [(expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name)
              for d in degrees]
     par = dict(workers=workers, scheduler=scheduler, progress=progress)
