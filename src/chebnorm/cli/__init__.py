@@ -17,7 +17,8 @@ import sys
 __all__ = ["main", "build_parser", "UsageError"]
 
 #: subcommand modules, in the order ``chebnorm --help`` lists them
-SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "hw", "design", "repro")
+SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "render_sweep", "hw", "design",
+               "repro")
 
 
 class UsageError(ValueError):

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 from ._common import command_line, print_json
+from ._parallel import add_parallel_args, parallel_kwargs
 
 
 def register(sub) -> None:
@@ -28,6 +29,7 @@ def register(sub) -> None:
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
+    add_parallel_args(p)
     p.set_defaults(func=run)
 
 
@@ -45,7 +47,7 @@ def run(args) -> int:
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, args.max_error,
                  degrees=args.degrees, max_index_bits=parse_segments(args.max_segments),
-                 var=args.var, synth=not args.no_synth, name=name)
+                 var=args.var, synth=not args.no_synth, name=name, **parallel_kwargs(args))
     csv, png = res.csv(), res.plot_png()
     make_folder(out)
     write_atomic(out / f"design_{name}.csv", csv)
@@ -144,7 +146,7 @@ def hw_sweep_piecewise(args) -> int:
     res = grid(args.expr or "1/sqrt(x)", tuple(args.interval or ("1", "4")), args.in_bits,
                args.out_bits, index_bits=[parse_segments(v) for v in args.segments],
                degrees=args.degrees or (1, 2, 3), coef_frac_bits=args.coef_bits or (12, 16, 20),
-               synth=not args.no_synth)
+               synth=not args.no_synth, **parallel_kwargs(args))
     out = make_folder(Path(args.output))
     write_atomic(out / "sweep_piecewise.csv", res.csv())
     write_atomic(out / "sweep_piecewise.png", res.plot_png())

@@ -14,7 +14,7 @@ the Pareto front's points that meet ``E`` (so the search stays bounded: at
 most ``len(degrees) * (max_index_bits + 1) + 2 * len(degrees) * 16`` fits).
 
 >>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
-...            progress=False)
+...            progress=False, workers=1)
 >>> w = r.winner
 >>> (w.degree, w.segments, w.total_bound <= 2e-3)
 (1, 32, True)
@@ -24,8 +24,10 @@ from __future__ import annotations
 
 import io
 import math
+import threading
 from dataclasses import dataclass, replace
 
+from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.approx.piecewise import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE, fit_piecewise
 from chebnorm.approx.textsafe import csv_cell
 
@@ -40,6 +42,9 @@ COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits
 #: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
 ROM_CELLS_PER_BIT = 0.15
 MAX_SYNTH = 6
+#: a worker thread fits one table at a time: the certifier sets python-flint's global
+#: precision, which threads of one process (a threaded Dask worker) would share
+_FIT_LOCK = threading.Lock()
 
 
 def model_cost(d: PiecewiseDesign) -> float:
@@ -188,69 +193,90 @@ def _point(d: PiecewiseDesign) -> DesignPoint:
                        b["total"], False, model_cost(d))
 
 
-def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
-           degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
-           progress: bool = True, name: str = "design") -> SearchResult:
-    """Cheapest certified piecewise design meeting ``max_error`` (module docstring)."""
-    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
-    if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) or \
-            not math.isfinite(max_error) or max_error <= 0:
-        raise ValueError(f"max-error {max_error!r} is not a positive number; accepted: E > 0")
-    degrees = tuple(sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees}))
-    if not degrees:
-        raise ValueError("degrees: empty; accepted: one or more of 0..8")
-    kmax = check_width(max_index_bits, "max-index-bits", 0, min(12, in_bits - 1))
-    f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(degrees) * (kmax + 1), desc="design search", unit="fit",
-                   leave=False)
+def _evaluate_chain(item) -> list:
+    """One degree of :func:`search` (run by ``map_ordered`` on a worker): walk the
+    segment count ``2**k`` up at ``F_hi`` coefficient bits until the bound is met,
+    then lower the coefficient bits at the first meeting ``k`` and at ``k + 1``.
+    Returns ``[(key, DesignPoint, PiecewiseDesign)]`` sorted by ``key = (d, k, f)``."""
+    expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name = item
     designs: dict[tuple[int, int, int], PiecewiseDesign] = {}
+    points: dict[tuple[int, int, int], DesignPoint] = {}
 
-    def evaluate(d, k, f):
+    def evaluate(k, f):
         key = (d, k, f)
         if key not in designs:
             t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
                               name=name)
             designs[key] = design_piecewise(t, in_bits, out_bits)
-        return designs[key]
+            p = _point(designs[key])
+            points[key] = replace(p, meets=p.total_bound <= max_error)
+        return points[key]
 
-    # the first fit reports a bad expression or interval as it is (one clear error)
-    evaluate(degrees[0], 0, f_hi)
+    with _FIT_LOCK:
+        first = next((k for k in range(kmax + 1) if evaluate(k, f_hi).meets), None)
+        if first is not None:
+            for k in (first, first + 1):
+                if k > kmax:
+                    continue
+                for f in range(f_hi - 1, 0, -1):
+                    if not evaluate(k, f).meets:
+                        break
+                evaluate(k, f_hi)
+    return [(key, points[key], designs[key]) for key in sorted(points)]
 
+
+def _cells(design: PiecewiseDesign) -> int:
+    """Yosys' cell count of one design (run by ``map_ordered`` on a worker)."""
+    from .piecewise import piecewise_cells
+
+    return piecewise_cells(design).cells
+
+
+def _check_max_error(max_error) -> float:
+    if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) or \
+            not math.isfinite(max_error) or max_error <= 0:
+        raise ValueError(f"max-error {max_error!r} is not a positive number; accepted: E > 0")
+    return float(max_error)
+
+
+def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
+           degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
+           progress: bool = True, name: str = "design", workers: int | None = None,
+           scheduler=None) -> SearchResult:
+    """Cheapest certified piecewise design meeting ``max_error`` (module docstring).
+
+    Each degree's walk is one parallel item, and so is each Yosys run: they run
+    on ``workers`` local processes (default: the core count; 1: here) or on a
+    Dask ``scheduler`` (:func:`chebnorm.approx.parallel.map_ordered`). The
+    candidates evaluated, and so the result and its CSV, do not depend on which.
+
+    >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2), max_index_bits=4,
+    ...            synth=False, progress=False, workers=1)
+    >>> r.winner.degree, r.winner.segments, r.winner.total_bound <= 1e-2
+    (1, 16, True)
+    """
+    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    max_error = _check_max_error(max_error)
+    degrees = tuple(sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees}))
+    if not degrees:
+        raise ValueError("degrees: empty; accepted: one or more of 0..8")
+    kmax = check_width(max_index_bits, "max-index-bits", 0, min(12, in_bits - 1))
+    workers = check_workers(workers)
+    check_scheduler(scheduler)
+    f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
+    # the first fit reports a bad expression or interval as it is (one clear error), here
+    with _FIT_LOCK:
+        fit_piecewise(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var,
+                      name=name)
+    items = [(expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name)
+             for d in degrees]
+    par = dict(workers=workers, scheduler=scheduler, progress=progress)
+    designs: dict[tuple[int, int, int], PiecewiseDesign] = {}
     points: dict[tuple[int, int, int], DesignPoint] = {}
-    for d in degrees:
-        first = None
-        for k in range(kmax + 1):
-            des = evaluate(d, k, f_hi)
-            p = _point(des)
-            points[(d, k, f_hi)] = replace(p, meets=p.total_bound <= max_error)
-            if bar is not None:
-                bar.update(1)
-            if points[(d, k, f_hi)].meets:
-                first = k
-                break
-        if bar is not None and first is not None:
-            bar.update(kmax - first)
-        if first is None:
-            continue
-        for k in (first, first + 1):
-            if k > kmax:
-                continue
-            for f in range(f_hi - 1, 0, -1):
-                des = evaluate(d, k, f)
-                p = _point(des)
-                p = replace(p, meets=p.total_bound <= max_error)
-                points[(d, k, f)] = p
-                if not p.meets:
-                    break
-            if (d, k, f_hi) not in points:
-                p = _point(evaluate(d, k, f_hi))
-                points[(d, k, f_hi)] = replace(p, meets=p.total_bound <= max_error)
-    if bar is not None:
-        bar.close()
+    for chain in map_ordered(_evaluate_chain, items, desc="design search", **par):
+        for key, p, des in chain:
+            points[key], designs[key] = p, des
     keys = sorted(points)
     # Pareto front over (model cost, total bound)
     front = set()
@@ -269,12 +295,11 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
         import shutil
 
         if shutil.which("yosys") is not None:
-            from .piecewise import piecewise_cells
-
             cost_source = "yosys cells"
             chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
-            for key in chosen:
-                points[key] = replace(points[key], yosys_cells=piecewise_cells(designs[key]).cells)
+            cells = map_ordered(_cells, [designs[k] for k in chosen], desc="yosys", **par)
+            for key, n in zip(chosen, cells):
+                points[key] = replace(points[key], yosys_cells=n)
     ordered = tuple(points[k] for k in keys)
     winner = None
     if meeting:
@@ -282,21 +307,38 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
                                                    or cost_source == "model estimate")]
         winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
-                        float(max_error), ordered, winner, cost_source,
+                        max_error, ordered, winner, cost_source,
                         {k: designs[k] for k in keys})
+
+
+def _grid_point(item) -> tuple[DesignPoint, PiecewiseDesign]:
+    """One point of :func:`grid`: fitted, certified, sized and, with ``synth``,
+    synthesized (run by ``map_ordered`` on a worker). ``limit`` is the error to
+    meet, or None for none."""
+    expr, interval, (d, k, f), in_bits, out_bits, limit, var, name, synth = item
+    with _FIT_LOCK:
+        t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
+                          name=name)
+        des = design_piecewise(t, in_bits, out_bits)
+    p = _point(des)
+    p = replace(p, meets=limit is not None and p.total_bound <= limit)
+    if synth:
+        p = replace(p, yosys_cells=_cells(des))
+    return p, des
 
 
 def grid(expr, interval, in_bits: int, out_bits: int, *, index_bits=(0, 2, 4, 6, 8),
          degrees=(1, 2, 3), coef_frac_bits=(12, 16, 20), max_error: float | None = None,
          var: str = "x", synth: bool = False, progress: bool = True,
-         name: str = "sweep") -> SearchResult:
+         name: str = "sweep", workers: int | None = None, scheduler=None) -> SearchResult:
     """Every ``(2**k segments, degree, coefficient bits)`` of the grid, fitted,
     certified and sized: the piecewise ``hw sweep`` (no search, no pruning).
     With ``synth`` Yosys counts the cells of every point. ``max_error``
-    (optional) marks the points that meet it and picks the cheapest.
+    (optional) marks the points that meet it and picks the cheapest. Each
+    point is one parallel item (``workers``, ``scheduler``: as :func:`search`).
 
     >>> r = grid("1/sqrt(x)", ("1", "4"), 8, 8, index_bits=(1, 2), degrees=(1,),
-    ...          coef_frac_bits=(10,), progress=False)
+    ...          coef_frac_bits=(10,), progress=False, workers=1)
     >>> [(p.segments, p.degree) for p in r.points]
     [(2, 1), (4, 1)]
     """
@@ -308,24 +350,16 @@ def grid(expr, interval, in_bits: int, out_bits: int, *, index_bits=(0, 2, 4, 6,
     if not ks or not ds or not fs:
         raise ValueError("empty sweep list; accepted: at least one segment count, degree and "
                          "coefficient width")
-    limit = math.inf if max_error is None else float(max_error)
-    items = [(d, k, f) for d in ds for k in ks for f in fs]
-    it = items
-    if progress:
-        from tqdm import tqdm
-        it = tqdm(items, desc="piecewise sweep", unit="design", leave=False)
-    points, designs = [], {}
-    for d, k, f in it:
-        t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
-                          name=name)
-        des = design_piecewise(t, in_bits, out_bits)
-        p = _point(des)
-        p = replace(p, meets=max_error is not None and p.total_bound <= limit)
-        if synth:
-            from .piecewise import piecewise_cells
-            p = replace(p, yosys_cells=piecewise_cells(des).cells)
-        points.append(p)
-        designs[(d, k, f)] = des
+    limit = math.inf if max_error is None else _check_max_error(max_error)
+    workers = check_workers(workers)
+    check_scheduler(scheduler)
+    keys = [(d, k, f) for d in ds for k in ks for f in fs]
+    items = [(expr, interval, key, in_bits, out_bits, None if max_error is None else limit,
+              var, name, synth) for key in keys]
+    done = map_ordered(_grid_point, items, workers=workers, scheduler=scheduler,
+                       progress=progress, desc="piecewise sweep")
+    points = [p for p, _ in done]
+    designs = {key: des for key, (_, des) in zip(keys, done)}
     front = [p for p in points if not any(
         q.cost <= p.cost and q.total_bound <= p.total_bound
         and (q.cost, q.total_bound) != (p.cost, p.total_bound) for q in points)]

@@ -13,7 +13,8 @@ Public API: :func:`render` (one frame, any mode), :func:`compare` (metrics
 and the signed 8-bit difference), :func:`error_map_rgb`, :func:`write_image`
 (PNG, JPEG, TIFF or BMP by file extension); meshes (:func:`get_mesh` and the
 generators); studies for the paper reproduction (:func:`eta_study`, :func:`split_gouraud_study`,
-:func:`bump_comparison`, :func:`write_bump_figures`).
+:func:`bump_comparison`, :func:`write_bump_figures`); render sweeps over a grid of cases
+(:func:`render_sweep_cases`, :func:`render_sweep`: one CSV of metrics, run in parallel).
 """
 
 from .meshes import (MESH_NAMES, Mesh, crease_normals, get_mesh, icosphere, load_mesh, square,
@@ -23,8 +24,9 @@ from .render import (BUMP_VARIANTS, SHADING_MODES, HeightMap, Lighting, RenderRe
                      available_methods, get_span_normals, render, to_8bit)
 from .spans import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
 from .display import RenderComparison, png_data_uri, render_html
-from .studies import (BumpCase, EtaLevel, SplitGouraudStudy, bump_comparison, eta_study,
-                      split_gouraud_study, write_bump_figures)
+from .studies import (RENDER_SWEEP_COLUMNS, BumpCase, EtaLevel, RenderCase, RenderSweep,
+                      RenderSweepRow, SplitGouraudStudy, bump_comparison, eta_study,
+                      render_sweep, render_sweep_cases, split_gouraud_study, write_bump_figures)
 
 __all__ = [
     "render", "compare", "error_map_rgb", "write_image", "write_png", "IMAGE_FORMATS", "to_8bit",
@@ -34,6 +36,7 @@ __all__ = [
     "load_mesh", "crease_normals",
     "Camera", "Spans", "default_camera", "fit_camera", "project", "setup_spans", "zbuffer",
     "eta_study", "EtaLevel", "split_gouraud_study", "SplitGouraudStudy", "bump_comparison",
-    "BumpCase", "write_bump_figures",
+    "BumpCase", "write_bump_figures", "render_sweep", "render_sweep_cases", "RenderCase",
+    "RenderSweepRow", "RenderSweep", "RENDER_SWEEP_COLUMNS",
     "RenderComparison", "render_html", "png_data_uri",
 ]

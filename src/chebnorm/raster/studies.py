@@ -10,11 +10,18 @@ writes files unless asked (``write_*`` helpers write PNGs atomically).
 * :func:`bump_comparison` -- seed 001 (C12): square-patch against full
   tangent-space coefficients (and the object-space variant) on the flat
   square, a sphere and a torus, with error maps.
+* :func:`render_sweep` -- a grid of meshes x shading modes x methods x sizes
+  (:func:`render_sweep_cases`), each render measured against its reference;
+  one CSV, the same bytes whatever number of workers runs it.
 """
 
 from __future__ import annotations
 
+import functools
+import itertools
 import os
+import re
+import threading
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -24,7 +31,8 @@ from .metrics import compare, error_map_rgb, write_png
 from .render import HeightMap, Lighting, render
 
 __all__ = ["EtaLevel", "eta_study", "split_gouraud_study", "SplitGouraudStudy", "BumpCase",
-           "bump_comparison", "write_bump_figures"]
+           "bump_comparison", "write_bump_figures", "RenderCase", "RenderSweepRow", "RenderSweep",
+           "render_sweep_cases", "render_sweep", "RENDER_SWEEP_COLUMNS"]
 
 
 @dataclass
@@ -215,3 +223,257 @@ def write_bump_figures(cases, directory) -> list[str]:
             write_png(p, error_map_rgb(c.images[key], scale))
             paths.append(p)
     return paths
+
+
+# ------------------------------------------------------------ render sweeps
+#: columns of :meth:`RenderSweep.csv`, in order
+RENDER_SWEEP_COLUMNS = ("mesh", "tess", "width", "height", "shininess", "shading", "method",
+                        "bump", "reference", "triangles", "fragments", "pixels", "max_abs_8bit",
+                        "pixels_off_1", "mean_abs_8bit", "psnr", "ssim", "flip", "name")
+#: one process-wide lock: a worker thread renders one case at a time (the fits behind
+#: the method tables set python-flint's global precision, which threads would share)
+_CASE_LOCK = threading.Lock()
+#: largest image side a sweep accepts (as :func:`render`)
+MAX_SIZE = 16384
+#: the render engines (:func:`render`'s ``engine``)
+ENGINES = ("auto", "numpy", "numba")
+
+
+@dataclass(frozen=True)
+class RenderCase:
+    """One point of a render sweep: the mesh (a name, or a file path as given),
+    its tessellation (None: the generator's default; always None for a file),
+    the image size, the shininess, the shading mode, the normalization method
+    (None for ``gouraud`` and ``split-gouraud``, which have none), the bump
+    variant (None unless ``bump``) and the reference ``(mode, method, variant)``."""
+
+    mesh: str
+    tess: int | None
+    width: int
+    height: int
+    shininess: float
+    shading: str
+    method: str | None
+    bump: str | None
+    reference: tuple
+
+    @property
+    def sort_key(self) -> tuple:
+        """The order of the sweep's rows."""
+        return (self.mesh, -1 if self.tess is None else self.tess, self.width, self.height,
+                self.shininess, self.shading, self.method or "", self.bump or "")
+
+    @property
+    def reference_text(self) -> str:
+        """``MODE:METHOD`` (``bump:VARIANT`` for a bump reference), as ``chebnorm render``."""
+        mode, method, variant = self.reference
+        return f"{mode}:{variant if mode == 'bump' else method}"
+
+    @property
+    def name(self) -> str:
+        """A file-name stem naming the case (letters, digits, ``_``, ``-``, ``.``)."""
+        stem = re.sub(r"[^A-Za-z0-9]+", "-", os.path.splitext(os.path.basename(self.mesh))[0])
+        parts = [stem.strip("-") or "mesh", "" if self.tess is None else f"t{self.tess}",
+                 f"{self.width}x{self.height}", f"n{self.shininess:g}", self.shading,
+                 self.method or "", self.bump or ""]
+        return "_".join(p for p in parts if p)
+
+
+@dataclass(frozen=True)
+class RenderSweepRow:
+    """A rendered case: its triangle and fragment counts, its
+    :class:`~chebnorm.raster.ImageMetrics` against the reference (as a dict),
+    and, when asked for, the image and its error map as PNG bytes."""
+
+    case: RenderCase
+    triangles: int
+    fragments: int
+    metrics: dict
+    image_png: bytes | None = field(default=None, repr=False)
+    error_png: bytes | None = field(default=None, repr=False)
+
+    def cells(self) -> list[str]:
+        """The CSV cells of the row, in the order of :data:`RENDER_SWEEP_COLUMNS`;
+        floats in fixed formats (a PSNR of identical images is ``inf``)."""
+        c, m = self.case, self.metrics
+        return [c.mesh, "" if c.tess is None else str(c.tess), str(c.width), str(c.height),
+                f"{c.shininess:.10g}", c.shading, c.method or "", c.bump or "",
+                c.reference_text, str(self.triangles), str(self.fragments), str(m["pixels"]),
+                str(m["max_abs_8bit"]), str(m["pixels_off_1"]), f"{m['mean_abs_8bit']:.6f}",
+                "inf" if m["psnr"] is None else f"{m['psnr']:.4f}", f"{m['ssim']:.6f}",
+                f"{m['flip']:.6f}", c.name]
+
+
+@dataclass(frozen=True)
+class RenderSweep:
+    """The rows of :func:`render_sweep`, in the order of the cases' ``sort_key``."""
+
+    rows: tuple
+
+    def csv(self) -> str:
+        """The rows as CSV text: a header line, then one line per row (text
+        fields through :func:`chebnorm.approx.textsafe.csv_cell`)."""
+        from chebnorm.approx.textsafe import csv_cell
+
+        lines = [",".join(RENDER_SWEEP_COLUMNS)]
+        lines += [",".join(csv_cell(v) for v in r.cells()) for r in self.rows]
+        return "\n".join(lines) + "\n"
+
+
+def _check_list(values, what, accepted=None) -> list:
+    values = list(dict.fromkeys(values))
+    if not values:
+        raise ValueError(f"{what}: empty list; accepted: one or more"
+                         + (f" of {', '.join(accepted)}" if accepted else " values"))
+    for v in values:
+        if accepted is not None and v not in accepted:
+            raise ValueError(f"unknown {what} {v!r}; accepted: {', '.join(accepted)}")
+    return values
+
+
+def _check_sizes(sizes) -> list:
+    out = []
+    for s in sizes:
+        try:
+            w, h = (int(v) for v in s)
+            ok = [w, h] == list(s) and 1 <= w <= MAX_SIZE and 1 <= h <= MAX_SIZE
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise ValueError(f"size {s!r}: expected two integers (width, height) in "
+                             f"[1, {MAX_SIZE}]")
+        out.append((w, h))
+    return _check_list(out, "size")
+
+
+
+
+def _sweep_meshes(meshes, tess_levels, bump_wanted) -> dict:
+    """``{(mesh, tess): Mesh or None}``, every mesh built once here (which checks
+    names, tessellation levels and files); None for a generated mesh, which the
+    worker builds again rather than receive."""
+    from .meshes import MESH_NAMES
+
+    out = {}
+    for name in _check_list(meshes, "mesh"):
+        generated = name in MESH_NAMES
+        for t in (tess_levels if generated else [None]):
+            m = get_mesh(name, t)
+            if bump_wanted and not m.has_parametrization:
+                raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh "
+                                 f"{name!r} has none; accepted for bump: teapot, sphere, torus, "
+                                 "square")
+            out[(name, t)] = None if generated else m
+    return out
+
+
+def render_sweep_cases(meshes=("teapot",), shadings=("phong",), methods=None,
+                       sizes=((256, 256),), tess=(None,), shininess=(32.0,), bumps=("full",),
+                       reference=None) -> list[RenderCase]:
+    """The sorted, checked cases of a render sweep: every mesh x tessellation x
+    size x shininess x shading x method (x bump variant for ``bump``); a shading
+    without a normalization method (``gouraud``, ``split-gouraud``) gets one case,
+    not one per method. ``methods``: default every registered method.
+    ``reference``: ``(mode, method, bump variant)`` for every case; default
+    ``phong:exact`` (``bump:full`` for bump cases). A bad name or size raises
+    ``ValueError`` naming it and the accepted set.
+
+    >>> [(c.shading, c.method) for c in render_sweep_cases(
+    ...     ("sphere",), ("gouraud", "phong"), ("none", "exact"), sizes=[(32, 32)])]
+    [('gouraud', None), ('phong', 'exact'), ('phong', 'none')]
+    """
+    from .render import BUMP_VARIANTS, SHADING_MODES, available_methods
+
+    shadings = _check_list(shadings, "shading mode", SHADING_MODES)
+    methods = _check_list(available_methods() if methods is None else methods, "method",
+                          available_methods())
+    bumps = _check_list(bumps, "bump variant", BUMP_VARIANTS)
+    sizes = _check_sizes(sizes)
+    tess = _check_list(tess, "tessellation level")
+    for n in _check_list(shininess, "shininess"):
+        Lighting(shininess=n).validate()
+    if reference is not None:
+        mode, method, variant = reference
+        _check_list([mode], "reference mode", SHADING_MODES)
+        _check_list([method], "reference method", available_methods())
+        _check_list([variant], "reference bump variant", BUMP_VARIANTS)
+    meshes = _sweep_meshes(meshes, tess, "bump" in shadings or
+                           (reference is not None and reference[0] == "bump"))
+    cases = set()
+    for (mesh, t), (w, h), n, shading in itertools.product(meshes, sizes, shininess, shadings):
+        ref = reference or (("bump", "exact", "full") if shading == "bump"
+                            else ("phong", "exact", "full"))
+        for method in (methods if shading in ("phong", "adaptive", "bump") else [None]):
+            for variant in (bumps if shading == "bump" else [None]):
+                cases.add(RenderCase(mesh, t, w, h, float(n), shading, method, variant, ref))
+    return sorted(cases, key=lambda c: c.sort_key)
+
+
+@functools.lru_cache(maxsize=4)
+def _generated_mesh(name, tess):
+    return get_mesh(name, tess)
+
+
+def _render_case(item) -> RenderSweepRow:
+    """Render one case and its reference and compare them (run by ``map_ordered``
+    on a worker)."""
+    case, mesh, opts, images = item
+    with _CASE_LOCK:
+        mesh = mesh if mesh is not None else _generated_mesh(case.mesh, case.tess)
+        light = Lighting(shininess=case.shininess, half_vector=opts["half_vector"])
+        kw = dict(size=(case.width, case.height), lighting=light, engine=opts["engine"],
+                  eta_threshold=opts["eta_threshold"], q=opts["q"])
+        result = render(mesh, case.shading, case.method, bump=case.bump or "full", **kw)
+        mode, method, variant = case.reference
+        ref = render(mesh, mode, method, bump=variant, dtype=np.float64, **kw)
+        metrics, diff = compare(result, ref)
+    png = err = None
+    if images:
+        from .metrics import image_bytes
+
+        png, err = image_bytes(result.image8), image_bytes(error_map_rgb(diff))
+    return RenderSweepRow(case, result.triangles, result.fragments, metrics.to_dict(), png, err)
+
+
+def render_sweep(cases, *, half_vector: str = "pixel", eta_threshold: float = 0.005,
+                 q: float = 1.0 / 255.0, engine: str = "auto", images: bool = False,
+                 workers: int | None = None, scheduler=None, progress: bool = False,
+                 on_row=None) -> RenderSweep:
+    """Render every case of :func:`render_sweep_cases` and its reference, and
+    measure the error (:func:`compare`: max and mean 8-bit error, pixels off,
+    PSNR, SSIM, FLIP); ``images``: keep each image and error map as PNG bytes.
+
+    Each case is one parallel item: on ``workers`` local processes (default: the
+    core count; 1: here) or a Dask ``scheduler``
+    (:func:`chebnorm.approx.parallel.map_ordered`); the rows, and so the CSV, are
+    the same whatever runs them. ``on_row(index, row)`` sees each row as it
+    finishes (``index`` into ``cases``), so a caller can keep finished rows when
+    interrupted. ``half_vector``, ``eta_threshold``, ``q``, ``engine``: as
+    :func:`render`, for every case.
+
+    >>> cases = render_sweep_cases(("sphere",), ("phong",), ("exact", "none"),
+    ...                            sizes=[(48, 48)], tess=[8])
+    >>> sweep = render_sweep(cases, workers=1)
+    >>> [(r.case.method, r.metrics["max_abs_8bit"] > 0) for r in sweep.rows]
+    [('exact', False), ('none', True)]
+    >>> sweep.csv().splitlines()[0].startswith("mesh,tess,width,height,shininess")
+    True
+    """
+    from chebnorm.approx.parallel import map_ordered
+
+    from .meshes import MESH_NAMES
+    from .render import _check_options
+
+    cases = list(cases)
+    Lighting(half_vector=half_vector).validate()
+    _check_options("phong", "full", eta_threshold, q)
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; accepted: {', '.join(ENGINES)}")
+    opts = dict(half_vector=half_vector, eta_threshold=float(eta_threshold), q=float(q),
+                engine=engine)
+    # a mesh file is read once, here; a generated mesh is built by the worker
+    files = {c.mesh: get_mesh(c.mesh) for c in cases if c.mesh not in MESH_NAMES}
+    items = [(c, files.get(c.mesh), opts, bool(images)) for c in cases]
+    rows = map_ordered(_render_case, items, workers=workers, scheduler=scheduler,
+                       progress=progress, desc="render sweep", on_result=on_row)
+    return RenderSweep(tuple(rows))
