@@ -33,7 +33,7 @@ from chebnorm.methods import default_tables, get_method, method_names
 from chebnorm.methods import span_normals as _span_normals
 from chebnorm.symbolic import eta as _eta_criterion
 
-from . import fast
+from . import fast, fused
 from .meshes import Mesh, _unit, get_mesh
 from .spans import Camera, fit_camera, project, setup_spans, zbuffer
 
@@ -198,10 +198,13 @@ class _Setup:
         return fast.fast_lerp(sp, cols, vis) if self.engine == "numba" else sp.lerp(cols)[vis]
 
 
-def _setup(mesh, camera, size, cull=True):
+def _setup(mesh, camera, size, cull=True, engine="numpy"):
     w, h = size
     cam = camera or fit_camera(mesh.positions, w, h)
     xy, inv_w = project(cam, mesh.positions, w, h)
+    if engine == "numba":  # the same gathers, compiled
+        tri, txy, iw, pos, nrm = fused.gather_setup(mesh, xy, inv_w, cull)
+        return _Setup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, engine)
     f = mesh.faces
     txy = xy[f]
     area = ((txy[:, 1, 0] - txy[:, 0, 0]) * (txy[:, 2, 1] - txy[:, 0, 1])
@@ -282,7 +285,7 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     if shading == "bump" and not mesh.has_parametrization:
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
-    st = _setup(mesh, camera, (w, h), cull)
+    st = _setup(mesh, camera, (w, h), cull, engine)
     st.engine = engine
     st.L = lighting.direction(st.camera)
     kw = dict(lighting=lighting, interp=_interpolator(spec, span_normals, engine), tables=tables,
@@ -317,7 +320,9 @@ def _interpolator(spec, span_normals, engine="numpy"):
     if span_normals is not None:
         return span_normals
     if engine == "numba" and spec is not None and fast.supports(spec):
-        return lambda _name, *args, **kw: fast.fast_span_normals(spec, *args, **kw)
+        fn = lambda _name, *args, **kw: fast.fast_span_normals(spec, *args, **kw)  # noqa: E731
+        fn.builtin = True  # the registry's kernel: _phong may take the fused path
+        return fn
     return lambda _name, *args, **kw: _span_normals(spec, *args, **kw)
 
 
@@ -412,6 +417,13 @@ def _auto_tables(spec, sp, col_groups, tables, stats):
 
 
 def _phong(st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None):
+    if (st.engine == "numba" and skip_eta is None and getattr(interp, "builtin", False)
+            and fused.supports(spec)):
+        # fused visibility + deferred shading (raster.fused): the same bytes as below
+        out = fused.phong(st, spec, lighting, tables, dtype, _tri_half, _auto_tables)
+        if out is not None:
+            img, mask, tri, nlen, frags, stats = out
+            return _ModeResult(img, mask, frags, stats, triangle=tri, normal_length=nlen)
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.nrm] + ([st.pos] if per_pixel_h else [])
     sp, vis = st.rasterize(np.concatenate(extra, axis=2))

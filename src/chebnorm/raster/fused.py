@@ -1,0 +1,769 @@
+"""Fused, parallel Phong frame (numba): visibility per scan line, then deferred shading.
+
+:mod:`.render` (numpy) is the reference and :mod:`.fast` its compiled twin operation by
+operation; this module computes the same ``phong`` frame, byte for byte, without
+the full-frame intermediate arrays of those two paths (fragment lists, a frame-sized
+z-buffer, per-fragment normals, half vectors and dot products):
+
+1. triangle set-up and span set-up, compiled and parallel over triangles (the
+   arithmetic of :func:`.spans.setup_spans`);
+2. the method's checks and per-span set-up, as :func:`chebnorm.methods.span_normals`
+   does them (the same calls; sine, cosine and arc cosine element by element with
+   the bits of :mod:`chebnorm.methods.detmath`, see :func:`det`);
+3. one pass per scan line, rows split across the cores (``prange``): a z-test of the
+   line's spans in span order into a line buffer (the winning span of every pixel,
+   ties to the earliest fragment as in :func:`.spans.zbuffer`), then each span's
+   pixel normals by the method's kernel (stepping kernels step through every pixel
+   of the span, the others are evaluated only where the span won) and, for the
+   winners only, half vector, Blinn-Phong intensity, ``|N|`` and the triangle id,
+   each output pixel written once.
+
+Every float operation is the reference's, in its order and dtype (no ``fastmath``;
+LLVM does not contract a multiply-add without it).  Two reductions of the reference
+are library calls whose summation order is the library's: ``N @ L`` (BLAS ``gemv``)
+and ``einsum`` (``N . H``).  :func:`calibrated` finds, once per process, which
+explicit order reproduces each on this machine (OpenBLAS's AVX2 kernel fuses two of
+the three products); when none does, :func:`phong` returns None and the caller
+runs :mod:`.fast` instead, so the bytes never depend on the guess.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from types import SimpleNamespace
+
+import numpy as np
+
+from chebnorm.methods import detmath
+from chebnorm.methods import kernels as K
+from chebnorm.methods.ops import NumpyOps
+from chebnorm.methods.registry import method_kernel
+from chebnorm.methods.spans import MAX_LEVELS, check_span_input
+
+from . import fast
+from .meshes import _unit
+
+try:  # pragma: no cover - exercised by whichever environment runs the tests
+    import numba
+    from llvmlite import ir as _ir
+    from numba import prange
+    from numba.core import types as _types
+    from numba.core.extending import intrinsic as _intrinsic
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover
+    numba = None
+    prange = range
+    HAVE_NUMBA = False
+
+__all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det", "phong"]
+
+#: kernel -> mode number of the fused kernel
+MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLERP): 4,
+         id(K.QUADRATIC): 5, id(K.ANGULAR): 6, id(K.DICHOTOMY): 7}
+
+
+def _njit(parallel=False):
+    def deco(fn):
+        if not HAVE_NUMBA:
+            return fn
+        return numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy",
+                          parallel=parallel)(fn)
+    return deco
+
+
+if HAVE_NUMBA:
+    @_intrinsic
+    def _fma(typingctx, a, b, c):
+        """``a * b + c`` rounded once (LLVM's ``fma``)."""
+        sig = _types.float64(_types.float64, _types.float64, _types.float64)
+
+        def codegen(context, builder, signature, args):
+            d = _ir.DoubleType()
+            fn = builder.module.declare_intrinsic("llvm.fma", [d], _ir.FunctionType(d, [d, d, d]))
+            return builder.call(fn, args)
+        return sig, codegen
+else:  # pragma: no cover
+    def _fma(a, b, c):
+        raise RuntimeError("numba is not installed")
+
+
+# ------------------------------------------------------- reduction orders
+@_njit()
+def _dot3(a0, a1, a2, b0, b1, b2, order):
+    """``a . b`` in summation order ``order``: 0 ``(a0b0 + a1b1) + a2b2``,
+    1 ``(a0b0 + a2b2) + a1b1``, 2 ``fma(a2, b2, fma(a0, b0, a1b1))``."""
+    if order == 0:
+        return (a0 * b0 + a1 * b1) + a2 * b2
+    if order == 1:
+        return (a0 * b0 + a2 * b2) + a1 * b1
+    return _fma(a2, b2, _fma(a0, b0, a1 * b1))
+
+
+@_njit()
+def _dots(N, H, order):
+    out = np.empty(N.shape[0])
+    for i in range(N.shape[0]):
+        out[i] = _dot3(N[i, 0], N[i, 1], N[i, 2], H[i, 0], H[i, 1], H[i, 2], order)
+    return out
+
+
+_ORDERS = (0, 1, 2)
+
+
+@lru_cache(maxsize=None)
+def calibrated():
+    """``(order of N @ L, order of einsum N.H, order of |N|^2)`` on this machine (see
+    :func:`_dot3`), or None if some reduction matches none of the orders. Probed with
+    random vectors of several lengths (>= 2: numpy sends one row elsewhere).
+
+    >>> calibrated() is None or len(calibrated()) == 3
+    True
+    """
+    if not HAVE_NUMBA:
+        return None
+    rng = np.random.default_rng(20261123)
+    found = []
+    for kind in ("matmul", "einsum", "norm"):
+        ok = None
+        for order in _ORDERS:
+            good = True
+            for n in (2, 3, 5, 8, 17, 1000, 4099):
+                N = rng.standard_normal((n, 3))
+                H = rng.standard_normal((n, 3))
+                if kind == "matmul":
+                    ref, got = N @ H[0], _dots(N, np.broadcast_to(H[0], N.shape).copy(), order)
+                elif kind == "einsum":
+                    ref, got = np.einsum("...k,...k->...", N, H), _dots(N, H, order)
+                else:
+                    ref, got = np.linalg.norm(N, axis=1), np.sqrt(_dots(N, N, order))
+                if ref.tobytes() != got.tobytes():
+                    good = False
+                    break
+            if good:
+                ok = order
+                break
+        if ok is None:
+            return None
+        found.append(ok)
+    return tuple(found)
+
+
+# ------------------------------------------------------ deterministic trig
+@_njit()
+def _det64(kind, x, out):
+    for i in range(x.shape[0]):
+        v = x[i]
+        out[i] = np.sin(v) if kind == 0 else (np.cos(v) if kind == 1 else np.arccos(v))
+
+
+@_njit()
+def _f32_round(y):
+    """``y`` (float64) rounded to float32, and whether that rounding could differ from
+    the correctly rounded one (within 2**-16 ulp of a tie, at a power of two, zero,
+    subnormal or not finite)."""
+    r = np.float32(y)
+    a = abs(np.float64(r))
+    if not np.isfinite(y) or a < 2.0 ** -126 or not np.isfinite(a):
+        return r, True
+    m, e = math.frexp(a)
+    if m == 0.5:
+        return r, True
+    ulp = math.ldexp(1.0, e - 24)
+    frac = abs(y - np.float64(r)) / ulp
+    return r, abs(frac - 0.5) < 2.0 ** -16
+
+
+@_njit()
+def _det32(kind, x, out, hard):
+    n = 0
+    for i in range(x.shape[0]):
+        v = np.float64(x[i])
+        y = np.sin(v) if kind == 0 else (np.cos(v) if kind == 1 else np.arccos(v))
+        r, h = _f32_round(y)
+        out[i] = r
+        hard[i] = h
+        n += h
+    return n
+
+
+_KINDS = {"sin": 0, "cos": 1, "arccos": 2}
+
+
+def det(name: str, x):
+    """``detmath.<name>(x)`` (``sin``, ``cos``, ``arccos``), the same bits, compiled:
+    float64 by the C library (what :mod:`math` calls), float32 correctly rounded from
+    it, the few arguments whose rounding is in doubt handed to :mod:`detmath`.
+
+    >>> import numpy as np
+    >>> x = np.linspace(-3, 3, 101, dtype=np.float32)
+    >>> bool((det("sin", x) == detmath.sin(x)).all())
+    True
+    """
+    arr = np.asarray(x)
+    if not HAVE_NUMBA or not isinstance(x, np.ndarray) or arr.dtype not in (np.float32,
+                                                                             np.float64):
+        return getattr(detmath, name)(x)
+    flat = np.ascontiguousarray(arr).ravel()
+    out = np.empty_like(flat)
+    if arr.dtype == np.float64:
+        _det64(_KINDS[name], flat, out)
+    else:
+        hard = np.empty(flat.shape, np.bool_)
+        if _det32(_KINDS[name], flat, out, hard):
+            out[hard] = getattr(detmath, name)(flat[hard])
+    return out.reshape(arr.shape)
+
+
+class _DetOps(NumpyOps):
+    """:class:`NumpyOps` with :func:`det` for the transcendental functions."""
+
+    def sin(self, x):
+        return det("sin", x)
+
+    def cos(self, x):
+        return det("cos", x)
+
+    def arccos(self, x):
+        return det("arccos", x)
+
+
+# --------------------------------------------------------- triangle set-up
+@_njit(parallel=True)
+def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
+    """``_setup`` of :mod:`.render`: front-facing triangles and their corners."""
+    F = faces.shape[0]
+    keep = np.empty(F, np.bool_)
+    for i in prange(F):
+        a, b, c = faces[i, 0], faces[i, 1], faces[i, 2]
+        area = ((xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1])
+                - (xy[c, 0] - xy[a, 0]) * (xy[b, 1] - xy[a, 1]))
+        keep[i] = area < 0 if cull else area != 0
+    n = 0
+    for i in range(F):
+        n += keep[i]
+    tri = np.empty(n, np.int64)
+    n = 0
+    for i in range(F):
+        if keep[i]:
+            tri[n] = i
+            n += 1
+    txy = np.empty((n, 3, 2))
+    attrs = np.empty((n, 3, 7))
+    for k in prange(n):
+        i = tri[k]
+        for v in range(3):
+            q = faces[i, v]
+            txy[k, v, 0] = xy[q, 0]
+            txy[k, v, 1] = xy[q, 1]
+            attrs[k, v, 0] = inv_w[q]
+            for c in range(3):
+                attrs[k, v, 1 + c] = nrm[q, c]
+                attrs[k, v, 4 + c] = pos[q, c]
+    return tri, txy, attrs
+
+
+# ------------------------------------------------------------- span set-up
+@_njit(parallel=True)
+def _spans_par(xy, attrs, width, r0, nrows, start, n_max):
+    """The spans of :func:`.spans.setup_spans` (slot per triangle row; ``valid``
+    marks the kept ones), parallel over triangles."""
+    T, _, Kc = attrs.shape
+    valid = np.zeros(n_max, np.bool_)
+    row = np.empty(n_max, np.int64)
+    c0 = np.empty(n_max, np.int64)
+    count = np.empty(n_max, np.int64)
+    m = np.empty(n_max, np.int64)
+    t0 = np.empty(n_max, np.float64)
+    dt = np.empty(n_max, np.float64)
+    left = np.empty((n_max, Kc), np.float64)
+    right = np.empty((n_max, Kc), np.float64)
+    for i in prange(T):
+        y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
+        for r in range(r0[i], r0[i] + nrows[i]):
+            y = r + 0.5
+            # edges (0,1), (1,2), (2,0): hit when min <= y < max; the first and last hit
+            h0 = min(y0, y1) <= y and y < max(y0, y1)
+            h1 = min(y1, y2) <= y and y < max(y1, y2)
+            h2 = min(y2, y0) <= y and y < max(y2, y0)
+            if np.int64(h0) + np.int64(h1) + np.int64(h2) != 2:
+                continue
+            e1 = 0 if h0 else 1
+            e2 = 2 if h2 else 1
+            p = e1
+            q = (e1 + 1) % 3
+            sa = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
+            xa = xy[i, p, 0] + sa * (xy[i, q, 0] - xy[i, p, 0])
+            pa, qa = p, q
+            p = e2
+            q = (e2 + 1) % 3
+            sb = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
+            xb = xy[i, p, 0] + sb * (xy[i, q, 0] - xy[i, p, 0])
+            swap = xb < xa
+            xl = xb if swap else xa
+            xr = xa if swap else xb
+            a = np.int64(min(max(np.ceil(xl - 0.5), 0.0), float(width)))
+            b = np.int64(min(max(np.ceil(xr - 0.5), 0.0), float(width)))
+            c = max(b - a, 0)
+            if c <= 0:
+                continue
+            n = start[i] + (r - r0[i])
+            valid[n] = True
+            row[n] = r
+            c0[n] = a
+            count[n] = c
+            for k in range(Kc):
+                va = attrs[i, pa, k] + sa * (attrs[i, qa, k] - attrs[i, pa, k])
+                vb = attrs[i, p, k] + sb * (attrs[i, q, k] - attrs[i, p, k])
+                left[n, k] = vb if swap else va
+                right[n, k] = va if swap else vb
+            ws = xr - xl
+            d = 1.0 / ws
+            dt[n] = d
+            t0[n] = ((a + 0.5) - xl) * d
+            m[n] = np.int64(max(1.0, np.ceil(ws)))
+    return valid, row, c0, count, m, t0, dt, left, right
+
+
+@_njit()
+def _compact(valid, nrows, row, c0, count, m, t0, dt, left, right, height):
+    """Keep the valid slots (in order), and bucket the spans by row (stable)."""
+    n = 0
+    T = nrows.shape[0]
+    for k in range(valid.shape[0]):
+        n += valid[k]
+    Kc = left.shape[1]
+    tri = np.empty(n, np.int64)
+    o_row, o_c0, o_cnt = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
+    o_m, o_t0, o_dt = np.empty(n, np.int64), np.empty(n), np.empty(n)
+    o_l, o_r = np.empty((n, Kc)), np.empty((n, Kc))
+    j = 0
+    k = 0
+    for i in range(T):
+        for _ in range(nrows[i]):
+            if valid[k]:
+                tri[j] = i
+                o_row[j], o_c0[j], o_cnt[j], o_m[j] = row[k], c0[k], count[k], m[k]
+                o_t0[j], o_dt[j] = t0[k], dt[k]
+                for c in range(Kc):
+                    o_l[j, c] = left[k, c]
+                    o_r[j, c] = right[k, c]
+                j += 1
+            k += 1
+    row_start = np.zeros(height + 1, np.int64)
+    for s in range(n):
+        row_start[o_row[s] + 1] += 1
+    for r in range(height):
+        row_start[r + 1] += row_start[r]
+    fill = row_start[:-1].copy()
+    by_row = np.empty(n, np.int64)
+    for s in range(n):
+        r = o_row[s]
+        by_row[fill[r]] = s
+        fill[r] += 1
+    return tri, o_row, o_c0, o_cnt, o_m, o_t0, o_dt, o_l, o_r, row_start, by_row
+
+
+# ------------------------------------------------------------ dichotomy prep
+@_njit()
+def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
+    """Per-span denominators of every level and, per depth, whether any pixel of any
+    span is off the dyadic grid (then every pixel of that depth is picked), as
+    :func:`.fast._dichotomy_kernel` computes them."""
+    S = levels.shape[0]
+    Lmax = 0
+    for i in range(S):
+        Lmax = max(Lmax, levels[i])
+    r = np.empty((S, max(Lmax, 1)), nl.dtype)
+    for i in range(S):
+        z = (nl[0, i] * nr[0, i] + nl[1, i] * nr[1, i] + nl[2, i] * nr[2, i]) * kc[0]
+        L = levels[i]
+        for lev in range(L):
+            s = z + kc[0]
+            if exact:
+                rr = kc[1] / np.sqrt(s)
+            else:
+                p = coeffs[coeffs.shape[0] - 1]
+                for q in range(coeffs.shape[0] - 2, -1, -1):
+                    p = p * z + coeffs[q]
+                rr = p
+            r[i, lev] = rr
+            if lev < L - 1:
+                z = s * rr
+    off = np.zeros(Lmax + 1, np.bool_)
+    tcb = np.empty(1, nl.dtype)
+    for i in range(S):
+        L = levels[i]
+        if off[L]:
+            continue
+        scale = kc[2 + L]
+        for j in range(count[i]):
+            tcb[0] = t0[i] + j * dt[i]
+            u = tcb[0] * scale
+            if u - np.floor(u) != 0:
+                off[L] = True
+                break
+    return r, off
+
+
+# ---------------------------------------------------------------- shading
+@_njit()
+def _shade_px(p, s, N0, N1, N2, t, left, right, per_pixel_h, Htri, stri, L, eye, light,
+              orders, img, mask, tri_map, nlen, face_id):
+    """Blinn-Phong at pixel ``p`` (the winner span ``s``, clamped position ``t``) with the
+    pixel normal ``N`` (float64), as :func:`.render._phong` computes it."""
+    if per_pixel_h:
+        lo0, lo1, lo2 = left[s, 4], left[s, 5], left[s, 6]
+        p0 = lo0 + t * (right[s, 4] - lo0)
+        p1 = lo1 + t * (right[s, 5] - lo1)
+        p2 = lo2 + t * (right[s, 6] - lo2)
+        v0, v1, v2 = eye[0] - p0, eye[1] - p1, eye[2] - p2
+        r = np.sqrt(_dot3(v0, v1, v2, v0, v1, v2, orders[2]))
+        v0, v1, v2 = v0 / r, v1 / r, v2 / r
+        h0, h1, h2 = L[0] + v0, L[1] + v1, L[2] + v2
+        r = np.sqrt(_dot3(h0, h1, h2, h0, h1, h2, orders[2]))
+        h0, h1, h2 = h0 / r, h1 / r, h2 / r
+    else:
+        k = stri[s]
+        h0, h1, h2 = Htri[k, 0], Htri[k, 1], Htri[k, 2]
+    a = _dot3(N0, N1, N2, L[0], L[1], L[2], orders[0])
+    b = _dot3(N0, N1, N2, h0, h1, h2, orders[1])
+    a = a if (a >= 0.0 or a != a) else 0.0      # np.maximum(a, 0.0)
+    b = b if (b >= 0.0 or b != b) else 0.0
+    # numpy squares for the exponent 2 (its fast scalar power), calls pow otherwise
+    v = light[0] * (light[1] + light[2] * a + light[3] * (b * b if light[4] == 2.0
+                                                          else b ** light[4]))
+    if v < 0.0:
+        v = 0.0
+    elif v > 1.0:
+        v = 1.0
+    img[p] = v
+    mask[p] = True
+    tri_map[p] = face_id[stri[s]]
+    nlen[p] = np.sqrt(_dot3(N0, N1, N2, N0, N1, N2, orders[2]))
+
+
+@_njit()
+def _slerp_px(A, B, inv, i, sa, sb):
+    wa = sa * inv[i]
+    wb = sb * inv[i]
+    return (A[0, i] * wa + B[0, i] * wb, A[1, i] * wa + B[1, i] * wb,
+            A[2, i] * wa + B[2, i] * wb)
+
+
+@_njit(parallel=True)
+def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
+           A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
+           light, orders, nchunks):
+    """The visibility and shading passes, one scan line at a time (rows strided over
+    ``nchunks`` chunks run in parallel). Returns the four output maps and the number of
+    slerp float32 pixels whose sine needs :mod:`detmath` (marked ``-2 - span`` in
+    the triangle map)."""
+    npx = width * height
+    img = np.empty(npx)
+    mask = np.empty(npx, np.bool_)
+    tri_map = np.empty(npx, np.int64)
+    nlen = np.empty(npx)
+    hard = np.zeros(nchunks, np.int64)
+    for ch in prange(nchunks):
+        bw = np.empty(width)
+        bs = np.empty(width, np.int64)
+        tcb = np.empty(1, A.dtype)
+        sab = np.empty(2, A.dtype)
+        for rr in range(ch, height, nchunks):
+            base = rr * width
+            for x in range(width):
+                bs[x] = -1
+                img[base + x] = 0.0
+                mask[base + x] = False
+                tri_map[base + x] = -1
+                nlen[base + x] = np.nan
+            # visibility: largest 1/w, ties to the earliest span
+            for k in range(row_start[rr], row_start[rr + 1]):
+                s = by_row[k]
+                lo = left[s, 0]
+                dw = right[s, 0] - lo
+                for j in range(count[s]):
+                    t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+                    w = lo + t * dw
+                    x = c0[s] + j
+                    if bs[x] < 0 or w > bw[x]:
+                        bs[x] = s
+                        bw[x] = w
+            # shading of the winners
+            for k in range(row_start[rr], row_start[rr + 1]):
+                s = by_row[k]
+                cnt = count[s]
+                x0 = c0[s]
+                if mode == 5 or mode == 6:
+                    # stepping kernels: every pixel of the span, in order
+                    v0, v1, v2 = A[0, s], A[1, s], A[2, s]
+                    e0, e1, e2 = B[0, s], B[1, s], B[2, s]
+                    f0, f1, f2 = C[0, s], C[1, s], C[2, s]
+                    for j in range(cnt):
+                        if j > 0:
+                            if mode == 5:
+                                v0 = v0 + e0
+                                v1 = v1 + e1
+                                v2 = v2 + e2
+                                e0 = e0 + f0
+                                e1 = e1 + f1
+                                e2 = e2 + f2
+                            elif j == 1:
+                                v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
+                            else:
+                                k2 = sc[s]
+                                c0_ = v0 * k2 - e0
+                                c1_ = v1 * k2 - e1
+                                c2_ = v2 * k2 - e2
+                                e0, e1, e2 = v0, v1, v2
+                                v0, v1, v2 = c0_, c1_, c2_
+                        if bs[x0 + j] != s:
+                            continue
+                        t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+                        _shade_px(base + x0 + j, s, np.float64(v0), np.float64(v1),
+                                  np.float64(v2), t, left, right, per_pixel_h, Htri, stri, L,
+                                  eye, light, orders, img, mask, tri_map, nlen, face_id)
+                    continue
+                for j in range(cnt):
+                    if bs[x0 + j] != s:
+                        continue
+                    tu = t0[s] + j * dt[s]
+                    t = min(max(tu, 0.0), 1.0)
+                    if mode == 0:
+                        lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
+                        n0 = lo1 + t * (right[s, 1] - lo1)
+                        n1 = lo2 + t * (right[s, 2] - lo2)
+                        n2 = lo3 + t * (right[s, 3] - lo3)
+                        _shade_px(base + x0 + j, s, n0, n1, n2, t, left, right, per_pixel_h,
+                                  Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
+                                  face_id)
+                        continue
+                    tcb[0] = tu           # the reference's t.astype(dtype)
+                    tc = tcb[0]
+                    if mode <= 3:
+                        m0 = A[0, s] + tc * B[0, s]
+                        m1 = A[1, s] + tc * B[1, s]
+                        m2 = A[2, s] + tc * B[2, s]
+                        if mode == 1:
+                            q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+                            m0, m1, m2 = m0 / q, m1 / q, m2 / q
+                        else:
+                            xx = m0 * m0 + m1 * m1 + m2 * m2
+                            if mode == 2:
+                                q = (kc[0] - xx) * kc[1]
+                            else:
+                                q = (xx * kc[2] - kc[3]) * xx + kc[4]
+                            m0, m1, m2 = m0 * q, m1 * q, m2 * q
+                    elif mode == 4:
+                        arg_a = (kc[5] - tc) * sc[s]
+                        arg_b = tc * sc[s]
+                        if is64:
+                            sab[0] = np.sin(arg_a)
+                            sab[1] = np.sin(arg_b)
+                        else:
+                            ra, ha = _f32_round(np.sin(np.float64(arg_a)))
+                            rb, hb = _f32_round(np.sin(np.float64(arg_b)))
+                            if ha or hb:
+                                tri_map[base + x0 + j] = -2 - s
+                                hard[ch] += 1
+                                continue
+                            sab[0] = ra
+                            sab[1] = rb
+                        m0, m1, m2 = _slerp_px(A, B, sc2, s, sab[0], sab[1])
+                    else:
+                        m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
+                    _shade_px(base + x0 + j, s, np.float64(m0), np.float64(m1), np.float64(m2),
+                              t, left, right, per_pixel_h, Htri, stri, L, eye, light, orders,
+                              img, mask, tri_map, nlen, face_id)
+    nh = 0
+    for ch in range(nchunks):
+        nh += hard[ch]
+    return img, mask, tri_map, nlen, nh
+
+
+@_njit()
+def _node(A, B, R, i, L, k):
+    """Node ``k`` of the ``2**L + 1`` of span ``i`` (descending the halving tree), as
+    :func:`.fast._dichotomy_node`."""
+    top = np.int64(1) << L
+    if k == 0:
+        return A[0, i], A[1, i], A[2, i]
+    if k == top:
+        return B[0, i], B[1, i], B[2, i]
+    a0, a1, a2 = A[0, i], A[1, i], A[2, i]
+    b0, b1, b2 = B[0, i], B[1, i], B[2, i]
+    lo = np.int64(0)
+    hi = top
+    for lev in range(L):
+        mid = (lo + hi) >> 1
+        rr = R[i, lev]
+        m0 = (a0 + b0) * rr
+        m1 = (a1 + b1) * rr
+        m2 = (a2 + b2) * rr
+        if k == mid:
+            return m0, m1, m2
+        if k < mid:
+            hi = mid
+            b0, b1, b2 = m0, m1, m2
+        else:
+            lo = mid
+            a0, a1, a2 = m0, m1, m2
+    return a0, a1, a2
+
+
+@_njit()
+def _dichotomy_px(A, B, R, levels, off, kd, i, tc):
+    L = levels[i]
+    u = tc * kd[2 + L]
+    kf = np.floor(u)
+    fr = u - kf
+    k = np.int64(kf)
+    a0, a1, a2 = _node(A, B, R, i, L, k)
+    if not off[L]:
+        return a0, a1, a2
+    b0, b1, b2 = _node(A, B, R, i, L, min(k + 1, np.int64(1) << L))
+    return a0 + fr * (b0 - a0), a1 + fr * (b1 - a1), a2 + fr * (b2 - a2)
+
+
+@_njit()
+def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, per_pixel_h,
+                 Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen, face_id):
+    """Shade the slerp pixels whose sines :mod:`detmath` gave (``sa``, ``sb``)."""
+    for q in range(pix.shape[0]):
+        p = pix[q]
+        s = span[q]
+        j = p % width - c0[s]
+        t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+        m0, m1, m2 = _slerp_px(A, B, sc2, s, sa[q], sb[q])
+        _shade_px(p, s, np.float64(m0), np.float64(m1), np.float64(m2), t, left, right,
+                  per_pixel_h, Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
+                  face_id)
+
+
+# ------------------------------------------------------------------ driver
+def supports(spec) -> bool:
+    """Whether :func:`phong` renders method ``spec`` (its kernel has a fused twin, numba is
+    installed and :func:`calibrated` found the reductions' orders)."""
+    return (HAVE_NUMBA and id(method_kernel(spec)) in MODES
+            and calibrated() is not None)
+
+
+def gather_setup(mesh, xy, inv_w, cull):
+    """The per-triangle arrays of ``render._setup``, gathered in compiled code: front
+    triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``."""
+    tri, txy, attrs = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
+                                    np.ascontiguousarray(mesh.normals, np.float64),
+                                    np.ascontiguousarray(xy, np.float64),
+                                    np.ascontiguousarray(inv_w, np.float64),
+                                    np.ascontiguousarray(mesh.faces, np.int64), bool(cull))
+    return (tri, txy, np.ascontiguousarray(attrs[..., 0]), np.ascontiguousarray(attrs[..., 4:]),
+            np.ascontiguousarray(attrs[..., 1:4]))
+
+
+def spans(xy, attrs, width, height):
+    """The spans of :func:`.spans.setup_spans` without the fragment arrays, and the
+    spans of each row: ``(namespace of tri, row, x0, count, m, t0, dt, left, right,
+    row_start, by_row)``; row ``r``'s spans are ``by_row[row_start[r]:row_start[r+1]]``
+    (in span order)."""
+    xy = np.ascontiguousarray(xy, dtype=np.float64)
+    attrs = np.ascontiguousarray(attrs, dtype=np.float64)
+    r0, nrows = fast._count_rows(np.ascontiguousarray(xy[..., 1]), int(height))
+    start = np.cumsum(nrows) - nrows
+    out = _spans_par(xy, attrs, int(width), r0, nrows, start, int(nrows.sum()))
+    (tri, row, c0, count, m, t0, dt, left, right, row_start,
+     by_row) = _compact(*out[:1], nrows, *out[1:], int(height))
+    return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
+                           right=right, row_start=row_start, by_row=by_row)
+
+
+def _nchunks(height):
+    threads = numba.get_num_threads() if HAVE_NUMBA else 1
+    return max(1, min(height, 8 * threads))
+
+
+def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
+    """The ``phong`` frame of ``render`` (setup ``st``, method entry ``spec``): ``(image,
+    mask, triangle, normal_length, fragments, stats)``, or None when this path cannot
+    promise the reference's bytes (then the caller takes :mod:`.fast`). ``tri_half`` and
+    ``auto_tables`` are ``render``'s own helpers (per-triangle ``H``, table choice)."""
+    orders = calibrated()
+    if orders is None or id(method_kernel(spec)) not in MODES:
+        return None
+    per_pixel_h = lighting.half_vector == "pixel"
+    extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
+    sp = spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
+    S = len(sp.count)
+    stats = {}
+    tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
+    mode = MODES[id(method_kernel(spec))]
+    dtype = np.dtype(dtype).type
+    dt_ = dtype if mode else np.float64
+    A = B = C = np.zeros((3, 1), dt_)
+    sc = sc2 = np.zeros(1, dt_)
+    levels = np.zeros(1, np.int64)
+    R = np.zeros((1, 1), dt_)
+    off = np.zeros(1, np.bool_)
+    kd = np.zeros(1, dt_)
+    if mode and S:
+        cols = [1, 2, 3]
+        inp = check_span_input(spec, _unit(sp.left[:, cols]), _unit(sp.right[:, cols]), sp.m,
+                               t0=sp.t0, dt=sp.dt, count=sp.count, tables=tables, dtype=dtype)
+        dt_ = dtype = inp.dtype
+        coeffs = inp.coefficients
+        ops = _DetOps(dtype)
+        A = np.ascontiguousarray(inp.n_left.astype(dtype).T)
+        B = np.ascontiguousarray(inp.n_right.astype(dtype).T)
+        a, b = tuple(A), tuple(B)
+        start_left = bool((inp.t0 == 0).all())
+        if mode <= 3:
+            B = np.ascontiguousarray(np.stack(K.vsub(b, a)))
+        elif mode == 4:
+            s = spec_kernel_setup(ops, spec, a, b, coeffs)
+            sc, sc2 = np.ascontiguousarray(s["psi"], dtype), np.ascontiguousarray(s["inv"], dtype)
+        elif mode == 5:
+            A, B, C = fast._quadratic_setup(ops, a, b, inp.t0.astype(dtype), inp.dt.astype(dtype),
+                                            coeffs, start_left)
+        elif mode == 6:
+            A, B, sc = fast._angular_setup(ops, a, b, inp.t0.astype(dtype),
+                                           inp.dt.astype(dtype), int(inp.count.max()), start_left)
+        else:
+            cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
+            kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
+            levels = inp.levels.astype(np.int64)
+            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, inp.t0, inp.dt,
+                                     inp.count)
+    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
+    C = np.ascontiguousarray(C, dt_) if C.dtype == dt_ else np.zeros((3, 1), dt_)
+    Htri = (np.ascontiguousarray(tri_half(st), np.float64) if not per_pixel_h
+            else np.zeros((1, 3)))
+    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess],
+                     np.float64)
+    L = np.ascontiguousarray(st.L, np.float64)
+    eye = np.asarray(st.camera.eye, np.float64)
+    ords = np.array(orders, np.int64)
+    face_id = np.ascontiguousarray(st.tri, np.int64)
+    args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
+    img, mask, tri_map, nlen, nh = _frame(
+        st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count, *args[1:],
+        A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id, per_pixel_h, Htri,
+        L, eye, light, ords, _nchunks(st.height))
+    if nh:
+        pix = np.flatnonzero(tri_map < -1)
+        span = -2 - tri_map[pix]
+        j = pix % st.width - sp.x0[span]
+        tc = (sp.t0[span] + j * sp.dt[span]).astype(dt_)
+        psi = sc[span]
+        sa, sb = detmath.sin((kc[5] - tc) * psi), detmath.sin(tc * psi)
+        _slerp_fixup(pix, span, sa, sb, st.width, *args, A, B, sc2, per_pixel_h, Htri, sp.tri,
+                     L, eye, light, ords, img, mask, tri_map, nlen, face_id)
+    if np.count_nonzero(mask) < 2:
+        return None    # numpy computes N @ L for one row by another route than BLAS
+    shape = (st.height, st.width)
+    return (img.reshape(shape), mask.reshape(shape), tri_map.reshape(shape),
+            nlen.reshape(shape), int(sp.count.sum()), stats)
+
+
+def spec_kernel_setup(ops, spec, a, b, coeffs):
+    """The per-span set-up of a direct kernel (``kernel.setup``)."""
+    return method_kernel(spec).setup(ops, a, b, coeffs)
