@@ -5,12 +5,13 @@ operation; this module computes the same ``phong`` frame, byte for byte, without
 the full-frame intermediate arrays of those two paths (fragment lists, a frame-sized
 z-buffer, per-fragment normals, half vectors and dot products):
 
-1. triangle set-up and span set-up, compiled and parallel over triangles (the
+1. triangle set-up and span set-up, compiled, the spans split over threads (the
    arithmetic of :func:`.spans.setup_spans`);
 2. the method's checks and per-span set-up, as :func:`chebnorm.methods.span_normals`
    does them (the same calls; sine, cosine and arc cosine element by element with
    the bits of :mod:`chebnorm.methods.detmath`, see :func:`det`);
-3. one pass per scan line, rows split across the cores (``prange``): a z-test of the
+3. one pass per scan line, rows split across the cores (threads running the compiled
+   kernels without the GIL, rows interleaved): a z-test of the
    line's spans in span order into a line buffer (the winning span of every pixel,
    ties to the earliest fragment as in :func:`.spans.zbuffer`), then each span's
    pixel normals by the method's kernel (stepping kernels step through every pixel
@@ -30,6 +31,8 @@ runs :mod:`.fast` instead, so the bytes never depend on the guess.
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from types import SimpleNamespace
 
@@ -47,13 +50,11 @@ from .meshes import _unit
 try:  # pragma: no cover - exercised by whichever environment runs the tests
     import numba
     from llvmlite import ir as _ir
-    from numba import prange
     from numba.core import types as _types
     from numba.core.extending import intrinsic as _intrinsic
     HAVE_NUMBA = True
 except ImportError:  # pragma: no cover
     numba = None
-    prange = range
     HAVE_NUMBA = False
 
 __all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det", "phong"]
@@ -63,12 +64,15 @@ MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLE
          id(K.QUADRATIC): 5, id(K.ANGULAR): 6, id(K.DICHOTOMY): 7}
 
 
-def _njit(parallel=False):
+def _njit(inline=False):
+    """numba's ``njit`` (cached, no fast-math); ``inline``: inlined into its callers in
+    numba's IR (per-pixel helpers: no call, no reference counting of the arrays passed
+    in the inner loop)."""
     def deco(fn):
         if not HAVE_NUMBA:
             return fn
         return numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy",
-                          parallel=parallel)(fn)
+                          inline="always" if inline else "never")(fn)
     return deco
 
 
@@ -89,7 +93,7 @@ else:  # pragma: no cover
 
 
 # ------------------------------------------------------- reduction orders
-@_njit()
+@_njit(inline=True)
 def _dot3(a0, a1, a2, b0, b1, b2, order):
     """``a . b`` in summation order ``order``: 0 ``(a0b0 + a1b1) + a2b2``,
     1 ``(a0b0 + a2b2) + a1b1``, 2 ``fma(a2, b2, fma(a0, b0, a1b1))``."""
@@ -157,7 +161,7 @@ def _det64(kind, x, out):
         out[i] = np.sin(v) if kind == 0 else (np.cos(v) if kind == 1 else np.arccos(v))
 
 
-@_njit()
+@_njit(inline=True)
 def _f32_round(y):
     """``y`` (float64) rounded to float32, and whether that rounding could differ from
     the correctly rounded one (within 2**-16 ulp of a tie, at a power of two, zero,
@@ -229,12 +233,12 @@ class _DetOps(NumpyOps):
 
 
 # --------------------------------------------------------- triangle set-up
-@_njit(parallel=True)
+@_njit()
 def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
     """``_setup`` of :mod:`.render`: front-facing triangles and their corners."""
     F = faces.shape[0]
     keep = np.empty(F, np.bool_)
-    for i in prange(F):
+    for i in range(F):
         a, b, c = faces[i, 0], faces[i, 1], faces[i, 2]
         area = ((xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1])
                 - (xy[c, 0] - xy[a, 0]) * (xy[b, 1] - xy[a, 1]))
@@ -250,7 +254,7 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
             n += 1
     txy = np.empty((n, 3, 2))
     attrs = np.empty((n, 3, 7))
-    for k in prange(n):
+    for k in range(n):
         i = tri[k]
         for v in range(3):
             q = faces[i, v]
@@ -264,21 +268,13 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
 
 
 # ------------------------------------------------------------- span set-up
-@_njit(parallel=True)
-def _spans_par(xy, attrs, width, r0, nrows, start, n_max):
-    """The spans of :func:`.spans.setup_spans` (slot per triangle row; ``valid``
-    marks the kept ones), parallel over triangles."""
-    T, _, Kc = attrs.shape
-    valid = np.zeros(n_max, np.bool_)
-    row = np.empty(n_max, np.int64)
-    c0 = np.empty(n_max, np.int64)
-    count = np.empty(n_max, np.int64)
-    m = np.empty(n_max, np.int64)
-    t0 = np.empty(n_max, np.float64)
-    dt = np.empty(n_max, np.float64)
-    left = np.empty((n_max, Kc), np.float64)
-    right = np.empty((n_max, Kc), np.float64)
-    for i in prange(T):
+@_njit()
+def _spans_part(xy, attrs, width, r0, nrows, start, lo, hi, valid, row, c0, count, m, t0, dt,
+                left, right):
+    """The spans of :func:`.spans.setup_spans` of triangles ``lo .. hi-1``, one slot per
+    triangle row from ``start`` (``valid`` marks the kept ones)."""
+    Kc = attrs.shape[2]
+    for i in range(lo, hi):
         y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
         for r in range(r0[i], r0[i] + nrows[i]):
             y = r + 0.5
@@ -322,7 +318,6 @@ def _spans_par(xy, attrs, width, r0, nrows, start, n_max):
             dt[n] = d
             t0[n] = ((a + 0.5) - xl) * d
             m[n] = np.int64(max(1.0, np.ceil(ws)))
-    return valid, row, c0, count, m, t0, dt, left, right
 
 
 @_njit()
@@ -407,7 +402,7 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
 
 
 # ---------------------------------------------------------------- shading
-@_njit()
+@_njit(inline=True)
 def _shade_px(p, s, N0, N1, N2, t, left, right, per_pixel_h, Htri, stri, L, eye, light,
               orders, img, mask, tri_map, nlen, face_id):
     """Blinn-Phong at pixel ``p`` (the winner span ``s``, clamped position ``t``) with the
@@ -443,7 +438,7 @@ def _shade_px(p, s, N0, N1, N2, t, left, right, per_pixel_h, Htri, stri, L, eye,
     nlen[p] = np.sqrt(_dot3(N0, N1, N2, N0, N1, N2, orders[2]))
 
 
-@_njit()
+@_njit(inline=True)
 def _slerp_px(A, B, inv, i, sa, sb):
     wa = sa * inv[i]
     wb = sb * inv[i]
@@ -451,138 +446,129 @@ def _slerp_px(A, B, inv, i, sa, sb):
             A[2, i] * wa + B[2, i] * wb)
 
 
-@_njit(parallel=True)
+@_njit()
 def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
            A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
-           light, orders, nchunks):
-    """The visibility and shading passes, one scan line at a time (rows strided over
-    ``nchunks`` chunks run in parallel). Returns the four output maps and the number of
-    slerp float32 pixels whose sine needs :mod:`detmath` (marked ``-2 - span`` in
-    the triangle map)."""
-    npx = width * height
-    img = np.empty(npx)
-    mask = np.empty(npx, np.bool_)
-    tri_map = np.empty(npx, np.int64)
-    nlen = np.empty(npx)
-    hard = np.zeros(nchunks, np.int64)
-    for ch in prange(nchunks):
-        bw = np.empty(width)
-        bs = np.empty(width, np.int64)
-        tcb = np.empty(1, A.dtype)
-        sab = np.empty(2, A.dtype)
-        for rr in range(ch, height, nchunks):
-            base = rr * width
-            for x in range(width):
-                bs[x] = -1
-                img[base + x] = 0.0
-                mask[base + x] = False
-                tri_map[base + x] = -1
-                nlen[base + x] = np.nan
-            # visibility: largest 1/w, ties to the earliest span
-            for k in range(row_start[rr], row_start[rr + 1]):
-                s = by_row[k]
-                lo = left[s, 0]
-                dw = right[s, 0] - lo
-                for j in range(count[s]):
-                    t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
-                    w = lo + t * dw
-                    x = c0[s] + j
-                    if bs[x] < 0 or w > bw[x]:
-                        bs[x] = s
-                        bw[x] = w
-            # shading of the winners
-            for k in range(row_start[rr], row_start[rr + 1]):
-                s = by_row[k]
-                cnt = count[s]
-                x0 = c0[s]
-                if mode == 5 or mode == 6:
-                    # stepping kernels: every pixel of the span, in order
-                    v0, v1, v2 = A[0, s], A[1, s], A[2, s]
-                    e0, e1, e2 = B[0, s], B[1, s], B[2, s]
-                    f0, f1, f2 = C[0, s], C[1, s], C[2, s]
-                    for j in range(cnt):
-                        if j > 0:
-                            if mode == 5:
-                                v0 = v0 + e0
-                                v1 = v1 + e1
-                                v2 = v2 + e2
-                                e0 = e0 + f0
-                                e1 = e1 + f1
-                                e2 = e2 + f2
-                            elif j == 1:
-                                v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
-                            else:
-                                k2 = sc[s]
-                                c0_ = v0 * k2 - e0
-                                c1_ = v1 * k2 - e1
-                                c2_ = v2 * k2 - e2
-                                e0, e1, e2 = v0, v1, v2
-                                v0, v1, v2 = c0_, c1_, c2_
-                        if bs[x0 + j] != s:
-                            continue
-                        t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
-                        _shade_px(base + x0 + j, s, np.float64(v0), np.float64(v1),
-                                  np.float64(v2), t, left, right, per_pixel_h, Htri, stri, L,
-                                  eye, light, orders, img, mask, tri_map, nlen, face_id)
-                    continue
+           light, orders, part, parts, img, mask, tri_map, nlen):
+    """The visibility and shading passes, one scan line at a time, on the rows
+    ``part, part + parts, ...`` (threads run the parts at once: each writes its own
+    rows of the four output maps). Returns the number of slerp float32 pixels whose
+    sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map)."""
+    hard = 0
+    bw = np.empty(width)
+    bs = np.empty(width, np.int64)
+    tcb = np.empty(1, A.dtype)
+    sab = np.empty(2, A.dtype)
+    for rr in range(part, height, parts):
+        base = rr * width
+        for x in range(width):
+            bs[x] = -1
+            img[base + x] = 0.0
+            mask[base + x] = False
+            tri_map[base + x] = -1
+            nlen[base + x] = np.nan
+        # visibility: largest 1/w, ties to the earliest span
+        for k in range(row_start[rr], row_start[rr + 1]):
+            s = by_row[k]
+            lo = left[s, 0]
+            dw = right[s, 0] - lo
+            for j in range(count[s]):
+                t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+                w = lo + t * dw
+                x = c0[s] + j
+                if bs[x] < 0 or w > bw[x]:
+                    bs[x] = s
+                    bw[x] = w
+        # shading of the winners
+        for k in range(row_start[rr], row_start[rr + 1]):
+            s = by_row[k]
+            cnt = count[s]
+            x0 = c0[s]
+            if mode == 5 or mode == 6:
+                # stepping kernels: every pixel of the span, in order
+                v0, v1, v2 = A[0, s], A[1, s], A[2, s]
+                e0, e1, e2 = B[0, s], B[1, s], B[2, s]
+                f0, f1, f2 = C[0, s], C[1, s], C[2, s]
                 for j in range(cnt):
+                    if j > 0:
+                        if mode == 5:
+                            v0 = v0 + e0
+                            v1 = v1 + e1
+                            v2 = v2 + e2
+                            e0 = e0 + f0
+                            e1 = e1 + f1
+                            e2 = e2 + f2
+                        elif j == 1:
+                            v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
+                        else:
+                            k2 = sc[s]
+                            c0_ = v0 * k2 - e0
+                            c1_ = v1 * k2 - e1
+                            c2_ = v2 * k2 - e2
+                            e0, e1, e2 = v0, v1, v2
+                            v0, v1, v2 = c0_, c1_, c2_
                     if bs[x0 + j] != s:
                         continue
-                    tu = t0[s] + j * dt[s]
-                    t = min(max(tu, 0.0), 1.0)
-                    if mode == 0:
-                        lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
-                        n0 = lo1 + t * (right[s, 1] - lo1)
-                        n1 = lo2 + t * (right[s, 2] - lo2)
-                        n2 = lo3 + t * (right[s, 3] - lo3)
-                        _shade_px(base + x0 + j, s, n0, n1, n2, t, left, right, per_pixel_h,
-                                  Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
-                                  face_id)
-                        continue
-                    tcb[0] = tu           # the reference's t.astype(dtype)
-                    tc = tcb[0]
-                    if mode <= 3:
-                        m0 = A[0, s] + tc * B[0, s]
-                        m1 = A[1, s] + tc * B[1, s]
-                        m2 = A[2, s] + tc * B[2, s]
-                        if mode == 1:
-                            q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-                            m0, m1, m2 = m0 / q, m1 / q, m2 / q
-                        else:
-                            xx = m0 * m0 + m1 * m1 + m2 * m2
-                            if mode == 2:
-                                q = (kc[0] - xx) * kc[1]
-                            else:
-                                q = (xx * kc[2] - kc[3]) * xx + kc[4]
-                            m0, m1, m2 = m0 * q, m1 * q, m2 * q
-                    elif mode == 4:
-                        arg_a = (kc[5] - tc) * sc[s]
-                        arg_b = tc * sc[s]
-                        if is64:
-                            sab[0] = np.sin(arg_a)
-                            sab[1] = np.sin(arg_b)
-                        else:
-                            ra, ha = _f32_round(np.sin(np.float64(arg_a)))
-                            rb, hb = _f32_round(np.sin(np.float64(arg_b)))
-                            if ha or hb:
-                                tri_map[base + x0 + j] = -2 - s
-                                hard[ch] += 1
-                                continue
-                            sab[0] = ra
-                            sab[1] = rb
-                        m0, m1, m2 = _slerp_px(A, B, sc2, s, sab[0], sab[1])
+                    t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+                    _shade_px(base + x0 + j, s, np.float64(v0), np.float64(v1),
+                              np.float64(v2), t, left, right, per_pixel_h, Htri, stri, L,
+                              eye, light, orders, img, mask, tri_map, nlen, face_id)
+                continue
+            for j in range(cnt):
+                if bs[x0 + j] != s:
+                    continue
+                tu = t0[s] + j * dt[s]
+                t = min(max(tu, 0.0), 1.0)
+                if mode == 0:
+                    lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
+                    n0 = lo1 + t * (right[s, 1] - lo1)
+                    n1 = lo2 + t * (right[s, 2] - lo2)
+                    n2 = lo3 + t * (right[s, 3] - lo3)
+                    _shade_px(base + x0 + j, s, n0, n1, n2, t, left, right, per_pixel_h,
+                              Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
+                              face_id)
+                    continue
+                tcb[0] = tu           # the reference's t.astype(dtype)
+                tc = tcb[0]
+                if mode <= 3:
+                    m0 = A[0, s] + tc * B[0, s]
+                    m1 = A[1, s] + tc * B[1, s]
+                    m2 = A[2, s] + tc * B[2, s]
+                    if mode == 1:
+                        q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+                        m0, m1, m2 = m0 / q, m1 / q, m2 / q
                     else:
-                        m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
-                    _shade_px(base + x0 + j, s, np.float64(m0), np.float64(m1), np.float64(m2),
-                              t, left, right, per_pixel_h, Htri, stri, L, eye, light, orders,
-                              img, mask, tri_map, nlen, face_id)
-    nh = 0
-    for ch in range(nchunks):
-        nh += hard[ch]
-    return img, mask, tri_map, nlen, nh
+                        xx = m0 * m0 + m1 * m1 + m2 * m2
+                        if mode == 2:
+                            q = (kc[0] - xx) * kc[1]
+                        else:
+                            q = (xx * kc[2] - kc[3]) * xx + kc[4]
+                        m0, m1, m2 = m0 * q, m1 * q, m2 * q
+                elif mode == 4:
+                    arg_a = (kc[5] - tc) * sc[s]
+                    arg_b = tc * sc[s]
+                    if is64:
+                        sab[0] = np.sin(arg_a)
+                        sab[1] = np.sin(arg_b)
+                    else:
+                        ra, ha = _f32_round(np.sin(np.float64(arg_a)))
+                        rb, hb = _f32_round(np.sin(np.float64(arg_b)))
+                        if ha or hb:
+                            tri_map[base + x0 + j] = -2 - s
+                            hard += 1
+                            continue
+                        sab[0] = ra
+                        sab[1] = rb
+                    m0, m1, m2 = _slerp_px(A, B, sc2, s, sab[0], sab[1])
+                else:
+                    m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
+                _shade_px(base + x0 + j, s, np.float64(m0), np.float64(m1), np.float64(m2),
+                          t, left, right, per_pixel_h, Htri, stri, L, eye, light, orders,
+                          img, mask, tri_map, nlen, face_id)
+    return hard
 
 
-@_njit()
+@_njit(inline=True)
 def _node(A, B, R, i, L, k):
     """Node ``k`` of the ``2**L + 1`` of span ``i`` (descending the halving tree), as
     :func:`.fast._dichotomy_node`."""
@@ -612,7 +598,7 @@ def _node(A, B, R, i, L, k):
     return a0, a1, a2
 
 
-@_njit()
+@_njit(inline=True)
 def _dichotomy_px(A, B, R, levels, off, kd, i, tc):
     L = levels[i]
     u = tc * kd[2 + L]
@@ -669,17 +655,46 @@ def spans(xy, attrs, width, height):
     xy = np.ascontiguousarray(xy, dtype=np.float64)
     attrs = np.ascontiguousarray(attrs, dtype=np.float64)
     r0, nrows = fast._count_rows(np.ascontiguousarray(xy[..., 1]), int(height))
-    start = np.cumsum(nrows) - nrows
-    out = _spans_par(xy, attrs, int(width), r0, nrows, start, int(nrows.sum()))
+    ends = np.cumsum(nrows)
+    start = ends - nrows
+    n_max = int(ends[-1]) if len(ends) else 0
+    Kc = attrs.shape[2]
+    out = (np.zeros(n_max, np.bool_), np.empty(n_max, np.int64), np.empty(n_max, np.int64),
+           np.empty(n_max, np.int64), np.empty(n_max, np.int64), np.empty(n_max),
+           np.empty(n_max), np.empty((n_max, Kc)), np.empty((n_max, Kc)))
+    # parts of about equal numbers of rows
+    k = _threads()
+    cuts = [0] + [int(np.searchsorted(ends, n_max * q / k)) for q in range(1, k)] + [len(nrows)]
+    _run([(_spans_part, (xy, attrs, int(width), r0, nrows, start, cuts[q], cuts[q + 1], *out))
+          for q in range(k) if cuts[q] < cuts[q + 1]])
     (tri, row, c0, count, m, t0, dt, left, right, row_start,
      by_row) = _compact(*out[:1], nrows, *out[1:], int(height))
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
                            right=right, row_start=row_start, by_row=by_row)
 
 
-def _nchunks(height):
-    threads = numba.get_num_threads() if HAVE_NUMBA else 1
-    return max(1, min(height, 8 * threads))
+def _threads() -> int:
+    """Threads to split a frame over: the CPUs this process may run on (at most 8)."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        n = os.cpu_count() or 1
+    return max(1, min(8, n))
+
+
+_POOL: list = []
+
+
+def _run(jobs):
+    """Run ``[(kernel, args), ...]`` (compiled with ``nogil``) at once on a thread pool;
+    their results in order."""
+    if len(jobs) == 1:
+        return [jobs[0][0](*jobs[0][1])]
+    if not _POOL:
+        _POOL.append(ThreadPoolExecutor(max_workers=_threads(),
+                                        thread_name_prefix="chebnorm-raster"))
+    futures = [_POOL[0].submit(fn, *args) for fn, args in jobs]
+    return [f.result() for f in futures]
 
 
 def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
@@ -744,10 +759,14 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     ords = np.array(orders, np.int64)
     face_id = np.ascontiguousarray(st.tri, np.int64)
     args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
-    img, mask, tri_map, nlen, nh = _frame(
-        st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count, *args[1:],
-        A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id, per_pixel_h, Htri,
-        L, eye, light, ords, _nchunks(st.height))
+    npx = st.width * st.height
+    maps = (np.empty(npx), np.empty(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
+    img, mask, tri_map, nlen = maps
+    common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
+              *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
+              per_pixel_h, Htri, L, eye, light, ords)
+    k = min(_threads(), st.height)
+    nh = sum(_run([(_frame, (*common, q, k, *maps)) for q in range(k)]))
     if nh:
         pix = np.flatnonzero(tri_map < -1)
         span = -2 - tri_map[pix]
