@@ -269,13 +269,15 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
 
 # ------------------------------------------------------------- span set-up
 @_njit()
-def _spans_part(xy, attrs, width, r0, nrows, start, lo, hi, valid, row, c0, count, m, t0, dt,
-                left, right):
-    """The spans of :func:`.spans.setup_spans` of triangles ``lo .. hi-1``, one slot per
-    triangle row from ``start`` (``valid`` marks the kept ones)."""
+def _spans_part(xy, attrs, width, r0, nrows, lo, hi, write, nvalid, start, tri, row, c0, count,
+                m, t0, dt, left, right):
+    """The spans of :func:`.spans.setup_spans` of triangles ``lo .. hi-1``: with ``write``
+    False, how many each triangle keeps (into ``nvalid``); with ``write`` True, the spans
+    themselves, triangle ``i``'s from index ``start[i]`` on."""
     Kc = attrs.shape[2]
     for i in range(lo, hi):
         y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
+        n = start[i] if write else 0
         for r in range(r0[i], r0[i] + nrows[i]):
             y = r + 0.5
             # edges (0,1), (1,2), (2,0): hit when min <= y < max; the first and last hit
@@ -303,8 +305,10 @@ def _spans_part(xy, attrs, width, r0, nrows, start, lo, hi, valid, row, c0, coun
             c = max(b - a, 0)
             if c <= 0:
                 continue
-            n = start[i] + (r - r0[i])
-            valid[n] = True
+            if not write:
+                n += 1
+                continue
+            tri[n] = i
             row[n] = r
             c0[n] = a
             count[n] = c
@@ -318,45 +322,28 @@ def _spans_part(xy, attrs, width, r0, nrows, start, lo, hi, valid, row, c0, coun
             dt[n] = d
             t0[n] = ((a + 0.5) - xl) * d
             m[n] = np.int64(max(1.0, np.ceil(ws)))
+            n += 1
+        if not write:
+            nvalid[i] = n
 
 
 @_njit()
-def _compact(valid, nrows, row, c0, count, m, t0, dt, left, right, height):
-    """Keep the valid slots (in order), and bucket the spans by row (stable)."""
-    n = 0
-    T = nrows.shape[0]
-    for k in range(valid.shape[0]):
-        n += valid[k]
-    Kc = left.shape[1]
-    tri = np.empty(n, np.int64)
-    o_row, o_c0, o_cnt = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
-    o_m, o_t0, o_dt = np.empty(n, np.int64), np.empty(n), np.empty(n)
-    o_l, o_r = np.empty((n, Kc)), np.empty((n, Kc))
-    j = 0
-    k = 0
-    for i in range(T):
-        for _ in range(nrows[i]):
-            if valid[k]:
-                tri[j] = i
-                o_row[j], o_c0[j], o_cnt[j], o_m[j] = row[k], c0[k], count[k], m[k]
-                o_t0[j], o_dt[j] = t0[k], dt[k]
-                for c in range(Kc):
-                    o_l[j, c] = left[k, c]
-                    o_r[j, c] = right[k, c]
-                j += 1
-            k += 1
+def _by_row(row, height):
+    """The spans of each row, in span order: row ``r``'s are
+    ``by_row[row_start[r]:row_start[r+1]]``."""
+    n = row.shape[0]
     row_start = np.zeros(height + 1, np.int64)
     for s in range(n):
-        row_start[o_row[s] + 1] += 1
+        row_start[row[s] + 1] += 1
     for r in range(height):
         row_start[r + 1] += row_start[r]
     fill = row_start[:-1].copy()
     by_row = np.empty(n, np.int64)
     for s in range(n):
-        r = o_row[s]
+        r = row[s]
         by_row[fill[r]] = s
         fill[r] += 1
-    return tri, o_row, o_c0, o_cnt, o_m, o_t0, o_dt, o_l, o_r, row_start, by_row
+    return row_start, by_row
 
 
 # ------------------------------------------------------------ dichotomy prep
@@ -655,20 +642,27 @@ def spans(xy, attrs, width, height):
     xy = np.ascontiguousarray(xy, dtype=np.float64)
     attrs = np.ascontiguousarray(attrs, dtype=np.float64)
     r0, nrows = fast._count_rows(np.ascontiguousarray(xy[..., 1]), int(height))
-    ends = np.cumsum(nrows)
-    start = ends - nrows
-    n_max = int(ends[-1]) if len(ends) else 0
+    T = len(nrows)
     Kc = attrs.shape[2]
-    out = (np.zeros(n_max, np.bool_), np.empty(n_max, np.int64), np.empty(n_max, np.int64),
-           np.empty(n_max, np.int64), np.empty(n_max, np.int64), np.empty(n_max),
-           np.empty(n_max), np.empty((n_max, Kc)), np.empty((n_max, Kc)))
     # parts of about equal numbers of rows
     k = _threads()
-    cuts = [0] + [int(np.searchsorted(ends, n_max * q / k)) for q in range(1, k)] + [len(nrows)]
-    _run([(_spans_part, (xy, attrs, int(width), r0, nrows, start, cuts[q], cuts[q + 1], *out))
-          for q in range(k) if cuts[q] < cuts[q + 1]])
-    (tri, row, c0, count, m, t0, dt, left, right, row_start,
-     by_row) = _compact(*out[:1], nrows, *out[1:], int(height))
+    ends = np.cumsum(nrows)
+    cuts = [0] + [int(np.searchsorted(ends, ends[-1] * q / k)) if T else 0
+                  for q in range(1, k)] + [T]
+    parts = [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
+    nvalid = np.zeros(T, np.int64)
+    z1, z2 = np.zeros(1, np.int64), np.zeros((1, Kc))
+    fixed = (xy, attrs, int(width), r0, nrows)
+    _run([(_spans_part, (*fixed, lo, hi, False, nvalid, nvalid, z1, z1, z1, z1, z1, z2[0], z2[0],
+                         z2, z2)) for lo, hi in parts])
+    start = np.cumsum(nvalid) - nvalid
+    S = int(nvalid.sum())
+    out = (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
+           np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
+           np.empty((S, Kc)), np.empty((S, Kc)))
+    _run([(_spans_part, (*fixed, lo, hi, True, nvalid, start, *out)) for lo, hi in parts])
+    tri, row, c0, count, m, t0, dt, left, right = out
+    row_start, by_row = _by_row(row, int(height))
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
                            right=right, row_start=row_start, by_row=by_row)
 
