@@ -106,3 +106,105 @@ def test_render_identical_other_lighting():
         got = render("teapot", "phong", "lyon", size=SIZE, lighting=light, engine="numba")
         assert _same(got.image, ref.image) and _same(got.normal_length, ref.normal_length)
         assert _same(got.triangle, ref.triangle)
+
+
+# ------------------------------------------------- fused phong (raster.fused)
+from chebnorm.raster import fused  # noqa: E402
+
+
+def test_fused_spans_identical():
+    rng = np.random.default_rng(5)
+    T = 400
+    xy = rng.random((T, 3, 2)) * [70, 60] - 5
+    xy[:5, 1, 1] = xy[:5, 0, 1]
+    attrs = rng.standard_normal((T, 3, 7))
+    ref = setup_spans(xy, attrs, 64, 50)
+    got = fused.spans(xy, attrs, 64, 50)
+    for name in ("tri", "row", "x0", "count", "m", "t0", "dt", "left", "right"):
+        assert _same(getattr(got, name), getattr(ref, name)), name
+    # the row buckets list every span once, in span order within a row
+    assert _same(np.sort(got.by_row), np.arange(len(ref.count)))
+    for r in range(50):
+        ids = got.by_row[got.row_start[r]:got.row_start[r + 1]]
+        assert (ref.row[ids] == r).all() and (np.diff(ids) > 0).all()
+
+
+def test_det_matches_detmath():
+    from chebnorm.methods import detmath
+
+    rng = np.random.default_rng(11)
+    for name, lo, hi in (("sin", -4, 4), ("cos", -4, 4), ("arccos", -1.1, 1.1)):
+        for dtype in (np.float32, np.float64):
+            x = rng.uniform(lo, hi, 200_000).astype(dtype)
+            x[:4] = [0.0, -0.0, 1.0, -1.0]
+            with np.errstate(invalid="ignore"):
+                assert _same(fused.det(name, x), getattr(detmath, name)(x)), (name, dtype)
+
+
+def test_calibrated_orders_reproduce_numpy():
+    orders = fused.calibrated()
+    assert orders is not None  # on the machines chebnorm is tested on
+    rng = np.random.default_rng(2)
+    N, H = rng.standard_normal((999, 3)), rng.standard_normal((999, 3))
+    assert _same(fused._dots(N, np.broadcast_to(H[0], N.shape).copy(), orders[0]), N @ H[0])
+    assert _same(fused._dots(N, H, orders[1]), np.einsum("...k,...k->...", N, H))
+    assert _same(np.sqrt(fused._dots(N, N, orders[2])), np.linalg.norm(N, axis=1))
+
+
+def _spy(monkeypatch, name):
+    calls = []
+    real = getattr(fused, name)
+
+    def spy(*args, **kw):
+        out = real(*args, **kw)
+        calls.append(out)
+        return out
+    monkeypatch.setattr(fused, name, spy)
+    return calls
+
+
+def _check_identical(mesh, method, size, dtype=np.float64, lighting=None):
+    ref = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numpy")
+    got = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numba")
+    for name in ("image", "mask", "triangle", "normal_length"):
+        assert _same(getattr(got, name), getattr(ref, name)), (method, name)
+    assert got.fragments == ref.fragments and got.stats == ref.stats
+    return got
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("method", method_names())
+def test_fused_phong_identical_larger_frame(method, dtype, monkeypatch):
+    calls = _spy(monkeypatch, "phong")
+    _check_identical(get_mesh("teapot"), method, (256, 200), dtype)
+    assert len(calls) == 1 and calls[0] is not None   # the fused path drew it
+
+
+def test_fused_slerp_float32_rounding_fixup(monkeypatch):
+    # sines whose float32 rounding is in doubt (about 3 in 100 000) go to detmath
+    fix = _spy(monkeypatch, "_slerp_fixup")
+    _check_identical(get_mesh("teapot"), "slerp", (640, 640), np.float32)
+    assert len(fix) == 1
+
+
+@pytest.mark.parametrize("lighting", [dict(shininess=2.0), dict(shininess=1.0, ka=0.0),
+                                      dict(half_vector="triangle", shininess=2.0),
+                                      dict(I0=2.5, light=(0.3, 1.0, -0.2), ks=0.9)])
+def test_fused_phong_identical_lighting(lighting):
+    from chebnorm.raster import Lighting
+
+    for method in ("exact", "angular", "dichotomy"):
+        _check_identical(get_mesh("torus", 12), method, SIZE, lighting=Lighting(**lighting))
+
+
+@pytest.mark.parametrize("size", [(1, 1), (2, 1), (3, 3), (5, 4)])
+def test_fused_phong_tiny_frames(size):
+    for method in ("exact", "none", "quadratic"):
+        _check_identical(get_mesh("sphere", 8), method, size)
+
+
+def test_fused_falls_back_without_calibration(monkeypatch):
+    monkeypatch.setattr(fused, "calibrated", lambda: None)
+    calls = _spy(monkeypatch, "_frame")
+    _check_identical(get_mesh("teapot"), "lyon", SIZE)
+    assert not calls
