@@ -7,11 +7,13 @@ frame relative to a bare numpy normalization of the same number of vectors
 
 Uses the public API only.  Times are the best of ``--repeat`` runs (after one
 warm-up run that also fills caches: sympy kernels, tables, numba's compiled
-code).  Both engines run single-threaded (the compiled path has no parallel
-loops), so ``speedup`` (numpy time / numba time, same frame) is a like-for-like
-figure; ``cpu_s`` is the process CPU time of the best run, less sensitive than
-wall time to a machine shared with other jobs.  The load average is printed
-beside the figures.
+code, so the figures are steady state).  The numpy engine is single-threaded;
+the numba engine's ``phong`` frame (chebnorm.raster.fused) splits its scan lines
+over the CPUs the process may use (``threads`` in the output), the other modes
+run single-threaded, so ``speedup`` (numpy time / numba time, same frame) is the
+speedup a user sees, not a per-core figure.  ``cpu_s`` is the process CPU time
+(all threads) of the best run, less sensitive than wall time to a machine shared
+with other jobs.  The load average is printed beside the figures.
 """
 
 from __future__ import annotations
@@ -76,6 +78,8 @@ def main(argv=None):
                          args.repeat)
     summary = {"mesh": mesh.name, "triangles": int(len(mesh.faces)), "size": list(size),
                "engines": args.engine, "load_average_before": load_before,
+               "threads": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+               else os.cpu_count(),
                "load_average_after": os.getloadavg(), "cores": os.cpu_count(),
                "phong_exact_frame_s": phong["seconds"], "bare_normalize_s": bare,
                "ratio_frame_to_bare": phong["seconds"] / bare, "goal_ratio": 3.0, "modes": rows}
@@ -84,7 +88,7 @@ def main(argv=None):
     else:
         print(f"{mesh.name}: {len(mesh.faces)} triangles, {size[0]}x{size[1]}; load average "
               f"{load_before[0]:.2f} before, {summary['load_average_after'][0]:.2f} after "
-              f"({os.cpu_count()} cores)")
+              f"({os.cpu_count()} cores, {summary['threads']} usable)")
         head = "".join(f"  {e + ' ms':>10s} {e + ' Mfrag/s':>15s} {'(cpu)':>7s}"
                        for e in args.engine)
         print(f"  {'mode':22s} {'fragments':>9s}{head}  speedup")
