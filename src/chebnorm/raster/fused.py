@@ -390,47 +390,32 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
 
 # ---------------------------------------------------------------- shading
 @_njit(inline=True)
-def _shade_px(p, s, N0, N1, N2, t, left, right, per_pixel_h, Htri, stri, L, eye, light,
-              orders, img, mask, tri_map, nlen, face_id):
-    """Blinn-Phong at pixel ``p`` (the winner span ``s``, clamped position ``t``) with the
-    pixel normal ``N`` (float64), as :func:`.render._phong` computes it."""
-    if per_pixel_h:
-        lo0, lo1, lo2 = left[s, 4], left[s, 5], left[s, 6]
-        p0 = lo0 + t * (right[s, 4] - lo0)
-        p1 = lo1 + t * (right[s, 5] - lo1)
-        p2 = lo2 + t * (right[s, 6] - lo2)
-        v0, v1, v2 = eye[0] - p0, eye[1] - p1, eye[2] - p2
-        r = np.sqrt(_dot3(v0, v1, v2, v0, v1, v2, orders[2]))
-        v0, v1, v2 = v0 / r, v1 / r, v2 / r
-        h0, h1, h2 = L[0] + v0, L[1] + v1, L[2] + v2
-        r = np.sqrt(_dot3(h0, h1, h2, h0, h1, h2, orders[2]))
-        h0, h1, h2 = h0 / r, h1 / r, h2 / r
-    else:
-        k = stri[s]
-        h0, h1, h2 = Htri[k, 0], Htri[k, 1], Htri[k, 2]
-    a = _dot3(N0, N1, N2, L[0], L[1], L[2], orders[0])
-    b = _dot3(N0, N1, N2, h0, h1, h2, orders[1])
+def _half(p0, p1, p2, e0, e1, e2, l0, l1, l2, order):
+    """``_unit(L + _unit(eye - P))`` (:func:`.render._half_vectors`; ``|v|`` as
+    ``np.linalg.norm`` sums, ``order``)."""
+    v0, v1, v2 = e0 - p0, e1 - p1, e2 - p2
+    r = np.sqrt(_dot3(v0, v1, v2, v0, v1, v2, order))
+    v0, v1, v2 = v0 / r, v1 / r, v2 / r
+    h0, h1, h2 = l0 + v0, l1 + v1, l2 + v2
+    r = np.sqrt(_dot3(h0, h1, h2, h0, h1, h2, order))
+    return h0 / r, h1 / r, h2 / r
+
+
+@_njit(inline=True)
+def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd, ks, sh):
+    """``Lighting.intensity(N @ L, _dot(N, H))`` clipped to [0, 1] (``N @ L`` and the
+    einsum summed in their calibrated orders)."""
+    a = _dot3(N0, N1, N2, l0, l1, l2, order_l)
+    b = _dot3(N0, N1, N2, h0, h1, h2, order_h)
     a = a if (a >= 0.0 or a != a) else 0.0      # np.maximum(a, 0.0)
     b = b if (b >= 0.0 or b != b) else 0.0
     # numpy squares for the exponent 2 (its fast scalar power), calls pow otherwise
-    v = light[0] * (light[1] + light[2] * a + light[3] * (b * b if light[4] == 2.0
-                                                          else b ** light[4]))
+    v = I0 * (ka + kd * a + ks * (b * b if sh == 2.0 else b ** sh))
     if v < 0.0:
         v = 0.0
     elif v > 1.0:
         v = 1.0
-    img[p] = v
-    mask[p] = True
-    tri_map[p] = face_id[stri[s]]
-    nlen[p] = np.sqrt(_dot3(N0, N1, N2, N0, N1, N2, orders[2]))
-
-
-@_njit(inline=True)
-def _slerp_px(A, B, inv, i, sa, sb):
-    wa = sa * inv[i]
-    wb = sb * inv[i]
-    return (A[0, i] * wa + B[0, i] * wb, A[1, i] * wa + B[1, i] * wb,
-            A[2, i] * wa + B[2, i] * wb)
+    return v
 
 
 @_njit()
@@ -442,6 +427,10 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     rows of the four output maps). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map)."""
     hard = 0
+    l0, l1, l2 = L[0], L[1], L[2]
+    ey0, ey1, ey2 = eye[0], eye[1], eye[2]
+    I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
+    o0, o1, o2 = orders[0], orders[1], orders[2]
     bw = np.empty(width)
     bs = np.empty(width, np.int64)
     tcb = np.empty(1, A.dtype)
@@ -471,147 +460,176 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             s = by_row[k]
             cnt = count[s]
             x0 = c0[s]
-            if mode == 5 or mode == 6:
-                # stepping kernels: every pixel of the span, in order
-                v0, v1, v2 = A[0, s], A[1, s], A[2, s]
-                e0, e1, e2 = B[0, s], B[1, s], B[2, s]
-                f0, f1, f2 = C[0, s], C[1, s], C[2, s]
-                for j in range(cnt):
-                    if j > 0:
-                        if mode == 5:
-                            v0 = v0 + e0
-                            v1 = v1 + e1
-                            v2 = v2 + e2
-                            e0 = e0 + f0
-                            e1 = e1 + f1
-                            e2 = e2 + f2
-                        elif j == 1:
-                            v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
-                        else:
-                            k2 = sc[s]
-                            c0_ = v0 * k2 - e0
-                            c1_ = v1 * k2 - e1
-                            c2_ = v2 * k2 - e2
-                            e0, e1, e2 = v0, v1, v2
-                            v0, v1, v2 = c0_, c1_, c2_
-                    if bs[x0 + j] != s:
-                        continue
-                    t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
-                    _shade_px(base + x0 + j, s, np.float64(v0), np.float64(v1),
-                              np.float64(v2), t, left, right, per_pixel_h, Htri, stri, L,
-                              eye, light, orders, img, mask, tri_map, nlen, face_id)
-                continue
+            # stepping kernels (5, 6) run through every pixel of the span, in order
+            v0, v1, v2 = A[0, s], A[1, s], A[2, s]
+            e0, e1, e2 = B[0, s], B[1, s], B[2, s]
+            f0, f1, f2 = C[0, s], C[1, s], C[2, s]
             for j in range(cnt):
+                if j > 0 and (mode == 5 or mode == 6):
+                    if mode == 5:
+                        v0 = v0 + e0
+                        v1 = v1 + e1
+                        v2 = v2 + e2
+                        e0 = e0 + f0
+                        e1 = e1 + f1
+                        e2 = e2 + f2
+                    elif j == 1:
+                        v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
+                    else:
+                        k2 = sc[s]
+                        g0 = v0 * k2 - e0
+                        g1 = v1 * k2 - e1
+                        g2 = v2 * k2 - e2
+                        e0, e1, e2 = v0, v1, v2
+                        v0, v1, v2 = g0, g1, g2
                 if bs[x0 + j] != s:
                     continue
+                p = base + x0 + j
                 tu = t0[s] + j * dt[s]
                 t = min(max(tu, 0.0), 1.0)
                 if mode == 0:
                     lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
-                    n0 = lo1 + t * (right[s, 1] - lo1)
-                    n1 = lo2 + t * (right[s, 2] - lo2)
-                    n2 = lo3 + t * (right[s, 3] - lo3)
-                    _shade_px(base + x0 + j, s, n0, n1, n2, t, left, right, per_pixel_h,
-                              Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
-                              face_id)
-                    continue
-                tcb[0] = tu           # the reference's t.astype(dtype)
-                tc = tcb[0]
-                if mode <= 3:
-                    m0 = A[0, s] + tc * B[0, s]
-                    m1 = A[1, s] + tc * B[1, s]
-                    m2 = A[2, s] + tc * B[2, s]
-                    if mode == 1:
-                        q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-                        m0, m1, m2 = m0 / q, m1 / q, m2 / q
-                    else:
-                        xx = m0 * m0 + m1 * m1 + m2 * m2
-                        if mode == 2:
-                            q = (kc[0] - xx) * kc[1]
-                        else:
-                            q = (xx * kc[2] - kc[3]) * xx + kc[4]
-                        m0, m1, m2 = m0 * q, m1 * q, m2 * q
-                elif mode == 4:
-                    arg_a = (kc[5] - tc) * sc[s]
-                    arg_b = tc * sc[s]
-                    if is64:
-                        sab[0] = np.sin(arg_a)
-                        sab[1] = np.sin(arg_b)
-                    else:
-                        ra, ha = _f32_round(np.sin(np.float64(arg_a)))
-                        rb, hb = _f32_round(np.sin(np.float64(arg_b)))
-                        if ha or hb:
-                            tri_map[base + x0 + j] = -2 - s
-                            hard += 1
-                            continue
-                        sab[0] = ra
-                        sab[1] = rb
-                    m0, m1, m2 = _slerp_px(A, B, sc2, s, sab[0], sab[1])
+                    N0 = lo1 + t * (right[s, 1] - lo1)
+                    N1 = lo2 + t * (right[s, 2] - lo2)
+                    N2 = lo3 + t * (right[s, 3] - lo3)
+                elif mode == 5 or mode == 6:
+                    N0, N1, N2 = np.float64(v0), np.float64(v1), np.float64(v2)
                 else:
-                    m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
-                _shade_px(base + x0 + j, s, np.float64(m0), np.float64(m1), np.float64(m2),
-                          t, left, right, per_pixel_h, Htri, stri, L, eye, light, orders,
-                          img, mask, tri_map, nlen, face_id)
+                    tcb[0] = tu           # the reference's t.astype(dtype)
+                    tc = tcb[0]
+                    if mode <= 3:
+                        m0 = A[0, s] + tc * B[0, s]
+                        m1 = A[1, s] + tc * B[1, s]
+                        m2 = A[2, s] + tc * B[2, s]
+                        if mode == 1:
+                            q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+                            m0, m1, m2 = m0 / q, m1 / q, m2 / q
+                        else:
+                            xx = m0 * m0 + m1 * m1 + m2 * m2
+                            if mode == 2:
+                                q = (kc[0] - xx) * kc[1]
+                            else:
+                                q = (xx * kc[2] - kc[3]) * xx + kc[4]
+                            m0, m1, m2 = m0 * q, m1 * q, m2 * q
+                    elif mode == 4:
+                        arg_a = (kc[5] - tc) * sc[s]
+                        arg_b = tc * sc[s]
+                        if is64:
+                            sab[0] = np.sin(arg_a)
+                            sab[1] = np.sin(arg_b)
+                        else:
+                            ra, ha = _f32_round(np.sin(np.float64(arg_a)))
+                            rb, hb = _f32_round(np.sin(np.float64(arg_b)))
+                            if ha or hb:
+                                tri_map[p] = -2 - s
+                                hard += 1
+                                continue
+                            sab[0] = ra
+                            sab[1] = rb
+                        wa = sab[0] * sc2[s]
+                        wb = sab[1] * sc2[s]
+                        m0 = A[0, s] * wa + B[0, s] * wb
+                        m1 = A[1, s] * wa + B[1, s] * wb
+                        m2 = A[2, s] * wa + B[2, s] * wb
+                    else:
+                        m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
+                    N0, N1, N2 = np.float64(m0), np.float64(m1), np.float64(m2)
+                if per_pixel_h:
+                    q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
+                    h0, h1, h2 = _half(q0 + t * (right[s, 4] - q0), q1 + t * (right[s, 5] - q1),
+                                       q2 + t * (right[s, 6] - q2), ey0, ey1, ey2, l0, l1, l2,
+                                       o2)
+                else:
+                    ft = stri[s]
+                    h0, h1, h2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+                img[p] = _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, o0, o1, I0, ka, kdif,
+                                    ks, sh)
+                mask[p] = True
+                tri_map[p] = face_id[stri[s]]
+                nlen[p] = np.sqrt(_dot3(N0, N1, N2, N0, N1, N2, o2))
     return hard
 
 
 @_njit(inline=True)
-def _node(A, B, R, i, L, k):
-    """Node ``k`` of the ``2**L + 1`` of span ``i`` (descending the halving tree), as
-    :func:`.fast._dichotomy_node`."""
-    top = np.int64(1) << L
-    if k == 0:
-        return A[0, i], A[1, i], A[2, i]
-    if k == top:
-        return B[0, i], B[1, i], B[2, i]
-    a0, a1, a2 = A[0, i], A[1, i], A[2, i]
-    b0, b1, b2 = B[0, i], B[1, i], B[2, i]
-    lo = np.int64(0)
-    hi = top
-    for lev in range(L):
-        mid = (lo + hi) >> 1
-        rr = R[i, lev]
-        m0 = (a0 + b0) * rr
-        m1 = (a1 + b1) * rr
-        m2 = (a2 + b2) * rr
-        if k == mid:
-            return m0, m1, m2
-        if k < mid:
-            hi = mid
-            b0, b1, b2 = m0, m1, m2
-        else:
-            lo = mid
-            a0, a1, a2 = m0, m1, m2
-    return a0, a1, a2
-
-
-@_njit(inline=True)
 def _dichotomy_px(A, B, R, levels, off, kd, i, tc):
+    """The pixel at ``tc`` of dichotomy span ``i``: node ``k = floor(tc 2**L)`` of the
+    halving tree, or (depth ``L`` off the grid somewhere in the frame) the linear pick
+    between nodes ``k`` and ``min(k + 1, 2**L)``, as :func:`.fast._dichotomy_kernel`.
+    Both nodes come from one descent of the tree: every midpoint on the way is
+    ``(A + B) r`` of its interval's ends with the level's ``r``, as in the reference."""
     L = levels[i]
     u = tc * kd[2 + L]
     kf = np.floor(u)
     fr = u - kf
     k = np.int64(kf)
-    a0, a1, a2 = _node(A, B, R, i, L, k)
-    if not off[L]:
-        return a0, a1, a2
-    b0, b1, b2 = _node(A, B, R, i, L, min(k + 1, np.int64(1) << L))
-    return a0 + fr * (b0 - a0), a1 + fr * (b1 - a1), a2 + fr * (b2 - a2)
+    top = np.int64(1) << L
+    need_b = off[L]
+    a0, a1, a2 = A[0, i], A[1, i], A[2, i]
+    b0, b1, b2 = B[0, i], B[1, i], B[2, i]
+    lo = np.int64(0)
+    hi = top
+    lev = 0
+    target = k
+    n0 = n1 = n2 = a0        # node k, once found
+    while True:
+        if target == lo:
+            v0, v1, v2 = a0, a1, a2
+        elif target == hi:
+            v0, v1, v2 = b0, b1, b2
+        else:
+            mid = (lo + hi) >> 1
+            rr = R[i, lev]
+            lev += 1
+            m0 = (a0 + b0) * rr
+            m1 = (a1 + b1) * rr
+            m2 = (a2 + b2) * rr
+            if target < mid:
+                hi = mid
+                b0, b1, b2 = m0, m1, m2
+                continue
+            lo = mid
+            a0, a1, a2 = m0, m1, m2
+            if target > mid:
+                continue
+            v0, v1, v2 = m0, m1, m2
+        # the node ``target`` is v; [lo, hi] still holds target + 1 (or target == top)
+        if target == k:
+            n0, n1, n2 = v0, v1, v2
+            if not need_b:
+                return n0, n1, n2
+            target = min(k + 1, top)
+            continue
+        return n0 + fr * (v0 - n0), n1 + fr * (v1 - n1), n2 + fr * (v2 - n2)
 
 
 @_njit()
 def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, per_pixel_h,
                  Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen, face_id):
-    """Shade the slerp pixels whose sines :mod:`detmath` gave (``sa``, ``sb``)."""
+    """Shade the slerp pixels whose sines :mod:`detmath` gave (``sa``, ``sb``), as
+    :func:`_frame` does the others."""
     for q in range(pix.shape[0]):
         p = pix[q]
         s = span[q]
         j = p % width - c0[s]
         t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
-        m0, m1, m2 = _slerp_px(A, B, sc2, s, sa[q], sb[q])
-        _shade_px(p, s, np.float64(m0), np.float64(m1), np.float64(m2), t, left, right,
-                  per_pixel_h, Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen,
-                  face_id)
+        wa = sa[q] * sc2[s]
+        wb = sb[q] * sc2[s]
+        N0 = np.float64(A[0, s] * wa + B[0, s] * wb)
+        N1 = np.float64(A[1, s] * wa + B[1, s] * wb)
+        N2 = np.float64(A[2, s] * wa + B[2, s] * wb)
+        if per_pixel_h:
+            q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
+            h0, h1, h2 = _half(q0 + t * (right[s, 4] - q0), q1 + t * (right[s, 5] - q1),
+                               q2 + t * (right[s, 6] - q2), eye[0], eye[1], eye[2], L[0], L[1],
+                               L[2], orders[2])
+        else:
+            ft = stri[s]
+            h0, h1, h2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+        img[p] = _intensity(N0, N1, N2, h0, h1, h2, L[0], L[1], L[2], orders[0], orders[1],
+                            light[0], light[1], light[2], light[3], light[4])
+        mask[p] = True
+        tri_map[p] = face_id[stri[s]]
+        nlen[p] = np.sqrt(_dot3(N0, N1, N2, N0, N1, N2, orders[2]))
 
 
 # ------------------------------------------------------------------ driver
