@@ -419,6 +419,61 @@ def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd,
 
 
 @_njit()
+def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs, img,
+                    mask, tri_map, nlen):
+    """Row ``rr``: the background in the four maps, and in ``bs`` the winning span of each
+    pixel (largest ``1/w``, ties to the earliest span; -1: none)."""
+    base = rr * width
+    for x in range(width):
+        bs[x] = -1
+        img[base + x] = 0.0
+        mask[base + x] = False
+        tri_map[base + x] = -1
+        nlen[base + x] = np.nan
+    for k in range(row_start[rr], row_start[rr + 1]):
+        s = by_row[k]
+        lo = left[s, 0]
+        dw = right[s, 0] - lo
+        for j in range(count[s]):
+            t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+            w = lo + t * dw
+            x = c0[s] + j
+            if bs[x] < 0 or w > bw[x]:
+                bs[x] = s
+                bw[x] = w
+
+
+@_njit(inline=True)
+def _linear(mode, a0, a1, a2, d0, d1, d2, t, k0, k1, k2, k3, k4):
+    """``N_l + t (N_r - N_l)`` normalized by mode 1 (``N/sqrt(N.N)``), 2 (Newton) or 3
+    (Lyon), or not (0), as :func:`.fast._linear_kernel` (constants ``k`` in the dtype)."""
+    n0 = a0 + t * d0
+    n1 = a1 + t * d1
+    n2 = a2 + t * d2
+    if mode == 0:
+        return n0, n1, n2
+    if mode == 1:
+        r = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        return n0 / r, n1 / r, n2 / r
+    x = n0 * n0 + n1 * n1 + n2 * n2
+    q = (k0 - x) * k1 if mode == 2 else (x * k2 - k3) * x + k4
+    return n0 * q, n1 * q, n2 * q
+
+
+@_njit(inline=True)
+def _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1, f2, k2):
+    """One step (``j >= 1``) of the stepping kernels: quadratic (mode 5, value ``v``,
+    first and second differences ``e``, ``f``) or angular (mode 6, current ``v`` and
+    previous ``e`` pixel, factor ``k2 = 2 cos(phi)``; at ``j = 1`` the second pixel is
+    the given one)."""
+    if mode == 5:
+        return v0 + e0, v1 + e1, v2 + e2, e0 + f0, e1 + f1, e2 + f2
+    if j == 1:
+        return e0, e1, e2, v0, v1, v2
+    return v0 * k2 - e0, v1 * k2 - e1, v2 * k2 - e2, v0, v1, v2
+
+
+@_njit()
 def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
            A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
            light, orders, part, parts, img, mask, tri_map, nlen):
@@ -437,24 +492,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     sab = np.empty(2, A.dtype)
     for rr in range(part, height, parts):
         base = rr * width
-        for x in range(width):
-            bs[x] = -1
-            img[base + x] = 0.0
-            mask[base + x] = False
-            tri_map[base + x] = -1
-            nlen[base + x] = np.nan
-        # visibility: largest 1/w, ties to the earliest span
-        for k in range(row_start[rr], row_start[rr + 1]):
-            s = by_row[k]
-            lo = left[s, 0]
-            dw = right[s, 0] - lo
-            for j in range(count[s]):
-                t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
-                w = lo + t * dw
-                x = c0[s] + j
-                if bs[x] < 0 or w > bw[x]:
-                    bs[x] = s
-                    bw[x] = w
+        _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs,
+                        img, mask, tri_map, nlen)
         # shading of the winners
         for k in range(row_start[rr], row_start[rr + 1]):
             s = by_row[k]
@@ -466,22 +505,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             f0, f1, f2 = C[0, s], C[1, s], C[2, s]
             for j in range(cnt):
                 if j > 0 and (mode == 5 or mode == 6):
-                    if mode == 5:
-                        v0 = v0 + e0
-                        v1 = v1 + e1
-                        v2 = v2 + e2
-                        e0 = e0 + f0
-                        e1 = e1 + f1
-                        e2 = e2 + f2
-                    elif j == 1:
-                        v0, v1, v2, e0, e1, e2 = e0, e1, e2, v0, v1, v2
-                    else:
-                        k2 = sc[s]
-                        g0 = v0 * k2 - e0
-                        g1 = v1 * k2 - e1
-                        g2 = v2 * k2 - e2
-                        e0, e1, e2 = v0, v1, v2
-                        v0, v1, v2 = g0, g1, g2
+                    v0, v1, v2, e0, e1, e2 = _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1, f2,
+                                                   sc[s])
                 if bs[x0 + j] != s:
                     continue
                 p = base + x0 + j
@@ -498,19 +523,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                     tcb[0] = tu           # the reference's t.astype(dtype)
                     tc = tcb[0]
                     if mode <= 3:
-                        m0 = A[0, s] + tc * B[0, s]
-                        m1 = A[1, s] + tc * B[1, s]
-                        m2 = A[2, s] + tc * B[2, s]
-                        if mode == 1:
-                            q = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-                            m0, m1, m2 = m0 / q, m1 / q, m2 / q
-                        else:
-                            xx = m0 * m0 + m1 * m1 + m2 * m2
-                            if mode == 2:
-                                q = (kc[0] - xx) * kc[1]
-                            else:
-                                q = (xx * kc[2] - kc[3]) * xx + kc[4]
-                            m0, m1, m2 = m0 * q, m1 * q, m2 * q
+                        m0, m1, m2 = _linear(mode, A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                             B[2, s], tc, kc[0], kc[1], kc[2], kc[3], kc[4])
                     elif mode == 4:
                         arg_a = (kc[5] - tc) * sc[s]
                         arg_b = tc * sc[s]
@@ -520,7 +534,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                         else:
                             ra, ha = _f32_round(np.sin(np.float64(arg_a)))
                             rb, hb = _f32_round(np.sin(np.float64(arg_b)))
-                            if ha or hb:
+                            if ha or hb:     # a float32 sine for detmath (see phong)
                                 tri_map[p] = -2 - s
                                 hard += 1
                                 continue
