@@ -546,7 +546,9 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                         m1 = A[1, s] * wa + B[1, s] * wb
                         m2 = A[2, s] * wa + B[2, s] * wb
                     else:
-                        m0, m1, m2 = _dichotomy_px(A, B, R, levels, off, kd, s, tc)
+                        L = levels[s]
+                        m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                                   B[2, s], R, s, L, off[L], kd[2 + L], tc)
                     N0, N1, N2 = np.float64(m0), np.float64(m1), np.float64(m2)
                 if per_pixel_h:
                     q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
@@ -565,21 +567,18 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
 
 
 @_njit(inline=True)
-def _dichotomy_px(A, B, R, levels, off, kd, i, tc):
-    """The pixel at ``tc`` of dichotomy span ``i``: node ``k = floor(tc 2**L)`` of the
-    halving tree, or (depth ``L`` off the grid somewhere in the frame) the linear pick
+def _dichotomy_px(a0, a1, a2, b0, b1, b2, R, i, L, need_b, scale, tc):
+    """The pixel at ``tc`` of dichotomy span ``i`` (ends ``a``, ``b``, depth ``L``, ``scale =
+    2**L`` in the dtype, denominators ``R[i]``): node ``k = floor(tc 2**L)`` of the
+    halving tree, or (``need_b``: depth ``L`` off the grid in the frame) the linear pick
     between nodes ``k`` and ``min(k + 1, 2**L)``, as :func:`.fast._dichotomy_kernel`.
     Both nodes come from one descent of the tree: every midpoint on the way is
     ``(A + B) r`` of its interval's ends with the level's ``r``, as in the reference."""
-    L = levels[i]
-    u = tc * kd[2 + L]
+    u = tc * scale
     kf = np.floor(u)
     fr = u - kf
     k = np.int64(kf)
     top = np.int64(1) << L
-    need_b = off[L]
-    a0, a1, a2 = A[0, i], A[1, i], A[2, i]
-    b0, b1, b2 = B[0, i], B[1, i], B[2, i]
     lo = np.int64(0)
     hi = top
     lev = 0
