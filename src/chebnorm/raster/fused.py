@@ -57,7 +57,7 @@ except ImportError:  # pragma: no cover
     numba = None
     HAVE_NUMBA = False
 
-__all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det", "phong"]
+__all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det"]
 
 #: kernel -> mode number of the fused kernel
 MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLERP): 4,
@@ -648,7 +648,12 @@ def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, p
 # ------------------------------------------------------------------ driver
 def supports(spec) -> bool:
     """Whether :func:`phong` renders method ``spec`` (its kernel has a fused twin, numba is
-    installed and :func:`calibrated` found the reductions' orders)."""
+    installed and :func:`calibrated` found the reductions' orders).
+
+    >>> from chebnorm.methods import get_method
+    >>> supports(get_method("dichotomy")) == (HAVE_NUMBA and calibrated() is not None)
+    True
+    """
     return (HAVE_NUMBA and id(method_kernel(spec)) in MODES
             and calibrated() is not None)
 
@@ -759,7 +764,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         if mode <= 3:
             B = np.ascontiguousarray(np.stack(K.vsub(b, a)))
         elif mode == 4:
-            s = spec_kernel_setup(ops, spec, a, b, coeffs)
+            s = method_kernel(spec).setup(ops, a, b, coeffs)
             sc, sc2 = np.ascontiguousarray(s["psi"], dtype), np.ascontiguousarray(s["inv"], dtype)
         elif mode == 5:
             A, B, C = fast._quadratic_setup(ops, a, b, inp.t0.astype(dtype), inp.dt.astype(dtype),
@@ -774,7 +779,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
             R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, inp.t0, inp.dt,
                                      inp.count)
     kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
-    C = np.ascontiguousarray(C, dt_) if C.dtype == dt_ else np.zeros((3, 1), dt_)
+    C = np.ascontiguousarray(C)
     Htri = (np.ascontiguousarray(tri_half(st), np.float64) if not per_pixel_h
             else np.zeros((1, 3)))
     light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess],
@@ -807,7 +812,3 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     return (img.reshape(shape), mask.reshape(shape), tri_map.reshape(shape),
             nlen.reshape(shape), int(sp.count.sum()), stats)
 
-
-def spec_kernel_setup(ops, spec, a, b, coeffs):
-    """The per-span set-up of a direct kernel (``kernel.setup``)."""
-    return method_kernel(spec).setup(ops, a, b, coeffs)

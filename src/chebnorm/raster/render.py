@@ -259,7 +259,8 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     L and H in object space).  ``span_normals``: a replacement span
     interpolator (same signature as :func:`chebnorm.methods.span_normals`).
     ``engine``: ``"numpy"`` (the reference), ``"numba"`` (the compiled fast path of
-    :mod:`chebnorm.raster.fast`: the same image bytes) or ``"auto"`` (numba when
+    :mod:`chebnorm.raster.fast`, and for ``phong`` the fused, threaded frame of
+    :mod:`chebnorm.raster.fused`: the same image bytes) or ``"auto"`` (numba when
     installed).
 
     >>> r = render("sphere", "phong", "exact", size=(32, 32), tess=8)
