@@ -208,3 +208,17 @@ def test_fused_falls_back_without_calibration(monkeypatch):
     calls = _spy(monkeypatch, "_frame")
     _check_identical(get_mesh("teapot"), "lyon", SIZE)
     assert not calls
+
+
+def test_fused_renders_in_a_forked_child():
+    import multiprocessing as mp
+
+    render("sphere", "phong", "exact", size=(24, 24), tess=8)   # the parent's thread pool
+    ctx = mp.get_context("fork")
+    with ctx.Pool(1) as pool:
+        child = pool.apply(_render_bytes, ((24, 24),))
+    assert child == _render_bytes((24, 24))
+
+
+def _render_bytes(size):
+    return render("sphere", "phong", "exact", size=size, tess=8, engine="numba").image.tobytes()

@@ -712,7 +712,8 @@ def _threads() -> int:
     return max(1, min(8, n))
 
 
-_POOL: list = []
+#: the thread pool of this process: {pid: executor} (a forked child makes its own)
+_POOL: dict = {}
 
 
 def _run(jobs):
@@ -720,10 +721,12 @@ def _run(jobs):
     their results in order."""
     if len(jobs) == 1:
         return [jobs[0][0](*jobs[0][1])]
-    if not _POOL:
-        _POOL.append(ThreadPoolExecutor(max_workers=_threads(),
-                                        thread_name_prefix="chebnorm-raster"))
-    futures = [_POOL[0].submit(fn, *args) for fn, args in jobs]
+    pool = _POOL.get(os.getpid())
+    if pool is None:
+        _POOL.clear()
+        pool = _POOL[os.getpid()] = ThreadPoolExecutor(max_workers=_threads(),
+                                                        thread_name_prefix="chebnorm-raster")
+    futures = [pool.submit(fn, *args) for fn, args in jobs]
     return [f.result() for f in futures]
 
 
