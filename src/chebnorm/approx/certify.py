@@ -45,10 +45,12 @@ series type, and its naive interval evaluation of ``p - f`` overestimates by
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Sequence
 
+import numpy as np
 import sympy as sp
 from flint import arb, arb_poly, arb_series, ctx
 
@@ -83,7 +85,18 @@ class Certificate:
 def arb_enclose(value: sp.Expr) -> arb:
     """A ball enclosing a real sympy constant (``sqrt(2)``, ``2*cos(pi/4)``) at
     the current ``flint.ctx.prec``."""
-    return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+    return _enclose(value, ctx.prec)
+
+
+@functools.lru_cache(maxsize=1024)
+def _enclose(value: sp.Expr, prec: int) -> arb:
+    """:func:`arb_enclose` at ``prec`` bits, cached (balls are immutable)."""
+    old = ctx.prec
+    try:
+        ctx.prec = prec
+        return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+    finally:
+        ctx.prec = old
 
 
 def _float_up(x: arb) -> float:
@@ -196,6 +209,41 @@ def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     return best
 
 
+def _cubic_max(c0: arb, c1: arb, c2: arb, c3: arb, r: arb) -> arb:
+    """An upper bound of max_{|h| <= r} |c0 + c1 h + c2 h^2 + c3 h^3| (balls
+    allowed): both ends, and each critical point (a root of ``c1 + 2 c2 h +
+    3 c3 h^2``, enclosed in ball arithmetic) whose ball meets ``[-r, r]``.
+    Where the roots cannot be separated (``c3`` or the discriminant
+    containing 0) the quadratic's maximum plus ``|c3| r^3``."""
+    if not (c0.is_finite() and c1.is_finite() and c2.is_finite() and c3.is_finite()):
+        return arb("nan")
+
+    def cubic(h):
+        return c0 + h * (c1 + h * (c2 + h * c3))
+
+    best = abs(cubic(-r)).upper().max(abs(cubic(r)).upper())
+    disc = c2 * c2 - 3 * c1 * c3
+    if disc < 0:  # no real critical point: monotonic
+        return best
+    if c3.contains(0) or not disc > 0:
+        return best.max(_quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r))
+    sq = disc.sqrt()
+    if c2 > 0 or c2 < 0:  # the root pair without cancellation
+        q = -(c2 + sq) if c2 > 0 else sq - c2
+        roots = (q / (3 * c3), c1 / q)
+    else:
+        roots = ((sq - c2) / (3 * c3), -(c2 + sq) / (3 * c3))
+    box = arb(0, r.upper())
+    for h in roots:
+        if h.overlaps(box):
+            best = best.max(abs(cubic(h.intersection(box))).upper())
+    return best
+
+
+#: order of the Taylor forms of the subdivision: ``g`` to ``h^3`` at the
+#: midpoint, the ``h^4`` term enclosed over the piece
+ORDER = 4
+
 #: order of the Taylor forms tried when |g| is far below |f| (see _high_order_upper)
 HIGH_ORDER = 8
 
@@ -248,7 +296,8 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     quotient taken exactly.
 
     >>> from chebnorm.approx.expr import parse_function
-    >>> import sympy as sp
+    >>> import numpy as np
+import sympy as sp
     >>> c = certify(parse_function("x**2"), [0.0, 0.0, 1.0], sp.Integer(0), sp.Integer(1))
     >>> c.bound == 0.0, c.tight
     (True, True)
@@ -267,7 +316,7 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
             if not (math.isfinite(shift[0]) and math.isfinite(shift[1]) and shift[1] > 0):
                 raise ValueError(f"shift {shift!r}: accepted: a finite center and a finite "
                                  f"positive scale")
-        return _certify(fn, [arb(float(c)) for c in coefficients], lo, hi, kind, tol,
+        return _certify(fn, [float(c) for c in coefficients], lo, hi, kind, tol,
                         max_subintervals, shift)
     finally:
         ctx.prec = old_prec
@@ -288,7 +337,8 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
     return best if best > 0 else arb(1)
 
 
-def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
+def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
+    coeffs = [arb(c) for c in floats]
     g = _error_function(fn.arb_series, coeffs, kind, shift)
     g_point = _error_function(fn.arb, coeffs, kind, shift)
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
@@ -310,8 +360,16 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     # an error below this is a cancellation: order-3 forms converge too slowly
     tiny = scale * arb(2) ** -30
 
-    best_lower = arb(0)
-    best_at = (a0 + b0) / 2
+    # the largest |g| located first (float64 search, then Newton in Arb): the
+    # pieces are compared with it from the start, and fewer are split
+    start = _float_argmax(fn, floats, kind, shift, lo_f, hi_f)
+    located = None
+    best_lower, best_at = arb(0), (a0 + b0) / 2
+    if start is not None:
+        located = _locate_maximum(g, g_point, arb(start), lo_f, hi_f)
+        if located[2] > 0:
+            best_lower, best_at = located[2], arb(located[1])
+    seeded_at = best_at
     accepted_upper = arb(0)
     count = 0
     reasons: set[str] = set()
@@ -322,9 +380,10 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             count += 1
             m = (a + b) / 2
             r = (b - a) / 2
-            c0, c1, c2 = _coeffs(g(arb_series([m, 1], prec=3)), 3)
-            c3 = _coeffs(g(arb_series([a.union(b), 1], prec=4)), 4)[3]
-            upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r)
+            c0, c1, c2, c3 = _coeffs(g(arb_series([m, 1], prec=ORDER)), ORDER)
+            rest = _coeffs(g(arb_series([a.union(b), 1], prec=ORDER + 1)), ORDER + 1)[ORDER]
+            r2 = r * r
+            upper = _cubic_max(c0, c1, c2, c3, r) + abs(rest).upper() * (r2 * r2)
             value = c0 if c0.is_finite() else g_point(m)
             if value.is_finite() and abs(value).lower() > best_lower:
                 best_lower, best_at = abs(value).lower(), m
@@ -365,7 +424,10 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             if not (a < m < b):
                 m = (a + b) / 2
             work.extend([(a, m), (m, b)])
-    maximum, at = _locate_maximum(g, g_point, best_at, lo_f, hi_f)
+    if located is None or best_at is not seeded_at:  # a piece's midpoint did better
+        again = _locate_maximum(g, g_point, best_at, lo_f, hi_f)
+        located = again if located is None or again[0] > located[0] else located
+    maximum, at = located[0], located[1]
     bound = accepted_upper.max(arb(maximum))
     return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
                        tight=not reasons, reason="; ".join(sorted(reasons)))
@@ -397,17 +459,18 @@ def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> Valu
                       f"accepted: a function defined and finite on the whole interval")
 
 
-def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float]:
+def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float, arb]:
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
-    the float nearest the best piece midpoint, and Newton steps on ``g'``
-    from the best of these. Returns ``(|g(at)|, at)``."""
-    best, best_at = -1.0, lo
+    the float nearest ``start``, and Newton steps on ``g'`` from the best of
+    these. Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
+    bound of ``|g(at)|`` (0 when nothing was finite)."""
+    best, best_at, best_lower = -1.0, lo, arb(0)
 
     def visit(x: float) -> None:
-        nonlocal best, best_at
+        nonlocal best, best_at, best_lower
         v = abs(g_point(arb(x)))
         if v.is_finite() and float(v.mid()) > best:
-            best, best_at = float(v.mid()), x
+            best, best_at, best_lower = float(v.mid()), x, v.lower()
 
     for x in (min(max(float(start.mid()), lo), hi), lo, hi):
         visit(x)
@@ -422,4 +485,33 @@ def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float
             break
         x = nxt
         visit(x)
-    return max(best, 0.0), best_at
+    return max(best, 0.0), best_at, best_lower
+
+
+#: points of the float64 search for the largest error (per degree + 2)
+SEARCH_POINTS = 64
+
+
+def _float_argmax(fn, floats: Sequence[float], kind: str, shift, lo: float, hi: float
+                  ) -> float | None:
+    """Where ``|g|`` is largest on a float64 grid of ``[lo, hi]`` (Chebyshev
+    points, ends included), or None when float64 cannot tell (``f`` has no
+    numpy evaluator, nothing finite). A starting point only: nothing rigorous
+    depends on it."""
+    f_np = getattr(fn, "numpy", None)
+    if f_np is None or not lo < hi:
+        return None
+    n = SEARCH_POINTS * (len(floats) + 1)
+    x = 0.5 * (lo + hi) - 0.5 * (hi - lo) * np.cos(np.pi * np.arange(n + 1) / n)
+    x[0], x[-1] = lo, hi
+    t = x if shift is None else (x - shift[0]) / shift[1]
+    with np.errstate(all="ignore"):
+        try:
+            f = np.asarray(f_np(x), dtype=float)
+        except (ArithmeticError, ValueError, TypeError):
+            return None
+        p = np.polyval(np.asarray(floats[::-1], dtype=float), t) if floats else np.zeros_like(x)
+        e = np.abs(p - f if kind == "abs" else p / f - 1)
+    e[~np.isfinite(e)] = -1.0
+    k = int(np.argmax(e))
+    return float(x[k]) if e[k] >= 0 else None

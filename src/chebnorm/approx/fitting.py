@@ -7,12 +7,13 @@ floats (:mod:`chebnorm.approx.certify`). Internal module: callers validate.
 
 from __future__ import annotations
 
+import functools
 import math
-from fractions import Fraction
 from typing import Callable
 
 import mpmath
 import numpy as np
+from flint import fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
@@ -55,45 +56,37 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
     [-1.0, 0.0, 2.0]
     """
     n = len(cheb)
-    # monomial coefficients in t, exactly: T_0 = 1, T_1 = t, T_k = 2t T_{k-1} - T_{k-2}
-    t_polys = [[Fraction(1)], [Fraction(0), Fraction(1)]]
-    for k in range(2, n):
-        prev, prev2 = t_polys[-1], t_polys[-2]
-        cur = [Fraction(0)] + [2 * c for c in prev]
-        for i, c in enumerate(prev2):
-            cur[i] -= c
-        t_polys.append(cur)
-    in_t = [Fraction(0)] * n  # monomial coefficients in u
+    if n == 0:
+        return []
+    series = fmpq_poly([])
     for k, ck in enumerate(cheb):
-        exact = _exact(ck)
-        for i, c in enumerate(t_polys[k]):
-            in_t[i] += exact * c
-    # substitute u = alpha t + beta (x = center + scale t)
-    lo_f, hi_f = Fraction(float(lo)), Fraction(float(hi))
-    c_f, s_f = Fraction(float(center)), Fraction(float(scale))
-    alpha = 2 * s_f / (hi_f - lo_f)
-    beta = (2 * c_f - lo_f - hi_f) / (hi_f - lo_f)
-    out = [Fraction(0)] * n
-    power = [Fraction(1)]  # (alpha t + beta)^i, ascending in t
-    for i in range(n):
-        for j, c in enumerate(power):
-            out[j] += in_t[i] * c
-        nxt = [Fraction(0)] * (len(power) + 1)
-        for j, c in enumerate(power):
-            nxt[j] += beta * c
-            nxt[j + 1] += alpha * c
-        power = nxt
-    return [float(c) for c in out]
+        series += _exact(ck) * _chebyshev_t(k)
+    # substitute u = alpha t + beta (x = center + scale t), exactly
+    lo_q, hi_q = _exact(float(lo)), _exact(float(hi))
+    c_q, s_q = _exact(float(center)), _exact(float(scale))
+    alpha = 2 * s_q / (hi_q - lo_q)
+    beta = (2 * c_q - lo_q - hi_q) / (hi_q - lo_q)
+    coeffs = series(fmpq_poly([beta, alpha])).coeffs()
+    # int / int is correctly rounded in Python, as Fraction's float() is
+    return [int(c.p) / int(c.q) for c in coeffs] + [0.0] * (n - len(coeffs))
 
 
-def _exact(v) -> Fraction:
+@functools.lru_cache(maxsize=None)
+def _chebyshev_t(k: int) -> fmpq_poly:
+    """``T_k`` with exact rational coefficients."""
+    return fmpq_poly(fmpz_poly.chebyshev_t(k))
+
+
+def _exact(v) -> fmpq:
     """A float or an mpmath number as an exact rational."""
     if isinstance(v, mpmath.mpf):
         if not mpmath.isfinite(v):
             raise ValueError(f"coefficient {v} is not finite")
         sign, man, exp, _ = v._mpf_  # man_exp drops the sign
-        return (-1) ** sign * Fraction(int(man)) * Fraction(2) ** int(exp)
-    return Fraction(float(v))
+        man, exp = (-1) ** sign * int(man), int(exp)
+        return fmpq(man * 2 ** exp) if exp >= 0 else fmpq(man, 2 ** -exp)
+    num, den = float(v).as_integer_ratio()  # raises on inf and nan
+    return fmpq(num, den)
 
 
 def shift_for(lo: float, hi: float) -> tuple[float, float]:
@@ -132,77 +125,66 @@ class RemezResult:
         self.noise_limited = noise_limited
 
 
-def _clenshaw(t: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """``sum c_k T_k(t)`` by Clenshaw's recurrence (numpy's ``chebval``
-    without its per-call checks, which dominate on short arrays)."""
-    if len(c) == 1:
-        return np.full_like(t, c[0])
-    b1 = np.zeros_like(t)
-    b2 = np.zeros_like(t)
-    t2 = 2 * t
-    for ck in c[:0:-1]:
-        b1, b2 = ck + t2 * b1 - b2, b1
-    return c[0] + t * b1 - b2
-
-
 def _unit(x):
     return np.ones_like(x)
 
 
-def _local_extrema(t: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """Indices of local extrema of ``e`` on the grid (ends included)."""
-    d = np.diff(e)
-    inner = np.nonzero((d[:-1] * d[1:] <= 0) & ((d[:-1] != 0) | (d[1:] != 0)))[0] + 1
-    return np.unique(np.concatenate([[0], inner, [len(t) - 1]]))
+@functools.lru_cache(maxsize=32)
+def _grid(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The exchange's search grid for degree ``n`` (cached, read-only):
+    angles ``theta`` (uniform, from pi down to 0), the points
+    ``t = cos(theta)`` (the Chebyshev extreme points, ascending) and the
+    Vandermonde matrix ``T_k(t)``, so the error on the grid is one product."""
+    grid_n = max(4000, 200 * (n + 2))
+    theta = np.pi * np.arange(grid_n, -1, -1) / grid_n
+    t = np.cos(theta)
+    v = C.chebvander(t, n)
+    for a in (theta, t, v):
+        a.flags.writeable = False
+    return theta, t, v
 
 
-def _refine(t_grid, idx, e_idx, err_fn, points: int = 16, rounds: int = 1):
-    """Refine grid extrema of ``|e|`` by successive local grids (vectorized
-    over extrema, one ``err_fn`` call per round) and a final parabola
-    through the best point and its neighbours; end points stay put.
-    Returns the points and their errors.
+def _sign_runs(e: np.ndarray) -> np.ndarray:
+    """Index of the largest ``|e|`` in each maximal run of one sign (zero
+    counts as positive), ascending: alternating in sign, and each the
+    largest extremum of its run (consecutive same-sign extrema merged into
+    the larger)."""
+    pos = e >= 0
+    change = np.flatnonzero(pos[1:] != pos[:-1]) + 1
+    a = np.abs(e)
+    if len(change) < 64:  # the usual case: a few runs, a few slices
+        bounds = [0, *change.tolist(), len(e)]
+        return np.array([s + int(np.argmax(a[s:t])) for s, t in zip(bounds[:-1], bounds[1:])])
+    run = np.zeros(len(e), dtype=np.intp)
+    run[change] = 1
+    run = np.cumsum(run)
+    hit = np.flatnonzero(a == np.maximum.reduceat(a, np.concatenate(([0], change)))[run])
+    first = np.ones(len(hit), dtype=bool)
+    first[1:] = run[hit[1:]] != run[hit[:-1]]
+    return hit[first]
 
-    Each round samples ``points`` points across the bracket around every
-    extremum and shrinks the bracket to two spacings around the largest, so
-    after ``rounds`` rounds the location is known to ``(2/points)**rounds``
-    of the grid spacing; the parabola then gains two more orders (the error
-    is flat to second order at an interior extremum, so its value is exact
-    to float64 rounding). ``e_idx`` are the errors at the grid extrema.
-    """
-    i = np.asarray(idx)
-    last = len(t_grid) - 1
-    inner = (i > 0) & (i < last)
-    lo = np.where(inner, t_grid[np.maximum(i - 1, 0)], t_grid[i])
-    hi = np.where(inner, t_grid[np.minimum(i + 1, last)], t_grid[i])
-    s = np.linspace(0.0, 1.0, points)
-    rows = np.arange(len(i))
-    best_x = t_grid[i]
-    best_e = np.asarray(e_idx, dtype=float)
-    for _ in range(rounds):
-        x = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-        e = err_fn(x.ravel()).reshape(x.shape)
-        k = np.argmax(np.abs(e), axis=1)
-        better = np.abs(e[rows, k]) > np.abs(best_e)
-        best_x = np.where(better, x[rows, k], best_x)
-        best_e = np.where(better, e[rows, k], best_e)
-        step = (hi - lo) / (points - 1)
-        lo = np.where(inner, np.maximum(lo, best_x - step), lo)
-        hi = np.where(inner, np.minimum(hi, best_x + step), hi)
-    # parabola through (lo, mid, hi) of |e| around the best point
-    h = 0.5 * (hi - lo)
-    ok = inner & (h > 0)
-    if ok.any():
-        m = 0.5 * (lo + hi)
-        ea = np.abs(err_fn(np.stack([lo, m, hi]).ravel())).reshape(3, -1)
-        den = ea[0] - 2 * ea[1] + ea[2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            v = m + 0.5 * h * (ea[0] - ea[2]) / den
-        v = np.where(ok & (den < 0) & (v > lo) & (v < hi), v, best_x)
-        ev = err_fn(v)
-        better = np.abs(ev) > np.abs(best_e)
-        best_x = np.where(better, v, best_x)
-        best_e = np.where(better, ev, best_e)
-    return best_x, best_e
+
+def _trim(idx: np.ndarray, a: np.ndarray, m: int) -> np.ndarray:
+    """Keep ``m`` consecutive entries of ``idx``, dropping the end with the
+    smaller ``a`` one at a time: keeps the alternation and the largest."""
+    lo, hi = 0, len(idx) - 1
+    vals = a[idx].tolist()
+    while hi - lo + 1 > m:
+        if vals[lo] < vals[hi]:
+            lo += 1
+        else:
+            hi -= 1
+    return idx[lo:hi + 1]
+
+
+def _vertex(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Offset, in units of the spacing, of the vertex of the parabola through
+    ``(-1, a), (0, b), (1, c)``, clipped to ``[-1, 1]``; 0 where it is not
+    concave (``b`` is then kept)."""
+    den = a - 2 * b + c
+    concave = den < 0  # False where nan
+    u = (0.5 * (a - c)) / np.where(concave, den, -1.0)
+    return np.where(concave, np.minimum(np.maximum(u, -1.0), 1.0), 0.0)
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
@@ -217,6 +199,15 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     longer lowers the largest error.
     ``weight=None`` is the constant 1 (absolute error), without its calls.
 
+    Each exchange is vectorized over the extrema: the error on a grid
+    uniform in ``theta`` (``t = cos theta``, cached per degree), the
+    largest ``|e|`` of each run of one sign, then a parabola through the
+    grid values around each, a second parabola through three evaluations
+    at a quarter of the spacing around its vertex, and an evaluation at the
+    vertex of that (two calls of ``f`` per exchange; the values of ``f`` at
+    the new reference are those of the last call). The refined points stay
+    those of the grid where that is larger, and end points stay put.
+
     The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
     ``3/8 + t/2``:
@@ -227,70 +218,88 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     ([0.375, 0.5], 0.125, True)
     """
     n = degree
-    if weight is None:
-        weight = _unit
-    to_x = lambda t: 0.5 * (hi - lo) * t + 0.5 * (hi + lo)
-    grid_n = max(4000, 200 * (n + 2))
-    t_grid = np.cos(np.pi * np.arange(grid_n, -1, -1) / grid_n)
-    f_grid = f(to_x(t_grid))
-    v_grid = C.chebvander(t_grid, n)  # the grid values are one matrix product
-    w_grid = weight(to_x(t_grid))
+    unit = weight is None or weight is _unit
+    half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    theta_grid, t_grid, v_grid = _grid(n)
+    last = len(t_grid) - 1
+    step = theta_grid[0] - theta_grid[1]
+    f_grid = f(half * t_grid + mid)
+    w_grid = None if unit else weight(half * t_grid + mid)
     # float64 noise floor of the error: a gap below a few roundings of w f
     # cannot shrink further, so it counts as converged
-    floor = 8 * np.finfo(float).eps * float(np.max(np.abs(w_grid * f_grid)))
-    ref = np.cos(np.pi * np.arange(n + 1, -1, -1) / (n + 1))
+    floor = 8 * np.finfo(float).eps * float(np.max(np.abs(f_grid if unit else w_grid * f_grid)))
+    ks = np.arange(n + 1)
     signs = (-1.0) ** np.arange(n + 2)
+
+    def evaluate(theta, cheb):
+        """Error, ``f`` and weight at the angles ``theta`` (any shape)."""
+        x = half * np.cos(theta) + mid
+        fx = f(x)
+        e = np.cos(theta[..., None] * ks) @ cheb - fx
+        if unit:
+            return e, fx, None
+        wx = weight(x)
+        return wx * e, fx, wx
+
+    ref = np.pi * np.arange(n + 1, -1, -1) / (n + 1)  # angles of the reference
+    x_ref = half * np.cos(ref) + mid
+    f_ref = f(x_ref)
+    w_ref = None if unit else weight(x_ref)
     best = None
     for it in range(1, max_iter + 1):
-        x_ref = to_x(ref)
         A = np.empty((n + 2, n + 2))
-        A[:, : n + 1] = C.chebvander(ref, n)
-        A[:, n + 1] = signs / weight(x_ref)
+        A[:, : n + 1] = np.cos(ref[:, None] * ks)
+        A[:, n + 1] = signs if unit else signs / w_ref
         try:
-            sol = np.linalg.solve(A, f(x_ref))
+            sol = np.linalg.solve(A, f_ref)
         except np.linalg.LinAlgError:
             break
         cheb, E = sol[: n + 1], abs(sol[n + 1])
-
-        def err_fn(t, cheb=cheb):
-            x = to_x(t)
-            e = _clenshaw(t, cheb) - f(x)
-            return e if weight is _unit else weight(x) * e
-
         e_grid = v_grid @ cheb - f_grid
-        if weight is not _unit:
+        if not unit:
             e_grid *= w_grid
-        idx = _local_extrema(t_grid, e_grid)
-        # merge consecutive same-sign extrema, keeping the larger
-        keep = [idx[0]]
-        for k in idx[1:]:
-            if np.sign(e_grid[k]) == np.sign(e_grid[keep[-1]]):
-                if abs(e_grid[k]) > abs(e_grid[keep[-1]]):
-                    keep[-1] = k
-            else:
-                keep.append(k)
-        while len(keep) > n + 2:  # drop the smaller end: keeps alternation and the max
-            if abs(e_grid[keep[0]]) < abs(e_grid[keep[-1]]):
-                keep.pop(0)
-            else:
-                keep.pop()
-        keep_p, keep_v = _refine(t_grid, keep, e_grid[keep], err_fn)
-        max_err = float(max(np.max(np.abs(keep_v)), np.max(np.abs(e_grid))))
-        E = min(E, float(np.min(np.abs(keep_v)))) if len(keep) == n + 2 else E
+        keep = _sign_runs(e_grid)
+        abs_grid = np.abs(e_grid)
+        if len(keep) > n + 2:
+            keep = _trim(keep, abs_grid, n + 2)
+        # refine the extrema: a parabola on the grid (in theta), one through
+        # three evaluations around its vertex, then its vertex; the largest
+        # of these and the grid point is kept; end points stay put
+        i_lo, i_hi = np.maximum(keep - 1, 0), np.minimum(keep + 1, last)
+        inner = (keep > 0) & (keep < last)
+        e_keep, th_keep = e_grid[keep], theta_grid[keep]
+        sg = np.where(e_keep >= 0, 1.0, -1.0)
+        u = _vertex(sg * e_grid[i_lo], sg * e_keep, sg * e_grid[i_hi]) * inner
+        q = inner * (0.25 * step)
+        th = th_keep - u * step  # theta decreases along the grid
+        pts = np.array([th + q, th, th - q])
+        e3, f3, w3 = evaluate(pts, cheb)
+        th2 = th - _vertex(sg * e3[0], sg * e3[1], sg * e3[2]) * q
+        e1, f1, w1 = evaluate(th2, cheb)
+        cand_e = np.concatenate([e_keep[None], e3, e1[None]])
+        j = np.argmax(sg * cand_e, axis=0)
+        cols = np.arange(len(keep))
+        k_p = np.concatenate([th_keep[None], pts, th2[None]])[j, cols]
+        k_v = cand_e[j, cols]
+        k_f = np.concatenate([f_grid[keep][None], f3, f1[None]])[j, cols]
+        k_w = None if unit else np.concatenate([w_grid[keep][None], w3, w1[None]])[j, cols]
+        abs_v = np.abs(k_v)
+        max_err = float(max(abs_v.max(), abs_grid.max()))
+        E = min(E, float(abs_v.min())) if len(keep) == n + 2 else E
         improved = best is None or max_err < best.max_error
         if improved:
-            best = RemezResult(cheb.copy(), E, max_err, it, False, ref.copy())
+            best = RemezResult(cheb.copy(), E, max_err, it, False, np.cos(ref))
         if max_err - E <= rtol * max_err:
-            best = RemezResult(cheb.copy(), E, max_err, it, True, ref.copy())
+            best = RemezResult(cheb.copy(), E, max_err, it, True, np.cos(ref))
             break
         if max_err - E <= floor:
             # at the noise floor: keep exchanging only while it still helps
             best.converged = True
             if not improved:
                 break
-        if len(keep_p) < n + 2:
+        if len(keep) < n + 2:
             break
-        ref = np.array(keep_p)
+        ref, f_ref, w_ref = k_p, k_f, k_w
     if best is not None:
         best.noise_limited = best.max_error <= NOISE_LIMIT * floor / 8
     return best
