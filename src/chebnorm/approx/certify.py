@@ -1,23 +1,26 @@
 """Rigorous upper bounds of sup |p - f| and sup |p/f - 1| on an interval.
 
-Method (branch and bound on order-3 Taylor forms in ball arithmetic)
+Method (branch and bound on order-4 Taylor forms in ball arithmetic)
 --------------------------------------------------------------------
 Let ``g = p - f`` (absolute) or ``g = p/f - 1`` (relative). On a subinterval
 ``X = [m - r, m + r]`` Taylor's theorem with the Lagrange remainder gives,
 for every ``x = m + h`` in ``X``,
 
-    g(x) = g0 + g1 h + g2 h^2 + g3(xi) h^3,   g_k = g^(k)(m)/k!,  xi in X,
+    g(x) = g0 + g1 h + g2 h^2 + g3 h^3 + g4(xi) h^4,  g_k = g^(k)(m)/k!,  xi in X,
 
-so ``|g(x)| <= max_{|h|<=r} |g0 + g1 h + g2 h^2| + sup_X |g3| r^3``. The
-point coefficients ``g0, g1, g2`` and an enclosure of ``g3`` over the whole
-ball ``X`` come from python-flint's ``arb_series`` (Taylor arithmetic on
-Arb balls, every rounding error accounted for); the maximum of the quadratic
-is taken exactly (both ends and the vertex, in ball arithmetic). The
-polynomial is evaluated with its coefficients as exact binary numbers, so the
-bound is for the very float64 coefficients that are stored and exported.
+so ``|g(x)| <= max_{|h|<=r} |g0 + g1 h + g2 h^2 + g3 h^3| + sup_X |g4| r^4``.
+The point coefficients ``g0 .. g3`` and an enclosure of ``g4`` over the
+whole ball ``X`` come from python-flint's ``arb_series`` (Taylor arithmetic
+on Arb balls, every rounding error accounted for); the maximum of the cubic
+is taken exactly (both ends and the critical points, the roots of its
+derivative enclosed in ball arithmetic). The polynomial is evaluated with
+its coefficients as exact binary numbers, so the bound is for the very
+float64 coefficients that are stored and exported.
 
 Subintervals are bisected until each upper bound is within ``(1 + tol)`` of
-the best lower bound found (the largest ``|g|`` at a point), so the returned
+the best lower bound found (the largest ``|g|`` at a point; the search
+starts from the largest ``|g|`` on a float64 grid, refined by Newton steps
+in Arb, so that the pieces are compared with it from the first), so the returned
 bound is rigorous and at most ``(1 + tol)`` times the true supremum. When a
 cap stops the bisection first (``max_subintervals``, a piece narrower than
 ``2**-60`` of the interval, or an error below the working precision) the
@@ -144,6 +147,7 @@ class _PolyTaylor:
         # p(x) = q((x - c)/s): the k-th Taylor coefficient in x is q_k(t0) / s^k
         self.c, self.s = (arb(0), arb(1)) if shift is None else (arb(shift[0]), arb(shift[1]))
         self.shifted = shift is not None
+        self.s_pow: list[arb] = [arb(1)]
 
     def _t(self, x):
         return (x - self.c) / self.s if self.shifted else x
@@ -156,15 +160,22 @@ class _PolyTaylor:
                                        or [arb(0)]))
         return self.polys[k]
 
+    def taylor(self, x0: arb, n: int) -> list[arb]:
+        """The first ``n`` Taylor coefficients of ``p`` at ``x0`` (a ball)."""
+        self._q(n - 1)
+        polys = self.polys
+        if not self.shifted:
+            return [polys[k](x0) for k in range(n)]
+        while len(self.s_pow) < n:
+            self.s_pow.append(self.s_pow[-1] * self.s)
+        t0, s_pow = self._t(x0), self.s_pow
+        return [polys[k](t0) / s_pow[k] for k in range(n)]
+
     def __call__(self, s):
         if isinstance(s, arb_series):
             c = s.coeffs()
             if len(c) == 2 and c[1] == 1:  # s = x0 + h, the only form certify builds
-                t0 = self._t(c[0])
-                if not self.shifted:
-                    return arb_series([self._q(k)(t0) for k in range(s.prec)], prec=s.prec)
-                return arb_series([self._q(k)(t0) / self.s ** k for k in range(s.prec)],
-                                  prec=s.prec)
+                return arb_series(self.taylor(c[0], s.prec), prec=s.prec)
             return _horner(self.coeffs, self._t(s))
         return self._q(0)(self._t(s))
 
@@ -173,7 +184,7 @@ def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     """``g = p - f`` or ``p/f - 1`` for ``f`` an arb or arb_series function;
     nan wherever Arb cannot evaluate it (a division by a ball containing 0).
     With ``shift = (c, s)``, ``p(x) = sum coeffs[k] ((x - c)/s)^k``."""
-    p = _PolyTaylor(coeffs, shift)
+    p = coeffs if isinstance(coeffs, _PolyTaylor) else _PolyTaylor(coeffs, shift)
     if kind == "abs":
         def g(s):
             return p(s) - f(s)
@@ -191,6 +202,30 @@ def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
                 return arb_series([arb("nan")] * s.prec, prec=s.prec)
             return arb("nan")
     return safe
+
+
+def _error_taylor(f_series, p: _PolyTaylor, kind: str):
+    """``(x0, n) ->`` the first ``n`` Taylor coefficients of ``g`` at the ball
+    ``x0`` (all nan where Arb cannot evaluate it): the error function of
+    :func:`_error_function` without building the series of ``p``, for the
+    subdivision's inner loop."""
+    if kind not in ("abs", "rel"):
+        raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
+    nan = arb("nan")
+
+    def taylor(x0: arb, n: int) -> list[arb]:
+        try:
+            fs = f_series(arb_series([x0, 1], prec=n))
+            if not isinstance(fs, arb_series):  # f constant
+                fs = arb_series([fs], prec=n)
+            pc = p.taylor(x0, n)
+            if kind == "rel":
+                return _coeffs(arb_series(pc, prec=n) / fs - 1, n)
+            fc = fs.coeffs()
+            return [pc[k] - fc[k] for k in range(len(fc))] + pc[len(fc):]
+        except (ValueError, ZeroDivisionError):
+            return [nan] * n
+    return taylor
 
 
 def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
@@ -249,21 +284,22 @@ HIGH_ORDER = 8
 
 
 def _high_order_upper(g, a: arb, b: arb, m: arb, r: arb) -> arb:
-    """An order-``HIGH_ORDER`` Taylor form of ``|g|`` on ``[a, b]``.
+    """An order-``HIGH_ORDER`` Taylor form of ``|g|`` on ``[a, b]``; ``g(x0,
+    n)`` gives the first ``n`` Taylor coefficients at the ball ``x0``.
 
-    ``g = g0 + g1 h + g2 h^2 + sum_{3 <= k <= n} g_k h^k + g_{n+1}(xi) h^{n+1}``:
-    the quadratic's maximum exactly, the middle terms by ``|g_k| r^k`` (point
+    ``g = g0 + .. + g3 h^3 + sum_{4 <= k <= n} g_k h^k + g_{n+1}(xi) h^{n+1}``:
+    the cubic's maximum exactly, the middle terms by ``|g_k| r^k`` (point
     coefficients) and the remainder over the ball. When ``g`` is a tiny
     difference of large terms (an error at rounding level) the ball
-    enclosure of ``g_3`` is dominated by the width of the ball times ``|f|``;
-    the remainder's ``r^{n+1}`` shrinks that much faster than ``r^3``.
+    enclosure of ``g_4`` is dominated by the width of the ball times ``|f|``;
+    the remainder's ``r^{n+1}`` shrinks that much faster than ``r^4``.
     """
     n = HIGH_ORDER
-    c = _coeffs(g(arb_series([m, 1], prec=n + 1)), n + 1)
-    rest = _coeffs(g(arb_series([a.union(b), 1], prec=n + 2)), n + 2)[n + 1]
-    upper = _quadratic_max(c[0], c[1], c[2], r)
-    rk = r * r * r
-    for k in range(3, n + 1):
+    c = g(m, n + 1)
+    rest = g(a.union(b), n + 2)[n + 1]
+    upper = _cubic_max(c[0], c[1], c[2], c[3], r)
+    rk = (r * r) * (r * r)
+    for k in range(4, n + 1):
         upper = upper + abs(c[k]).upper() * rk
         rk = rk * r
     return upper + abs(rest).upper() * rk
@@ -296,8 +332,7 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     quotient taken exactly.
 
     >>> from chebnorm.approx.expr import parse_function
-    >>> import numpy as np
-import sympy as sp
+    >>> import sympy as sp
     >>> c = certify(parse_function("x**2"), [0.0, 0.0, 1.0], sp.Integer(0), sp.Integer(1))
     >>> c.bound == 0.0, c.tight
     (True, True)
@@ -338,16 +373,16 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
 
 
 def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
-    coeffs = [arb(c) for c in floats]
-    g = _error_function(fn.arb_series, coeffs, kind, shift)
-    g_point = _error_function(fn.arb, coeffs, kind, shift)
+    p = _PolyTaylor([arb(c) for c in floats], shift)
+    g = _error_taylor(fn.arb_series, p, kind)  # (x0, n) -> Taylor coefficients
+    g_point = _error_function(fn.arb, p, kind)
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
     lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
     if not lo_f <= hi_f:
         raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
                          f"interval wider than one float64 spacing")
     a0, b0 = lo_b.lower(), hi_b.upper()
-    degree = max(len(coeffs) - 1, 0)
+    degree = max(len(floats) - 1, 0)
     pieces = 2 * (degree + 2)
     edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
     # exact binary split points (the outer two keep the enclosing endpoints)
@@ -357,7 +392,7 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     # below this, |g| is rounding noise of the working precision
     scale = _scale(fn, kind, (a0, (a0 + b0) / 2, b0))
     floor = scale * arb(2) ** (24 - ctx.prec)
-    # an error below this is a cancellation: order-3 forms converge too slowly
+    # an error below this is a cancellation: order-4 forms converge too slowly
     tiny = scale * arb(2) ** -30
 
     # the largest |g| located first (float64 search, then Newton in Arb): the
@@ -380,8 +415,8 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             count += 1
             m = (a + b) / 2
             r = (b - a) / 2
-            c0, c1, c2, c3 = _coeffs(g(arb_series([m, 1], prec=ORDER)), ORDER)
-            rest = _coeffs(g(arb_series([a.union(b), 1], prec=ORDER + 1)), ORDER + 1)[ORDER]
+            c0, c1, c2, c3 = g(m, ORDER)
+            rest = g(a.union(b), ORDER + 1)[ORDER]
             r2 = r * r
             upper = _cubic_max(c0, c1, c2, c3, r) + abs(rest).upper() * (r2 * r2)
             value = c0 if c0.is_finite() else g_point(m)
@@ -462,7 +497,7 @@ def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> Valu
 def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float, arb]:
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
     the float nearest ``start``, and Newton steps on ``g'`` from the best of
-    these. Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
+    these (``g(x0, n)``: Taylor coefficients; ``g_point``: values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
     bound of ``|g(at)|`` (0 when nothing was finite)."""
     best, best_at, best_lower = -1.0, lo, arb(0)
 
@@ -476,7 +511,7 @@ def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float
         visit(x)
     x = best_at
     for _ in range(8):
-        s = _coeffs(g(arb_series([arb(x), 1], prec=3)), 3)
+        s = g(arb(x), 3)
         if not all(c.is_finite() for c in s) or s[2].contains(0):
             break
         step = float((-s[1] / (2 * s[2])).mid())

@@ -13,7 +13,7 @@ from typing import Callable
 
 import mpmath
 import numpy as np
-from flint import fmpq, fmpq_poly, fmpz_poly
+from flint import arb, arb_mat, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
@@ -177,14 +177,43 @@ def _trim(idx: np.ndarray, a: np.ndarray, m: int) -> np.ndarray:
     return idx[lo:hi + 1]
 
 
-def _vertex(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Offset, in units of the spacing, of the vertex of the parabola through
-    ``(-1, a), (0, b), (1, c)``, clipped to ``[-1, 1]``; 0 where it is not
-    concave (``b`` is then kept)."""
-    den = a - 2 * b + c
-    concave = den < 0  # False where nan
-    u = (0.5 * (a - c)) / np.where(concave, den, -1.0)
-    return np.where(concave, np.minimum(np.maximum(u, -1.0), 1.0), 0.0)
+_STENCIL = np.arange(-2, 3)
+
+
+def _peaks(e: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """Offsets, in grid spacings within ``[-1, 1]``, of the maxima of ``|e|``
+    next to the grid points ``idx``: the root of the derivative of the
+    quartic through the five grid values around each (Newton from the
+    parabola's vertex). The grid is uniform in ``theta`` and ``e`` is even in
+    ``theta`` about both ends (``t = cos theta``), so the values are
+    reflected there and an end point's offset is exactly 0.
+
+    The quartic's Taylor coefficients at the centre are the five-point
+    differences (exact for quartics); with spacing ``h`` the located point is
+    off by ``O(h^4)`` and its value by ``O(h^8)``, relative:
+
+    >>> th = np.linspace(0, 1, 101); e = np.cos(7 * (th - 0.3013))
+    >>> k = np.array([30]); bool(abs(th[30] + 0.01 * _peaks(e, k)[0] - 0.3013) < 1e-9)
+    True
+    """
+    last = len(e) - 1
+    j = np.abs(idx[None, :] + _STENCIL[:, None])  # reflected at 0
+    j = np.where(j > last, 2 * last - j, j)  # and at the other end
+    v = e[j]
+    v = v * np.where(v[2] >= 0, 1.0, -1.0)  # maxima of sign * e
+    em2, em1, e0, e1, e2 = v
+    d1 = (8 * (e1 - em1) - (e2 - em2)) / 12
+    d2 = (16 * (e1 + em1) - 30 * e0 - (e2 + em2)) / 12
+    d3 = 0.5 * ((e2 - em2) - 2 * (e1 - em1))
+    d4 = (e2 + em2) - 4 * (e1 + em1) + 6 * e0
+    concave = d2 < 0  # False where nan: the grid point is kept
+    u = np.minimum(np.maximum(-d1 / np.where(concave, d2, -1.0), -1.0), 1.0)
+    for _ in range(2):  # q'(u) = d1 + d2 u + d3 u^2/2 + d4 u^3/6
+        q1 = d1 + u * (d2 + u * (0.5 * d3 + u * (d4 / 6)))
+        q2 = d2 + u * (d3 + u * (0.5 * d4))
+        ok = q2 < 0
+        u = np.minimum(np.maximum(u - q1 / np.where(ok, q2, -1.0) * ok, -1.0), 1.0)
+    return np.where(concave, u, 0.0)
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
@@ -201,12 +230,11 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
 
     Each exchange is vectorized over the extrema: the error on a grid
     uniform in ``theta`` (``t = cos theta``, cached per degree), the
-    largest ``|e|`` of each run of one sign, then a parabola through the
-    grid values around each, a second parabola through three evaluations
-    at a quarter of the spacing around its vertex, and an evaluation at the
-    vertex of that (two calls of ``f`` per exchange; the values of ``f`` at
-    the new reference are those of the last call). The refined points stay
-    those of the grid where that is larger, and end points stay put.
+    largest ``|e|`` of each run of one sign, each located between grid
+    points by the quartic through the five grid values around it
+    (:func:`_peaks`) and evaluated there: one call of ``f`` per exchange,
+    whose values are also those of the next solve. A grid point stays where
+    its error is the larger, and end points stay put.
 
     The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
@@ -262,27 +290,16 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
         abs_grid = np.abs(e_grid)
         if len(keep) > n + 2:
             keep = _trim(keep, abs_grid, n + 2)
-        # refine the extrema: a parabola on the grid (in theta), one through
-        # three evaluations around its vertex, then its vertex; the largest
-        # of these and the grid point is kept; end points stay put
-        i_lo, i_hi = np.maximum(keep - 1, 0), np.minimum(keep + 1, last)
-        inner = (keep > 0) & (keep < last)
-        e_keep, th_keep = e_grid[keep], theta_grid[keep]
-        sg = np.where(e_keep >= 0, 1.0, -1.0)
-        u = _vertex(sg * e_grid[i_lo], sg * e_keep, sg * e_grid[i_hi]) * inner
-        q = inner * (0.25 * step)
-        th = th_keep - u * step  # theta decreases along the grid
-        pts = np.array([th + q, th, th - q])
-        e3, f3, w3 = evaluate(pts, cheb)
-        th2 = th - _vertex(sg * e3[0], sg * e3[1], sg * e3[2]) * q
-        e1, f1, w1 = evaluate(th2, cheb)
-        cand_e = np.concatenate([e_keep[None], e3, e1[None]])
-        j = np.argmax(sg * cand_e, axis=0)
-        cols = np.arange(len(keep))
-        k_p = np.concatenate([th_keep[None], pts, th2[None]])[j, cols]
-        k_v = cand_e[j, cols]
-        k_f = np.concatenate([f_grid[keep][None], f3, f1[None]])[j, cols]
-        k_w = None if unit else np.concatenate([w_grid[keep][None], w3, w1[None]])[j, cols]
+        # the extrema between grid points (end points stay put), kept where
+        # larger than at the grid point
+        th_keep, e_keep = theta_grid[keep], e_grid[keep]
+        th = th_keep - _peaks(e_grid, keep) * step  # theta decreases along the grid
+        ev, fv, wv = evaluate(th, cheb)
+        better = np.where(e_keep >= 0, ev > e_keep, ev < e_keep)
+        k_p = np.where(better, th, th_keep)
+        k_v = np.where(better, ev, e_keep)
+        k_f = np.where(better, fv, f_grid[keep])
+        k_w = None if unit else np.where(better, wv, w_grid[keep])
         abs_v = np.abs(k_v)
         max_err = float(max(abs_v.max(), abs_grid.max()))
         E = min(E, float(abs_v.min())) if len(keep) == n + 2 else E
@@ -340,5 +357,39 @@ def polish(f_mp: Callable, lo: float, hi: float, ref: np.ndarray, degree: int,
             sign = 1 if i % 2 == 0 else -1
             rows.append(t[: n + 1] + [sign * (abs(fx) if relative else 1)])
             rhs.append(fx)
-        sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
-        return [sol[k] for k in range(n + 1)]
+        return _solve(rows, rhs, dps)[: n + 1]
+
+
+def _solve(rows: list, rhs: list, dps: int) -> list:
+    """``rows x = rhs`` (mpmath numbers) to about ``dps`` digits: Arb's
+    approximate LU solve in C at the same precision, its midpoints returned
+    exactly as mpmath numbers (mpmath's pure-Python ``lu_solve`` where Arb
+    finds the system singular). Like mpmath's, not a rigorous enclosure:
+    the coefficients are certified afterwards."""
+    old = ctx.prec
+    try:
+        ctx.prec = math.ceil(dps * math.log2(10)) + 16
+        a = arb_mat([[_to_arb(v) for v in row] for row in rows])
+        b = arb_mat([[_to_arb(v)] for v in rhs])
+        x = a.solve(b, algorithm="approx")
+        out = []
+        for k in range(len(rhs)):
+            man, exp = x[k, 0].mid().man_exp()
+            out.append(mpmath.mpf((int(man), int(exp))))
+        return out
+    except ZeroDivisionError:
+        with mpmath.workdps(dps):
+            sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
+            return [sol[k] for k in range(len(rhs))]
+    finally:
+        ctx.prec = old
+
+
+def _to_arb(v) -> arb:
+    """An mpmath number (or a float) as an exact Arb ball."""
+    if not isinstance(v, mpmath.mpf):
+        v = mpmath.mpf(v)
+    if not mpmath.isfinite(v):
+        raise ValueError(f"value {v} is not finite")
+    sign, man, exp, _ = v._mpf_
+    return arb(((-1) ** sign * int(man), int(exp)))
