@@ -232,6 +232,8 @@ def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     """An upper bound of max_{|h| <= r} |c0 + c1 h + c2 h^2| (balls allowed)."""
     ends = [abs(c0 - c1 * r + c2 * r * r), abs(c0 + c1 * r + c2 * r * r)]
     best = ends[0].upper().max(ends[1].upper())
+    if c2.is_zero():  # a line: largest at an end
+        return best
     box = arb(0, r.upper())
     if c2.contains(0):
         inner = abs(c0 + c1 * box + c2 * (box * box))
@@ -260,6 +262,8 @@ def _cubic_max(c0: arb, c1: arb, c2: arb, c3: arb, r: arb) -> arb:
     disc = c2 * c2 - 3 * c1 * c3
     if disc < 0:  # no real critical point: monotonic
         return best
+    if c3.is_zero():
+        return _quadratic_max(c0, c1, c2, r)
     if c3.contains(0) or not disc > 0:
         return best.max(_quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r))
     sq = disc.sqrt()
