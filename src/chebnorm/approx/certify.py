@@ -162,8 +162,9 @@ class _PolyTaylor:
 
     def taylor(self, x0: arb, n: int) -> list[arb]:
         """The first ``n`` Taylor coefficients of ``p`` at ``x0`` (a ball)."""
-        self._q(n - 1)
         polys = self.polys
+        if len(polys) < n:
+            self._q(n - 1)
         if not self.shifted:
             return [polys[k](x0) for k in range(n)]
         while len(self.s_pow) < n:
@@ -252,13 +253,14 @@ def _cubic_max(c0: arb, c1: arb, c2: arb, c3: arb, r: arb) -> arb:
     3 c3 h^2``, enclosed in ball arithmetic) whose ball meets ``[-r, r]``.
     Where the roots cannot be separated (``c3`` or the discriminant
     containing 0) the quadratic's maximum plus ``|c3| r^3``."""
-    if not (c0.is_finite() and c1.is_finite() and c2.is_finite() and c3.is_finite()):
-        return arb("nan")
-
     def cubic(h):
         return c0 + h * (c1 + h * (c2 + h * c3))
 
-    best = abs(cubic(-r)).upper().max(abs(cubic(r)).upper())
+    # both ends: p(+-r) = even +- odd, so max |p(+-r)| = |even| + |odd|
+    r2 = r * r
+    best = (abs(c0 + c2 * r2) + abs(r * (c1 + c3 * r2))).upper()
+    if not best.is_finite():  # some coefficient is not
+        return best
     disc = c2 * c2 - 3 * c1 * c3
     if disc < 0:  # no real critical point: monotonic
         return best
@@ -501,29 +503,33 @@ def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> Valu
 def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float, arb]:
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
     the float nearest ``start``, and Newton steps on ``g'`` from the best of
-    these (``g(x0, n)``: Taylor coefficients; ``g_point``: values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
+    these, until a step moves less than ``2^-40`` of the interval (``g(x0,
+    n)``: Taylor coefficients, whose first is the value; ``g_point``:
+    values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
     bound of ``|g(at)|`` (0 when nothing was finite)."""
     best, best_at, best_lower = -1.0, lo, arb(0)
 
-    def visit(x: float) -> None:
+    def record(x: float, v: arb) -> None:
         nonlocal best, best_at, best_lower
-        v = abs(g_point(arb(x)))
+        v = abs(v)
         if v.is_finite() and float(v.mid()) > best:
             best, best_at, best_lower = float(v.mid()), x, v.lower()
 
     for x in (min(max(float(start.mid()), lo), hi), lo, hi):
-        visit(x)
-    x = best_at
-    for _ in range(8):
+        record(x, g_point(arb(x)))
+    x, small = best_at, 2.0 ** -40 * (hi - lo)
+    for k in range(8):
         s = g(arb(x), 3)
-        if not all(c.is_finite() for c in s) or s[2].contains(0):
+        if k:
+            record(x, s[0])
+        if not (s[1].is_finite() and s[2].is_finite()) or s[2].contains(0):
             break
-        step = float((-s[1] / (2 * s[2])).mid())
-        nxt = min(max(x + step, lo), hi)
-        if nxt == x:
+        nxt = min(max(x + float((-s[1] / (2 * s[2])).mid()), lo), hi)
+        if abs(nxt - x) <= small:
             break
         x = nxt
-        visit(x)
+    else:
+        record(x, g_point(arb(x)))
     return max(best, 0.0), best_at, best_lower
 
 

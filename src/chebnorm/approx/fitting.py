@@ -199,21 +199,26 @@ def _peaks(e: np.ndarray, idx: np.ndarray) -> np.ndarray:
     last = len(e) - 1
     j = np.abs(idx[None, :] + _STENCIL[:, None])  # reflected at 0
     j = np.where(j > last, 2 * last - j, j)  # and at the other end
-    v = e[j]
-    v = v * np.where(v[2] >= 0, 1.0, -1.0)  # maxima of sign * e
-    em2, em1, e0, e1, e2 = v
-    d1 = (8 * (e1 - em1) - (e2 - em2)) / 12
-    d2 = (16 * (e1 + em1) - 30 * e0 - (e2 + em2)) / 12
-    d3 = 0.5 * ((e2 - em2) - 2 * (e1 - em1))
-    d4 = (e2 + em2) - 4 * (e1 + em1) + 6 * e0
-    concave = d2 < 0  # False where nan: the grid point is kept
-    u = np.minimum(np.maximum(-d1 / np.where(concave, d2, -1.0), -1.0), 1.0)
-    for _ in range(2):  # q'(u) = d1 + d2 u + d3 u^2/2 + d4 u^3/6
-        q1 = d1 + u * (d2 + u * (0.5 * d3 + u * (d4 / 6)))
-        q2 = d2 + u * (d3 + u * (0.5 * d4))
-        ok = q2 < 0
-        u = np.minimum(np.maximum(u - q1 / np.where(ok, q2, -1.0) * ok, -1.0), 1.0)
-    return np.where(concave, u, 0.0)
+    out = []
+    # a few extrema: Python floats cost less than numpy calls on tiny arrays
+    for em2, em1, e0, e1, e2 in e[j].T.tolist():
+        if e0 < 0:  # maxima of sign * e
+            em2, em1, e0, e1, e2 = -em2, -em1, -e0, -e1, -e2
+        d1 = (8 * (e1 - em1) - (e2 - em2)) / 12
+        d2 = (16 * (e1 + em1) - 30 * e0 - (e2 + em2)) / 12
+        if not d2 < 0:  # not concave (or nan): the grid point is kept
+            out.append(0.0)
+            continue
+        d3 = 0.5 * ((e2 - em2) - 2 * (e1 - em1))
+        d4 = (e2 + em2) - 4 * (e1 + em1) + 6 * e0
+        u = min(max(-d1 / d2, -1.0), 1.0)
+        for _ in range(2):  # Newton on q'(u) = d1 + d2 u + d3 u^2/2 + d4 u^3/6
+            q2 = d2 + u * (d3 + u * (0.5 * d4))
+            if q2 < 0:
+                q1 = d1 + u * (d2 + u * (0.5 * d3 + u * (d4 / 6)))
+                u = min(max(u - q1 / q2, -1.0), 1.0)
+        out.append(u if u == u else 0.0)
+    return np.array(out)
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
@@ -249,7 +254,6 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     unit = weight is None or weight is _unit
     half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
     theta_grid, t_grid, v_grid = _grid(n)
-    last = len(t_grid) - 1
     step = theta_grid[0] - theta_grid[1]
     f_grid = f(half * t_grid + mid)
     w_grid = None if unit else weight(half * t_grid + mid)
