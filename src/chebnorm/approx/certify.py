@@ -172,6 +172,13 @@ class _PolyTaylor:
         t0, s_pow = self._t(x0), self.s_pow
         return [polys[k](t0) / s_pow[k] for k in range(n)]
 
+    def coefficient(self, x0: arb, k: int) -> arb:
+        """The ``k``-th Taylor coefficient of ``p`` at ``x0`` alone."""
+        q = self._q(k)
+        if not self.shifted:
+            return q(x0)
+        return q(self._t(x0)) / self.s ** k
+
     def __call__(self, s):
         if isinstance(s, arb_series):
             c = s.coeffs()
@@ -209,16 +216,19 @@ def _error_taylor(f_series, p: _PolyTaylor, kind: str):
     """``(x0, n) ->`` the first ``n`` Taylor coefficients of ``g`` at the ball
     ``x0`` (all nan where Arb cannot evaluate it): the error function of
     :func:`_error_function` without building the series of ``p``, for the
-    subdivision's inner loop."""
+    subdivision's inner loop. Its attribute ``top(x0, n)`` is the last of
+    them alone (the remainder term)."""
     if kind not in ("abs", "rel"):
         raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
     nan = arb("nan")
 
+    def f_at(x0: arb, n: int) -> arb_series:
+        fs = f_series(arb_series([x0, 1], prec=n))
+        return fs if isinstance(fs, arb_series) else arb_series([fs], prec=n)  # f constant
+
     def taylor(x0: arb, n: int) -> list[arb]:
         try:
-            fs = f_series(arb_series([x0, 1], prec=n))
-            if not isinstance(fs, arb_series):  # f constant
-                fs = arb_series([fs], prec=n)
+            fs = f_at(x0, n)
             pc = p.taylor(x0, n)
             if kind == "rel":
                 return _coeffs(arb_series(pc, prec=n) / fs - 1, n)
@@ -226,6 +236,18 @@ def _error_taylor(f_series, p: _PolyTaylor, kind: str):
             return [pc[k] - fc[k] for k in range(len(fc))] + pc[len(fc):]
         except (ValueError, ZeroDivisionError):
             return [nan] * n
+
+    def top(x0: arb, n: int) -> arb:
+        if kind == "rel":
+            return taylor(x0, n)[n - 1]
+        try:
+            fc = f_at(x0, n).coeffs()
+            pk = p.coefficient(x0, n - 1)
+            return pk - fc[n - 1] if len(fc) >= n else pk
+        except (ValueError, ZeroDivisionError):
+            return nan
+
+    taylor.top = top
     return taylor
 
 
@@ -302,7 +324,7 @@ def _high_order_upper(g, a: arb, b: arb, m: arb, r: arb) -> arb:
     """
     n = HIGH_ORDER
     c = g(m, n + 1)
-    rest = g(a.union(b), n + 2)[n + 1]
+    rest = g.top(a.union(b), n + 2)
     upper = _cubic_max(c[0], c[1], c[2], c[3], r)
     rk = (r * r) * (r * r)
     for k in range(4, n + 1):
@@ -422,7 +444,7 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             m = (a + b) / 2
             r = (b - a) / 2
             c0, c1, c2, c3 = g(m, ORDER)
-            rest = g(a.union(b), ORDER + 1)[ORDER]
+            rest = g.top(a.union(b), ORDER + 1)
             r2 = r * r
             upper = _cubic_max(c0, c1, c2, c3, r) + abs(rest).upper() * (r2 * r2)
             value = c0 if c0.is_finite() else g_point(m)
@@ -502,8 +524,9 @@ def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> Valu
 
 def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float, arb]:
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
-    the float nearest ``start``, and Newton steps on ``g'`` from the best of
-    these, until a step moves less than ``2^-40`` of the interval (``g(x0,
+    the float nearest ``start``, and Newton steps on ``g'`` from that one
+    while ``|g|`` is concave, until a step moves less than ``2^-30`` of
+    the interval (its value is then that of the maximum to ``2^-60``; ``g(x0,
     n)``: Taylor coefficients, whose first is the value; ``g_point``:
     values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
     bound of ``|g(at)|`` (0 when nothing was finite)."""
@@ -515,15 +538,18 @@ def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float
         if v.is_finite() and float(v.mid()) > best:
             best, best_at, best_lower = float(v.mid()), x, v.lower()
 
-    for x in (min(max(float(start.mid()), lo), hi), lo, hi):
+    first = min(max(float(start.mid()), lo), hi)
+    for x in (first, lo, hi):
         record(x, g_point(arb(x)))
-    x, small = best_at, 2.0 ** -40 * (hi - lo)
+    x, small = first, 2.0 ** -30 * (hi - lo)
     for k in range(8):
         s = g(arb(x), 3)
         if k:
             record(x, s[0])
-        if not (s[1].is_finite() and s[2].is_finite()) or s[2].contains(0):
+        if not (s[0].is_finite() and s[1].is_finite() and s[2].is_finite()):
             break
+        if not ((s[0] > 0 and s[2] < 0) or (s[0] < 0 and s[2] > 0)):
+            break  # |g| is not concave here: no nearby maximum for Newton
         nxt = min(max(x + float((-s[1] / (2 * s[2])).mid()), lo), hi)
         if abs(nxt - x) <= small:
             break
