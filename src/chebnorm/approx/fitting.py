@@ -15,6 +15,7 @@ import mpmath
 import numpy as np
 from flint import arb, arb_mat, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
+from scipy.linalg import lapack
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish"]
@@ -144,43 +145,43 @@ def _grid(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return theta, t, v
 
 
-def _sign_runs(e: np.ndarray) -> np.ndarray:
+def _sign_runs(e: np.ndarray) -> tuple[list[int], np.ndarray]:
     """Index of the largest ``|e|`` in each maximal run of one sign (zero
     counts as positive), ascending: alternating in sign, and each the
     largest extremum of its run (consecutive same-sign extrema merged into
-    the larger)."""
+    the larger). Returns them and ``|e|``."""
     pos = e >= 0
-    change = np.flatnonzero(pos[1:] != pos[:-1]) + 1
+    change = (pos[1:] != pos[:-1]).nonzero()[0] + 1
     a = np.abs(e)
-    if len(change) < 64:  # the usual case: a few runs, a few slices
+    if len(change) < 64:  # the usual case: a few runs, a few slices (methods: no wrappers)
         bounds = [0, *change.tolist(), len(e)]
-        return np.array([s + int(np.argmax(a[s:t])) for s, t in zip(bounds[:-1], bounds[1:])])
+        return [s + int(a[s:t].argmax()) for s, t in zip(bounds[:-1], bounds[1:])], a
     run = np.zeros(len(e), dtype=np.intp)
     run[change] = 1
     run = np.cumsum(run)
     hit = np.flatnonzero(a == np.maximum.reduceat(a, np.concatenate(([0], change)))[run])
     first = np.ones(len(hit), dtype=bool)
     first[1:] = run[hit[1:]] != run[hit[:-1]]
-    return hit[first]
+    return hit[first].tolist(), a
 
 
-def _trim(idx: np.ndarray, a: np.ndarray, m: int) -> np.ndarray:
-    """Keep ``m`` consecutive entries of ``idx``, dropping the end with the
-    smaller ``a`` one at a time: keeps the alternation and the largest."""
+def _trim(idx: list[int], vals: list[float], m: int) -> tuple[list[int], list[float]]:
+    """Keep ``m`` consecutive entries of ``idx`` (and of their ``vals``),
+    dropping the end with the smaller value one at a time: keeps the
+    alternation and the largest."""
     lo, hi = 0, len(idx) - 1
-    vals = a[idx].tolist()
     while hi - lo + 1 > m:
         if vals[lo] < vals[hi]:
             lo += 1
         else:
             hi -= 1
-    return idx[lo:hi + 1]
+    return idx[lo:hi + 1], vals[lo:hi + 1]
 
 
 _STENCIL = np.arange(-2, 3)
 
 
-def _peaks(e: np.ndarray, idx: np.ndarray) -> np.ndarray:
+def _peaks(e: np.ndarray, idx: list[int]) -> list[float]:
     """Offsets, in grid spacings within ``[-1, 1]``, of the maxima of ``|e|``
     next to the grid points ``idx``: the root of the derivative of the
     quartic through the five grid values around each (Newton from the
@@ -193,15 +194,17 @@ def _peaks(e: np.ndarray, idx: np.ndarray) -> np.ndarray:
     off by ``O(h^4)`` and its value by ``O(h^8)``, relative:
 
     >>> th = np.linspace(0, 1, 101); e = np.cos(7 * (th - 0.3013))
-    >>> k = np.array([30]); bool(abs(th[30] + 0.01 * _peaks(e, k)[0] - 0.3013) < 1e-9)
+    >>> bool(abs(th[30] + 0.01 * _peaks(e, [30])[0] - 0.3013) < 1e-9)
     True
     """
     last = len(e) - 1
-    j = np.abs(idx[None, :] + _STENCIL[:, None])  # reflected at 0
-    j = np.where(j > last, 2 * last - j, j)  # and at the other end
+    j = [abs(i + d) for i in idx for d in (-2, -1, 0, 1, 2)]  # reflected at 0
+    j = [2 * last - i if i > last else i for i in j]  # and at the other end
+    vals = e[j].tolist()
     out = []
     # a few extrema: Python floats cost less than numpy calls on tiny arrays
-    for em2, em1, e0, e1, e2 in e[j].T.tolist():
+    for k in range(0, len(vals), 5):
+        em2, em1, e0, e1, e2 = vals[k:k + 5]
         if e0 < 0:  # maxima of sign * e
             em2, em1, e0, e1, e2 = -em2, -em1, -e0, -e1, -e2
         d1 = (8 * (e1 - em1) - (e2 - em2)) / 12
@@ -218,7 +221,7 @@ def _peaks(e: np.ndarray, idx: np.ndarray) -> np.ndarray:
                 q1 = d1 + u * (d2 + u * (0.5 * d3 + u * (d4 / 6)))
                 u = min(max(u - q1 / q2, -1.0), 1.0)
         out.append(u if u == u else 0.0)
-    return np.array(out)
+    return out
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
@@ -282,31 +285,37 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
         A = np.empty((n + 2, n + 2))
         A[:, : n + 1] = np.cos(ref[:, None] * ks)
         A[:, n + 1] = signs if unit else signs / w_ref
-        try:
-            sol = np.linalg.solve(A, f_ref)
-        except np.linalg.LinAlgError:
+        sol, info = lapack.dgesv(A, f_ref)[2:]  # LAPACK's solve, without numpy's wrapping
+        if info != 0:  # singular
             break
-        cheb, E = sol[: n + 1], abs(sol[n + 1])
+        cheb, E = sol[: n + 1], float(abs(sol[n + 1]))
         e_grid = v_grid @ cheb - f_grid
         if not unit:
             e_grid *= w_grid
-        keep = _sign_runs(e_grid)
-        abs_grid = np.abs(e_grid)
+        keep, abs_grid = _sign_runs(e_grid)
+        vals = abs_grid[keep].tolist()
+        grid_max = max(vals)
         if len(keep) > n + 2:
-            keep = _trim(keep, abs_grid, n + 2)
+            keep, vals = _trim(keep, vals, n + 2)
         # the extrema between grid points (end points stay put), kept where
-        # larger than at the grid point
-        th_keep, e_keep = theta_grid[keep], e_grid[keep]
-        th = th_keep - _peaks(e_grid, keep) * step  # theta decreases along the grid
+        # larger than at the grid point; small lists, so in Python floats
+        th_keep = theta_grid[keep]
+        th = th_keep - step * np.array(_peaks(e_grid, keep))  # theta decreases along the grid
         ev, fv, wv = evaluate(th, cheb)
-        better = np.where(e_keep >= 0, ev > e_keep, ev < e_keep)
-        k_p = np.where(better, th, th_keep)
-        k_v = np.where(better, ev, e_keep)
-        k_f = np.where(better, fv, f_grid[keep])
-        k_w = None if unit else np.where(better, wv, w_grid[keep])
-        abs_v = np.abs(k_v)
-        max_err = float(max(abs_v.max(), abs_grid.max()))
-        E = min(E, float(abs_v.min())) if len(keep) == n + 2 else E
+        k_p, k_v, k_f, k_w = [], [], [], []
+        for j, (g_e, new_e) in enumerate(zip(e_grid[keep].tolist(), ev.tolist())):
+            if new_e > g_e if g_e >= 0 else new_e < g_e:
+                k_p.append(th[j])
+                k_v.append(abs(new_e))
+                k_f.append(fv[j])
+                k_w.append(None if unit else wv[j])
+            else:
+                k_p.append(th_keep[j])
+                k_v.append(abs(g_e))
+                k_f.append(f_grid[keep[j]])
+                k_w.append(None if unit else w_grid[keep[j]])
+        max_err = max(grid_max, *k_v)
+        E = min(E, min(k_v)) if len(keep) == n + 2 else E
         improved = best is None or max_err < best.max_error
         if improved:
             best = RemezResult(cheb.copy(), E, max_err, it, False, np.cos(ref))
@@ -320,7 +329,8 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
                 break
         if len(keep) < n + 2:
             break
-        ref, f_ref, w_ref = k_p, k_f, k_w
+        ref, f_ref = np.array(k_p), np.array(k_f)
+        w_ref = None if unit else np.array(k_w)
     if best is not None:
         best.noise_limited = best.max_error <= NOISE_LIMIT * floor / 8
     return best
