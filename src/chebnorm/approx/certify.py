@@ -526,9 +526,9 @@ def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
     the float nearest ``start``, and Newton steps on ``g'`` from that one
     while ``|g|`` is concave, until a step moves less than ``2^-30`` of
-    the interval (its value is then that of the maximum to ``2^-60``; ``g(x0,
-    n)``: Taylor coefficients, whose first is the value; ``g_point``:
-    values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
+    the interval (near a maximum a step changes the value by about its
+    square; ``g(x0, n)``: Taylor coefficients, whose first is the value;
+    ``g_point``: values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
     bound of ``|g(at)|`` (0 when nothing was finite)."""
     best, best_at, best_lower = -1.0, lo, arb(0)
 
