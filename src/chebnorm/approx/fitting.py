@@ -236,13 +236,14 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     longer lowers the largest error.
     ``weight=None`` is the constant 1 (absolute error), without its calls.
 
-    Each exchange is vectorized over the extrema: the error on a grid
-    uniform in ``theta`` (``t = cos theta``, cached per degree), the
-    largest ``|e|`` of each run of one sign, each located between grid
-    points by the quartic through the five grid values around it
-    (:func:`_peaks`) and evaluated there: one call of ``f`` per exchange,
-    whose values are also those of the next solve. A grid point stays where
-    its error is the larger, and end points stay put.
+    Each exchange: the error on a grid uniform in ``theta`` (``t = cos
+    theta``, cached per degree; one matrix product), the largest ``|e|`` of
+    each run of one sign, each located between grid points by the quartic
+    through the five grid values around it (:func:`_peaks`) and all of them
+    evaluated in one call of ``f``, whose values are also those of the next
+    solve. A grid point stays where its error is the larger, and end points
+    stay put. The few per-extremum steps run on Python floats, cheaper than
+    numpy calls on arrays of ``degree + 2`` elements.
 
     The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
