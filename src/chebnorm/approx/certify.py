@@ -216,8 +216,9 @@ def _error_taylor(f_series, p: _PolyTaylor, kind: str):
     """``(x0, n) ->`` the first ``n`` Taylor coefficients of ``g`` at the ball
     ``x0`` (all nan where Arb cannot evaluate it): the error function of
     :func:`_error_function` without building the series of ``p``, for the
-    subdivision's inner loop. Its attribute ``top(x0, n)`` is the last of
-    them alone (the remainder term)."""
+    subdivision's inner loop. Its attribute ``over(x0, n)`` gives the
+    second and the last of them alone (over a piece: an enclosure of ``g'``,
+    and the remainder term)."""
     if kind not in ("abs", "rel"):
         raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
     nan = arb("nan")
@@ -237,17 +238,18 @@ def _error_taylor(f_series, p: _PolyTaylor, kind: str):
         except (ValueError, ZeroDivisionError):
             return [nan] * n
 
-    def top(x0: arb, n: int) -> arb:
+    def over(x0: arb, n: int) -> tuple[arb, arb]:
         if kind == "rel":
-            return taylor(x0, n)[n - 1]
+            c = taylor(x0, n)
+            return c[1], c[n - 1]
         try:
-            fc = f_at(x0, n).coeffs()
-            pk = p.coefficient(x0, n - 1)
-            return pk - fc[n - 1] if len(fc) >= n else pk
+            fc = f_at(x0, n).coeffs() + [arb(0)] * n
+            return (p.coefficient(x0, 1) - fc[1],
+                    p.coefficient(x0, n - 1) - fc[n - 1])
         except (ValueError, ZeroDivisionError):
-            return nan
+            return nan, nan
 
-    taylor.top = top
+    taylor.over = over
     return taylor
 
 
@@ -324,7 +326,7 @@ def _high_order_upper(g, a: arb, b: arb, m: arb, r: arb) -> arb:
     """
     n = HIGH_ORDER
     c = g(m, n + 1)
-    rest = g.top(a.union(b), n + 2)
+    rest = g.over(a.union(b), n + 2)[1]
     upper = _cubic_max(c[0], c[1], c[2], c[3], r)
     rk = (r * r) * (r * r)
     for k in range(4, n + 1):
@@ -426,25 +428,22 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     # the largest |g| located first (float64 search, then Newton in Arb): the
     # pieces are compared with it from the start, and fewer are split
     start = _float_argmax(fn, floats, kind, shift, lo_f, hi_f)
-    located = None
-    best_lower, best_at = arb(0), (a0 + b0) / 2
-    if start is not None:
-        located = _locate_maximum(g, g_point, arb(start), lo_f, hi_f)
-        if located[2] > 0:
-            best_lower, best_at = located[2], arb(located[1])
+    located = None if start is None else _locate_maximum(g, g_point, arb(start), lo_f, hi_f)
+    best_lower, best_at = ((located[2], arb(located[1])) if located and located[2] > 0
+                           else (arb(0), (a0 + b0) / 2))
     seeded_at = best_at
     accepted_upper = arb(0)
     count = 0
     reasons: set[str] = set()
-    # (upper, a, b) of subintervals bounded above more loosely than the target
-    pending: list[tuple[arb, arb, arb]] = []
+    # (upper, a, b, monotone) of the pieces evaluated, before the comparison
+    pending: list[tuple[arb, arb, arb, bool]] = []
     while work or pending:
         for a, b in work:
             count += 1
             m = (a + b) / 2
             r = (b - a) / 2
             c0, c1, c2, c3 = g(m, ORDER)
-            rest = g.top(a.union(b), ORDER + 1)
+            slope, rest = g.over(a.union(b), ORDER + 1)
             r2 = r * r
             upper = _cubic_max(c0, c1, c2, c3, r) + abs(rest).upper() * (r2 * r2)
             value = c0 if c0.is_finite() else g_point(m)
@@ -457,15 +456,21 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
                 if (b - a) < min_width or count > max_subintervals:
                     end = (a, lo_b) if a is a0 else (b, hi_b) if b is b0 else None
                     raise _not_finite(kind, m, end, g_point)
-                pending.append((arb("inf"), a, b))
+                pending.append((arb("inf"), a, b, False))
                 continue
-            pending.append((upper.upper(), a, b))
+            # g' of one sign on the piece: |g| is largest at one of its ends
+            monotone = slope.is_finite() and not slope.contains(0)
+            pending.append((upper.upper(), a, b, monotone))
         work = []
         target = best_lower * (1 + arb(tol))
         keep = []
-        for upper, a, b in pending:
+        for upper, a, b, monotone in pending:
             if upper.is_finite() and upper > target and best_lower < tiny:
                 upper = upper.min(_high_order_upper(g, a, b, (a + b) / 2, (b - a) / 2).upper())
+            if monotone and upper > target:  # the ends' values, exact but for Arb's radii
+                ends = abs(g_point(a)).upper().max(abs(g_point(b)).upper())
+                if ends.is_finite():
+                    upper = upper.min(ends)
             if not upper.is_finite():
                 keep.append((upper, a, b))
             elif upper <= target:

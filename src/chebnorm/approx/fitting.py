@@ -224,6 +224,40 @@ def _peaks(e: np.ndarray, idx: list[int]) -> list[float]:
     return out
 
 
+def _exchange(e_grid, cheb, n, grid, evaluate):
+    """The new reference from the errors ``e_grid`` on the grid ``grid =
+    (theta, f, w)``: the largest ``|e|`` of each run of one sign (``n + 2``
+    of them kept, dropping the smaller end), each located between grid
+    points by :func:`_peaks` and evaluated there (one call of ``f``); a grid
+    point stays where its error is the larger. Returns the lists of angles,
+    ``|e|``, ``f`` and weights (None without one) and the grid's largest
+    ``|e|``. The few per-extremum steps run on Python floats, cheaper than
+    numpy calls on arrays of ``n + 2`` elements."""
+    theta_grid, f_grid, w_grid = grid
+    keep, abs_grid = _sign_runs(e_grid)
+    vals = abs_grid[keep].tolist()
+    grid_max = max(vals)
+    if len(keep) > n + 2:
+        keep, vals = _trim(keep, vals, n + 2)
+    th_keep = theta_grid[keep]
+    step = theta_grid[0] - theta_grid[1]
+    th = th_keep - step * np.array(_peaks(e_grid, keep))  # theta decreases along the grid
+    ev, fv, wv = evaluate(th, cheb)
+    k_p, k_v, k_f, k_w = [], [], [], []
+    for j, (g_e, new_e) in enumerate(zip(e_grid[keep].tolist(), ev.tolist())):
+        if new_e > g_e if g_e >= 0 else new_e < g_e:
+            k_p.append(th[j])
+            k_v.append(abs(new_e))
+            k_f.append(fv[j])
+            k_w.append(None if wv is None else wv[j])
+        else:
+            k_p.append(th_keep[j])
+            k_v.append(abs(g_e))
+            k_f.append(f_grid[keep[j]])
+            k_w.append(None if w_grid is None else w_grid[keep[j]])
+    return k_p, k_v, k_f, k_w, grid_max
+
+
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
           lo: float, hi: float, degree: int, max_iter: int = 60, rtol: float = 1e-8
           ) -> RemezResult:
@@ -237,13 +271,10 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     ``weight=None`` is the constant 1 (absolute error), without its calls.
 
     Each exchange: the error on a grid uniform in ``theta`` (``t = cos
-    theta``, cached per degree; one matrix product), the largest ``|e|`` of
-    each run of one sign, each located between grid points by the quartic
-    through the five grid values around it (:func:`_peaks`) and all of them
+    theta``, cached per degree; one matrix product), then
+    :func:`_exchange`: the extrema located between grid points and
     evaluated in one call of ``f``, whose values are also those of the next
-    solve. A grid point stays where its error is the larger, and end points
-    stay put. The few per-extremum steps run on Python floats, cheaper than
-    numpy calls on arrays of ``degree + 2`` elements.
+    solve.
 
     The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
@@ -258,9 +289,9 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     unit = weight is None or weight is _unit
     half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
     theta_grid, t_grid, v_grid = _grid(n)
-    step = theta_grid[0] - theta_grid[1]
     f_grid = f(half * t_grid + mid)
     w_grid = None if unit else weight(half * t_grid + mid)
+    grid = (theta_grid, f_grid, w_grid)
     # float64 noise floor of the error: a gap below a few roundings of w f
     # cannot shrink further, so it counts as converged
     floor = 8 * np.finfo(float).eps * float(np.max(np.abs(f_grid if unit else w_grid * f_grid)))
@@ -293,30 +324,9 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
         e_grid = v_grid @ cheb - f_grid
         if not unit:
             e_grid *= w_grid
-        keep, abs_grid = _sign_runs(e_grid)
-        vals = abs_grid[keep].tolist()
-        grid_max = max(vals)
-        if len(keep) > n + 2:
-            keep, vals = _trim(keep, vals, n + 2)
-        # the extrema between grid points (end points stay put), kept where
-        # larger than at the grid point; small lists, so in Python floats
-        th_keep = theta_grid[keep]
-        th = th_keep - step * np.array(_peaks(e_grid, keep))  # theta decreases along the grid
-        ev, fv, wv = evaluate(th, cheb)
-        k_p, k_v, k_f, k_w = [], [], [], []
-        for j, (g_e, new_e) in enumerate(zip(e_grid[keep].tolist(), ev.tolist())):
-            if new_e > g_e if g_e >= 0 else new_e < g_e:
-                k_p.append(th[j])
-                k_v.append(abs(new_e))
-                k_f.append(fv[j])
-                k_w.append(None if unit else wv[j])
-            else:
-                k_p.append(th_keep[j])
-                k_v.append(abs(g_e))
-                k_f.append(f_grid[keep[j]])
-                k_w.append(None if unit else w_grid[keep[j]])
+        k_p, k_v, k_f, k_w, grid_max = _exchange(e_grid, cheb, n, grid, evaluate)
         max_err = max(grid_max, *k_v)
-        E = min(E, min(k_v)) if len(keep) == n + 2 else E
+        E = min(E, min(k_v)) if len(k_v) == n + 2 else E
         improved = best is None or max_err < best.max_error
         if improved:
             best = RemezResult(cheb.copy(), E, max_err, it, False, np.cos(ref))
@@ -328,7 +338,7 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
             best.converged = True
             if not improved:
                 break
-        if len(keep) < n + 2:
+        if len(k_v) < n + 2:
             break
         ref, f_ref = np.array(k_p), np.array(k_f)
         w_ref = None if unit else np.array(k_w)
