@@ -20,7 +20,23 @@ running ``supnorm`` on each segment's composed function ``f(a_s + h t)``, t in
 
 Usage: python benchmarks/bench_fit.py [--json] [--repeat N] [--tight T ...] [--piecewise-only]
                                       [--high-degree]
-Columns: fit, certify, fit + certify ("both"), and chebnorm's public fit() call.
+Columns of the 18-case table, seconds summed over the cases, medians of the
+``--repeat`` runs (each run does every case once; on both sides parsing the
+expression and the interval happens outside the timers):
+* fit: chebnorm ``remez`` (float64 exchange to its convergence criterion:
+  largest and levelled error within 1e-8 of each other), ``polish`` when the
+  exchange is noise limited, ``cheb_to_monomial`` (exact, rounded once);
+  Sollya ``remez(f, d, dom)``;
+* certify: chebnorm ``certify(fn, coeffs, lo, hi, "abs", tol=T)``, a rigorous
+  upper bound of sup|p - f| with bound <= (1 + T) * (located maximum); Sollya
+  ``supnorm(p, f, dom, absolute, T)``, an enclosure [l, u] with u/l - 1 <= T;
+* both: the median of each run's fit + certify (not the sum of the medians);
+* fit(): chebnorm only, the public ``fit()`` end to end (see above);
+* worst bound/max-1: the loosest certificate seen (Sollya: u/l - 1).
+The speed-up row divides Sollya's column by chebnorm's. A warm-up ``fit()``
+of each case before the timed runs compiles its evaluators and Arb encloses
+its endpoints (cached, as Sollya holds ``f`` and ``dom`` evaluated); the
+exchange's search grid is a per-degree constant, computed in the first run.
 Not a test: timings are printed, nothing is asserted.
 """
 

@@ -1,23 +1,26 @@
 """Rigorous upper bounds of sup |p - f| and sup |p/f - 1| on an interval.
 
-Method (branch and bound on order-3 Taylor forms in ball arithmetic)
+Method (branch and bound on order-4 Taylor forms in ball arithmetic)
 --------------------------------------------------------------------
 Let ``g = p - f`` (absolute) or ``g = p/f - 1`` (relative). On a subinterval
 ``X = [m - r, m + r]`` Taylor's theorem with the Lagrange remainder gives,
 for every ``x = m + h`` in ``X``,
 
-    g(x) = g0 + g1 h + g2 h^2 + g3(xi) h^3,   g_k = g^(k)(m)/k!,  xi in X,
+    g(x) = g0 + g1 h + g2 h^2 + g3 h^3 + g4(xi) h^4,  g_k = g^(k)(m)/k!,  xi in X,
 
-so ``|g(x)| <= max_{|h|<=r} |g0 + g1 h + g2 h^2| + sup_X |g3| r^3``. The
-point coefficients ``g0, g1, g2`` and an enclosure of ``g3`` over the whole
-ball ``X`` come from python-flint's ``arb_series`` (Taylor arithmetic on
-Arb balls, every rounding error accounted for); the maximum of the quadratic
-is taken exactly (both ends and the vertex, in ball arithmetic). The
-polynomial is evaluated with its coefficients as exact binary numbers, so the
-bound is for the very float64 coefficients that are stored and exported.
+so ``|g(x)| <= max_{|h|<=r} |g0 + g1 h + g2 h^2 + g3 h^3| + sup_X |g4| r^4``.
+The point coefficients ``g0 .. g3`` and an enclosure of ``g4`` over the
+whole ball ``X`` come from python-flint's ``arb_series`` (Taylor arithmetic
+on Arb balls, every rounding error accounted for); the maximum of the cubic
+is taken exactly (both ends and the critical points, the roots of its
+derivative enclosed in ball arithmetic). The polynomial is evaluated with
+its coefficients as exact binary numbers, so the bound is for the very
+float64 coefficients that are stored and exported.
 
 Subintervals are bisected until each upper bound is within ``(1 + tol)`` of
-the best lower bound found (the largest ``|g|`` at a point), so the returned
+the best lower bound found (the largest ``|g|`` at a point; the search
+starts from the largest ``|g|`` on a float64 grid, refined by Newton steps
+in Arb, so that the pieces are compared with it from the first), so the returned
 bound is rigorous and at most ``(1 + tol)`` times the true supremum. When a
 cap stops the bisection first (``max_subintervals``, a piece narrower than
 ``2**-60`` of the interval, or an error below the working precision) the
@@ -45,10 +48,12 @@ series type, and its naive interval evaluation of ``p - f`` overestimates by
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Sequence
 
+import numpy as np
 import sympy as sp
 from flint import arb, arb_poly, arb_series, ctx
 
@@ -83,7 +88,18 @@ class Certificate:
 def arb_enclose(value: sp.Expr) -> arb:
     """A ball enclosing a real sympy constant (``sqrt(2)``, ``2*cos(pi/4)``) at
     the current ``flint.ctx.prec``."""
-    return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+    return _enclose(value, ctx.prec)
+
+
+@functools.lru_cache(maxsize=1024)
+def _enclose(value: sp.Expr, prec: int) -> arb:
+    """:func:`arb_enclose` at ``prec`` bits, cached (balls are immutable)."""
+    old = ctx.prec
+    try:
+        ctx.prec = prec
+        return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+    finally:
+        ctx.prec = old
 
 
 def _float_up(x: arb) -> float:
@@ -131,6 +147,7 @@ class _PolyTaylor:
         # p(x) = q((x - c)/s): the k-th Taylor coefficient in x is q_k(t0) / s^k
         self.c, self.s = (arb(0), arb(1)) if shift is None else (arb(shift[0]), arb(shift[1]))
         self.shifted = shift is not None
+        self.s_pow: list[arb] = [arb(1)]
 
     def _t(self, x):
         return (x - self.c) / self.s if self.shifted else x
@@ -143,15 +160,30 @@ class _PolyTaylor:
                                        or [arb(0)]))
         return self.polys[k]
 
+    def taylor(self, x0: arb, n: int) -> list[arb]:
+        """The first ``n`` Taylor coefficients of ``p`` at ``x0`` (a ball)."""
+        polys = self.polys
+        if len(polys) < n:
+            self._q(n - 1)
+        if not self.shifted:
+            return [polys[k](x0) for k in range(n)]
+        while len(self.s_pow) < n:
+            self.s_pow.append(self.s_pow[-1] * self.s)
+        t0, s_pow = self._t(x0), self.s_pow
+        return [polys[k](t0) / s_pow[k] for k in range(n)]
+
+    def coefficient(self, x0: arb, k: int) -> arb:
+        """The ``k``-th Taylor coefficient of ``p`` at ``x0`` alone."""
+        q = self._q(k)
+        if not self.shifted:
+            return q(x0)
+        return q(self._t(x0)) / self.s ** k
+
     def __call__(self, s):
         if isinstance(s, arb_series):
             c = s.coeffs()
             if len(c) == 2 and c[1] == 1:  # s = x0 + h, the only form certify builds
-                t0 = self._t(c[0])
-                if not self.shifted:
-                    return arb_series([self._q(k)(t0) for k in range(s.prec)], prec=s.prec)
-                return arb_series([self._q(k)(t0) / self.s ** k for k in range(s.prec)],
-                                  prec=s.prec)
+                return arb_series(self.taylor(c[0], s.prec), prec=s.prec)
             return _horner(self.coeffs, self._t(s))
         return self._q(0)(self._t(s))
 
@@ -160,7 +192,7 @@ def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     """``g = p - f`` or ``p/f - 1`` for ``f`` an arb or arb_series function;
     nan wherever Arb cannot evaluate it (a division by a ball containing 0).
     With ``shift = (c, s)``, ``p(x) = sum coeffs[k] ((x - c)/s)^k``."""
-    p = _PolyTaylor(coeffs, shift)
+    p = coeffs if isinstance(coeffs, _PolyTaylor) else _PolyTaylor(coeffs, shift)
     if kind == "abs":
         def g(s):
             return p(s) - f(s)
@@ -180,10 +212,53 @@ def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     return safe
 
 
+def _error_taylor(f_series, p: _PolyTaylor, kind: str):
+    """``(x0, n) ->`` the first ``n`` Taylor coefficients of ``g`` at the ball
+    ``x0`` (all nan where Arb cannot evaluate it): the error function of
+    :func:`_error_function` without building the series of ``p``, for the
+    subdivision's inner loop. Its attribute ``over(x0, n)`` gives the
+    second and the last of them alone (over a piece: an enclosure of ``g'``,
+    and the remainder term)."""
+    if kind not in ("abs", "rel"):
+        raise ValueError(f"error kind {kind!r} is not one of 'abs', 'rel'")
+    nan = arb("nan")
+
+    def f_at(x0: arb, n: int) -> arb_series:
+        fs = f_series(arb_series([x0, 1], prec=n))
+        return fs if isinstance(fs, arb_series) else arb_series([fs], prec=n)  # f constant
+
+    def taylor(x0: arb, n: int) -> list[arb]:
+        try:
+            fs = f_at(x0, n)
+            pc = p.taylor(x0, n)
+            if kind == "rel":
+                return _coeffs(arb_series(pc, prec=n) / fs - 1, n)
+            fc = fs.coeffs()
+            return [pc[k] - fc[k] for k in range(len(fc))] + pc[len(fc):]
+        except (ValueError, ZeroDivisionError):
+            return [nan] * n
+
+    def over(x0: arb, n: int) -> tuple[arb, arb]:
+        if kind == "rel":
+            c = taylor(x0, n)
+            return c[1], c[n - 1]
+        try:
+            fc = f_at(x0, n).coeffs() + [arb(0)] * n
+            return (p.coefficient(x0, 1) - fc[1],
+                    p.coefficient(x0, n - 1) - fc[n - 1])
+        except (ValueError, ZeroDivisionError):
+            return nan, nan
+
+    taylor.over = over
+    return taylor
+
+
 def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     """An upper bound of max_{|h| <= r} |c0 + c1 h + c2 h^2| (balls allowed)."""
     ends = [abs(c0 - c1 * r + c2 * r * r), abs(c0 + c1 * r + c2 * r * r)]
     best = ends[0].upper().max(ends[1].upper())
+    if c2.is_zero():  # a line: largest at an end
+        return best
     box = arb(0, r.upper())
     if c2.contains(0):
         inner = abs(c0 + c1 * box + c2 * (box * box))
@@ -196,26 +271,65 @@ def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:
     return best
 
 
+def _cubic_max(c0: arb, c1: arb, c2: arb, c3: arb, r: arb) -> arb:
+    """An upper bound of max_{|h| <= r} |c0 + c1 h + c2 h^2 + c3 h^3| (balls
+    allowed): both ends, and each critical point (a root of ``c1 + 2 c2 h +
+    3 c3 h^2``, enclosed in ball arithmetic) whose ball meets ``[-r, r]``.
+    Where the roots cannot be separated (``c3`` or the discriminant
+    containing 0) the quadratic's maximum plus ``|c3| r^3``."""
+    def cubic(h):
+        return c0 + h * (c1 + h * (c2 + h * c3))
+
+    # both ends: p(+-r) = even +- odd, so max |p(+-r)| = |even| + |odd|
+    r2 = r * r
+    best = (abs(c0 + c2 * r2) + abs(r * (c1 + c3 * r2))).upper()
+    if not best.is_finite():  # some coefficient is not
+        return best
+    disc = c2 * c2 - 3 * c1 * c3
+    if disc < 0:  # no real critical point: monotonic
+        return best
+    if c3.is_zero():
+        return _quadratic_max(c0, c1, c2, r)
+    if c3.contains(0) or not disc > 0:
+        return best.max(_quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r))
+    sq = disc.sqrt()
+    if c2 > 0 or c2 < 0:  # the root pair without cancellation
+        q = -(c2 + sq) if c2 > 0 else sq - c2
+        roots = (q / (3 * c3), c1 / q)
+    else:
+        roots = ((sq - c2) / (3 * c3), -(c2 + sq) / (3 * c3))
+    box = arb(0, r.upper())
+    for h in roots:
+        if h.overlaps(box):
+            best = best.max(abs(cubic(h.intersection(box))).upper())
+    return best
+
+
+#: order of the Taylor forms of the subdivision: ``g`` to ``h^3`` at the
+#: midpoint, the ``h^4`` term enclosed over the piece
+ORDER = 4
+
 #: order of the Taylor forms tried when |g| is far below |f| (see _high_order_upper)
 HIGH_ORDER = 8
 
 
 def _high_order_upper(g, a: arb, b: arb, m: arb, r: arb) -> arb:
-    """An order-``HIGH_ORDER`` Taylor form of ``|g|`` on ``[a, b]``.
+    """An order-``HIGH_ORDER`` Taylor form of ``|g|`` on ``[a, b]``; ``g(x0,
+    n)`` gives the first ``n`` Taylor coefficients at the ball ``x0``.
 
-    ``g = g0 + g1 h + g2 h^2 + sum_{3 <= k <= n} g_k h^k + g_{n+1}(xi) h^{n+1}``:
-    the quadratic's maximum exactly, the middle terms by ``|g_k| r^k`` (point
+    ``g = g0 + .. + g3 h^3 + sum_{4 <= k <= n} g_k h^k + g_{n+1}(xi) h^{n+1}``:
+    the cubic's maximum exactly, the middle terms by ``|g_k| r^k`` (point
     coefficients) and the remainder over the ball. When ``g`` is a tiny
     difference of large terms (an error at rounding level) the ball
-    enclosure of ``g_3`` is dominated by the width of the ball times ``|f|``;
-    the remainder's ``r^{n+1}`` shrinks that much faster than ``r^3``.
+    enclosure of ``g_4`` is dominated by the width of the ball times ``|f|``;
+    the remainder's ``r^{n+1}`` shrinks that much faster than ``r^4``.
     """
     n = HIGH_ORDER
-    c = _coeffs(g(arb_series([m, 1], prec=n + 1)), n + 1)
-    rest = _coeffs(g(arb_series([a.union(b), 1], prec=n + 2)), n + 2)[n + 1]
-    upper = _quadratic_max(c[0], c[1], c[2], r)
-    rk = r * r * r
-    for k in range(3, n + 1):
+    c = g(m, n + 1)
+    rest = g.over(a.union(b), n + 2)[1]
+    upper = _cubic_max(c[0], c[1], c[2], c[3], r)
+    rk = (r * r) * (r * r)
+    for k in range(4, n + 1):
         upper = upper + abs(c[k]).upper() * rk
         rk = rk * r
     return upper + abs(rest).upper() * rk
@@ -267,7 +381,7 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
             if not (math.isfinite(shift[0]) and math.isfinite(shift[1]) and shift[1] > 0):
                 raise ValueError(f"shift {shift!r}: accepted: a finite center and a finite "
                                  f"positive scale")
-        return _certify(fn, [arb(float(c)) for c in coefficients], lo, hi, kind, tol,
+        return _certify(fn, [float(c) for c in coefficients], lo, hi, kind, tol,
                         max_subintervals, shift)
     finally:
         ctx.prec = old_prec
@@ -288,16 +402,17 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
     return best if best > 0 else arb(1)
 
 
-def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
-    g = _error_function(fn.arb_series, coeffs, kind, shift)
-    g_point = _error_function(fn.arb, coeffs, kind, shift)
+def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
+    p = _PolyTaylor([arb(c) for c in floats], shift)
+    g = _error_taylor(fn.arb_series, p, kind)  # (x0, n) -> Taylor coefficients
+    g_point = _error_function(fn.arb, p, kind)
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
     lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
     if not lo_f <= hi_f:
         raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
                          f"interval wider than one float64 spacing")
     a0, b0 = lo_b.lower(), hi_b.upper()
-    degree = max(len(coeffs) - 1, 0)
+    degree = max(len(floats) - 1, 0)
     pieces = 2 * (degree + 2)
     edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
     # exact binary split points (the outer two keep the enclosing endpoints)
@@ -307,24 +422,30 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     # below this, |g| is rounding noise of the working precision
     scale = _scale(fn, kind, (a0, (a0 + b0) / 2, b0))
     floor = scale * arb(2) ** (24 - ctx.prec)
-    # an error below this is a cancellation: order-3 forms converge too slowly
+    # an error below this is a cancellation: order-4 forms converge too slowly
     tiny = scale * arb(2) ** -30
 
-    best_lower = arb(0)
-    best_at = (a0 + b0) / 2
+    # the largest |g| located first (float64 search, then Newton in Arb): the
+    # pieces are compared with it from the start, and fewer are split
+    start = _float_argmax(fn, floats, kind, shift, lo_f, hi_f)
+    located = None if start is None else _locate_maximum(g, g_point, arb(start), lo_f, hi_f)
+    best_lower, best_at = ((located[2], arb(located[1])) if located and located[2] > 0
+                           else (arb(0), (a0 + b0) / 2))
+    seeded_at = best_at
     accepted_upper = arb(0)
     count = 0
     reasons: set[str] = set()
-    # (upper, a, b) of subintervals bounded above more loosely than the target
-    pending: list[tuple[arb, arb, arb]] = []
+    # (upper, a, b, monotone) of the pieces evaluated, before the comparison
+    pending: list[tuple[arb, arb, arb, bool]] = []
     while work or pending:
         for a, b in work:
             count += 1
             m = (a + b) / 2
             r = (b - a) / 2
-            c0, c1, c2 = _coeffs(g(arb_series([m, 1], prec=3)), 3)
-            c3 = _coeffs(g(arb_series([a.union(b), 1], prec=4)), 4)[3]
-            upper = _quadratic_max(c0, c1, c2, r) + abs(c3).upper() * (r * r * r)
+            c0, c1, c2, c3 = g(m, ORDER)
+            slope, rest = g.over(a.union(b), ORDER + 1)
+            r2 = r * r
+            upper = _cubic_max(c0, c1, c2, c3, r) + abs(rest).upper() * (r2 * r2)
             value = c0 if c0.is_finite() else g_point(m)
             if value.is_finite() and abs(value).lower() > best_lower:
                 best_lower, best_at = abs(value).lower(), m
@@ -335,15 +456,21 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
                 if (b - a) < min_width or count > max_subintervals:
                     end = (a, lo_b) if a is a0 else (b, hi_b) if b is b0 else None
                     raise _not_finite(kind, m, end, g_point)
-                pending.append((arb("inf"), a, b))
+                pending.append((arb("inf"), a, b, False))
                 continue
-            pending.append((upper.upper(), a, b))
+            # g' of one sign on the piece: |g| is largest at one of its ends
+            monotone = slope.is_finite() and not slope.contains(0)
+            pending.append((upper.upper(), a, b, monotone))
         work = []
         target = best_lower * (1 + arb(tol))
         keep = []
-        for upper, a, b in pending:
+        for upper, a, b, monotone in pending:
             if upper.is_finite() and upper > target and best_lower < tiny:
                 upper = upper.min(_high_order_upper(g, a, b, (a + b) / 2, (b - a) / 2).upper())
+            if monotone and upper > target:  # the ends' values, exact but for Arb's radii
+                ends = abs(g_point(a)).upper().max(abs(g_point(b)).upper())
+                if ends.is_finite():
+                    upper = upper.min(ends)
             if not upper.is_finite():
                 keep.append((upper, a, b))
             elif upper <= target:
@@ -365,7 +492,10 @@ def _certify(fn, coeffs, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             if not (a < m < b):
                 m = (a + b) / 2
             work.extend([(a, m), (m, b)])
-    maximum, at = _locate_maximum(g, g_point, best_at, lo_f, hi_f)
+    if located is None or best_at is not seeded_at:  # a piece's midpoint did better
+        again = _locate_maximum(g, g_point, best_at, lo_f, hi_f)
+        located = again if located is None or again[0] > located[0] else located
+    maximum, at = located[0], located[1]
     bound = accepted_upper.max(arb(maximum))
     return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
                        tight=not reasons, reason="; ".join(sorted(reasons)))
@@ -397,29 +527,67 @@ def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> Valu
                       f"accepted: a function defined and finite on the whole interval")
 
 
-def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float]:
+def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float, float, arb]:
     """The largest ``|g|`` found at float points of ``[lo, hi]``: both ends,
-    the float nearest the best piece midpoint, and Newton steps on ``g'``
-    from the best of these. Returns ``(|g(at)|, at)``."""
-    best, best_at = -1.0, lo
+    the float nearest ``start``, and Newton steps on ``g'`` from that one
+    while ``|g|`` is concave, until a step moves less than ``2^-30`` of
+    the interval (near a maximum a step changes the value by about its
+    square; ``g(x0, n)``: Taylor coefficients, whose first is the value;
+    ``g_point``: values). Returns ``(|g(at)|, at, lower)``, ``lower`` a rigorous lower
+    bound of ``|g(at)|`` (0 when nothing was finite)."""
+    best, best_at, best_lower = -1.0, lo, arb(0)
 
-    def visit(x: float) -> None:
-        nonlocal best, best_at
-        v = abs(g_point(arb(x)))
+    def record(x: float, v: arb) -> None:
+        nonlocal best, best_at, best_lower
+        v = abs(v)
         if v.is_finite() and float(v.mid()) > best:
-            best, best_at = float(v.mid()), x
+            best, best_at, best_lower = float(v.mid()), x, v.lower()
 
-    for x in (min(max(float(start.mid()), lo), hi), lo, hi):
-        visit(x)
-    x = best_at
-    for _ in range(8):
-        s = _coeffs(g(arb_series([arb(x), 1], prec=3)), 3)
-        if not all(c.is_finite() for c in s) or s[2].contains(0):
+    first = min(max(float(start.mid()), lo), hi)
+    for x in (first, lo, hi):
+        record(x, g_point(arb(x)))
+    x, small = first, 2.0 ** -30 * (hi - lo)
+    for k in range(8):
+        s = g(arb(x), 3)
+        if k:
+            record(x, s[0])
+        if not (s[0].is_finite() and s[1].is_finite() and s[2].is_finite()):
             break
-        step = float((-s[1] / (2 * s[2])).mid())
-        nxt = min(max(x + step, lo), hi)
-        if nxt == x:
+        if not ((s[0] > 0 and s[2] < 0) or (s[0] < 0 and s[2] > 0)):
+            break  # |g| is not concave here: no nearby maximum for Newton
+        nxt = min(max(x + float((-s[1] / (2 * s[2])).mid()), lo), hi)
+        if abs(nxt - x) <= small:
             break
         x = nxt
-        visit(x)
-    return max(best, 0.0), best_at
+    else:
+        record(x, g_point(arb(x)))
+    return max(best, 0.0), best_at, best_lower
+
+
+#: points of the float64 search for the largest error (per degree + 2)
+SEARCH_POINTS = 64
+
+
+def _float_argmax(fn, floats: Sequence[float], kind: str, shift, lo: float, hi: float
+                  ) -> float | None:
+    """Where ``|g|`` is largest on a float64 grid of ``[lo, hi]`` (Chebyshev
+    points, ends included), or None when float64 cannot tell (``f`` has no
+    numpy evaluator, nothing finite). A starting point only: nothing rigorous
+    depends on it."""
+    f_np = getattr(fn, "numpy", None)
+    if f_np is None or not lo < hi:
+        return None
+    n = SEARCH_POINTS * (len(floats) + 1)
+    x = 0.5 * (lo + hi) - 0.5 * (hi - lo) * np.cos(np.pi * np.arange(n + 1) / n)
+    x[0], x[-1] = lo, hi
+    t = x if shift is None else (x - shift[0]) / shift[1]
+    with np.errstate(all="ignore"):
+        try:
+            f = np.asarray(f_np(x), dtype=float)
+        except (ArithmeticError, ValueError, TypeError):
+            return None
+        p = np.polyval(np.asarray(floats[::-1], dtype=float), t) if floats else np.zeros_like(x)
+        e = np.abs(p - f if kind == "abs" else p / f - 1)
+    e[~np.isfinite(e)] = -1.0
+    k = int(np.argmax(e))
+    return float(x[k]) if e[k] >= 0 else None

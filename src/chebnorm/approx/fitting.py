@@ -7,13 +7,15 @@ floats (:mod:`chebnorm.approx.certify`). Internal module: callers validate.
 
 from __future__ import annotations
 
+import functools
 import math
-from fractions import Fraction
 from typing import Callable
 
 import mpmath
 import numpy as np
+from flint import arb, arb_mat, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
+from scipy.linalg import lapack
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish"]
@@ -55,45 +57,37 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
     [-1.0, 0.0, 2.0]
     """
     n = len(cheb)
-    # monomial coefficients in t, exactly: T_0 = 1, T_1 = t, T_k = 2t T_{k-1} - T_{k-2}
-    t_polys = [[Fraction(1)], [Fraction(0), Fraction(1)]]
-    for k in range(2, n):
-        prev, prev2 = t_polys[-1], t_polys[-2]
-        cur = [Fraction(0)] + [2 * c for c in prev]
-        for i, c in enumerate(prev2):
-            cur[i] -= c
-        t_polys.append(cur)
-    in_t = [Fraction(0)] * n  # monomial coefficients in u
+    if n == 0:
+        return []
+    series = fmpq_poly([])
     for k, ck in enumerate(cheb):
-        exact = _exact(ck)
-        for i, c in enumerate(t_polys[k]):
-            in_t[i] += exact * c
-    # substitute u = alpha t + beta (x = center + scale t)
-    lo_f, hi_f = Fraction(float(lo)), Fraction(float(hi))
-    c_f, s_f = Fraction(float(center)), Fraction(float(scale))
-    alpha = 2 * s_f / (hi_f - lo_f)
-    beta = (2 * c_f - lo_f - hi_f) / (hi_f - lo_f)
-    out = [Fraction(0)] * n
-    power = [Fraction(1)]  # (alpha t + beta)^i, ascending in t
-    for i in range(n):
-        for j, c in enumerate(power):
-            out[j] += in_t[i] * c
-        nxt = [Fraction(0)] * (len(power) + 1)
-        for j, c in enumerate(power):
-            nxt[j] += beta * c
-            nxt[j + 1] += alpha * c
-        power = nxt
-    return [float(c) for c in out]
+        series += _exact(ck) * _chebyshev_t(k)
+    # substitute u = alpha t + beta (x = center + scale t), exactly
+    lo_q, hi_q = _exact(float(lo)), _exact(float(hi))
+    c_q, s_q = _exact(float(center)), _exact(float(scale))
+    alpha = 2 * s_q / (hi_q - lo_q)
+    beta = (2 * c_q - lo_q - hi_q) / (hi_q - lo_q)
+    coeffs = series(fmpq_poly([beta, alpha])).coeffs()
+    # int / int is correctly rounded in Python, as Fraction's float() is
+    return [int(c.p) / int(c.q) for c in coeffs] + [0.0] * (n - len(coeffs))
 
 
-def _exact(v) -> Fraction:
+@functools.lru_cache(maxsize=None)
+def _chebyshev_t(k: int) -> fmpq_poly:
+    """``T_k`` with exact rational coefficients."""
+    return fmpq_poly(fmpz_poly.chebyshev_t(k))
+
+
+def _exact(v) -> fmpq:
     """A float or an mpmath number as an exact rational."""
     if isinstance(v, mpmath.mpf):
         if not mpmath.isfinite(v):
             raise ValueError(f"coefficient {v} is not finite")
         sign, man, exp, _ = v._mpf_  # man_exp drops the sign
-        return (-1) ** sign * Fraction(int(man)) * Fraction(2) ** int(exp)
-    return Fraction(float(v))
+        man, exp = (-1) ** sign * int(man), int(exp)
+        return fmpq(man * 2 ** exp) if exp >= 0 else fmpq(man, 2 ** -exp)
+    num, den = float(v).as_integer_ratio()  # raises on inf and nan
+    return fmpq(num, den)
 
 
 def shift_for(lo: float, hi: float) -> tuple[float, float]:
@@ -132,77 +126,136 @@ class RemezResult:
         self.noise_limited = noise_limited
 
 
-def _clenshaw(t: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """``sum c_k T_k(t)`` by Clenshaw's recurrence (numpy's ``chebval``
-    without its per-call checks, which dominate on short arrays)."""
-    if len(c) == 1:
-        return np.full_like(t, c[0])
-    b1 = np.zeros_like(t)
-    b2 = np.zeros_like(t)
-    t2 = 2 * t
-    for ck in c[:0:-1]:
-        b1, b2 = ck + t2 * b1 - b2, b1
-    return c[0] + t * b1 - b2
-
-
 def _unit(x):
     return np.ones_like(x)
 
 
-def _local_extrema(t: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """Indices of local extrema of ``e`` on the grid (ends included)."""
-    d = np.diff(e)
-    inner = np.nonzero((d[:-1] * d[1:] <= 0) & ((d[:-1] != 0) | (d[1:] != 0)))[0] + 1
-    return np.unique(np.concatenate([[0], inner, [len(t) - 1]]))
+@functools.lru_cache(maxsize=32)
+def _grid(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The exchange's search grid for degree ``n`` (cached, read-only):
+    angles ``theta`` (uniform, from pi down to 0), the points
+    ``t = cos(theta)`` (the Chebyshev extreme points, ascending) and the
+    Vandermonde matrix ``T_k(t)``, so the error on the grid is one product."""
+    grid_n = max(4000, 200 * (n + 2))
+    theta = np.pi * np.arange(grid_n, -1, -1) / grid_n
+    t = np.cos(theta)
+    v = C.chebvander(t, n)
+    for a in (theta, t, v):
+        a.flags.writeable = False
+    return theta, t, v
 
 
-def _refine(t_grid, idx, e_idx, err_fn, points: int = 16, rounds: int = 1):
-    """Refine grid extrema of ``|e|`` by successive local grids (vectorized
-    over extrema, one ``err_fn`` call per round) and a final parabola
-    through the best point and its neighbours; end points stay put.
-    Returns the points and their errors.
+def _sign_runs(e: np.ndarray) -> tuple[list[int], np.ndarray]:
+    """Index of the largest ``|e|`` in each maximal run of one sign (zero
+    counts as positive), ascending: alternating in sign, and each the
+    largest extremum of its run (consecutive same-sign extrema merged into
+    the larger). Returns them and ``|e|``."""
+    pos = e >= 0
+    change = (pos[1:] != pos[:-1]).nonzero()[0] + 1
+    a = np.abs(e)
+    if len(change) < 64:  # the usual case: a few runs, a few slices (methods: no wrappers)
+        bounds = [0, *change.tolist(), len(e)]
+        return [s + int(a[s:t].argmax()) for s, t in zip(bounds[:-1], bounds[1:])], a
+    run = np.zeros(len(e), dtype=np.intp)
+    run[change] = 1
+    run = np.cumsum(run)
+    hit = np.flatnonzero(a == np.maximum.reduceat(a, np.concatenate(([0], change)))[run])
+    first = np.ones(len(hit), dtype=bool)
+    first[1:] = run[hit[1:]] != run[hit[:-1]]
+    return hit[first].tolist(), a
 
-    Each round samples ``points`` points across the bracket around every
-    extremum and shrinks the bracket to two spacings around the largest, so
-    after ``rounds`` rounds the location is known to ``(2/points)**rounds``
-    of the grid spacing; the parabola then gains two more orders (the error
-    is flat to second order at an interior extremum, so its value is exact
-    to float64 rounding). ``e_idx`` are the errors at the grid extrema.
+
+def _trim(idx: list[int], vals: list[float], m: int) -> tuple[list[int], list[float]]:
+    """Keep ``m`` consecutive entries of ``idx`` (and of their ``vals``),
+    dropping the end with the smaller value one at a time: keeps the
+    alternation and the largest."""
+    lo, hi = 0, len(idx) - 1
+    while hi - lo + 1 > m:
+        if vals[lo] < vals[hi]:
+            lo += 1
+        else:
+            hi -= 1
+    return idx[lo:hi + 1], vals[lo:hi + 1]
+
+
+_STENCIL = np.arange(-2, 3)
+
+
+def _peaks(e: np.ndarray, idx: list[int]) -> list[float]:
+    """Offsets, in grid spacings within ``[-1, 1]``, of the maxima of ``|e|``
+    next to the grid points ``idx``: the root of the derivative of the
+    quartic through the five grid values around each (Newton from the
+    parabola's vertex). The grid is uniform in ``theta`` and ``e`` is even in
+    ``theta`` about both ends (``t = cos theta``), so the values are
+    reflected there and an end point's offset is exactly 0.
+
+    The quartic's Taylor coefficients at the centre are the five-point
+    differences (exact for quartics); with spacing ``h`` the located point is
+    off by ``O(h^4)`` and its value by ``O(h^8)``, relative:
+
+    >>> th = np.linspace(0, 1, 101); e = np.cos(7 * (th - 0.3013))
+    >>> bool(abs(th[30] + 0.01 * _peaks(e, [30])[0] - 0.3013) < 1e-9)
+    True
     """
-    i = np.asarray(idx)
-    last = len(t_grid) - 1
-    inner = (i > 0) & (i < last)
-    lo = np.where(inner, t_grid[np.maximum(i - 1, 0)], t_grid[i])
-    hi = np.where(inner, t_grid[np.minimum(i + 1, last)], t_grid[i])
-    s = np.linspace(0.0, 1.0, points)
-    rows = np.arange(len(i))
-    best_x = t_grid[i]
-    best_e = np.asarray(e_idx, dtype=float)
-    for _ in range(rounds):
-        x = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-        e = err_fn(x.ravel()).reshape(x.shape)
-        k = np.argmax(np.abs(e), axis=1)
-        better = np.abs(e[rows, k]) > np.abs(best_e)
-        best_x = np.where(better, x[rows, k], best_x)
-        best_e = np.where(better, e[rows, k], best_e)
-        step = (hi - lo) / (points - 1)
-        lo = np.where(inner, np.maximum(lo, best_x - step), lo)
-        hi = np.where(inner, np.minimum(hi, best_x + step), hi)
-    # parabola through (lo, mid, hi) of |e| around the best point
-    h = 0.5 * (hi - lo)
-    ok = inner & (h > 0)
-    if ok.any():
-        m = 0.5 * (lo + hi)
-        ea = np.abs(err_fn(np.stack([lo, m, hi]).ravel())).reshape(3, -1)
-        den = ea[0] - 2 * ea[1] + ea[2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            v = m + 0.5 * h * (ea[0] - ea[2]) / den
-        v = np.where(ok & (den < 0) & (v > lo) & (v < hi), v, best_x)
-        ev = err_fn(v)
-        better = np.abs(ev) > np.abs(best_e)
-        best_x = np.where(better, v, best_x)
-        best_e = np.where(better, ev, best_e)
-    return best_x, best_e
+    last = len(e) - 1
+    j = [abs(i + d) for i in idx for d in (-2, -1, 0, 1, 2)]  # reflected at 0
+    j = [2 * last - i if i > last else i for i in j]  # and at the other end
+    vals = e[j].tolist()
+    out = []
+    # a few extrema: Python floats cost less than numpy calls on tiny arrays
+    for k in range(0, len(vals), 5):
+        em2, em1, e0, e1, e2 = vals[k:k + 5]
+        if e0 < 0:  # maxima of sign * e
+            em2, em1, e0, e1, e2 = -em2, -em1, -e0, -e1, -e2
+        d1 = (8 * (e1 - em1) - (e2 - em2)) / 12
+        d2 = (16 * (e1 + em1) - 30 * e0 - (e2 + em2)) / 12
+        if not d2 < 0:  # not concave (or nan): the grid point is kept
+            out.append(0.0)
+            continue
+        d3 = 0.5 * ((e2 - em2) - 2 * (e1 - em1))
+        d4 = (e2 + em2) - 4 * (e1 + em1) + 6 * e0
+        u = min(max(-d1 / d2, -1.0), 1.0)
+        for _ in range(2):  # Newton on q'(u) = d1 + d2 u + d3 u^2/2 + d4 u^3/6
+            q2 = d2 + u * (d3 + u * (0.5 * d4))
+            if q2 < 0:
+                q1 = d1 + u * (d2 + u * (0.5 * d3 + u * (d4 / 6)))
+                u = min(max(u - q1 / q2, -1.0), 1.0)
+        out.append(u if u == u else 0.0)
+    return out
+
+
+def _exchange(e_grid, cheb, n, grid, evaluate):
+    """The new reference from the errors ``e_grid`` on the grid ``grid =
+    (theta, f, w)``: the largest ``|e|`` of each run of one sign (``n + 2``
+    of them kept, dropping the smaller end), each located between grid
+    points by :func:`_peaks` and evaluated there (one call of ``f``); a grid
+    point stays where its error is the larger. Returns the lists of angles,
+    ``|e|``, ``f`` and weights (None without one) and the grid's largest
+    ``|e|``. The few per-extremum steps run on Python floats, cheaper than
+    numpy calls on arrays of ``n + 2`` elements."""
+    theta_grid, f_grid, w_grid = grid
+    keep, abs_grid = _sign_runs(e_grid)
+    vals = abs_grid[keep].tolist()
+    grid_max = max(vals)
+    if len(keep) > n + 2:
+        keep, vals = _trim(keep, vals, n + 2)
+    th_keep = theta_grid[keep]
+    step = theta_grid[0] - theta_grid[1]
+    th = th_keep - step * np.array(_peaks(e_grid, keep))  # theta decreases along the grid
+    ev, fv, wv = evaluate(th, cheb)
+    k_p, k_v, k_f, k_w = [], [], [], []
+    for j, (g_e, new_e) in enumerate(zip(e_grid[keep].tolist(), ev.tolist())):
+        if new_e > g_e if g_e >= 0 else new_e < g_e:
+            k_p.append(th[j])
+            k_v.append(abs(new_e))
+            k_f.append(fv[j])
+            k_w.append(None if wv is None else wv[j])
+        else:
+            k_p.append(th_keep[j])
+            k_v.append(abs(g_e))
+            k_f.append(f_grid[keep[j]])
+            k_w.append(None if w_grid is None else w_grid[keep[j]])
+    return k_p, k_v, k_f, k_w, grid_max
 
 
 def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], np.ndarray] | None,
@@ -217,6 +270,12 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     longer lowers the largest error.
     ``weight=None`` is the constant 1 (absolute error), without its calls.
 
+    Each exchange: the error on a grid uniform in ``theta`` (``t = cos
+    theta``, cached per degree; one matrix product), then
+    :func:`_exchange`: the extrema located between grid points and
+    evaluated in one call of ``f``, whose values are also those of the next
+    solve.
+
     The best line to ``x^2`` on ``[0, 1]`` is ``x - 1/8`` (error ``1/8``,
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
     ``3/8 + t/2``:
@@ -227,70 +286,62 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     ([0.375, 0.5], 0.125, True)
     """
     n = degree
-    if weight is None:
-        weight = _unit
-    to_x = lambda t: 0.5 * (hi - lo) * t + 0.5 * (hi + lo)
-    grid_n = max(4000, 200 * (n + 2))
-    t_grid = np.cos(np.pi * np.arange(grid_n, -1, -1) / grid_n)
-    f_grid = f(to_x(t_grid))
-    v_grid = C.chebvander(t_grid, n)  # the grid values are one matrix product
-    w_grid = weight(to_x(t_grid))
+    unit = weight is None or weight is _unit
+    half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    theta_grid, t_grid, v_grid = _grid(n)
+    f_grid = f(half * t_grid + mid)
+    w_grid = None if unit else weight(half * t_grid + mid)
+    grid = (theta_grid, f_grid, w_grid)
     # float64 noise floor of the error: a gap below a few roundings of w f
     # cannot shrink further, so it counts as converged
-    floor = 8 * np.finfo(float).eps * float(np.max(np.abs(w_grid * f_grid)))
-    ref = np.cos(np.pi * np.arange(n + 1, -1, -1) / (n + 1))
+    floor = 8 * np.finfo(float).eps * float(np.max(np.abs(f_grid if unit else w_grid * f_grid)))
+    ks = np.arange(n + 1)
     signs = (-1.0) ** np.arange(n + 2)
+
+    def evaluate(theta, cheb):
+        """Error, ``f`` and weight at the angles ``theta`` (any shape)."""
+        x = half * np.cos(theta) + mid
+        fx = f(x)
+        e = np.cos(theta[..., None] * ks) @ cheb - fx
+        if unit:
+            return e, fx, None
+        wx = weight(x)
+        return wx * e, fx, wx
+
+    ref = np.pi * np.arange(n + 1, -1, -1) / (n + 1)  # angles of the reference
+    x_ref = half * np.cos(ref) + mid
+    f_ref = f(x_ref)
+    w_ref = None if unit else weight(x_ref)
     best = None
     for it in range(1, max_iter + 1):
-        x_ref = to_x(ref)
         A = np.empty((n + 2, n + 2))
-        A[:, : n + 1] = C.chebvander(ref, n)
-        A[:, n + 1] = signs / weight(x_ref)
-        try:
-            sol = np.linalg.solve(A, f(x_ref))
-        except np.linalg.LinAlgError:
+        A[:, : n + 1] = np.cos(ref[:, None] * ks)
+        A[:, n + 1] = signs if unit else signs / w_ref
+        sol, info = lapack.dgesv(A, f_ref)[2:]  # LAPACK's solve, without numpy's wrapping
+        if info != 0:  # singular
             break
-        cheb, E = sol[: n + 1], abs(sol[n + 1])
-
-        def err_fn(t, cheb=cheb):
-            x = to_x(t)
-            e = _clenshaw(t, cheb) - f(x)
-            return e if weight is _unit else weight(x) * e
-
+        cheb, E = sol[: n + 1], float(abs(sol[n + 1]))
         e_grid = v_grid @ cheb - f_grid
-        if weight is not _unit:
+        if not unit:
             e_grid *= w_grid
-        idx = _local_extrema(t_grid, e_grid)
-        # merge consecutive same-sign extrema, keeping the larger
-        keep = [idx[0]]
-        for k in idx[1:]:
-            if np.sign(e_grid[k]) == np.sign(e_grid[keep[-1]]):
-                if abs(e_grid[k]) > abs(e_grid[keep[-1]]):
-                    keep[-1] = k
-            else:
-                keep.append(k)
-        while len(keep) > n + 2:  # drop the smaller end: keeps alternation and the max
-            if abs(e_grid[keep[0]]) < abs(e_grid[keep[-1]]):
-                keep.pop(0)
-            else:
-                keep.pop()
-        keep_p, keep_v = _refine(t_grid, keep, e_grid[keep], err_fn)
-        max_err = float(max(np.max(np.abs(keep_v)), np.max(np.abs(e_grid))))
-        E = min(E, float(np.min(np.abs(keep_v)))) if len(keep) == n + 2 else E
+        k_p, k_v, k_f, k_w, grid_max = _exchange(e_grid, cheb, n, grid, evaluate)
+        max_err = max(grid_max, *k_v)
+        E = min(E, min(k_v)) if len(k_v) == n + 2 else E
         improved = best is None or max_err < best.max_error
         if improved:
-            best = RemezResult(cheb.copy(), E, max_err, it, False, ref.copy())
+            best = RemezResult(cheb.copy(), E, max_err, it, False, np.cos(ref))
         if max_err - E <= rtol * max_err:
-            best = RemezResult(cheb.copy(), E, max_err, it, True, ref.copy())
+            best = RemezResult(cheb.copy(), E, max_err, it, True, np.cos(ref))
             break
         if max_err - E <= floor:
             # at the noise floor: keep exchanging only while it still helps
             best.converged = True
             if not improved:
                 break
-        if len(keep_p) < n + 2:
+        if len(k_v) < n + 2:
             break
-        ref = np.array(keep_p)
+        ref, f_ref = np.array(k_p), np.array(k_f)
+        w_ref = None if unit else np.array(k_w)
     if best is not None:
         best.noise_limited = best.max_error <= NOISE_LIMIT * floor / 8
     return best
@@ -331,5 +382,39 @@ def polish(f_mp: Callable, lo: float, hi: float, ref: np.ndarray, degree: int,
             sign = 1 if i % 2 == 0 else -1
             rows.append(t[: n + 1] + [sign * (abs(fx) if relative else 1)])
             rhs.append(fx)
-        sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
-        return [sol[k] for k in range(n + 1)]
+        return _solve(rows, rhs, dps)[: n + 1]
+
+
+def _solve(rows: list, rhs: list, dps: int) -> list:
+    """``rows x = rhs`` (mpmath numbers) to about ``dps`` digits: Arb's
+    approximate LU solve in C at the same precision, its midpoints returned
+    exactly as mpmath numbers (mpmath's pure-Python ``lu_solve`` where Arb
+    finds the system singular). Like mpmath's, not a rigorous enclosure:
+    the coefficients are certified afterwards."""
+    old = ctx.prec
+    try:
+        ctx.prec = math.ceil(dps * math.log2(10)) + 16
+        a = arb_mat([[_to_arb(v) for v in row] for row in rows])
+        b = arb_mat([[_to_arb(v)] for v in rhs])
+        x = a.solve(b, algorithm="approx")
+        out = []
+        for k in range(len(rhs)):
+            man, exp = x[k, 0].mid().man_exp()
+            out.append(mpmath.mpf((int(man), int(exp))))
+        return out
+    except ZeroDivisionError:
+        with mpmath.workdps(dps):
+            sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
+            return [sol[k] for k in range(len(rhs))]
+    finally:
+        ctx.prec = old
+
+
+def _to_arb(v) -> arb:
+    """An mpmath number (or a float) as an exact Arb ball."""
+    if not isinstance(v, mpmath.mpf):
+        v = mpmath.mpf(v)
+    if not mpmath.isfinite(v):
+        raise ValueError(f"value {v} is not finite")
+    sign, man, exp, _ = v._mpf_
+    return arb(((-1) ** sign * int(man), int(exp)))

@@ -271,7 +271,7 @@ class CoefficientTable:
         >>> replace(t, abs_error_bound=t.abs_error_bound / 2).verify()
         Traceback (most recent call last):
         ...
-        ValueError: abs_error_bound: stated 1.56e-02 but the coefficients' certified error is 3.13e-02; |p - f| reaches 3.12e-02 at x = 0.0
+        ValueError: abs_error_bound: stated 1.56e-02 but the coefficients' certified error is 3.12e-02; |p - f| reaches 3.12e-02 at x = 0.0
         """
         return type(self).from_dict(self.to_dict())
 
