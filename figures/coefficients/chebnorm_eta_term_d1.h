@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('eta_term', 1, psi_max='pi/4', kind='chebyshev', error='abs', frac_bits=24)
  * p(x) ~ sqrt(2*x + 2)/2 on [0, 1] = [0.0, 1.0]
  * kind: chebyshev, error kind: abs, degree 1; coefficients in ascending powers of x.
- * Certified: |p - f| <= 0.00743188576729251, |p/f - 1| <= 0.010510273646123407; located max |p - f| = 0.007431885767291084 at x = 0.0.
+ * Certified: |p - f| <= 0.007432260424444055, |p/f - 1| <= 0.010515128116648802; located max |p - f| = 0.007431885767291084 at x = 0.0.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_ETA_TERM_D1_H
@@ -15,13 +15,13 @@
 #define CHEBNORM_ETA_TERM_D1_DEGREE 1
 #define CHEBNORM_ETA_TERM_D1_LO 0x0.0p+0 /* 0.0 */
 #define CHEBNORM_ETA_TERM_D1_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_ETA_TERM_D1_ABS_ERROR_BOUND 0x1.e70e5a5170ea4p-8 /* 0.00743188576729251 */
-#define CHEBNORM_ETA_TERM_D1_REL_ERROR_BOUND 0x1.586690ca829a9p-7 /* 0.010510273646123407 */
-#define CHEBNORM_ETA_TERM_D1_EVAL_ERROR_BOUND 0x1.e70e5a5170fa6p-8 /* 0.007431885767292734 */
-#define CHEBNORM_ETA_TERM_D1_F_EVAL_ERROR_BOUND 0x1.e710d8c1aa77bp-8 /* 0.007432034415311035 */
+#define CHEBNORM_ETA_TERM_D1_ABS_ERROR_BOUND 0x1.e714a37555ebbp-8 /* 0.007432260424444055 */
+#define CHEBNORM_ETA_TERM_D1_REL_ERROR_BOUND 0x1.588f49afe7a49p-7 /* 0.010515128116648802 */
+#define CHEBNORM_ETA_TERM_D1_EVAL_ERROR_BOUND 0x1.e714a37555fbdp-8 /* 0.007432260424444279 */
+#define CHEBNORM_ETA_TERM_D1_F_EVAL_ERROR_BOUND 0x1.e71721e58f792p-8 /* 0.00743240907246258 */
 #define CHEBNORM_ETA_TERM_D1_FRAC_BITS 24
-#define CHEBNORM_ETA_TERM_D1_Q_ABS_ERROR_BOUND 0x1.a8b536ba6dcb8p-8 /* 0.0064805277456151875 */
-#define CHEBNORM_ETA_TERM_D1_Q_EVAL_ERROR_BOUND 0x1.a8b5b6ba6dcb8p-8 /* 0.006480557547937575 */
+#define CHEBNORM_ETA_TERM_D1_Q_ABS_ERROR_BOUND 0x1.a8b53ea052bb0p-8 /* 0.006480529584517322 */
+#define CHEBNORM_ETA_TERM_D1_Q_EVAL_ERROR_BOUND 0x1.a8b5bea052bb0p-8 /* 0.00648055938683971 */
 
 static const double chebnorm_eta_term_d1_coeffs[2] = {
     0x1.6dd8031c969ddp-1 /* 0.7145386669538386 */,  /* x^0 */

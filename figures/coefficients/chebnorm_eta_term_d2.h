@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('eta_term', 2, psi_max='pi/4', kind='chebyshev', error='abs', frac_bits=24)
  * p(x) ~ sqrt(2*x + 2)/2 on [0, 1] = [0.0, 1.0]
  * kind: chebyshev, error kind: abs, degree 2; coefficients in ascending powers of x.
- * Certified: |p - f| <= 0.0006640275388930184, |p/f - 1| <= 0.0009390767512919273; located max |p - f| = 0.0006640275388929901 at x = 0.0.
+ * Certified: |p - f| <= 0.0006641189981334631, |p/f - 1| <= 0.0009401260494140301; located max |p - f| = 0.0006640275388929901 at x = 0.0.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_ETA_TERM_D2_H
@@ -15,13 +15,13 @@
 #define CHEBNORM_ETA_TERM_D2_DEGREE 2
 #define CHEBNORM_ETA_TERM_D2_LO 0x0.0p+0 /* 0.0 */
 #define CHEBNORM_ETA_TERM_D2_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_ETA_TERM_D2_ABS_ERROR_BOUND 0x1.5c244481692c3p-11 /* 0.0006640275388930184 */
-#define CHEBNORM_ETA_TERM_D2_REL_ERROR_BOUND 0x1.ec58bf7b5b4f5p-11 /* 0.0009390767512919273 */
-#define CHEBNORM_ETA_TERM_D2_EVAL_ERROR_BOUND 0x1.5c2444816a457p-11 /* 0.0006640275388935063 */
-#define CHEBNORM_ETA_TERM_D2_F_EVAL_ERROR_BOUND 0x1.5c4b3d059a391p-11 /* 0.0006643178937341001 */
+#define CHEBNORM_ETA_TERM_D2_ABS_ERROR_BOUND 0x1.5c308b0565c41p-11 /* 0.0006641189981334631 */
+#define CHEBNORM_ETA_TERM_D2_REL_ERROR_BOUND 0x1.ece595173f294p-11 /* 0.0009401260494140301 */
+#define CHEBNORM_ETA_TERM_D2_EVAL_ERROR_BOUND 0x1.5c308b0566dd5p-11 /* 0.000664118998133951 */
+#define CHEBNORM_ETA_TERM_D2_F_EVAL_ERROR_BOUND 0x1.5c57838996d0fp-11 /* 0.0006644093529745448 */
 #define CHEBNORM_ETA_TERM_D2_FRAC_BITS 24
-#define CHEBNORM_ETA_TERM_D2_Q_ABS_ERROR_BOUND 0x1.2b8a07f9f4178p-11 /* 0.0005713256534765473 */
-#define CHEBNORM_ETA_TERM_D2_Q_EVAL_ERROR_BOUND 0x1.2b9207f9f4179p-11 /* 0.0005713852581213228 */
+#define CHEBNORM_ETA_TERM_D2_Q_ABS_ERROR_BOUND 0x1.2b8a02f65accap-11 /* 0.000571325507548259 */
+#define CHEBNORM_ETA_TERM_D2_Q_EVAL_ERROR_BOUND 0x1.2b9202f65accbp-11 /* 0.0005713851121930345 */
 
 static const double chebnorm_eta_term_d2_coeffs[3] = {
     0x1.6a60ef7914171p-1 /* 0.7077708087254405 */,  /* x^0 */

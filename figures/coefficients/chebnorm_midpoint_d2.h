@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('midpoint', 2, psi_max='pi/4', kind='chebyshev', error='abs', frac_bits=24)
  * p(x) ~ 1/sqrt(2*x + 2) on [sqrt(2)/2, 1] = [0.7071067811865476, 1.0]
  * kind: chebyshev, error kind: abs, degree 2; coefficients in ascending powers of x.
- * Certified: |p - f| <= 2.1581644227752808e-05, |p/f - 1| <= 3.987767875992287e-05; located max |p - f| = 2.1581644227752655e-05 at x = 0.7071067811865476.
+ * Certified: |p - f| <= 2.158171794462798e-05, |p/f - 1| <= 3.9878412947327774e-05; located max |p - f| = 2.1581644227752655e-05 at x = 0.7071067811865476.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_MIDPOINT_D2_H
@@ -15,13 +15,13 @@
 #define CHEBNORM_MIDPOINT_D2_DEGREE 2
 #define CHEBNORM_MIDPOINT_D2_LO 0x1.6a09e667f3bcdp-1 /* 0.7071067811865476 */
 #define CHEBNORM_MIDPOINT_D2_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_MIDPOINT_D2_ABS_ERROR_BOUND 0x1.6a1474c662671p-16 /* 2.1581644227752808e-05 */
-#define CHEBNORM_MIDPOINT_D2_REL_ERROR_BOUND 0x1.4e84a9be1cb64p-15 /* 3.987767875992287e-05 */
-#define CHEBNORM_MIDPOINT_D2_EVAL_ERROR_BOUND 0x1.6a1474c6819c7p-16 /* 2.1581644228185913e-05 */
-#define CHEBNORM_MIDPOINT_D2_F_EVAL_ERROR_BOUND 0x1.6e4ea50a67131p-16 /* 2.1833610881581345e-05 */
+#define CHEBNORM_MIDPOINT_D2_ABS_ERROR_BOUND 0x1.6a14c5d3d7114p-16 /* 2.158171794462798e-05 */
+#define CHEBNORM_MIDPOINT_D2_REL_ERROR_BOUND 0x1.4e863d5dcdb27p-15 /* 3.9878412947327774e-05 */
+#define CHEBNORM_MIDPOINT_D2_EVAL_ERROR_BOUND 0x1.6a14c5d3f646ap-16 /* 2.1581717945061084e-05 */
+#define CHEBNORM_MIDPOINT_D2_F_EVAL_ERROR_BOUND 0x1.6e4ef617dbbd4p-16 /* 2.1833684598456516e-05 */
 #define CHEBNORM_MIDPOINT_D2_FRAC_BITS 24
-#define CHEBNORM_MIDPOINT_D2_Q_ABS_ERROR_BOUND 0x1.5a6145cc7f23fp-16 /* 2.064585514637202e-05 */
-#define CHEBNORM_MIDPOINT_D2_Q_EVAL_ERROR_BOUND 0x1.5b6145cc7f240p-16 /* 2.0705459791147416e-05 */
+#define CHEBNORM_MIDPOINT_D2_Q_ABS_ERROR_BOUND 0x1.5a61485cd7a23p-16 /* 2.0645857478180284e-05 */
+#define CHEBNORM_MIDPOINT_D2_Q_EVAL_ERROR_BOUND 0x1.5b61485cd7a24p-16 /* 2.0705462122955678e-05 */
 
 static const double chebnorm_midpoint_d2_coeffs[3] = {
     0x1.5c8c146ff8a2cp-1 /* 0.6807562243159899 */,  /* x^0 */

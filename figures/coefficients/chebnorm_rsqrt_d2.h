@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('rsqrt', 2, psi_max='pi/4', kind='minimax', error='abs', frac_bits=24)
  * p(x) ~ 1/sqrt(x) on [sqrt(2)/4 + 1/2, 1] = [0.8535533905932737, 1.0]
  * kind: minimax, error kind: abs, degree 2; coefficients in ascending powers of x.
- * Certified: |p - f| <= 4.032532275505313e-05, |p/f - 1| <= 4.032008458410055e-05; located max |p - f| = 4.032008458417048e-05 at x = 0.9621220239628561.
+ * Certified: |p - f| <= 4.0325499648396114e-05, |p/f - 1| <= 4.032235100220883e-05; located max |p - f| = 4.03200845842111e-05 at x = 1.0.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_RSQRT_D2_H
@@ -15,26 +15,26 @@
 #define CHEBNORM_RSQRT_D2_DEGREE 2
 #define CHEBNORM_RSQRT_D2_LO 0x1.b504f333f9de6p-1 /* 0.8535533905932737 */
 #define CHEBNORM_RSQRT_D2_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_RSQRT_D2_ABS_ERROR_BOUND 0x1.5245f8a1aa04ap-15 /* 4.032532275505313e-05 */
-#define CHEBNORM_RSQRT_D2_REL_ERROR_BOUND 0x1.523ab8eaa4045p-15 /* 4.032008458410055e-05 */
-#define CHEBNORM_RSQRT_D2_EVAL_ERROR_BOUND 0x1.5245f8a1e70efp-15 /* 4.032532275674734e-05 */
-#define CHEBNORM_RSQRT_D2_F_EVAL_ERROR_BOUND 0x1.5aa1fb10d32acp-15 /* 4.132184233771505e-05 */
+#define CHEBNORM_RSQRT_D2_ABS_ERROR_BOUND 0x1.524659e1305ddp-15 /* 4.0325499648396114e-05 */
+#define CHEBNORM_RSQRT_D2_REL_ERROR_BOUND 0x1.523f96e4a2001p-15 /* 4.032235100220883e-05 */
+#define CHEBNORM_RSQRT_D2_EVAL_ERROR_BOUND 0x1.524659e16d682p-15 /* 4.032549965009032e-05 */
+#define CHEBNORM_RSQRT_D2_F_EVAL_ERROR_BOUND 0x1.5aa25c505d83fp-15 /* 4.1322019231169054e-05 */
 #define CHEBNORM_RSQRT_D2_FRAC_BITS 24
-#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.5246b9d0f0bd1p-15 /* 4.032567415592599e-05 */
-#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52c6b9d0f0bd2p-15 /* 4.0385278800701384e-05 */
+#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.5246be047eb72p-15 /* 4.0325681798201044e-05 */
+#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52c6be047eb73p-15 /* 4.038528644297644e-05 */
 
 static const double chebnorm_rsqrt_d2_coeffs[3] = {
-    0x1.f38fea70e0934p+0 /* 1.951414730604097 */,  /* x^0 */
-    -0x1.6851071104ad6p+0 /* -1.4074863831089508 */,  /* x^1 */
-    0x1.d30f045657bdap-2 /* 0.4561119725894379 */  /* x^2 */
+    0x1.f38fea70e092ap+0 /* 1.9514147306040948 */,  /* x^0 */
+    -0x1.6851071104ac2p+0 /* -1.4074863831089464 */,  /* x^1 */
+    0x1.d30f045657bb4p-2 /* 0.4561119725894358 */  /* x^2 */
 };
 
 /* Horner's rule in double; x must lie in [CHEBNORM_RSQRT_D2_LO, CHEBNORM_RSQRT_D2_HI]. */
 static inline double chebnorm_rsqrt_d2(double x)
 {
-    double acc = 0x1.d30f045657bdap-2 /* 0.4561119725894379 */;
-    acc = acc * x + -0x1.6851071104ad6p+0 /* -1.4074863831089508 */;
-    acc = acc * x + 0x1.f38fea70e0934p+0 /* 1.951414730604097 */;
+    double acc = 0x1.d30f045657bb4p-2 /* 0.4561119725894358 */;
+    acc = acc * x + -0x1.6851071104ac2p+0 /* -1.4074863831089464 */;
+    acc = acc * x + 0x1.f38fea70e092ap+0 /* 1.9514147306040948 */;
     return acc;
 }
 
