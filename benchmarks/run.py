@@ -652,6 +652,28 @@ def main_job():
 
 
 # ----------------------------------------------------------------- report
+def _raster_line(ra) -> str:
+    """The rasterizer row: per mode, each engine's frame time and throughput
+    (wall and per CPU-second), as bench_raster.py measured them."""
+    engines = ra.get("engines", ["numpy"])
+    parts = []
+    for m in ra["modes"]:
+        label = m["mode"] + (f":{m['method']}" if m["method"] else "")
+        cols = []
+        for e in engines:
+            sec = m.get(f"{e}_s", m.get("seconds"))
+            wall = m.get(f"{e}_mfrag_per_s", m.get("mfragments_per_s"))
+            cpu = m.get(f"{e}_mfrag_per_cpu_s")
+            cols.append(f"{e} {sec * 1e3:.0f} ms, {wall:.2f} Mfrag/s"
+                        + ("" if cpu is None else f" ({cpu:.2f} per CPU-second)"))
+        parts.append(f"{label} " + ", ".join(cols))
+    load = ra.get("load_average_before")
+    head = (f"- rasterizer ({ra['mesh']}, {ra['size'][0]}x{ra['size'][1]}, "
+            f"{' and '.join(engines)}" + ("" if load is None else f", load average {load[0]:.1f}")
+            + "; issue 16's goal: phong >= 20 Mfrag/s): ")
+    return head + "; ".join(parts)
+
+
 def _config_keys(timing):
     """config keys in table order: configuration, then compiler"""
     return sorted(timing, key=lambda c: (CONFIG_ORDER.index(_split(c)[1])
@@ -809,9 +831,7 @@ def markdown(res):
         L.append(f"- fit vs Sollya: skipped ({fs.get('skipped')})")
     ra = res["raster"]
     if "modes" in ra:
-        L.append(f"- rasterizer ({ra['mesh']}, {ra['size'][0]}x{ra['size'][1]}, numpy): " + "; ".join(
-            f"{m['mode']}{':' + m['method'] if m['method'] else ''} {m['seconds'] * 1e3:.0f} ms "
-            f"({m['mfragments_per_s']:.2f} Mfrag/s)" for m in ra["modes"]))
+        L.append(_raster_line(ra))
     else:
         L.append(f"- rasterizer: skipped ({ra.get('skipped')})")
     mj = res["main_job"]
@@ -917,7 +937,7 @@ def run(quick=False, out_dir=HERE, log=print):
         res["skipped"].append(f"fit vs Sollya: {exc}")
     log("rasterizer throughput (bench_raster.py)")
     try:
-        res["raster"] = raster_throughput((512, 512), quick)
+        res["raster"] = raster_throughput((1024, 1024), quick)
     except Exception as exc:
         res["raster"] = {"skipped": f"{type(exc).__name__}: {exc}"}
         res["skipped"].append(f"raster: {exc}")
