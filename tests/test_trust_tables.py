@@ -218,9 +218,9 @@ def test_malformed_json(text, match):
 
 
 def test_json_nan_literal_is_refused():
-    text = BASE.read_text().replace('"abs_error_bound": 2.1581644227752808e-05',
-                                    '"abs_error_bound": NaN')
-    assert "NaN" in text
+    text, n = re.subn(r'^  "abs_error_bound": [^,]+,$', '  "abs_error_bound": NaN,',
+                      BASE.read_text(), flags=re.M)
+    assert n == 1 and "NaN" in text
     with pytest.raises(ValueError, match=r"^abs_error_bound: expected a finite number >= 0, got nan$"):
         CoefficientTable.from_json(text)
 

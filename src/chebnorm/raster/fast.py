@@ -410,9 +410,12 @@ def _dichotomy_node(nl, nr, r, i, L, k, res):
 
 
 @_njit
-def _dichotomy_kernel(offsets, nl, nr, levels, coeffs, exact, kc, tc, out):
-    # kc[0] = 2 (in the dtype), kc[1] = 1; coeffs ascending, in the dtype
-    S = offsets.shape[0] - 1
+def _dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
+    """``(r, Lmax)``: ``r[i, lev]`` the reciprocal length of span ``i``'s
+    midpoint sum at depth ``lev`` (``1/sqrt(z + 2)``, exact or by the table's
+    polynomial in ``z``), stepped as ``z <- (z + 2) r``; ``Lmax`` the deepest
+    level. kc[0] = 2 (in the dtype), kc[1] = 1; coeffs ascending, in the dtype."""
+    S = levels.shape[0]
     Lmax = 0
     for i in range(S):
         Lmax = max(Lmax, levels[i])
@@ -432,6 +435,13 @@ def _dichotomy_kernel(offsets, nl, nr, levels, coeffs, exact, kc, tc, out):
             r[i, lev] = rr
             if lev < L - 1:
                 z = s * rr
+    return r, Lmax
+
+
+@_njit
+def _dichotomy_kernel(offsets, nl, nr, levels, coeffs, exact, kc, tc, out):
+    S = offsets.shape[0] - 1
+    r, Lmax = _dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
     # per level: does any pixel fall off the grid (then every pixel of the level is picked)
     off = np.zeros(Lmax + 1, np.bool_)
     for i in range(S):

@@ -353,25 +353,7 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
     span is off the dyadic grid (then every pixel of that depth is picked), as
     :func:`.fast._dichotomy_kernel` computes them."""
     S = levels.shape[0]
-    Lmax = 0
-    for i in range(S):
-        Lmax = max(Lmax, levels[i])
-    r = np.empty((S, max(Lmax, 1)), nl.dtype)
-    for i in range(S):
-        z = (nl[0, i] * nr[0, i] + nl[1, i] * nr[1, i] + nl[2, i] * nr[2, i]) * kc[0]
-        L = levels[i]
-        for lev in range(L):
-            s = z + kc[0]
-            if exact:
-                rr = kc[1] / np.sqrt(s)
-            else:
-                p = coeffs[coeffs.shape[0] - 1]
-                for q in range(coeffs.shape[0] - 2, -1, -1):
-                    p = p * z + coeffs[q]
-                rr = p
-            r[i, lev] = rr
-            if lev < L - 1:
-                z = s * rr
+    r, Lmax = fast._dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
     off = np.zeros(Lmax + 1, np.bool_)
     tcb = np.empty(1, nl.dtype)
     for i in range(S):
