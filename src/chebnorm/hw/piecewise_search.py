@@ -33,6 +33,7 @@ from chebnorm.approx.textsafe import csv_cell
 
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
+from .sweep import pareto_png
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS"]
 
@@ -155,34 +156,13 @@ class SearchResult:
         return lines
 
     def plot_png(self) -> bytes:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 4.5), dpi=120)
-        for deg in sorted({p.degree for p in self.points}):
-            pts = [p for p in self.points if p.degree == deg]
-            ax.scatter([p.model_cost for p in pts], [p.total_bound for p in pts], s=18,
-                       label=f"degree {deg}")
-        front = sorted((p for p in self.points if p.pareto), key=lambda p: p.model_cost)
-        ax.step([p.model_cost for p in front], [p.total_bound for p in front], where="post",
-                color="k", lw=1, label="Pareto front")
-        ax.axhline(self.max_error, color="r", ls="--", lw=1, label="max error")
-        if self.winner is not None:
-            ax.scatter([self.winner.model_cost], [self.winner.total_bound], s=90,
-                       facecolors="none", edgecolors="r", label="winner")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("model cost (Yosys-cell units)")
-        ax.set_ylabel("certified max |y - f(x)|")
-        ax.set_title(f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", metadata={"Software": None})
-        plt.close(fig)
-        return buf.getvalue()
+        """The Pareto plot of the search (cost against certified error), as PNG bytes."""
+        return pareto_png(
+            self.points, lambda p: p.model_cost, lambda p: p.total_bound,
+            hline=(self.max_error, "max error"), best=(self.winner, "winner"),
+            xlabel="model cost (Yosys-cell units)", ylabel="certified max |y - f(x)|",
+            title=f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out",
+            xlog=True)
 
 
 def _point(d: PiecewiseDesign) -> DesignPoint:

@@ -22,7 +22,7 @@ from .fixed import check_width
 from .horner import MAX_FRAC_BITS, design_horner, max_coef_bits
 from .verilog import synthesize_text, verilog_module
 
-__all__ = ["SweepPoint", "SweepResult", "sweep", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
+__all__ = ["SweepPoint", "SweepResult", "sweep", "pareto_png", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
            "DEFAULT_ACC_BITS", "HALF_LEVEL"]
 
 DEFAULT_DEGREES = (1, 2, 3, 4)
@@ -123,34 +123,57 @@ class SweepResult:
 
     def plot_png(self) -> bytes:
         """The Pareto plot (matplotlib, Agg), as PNG bytes."""
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        return pareto_png(
+            self.points, lambda p: p.area, lambda p: p.shading_levels,
+            hline=(HALF_LEVEL, "half a level (8-bit)"),
+            best=(self.cheapest, "cheapest under half a level"),
+            xlabel="Yosys cells" if self.area_source == "yosys" else "area estimate (FA)",
+            ylabel="max shading error (8-bit levels)", title=f"{self.target}: error against area")
 
-        fig, ax = plt.subplots(figsize=(7, 4.5), dpi=120)
-        for deg in sorted({p.degree for p in self.points}):
-            pts = [p for p in self.points if p.degree == deg]
-            ax.scatter([p.area for p in pts], [p.shading_levels for p in pts], s=18,
-                       label=f"degree {deg}")
-        front = sorted((p for p in self.points if p.pareto), key=lambda p: p.area)
-        ax.step([p.area for p in front], [p.shading_levels for p in front], where="post",
-                color="k", lw=1, label="Pareto front")
-        ax.axhline(HALF_LEVEL, color="r", ls="--", lw=1, label="half a level (8-bit)")
-        best = self.cheapest
-        if best is not None:
-            ax.scatter([best.area], [best.shading_levels], s=90, facecolors="none",
-                       edgecolors="r", label="cheapest under half a level")
-        ax.set_xlabel("Yosys cells" if self.area_source == "yosys" else "area estimate (FA)")
-        ax.set_ylabel("max shading error (8-bit levels)")
-        ax.set_yscale("log")
-        ax.set_title(f"{self.target}: error against area")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", metadata={"Software": None})
-        plt.close(fig)
-        return buf.getvalue()
+
+def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: str,
+               xlog: bool = False) -> bytes:
+    """A design sweep's Pareto plot as PNG bytes (matplotlib, Agg, no
+    timestamp): ``points`` (each with ``degree`` and ``pareto``) scattered by
+    degree at ``(x(p), y(p))`` on a log ``y`` axis (and ``x`` with ``xlog``),
+    the front as a step line, ``hline = (value, label)`` dashed and ``best =
+    (point or None, label)`` circled.
+
+    >>> from types import SimpleNamespace as P
+    >>> pts = [P(degree=1, pareto=True, c=1.0, e=0.1), P(degree=2, pareto=False, c=2.0, e=0.2)]
+    >>> png = pareto_png(pts, lambda p: p.c, lambda p: p.e, hline=(0.5, "limit"),
+    ...                  best=(pts[0], "best"), xlabel="cost", ylabel="error", title="t")
+    >>> png[1:4]
+    b'PNG'
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5), dpi=120)
+    for deg in sorted({p.degree for p in points}):
+        pts = [p for p in points if p.degree == deg]
+        ax.scatter([x(p) for p in pts], [y(p) for p in pts], s=18, label=f"degree {deg}")
+    front = sorted((p for p in points if p.pareto), key=x)
+    ax.step([x(p) for p in front], [y(p) for p in front], where="post",
+            color="k", lw=1, label="Pareto front")
+    ax.axhline(hline[0], color="r", ls="--", lw=1, label=hline[1])
+    if best[0] is not None:
+        ax.scatter([x(best[0])], [y(best[0])], s=90, facecolors="none", edgecolors="r",
+                   label=best[1])
+    if xlog:
+        ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
 
 
 def _validate_list(values, name, lo, hi) -> tuple[int, ...]:
