@@ -680,6 +680,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     hh, ll = np.empty(W), np.empty(W)
     ok = np.empty(W, np.bool_)
     skip = np.zeros(W, np.bool_)
+    nd = np.empty((3, _TREE_MAX + 1), A.dtype)
     sab = np.empty(2, A.dtype)
     for rr in range(part, height, parts):
         base = rr * W
@@ -761,11 +762,21 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                 n1[k] = np.float64(A[1, s] * wa + B[1, s] * wb)
                 n2[k] = np.float64(A[2, s] * wa + B[2, s] * wb)
         else:
+            cur = -1
+            tree = False
             for k in range(nw):
                 s = ws[k]
                 lv = levels[s]
-                m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s], B[2, s],
-                                           R, s, lv, off[lv], kd[2 + lv], tc[k])
+                if s != cur:    # a span's winners are adjacent: its tree once
+                    cur = s
+                    tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
+                    if tree:
+                        _dichotomy_tree(A, B, R, s, lv, nd)
+                if tree:
+                    m0, m1, m2 = _dichotomy_pick(nd, lv, off[lv], kd[2 + lv], tc[k])
+                else:
+                    m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                               B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
                 n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
         # half vectors
         if per_pixel_h:
@@ -804,6 +815,57 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             tri_map[p] = face_id[stri[ws[k]]]
             nlen[p] = nl[k]
     return hard
+
+
+#: the dichotomy builds a span's whole halving tree when it has at most this many nodes
+#: (and not many more than the span has pixels); deeper spans descend per pixel
+_TREE_MAX = 1 << 12
+
+
+@_njit(inline=True)
+def _dichotomy_tree(A, B, R, i, L, nd):
+    """Every node of span ``i``'s halving tree of depth ``L`` into ``nd[:, 0 .. 2**L]``:
+    the midpoint of an interval at depth ``d`` is ``(A + B) R[i, d]`` of its ends, as
+    :func:`_dichotomy_px` computes it on its way down."""
+    top = np.int64(1) << L
+    for c in range(3):
+        nd[c, 0] = A[c, i]
+        nd[c, top] = B[c, i]
+    step = top
+    for d in range(L):
+        half = step >> 1
+        r = R[i, d]
+        for m in range(half, top, step):
+            for c in range(3):
+                nd[c, m] = (nd[c, m - half] + nd[c, m + half]) * r
+        step = half
+
+
+@_njit(inline=True)
+def _dichotomy_pick(nd, L, need_b, scale, tc):
+    """:func:`_dichotomy_px` from the span's whole tree ``nd``."""
+    u = tc * scale
+    kf = np.floor(u)
+    fr = u - kf
+    k = np.int64(kf)
+    if not need_b:
+        return nd[0, k], nd[1, k], nd[2, k]
+    kb = min(k + 1, np.int64(1) << L)
+    return (nd[0, k] + fr * (nd[0, kb] - nd[0, k]), nd[1, k] + fr * (nd[1, kb] - nd[1, k]),
+            nd[2, k] + fr * (nd[2, kb] - nd[2, k]))
+
+
+@_njit(inline=True)
+def _background(img, mask, tri_map, nlen, lo, hi):
+    """Pixels ``lo .. hi-1`` of the four maps: no fragment."""
+    for p in range(lo, hi):
+        img[p] = 0.0
+    for p in range(lo, hi):
+        mask[p] = False
+    for p in range(lo, hi):
+        tri_map[p] = -1
+    for p in range(lo, hi):
+        nlen[p] = np.nan
 
 
 @_njit(inline=True)
