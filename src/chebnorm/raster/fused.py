@@ -1005,6 +1005,52 @@ def spans(xy, attrs, width, height):
                            right=right, row_start=row_start, by_row=by_row)
 
 
+@_njit()
+def _gather_rows(order, tri, row, c0, count, m, t0, dt, left, right):
+    """The span arrays taken in ``order``."""
+    S, Kc = order.shape[0], left.shape[1]
+    out = (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
+           np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
+           np.empty((S, Kc)), np.empty((S, Kc)))
+    for i in range(S):
+        s = order[i]
+        out[0][i] = tri[s]
+        out[1][i] = row[s]
+        out[2][i] = c0[s]
+        out[3][i] = count[s]
+        out[4][i] = m[s]
+        out[5][i] = t0[s]
+        out[6][i] = dt[s]
+        for k in range(Kc):
+            out[7][i, k] = left[s, k]
+            out[8][i, k] = right[s, k]
+    return out
+
+
+def row_ordered(sp):
+    """The spans of :func:`spans` renumbered row by row (row ``r``'s are
+    ``row_start[r] .. row_start[r+1]-1``, in their old order, so ties of the z-test
+    still go to the earliest fragment; ``by_row`` becomes the identity and ``order``
+    maps the new numbers to the old). A frame reads each span's data once per row it
+    draws: in this order the reads are sequential, not scattered over every triangle's
+    spans (a third of the frame's time at 1024x1024).
+
+    >>> import numpy as np
+    >>> xy = np.array([[[0.0, 0.0], [8.0, 0.0], [0.0, 6.0]], [[1.0, 0.5], [7.0, 1.5], [2.0, 5.0]]])
+    >>> sp = spans(xy, np.ones((2, 3, 1)), 8, 6)
+    >>> rs = row_ordered(sp)
+    >>> bool((np.diff(rs.row) >= 0).all()) and bool((sp.row[rs.order] == rs.row).all())
+    True
+    """
+    order = sp.by_row
+    parts = _gather_rows(order, sp.tri, sp.row, sp.x0, sp.count, sp.m, sp.t0, sp.dt, sp.left,
+                         sp.right)
+    tri, row, c0, count, m, t0, dt, left, right = parts
+    return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
+                           right=right, row_start=sp.row_start,
+                           by_row=np.arange(len(order), dtype=np.int64), order=order)
+
+
 def _threads() -> int:
     """Threads to split a frame over: the CPUs this process may run on (at most 8)."""
     try:
@@ -1042,7 +1088,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         return None
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
-    sp = spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
+    sp = row_ordered(spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height))
     S = len(sp.count)
     stats = {}
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
