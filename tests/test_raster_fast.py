@@ -129,6 +129,25 @@ def test_fused_spans_identical():
         assert (ref.row[ids] == r).all() and (np.diff(ids) > 0).all()
 
 
+def test_row_spans_are_spans_renumbered_by_row(monkeypatch):
+    rng = np.random.default_rng(6)
+    T = 500
+    xy = rng.random((T, 3, 2)) * [70, 60] - 5
+    xy[:5, 1, 1] = xy[:5, 0, 1]
+    attrs = rng.standard_normal((T, 3, 7))
+    ref = fused.spans(xy, attrs, 64, 50)
+    for threads in (1, 2, 3):
+        monkeypatch.setattr(fused, "_threads", lambda: threads)
+        got = fused.row_spans(xy, attrs, 64, 50)
+        old = np.lexsort((got.row, got.tri))     # the spans() numbering
+        for name in ("tri", "row", "x0", "count", "m", "t0", "dt", "left", "right"):
+            assert _same(getattr(got, name)[old], getattr(ref, name)), name
+        assert _same(got.row_start, ref.row_start)
+        assert _same(got.by_row, np.arange(len(ref.count)))
+        # row r holds ref's row-r spans, in span order
+        assert _same(np.argsort(old), ref.by_row)
+
+
 def test_det_matches_detmath():
     from chebnorm.methods import detmath
 

@@ -268,63 +268,115 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
 
 
 # ------------------------------------------------------------- span set-up
+@_njit(inline=True)
+def _span_geom(xy, i, r, width):
+    """Row ``r`` of triangle ``i`` as :func:`.spans.setup_spans` finds it: ``(c, a, pa,
+    qa, sa, p, q, sb, swap, xl, xr)``, ``c`` the pixel count (0: no span), ``a`` the first
+    pixel, ``sa``, ``sb`` the positions along edges ``pa -> qa`` and ``p -> q``."""
+    y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
+    y = r + 0.5
+    # edges (0,1), (1,2), (2,0): hit when min <= y < max; the first and last hit
+    h0 = min(y0, y1) <= y and y < max(y0, y1)
+    h1 = min(y1, y2) <= y and y < max(y1, y2)
+    h2 = min(y2, y0) <= y and y < max(y2, y0)
+    if np.int64(h0) + np.int64(h1) + np.int64(h2) != 2:
+        return 0, 0, 0, 0, 0.0, 0, 0, 0.0, False, 0.0, 0.0
+    e1 = 0 if h0 else 1
+    e2 = 2 if h2 else 1
+    pa = e1
+    qa = (e1 + 1) % 3
+    sa = (y - xy[i, pa, 1]) / (xy[i, qa, 1] - xy[i, pa, 1])
+    xa = xy[i, pa, 0] + sa * (xy[i, qa, 0] - xy[i, pa, 0])
+    p = e2
+    q = (e2 + 1) % 3
+    sb = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
+    xb = xy[i, p, 0] + sb * (xy[i, q, 0] - xy[i, p, 0])
+    swap = xb < xa
+    xl = xb if swap else xa
+    xr = xa if swap else xb
+    a = np.int64(min(max(np.ceil(xl - 0.5), 0.0), float(width)))
+    b = np.int64(min(max(np.ceil(xr - 0.5), 0.0), float(width)))
+    return max(b - a, 0), a, pa, qa, sa, p, q, sb, swap, xl, xr
+
+
+@_njit(inline=True)
+def _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, row, c0, count,
+                m, t0, dt, left, right):
+    """Span ``n``: row ``r`` of triangle ``i`` (from :func:`_span_geom`)."""
+    tri[n] = i
+    row[n] = r
+    c0[n] = a
+    count[n] = c
+    for k in range(attrs.shape[2]):
+        va = attrs[i, pa, k] + sa * (attrs[i, qa, k] - attrs[i, pa, k])
+        vb = attrs[i, p, k] + sb * (attrs[i, q, k] - attrs[i, p, k])
+        left[n, k] = vb if swap else va
+        right[n, k] = va if swap else vb
+    ws = xr - xl
+    d = 1.0 / ws
+    dt[n] = d
+    t0[n] = ((a + 0.5) - xl) * d
+    m[n] = np.int64(max(1.0, np.ceil(ws)))
+
+
 @_njit()
 def _spans_part(xy, attrs, width, r0, nrows, lo, hi, write, nvalid, start, tri, row, c0, count,
                 m, t0, dt, left, right):
     """The spans of :func:`.spans.setup_spans` of triangles ``lo .. hi-1``: with ``write``
     False, how many each triangle keeps (into ``nvalid``); with ``write`` True, the spans
     themselves, triangle ``i``'s from index ``start[i]`` on."""
-    Kc = attrs.shape[2]
     for i in range(lo, hi):
-        y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
         n = start[i] if write else 0
         for r in range(r0[i], r0[i] + nrows[i]):
-            y = r + 0.5
-            # edges (0,1), (1,2), (2,0): hit when min <= y < max; the first and last hit
-            h0 = min(y0, y1) <= y and y < max(y0, y1)
-            h1 = min(y1, y2) <= y and y < max(y1, y2)
-            h2 = min(y2, y0) <= y and y < max(y2, y0)
-            if np.int64(h0) + np.int64(h1) + np.int64(h2) != 2:
-                continue
-            e1 = 0 if h0 else 1
-            e2 = 2 if h2 else 1
-            p = e1
-            q = (e1 + 1) % 3
-            sa = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
-            xa = xy[i, p, 0] + sa * (xy[i, q, 0] - xy[i, p, 0])
-            pa, qa = p, q
-            p = e2
-            q = (e2 + 1) % 3
-            sb = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
-            xb = xy[i, p, 0] + sb * (xy[i, q, 0] - xy[i, p, 0])
-            swap = xb < xa
-            xl = xb if swap else xa
-            xr = xa if swap else xb
-            a = np.int64(min(max(np.ceil(xl - 0.5), 0.0), float(width)))
-            b = np.int64(min(max(np.ceil(xr - 0.5), 0.0), float(width)))
-            c = max(b - a, 0)
+            c, a, pa, qa, sa, p, q, sb, swap, xl, xr = _span_geom(xy, i, r, width)
             if c <= 0:
                 continue
-            if not write:
-                n += 1
-                continue
-            tri[n] = i
-            row[n] = r
-            c0[n] = a
-            count[n] = c
-            for k in range(Kc):
-                va = attrs[i, pa, k] + sa * (attrs[i, qa, k] - attrs[i, pa, k])
-                vb = attrs[i, p, k] + sb * (attrs[i, q, k] - attrs[i, p, k])
-                left[n, k] = vb if swap else va
-                right[n, k] = va if swap else vb
-            ws = xr - xl
-            d = 1.0 / ws
-            dt[n] = d
-            t0[n] = ((a + 0.5) - xl) * d
-            m[n] = np.int64(max(1.0, np.ceil(ws)))
+            if write:
+                _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, row,
+                            c0, count, m, t0, dt, left, right)
             n += 1
         if not write:
             nvalid[i] = n
+
+
+@_njit()
+def _row_buckets(r0, nrows, height):
+    """The triangles crossing each row, in triangle order: row ``r``'s are
+    ``ids[first[r]:first[r+1]]``."""
+    first = np.zeros(height + 1, np.int64)
+    for i in range(r0.shape[0]):
+        for r in range(r0[i], r0[i] + nrows[i]):
+            first[r + 1] += 1
+    for r in range(height):
+        first[r + 1] += first[r]
+    fill = first[:-1].copy()
+    ids = np.empty(first[height], np.int64)
+    for i in range(r0.shape[0]):
+        for r in range(r0[i], r0[i] + nrows[i]):
+            ids[fill[r]] = i
+            fill[r] += 1
+    return first, ids
+
+
+@_njit()
+def _row_spans_part(xy, attrs, width, first, ids, rlo, rhi, write, row_start, tri, row, c0,
+                    count, m, t0, dt, left, right):
+    """:func:`_spans_part` row by row, rows ``rlo .. rhi-1`` (the triangles of each row
+    from :func:`_row_buckets`): with ``write`` False, each row's number of spans into
+    ``row_start[r + 1]``; with ``write`` True, the spans from ``row_start[r]`` on."""
+    for r in range(rlo, rhi):
+        n = row_start[r] if write else 0
+        for q in range(first[r], first[r + 1]):
+            i = ids[q]
+            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = _span_geom(xy, i, r, width)
+            if c <= 0:
+                continue
+            if write:
+                _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, tri, row,
+                            c0, count, m, t0, dt, left, right)
+            n += 1
+        if not write:
+            row_start[r + 1] = n
 
 
 @_njit()
@@ -982,12 +1034,7 @@ def spans(xy, attrs, width, height):
     r0, nrows = fast._count_rows(np.ascontiguousarray(xy[..., 1]), int(height))
     T = len(nrows)
     Kc = attrs.shape[2]
-    # parts of about equal numbers of rows
-    k = _threads()
-    ends = np.cumsum(nrows)
-    cuts = [0] + [int(np.searchsorted(ends, ends[-1] * q / k)) if T else 0
-                  for q in range(1, k)] + [T]
-    parts = [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
+    parts = _parts(nrows, _threads())
     nvalid = np.zeros(T, np.int64)
     z1, z2 = np.zeros(1, np.int64), np.zeros((1, Kc))
     fixed = (xy, attrs, int(width), r0, nrows)
@@ -1005,50 +1052,54 @@ def spans(xy, attrs, width, height):
                            right=right, row_start=row_start, by_row=by_row)
 
 
-@_njit()
-def _gather_rows(order, tri, row, c0, count, m, t0, dt, left, right):
-    """The span arrays taken in ``order``."""
-    S, Kc = order.shape[0], left.shape[1]
-    out = (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
-           np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
-           np.empty((S, Kc)), np.empty((S, Kc)))
-    for i in range(S):
-        s = order[i]
-        out[0][i] = tri[s]
-        out[1][i] = row[s]
-        out[2][i] = c0[s]
-        out[3][i] = count[s]
-        out[4][i] = m[s]
-        out[5][i] = t0[s]
-        out[6][i] = dt[s]
-        for k in range(Kc):
-            out[7][i, k] = left[s, k]
-            out[8][i, k] = right[s, k]
-    return out
+def _parts(nrows, k):
+    """Triangle ranges ``[(lo, hi), ...]`` of about equal numbers of rows, at most ``k``."""
+    T = len(nrows)
+    ends = np.cumsum(nrows)
+    cuts = [0] + [int(np.searchsorted(ends, ends[-1] * q / k)) if T else 0
+                  for q in range(1, k)] + [T]
+    return [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
 
 
-def row_ordered(sp):
-    """The spans of :func:`spans` renumbered row by row (row ``r``'s are
-    ``row_start[r] .. row_start[r+1]-1``, in their old order, so ties of the z-test
-    still go to the earliest fragment; ``by_row`` becomes the identity and ``order``
-    maps the new numbers to the old). A frame reads each span's data once per row it
-    draws: in this order the reads are sequential, not scattered over every triangle's
-    spans (a third of the frame's time at 1024x1024).
+def row_spans(xy, attrs, width, height):
+    """The spans of :func:`spans`, numbered row by row: row ``r``'s are
+    ``row_start[r] .. row_start[r+1]-1``, in their :func:`spans` order (so ties of the
+    z-test still go to the earliest fragment), ``by_row`` the identity. A frame reads
+    each span's data once per row: in this order the reads are sequential instead of
+    scattered over every triangle's spans (a third of the frame's time at 1024x1024).
+    The :func:`spans` numbering is the order of ``(tri, row)``.
 
     >>> import numpy as np
     >>> xy = np.array([[[0.0, 0.0], [8.0, 0.0], [0.0, 6.0]], [[1.0, 0.5], [7.0, 1.5], [2.0, 5.0]]])
-    >>> sp = spans(xy, np.ones((2, 3, 1)), 8, 6)
-    >>> rs = row_ordered(sp)
-    >>> bool((np.diff(rs.row) >= 0).all()) and bool((sp.row[rs.order] == rs.row).all())
+    >>> a, b = spans(xy, np.ones((2, 3, 1)), 8, 6), row_spans(xy, np.ones((2, 3, 1)), 8, 6)
+    >>> old = np.lexsort((b.row, b.tri))          # b's spans in spans() order
+    >>> bool((np.diff(b.row) >= 0).all()) and bool((b.t0[old] == a.t0).all())
     True
     """
-    order = sp.by_row
-    parts = _gather_rows(order, sp.tri, sp.row, sp.x0, sp.count, sp.m, sp.t0, sp.dt, sp.left,
-                         sp.right)
-    tri, row, c0, count, m, t0, dt, left, right = parts
+    xy = np.ascontiguousarray(xy, dtype=np.float64)
+    attrs = np.ascontiguousarray(attrs, dtype=np.float64)
+    height = int(height)
+    r0, nrows = fast._count_rows(np.ascontiguousarray(xy[..., 1]), height)
+    first, ids = _row_buckets(r0, nrows, height)
+    Kc = attrs.shape[2]
+    # row ranges of about equal numbers of (row, triangle) pairs
+    k = _threads()
+    cuts = [0] + [int(np.searchsorted(first, first[-1] * q / k)) for q in range(1, k)] + [height]
+    parts = [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
+    row_start = np.zeros(height + 1, np.int64)
+    z1, z2 = np.zeros(1, np.int64), np.zeros((1, Kc))
+    fixed = (xy, attrs, int(width), first, ids)
+    _run([(_row_spans_part, (*fixed, lo, hi, False, row_start, z1, z1, z1, z1, z1, z2[0], z2[0],
+                             z2, z2)) for lo, hi in parts])
+    np.cumsum(row_start, out=row_start)
+    S = int(row_start[-1])
+    out = (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
+           np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
+           np.empty((S, Kc)), np.empty((S, Kc)))
+    _run([(_row_spans_part, (*fixed, lo, hi, True, row_start, *out)) for lo, hi in parts])
+    tri, row, c0, count, m, t0, dt, left, right = out
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
-                           right=right, row_start=sp.row_start,
-                           by_row=np.arange(len(order), dtype=np.int64), order=order)
+                           right=right, row_start=row_start, by_row=np.arange(S, dtype=np.int64))
 
 
 def _threads() -> int:
@@ -1088,7 +1139,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         return None
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
-    sp = row_ordered(spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height))
+    sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
     S = len(sp.count)
     stats = {}
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
