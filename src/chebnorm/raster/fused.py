@@ -453,17 +453,11 @@ def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd,
 
 
 @_njit()
-def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs, img,
-                    mask, tri_map, nlen):
-    """Row ``rr``: the background in the four maps, and in ``bs`` the winning span of each
-    pixel (largest ``1/w``, ties to the earliest span; -1: none)."""
-    base = rr * width
+def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs):
+    """Row ``rr``: in ``bs`` the winning span of each pixel (largest ``1/w``, ties to the
+    earliest span; -1: none)."""
     for x in range(width):
         bs[x] = -1
-        img[base + x] = 0.0
-        mask[base + x] = False
-        tri_map[base + x] = -1
-        nlen[base + x] = np.nan
     for k in range(row_start[rr], row_start[rr + 1]):
         s = by_row[k]
         lo = left[s, 0]
@@ -704,7 +698,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
            light, orders, part, parts, img, mask, tri_map, nlen):
     """The visibility and shading passes, one scan line at a time, on the rows
     ``part, part + parts, ...`` (threads run the parts at once: each writes its own
-    rows of the four output maps). Returns the number of slerp float32 pixels whose
+    rows of the four output maps, which hold the background on entry: :func:`_background`). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
 
     Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
@@ -736,8 +730,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     sab = np.empty(2, A.dtype)
     for rr in range(part, height, parts):
         base = rr * W
-        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs,
-                        img, mask, tri_map, nlen)
+        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
         nw = 0
         for x in range(W):
             if bs[x] >= 0:
@@ -869,6 +862,19 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     return hard
 
 
+@_njit()
+def _background(img, mask, tri_map, nlen):
+    """The four maps of a frame with no fragment: 0, False, -1, NaN."""
+    for p in range(img.shape[0]):
+        img[p] = 0.0
+    for p in range(mask.shape[0]):
+        mask[p] = False
+    for p in range(tri_map.shape[0]):
+        tri_map[p] = -1
+    for p in range(nlen.shape[0]):
+        nlen[p] = np.nan
+
+
 #: the dichotomy builds a span's whole halving tree when it has at most this many nodes
 #: (and not many more than the span has pixels); deeper spans descend per pixel
 _TREE_MAX = 1 << 12
@@ -905,19 +911,6 @@ def _dichotomy_pick(nd, L, need_b, scale, tc):
     kb = min(k + 1, np.int64(1) << L)
     return (nd[0, k] + fr * (nd[0, kb] - nd[0, k]), nd[1, k] + fr * (nd[1, kb] - nd[1, k]),
             nd[2, k] + fr * (nd[2, kb] - nd[2, k]))
-
-
-@_njit(inline=True)
-def _background(img, mask, tri_map, nlen, lo, hi):
-    """Pixels ``lo .. hi-1`` of the four maps: no fragment."""
-    for p in range(lo, hi):
-        img[p] = 0.0
-    for p in range(lo, hi):
-        mask[p] = False
-    for p in range(lo, hi):
-        tri_map[p] = -1
-    for p in range(lo, hi):
-        nlen[p] = np.nan
 
 
 @_njit(inline=True)
@@ -1115,18 +1108,28 @@ def _threads() -> int:
 _POOL: dict = {}
 
 
-def _run(jobs):
-    """Run ``[(kernel, args), ...]`` (compiled with ``nogil``) at once on a thread pool;
-    their results in order."""
-    if len(jobs) == 1:
-        return [jobs[0][0](*jobs[0][1])]
+def _pool():
+    """This process's thread pool (a forked child makes its own)."""
     pool = _POOL.get(os.getpid())
     if pool is None:
         _POOL.clear()
         pool = _POOL[os.getpid()] = ThreadPoolExecutor(max_workers=_threads(),
                                                         thread_name_prefix="chebnorm-raster")
-    futures = [pool.submit(fn, *args) for fn, args in jobs]
+    return pool
+
+
+def _run(jobs):
+    """Run ``[(kernel, args), ...]`` (compiled with ``nogil``) at once on a thread pool;
+    their results in order."""
+    if len(jobs) == 1:
+        return [jobs[0][0](*jobs[0][1])]
+    futures = [_pool().submit(fn, *args) for fn, args in jobs]
     return [f.result() for f in futures]
+
+
+def _submit(fn, args):
+    """Start ``fn(*args)`` (compiled with ``nogil``) on the thread pool; its future."""
+    return _pool().submit(fn, *args)
 
 
 def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
@@ -1140,6 +1143,11 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
     sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
+    # the output maps' background (and their first touch: 26 MB of fresh pages at 1024x1024)
+    # on a pool thread while this thread does the per-span set-up
+    npx = st.width * st.height
+    maps = (np.empty(npx), np.empty(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
+    filled = _submit(_background, maps)
     S = len(sp.count)
     stats = {}
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
@@ -1191,9 +1199,8 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     ords = np.array(orders, np.int64)
     face_id = np.ascontiguousarray(st.tri, np.int64)
     args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
-    npx = st.width * st.height
-    maps = (np.empty(npx), np.empty(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
     img, mask, tri_map, nlen = maps
+    filled.result()
     common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
               *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
               per_pixel_h, Htri, L, eye, light, ords)
