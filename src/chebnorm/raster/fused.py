@@ -698,7 +698,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
            light, orders, part, parts, img, mask, tri_map, nlen):
     """The visibility and shading passes, one scan line at a time, on the rows
     ``part, part + parts, ...`` (threads run the parts at once: each writes its own
-    rows of the four output maps, which hold the background on entry: :func:`_background`). Returns the number of slerp float32 pixels whose
+    rows of the four output maps, which hold the background on entry: zeros and
+    :func:`_background`). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
 
     Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
@@ -863,12 +864,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
 
 
 @_njit()
-def _background(img, mask, tri_map, nlen):
-    """The four maps of a frame with no fragment: 0, False, -1, NaN."""
-    for p in range(img.shape[0]):
-        img[p] = 0.0
-    for p in range(mask.shape[0]):
-        mask[p] = False
+def _background(tri_map, nlen):
+    """The triangle and ``|N|`` maps of a frame with no fragment: -1, NaN."""
     for p in range(tri_map.shape[0]):
         tri_map[p] = -1
     for p in range(nlen.shape[0]):
@@ -1143,11 +1140,13 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
     sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
-    # the output maps' background (and their first touch: 26 MB of fresh pages at 1024x1024)
-    # on a pool thread while this thread does the per-span set-up
+    # the output maps' background: image and mask from zeroed pages (never touched where
+    # no fragment lands), the triangle map and |N| filled on a pool thread (with their
+    # first touch, 16 MB of fresh pages at 1024x1024) while this thread does the per-span
+    # set-up
     npx = st.width * st.height
-    maps = (np.empty(npx), np.empty(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
-    filled = _submit(_background, maps)
+    maps = (np.zeros(npx), np.zeros(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
+    filled = _submit(_background, maps[2:])
     S = len(sp.count)
     stats = {}
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
