@@ -295,3 +295,22 @@ def test_fused_phong_identical_shininess(shininess):
 
     _check_identical(get_mesh("teapot"), "exact", (160, 128),
                      lighting=Lighting(shininess=shininess))
+
+
+def test_fused_span_buffers_per_thread():
+    # the span arrays are reused between frames, one set per thread: renders running at
+    # once in two threads, and frames of growing and shrinking size, draw what they draw
+    # alone
+    from concurrent.futures import ThreadPoolExecutor
+
+    cases = [("teapot", "exact", (200, 160)), ("torus", "dichotomy", (120, 96)),
+             ("sphere", "slerp", (64, 64)), ("teapot", "angular", (260, 240))]
+    alone = [render(get_mesh(m, None if m == "teapot" else 12), "phong", meth, size=sz,
+                    engine="numpy").image.tobytes() for m, meth, sz in cases]
+    def draw(case):
+        m, meth, sz = case
+        return render(get_mesh(m, None if m == "teapot" else 12), "phong", meth, size=sz,
+                      engine="numba").image.tobytes()
+    with ThreadPoolExecutor(2) as pool:
+        for _ in range(3):
+            assert list(pool.map(draw, cases + cases[::-1])) == alone + alone[::-1]

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from types import SimpleNamespace
@@ -1051,13 +1052,43 @@ def _parts(nrows, k):
     return [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
 
 
-def row_spans(xy, attrs, width, height):
+def _span_arrays(S, Kc):
+    """Arrays for ``S`` spans of ``Kc`` attributes: ``tri, row, x0, count, m, t0, dt, left,
+    right``."""
+    return (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
+            np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
+            np.empty((S, Kc)), np.empty((S, Kc)))
+
+
+#: per thread: {Kc: span arrays} kept between frames (see _span_buffers)
+_SCRATCH = threading.local()
+_SCRATCH_MAX = 1 << 21     # spans (about 350 MB); larger frames get fresh arrays
+
+
+def _span_buffers(S, Kc):
+    """:func:`_span_arrays` as views of buffers this thread keeps between frames: fresh
+    pages cost as much as the span set-up itself (a page fault per 4 KiB in this VM,
+    13 MB of spans at 1024x1024), reused ones nothing. Grown by a quarter when short."""
+    cache = getattr(_SCRATCH, "spans", None)
+    if cache is None:
+        cache = _SCRATCH.spans = {}
+    buf = cache.get(Kc)
+    if buf is None or buf[0].shape[0] < S:
+        if S > _SCRATCH_MAX:
+            cache.pop(Kc, None)
+            return _span_arrays(S, Kc)
+        buf = cache[Kc] = _span_arrays(min(S + S // 4 + 64, _SCRATCH_MAX), Kc)
+    return tuple(b[:S] for b in buf)
+
+
+def row_spans(xy, attrs, width, height, reuse=False):
     """The spans of :func:`spans`, numbered row by row: row ``r``'s are
     ``row_start[r] .. row_start[r+1]-1``, in their :func:`spans` order (so ties of the
     z-test still go to the earliest fragment), ``by_row`` the identity. A frame reads
     each span's data once per row: in this order the reads are sequential instead of
     scattered over every triangle's spans (a third of the frame's time at 1024x1024).
-    The :func:`spans` numbering is the order of ``(tri, row)``.
+    The :func:`spans` numbering is the order of ``(tri, row)``. ``reuse``: the arrays are
+    views of this thread's :func:`_span_buffers`, valid until its next ``reuse`` call.
 
     >>> import numpy as np
     >>> xy = np.array([[[0.0, 0.0], [8.0, 0.0], [0.0, 6.0]], [[1.0, 0.5], [7.0, 1.5], [2.0, 5.0]]])
@@ -1083,9 +1114,7 @@ def row_spans(xy, attrs, width, height):
                              z2, z2)) for lo, hi in parts])
     np.cumsum(row_start, out=row_start)
     S = int(row_start[-1])
-    out = (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
-           np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
-           np.empty((S, Kc)), np.empty((S, Kc)))
+    out = _span_buffers(S, Kc) if reuse else _span_arrays(S, Kc)
     _run([(_row_spans_part, (*fixed, lo, hi, True, row_start, *out)) for lo, hi in parts])
     tri, row, c0, count, m, t0, dt, left, right = out
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
@@ -1139,7 +1168,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         return None
     per_pixel_h = lighting.half_vector == "pixel"
     extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
-    sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height)
+    sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height, reuse=True)
     # the output maps' background: image and mask from zeroed pages (never touched where
     # no fragment lands), the triangle map and |N| filled on a pool thread (with their
     # first touch, 16 MB of fresh pages at 1024x1024) while this thread does the per-span
