@@ -7,9 +7,10 @@ z-buffer, per-fragment normals, half vectors and dot products):
 
 1. triangle set-up and span set-up, compiled, the spans split over threads (the
    arithmetic of :func:`.spans.setup_spans`);
-2. the method's checks and per-span set-up, as :func:`chebnorm.methods.span_normals`
-   does them (the same calls; sine, cosine and arc cosine element by element with
-   the bits of :mod:`chebnorm.methods.detmath`, see :func:`det`);
+2. the method's checks and per-span set-up, the values and errors of
+   :func:`chebnorm.methods.span_normals`'s, compiled and split over threads in
+   :mod:`.fusedsetup` (the reference functions run where a check fails; sine, cosine
+   and arc cosine with the bits of :mod:`chebnorm.methods.detmath`, see :func:`det`);
 3. one pass per scan line, rows split across the cores (threads running the compiled
    kernels without the GIL, rows interleaved): a z-test of the
    line's spans in span order into a line buffer (the winning span of every pixel,
@@ -43,10 +44,9 @@ from chebnorm.methods import detmath
 from chebnorm.methods import kernels as K
 from chebnorm.methods.ops import NumpyOps
 from chebnorm.methods.registry import method_kernel
-from chebnorm.methods.spans import MAX_LEVELS, check_span_input
+from chebnorm.methods.spans import MAX_LEVELS
 
 from . import fast
-from .meshes import _unit
 
 try:  # pragma: no cover - exercised by whichever environment runs the tests
     import numba
@@ -255,6 +255,9 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
             n += 1
     txy = np.empty((n, 3, 2))
     attrs = np.empty((n, 3, 7))
+    tiw = np.empty((n, 3))
+    tpos = np.empty((n, 3, 3))
+    tnrm = np.empty((n, 3, 3))
     for k in range(n):
         i = tri[k]
         for v in range(3):
@@ -262,10 +265,13 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
             txy[k, v, 0] = xy[q, 0]
             txy[k, v, 1] = xy[q, 1]
             attrs[k, v, 0] = inv_w[q]
+            tiw[k, v] = inv_w[q]
             for c in range(3):
                 attrs[k, v, 1 + c] = nrm[q, c]
                 attrs[k, v, 4 + c] = pos[q, c]
-    return tri, txy, attrs
+                tnrm[k, v, c] = nrm[q, c]
+                tpos[k, v, c] = pos[q, c]
+    return tri, txy, attrs, tiw, tpos, tnrm
 
 
 # ------------------------------------------------------------- span set-up
@@ -1005,14 +1011,14 @@ def supports(spec) -> bool:
 
 def gather_setup(mesh, xy, inv_w, cull):
     """The per-triangle arrays of ``render._setup``, gathered in compiled code: front
-    triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``."""
-    tri, txy, attrs = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
-                                    np.ascontiguousarray(mesh.normals, np.float64),
-                                    np.ascontiguousarray(xy, np.float64),
-                                    np.ascontiguousarray(inv_w, np.float64),
-                                    np.ascontiguousarray(mesh.faces, np.int64), bool(cull))
-    return (tri, txy, np.ascontiguousarray(attrs[..., 0]), np.ascontiguousarray(attrs[..., 4:]),
-            np.ascontiguousarray(attrs[..., 1:4]))
+    triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``, and
+    the corner attributes of :func:`phong`'s spans, ``[1/w, normal, position] (T,3,7)``."""
+    tri, txy, attrs, iw, pos, nrm = _gather_setup(
+        np.ascontiguousarray(mesh.positions, np.float64),
+        np.ascontiguousarray(mesh.normals, np.float64), np.ascontiguousarray(xy, np.float64),
+        np.ascontiguousarray(inv_w, np.float64), np.ascontiguousarray(mesh.faces, np.int64),
+        bool(cull))
+    return tri, txy, iw, pos, nrm, attrs
 
 
 def spans(xy, attrs, width, height):
@@ -1166,56 +1172,66 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     orders = calibrated()
     if orders is None or id(method_kernel(spec)) not in MODES:
         return None
+    from . import fusedsetup
+
     per_pixel_h = lighting.half_vector == "pixel"
-    extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
-    sp = row_spans(st.xy, np.concatenate(extra, axis=2), st.width, st.height, reuse=True)
+    attrs = getattr(st, "attrs", None)   # [1/w, normal, position] of gather_setup
+    if attrs is None:
+        extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
+        attrs = np.concatenate(extra, axis=2)
+    elif not per_pixel_h:
+        attrs = attrs[..., :4]
+    work = fusedsetup.take()    # scratch arrays of an earlier frame (pages mapped)
+    sp = fusedsetup.row_spans(st.xy, attrs, st.width, st.height, work)
     # the output maps' background: image and mask from zeroed pages (never touched where
-    # no fragment lands), the triangle map and |N| filled on a pool thread (with their
-    # first touch, 16 MB of fresh pages at 1024x1024) while this thread does the per-span
-    # set-up
+    # no fragment lands), the triangle map and |N| (the memory of an earlier frame's once
+    # the user dropped it, else 16 MB of fresh pages at 1024x1024) filled on a pool
+    # thread while this thread does the per-span set-up
     npx = st.width * st.height
-    maps = (np.zeros(npx), np.zeros(npx, np.bool_), np.empty(npx, np.int64), np.empty(npx))
+    maps = (np.zeros(npx), np.zeros(npx, np.bool_), *fusedsetup.output_maps(npx))
     filled = _submit(_background, maps[2:])
     S = len(sp.count)
     stats = {}
-    tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats)
     mode = MODES[id(method_kernel(spec))]
-    dtype = np.dtype(dtype).type
-    dt_ = dtype if mode else np.float64
-    A = B = C = np.zeros((3, 1), dt_)
+    # the unit end normals, the checks of check_span_input and the values it derives,
+    # compiled (fusedsetup: the reference runs where a check fails)
+    ends, dot_min = (fusedsetup.widest_dot(sp, spec, dtype, mode <= 3, work)
+                     if S and (mode or spec.table is not None) else (None, None))
+    tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats, dot_min=dot_min)
+    dt_ = np.float64    # the computation's dtype, checked (as the reference) where spans use it
+    if mode and S:
+        dt_, coeffs, lv, A, B, start_left, count_max = fusedsetup.span_input(
+            spec, sp, tables, dtype, ends, mode <= 3)
+    else:
+        A = B = np.zeros((3, 1), dt_)
+    C = np.zeros((3, 1), dt_)
     sc = sc2 = np.zeros(1, dt_)
     levels = np.zeros(1, np.int64)
     R = np.zeros((1, 1), dt_)
     off = np.zeros(1, np.bool_)
     kd = np.zeros(1, dt_)
     if mode and S:
-        cols = [1, 2, 3]
-        inp = check_span_input(spec, _unit(sp.left[:, cols]), _unit(sp.right[:, cols]), sp.m,
-                               t0=sp.t0, dt=sp.dt, count=sp.count, tables=tables, dtype=dtype)
-        dt_ = dtype = inp.dtype
-        coeffs = inp.coefficients
+        dtype = dt_
         ops = _DetOps(dtype)
-        A = np.ascontiguousarray(inp.n_left.astype(dtype).T)
-        B = np.ascontiguousarray(inp.n_right.astype(dtype).T)
-        a, b = tuple(A), tuple(B)
-        start_left = bool((inp.t0 == 0).all())
         if mode <= 3:
-            B = np.ascontiguousarray(np.stack(K.vsub(b, a)))
-        elif mode == 4:
-            s = method_kernel(spec).setup(ops, a, b, coeffs)
-            sc, sc2 = np.ascontiguousarray(s["psi"], dtype), np.ascontiguousarray(s["inv"], dtype)
-        elif mode == 5:
-            A, B, C = fast._quadratic_setup(ops, a, b, inp.t0.astype(dtype), inp.dt.astype(dtype),
-                                            coeffs, start_left)
-        elif mode == 6:
-            A, B, sc = fast._angular_setup(ops, a, b, inp.t0.astype(dtype),
-                                           inp.dt.astype(dtype), int(inp.count.max()), start_left)
+            pass    # B is N_r - N_l (K.vsub(b, a)) in the dtype
+        elif mode == 4:     # K.SLERP.setup, compiled
+            sc, sc2 = fusedsetup.method_setup(mode, A, B, None, None, coeffs, start_left,
+                                              count_max, ops, work)
+        elif mode == 5:     # fast._quadratic_setup, compiled
+            A, B, C = fusedsetup.method_setup(mode, A, B, sp.t0.astype(dtype),
+                                              sp.dt.astype(dtype), coeffs, start_left,
+                                              count_max, ops, work)
+        elif mode == 6:     # fast._angular_setup, compiled
+            A, B, sc = fusedsetup.method_setup(mode, A, B, sp.t0.astype(dtype),
+                                               sp.dt.astype(dtype), coeffs, start_left,
+                                               count_max, ops, work)
         else:
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
             kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
-            levels = inp.levels.astype(np.int64)
-            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, inp.t0, inp.dt,
-                                     inp.count)
+            levels = np.ascontiguousarray(lv, np.int64)
+            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
+                                     sp.count)
     kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
     C = np.ascontiguousarray(C)
     Htri = (np.ascontiguousarray(tri_half(st), np.float64) if not per_pixel_h
@@ -1243,6 +1259,8 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         sa, sb = detmath.sin((kc[5] - tc) * psi), detmath.sin(tc * psi)
         _slerp_fixup(pix, span, sa, sb, st.width, *args, A, B, sc2, per_pixel_h, Htri, sp.tri,
                      L, eye, light, ords, img, mask, tri_map, nlen, face_id)
+    fusedsetup.give(work)
+    fusedsetup.keep_maps(maps[2:])
     if np.count_nonzero(mask) < 2:
         return None    # numpy computes N @ L for one row by another route than BLAS
     shape = (st.height, st.width)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -33,7 +34,7 @@ from chebnorm.methods import default_tables, get_method, method_names
 from chebnorm.methods import span_normals as _span_normals
 from chebnorm.symbolic import eta as _eta_criterion
 
-from . import fast, fused
+from . import fast, fused, fusedsetup
 from .meshes import Mesh, _unit, get_mesh
 from .spans import Camera, fit_camera, project, setup_spans, zbuffer
 
@@ -182,6 +183,7 @@ class _Setup:
     pos: np.ndarray            # (T,3,3)
     nrm: np.ndarray            # (T,3,3)
     engine: str = "numpy"      # "numpy" (the reference) or "numba" (compiled, same bytes)
+    attrs: np.ndarray | None = None   # numba: [inv_w, nrm, pos] (T,3,7), fused.phong's spans
 
     def rasterize(self, extra):
         """Spans and visible fragments with attributes [1/w, *extra] (extra (T,3,K))."""
@@ -200,11 +202,13 @@ class _Setup:
 
 def _setup(mesh, camera, size, cull=True, engine="numpy"):
     w, h = size
+    if engine == "numba":  # the same camera (remembered per mesh positions) and gathers
+        cam = camera or fusedsetup.default_camera_of(mesh.positions, w, h)
+        xy, inv_w = fusedsetup.project(cam, mesh.positions, w, h)
+        tri, txy, iw, pos, nrm, attrs = fused.gather_setup(mesh, xy, inv_w, cull)
+        return _Setup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, engine, attrs)
     cam = camera or fit_camera(mesh.positions, w, h)
     xy, inv_w = project(cam, mesh.positions, w, h)
-    if engine == "numba":  # the same gathers, compiled
-        tri, txy, iw, pos, nrm = fused.gather_setup(mesh, xy, inv_w, cull)
-        return _Setup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, engine)
     f = mesh.faces
     txy = xy[f]
     area = ((txy[:, 1, 0] - txy[:, 0, 0]) * (txy[:, 2, 1] - txy[:, 0, 1])
@@ -396,21 +400,32 @@ def _interpolated_normals(sp, cols, method, interp, tables, dtype, sel=None, eng
     return out
 
 
-def _auto_tables(spec, sp, col_groups, tables, stats):
+@lru_cache(maxsize=None)
+def _psi_max(text) -> float:
+    """A table's ``psi_max`` (``"pi/4"``) as a float."""
+    return float(parse_number(text))
+
+
+def _auto_tables(spec, sp, col_groups, tables, stats, dot_min=None):
     """The default tables cover end normals up to the registered ``psi_max`` (pi/4)
     apart.  When ``tables`` is None and a frame has wider spans (the teapot's spout
     lip) in any of ``col_groups`` (the normal columns the method interpolates), use
     :func:`chebnorm.methods.default_tables` on the smallest ``psi_max = j pi/32``
     covering them, and say so in ``stats["table_psi_max"]``; the widest angle is
-    ``stats["span_angle_max"]``."""
+    ``stats["span_angle_max"]``.  ``dot_min``: the smallest ``N_l.N_r`` of the unit
+    end normals of the one column group, already computed (the fused frame's)."""
     if tables is not None or spec is None or spec.table is None or len(sp.count) == 0:
         return tables
     psi = 0.0
     for cols in col_groups:
-        nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
-        psi = max(psi, float(np.arccos(np.clip(np.min(_dot(nl, nr)), -1.0, 1.0))))
+        if dot_min is None:
+            nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
+            d = np.min(_dot(nl, nr))
+        else:
+            d = np.float64(dot_min)
+        psi = max(psi, float(np.arccos(np.clip(d, -1.0, 1.0))))
     stats["span_angle_max"] = psi
-    if psi <= float(parse_number(spec.table.psi_max)):
+    if psi <= _psi_max(spec.table.psi_max):
         return None
     j = min(31, int(np.ceil(psi / (np.pi / 32) + 1e-9)))
     stats["table_psi_max"] = f"{j}*pi/32"
