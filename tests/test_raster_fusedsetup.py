@@ -287,7 +287,7 @@ def test_output_maps_never_shared_with_a_kept_result():
     mesh = get_mesh("torus", 10)
     first = render(mesh, "phong", "exact", size=(48, 40), engine="numba")
     image = first.image.copy()
-    tri = first.triangle           # one map kept, the result dropped
+    tri = first.normal_length      # one map kept, the result dropped
     tri_copy = tri.copy()
     del first
     frames = [render(mesh, "phong", m, size=(48, 40), engine="numba",
@@ -295,7 +295,7 @@ def test_output_maps_never_shared_with_a_kept_result():
     again = render(mesh, "phong", "exact", size=(48, 40), engine="numba")
     assert _same(tri, tri_copy) and _same(again.image, image)
     assert not _same(frames[0].image, frames[1].image)
-    ptrs = [r.image.base.ctypes.data for r in frames + [again]]
+    ptrs = [r.triangle.base.ctypes.data for r in frames + [again]]
     assert len(set(ptrs)) == len(ptrs)
     assert _reused_after_drop(mesh)
 
@@ -304,10 +304,10 @@ def _reused_after_drop(mesh):
     """A dropped result's memory is the next frame's (outside an assert statement, whose
     rewriting keeps values alive)."""
     r = render(mesh, "phong", "exact", size=(48, 40), engine="numba")
-    p = r.image.base.ctypes.data
+    p = r.normal_length.base.ctypes.data
     del r
     r = render(mesh, "phong", "exact", size=(48, 40), engine="numba")
-    return r.image.base.ctypes.data == p
+    return r.normal_length.base.ctypes.data == p
 
 
 def test_row_spans_identical():
