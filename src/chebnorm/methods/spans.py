@@ -396,3 +396,12 @@ def _tree(kern, ops, a, b, levels, coeffs, t, sid, out, dtype):
             res = kern.pick(ops, node_a, node_b, f)
         for c in range(3):
             out[pix, c] = res[c]
+
+
+# names a compiled twin of check_span_input (chebnorm.raster.fusedsetup) reuses, so
+# that it raises exactly these functions' errors
+COVER_SLACK = _COVER_SLACK
+span_levels = _levels
+resolve_table = _resolve_table
+check_dtype = _check_dtype
+check_method = _check_method

@@ -1,14 +1,17 @@
-"""Compiled set-up of the fused ``phong`` frame (:func:`.fused.phong`): the checks and
-per-span values of :func:`chebnorm.methods.spans.check_span_input` on the spans' unit
-end normals, the widest span angle of ``render._auto_tables``, the per-method span
-set-up, and the default camera of ``render``, with the bits of the numpy reference.
+"""Compiled set-up of the fused ``phong`` frame (:func:`.fused.phong`): the row spans,
+the checks and per-span values of :func:`chebnorm.methods.spans.check_span_input` on
+the spans' unit end normals, the widest span angle of ``render._auto_tables``, the
+per-method span set-up, and ``render``'s default camera and projection, with the bits
+of the numpy reference; scratch arrays kept between frames.
 
 The reference stays the reference: every value here is what it computes, in its
 operation order (the ``np.linalg.norm`` and ``einsum`` sums in the orders
-:func:`.fused.calibrated` found), and wherever a check fails, or a value lands where
-this code cannot promise the reference's bits (``ceil`` of a ``log2`` within 1e-6
-of an integer, a table's coverage test near its threshold), the reference functions
-run instead, so the user gets exactly the reference's values and errors.
+:func:`ends_orders` finds, the projection's ``@`` as :func:`_gemm_fma` checks), and
+wherever a check fails, or a value lands where this code cannot promise the
+reference's bits (a dichotomy depth whose ``log2`` is within 1e-6 of an integer, a
+table's coverage test that is not clear-cut, a float32 sine or cosine whose rounding
+is in doubt), the reference functions run instead, on those spans or on all, so the
+user gets exactly the reference's values and errors.
 """
 
 from __future__ import annotations
@@ -23,9 +26,13 @@ import numpy as np
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.methods.registry import default_tables, method_kernel
-from chebnorm.methods.spans import (_COVER_SLACK, ANTIPARALLEL_TOL, MAX_LEVELS, PICK_TOL, UNIT_TOL,
-                                    _check_dtype, _check_method, _levels,
-                                    _resolve_table, check_span_input)
+from chebnorm.methods.spans import ANTIPARALLEL_TOL, MAX_LEVELS, PICK_TOL, UNIT_TOL
+from chebnorm.methods.spans import COVER_SLACK as _COVER_SLACK
+from chebnorm.methods.spans import check_dtype as _check_dtype
+from chebnorm.methods.spans import check_method as _check_method
+from chebnorm.methods.spans import check_span_input
+from chebnorm.methods.spans import resolve_table as _resolve_table
+from chebnorm.methods.spans import span_levels as _levels
 
 from . import fused
 from .fused import _dot3, _njit, _threads
@@ -33,12 +40,13 @@ from .meshes import _unit
 from .spans import fit_camera
 from .spans import project as _ref_project
 
-__all__ = ["Workspace", "take", "give", "span_input", "widest_dot", "method_setup",
-           "ends_orders", "default_camera_of", "project"]
+__all__ = ["Workspace", "take", "give", "output_maps", "keep_maps", "row_spans", "span_input",
+           "widest_dot", "method_setup", "ends_orders", "default_camera_of", "project"]
 
 #: the position tolerance of ``check_span_input`` (pixels at ``t`` in [-tol, 1 + tol])
 _POS_TOL = 1e-9
-#: distance from an integer below which ``ceil`` of a compiled ``log2`` is handed to numpy
+#: margin (to an integer ``log2``, to a depth's cosine threshold) inside which numpy
+#: computes a dichotomy depth
 _NEAR_INT = 1e-6
 #: ``cos(theta_max 2**n)``, ``theta_max = 2 acos(1 - PICK_TOL)`` of ``_levels``, while
 #: ``theta_max 2**n < pi`` (past the last, every span angle is below ``theta_max 2**n``)
