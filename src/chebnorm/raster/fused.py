@@ -1177,9 +1177,8 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     per_pixel_h = lighting.half_vector == "pixel"
     attrs = getattr(st, "attrs", None)   # [1/w, normal, position] of gather_setup
     if attrs is None:
-        extra = [st.inv_w[..., None], st.nrm] + ([st.pos] if per_pixel_h else [])
-        attrs = np.concatenate(extra, axis=2)
-    elif not per_pixel_h:
+        attrs = np.concatenate([st.inv_w[..., None], st.nrm, st.pos], axis=2)
+    if not per_pixel_h:
         attrs = attrs[..., :4]
     work = fusedsetup.take()    # scratch arrays of an earlier frame (pages mapped)
     sp = fusedsetup.row_spans(st.xy, attrs, st.width, st.height, work)
@@ -1212,10 +1211,8 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     kd = np.zeros(1, dt_)
     if mode and S:
         dtype = dt_
-        ops = _DetOps(dtype)
-        if mode <= 3:
-            pass    # B is N_r - N_l (K.vsub(b, a)) in the dtype
-        elif mode == 4:     # K.SLERP.setup, compiled
+        ops = _DetOps(dtype)    # modes 1-3: B is N_r - N_l (K.vsub(b, a)) in the dtype
+        if mode == 4:       # K.SLERP.setup, compiled
             sc, sc2 = fusedsetup.method_setup(mode, A, B, None, None, coeffs, start_left,
                                               count_max, ops, work)
         elif mode == 5:     # fast._quadratic_setup, compiled
