@@ -1223,7 +1223,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
             A, B, sc = fusedsetup.method_setup(mode, A, B, sp.t0.astype(dtype),
                                                sp.dt.astype(dtype), coeffs, start_left,
                                                count_max, ops, work)
-        else:
+        elif mode == 7:     # dichotomy
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
             kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
             levels = np.ascontiguousarray(lv, np.int64)
