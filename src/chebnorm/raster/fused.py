@@ -716,9 +716,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     hard = 0
     l0, l1, l2 = L[0], L[1], L[2]
     ey0, ey1, ey2 = eye[0], eye[1], eye[2]
-    I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
-    fastpow = light[5] != 0.0
-    o0, o1, o2 = orders[0], orders[1], orders[2]
+    o2 = orders[2]
     W = width
     bw = np.empty(W)
     bs = np.empty(W, np.int64)
@@ -770,67 +768,12 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             _linear_row(mode, n0, n1, n2, ga[0], ga[1], ga[2], ga[3], ga[4], ga[5], tc, kc, n0,
                         n1, n2, nw)
         elif mode == 5 or mode == 6:
-            # stepping kernels run through every pixel of the span, in order
-            for q in range(row_start[rr], row_start[rr + 1]):
-                s = by_row[q]
-                x0 = c0[s]
-                v0, v1, v2 = A[0, s], A[1, s], A[2, s]
-                e0, e1, e2 = B[0, s], B[1, s], B[2, s]
-                f0, f1, f2 = C[0, s], C[1, s], C[2, s]
-                for j in range(count[s]):
-                    if j > 0:
-                        v0, v1, v2, e0, e1, e2 = _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1,
-                                                       f2, sc[s])
-                    if bs[x0 + j] == s:
-                        sx[0, x0 + j] = v0
-                        sx[1, x0 + j] = v1
-                        sx[2, x0 + j] = v2
-            for k in range(nw):
-                x = wx[k]
-                n0[k] = np.float64(sx[0, x])
-                n1[k] = np.float64(sx[1, x])
-                n2[k] = np.float64(sx[2, x])
+            _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1,
+                      n2, nw)
         elif mode == 4:
-            for k in range(nw):
-                s = ws[k]
-                t_ = tc[k]
-                arg_a = (kc[5] - t_) * sc[s]
-                arg_b = t_ * sc[s]
-                if is64:
-                    sab[0] = np.sin(arg_a)
-                    sab[1] = np.sin(arg_b)
-                else:
-                    ra, ha = _f32_round(np.sin(np.float64(arg_a)))
-                    rb, hb = _f32_round(np.sin(np.float64(arg_b)))
-                    if ha or hb:     # a float32 sine for detmath (see phong)
-                        skip[k] = True
-                        hard += 1
-                        n0[k] = n1[k] = n2[k] = 0.0
-                        continue
-                    sab[0] = ra
-                    sab[1] = rb
-                wa = sab[0] * sc2[s]
-                wb = sab[1] * sc2[s]
-                n0[k] = np.float64(A[0, s] * wa + B[0, s] * wb)
-                n1[k] = np.float64(A[1, s] * wa + B[1, s] * wb)
-                n2[k] = np.float64(A[2, s] * wa + B[2, s] * wb)
+            hard += _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, sab, skip, n0, n1, n2, nw)
         else:
-            cur = -1
-            tree = False
-            for k in range(nw):
-                s = ws[k]
-                lv = levels[s]
-                if s != cur:    # a span's winners are adjacent: its tree once
-                    cur = s
-                    tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
-                    if tree:
-                        _dichotomy_tree(A, B, R, s, lv, nd)
-                if tree:
-                    m0, m1, m2 = _dichotomy_pick(nd, lv, off[lv], kd[2 + lv], tc[k])
-                else:
-                    m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
-                                               B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
-                n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+            _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw)
         # half vectors
         if per_pixel_h:
             for k in range(nw):
@@ -845,29 +788,118 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             for k in range(nw):
                 ft = stri[ws[k]]
                 h0[k], h1[k], h2[k] = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
-        # Lighting.intensity(N @ L, N . H), clipped; |N|
-        _dotc_row(n0, n1, n2, l0, l1, l2, av, nw, o0)
-        _dots_row(n0, n1, n2, h0, h1, h2, bv, nw, o1)
-        _dots_row(n0, n1, n2, n0, n1, n2, nl, nw, o2)
-        for k in range(nw):
-            av[k] = _clamp0(av[k])
-            bv[k] = _clamp0(bv[k])
-            nl[k] = np.sqrt(nl[k])
-        _powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
-        for k in range(nw):
-            v = I0 * (ka + kdif * av[k] + ks * pw[k])
-            av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
-        for k in range(nw):
-            p = base + wx[k]
-            if skip[k]:
-                skip[k] = False
-                tri_map[p] = -2 - ws[k]
-                continue
-            img[p] = av[k]
-            mask[p] = True
-            tri_map[p] = face_id[stri[ws[k]]]
-            nlen[p] = nl[k]
+        _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
+                   bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
     return hard
+
+
+@_njit()
+def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv, nl,
+               pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw):
+    """``Lighting.intensity(N @ L, N . H)`` clipped, and ``|N|``, at the row's winners, into
+    the four maps (row offset ``base``)."""
+    l0, l1, l2 = L[0], L[1], L[2]
+    I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
+    fastpow = light[5] != 0.0
+    o0, o1, o2 = orders[0], orders[1], orders[2]
+    _dotc_row(n0, n1, n2, l0, l1, l2, av, nw, o0)
+    _dots_row(n0, n1, n2, h0, h1, h2, bv, nw, o1)
+    _dots_row(n0, n1, n2, n0, n1, n2, nl, nw, o2)
+    for k in range(nw):
+        av[k] = _clamp0(av[k])
+        bv[k] = _clamp0(bv[k])
+        nl[k] = np.sqrt(nl[k])
+    _powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
+    for k in range(nw):
+        v = I0 * (ka + kdif * av[k] + ks * pw[k])
+        av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
+    for k in range(nw):
+        p = base + wx[k]
+        if skip[k]:
+            skip[k] = False
+            tri_map[p] = -2 - ws[k]
+            continue
+        img[p] = av[k]
+        mask[p] = True
+        tri_map[p] = face_id[stri[ws[k]]]
+        nlen[p] = nl[k]
+
+
+@_njit()
+def _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw):
+    """Stepping kernels (5 quadratic, 6 angular) on row ``rr``: every pixel of each span
+    in order, the winners' normals (in ``x`` order) widened to float64."""
+    for q in range(row_start[rr], row_start[rr + 1]):
+        s = by_row[q]
+        x0 = c0[s]
+        v0, v1, v2 = A[0, s], A[1, s], A[2, s]
+        e0, e1, e2 = B[0, s], B[1, s], B[2, s]
+        f0, f1, f2 = C[0, s], C[1, s], C[2, s]
+        for j in range(count[s]):
+            if j > 0:
+                v0, v1, v2, e0, e1, e2 = _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1,
+                                               f2, sc[s])
+            if bs[x0 + j] == s:
+                sx[0, x0 + j] = v0
+                sx[1, x0 + j] = v1
+                sx[2, x0 + j] = v2
+    for k in range(nw):
+        x = wx[k]
+        n0[k] = np.float64(sx[0, x])
+        n1[k] = np.float64(sx[1, x])
+        n2[k] = np.float64(sx[2, x])
+
+
+@_njit()
+def _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, sab, skip, n0, n1, n2, nw):
+    """Slerp (mode 4) at the row's winners; the number of float32 pixels whose sine is in
+    doubt (``skip``: for :mod:`detmath`, see :func:`phong`)."""
+    hard = 0
+    for k in range(nw):
+        s = ws[k]
+        t_ = tc[k]
+        arg_a = (kc[5] - t_) * sc[s]
+        arg_b = t_ * sc[s]
+        if is64:
+            sab[0] = np.sin(arg_a)
+            sab[1] = np.sin(arg_b)
+        else:
+            ra, ha = _f32_round(np.sin(np.float64(arg_a)))
+            rb, hb = _f32_round(np.sin(np.float64(arg_b)))
+            if ha or hb:     # a float32 sine for detmath (see phong)
+                skip[k] = True
+                hard += 1
+                n0[k] = n1[k] = n2[k] = 0.0
+                continue
+            sab[0] = ra
+            sab[1] = rb
+        wa = sab[0] * sc2[s]
+        wb = sab[1] * sc2[s]
+        n0[k] = np.float64(A[0, s] * wa + B[0, s] * wb)
+        n1[k] = np.float64(A[1, s] * wa + B[1, s] * wb)
+        n2[k] = np.float64(A[2, s] * wa + B[2, s] * wb)
+    return hard
+
+
+@_njit()
+def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
+    """Dichotomy (mode 7) at the row's winners."""
+    cur = -1
+    tree = False
+    for k in range(nw):
+        s = ws[k]
+        lv = levels[s]
+        if s != cur:    # a span's winners are adjacent: its tree once
+            cur = s
+            tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
+            if tree:
+                _dichotomy_tree(A, B, R, s, lv, nd)
+        if tree:
+            m0, m1, m2 = _dichotomy_pick(nd, lv, off[lv], kd[2 + lv], tc[k])
+        else:
+            m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                       B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
+        n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
 
 
 @_njit()
