@@ -58,7 +58,8 @@ except ImportError:  # pragma: no cover
     numba = None
     HAVE_NUMBA = False
 
-__all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det", "pow_calibrated"]
+__all__ = ["HAVE_NUMBA", "MODES", "supports", "calibrated", "det", "pow_calibrated",
+           "first_orders"]
 
 #: kernel -> mode number of the fused kernel
 MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLERP): 4,
@@ -128,26 +129,32 @@ def calibrated():
     if not HAVE_NUMBA:
         return None
     rng = np.random.default_rng(20261123)
+
+    def probe(kind, order, n):
+        N = rng.standard_normal((n, 3))
+        H = rng.standard_normal((n, 3))
+        if kind == "matmul":
+            ref, got = N @ H[0], _dots(N, np.broadcast_to(H[0], N.shape).copy(), order)
+        elif kind == "einsum":
+            ref, got = np.einsum("...k,...k->...", N, H), _dots(N, H, order)
+        else:
+            ref, got = np.linalg.norm(N, axis=1), np.sqrt(_dots(N, N, order))
+        return ref.tobytes() == got.tobytes()
+    return first_orders(("matmul", "einsum", "norm"), (2, 3, 5, 8, 17, 1000, 4099), probe)
+
+
+def first_orders(kinds, cases, probe):
+    """For each of ``kinds``, the first summation order of :func:`_dot3` for which
+    ``probe(kind, order, case)`` holds on every one of ``cases`` (tried in order, the
+    next order at the first miss); None if some kind has none.
+
+    >>> first_orders(("a", "b"), (1, 2), lambda kind, order, case: order == len(kind))
+    (1, 1)
+    """
     found = []
-    for kind in ("matmul", "einsum", "norm"):
-        ok = None
-        for order in _ORDERS:
-            good = True
-            for n in (2, 3, 5, 8, 17, 1000, 4099):
-                N = rng.standard_normal((n, 3))
-                H = rng.standard_normal((n, 3))
-                if kind == "matmul":
-                    ref, got = N @ H[0], _dots(N, np.broadcast_to(H[0], N.shape).copy(), order)
-                elif kind == "einsum":
-                    ref, got = np.einsum("...k,...k->...", N, H), _dots(N, H, order)
-                else:
-                    ref, got = np.linalg.norm(N, axis=1), np.sqrt(_dots(N, N, order))
-                if ref.tobytes() != got.tobytes():
-                    good = False
-                    break
-            if good:
-                ok = order
-                break
+    for kind in kinds:
+        ok = next((order for order in _ORDERS
+                   if all(probe(kind, order, case) for case in cases)), None)
         if ok is None:
             return None
         found.append(ok)

@@ -269,35 +269,21 @@ def ends_orders():
     if not fused.HAVE_NUMBA:
         return None
     rng = np.random.default_rng(20261124)
-    found = []
-    for kind in ("einsum", "norm"):
-        ok = None
-        for order in (0, 1, 2):
-            good = True
-            for n, kc in ((2, 7), (3, 4), (5, 7), (8, 7), (17, 4), (1000, 7), (4099, 7),
-                          (20000, 4)):
-                a = rng.standard_normal((n, kc))[:, [1, 2, 3]]
-                b = rng.standard_normal((n, kc))[:, [1, 2, 3]]
-                ac, bc = np.ascontiguousarray(a), np.ascontiguousarray(b)
-                if kind == "einsum":
-                    got = fused._dots(ac, bc, order)
-                    same = (np.einsum("ij,ij->i", a, b).tobytes() == got.tobytes()
-                            and np.einsum("...k,...k->...", a, b).tobytes() == got.tobytes())
-                else:
-                    got = np.sqrt(fused._dots(ac, ac, order))
-                    same = (np.linalg.norm(a, axis=-1, keepdims=True)[:, 0].tobytes()
-                            == got.tobytes()
-                            and np.linalg.norm(a, axis=1).tobytes() == got.tobytes())
-                if not same:
-                    good = False
-                    break
-            if good:
-                ok = order
-                break
-        if ok is None:
-            return None
-        found.append(ok)
-    return tuple(found)
+
+    def probe(kind, order, case):
+        n, kc = case
+        a = rng.standard_normal((n, kc))[:, [1, 2, 3]]
+        b = rng.standard_normal((n, kc))[:, [1, 2, 3]]
+        ac, bc = np.ascontiguousarray(a), np.ascontiguousarray(b)
+        if kind == "einsum":
+            got = fused._dots(ac, bc, order)
+            return (np.einsum("ij,ij->i", a, b).tobytes() == got.tobytes()
+                    and np.einsum("...k,...k->...", a, b).tobytes() == got.tobytes())
+        got = np.sqrt(fused._dots(ac, ac, order))
+        return (np.linalg.norm(a, axis=-1, keepdims=True)[:, 0].tobytes() == got.tobytes()
+                and np.linalg.norm(a, axis=1).tobytes() == got.tobytes())
+    return fused.first_orders(("einsum", "norm"), ((2, 7), (3, 4), (5, 7), (8, 7), (17, 4),
+                                                   (1000, 7), (4099, 7), (20000, 4)), probe)
 
 
 def _run(jobs):
