@@ -711,9 +711,9 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
            A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
            light, orders, part, parts, img, mask, tri_map, nlen):
     """The visibility and shading passes, one scan line at a time, on the rows
-    ``part, part + parts, ...`` (threads run the parts at once: each writes its own
-    rows of the four output maps, which hold the background on entry: zeros and
-    :func:`_background`). Returns the number of slerp float32 pixels whose
+    ``part, part + parts, ...`` (threads run the parts at once: each writes every pixel
+    of its own rows of the four output maps, the background where no fragment lands:
+    0, False, -1, NaN). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
 
     Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
@@ -743,6 +743,11 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     sab = np.empty(2, A.dtype)
     for rr in range(part, height, parts):
         base = rr * W
+        for x in range(W):       # the background, overwritten where a fragment lands
+            img[base + x] = 0.0
+            mask[base + x] = False
+            tri_map[base + x] = -1
+            nlen[base + x] = np.nan
         _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
         nw = 0
         for x in range(W):
@@ -907,15 +912,6 @@ def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
             m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
                                        B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
         n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
-
-
-@_njit()
-def _background(tri_map, nlen):
-    """The triangle and ``|N|`` maps of a frame with no fragment: -1, NaN."""
-    for p in range(tri_map.shape[0]):
-        tri_map[p] = -1
-    for p in range(nlen.shape[0]):
-        nlen[p] = np.nan
 
 
 #: the dichotomy builds a span's whole halving tree when it has at most this many nodes
@@ -1198,11 +1194,6 @@ def _run(jobs):
     return [f.result() for f in futures]
 
 
-def _submit(fn, args):
-    """Start ``fn(*args)`` (compiled with ``nogil``) on the thread pool; its future."""
-    return _pool().submit(fn, *args)
-
-
 def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     """The ``phong`` frame of ``render`` (setup ``st``, method entry ``spec``): ``(image,
     mask, triangle, normal_length, fragments, stats)``, or None when this path cannot
@@ -1221,13 +1212,9 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         attrs = attrs[..., :4]
     work = fusedsetup.take()    # scratch arrays of an earlier frame (pages mapped)
     sp = fusedsetup.row_spans(st.xy, attrs, st.width, st.height, work)
-    # the output maps' background: image and mask from zeroed pages (never touched where
-    # no fragment lands), the triangle map and |N| (the memory of an earlier frame's once
-    # the user dropped it, else 16 MB of fresh pages at 1024x1024) filled on a pool
-    # thread while this thread does the per-span set-up
-    npx = st.width * st.height
-    maps = (np.zeros(npx), np.zeros(npx, np.bool_), *fusedsetup.output_maps(npx))
-    filled = _submit(_background, maps[2:])
+    # the output maps: the memory of an earlier frame's once the user dropped it (else
+    # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows
+    maps = fusedsetup.output_maps(st.width * st.height)
     S = len(sp.count)
     stats = {}
     mode = MODES[id(method_kernel(spec))]
@@ -1280,7 +1267,6 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     face_id = np.ascontiguousarray(st.tri, np.int64)
     args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
     img, mask, tri_map, nlen = maps
-    filled.result()
     common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
               *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
               per_pixel_h, Htri, L, eye, light, ords)
@@ -1296,7 +1282,7 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
         _slerp_fixup(pix, span, sa, sb, st.width, *args, A, B, sc2, per_pixel_h, Htri, sp.tri,
                      L, eye, light, ords, img, mask, tri_map, nlen, face_id)
     fusedsetup.give(work)
-    fusedsetup.keep_maps(maps[2:])
+    fusedsetup.keep_maps(maps)
     if np.count_nonzero(mask) < 2:
         return None    # numpy computes N @ L for one row by another route than BLAS
     shape = (st.height, st.width)

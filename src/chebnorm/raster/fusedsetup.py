@@ -98,29 +98,30 @@ def give(work: Workspace) -> None:
         _FREE.append(work)
 
 
-#: output-map pairs ``(triangle, normal length)`` of earlier frames, flat (at most
-#: :data:`_KEEP_MAPS`): a pair nobody else references any more is the next frame's (the
-#: memory of arrays the user dropped, its pages mapped already)
+#: output-map sets ``(image, mask, triangle, normal length)`` of earlier frames, flat (at
+#: most :data:`_KEEP_MAPS`): a set nobody else references any more is the next frame's
+#: (the memory of arrays the user dropped, its pages mapped already)
 _MAPS: list = []
 _MAPS_LOCK = threading.Lock()
 _KEEP_MAPS = 2
-_MAP_DTYPES = (np.int64, np.float64)
+_MAP_DTYPES = (np.float64, np.bool_, np.int64, np.float64)
 
 
 def output_maps(npx):
-    """Two uninitialised flat arrays for a frame's triangle and ``|N|`` maps (int64,
-    float64), each ``npx`` long: a pair of an earlier frame that only this pool still
-    references (``sys.getrefcount``: the user dropped every view of it), else new
-    arrays.  Hand the pair back with :func:`keep_maps` once the frame is drawn.
+    """Four uninitialised flat arrays for a frame's image, mask, triangle and ``|N|``
+    maps (float64, bool, int64, float64), each ``npx`` long: a set of an earlier frame
+    that only this pool still references (``sys.getrefcount``: the user dropped every
+    view of it), else new arrays.  Hand the set back with :func:`keep_maps` once the
+    frame is drawn.
 
-    >>> a = output_maps(10); keep_maps(a); a0 = a[0].ctypes.data; del a
-    >>> output_maps(10)[0].ctypes.data == a0   # dropped by the caller: the same memory
+    >>> a = output_maps(10); keep_maps(a); a0 = a[2].ctypes.data; del a
+    >>> output_maps(10)[2].ctypes.data == a0   # dropped by the caller: the same memory
     True
     """
     with _MAPS_LOCK:
         for i, ms in enumerate(_MAPS):
             # references: the pool's tuple and getrefcount's argument, nothing else
-            if ms[0].size == npx and all(sys.getrefcount(ms[k]) == 2 for k in range(2)):
+            if ms[0].size == npx and all(sys.getrefcount(ms[k]) == 2 for k in range(len(ms))):
                 del _MAPS[i]
                 return ms
     return tuple(np.empty(npx, dt) for dt in _MAP_DTYPES)
