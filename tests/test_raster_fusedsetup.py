@@ -310,6 +310,36 @@ def _reused_after_drop(mesh):
     return r.normal_length.base.ctypes.data == p
 
 
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")     # the reference on NaN normals
+def test_end_pass_on_row_spans(dtype):
+    """The end normals' pass (blocks of vectorized loops, then the checks) on the row
+    spans of random triangles, with zero, NaN, infinite and antiparallel vertex normals
+    among them (errors as the reference's), of the good ones alone, and of the teapot,
+    across more than one block."""
+    rng = np.random.default_rng(11)
+    T = 400
+    xy = rng.random((T, 3, 2)) * [70, 60] - 5
+    attrs = rng.standard_normal((T, 3, 7))
+    attrs[:4, 0, 1:4] = 0.0
+    attrs[4:6, 1, 2] = np.nan
+    attrs[6, 2, 3] = np.inf
+    attrs[7:10, 1, 1:4] = -attrs[7:10, 0, 1:4]
+    st = R._setup(get_mesh("teapot"), None, (300, 260), True, "numba")
+    seen = set()
+    for args in ((xy, attrs, 64, 50), (xy[10:], attrs[10:], 64, 50),
+                 (st.xy, st.attrs, 300, 260)):
+        rs = fusedsetup.row_spans(*args)
+        assert len(rs.count) > 2 * fusedsetup._BLOCK
+        # in (triangle, row) order, the order by which the errors name spans
+        o = np.lexsort((rs.row, rs.tri))
+        sp = SimpleNamespace(**{k: getattr(rs, k)[o] for k in ("tri", "row", "x0", "count",
+                                                              "m", "t0", "dt", "left", "right")})
+        for name in ("exact", "lyon", "slerp", "dichotomy", "quadratic"):
+            seen.add(_check_same(get_method(name), sp, None, dtype))
+    assert seen == {True, False}     # the bad spans fail, the others pass
+
+
 def test_row_spans_identical():
     """fusedsetup.row_spans (geometry kept between the passes, workspace arrays) against
     fused.row_spans: random triangles (off screen, horizontal edges, degenerate rows)
