@@ -1211,18 +1211,17 @@ def phong(st, spec, lighting, tables, dtype, tri_half, auto_tables):
     if not per_pixel_h:
         attrs = attrs[..., :4]
     work = fusedsetup.take()    # scratch arrays of an earlier frame (pages mapped)
-    mode = MODES[id(method_kernel(spec))]
-    want = mode or spec.table is not None      # the end normals' pass (widest_dot)
     sp = fusedsetup.row_spans(st.xy, attrs, st.width, st.height, work)
     # the output maps: the memory of an earlier frame's once the user dropped it (else
     # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows
     maps = fusedsetup.output_maps(st.width * st.height)
     S = len(sp.count)
     stats = {}
+    mode = MODES[id(method_kernel(spec))]
     # the unit end normals, the checks of check_span_input and the values it derives,
     # compiled (fusedsetup: the reference runs where a check fails)
     ends, dot_min = (fusedsetup.widest_dot(sp, spec, dtype, mode <= 3, work)
-                     if S and want else (None, None))
+                     if S and (mode or spec.table is not None) else (None, None))
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats, dot_min=dot_min)
     dt_ = np.float64    # the computation's dtype, checked (as the reference) where spans use it
     if mode and S:

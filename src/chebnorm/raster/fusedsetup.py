@@ -138,155 +138,105 @@ def _empty(work, name, shape, dtype=np.float64):
     return np.empty(shape, dtype) if work is None else work.empty(name, shape, dtype)
 
 
-@_njit(inline=True)
-def _unit_rows_o(src, lo, hi, u, order):
-    for i in range(lo, hi):
-        x0, x1, x2 = src[i, 1], src[i, 2], src[i, 3]
-        r = np.sqrt(_dot3(x0, x1, x2, x0, x1, x2, order))
-        u[0, i - lo], u[1, i - lo], u[2, i - lo] = x0 / r, x1 / r, x2 / r
-
-
-@_njit()
-def _unit_rows(src, lo, hi, u, order):
-    """``u[:, k] = _unit(src[lo + k, 1:4])`` (``|N|`` summed in ``order``; one loop per
-    order, so each vectorizes)."""
-    if order == 0:
-        _unit_rows_o(src, lo, hi, u, 0)
-    elif order == 1:
-        _unit_rows_o(src, lo, hi, u, 1)
-    else:
-        _unit_rows_o(src, lo, hi, u, 2)
-
-
-@_njit()
-def _ends_block(left, right, m, t0, dt, count, lo, hi, o_ein, o_norm, tree, thr, A, B, diff,
-                cos, levels, hard, red, sc):
-    """Spans ``lo .. hi-1``: the unit end normals ``_unit(left[:, 1:4])``,
-    ``_unit(right[:, 1:4])`` in the dtype of ``A``, ``B`` (3, S) (``diff``: ``B - A`` into
-    ``B``), their cosine as ``check_span_input`` computes it and its checks, and
-    (``tree``) the dichotomy depth of ``_levels`` (``hard[i]``: the depth is numpy's to
-    compute), folded into ``red``: [any check failed, smallest ``N_l.N_r`` (einsum), any
-    ``t0 != 0``, largest count, hard spans].  The arithmetic runs in loops of
-    its own over the block (vectorized: ``sqrt`` and division correctly rounded in every
-    lane), the checks after it; ``sc``: scratch, (9, at least ``hi - lo``)."""
-    n = hi - lo
-    ua, ub = sc[0:3], sc[3:6]
-    qa, qb, dd = sc[6], sc[7], sc[8]
-    _unit_rows(left, lo, hi, ua, o_norm)
-    _unit_rows(right, lo, hi, ub, o_norm)
-    for c in range(3):
-        for k in range(n):
-            A[c, lo + k] = ua[c, k]
-            B[c, lo + k] = ub[c, k]
-    if diff:
-        for c in range(3):
-            for k in range(n):
-                B[c, lo + k] = B[c, lo + k] - A[c, lo + k]
-    # _as_vectors: | |N| - 1 | <= UNIT_TOL, |N| by einsum; the cosine's |N| by norm
-    fused._dots_row(ua[0], ua[1], ua[2], ua[0], ua[1], ua[2], qa, n, o_ein)
-    fused._dots_row(ub[0], ub[1], ub[2], ub[0], ub[1], ub[2], qb, n, o_ein)
-    fused._dots_row(ua[0], ua[1], ua[2], ub[0], ub[1], ub[2], dd, n, o_ein)
-    bad = False
-    for k in range(n):
-        bad |= (abs(np.sqrt(qa[k]) - 1.0) > UNIT_TOL) | (abs(np.sqrt(qb[k]) - 1.0) > UNIT_TOL)
-    if o_norm != o_ein:
-        fused._dots_row(ua[0], ua[1], ua[2], ua[0], ua[1], ua[2], qa, n, o_norm)
-        fused._dots_row(ub[0], ub[1], ub[2], ub[0], ub[1], ub[2], qb, n, o_norm)
-    for k in range(n):
-        cos[lo + k] = dd[k] / (np.sqrt(qa[k]) * np.sqrt(qb[k]))
-    # any value not finite (x * 0 is NaN for an infinity or a NaN)
-    nan = False
-    for k in range(n):
-        i = lo + k
-        v = ((ua[0, k] * 0.0 + ua[1, k] * 0.0) + (ua[2, k] * 0.0 + ub[0, k] * 0.0)
-             + (ub[1, k] * 0.0 + ub[2, k] * 0.0) + (t0[i] * 0.0 + dt[i] * 0.0))
-        nan |= v != 0.0
-    # the antiparallel and _positions checks, and the reductions (which matter only
-    # where no check failed: then every value is finite)
-    dmin, cmax, t0nz = red[1], red[3], False
-    for k in range(n):
-        i = lo + k
-        last = t0[i] + (count[i] - 1) * dt[i]
-        bad |= ((1.0 + cos[i] <= ANTIPARALLEL_TOL) | (m[i] < 1) | (dt[i] <= 0.0)
-                | (count[i] < 1) | (t0[i] < -_POS_TOL) | (last > 1.0 + _POS_TOL))
-        dmin = min(dmin, dd[k])
-        t0nz |= t0[i] != 0.0
-        cmax = max(cmax, np.float64(count[i]))
-    for i in range(lo, hi):
-        hard[i] = False
-    nhard = 0
-    for k in range(n):
-        i = lo + k
-        if nan and not (np.isfinite(ua[0, k]) and np.isfinite(ua[1, k])
-                        and np.isfinite(ua[2, k]) and np.isfinite(ub[0, k])
-                        and np.isfinite(ub[1, k]) and np.isfinite(ub[2, k])
-                        and np.isfinite(t0[i]) and np.isfinite(dt[i])):
-            cos[i] = np.nan
-            levels[i] = 0
-        elif tree:
-            levels[i] = L = _end_depth(i, t0, dt, count, cos[i], thr, hard)
-            bad |= L > MAX_LEVELS
-            nhard += hard[i]
-    red[0] = 1.0 if (bad or nan or red[0] != 0.0) else 0.0
-    red[1] = dmin
-    red[2] = 1.0 if (t0nz or red[2] != 0.0) else 0.0
-    red[3] = cmax
-    red[4] += nhard
-
-
-@_njit(inline=True)
-def _end_depth(i, t0, dt, count, c, thr, hard):
-    """``_levels`` of span ``i`` (cosine ``c``): the base depth ceil(log2(1/dt) - 1e-12),
-    the exponent of 1/dt (a mantissa near 1/2: log2 near an integer, numpy's to round:
-    ``hard[i]``, depth 0) ..."""
-    mm, ee = math.frexp(1.0 / dt[i])
-    if not np.isfinite(mm) or mm < 0.5 * (1.0 + _NEAR_INT):
-        hard[i] = True
-        return 0
-    base = max(np.int64(ee), 0)
-    scale = math.ldexp(1.0, base)
-    off = False
-    for j in range(count[i]):
-        u = (t0[i] + j * dt[i]) * scale
-        if abs(u - np.rint(u)) > 1e-9 * max(1.0, abs(u)):
-            off = True
-            break
-    if not off:
-        return base
-    # ... then off the grid ceil(log2(arccos(c) / theta_max)): the smallest n >= 0 with
-    # c >= cos(theta_max 2**n) (thr[n]; 7 past the last), c near a threshold numpy's to
-    # round
-    cc = min(max(c, -1.0), 1.0)
-    need = thr.shape[0]
-    for q in range(thr.shape[0]):
-        if abs(cc - thr[q]) < _NEAR_INT:
-            hard[i] = True
-            break
-        if cc > thr[q]:
-            need = q
-            break
-    return max(base, np.int64(need))
-
-
-#: spans per block of :func:`_ends_part`
-_BLOCK = 256
-
-
 @_njit()
 def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A, B,
                diff, cos, levels, hard, red):
-    """:func:`_ends_block` of spans ``lo .. hi-1``, blocks of :data:`_BLOCK`."""
-    sc = np.empty((9, _BLOCK))
-    for b in range(lo, hi, _BLOCK):
-        _ends_block(left, right, m, t0, dt, count, b, min(b + _BLOCK, hi), o_ein, o_norm,
-                    tree, thr, A, B, diff, cos, levels, hard, red, sc)
-
-
-def _red0(k):
-    """``k`` empty reductions of :func:`_ends_block`."""
-    red = np.zeros((k, 5))
-    red[:, 1] = np.inf
-    return red
+    """Spans ``lo .. hi-1``: the unit end normals ``_unit(left[:, 1:4])``,
+    ``_unit(right[:, 1:4])`` in the dtype of ``A``, ``B`` (3, S) (``diff``: ``B - A``
+    into ``B``), their cosine as ``check_span_input`` computes it, and (``tree``) the
+    dichotomy depth of ``_levels`` (``hard[i]``: the depth is numpy's to compute).
+    ``red``: [any check failed, smallest ``N_l.N_r`` (einsum), any ``t0 != 0``, largest
+    count, hard spans]."""
+    bad = False
+    dmin = np.inf
+    t0nz = False
+    cmax = 0
+    nhard = 0
+    for i in range(lo, hi):
+        a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
+        r = np.sqrt(_dot3(a0, a1, a2, a0, a1, a2, o_norm))
+        a0, a1, a2 = a0 / r, a1 / r, a2 / r
+        b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
+        r = np.sqrt(_dot3(b0, b1, b2, b0, b1, b2, o_norm))
+        b0, b1, b2 = b0 / r, b1 / r, b2 / r
+        A[0, i], A[1, i], A[2, i] = a0, a1, a2
+        B[0, i], B[1, i], B[2, i] = b0, b1, b2
+        if diff:
+            for c in range(3):
+                B[c, i] = B[c, i] - A[c, i]
+        hard[i] = False
+        if not (np.isfinite(a0) and np.isfinite(a1) and np.isfinite(a2) and np.isfinite(b0)
+                and np.isfinite(b1) and np.isfinite(b2) and np.isfinite(t0[i])
+                and np.isfinite(dt[i])):
+            bad = True
+            cos[i] = np.nan
+            levels[i] = 0
+            continue
+        # _as_vectors: | |N| - 1 | <= UNIT_TOL, |N| by einsum; the cosine's |N| by norm
+        qa = np.sqrt(_dot3(a0, a1, a2, a0, a1, a2, o_ein))
+        qb = np.sqrt(_dot3(b0, b1, b2, b0, b1, b2, o_ein))
+        if abs(qa - 1.0) > UNIT_TOL or abs(qb - 1.0) > UNIT_TOL:
+            bad = True
+        if o_norm != o_ein:
+            qa = np.sqrt(_dot3(a0, a1, a2, a0, a1, a2, o_norm))
+            qb = np.sqrt(_dot3(b0, b1, b2, b0, b1, b2, o_norm))
+        d = _dot3(a0, a1, a2, b0, b1, b2, o_ein)
+        c = d / (qa * qb)
+        cos[i] = c
+        if 1.0 + c <= ANTIPARALLEL_TOL:
+            bad = True
+        dmin = min(dmin, d)
+        # _positions
+        if m[i] < 1 or dt[i] <= 0.0 or count[i] < 1:
+            bad = True
+        last = t0[i] + (count[i] - 1) * dt[i]
+        if t0[i] < -_POS_TOL or last > 1.0 + _POS_TOL:
+            bad = True
+        if t0[i] != 0.0:
+            t0nz = True
+        cmax = max(cmax, count[i])
+        if not tree:
+            continue
+        # _levels: the base depth ceil(log2(1/dt) - 1e-12), the exponent of 1/dt (a
+        # mantissa near 1/2: log2 near an integer, numpy's to round) ...
+        mm, ee = math.frexp(1.0 / dt[i])
+        if not np.isfinite(mm) or mm < 0.5 * (1.0 + _NEAR_INT):
+            hard[i] = True
+            nhard += 1
+            levels[i] = 0
+            continue
+        base = max(np.int64(ee), 0)
+        scale = math.ldexp(1.0, base)
+        off = False
+        for j in range(count[i]):
+            u = (t0[i] + j * dt[i]) * scale
+            if abs(u - np.rint(u)) > 1e-9 * max(1.0, abs(u)):
+                off = True
+                break
+        L = base
+        if off:
+            # ... then off the grid ceil(log2(arccos(c) / theta_max)): the smallest n >= 0
+            # with c >= cos(theta_max 2**n) (thr[n]; 7 past the last), c near a threshold
+            # numpy's to round
+            cc = min(max(c, -1.0), 1.0)
+            need = thr.shape[0]
+            for q in range(thr.shape[0]):
+                if abs(cc - thr[q]) < _NEAR_INT:
+                    hard[i] = True
+                    nhard += 1
+                    break
+                if cc > thr[q]:
+                    need = q
+                    break
+            L = max(base, np.int64(need))
+        levels[i] = L
+        if L > MAX_LEVELS:
+            bad = True
+    red[0] = 1.0 if bad else 0.0
+    red[1] = dmin
+    red[2] = 1.0 if t0nz else 0.0
+    red[3] = cmax
+    red[4] = nhard
 
 
 @_njit()
@@ -355,59 +305,28 @@ def _parts(n):
 
 
 class _Ends:
-    """What the compiled pass over the spans found (:func:`_ends_block` of every span):
-    the arrays, then (:meth:`finish`) the reductions."""
+    """What the compiled pass over the spans found (see :func:`_ends_part`)."""
 
-    def __init__(self, S, tree, orders, dtype, diff, work):
-        self.tree, self.orders, self.diff = tree, orders, diff
+    def __init__(self, sp, tree, orders, dtype, diff, work):
+        S = len(sp.count)
+        left, right = sp.left, sp.right
         self.A, self.B = _empty(work, "A", (3, S), dtype), _empty(work, "B", (3, S), dtype)
         self.cos = _empty(work, "cos", S)
         self.levels = _empty(work, "levels", S, np.int64)
         self.hard = _empty(work, "hard", S, np.bool_)
-
-    def args(self):
-        """The arguments of :func:`_ends_block` after the spans' arrays and range."""
-        return (self.orders[0], self.orders[1], self.tree, _THRESHOLDS, self.A, self.B,
-                self.diff, self.cos, self.levels, self.hard)
-
-    @classmethod
-    def of(cls, sp, tree, orders, dtype, diff, work):
-        """The pass over the spans ``sp`` (threaded)."""
-        S = len(sp.count)
-        ends = cls(S, tree, orders, dtype, diff, work)
         parts = _parts(S)
-        red = _red0(len(parts))
-        o_ein, o_norm, tree, thr, A, B, diff, cos, levels, hard = ends.args()
-        _run([(_ends_part, (sp.left, sp.right, sp.m, sp.t0, sp.dt, sp.count, o_ein, o_norm,
-                            tree, thr, lo, hi, A, B, diff, cos, levels, hard, red[q]))
-              for q, (lo, hi) in enumerate(parts)])
-        return ends.finish(sp, red)
-
-    def finish(self, sp, red):
-        """The reductions ``red`` (one row per part, :func:`_ends_block`) of the spans ``sp``."""
+        red = np.zeros((len(parts), 5))
+        _run([(_ends_part, (left, right, sp.m, sp.t0, sp.dt, sp.count, orders[0], orders[1],
+                            tree, _THRESHOLDS, lo, hi, self.A, self.B, diff, self.cos,
+                            self.levels, self.hard, red[q])) for q, (lo, hi) in enumerate(parts)])
         self.bad = bool(red[:, 0].any())
         self.dot_min = np.float64(red[:, 1].min())
         self.start_left = not red[:, 2].any()
         self.count_max = int(red[:, 3].max())
-        if self.tree and red[:, 4].any():     # depths numpy computes (log2 near an integer)
+        if tree and red[:, 4].any():     # depths numpy computes (log2 near an integer)
             h = np.flatnonzero(self.hard)
             self.levels[h] = _levels(sp.dt[h], sp.t0[h], sp.count[h], self.cos[h])
             self.bad = self.bad or bool((self.levels[h] > MAX_LEVELS).any())
-        return self
-
-
-def _ends_request(spec, dtype, diff):
-    """``(tree, orders, dtype)`` of the end normals' pass for method ``spec`` (None
-    without :func:`ends_orders`: then the reference runs)."""
-    orders = ends_orders()
-    if orders is None:
-        return None
-    try:
-        dt = np.dtype(dtype).type
-    except TypeError:
-        dt = None
-    dt = dt if dt in (np.float32, np.float64) else np.float64
-    return method_kernel(spec).shape == "tree", orders, dt, diff
 
 
 def widest_dot(sp, spec, dtype, diff, work=None):
@@ -416,10 +335,15 @@ def widest_dot(sp, spec, dtype, diff, work=None):
     or float64; ``diff``: see :func:`_ends_part`); ``(ends, None)`` when a check of
     ``check_span_input`` fails on them, ``(None, None)`` without :func:`ends_orders`
     (then the reference runs); arrays from ``work`` (a :class:`Workspace`) if given."""
-    req = _ends_request(spec, dtype, diff)
-    if req is None:
+    orders = ends_orders()
+    if orders is None:
         return None, None
-    ends = _Ends.of(sp, *req, work)
+    try:
+        dt = np.dtype(dtype).type
+    except TypeError:
+        dt = None
+    dt = dt if dt in (np.float32, np.float64) else np.float64
+    ends = _Ends(sp, method_kernel(spec).shape == "tree", orders, dt, diff, work)
     return ends, (None if ends.bad else ends.dot_min)
 
 
