@@ -743,14 +743,14 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     sab = np.empty(2, A.dtype)
     for rr in range(part, height, parts):
         base = rr * W
-        for x in range(W):       # the background, overwritten where a fragment lands
+        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
+        nw = 0
+        for x in range(W):
+            # the background (overwritten where a fragment lands), the winners listed
             img[base + x] = 0.0
             mask[base + x] = False
             tri_map[base + x] = -1
             nlen[base + x] = np.nan
-        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
-        nw = 0
-        for x in range(W):
             if bs[x] >= 0:
                 wx[nw] = x
                 ws[nw] = bs[x]
@@ -796,10 +796,15 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                 h1[k] = q1 + t * (right[s, 5] - q1)
                 h2[k] = q2 + t * (right[s, 6] - q2)
             _half_row(h0, h1, h2, ey0, ey1, ey2, l0, l1, l2, nw, o2)
-        else:
+        else:       # per triangle: looked up once per run of a span's winners
+            last = -1
+            g0 = g1 = g2 = 0.0
             for k in range(nw):
-                ft = stri[ws[k]]
-                h0[k], h1[k], h2[k] = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+                if ws[k] != last:
+                    last = ws[k]
+                    ft = stri[last]
+                    g0, g1, g2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+                h0[k], h1[k], h2[k] = g0, g1, g2
         _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
                    bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
     return hard
