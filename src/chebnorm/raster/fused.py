@@ -796,18 +796,25 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                 h1[k] = q1 + t * (right[s, 5] - q1)
                 h2[k] = q2 + t * (right[s, 6] - q2)
             _half_row(h0, h1, h2, ey0, ey1, ey2, l0, l1, l2, nw, o2)
-        else:       # per triangle: looked up once per run of a span's winners
-            last = -1
-            g0 = g1 = g2 = 0.0
-            for k in range(nw):
-                if ws[k] != last:
-                    last = ws[k]
-                    ft = stri[last]
-                    g0, g1, g2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
-                h0[k], h1[k], h2[k] = g0, g1, g2
+        else:
+            _tri_half_row(ws, stri, Htri, h0, h1, h2, nw)
         _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
                    bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
     return hard
+
+
+@_njit()
+def _tri_half_row(ws, stri, Htri, h0, h1, h2, nw):
+    """The per-triangle ``H`` of each winner's span, looked up once per run of a span's
+    winners (they are adjacent)."""
+    last = -1
+    g0 = g1 = g2 = 0.0
+    for k in range(nw):
+        if ws[k] != last:
+            last = ws[k]
+            ft = stri[last]
+            g0, g1, g2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+        h0[k], h1[k], h2[k] = g0, g1, g2
 
 
 @_njit()
