@@ -37,3 +37,16 @@ def deprecated_alias(parser, old: str, new: str, dest: str, **kwargs) -> None:
     same type): it still works for one release and prints one warning line."""
     parser.add_argument(old, dest=dest, action=_DeprecatedFlag, new_flag=new,
                         help=f"deprecated spelling of {new}", **kwargs)
+
+
+def add_lighting_options(p, engine_help: str) -> None:
+    """The options ``render`` and ``render-sweep`` share: ``--half-vector``,
+    ``--eta-threshold``, ``--q`` and ``--engine``."""
+    p.add_argument("--half-vector", default="pixel", choices=("pixel", "triangle"),
+                   help="H per pixel (default) or constant per triangle")
+    p.add_argument("--eta-threshold", type=float, default=0.005,
+                   help="adaptive: skip normalization where eta < this (default 0.005)")
+    p.add_argument("--q", type=float, default=1.0 / 255.0,
+                   help="split-gouraud: specular threshold at edge maxima (default 1/255)")
+    p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
+                   help=engine_help)

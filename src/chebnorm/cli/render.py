@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from ._common import print_json
+from ._common import add_lighting_options, print_json
 
 
 def register(sub) -> None:
@@ -29,12 +29,6 @@ def register(sub) -> None:
                    f"than DEG degrees ({CREASE_RANGE[0]:g}..{CREASE_RANGE[1]:g}); default: an "
                    "OBJ file's own vn normals, else 30")
     p.add_argument("--shininess", type=float, default=32.0, help="specular exponent n (default 32)")
-    p.add_argument("--half-vector", default="pixel", choices=("pixel", "triangle"),
-                   help="H per pixel (default) or constant per triangle")
-    p.add_argument("--eta-threshold", type=float, default=0.005,
-                   help="adaptive: skip normalization where eta < this (default 0.005)")
-    p.add_argument("--q", type=float, default=1.0 / 255.0,
-                   help="split-gouraud: specular threshold at edge maxima (default 1/255)")
     p.add_argument("--bump", default="full", help=f"bump variant: {'|'.join(BUMP_VARIANTS)} "
                    "(default full)")
     p.add_argument("--reference", default=None, metavar="MODE[:METHOD]",
@@ -45,9 +39,8 @@ def register(sub) -> None:
     p.add_argument("--error-map", metavar="ERR.png", help="write a heat map of |error| "
                    "(formats as --out)")
     p.add_argument("--json", action="store_true", help="print metrics and mode report as JSON")
-    p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
-                   help="numba: the compiled path (same image bytes); numpy: the reference; "
-                        "auto (default): numba when installed")
+    add_lighting_options(p, "numba: the compiled path (same image bytes); numpy: the "
+                         "reference; auto (default): numba when installed")
     p.set_defaults(func=run)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 
+from ._common import add_lighting_options
 from ._parallel import add_parallel_args, parallel_kwargs
 
 #: the CSV and the image folder inside ``-o DIR``
@@ -40,14 +41,7 @@ def register(sub) -> None:
     p.add_argument("--reference", default=None, metavar="MODE[:METHOD]",
                    help="reference render of every case (default phong:exact; bump:full for "
                    "bump cases), as chebnorm render")
-    p.add_argument("--half-vector", default="pixel", choices=("pixel", "triangle"),
-                   help="H per pixel (default) or constant per triangle")
-    p.add_argument("--eta-threshold", type=float, default=0.005,
-                   help="adaptive: skip normalization where eta < this (default 0.005)")
-    p.add_argument("--q", type=float, default=1.0 / 255.0,
-                   help="split-gouraud: specular threshold at edge maxima (default 1/255)")
-    p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
-                   help="as chebnorm render (every engine gives the same bytes)")
+    add_lighting_options(p, "as chebnorm render (every engine gives the same bytes)")
     p.add_argument("--images", action="store_true",
                    help=f"also write each image and its error map as PNG into "
                    f"DIR/{IMAGE_FOLDER}/ (NAME.png, NAME_error.png; NAME: the CSV's name column)")
