@@ -333,6 +333,19 @@ def _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, r
     m[n] = np.int64(max(1.0, np.ceil(ws)))
 
 
+@_njit(inline=True)
+def _span_at(xy, attrs, width, i, r, n, write, tri, row, c0, count, m, t0, dt, left, right):
+    """Row ``r`` of triangle ``i``: 1 if it is a span (written as span ``n`` when
+    ``write``), else 0."""
+    c, a, pa, qa, sa, p, q, sb, swap, xl, xr = _span_geom(xy, i, r, width)
+    if c <= 0:
+        return 0
+    if write:
+        _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, row, c0,
+                    count, m, t0, dt, left, right)
+    return 1
+
+
 @_njit()
 def _spans_part(xy, attrs, width, r0, nrows, lo, hi, write, nvalid, start, tri, row, c0, count,
                 m, t0, dt, left, right):
@@ -342,13 +355,8 @@ def _spans_part(xy, attrs, width, r0, nrows, lo, hi, write, nvalid, start, tri, 
     for i in range(lo, hi):
         n = start[i] if write else 0
         for r in range(r0[i], r0[i] + nrows[i]):
-            c, a, pa, qa, sa, p, q, sb, swap, xl, xr = _span_geom(xy, i, r, width)
-            if c <= 0:
-                continue
-            if write:
-                _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, row,
-                            c0, count, m, t0, dt, left, right)
-            n += 1
+            n += _span_at(xy, attrs, width, i, r, n, write, tri, row, c0, count, m, t0, dt,
+                          left, right)
         if not write:
             nvalid[i] = n
 
@@ -381,14 +389,8 @@ def _row_spans_part(xy, attrs, width, first, ids, rlo, rhi, write, row_start, tr
     for r in range(rlo, rhi):
         n = row_start[r] if write else 0
         for q in range(first[r], first[r + 1]):
-            i = ids[q]
-            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = _span_geom(xy, i, r, width)
-            if c <= 0:
-                continue
-            if write:
-                _span_write(attrs, i, r, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, tri, row,
-                            c0, count, m, t0, dt, left, right)
-            n += 1
+            n += _span_at(xy, attrs, width, ids[q], r, n, write, tri, row, c0, count, m, t0,
+                          dt, left, right)
         if not write:
             row_start[r + 1] = n
 
