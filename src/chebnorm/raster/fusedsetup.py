@@ -484,8 +484,24 @@ def _trig(kind, x, is64, buf):
 
 
 @_njit()
-def _slerp_part(A, B, k, is64, lo, hi, psi_out, inv_out, hard):
-    """``psi = max(arccos(min(N_l.N_r, 1)), TINY)``, ``inv = 1/sin(psi)``."""
+def _slerp_part(A, B, k, is64, fast, lo, hi, psi_out, inv_out, hard):
+    """``psi = max(arccos(min(N_l.N_r, 1)), TINY)``, ``inv = 1/sin(psi)`` (``fast``: the
+    float64 sines by :func:`.fused._trig64`)."""
+    if is64 and fast:
+        m = hi - lo
+        w = np.empty((6, m))
+        ok = np.empty(m, np.bool_)
+        for j in range(m):
+            i = lo + j
+            d = A[0, i] * B[0, i] + A[1, i] * B[1, i] + A[2, i] * B[2, i]
+            w[0, j] = max(np.arccos(min(d, k[0])), k[3])
+        fused._trig64(0, w[0], psi_out[lo:hi], ok, w[1:], m)
+        for j in range(m):
+            i = lo + j
+            inv_out[i] = k[0] / psi_out[i]
+            psi_out[i] = w[0, j]
+            hard[i] = False
+        return 0
     buf = np.empty(1, A.dtype)
     n = 0
     for i in range(lo, hi):
@@ -535,9 +551,13 @@ def _quadratic_part(A, B, t0, dt, k, coeffs, exact, start_left, lo, hi, V, D1, D
 
 
 @_njit()
-def _angular_part(A, B, t0, dt, k, is64, two, start_left, lo, hi, P0, P1, K2, hard):
+def _angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, K2, hard):
     """The first two pixels of ``angular_steps`` (``two``: the frame has spans of two
-    or more pixels, else ``P1 = P0``) and ``2 cos(phi)``."""
+    or more pixels, else ``P1 = P0``) and ``2 cos(phi)`` (``fast``: the float64 sines
+    and cosines by :func:`.fused._trig64`, :func:`_angular_fast`)."""
+    if is64 and fast:
+        _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard)
+        return 0
     buf = np.empty(1, A.dtype)
     n = 0
     for i in range(lo, hi):
@@ -573,6 +593,49 @@ def _angular_part(A, B, t0, dt, k, is64, two, start_left, lo, hi, P0, P1, K2, ha
     return n
 
 
+@_njit()
+def _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard):
+    """:func:`_angular_part` in float64, its cosines and sines of ``phi`` and of the
+    start angle computed for the spans ``lo .. hi-1`` at once (:func:`.fused._trig64`)."""
+    m = hi - lo
+    w = np.empty((11, m))
+    ok = np.empty(m, np.bool_)
+    for j in range(m):
+        i = lo + j
+        c = min(A[0, i] * B[0, i] + A[1, i] * B[1, i] + A[2, i] * B[2, i], k[0])
+        psi = np.arccos(c)
+        w[0, j] = psi * dt[i]
+        w[1, j] = t0[i] * psi
+    fused._trig64(1, w[0], w[2], ok, w[6:], m)
+    fused._trig64(0, w[0], w[3], ok, w[6:], m)
+    if not start_left:
+        fused._trig64(1, w[1], w[4], ok, w[6:], m)
+        fused._trig64(0, w[1], w[5], ok, w[6:], m)
+    for j in range(m):
+        i = lo + j
+        a0, a1, a2 = A[0, i], A[1, i], A[2, i]
+        b0, b1, b2 = B[0, i], B[1, i], B[2, i]
+        c = min(a0 * b0 + a1 * b1 + a2 * b2, k[0])
+        iw = k[0] / max(np.sqrt(k[0] - c * c), k[3])
+        n0, n1, n2 = (b0 - a0 * c) * iw, (b1 - a1 * c) * iw, (b2 - a2 * c) * iw
+        cp, sp = w[2, j], w[3, j]
+        K2[i] = cp * k[1]
+        if start_left:
+            q0, q1, q2 = a0, a1, a2
+            r0, r1, r2 = a0 * cp + n0 * sp, a1 * cp + n1 * sp, a2 * cp + n2 * sp
+        else:
+            ca, sa = w[4, j], w[5, j]
+            q0, q1, q2 = a0 * ca + n0 * sa, a1 * ca + n1 * sa, a2 * ca + n2 * sa
+            u0, u1, u2 = n0 * ca - a0 * sa, n1 * ca - a1 * sa, n2 * ca - a2 * sa
+            r0, r1, r2 = q0 * cp + u0 * sp, q1 * cp + u1 * sp, q2 * cp + u2 * sp
+        P0[0, i], P0[1, i], P0[2, i] = q0, q1, q2
+        if two:
+            P1[0, i], P1[1, i], P1[2, i] = r0, r1, r2
+        else:
+            P1[0, i], P1[1, i], P1[2, i] = q0, q1, q2
+        hard[i] = False
+
+
 def _consts(dtype):
     return np.array([1.0, 2.0, 4.0, 1e-30], dtype)
 
@@ -591,11 +654,12 @@ def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=No
     S = A.shape[1]
     k = _consts(dtype)
     is64 = dtype is np.float64
+    quick = is64 and fused.trig_calibrated()
     parts = _parts(S)
     if mode == 4:
         psi, inv = _empty(work, "sc", S, dtype), _empty(work, "sc2", S, dtype)
         hard = _empty(work, "hard2", S, np.bool_)
-        nh = sum(_run([(_slerp_part, (A, B, k, is64, lo, hi, psi, inv, hard))
+        nh = sum(_run([(_slerp_part, (A, B, k, is64, quick, lo, hi, psi, inv, hard))
                        for lo, hi in parts]))
         if nh:
             h = np.flatnonzero(hard)
@@ -610,8 +674,8 @@ def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=No
         return V, D1, D2
     P0, P1 = _empty(work, "P0", (3, S), dtype), _empty(work, "P1", (3, S), dtype)
     K2, hard = _empty(work, "sc", S, dtype), _empty(work, "hard2", S, np.bool_)
-    nh = sum(_run([(_angular_part, (A, B, t0, dt, k, is64, count_max >= 2, start_left, lo, hi,
-                                    P0, P1, K2, hard)) for lo, hi in parts]))
+    nh = sum(_run([(_angular_part, (A, B, t0, dt, k, is64, quick, count_max >= 2, start_left,
+                                    lo, hi, P0, P1, K2, hard)) for lo, hi in parts]))
     if nh:
         h = np.flatnonzero(hard)
         p0, p1, k2 = fast._angular_setup(ops, tuple(A[:, h]), tuple(B[:, h]), t0[h], dt[h],
