@@ -138,6 +138,21 @@ def _empty(work, name, shape, dtype=np.float64):
     return np.empty(shape, dtype) if work is None else work.empty(name, shape, dtype)
 
 
+@_njit(inline=True)
+def _depth_base(dt):
+    """``(base, 2**base)``, ``base = max(e, 0)`` for ``1/dt = m 2**e`` (``m`` in [1/2, 1),
+    :func:`math.frexp` by the bits: no library call), or ``(-1, 0)`` where ``m`` is
+    within ``_NEAR_INT`` of 1/2 (``log2`` near an integer) or ``1/dt`` is zero,
+    subnormal, negative or not finite: then numpy finds the depth."""
+    bits = fused._f2i(1.0 / dt)
+    ex = (bits >> 52) & 0x7FF
+    mm = fused._i2f((bits & 0xFFFFFFFFFFFFF) | (np.int64(1022) << 52))
+    if bits <= 0 or ex == 0 or ex == 0x7FF or mm < 0.5 * (1.0 + _NEAR_INT):
+        return np.int64(-1), 0.0
+    base = max(ex - 1022, 0)
+    return base, fused._i2f((base + 1023) << 52)
+
+
 @_njit()
 def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A, B,
                diff, cos, levels, hard, red):
@@ -199,14 +214,12 @@ def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, 
             continue
         # _levels: the base depth ceil(log2(1/dt) - 1e-12), the exponent of 1/dt (a
         # mantissa near 1/2: log2 near an integer, numpy's to round) ...
-        mm, ee = math.frexp(1.0 / dt[i])
-        if not np.isfinite(mm) or mm < 0.5 * (1.0 + _NEAR_INT):
+        base, scale = _depth_base(dt[i])
+        if base < 0:
             hard[i] = True
             nhard += 1
             levels[i] = 0
             continue
-        base = max(np.int64(ee), 0)
-        scale = math.ldexp(1.0, base)
         off = False
         for j in range(count[i]):
             u = (t0[i] + j * dt[i]) * scale
