@@ -96,6 +96,46 @@ def test_float64_functions_are_the_c_librarys():
     assert np.isnan(detmath.arccos(np.array([1.5])))[0]
 
 
+@pytest.mark.parametrize("y", [31.9, 3.0, 32.0, 1000.0, 2.0, 0.5, -1.0, 1.0, 0.0])
+def test_float64_power_is_the_c_librarys_or_numpys_fast_path(y):
+    rng = np.random.default_rng(11)
+    x = np.concatenate([rng.random(20000) * 3, [0.0, 1.0, np.nan, np.inf, 1e-300, 1e300, -2.0]])
+    with np.errstate(all="ignore"):      # numpy's ** warns the same way
+        got = detmath.power(x, y)
+    fast = {2.0: lambda v: v * v, 0.5: math.sqrt, -1.0: lambda v: 1.0 / v, 1.0: lambda v: v,
+            0.0: lambda v: 1.0}
+
+    def want(v):
+        if y in fast:
+            try:
+                return fast[y](v)
+            except (ValueError, ZeroDivisionError):
+                return math.nan if v < 0 else math.inf
+        try:
+            return math.pow(v, y)
+        except ValueError:          # a negative base, a non-integer exponent
+            return math.nan
+        except OverflowError:
+            return math.inf
+    assert got.dtype == np.float64
+    _same_bits_nan_as_nan(got, np.array([want(v) for v in x.tolist()]))
+
+
+def _same_bits_nan_as_nan(got, want):
+    """Bit for bit, except that a NaN's sign is free (math.nan is positive, the x86
+    default NaN that numpy and the C library return is negative)."""
+    nan = np.isnan(want)
+    assert (np.isnan(got) == nan).all()
+    assert got[~nan].tobytes() == want[~nan].tobytes()
+
+
+def test_float64_log2_is_the_c_librarys():
+    x = np.concatenate([np.linspace(1e-3, 1e3, 5001), [0.0, -1.0, np.inf, np.nan, 2.0 ** -1074]])
+    with np.errstate(all="ignore"):
+        want = [math.log2(v) if v > 0 else (-math.inf if v == 0 else math.nan) for v in x.tolist()]
+    _same_bits_nan_as_nan(detmath.log2(x), np.array(want))
+
+
 def test_powers_within_their_rounding_bound():
     x = np.array([0.9999999, 1.0000001, 0.5, 0.99])
     p = detmath.powers(x, 128)
@@ -140,7 +180,12 @@ from chebnorm.methods import error_sweep, METHODS
 from paper_repro import normalization as N
 out = Path(sys.argv[1])
 h = lambda b: hashlib.sha256(b).hexdigest()
-res = {"numpy_sin_f32": h(np.sin(np.linspace(0, 10, 10001, dtype=np.float32)).tobytes())}
+# numpy's own loops whose bits change with the SIMD path on some CPU: float32 sin/exp
+# (AVX2 vs baseline), float64 power/arccos (AVX-512's SVML vs the C library)
+u = np.linspace(0, 1, 10001)
+res = {"numpy_own": h(b"".join(a.tobytes() for a in (
+    np.sin(np.linspace(0, 10, 10001, dtype=np.float32)), np.exp(u.astype(np.float32)),
+    np.power(u, 31.9), np.arccos(u))))}
 methods = tuple(m for m in METHODS if m != "exact")
 psis = np.radians(np.linspace(1.0, 45.0, 45))
 for key, sweep in (("angle", error_sweep(methods, psis, (64,))),
@@ -153,6 +198,17 @@ res["drift"] = h(b"".join(np.asarray(v[k]).tobytes() for v in N.measure_drift().
 for f in (N.methods_table, N.fig_angular_drift):
     for p in f(out):
         res[p.name] = h(p.read_bytes())
+# the rasterizer: mesh construction (Bernstein cubes, corner angles), the numpy reference
+# and the compiled engine (specular power, span angles, camera)
+from chebnorm.raster import Lighting, get_mesh, render
+mesh = get_mesh("teapot")
+res["teapot"] = h(mesh.positions.tobytes() + mesh.normals.tobytes())
+for engine in ("numpy", "numba"):
+    for mode, method, dt in (("phong", "exact", np.float64), ("phong", "dichotomy", np.float32),
+                             ("phong", "slerp", np.float32), ("split-gouraud", None, np.float64)):
+        r = render(mesh, mode, method, size=(96, 80), dtype=dt, engine=engine,
+                   lighting=Lighting(shininess=31.0))
+        res[f"render_{engine}_{mode}_{method}"] = h(r.image.tobytes())
 print(json.dumps(res))
 """
 
@@ -176,8 +232,8 @@ def test_float32_jobs_do_not_depend_on_the_simd_path(tmp_path):
     for label, res in results.items():
         if label == ref_label:
             continue
-        # the probe shows the setting took effect: numpy's own float32 sin changed path ...
-        assert res.pop("numpy_sin_f32") != ref["numpy_sin_f32"], f"{label}: numpy path unchanged"
+        # the probe shows the setting took effect: numpy's own loops changed bits ...
+        assert res.pop("numpy_own") != ref["numpy_own"], f"{label}: numpy path unchanged"
         # ... and nothing the reproduction computes or writes did
         differ = sorted(k for k in res if res[k] != ref[k])
         assert not differ, f"{label} differs from {ref_label}: {differ}"

@@ -17,9 +17,13 @@ changes with the machine. The functions here do not:
   Both paths give the correctly rounded value, so the result is the same
   whichever numpy loop ran.
 * **float64** arguments are evaluated element by element with :mod:`math`
-  (the C library's ``sin``, ``cos``, ``acos``, ``atan2``), never with a
-  SIMD-dispatched numpy loop. (On x86-64 machines with or without AVX2 numpy's
-  float64 loops agree with :mod:`math`; on AVX-512 machines they may not.)
+  (the C library's ``sin``, ``cos``, ``acos``, ``atan2``, ``pow``, ``log2``),
+  never with a SIMD-dispatched numpy loop. (On x86-64 machines with or without
+  AVX2 numpy's float64 loops agree with :mod:`math`; on AVX-512 machines they
+  may not: on an AMD Zen 5 with numpy 2.4, ``power``, ``arccos``, ``arctan2``,
+  ``exp``, ``log``, ``log2``, ``log10``, ``tan`` and ``arctan`` differ from the
+  C library in up to a few percent of arguments, scalars included; ``sin``,
+  ``cos`` and ``sqrt`` do not.)
 
 Sums and products (``+ - * /``, ``sqrt``) are correctly rounded in every
 numpy loop and need nothing here; :func:`powers` gives ``x, x^2, ..., x^n``
@@ -33,16 +37,19 @@ by multiplications only for the same reason.
 True
 >>> powers(np.array([2.0]), 4).tolist()
 [[2.0, 4.0, 8.0, 16.0]]
+>>> float(power(np.float64([0.9]), 32.0)[0]) == math.pow(0.9, 32.0)
+True
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import mpmath
 import numpy as np
 
-__all__ = ["sin", "cos", "arccos", "arctan2", "powers"]
+__all__ = ["sin", "cos", "arccos", "arctan2", "power", "log2", "powers"]
 
 #: float32 results within this fraction of a float32 ulp of a rounding boundary are recomputed
 _TIE_MARGIN = 2.0 ** -16
@@ -64,17 +71,30 @@ def _mp_float32(name: str, x: float) -> np.float32:
     return np.float32(float(v))
 
 
+def _c_library(fn, x: np.ndarray, *args: float, numpy_fn=None) -> np.ndarray:
+    """``fn(v, *args)`` (a :mod:`math` function) for every element of the float64 array
+    ``x``, in x's shape. Where ``fn`` raises (a domain or range error: NaN, an infinity
+    or an overflow, whose values every loop gives exactly) the element is
+    ``numpy_fn(v, *args)``, or NaN without ``numpy_fn``."""
+    flat = x.ravel().tolist()
+    try:
+        out = np.fromiter(map(fn, flat, *(itertools.repeat(a) for a in args)),
+                          dtype=np.float64, count=len(flat))
+    except (ValueError, OverflowError):
+        def safe(v):
+            try:
+                return fn(v, *args)
+            except (ValueError, OverflowError):
+                if numpy_fn is None:
+                    return math.nan
+                with np.errstate(all="ignore"):
+                    return float(numpy_fn(np.float64(v), *args))
+        out = np.fromiter(map(safe, flat), dtype=np.float64, count=len(flat))
+    return out.reshape(x.shape)
+
+
 def _float64(name: str, x: np.ndarray) -> np.ndarray:
-    fn = _F64[name]
-
-    def safe(v):
-        try:
-            return fn(v)
-        except ValueError:      # math.acos outside [-1, 1]: numpy's answer, NaN
-            return math.nan
-
-    flat = np.fromiter(map(safe, x.ravel().tolist()), dtype=np.float64, count=x.size)
-    return flat.reshape(x.shape)
+    return _c_library(_F64[name], x)     # math.acos outside [-1, 1]: numpy's answer, NaN
 
 
 def _float32(name: str, x: np.ndarray) -> np.ndarray:
@@ -153,6 +173,46 @@ def arctan2(y, x) -> np.ndarray:
     flat = np.fromiter(map(math.atan2, y.ravel().tolist(), x.ravel().tolist()), dtype=np.float64,
                        count=y.size)
     return flat.reshape(y.shape)
+
+
+#: the exponents numpy's ``**`` operator computes without its power loop (numpy's
+#: ``fast_scalar_power``): the same functions here, so :func:`power` keeps ``**``'s bits
+_FAST_POWER = {2.0: np.square, 0.5: np.sqrt, -1.0: np.reciprocal, 1.0: np.positive,
+               0.0: np.ones_like}
+
+
+def power(x, y: float) -> np.ndarray:
+    """``x ** y`` (float64, ``y`` a real scalar) as numpy's ``**`` computes it where its
+    float64 power loop is the C library's ``pow`` (x86-64 without AVX-512): ``y`` = 2,
+    0.5, -1, 1, 0 by ``square``, ``sqrt``, ``reciprocal``, a copy and ones (correctly
+    rounded), any other ``y`` by ``pow`` element by element. NaN where ``x < 0`` and
+    ``y`` is not an integer, infinities where the power overflows, as numpy.
+
+    Examples
+    --------
+    >>> power(np.array([0.5, 2.0]), 3.0).tolist(), power(np.array([3.0]), 2.0).tolist()
+    ([0.125, 8.0], [9.0])
+    >>> x = np.linspace(0.0, 1.0, 1001)
+    >>> power(x, 31.9).tolist() == [math.pow(v, 31.9) for v in x]
+    True
+    """
+    x = np.asarray(x, dtype=np.float64)
+    y = float(y)
+    if y in _FAST_POWER:
+        return _FAST_POWER[y](x)
+    return _c_library(math.pow, x, y, numpy_fn=np.power)
+
+
+def log2(x) -> np.ndarray:
+    """``log2(x)`` in float64 by the C library, element by element: ``-inf`` at 0,
+    NaN below 0, as numpy.
+
+    Examples
+    --------
+    >>> log2(np.array([8.0, 0.0, -1.0, np.inf])).tolist()
+    [3.0, -inf, nan, inf]
+    """
+    return _c_library(math.log2, np.asarray(x, dtype=np.float64), numpy_fn=np.log2)
 
 
 def powers(x, n: int) -> np.ndarray:

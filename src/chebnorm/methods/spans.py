@@ -14,6 +14,7 @@ import numpy as np
 from chebnorm.approx import CoefficientTable, get_target
 from chebnorm.approx.method_registry import MethodSpec, get_method
 
+from . import detmath
 from .ops import NumpyOps
 from .registry import default_tables, method_kernel
 
@@ -128,7 +129,7 @@ def _needed_range(scale, cosines, levels):
         return scale * float(np.min(c)), scale * float(np.max(c))
     if not (levels > 0).any():
         return None, None
-    deepest = np.arccos(c) / np.exp2(np.maximum(levels - 1, 0))
+    deepest = detmath.arccos(c) / np.ldexp(1.0, np.maximum(levels - 1, 0))
     return scale * float(np.min(c[levels > 0])), scale * float(np.max(np.cos(deepest[levels > 0])))
 
 
@@ -152,7 +153,7 @@ def _resolve_table(spec, tables, cosines, levels):
     var = f"{get_target(spec.table.target).variable} = {'' if scale == 1 else f'{scale:g} '}cos(psi)"
     where = "the default" if defaults else "the given"
     if lo > need_lo + _COVER_SLACK:
-        psi = np.arccos(np.clip(cosines, -1.0, 1.0))
+        psi = detmath.arccos(np.clip(cosines, -1.0, 1.0))
         raise ValueError(
             f"largest span angle {float(np.max(psi)):.9g} rad exceeds {where} {method} table "
             f"{table.name!r}: its interval [{lo:.9g}, {hi:.9g}] of {var} covers angles "
@@ -185,7 +186,7 @@ def _levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
     """
     dt = np.asarray(dt, dtype=np.float64)
     with np.errstate(divide="ignore"):
-        lv = np.ceil(np.log2(1.0 / dt) - 1e-12)
+        lv = np.ceil(detmath.log2(1.0 / dt) - 1e-12)
     base = np.maximum(lv, 0).astype(np.int64)
     if cos is None:
         return base
@@ -193,13 +194,13 @@ def _levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
     count = np.asarray(count, dtype=np.int64)
     sid = np.repeat(np.arange(dt.size), count)
     j = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
-    u = (t0[sid] + j * dt[sid]) * np.exp2(base[sid])
+    u = (t0[sid] + j * dt[sid]) * np.ldexp(1.0, base[sid])
     off = np.abs(u - np.round(u)) > 1e-9 * np.maximum(1.0, np.abs(u))
     off_span = np.bincount(sid, weights=off, minlength=dt.size) > 0
-    psi = np.arccos(np.clip(np.asarray(cos, dtype=np.float64), -1.0, 1.0))
+    psi = detmath.arccos(np.clip(np.asarray(cos, dtype=np.float64), -1.0, 1.0))
     theta_max = 2.0 * math.acos(1.0 - PICK_TOL)
     with np.errstate(divide="ignore"):
-        need = np.ceil(np.log2(np.maximum(psi, 1e-300) / theta_max))
+        need = np.ceil(detmath.log2(np.maximum(psi, 1e-300) / theta_max))
     need = np.maximum(need, 0).astype(np.int64)
     return np.where(off_span, np.maximum(base, need), base)
 

@@ -522,8 +522,10 @@ def _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1, f2, k2):
 #: ("Worst-case error: 0.54 ULP", e_pow.c). Where ``x**n`` (n an integer) is known to
 #: within :data:`_POW_MARGIN` ulp of a double ``h``, every other double is more than
 #: ``1 - 0.45 = 0.55`` ulp away, so ``pow`` returns ``h``: the reference's bits without
-#: the call.  :func:`pow_calibrated` checks the claim against ``np.power`` once per
-#: process and exponent; elsewhere the frame calls ``pow``.
+#: the call.  :func:`pow_calibrated` checks the claim against the reference's power
+#: (:func:`chebnorm.methods.detmath.power`: the C library's ``pow``, not numpy's power
+#: loop, which is SVML on AVX-512 machines) once per process and exponent; elsewhere
+#: the frame calls ``pow``.
 _POW_MARGIN = 0.45
 _POW_TINY = 2.0 ** -900    # double-double products stay normal above this
 _POW_HUGE = 2.0 ** 1000
@@ -616,8 +618,8 @@ def _powers(b, sh, fast, hh, ll, ok, out, nw):
 @lru_cache(maxsize=64)
 def pow_calibrated(sh: float) -> bool:
     """Whether the frame may take :func:`_pow_int`'s shortcut for the exponent ``sh``:
-    ``sh`` an integer in ``[3, 2**16]``, numba installed, and the shortcut gave
-    ``np.power``'s bits on 1 + 20 000 probes (random bases in ``(0, 1]`` and numbers
+    ``sh`` an integer in ``[3, 2**16]``, numba installed, and the shortcut gave the
+    reference's bits (:func:`chebnorm.methods.detmath.power`) on 1 + 20 000 probes (random bases in ``(0, 1]`` and numbers
     close to ``1``) on this machine.
 
     >>> pow_calibrated(32.0) == HAVE_NUMBA
@@ -633,7 +635,7 @@ def pow_calibrated(sh: float) -> bool:
     out, hh, ll = np.empty(n), np.empty(n), np.empty(n)
     ok = np.empty(n, np.bool_)
     _powers(b, float(sh), True, hh, ll, ok, out, n)
-    return out.tobytes() == np.power(b, float(sh)).tobytes() and bool(ok.mean() > 0.5)
+    return out.tobytes() == detmath.power(b, float(sh)).tobytes() and bool(ok.mean() > 0.5)
 
 
 # ------------------------------------------------------------- fast sine, cosine

@@ -754,7 +754,7 @@ def project(camera, points, width, height):
     if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 2 or not _gemm_fma():
         return _ref_project(camera, points, width, height)
     frame = camera.frame()
-    f = 1.0 / np.tan(camera.fov_y / 2)
+    f = 1.0 / math.tan(camera.fov_y / 2)
     fa = f / (width / height)
     xy, inv_w = np.empty((len(pts), 2)), np.empty(len(pts))
     if not _project(np.ascontiguousarray(pts), np.asarray(camera.eye, float),

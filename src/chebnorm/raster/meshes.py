@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from chebnorm.methods import detmath
+
 __all__ = [
     "Mesh", "MESH_NAMES", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
     "teapot", "load_mesh", "crease_normals",
@@ -287,7 +289,7 @@ def square(tess: int = 8) -> Mesh:
 
 def _bernstein(t):
     s = 1 - t
-    b = np.stack([s ** 3, 3 * s * s * t, 3 * s * t * t, t ** 3], -1)
+    b = np.stack([detmath.power(s, 3), 3 * s * s * t, 3 * s * t * t, detmath.power(t, 3)], -1)
     db = np.stack([-3 * s * s, 3 * s * s - 6 * s * t, 6 * s * t - 3 * t * t, 3 * t * t], -1)
     return b, db
 
@@ -393,8 +395,8 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     tri_pos = pos[faces]
     e1 = np.roll(tri_pos, -1, axis=1) - tri_pos
     e2 = np.roll(tri_pos, 1, axis=1) - tri_pos
-    corner_angle = np.arctan2(np.linalg.norm(np.cross(e1, e2), axis=2),
-                              np.einsum("fck,fck->fc", e1, e2)).ravel()
+    corner_angle = detmath.arctan2(np.linalg.norm(np.cross(e1, e2), axis=2),
+                                   np.einsum("fck,fck->fc", e1, e2)).ravel()
     corner_v = faces.ravel()
     corner_f = np.repeat(np.arange(len(faces)), 3)
     order = np.argsort(corner_v, kind="stable")

@@ -12,6 +12,7 @@ whole image with an explicit ``data_range=255``.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import asdict, dataclass
 
@@ -73,7 +74,7 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
     ad = np.abs(diff)[mask]
     n = int(mask.sum())
     mse = float(np.mean(ad.astype(float) ** 2)) if n else 0.0
-    psnr = None if mse == 0 else float(10 * np.log10(255.0 ** 2 / mse))
+    psnr = None if mse == 0 else 10 * math.log10(255.0 ** 2 / float(mse))
     win = min(7, *a.shape)
     win -= 1 - win % 2
     ssim = float(structural_similarity(a, b, data_range=255, win_size=max(win, 1))) if win >= 3 else \

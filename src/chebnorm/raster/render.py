@@ -23,6 +23,7 @@ replacement with its signature); the methods are those of the method registry
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -30,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 
 from chebnorm.approx import parse_number
-from chebnorm.methods import default_tables, get_method, method_names
+from chebnorm.methods import default_tables, detmath, get_method, method_names
 from chebnorm.methods import span_normals as _span_normals
 from chebnorm.symbolic import eta as _eta_criterion
 
@@ -103,8 +104,9 @@ class Lighting:
         return _unit(1.6 * back + 1.0 * right + 1.2 * up)
 
     def intensity(self, ndotl, ndoth):
+        # the C library's pow, not numpy's power loop (SVML on AVX-512: other bits)
         return self.I0 * (self.ka + self.kd * np.maximum(ndotl, 0.0)
-                          + self.ks * np.maximum(ndoth, 0.0) ** self.shininess)
+                          + self.ks * detmath.power(np.maximum(ndoth, 0.0), self.shininess))
 
 
 @dataclass(frozen=True)
@@ -423,7 +425,7 @@ def _auto_tables(spec, sp, col_groups, tables, stats, dot_min=None):
             d = np.min(_dot(nl, nr))
         else:
             d = np.float64(dot_min)
-        psi = max(psi, float(np.arccos(np.clip(d, -1.0, 1.0))))
+        psi = max(psi, math.acos(min(1.0, max(-1.0, float(d)))))
     stats["span_angle_max"] = psi
     if psi <= _psi_max(spec.table.psi_max):
         return None
@@ -526,7 +528,7 @@ def _split_gouraud(st, lighting, q):
         a, b = _dot(H, st.nrm[:, i]), _dot(H, st.nrm[:, j])
         c = _dot(st.nrm[:, i], st.nrm[:, j])
         t, value = _edge_highlight(a, b, c)
-        spec = lighting.I0 * lighting.ks * np.maximum(value, 0.0) ** lighting.shininess
+        spec = lighting.I0 * lighting.ks * detmath.power(np.maximum(value, 0.0), lighting.shininess)
         t_e[:, e] = t
         split[:, e] = (t > 0) & (t < 1) & (spec > q)
     # the six slots of every triangle

@@ -26,6 +26,7 @@ The kernels here assume valid input (validated in :mod:`.render`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,7 +97,7 @@ def fit_camera(points, width: int, height: int, direction=(2.0, -3.0, 1.8),
     dist = float(np.linalg.norm(np.asarray(cam.eye) - center))
     shift = dist * ((sx.max() + sx.min()) / 2 * frame[0] + (sy.max() + sy.min()) / 2 * frame[1])
     return Camera(tuple(np.asarray(cam.eye) + shift), tuple(center + shift), cam.up,
-                  float(2 * np.arctan(half)))
+                  2 * math.atan(float(half)))
 
 
 def project(camera: Camera, points, width: int, height: int):
@@ -117,7 +118,7 @@ def project(camera: Camera, points, width: int, height: int):
     w = -pc[..., 2]
     if (w <= 1e-9).any():
         raise ValueError("the mesh reaches behind the camera; move the camera back")
-    f = 1.0 / np.tan(camera.fov_y / 2)
+    f = 1.0 / math.tan(camera.fov_y / 2)
     aspect = width / height
     x_ndc = f / aspect * pc[..., 0] / w
     y_ndc = f * pc[..., 1] / w
