@@ -3,7 +3,8 @@
 * :mod:`chebnorm.methods.detmath`: float32 results are the correctly rounded
   ones (checked against mpmath at 200 bits, rounded once), float64 ones are
   the C library's, whichever numpy SIMD loop runs;
-* the jobs whose float32 numbers came from numpy's CPU-dispatched loops give
+* the jobs whose float32 numbers came from numpy's CPU-dispatched loops, fits of
+  functions whose float64 loops are CPU-dispatched (exp, acos, pow) and renders give
   bit-identical raw numbers and byte-identical files with numpy's SIMD groups
   disabled (``NPY_DISABLE_CPU_FEATURES``) as with them enabled;
 * ``chebnorm repro`` after a non-editable ``pip install .`` finds the
@@ -198,6 +199,13 @@ res["drift"] = h(b"".join(np.asarray(v[k]).tobytes() for v in N.measure_drift().
 for f in (N.methods_table, N.fig_angular_drift):
     for p in f(out):
         res[p.name] = h(p.read_bytes())
+# fits whose float64 exchange evaluates exp, acos, pow (numpy's loops are SVML on AVX-512)
+import chebnorm as cn
+for expr, iv, d in (("exp(x)", ("0", "1"), 5), ("acos(x)", ("-0.9", "0.9"), 8),
+                    ("x**0.7", ("0.5", "2"), 4)):
+    t = cn.fit(expr, iv, d, "minimax")
+    res[f"fit {expr}"] = h(t.to_json().encode())
+    res[f"quantized {expr}"] = h(cn.quantize(t, 16).to_json().encode())
 # the rasterizer: mesh construction (Bernstein cubes, corner angles), the numpy reference
 # and the compiled engine (specular power, span angles, camera)
 from chebnorm.raster import Lighting, get_mesh, render

@@ -10,6 +10,7 @@ import numpy as np
 import sympy as sp
 from flint import arb
 
+from . import clib
 from .certify import Certificate, _float_down, _float_up, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import chebyshev_interpolant, cheb_to_monomial, polish, remez, shift_for
@@ -510,8 +511,8 @@ def _constrained_fit(fn, iv, degree, powers, fixed, error_kind):
                         * np.cos(np.pi * (np.arange(500) + 0.5) / 500)])
     f = np.asarray(fn.numpy(x), dtype=float) * np.ones_like(x)
     w = 1.0 / np.abs(f) if error_kind == "rel" else np.ones_like(f)
-    y = f - sum(math.ldexp(m, e) * x ** k for k, (m, e) in fixed.items())
-    cols = np.stack([x ** k for k in powers], axis=1)
+    y = f - sum(math.ldexp(m, e) * clib.power(x, k) for k, (m, e) in fixed.items())
+    cols = np.stack([clib.power(x, k) for k in powers], axis=1)
     scale = np.max(np.abs(cols), axis=0)
     scale[scale == 0] = 1.0
     a = cols / scale * w[:, None]

@@ -30,7 +30,9 @@ Compiling
 One sympy expression of one real variable is compiled to
 
 * a numpy function (``sympy.lambdify``, from our own tree), for dense
-  sampling in float64;
+  sampling in float64; its elementary functions and ``**`` are the C
+  library's (:mod:`.clib`), not numpy's CPU-dispatched loops, so a fit
+  writes the same bytes on machines with and without AVX-512;
 * an mpmath function, for high-precision point values;
 * a python-flint ``arb`` / ``arb_series`` function, for rigorous enclosures
   and Taylor coefficients over balls (the certification engine).
@@ -57,6 +59,9 @@ from typing import Callable, Iterable
 import numpy as np
 import sympy as sp
 from flint import arb, arb_series, ctx, fmpq
+from sympy.printing.numpy import SciPyPrinter
+
+from . import clib
 
 __all__ = ["Function1D", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
@@ -614,6 +619,30 @@ def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
     return build(expr)
 
 
+class _CLibraryPrinter(SciPyPrinter):
+    """sympy's numpy printer with the CPU-dispatched loops replaced: the functions of
+    :data:`.clib.FUNCTIONS` and every power but ``sqrt`` and ``1/sqrt`` print as
+    :mod:`.clib`'s (namespace name ``_clib``); the printed expression is otherwise
+    sympy's, so its evaluation order and constants do not change."""
+
+    def __init__(self, settings=None):
+        super().__init__(settings)
+        for name in clib.FUNCTIONS:
+            self.known_functions[name] = f"_clib.FUNCTIONS['{name}']"
+
+    def _print_known_func(self, expr):
+        name = type(expr).__name__
+        if name in clib.FUNCTIONS:
+            return f"_clib.FUNCTIONS['{name}']({', '.join(map(self._print, expr.args))})"
+        return super()._print_known_func(expr)
+
+    def _print_Pow(self, expr, rational=False):
+        if expr.exp in (sp.S.Half, -sp.S.Half):
+            return super()._print_Pow(expr, rational=rational)     # numpy.sqrt
+        e = expr.exp.evalf() if expr.exp.is_integer and expr.exp.is_negative else expr.exp
+        return f"_clib.power({self._print(expr.base)}, {self._print(e)})"
+
+
 @dataclass(frozen=True)
 class Function1D:
     """A real function of one variable, with its evaluators.
@@ -633,7 +662,8 @@ class Function1D:
 
     @functools.cached_property
     def numpy(self) -> Callable[[np.ndarray], np.ndarray]:
-        f = sp.lambdify(self.var, self.expr, ["scipy", "numpy"])
+        f = sp.lambdify(self.var, self.expr, [{"_clib": clib}, "scipy", "numpy"],
+                        printer=_CLibraryPrinter)
         return lambda x: np.asarray(f(np.asarray(x, dtype=float)), dtype=float) * np.ones_like(x, dtype=float)
 
     @functools.cached_property

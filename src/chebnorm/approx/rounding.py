@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from flint import fmpz_mat
 
+from . import clib
 from .certify import certify
 
 __all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
@@ -197,14 +198,14 @@ class _Sampler:
             ok &= fx != 0
         self.x, self.f = x[ok], fx[ok]
         self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
-        self.xp = {k: self.x ** k for k in range(prob.degree + 1)}
+        self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
         interpolation points, linearly interpolated between samples)."""
         order = np.argsort(self.x)
         x, f = self.x[order], self.f[order]
-        p = sum(c * x ** k for k, c in enumerate(coeffs))
+        p = sum(c * clib.power(x, k) for k, c in enumerate(coeffs))
         g = p - f
         idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
         t = g[idx] / (g[idx] - g[idx + 1])
@@ -274,7 +275,7 @@ def _fixed_poly(prob: _Problem):
     def poly(x):
         out = np.zeros_like(x)
         for k, (m, e) in prob.fixed.items():
-            out += math.ldexp(m, e) * x ** k
+            out += math.ldexp(m, e) * clib.power(x, k)
         return out
     return poly
 

@@ -43,11 +43,12 @@ True
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import mpmath
 import numpy as np
+
+from chebnorm.approx import clib
 
 __all__ = ["sin", "cos", "arccos", "arctan2", "power", "log2", "powers"]
 
@@ -71,30 +72,8 @@ def _mp_float32(name: str, x: float) -> np.float32:
     return np.float32(float(v))
 
 
-def _c_library(fn, x: np.ndarray, *args: float, numpy_fn=None) -> np.ndarray:
-    """``fn(v, *args)`` (a :mod:`math` function) for every element of the float64 array
-    ``x``, in x's shape. Where ``fn`` raises (a domain or range error: NaN, an infinity
-    or an overflow, whose values every loop gives exactly) the element is
-    ``numpy_fn(v, *args)``, or NaN without ``numpy_fn``."""
-    flat = x.ravel().tolist()
-    try:
-        out = np.fromiter(map(fn, flat, *(itertools.repeat(a) for a in args)),
-                          dtype=np.float64, count=len(flat))
-    except (ValueError, OverflowError):
-        def safe(v):
-            try:
-                return fn(v, *args)
-            except (ValueError, OverflowError):
-                if numpy_fn is None:
-                    return math.nan
-                with np.errstate(all="ignore"):
-                    return float(numpy_fn(np.float64(v), *args))
-        out = np.fromiter(map(safe, flat), dtype=np.float64, count=len(flat))
-    return out.reshape(x.shape)
-
-
 def _float64(name: str, x: np.ndarray) -> np.ndarray:
-    return _c_library(_F64[name], x)     # math.acos outside [-1, 1]: numpy's answer, NaN
+    return clib.elementwise(_F64[name], x)   # math.acos outside [-1, 1]: NaN, as numpy
 
 
 def _float32(name: str, x: np.ndarray) -> np.ndarray:
@@ -175,18 +154,11 @@ def arctan2(y, x) -> np.ndarray:
     return flat.reshape(y.shape)
 
 
-#: the exponents numpy's ``**`` operator computes without its power loop (numpy's
-#: ``fast_scalar_power``): the same functions here, so :func:`power` keeps ``**``'s bits
-_FAST_POWER = {2.0: np.square, 0.5: np.sqrt, -1.0: np.reciprocal, 1.0: np.positive,
-               0.0: np.ones_like}
-
-
 def power(x, y: float) -> np.ndarray:
     """``x ** y`` (float64, ``y`` a real scalar) as numpy's ``**`` computes it where its
     float64 power loop is the C library's ``pow`` (x86-64 without AVX-512): ``y`` = 2,
     0.5, -1, 1, 0 by ``square``, ``sqrt``, ``reciprocal``, a copy and ones (correctly
-    rounded), any other ``y`` by ``pow`` element by element. NaN where ``x < 0`` and
-    ``y`` is not an integer, infinities where the power overflows, as numpy.
+    rounded), any other ``y`` by ``pow`` element by element (:func:`chebnorm.approx.clib.power`).
 
     Examples
     --------
@@ -196,11 +168,7 @@ def power(x, y: float) -> np.ndarray:
     >>> power(x, 31.9).tolist() == [math.pow(v, 31.9) for v in x]
     True
     """
-    x = np.asarray(x, dtype=np.float64)
-    y = float(y)
-    if y in _FAST_POWER:
-        return _FAST_POWER[y](x)
-    return _c_library(math.pow, x, y, numpy_fn=np.power)
+    return clib.power(x, float(y))
 
 
 def log2(x) -> np.ndarray:
@@ -212,7 +180,7 @@ def log2(x) -> np.ndarray:
     >>> log2(np.array([8.0, 0.0, -1.0, np.inf])).tolist()
     [3.0, -inf, nan, inf]
     """
-    return _c_library(math.log2, np.asarray(x, dtype=np.float64), numpy_fn=np.log2)
+    return clib.elementwise(math.log2, x, numpy_fn=np.log2)
 
 
 def powers(x, n: int) -> np.ndarray:
