@@ -24,6 +24,7 @@ import os
 import time
 
 import numpy as np
+from machine import cpu_description
 
 from chebnorm.raster import available_methods, get_mesh, render
 
@@ -81,6 +82,7 @@ def main(argv=None):
                "threads": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
                else os.cpu_count(),
                "load_average_after": os.getloadavg(), "cores": os.cpu_count(),
+               "cpu": cpu_description(),
                "phong_exact_frame_s": phong["seconds"], "bare_normalize_s": bare,
                "ratio_frame_to_bare": phong["seconds"] / bare, "goal_ratio": 3.0, "modes": rows}
     if args.json:
@@ -88,7 +90,7 @@ def main(argv=None):
     else:
         print(f"{mesh.name}: {len(mesh.faces)} triangles, {size[0]}x{size[1]}; load average "
               f"{load_before[0]:.2f} before, {summary['load_average_after'][0]:.2f} after "
-              f"({os.cpu_count()} cores, {summary['threads']} usable)")
+              f"({os.cpu_count()} cores, {summary['threads']} usable; {summary['cpu']})")
         head = "".join(f"  {e + ' ms':>10s} {e + ' Mfrag/s':>15s} {'(cpu)':>7s}"
                        for e in args.engine)
         print(f"  {'mode':22s} {'fragments':>9s}{head}  speedup")

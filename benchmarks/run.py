@@ -30,7 +30,8 @@ results.json keys (``json.dumps(..., sort_keys=True)``: deterministic order)
 --------------------------------------------------------------------------
 ``schema``            1
 ``quick``             bool
-``machine``           {"cpu", "cores", "platform", "python", "loadavg_start", "loadavg_end"}
+``machine``           {"cpu" (model name, family, model, widest SIMD: benchmarks/machine.py),
+                      "cores", "platform", "python", "loadavg_start", "loadavg_end"}
                       (load averages, 1/5/15 min, before and after the C timing)
 ``skipped``           [str]: parts not run and why
 ``workloads``         {name: {"description", "spans", "pixels", "m_min", "m_max", "m_median",
@@ -95,6 +96,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import ckernels as ck  # noqa: E402
+from machine import cpu_description  # noqa: E402
 
 from chebnorm.methods import get_method  # noqa: E402
 
@@ -632,10 +634,12 @@ def fit_vs_sollya(quick):
 
 
 def raster_throughput(size, quick):
+    """bench_raster.py's summary; a full run times exactly issue 16's acceptance command
+    (``bench_raster.py --size W H``: its default repeats, best of 5 frames)."""
     import bench_raster
 
-    return _capture_json(bench_raster.main, ["--json", "--size", str(size[0]), str(size[1]),
-                                             "--repeat", "1" if quick else "3"])
+    return _capture_json(bench_raster.main, ["--json", "--size", str(size[0]), str(size[1])]
+                         + (["--repeat", "1"] if quick else []))
 
 
 def main_job():
@@ -841,21 +845,11 @@ def markdown(res):
 
 
 # ------------------------------------------------------------------- main
-def _cpu():
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
 def run(quick=False, out_dir=HERE, log=print):
     t_start = time.perf_counter()
     size = (QUICK_SIZE,) * 2 if quick else (MAIN_SIZE,) * 2
     res = {"schema": 1, "quick": quick, "skipped": [],
-           "machine": {"cpu": _cpu(), "cores": os.cpu_count(), "platform": platform.platform(),
+           "machine": {"cpu": cpu_description(), "cores": os.cpu_count(), "platform": platform.platform(),
                        "python": platform.python_version()}}
     res["machine"]["loadavg_start"] = list(os.getloadavg())
     log(f"recording the spans of a {MESH} {size[0]}x{size[1]} Phong frame")

@@ -154,3 +154,14 @@ def test_rerender_settles_from_the_measurements_alone(tmp_path):
     assert out["verdicts"]["C6"]["verdict"] == "reproduced"
     assert (tmp_path / "RESULTS.md").read_text().startswith("# Benchmark results")
     assert bench_run.json.loads((tmp_path / "results.json").read_text())["verdicts"]["C8"]
+
+
+def test_cpu_description_names_family_model_and_simd():
+    import doctest
+
+    import machine
+
+    assert doctest.testmod(machine).failed == 0
+    text = "model name\t: Some CPU\ncpu family\t: 25\nmodel\t\t: 17\nflags\t\t: fpu avx2 fma\n\n" \
+           "model name\t: Some CPU\ncpu family\t: 25\nmodel\t\t: 17\nflags\t\t: fpu avx2 avx512f\n"
+    assert machine.cpu_description(text) == "Some CPU (family 25, model 17; AVX2)"  # the first CPU's
