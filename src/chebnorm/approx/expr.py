@@ -622,25 +622,23 @@ def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
 class _CLibraryPrinter(SciPyPrinter):
     """sympy's numpy printer with the CPU-dispatched loops replaced: the functions of
     :data:`.clib.FUNCTIONS` and every power but ``sqrt`` and ``1/sqrt`` print as
-    :mod:`.clib`'s (namespace name ``_clib``); the printed expression is otherwise
-    sympy's, so its evaluation order and constants do not change."""
+    :mod:`.clib`'s (namespace name ``_clib``, no imports); the printed expression is
+    otherwise sympy's, so its evaluation order and constants do not change."""
 
-    def __init__(self, settings=None):
-        super().__init__(settings)
-        for name in clib.FUNCTIONS:
-            self.known_functions[name] = f"_clib.FUNCTIONS['{name}']"
-
-    def _print_known_func(self, expr):
-        name = type(expr).__name__
-        if name in clib.FUNCTIONS:
-            return f"_clib.FUNCTIONS['{name}']({', '.join(map(self._print, expr.args))})"
-        return super()._print_known_func(expr)
+    def _print_clib_function(self, expr):
+        args = ", ".join(map(self._print, expr.args))
+        return f"_clib.FUNCTIONS[{type(expr).__name__!r}]({args})"
 
     def _print_Pow(self, expr, rational=False):
         if expr.exp in (sp.S.Half, -sp.S.Half):
             return super()._print_Pow(expr, rational=rational)     # numpy.sqrt
         e = expr.exp.evalf() if expr.exp.is_integer and expr.exp.is_negative else expr.exp
         return f"_clib.power({self._print(expr.base)}, {self._print(e)})"
+
+
+# sympy binds _print_exp, _print_acos, ... to its numpy printer class; these override them
+for _name in clib.FUNCTIONS:
+    setattr(_CLibraryPrinter, f"_print_{_name}", _CLibraryPrinter._print_clib_function)
 
 
 @dataclass(frozen=True)
