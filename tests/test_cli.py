@@ -136,3 +136,15 @@ def test_help_names_each_quantity_once():
         rc, out, _ = run(*argv, "--help")
         assert rc == 0 and all(f in out for f in flags)
         assert "deprecated spelling of" in out
+
+
+def test_closed_output_pipe_stops_quietly():
+    # `chebnorm fit ... | head -1` when the output outgrows the pipe: the reader is gone; the command
+    # must neither print an error nor a traceback, and ends as SIGPIPE would (141)
+    proc = subprocess.Popen([sys.executable, "-m", "chebnorm", "fit", "exp(x)", "--interval",
+                             "0", "1", "--degree", "4", "--kind", "minimax"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()              # no reader at all: the first write fails
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 141
+    assert err == ""

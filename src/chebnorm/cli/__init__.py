@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 __all__ = ["main", "build_parser", "UsageError"]
@@ -51,7 +52,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``) and return
-    the exit status: 0 on success, 2 with one line on stderr on bad input.
+    the exit status: 0 on success, 2 with one line on stderr on bad input, 141
+    and nothing on stderr when the reader of the output went away (``| head``),
+    as a program that SIGPIPE ends.
 
     >>> main(["no-such-command"])
     2
@@ -62,6 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         args.argv = ["chebnorm", *argv]
         return int(args.func(args) or 0)
+    except BrokenPipeError:
+        # the rest of the output has no reader: stop quietly, and point stdout at
+        # /dev/null so the interpreter's flush at exit does not raise again
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 141
     except (ValueError, OSError) as exc:
         text = str(exc)
         if isinstance(exc, OSError) and exc.strerror and exc.filename and "Errno" in text:
