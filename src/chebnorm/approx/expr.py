@@ -639,6 +639,7 @@ class _CLibraryPrinter(SciPyPrinter):
 # sympy binds _print_exp, _print_acos, ... to its numpy printer class; these override them
 for _name in clib.FUNCTIONS:
     setattr(_CLibraryPrinter, f"_print_{_name}", _CLibraryPrinter._print_clib_function)
+del _name
 
 
 @dataclass(frozen=True)
