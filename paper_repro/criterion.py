@@ -205,18 +205,28 @@ def interior_min_norm(na, nb, nc) -> np.ndarray:
     Inputs are ``(..., 3)`` unit vectors (not checked).
     """
     na, nb, nc = (np.asarray(v, dtype=float) for v in (na, nb, nc))
-    V = np.stack([na, nb, nc], axis=-2)                     # (..., 3, 3) rows are normals
-    G = V @ np.swapaxes(V, -1, -2)
-    edge = np.minimum.reduce([(1 + G[..., 0, 1]) / 2, (1 + G[..., 1, 2]) / 2,
-                              (1 + G[..., 0, 2]) / 2])
-    det = np.linalg.det(G)
-    ok = det > 1e-14
-    Gs = np.where(ok[..., None, None], G, np.eye(3))
-    u = np.linalg.solve(Gs, np.ones(G.shape[:-1])[..., None])[..., 0]
-    s = u.sum(axis=-1)
-    w = u / s[..., None]
-    interior = ok & np.all(w > 0, axis=-1) & (s > 0)
-    m2 = np.where(interior, 1.0 / np.where(s > 0, s, 1.0), edge)
+
+    def dot(x, y):  # summed x, y, z in this order (not BLAS: its order differs by CPU)
+        return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
+
+    # 1 - |N|^2 for each edge midpoint, and inside: N(w) = N_C + w_a D_a + w_b D_b with
+    # D_i = N_i - N_C (short vectors, so the 2x2 system below is well scaled), whose
+    # stationary point solves [[D_a.D_a, D_a.D_b], [D_a.D_b, D_b.D_b]] w = -(D.N_C); there
+    # 1 - |N|^2 = (1 - |N_C|^2) - (D.N_C).w
+    edge_deficit = np.maximum.reduce([(1 - dot(na, nb)) / 2, (1 - dot(nb, nc)) / 2,
+                                      (1 - dot(na, nc)) / 2])
+    da, db = na - nc, nb - nc
+    aa, ab, bb = dot(da, da), dot(da, db), dot(db, db)
+    ba, bb_ = dot(da, nc), dot(db, nc)
+    det = aa * bb - ab * ab
+    ok = det > 1e-12 * aa * bb     # the two edges from N_C not parallel
+    safe = np.where(ok, det, 1.0)
+    wa = (-ba * bb + bb_ * ab) / safe
+    wb = (-bb_ * aa + ba * ab) / safe
+    interior = ok & (wa > 0) & (wb > 0) & (wa + wb < 1)
+    deficit = np.where(interior, (1 - dot(nc, nc)) - (ba * wa + bb_ * wb), edge_deficit)
+    m2 = 1.0 - np.maximum(deficit, edge_deficit)
+    edge = 1.0 - edge_deficit
     return np.sqrt(np.minimum(m2, edge))
 
 
@@ -241,8 +251,10 @@ def interior_min_norm_grid(na, nb, nc, steps: int = 48, refine: int = 2) -> np.n
             over = pts.sum(axis=-1) > 1.0
             pts = np.where(over[..., None], pts / pts.sum(axis=-1, keepdims=True), pts)
         w = np.concatenate([pts, 1.0 - pts.sum(axis=-1, keepdims=True)], axis=-1)
-        N = w @ V                                                       # (T, K, 3)
-        norm2 = np.einsum("...k,...k->...", N, N)
+        # N = w V summed over the three normals in order (not BLAS, whose order differs by CPU)
+        N = (w[..., 0:1] * V[..., None, 0, :] + w[..., 1:2] * V[..., None, 1, :]
+             + w[..., 2:3] * V[..., None, 2, :])                       # (T, K, 3)
+        norm2 = N[..., 0] * N[..., 0] + N[..., 1] * N[..., 1] + N[..., 2] * N[..., 2]
         k = np.argmin(norm2, axis=-1)
         best = np.minimum(best, np.take_along_axis(norm2, k[..., None], axis=-1)[..., 0])
         centre = np.take_along_axis(pts, k[..., None, None], axis=-2)[..., 0, :]

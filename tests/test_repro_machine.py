@@ -353,3 +353,69 @@ def test_ledger_dir_rule(tmp_path, monkeypatch):
     assert ledger_dir(tmp_path / "figures") == Path("paper_repro")
     assert ledger_dir("other") == Path("other") / "claims"
     assert ledger_dir("figures", tmp_path / "x") == tmp_path / "x"
+
+
+# ------------------------------------------------------- OpenBLAS kernels
+_BLAS_PROBE = r"""
+import hashlib, json
+import numpy as np
+h = lambda b: hashlib.sha256(b).hexdigest()
+rng = np.random.default_rng(0)
+a, b = rng.normal(size=(40, 40)), rng.normal(size=40)
+res = {"blas_own": h(np.linalg.solve(a, b).tobytes() + (a @ b).tobytes())}
+import chebnorm as cn
+from chebnorm.approx import fit_target
+for name, d in (("rsqrt", 3), ("dichotomy", 2)):
+    res[f"target {name}"] = h(fit_target(name, d, frac_bits=24).to_json().encode())
+for expr, iv, d, err in (("exp(x)", ("0", "1"), 9, "abs"), ("acos(x)", ("-0.9", "0.9"), 12, "rel"),
+                         ("1/sqrt(x)", ("1", "4"), 6, "rel")):
+    res[f"fit {expr}"] = h(cn.fit(expr, iv, d, "minimax", err).to_json().encode())
+pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=32, frac_bits=20)
+res["piecewise"] = h(pw.to_json().encode())
+from paper_repro.criterion import interior_min_norm
+v = rng.normal(size=(3, 500, 3))
+v[1:] = v[0] + 0.05 * v[1:]
+v /= np.sqrt((v * v).sum(axis=-1, keepdims=True))
+res["interior_min_norm"] = h(interior_min_norm(*v).tobytes())
+print(json.dumps(res))
+"""
+
+
+def _blas_core_types() -> list[str]:
+    """OpenBLAS kernel families this CPU can run (OPENBLAS_CORETYPE), or [] without OpenBLAS
+    dynamic dispatch: Haswell and Sandybridge need AVX2/AVX, SkylakeX AVX-512."""
+    from numpy._core._multiarray_umath import __cpu_features__ as feats
+    cfg = str(np.show_config(mode="dicts").get("Build Dependencies", {}).get("blas", {}))
+    if "openblas" not in cfg.lower() or "DYNAMIC_ARCH" not in cfg:
+        return []
+    out = []
+    if feats.get("AVX512F") and feats.get("AVX512BW"):
+        out.append("SkylakeX")
+    if feats.get("AVX2") and feats.get("FMA3"):
+        out.append("Haswell")
+    if feats.get("AVX"):
+        out.append("Sandybridge")
+    return out
+
+
+@pytest.mark.slow
+def test_fits_do_not_depend_on_the_blas_kernels():
+    """The Remez exchange, the batched certifier and the criterion's interior minimum
+    use no BLAS/LAPACK (chebnorm.approx.detlinalg): the same bytes whichever OpenBLAS
+    kernels the CPU selects (on an AMD Zen 4 OpenBLAS picks SkylakeX, on a Zen 5 Zen)."""
+    kinds = _blas_core_types()
+    if len(kinds) < 2:
+        pytest.skip(f"OpenBLAS with dynamic kernels for two CPU families needed; have {kinds}")
+    results = {}
+    for kind in kinds:
+        env = {**os.environ, "OPENBLAS_CORETYPE": kind}
+        proc = subprocess.run([sys.executable, "-c", _BLAS_PROBE], env=env, capture_output=True,
+                              text=True, cwd=REPO, timeout=900, check=False)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        results[kind] = json.loads(proc.stdout.splitlines()[-1])
+    ref_kind, ref = kinds[0], results[kinds[0]]
+    changed = [k for k in kinds[1:] if results[k]["blas_own"] != ref["blas_own"]]
+    assert changed, "no OPENBLAS_CORETYPE setting changed BLAS's own bits: the probe is void"
+    for kind in changed:
+        differ = sorted(k for k in ref if k != "blas_own" and results[kind][k] != ref[k])
+        assert not differ, f"OPENBLAS_CORETYPE={kind} differs from {ref_kind}: {differ}"

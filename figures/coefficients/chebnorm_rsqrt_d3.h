@@ -4,7 +4,7 @@
  * Table provenance: chebnorm.approx.fit_target('rsqrt', 3, psi_max='pi/4', kind='minimax', error='abs', frac_bits=24)
  * p(x) ~ 1/sqrt(x) on [sqrt(2)/4 + 1/2, 1] = [0.8535533905932737, 1.0]
  * kind: minimax, error kind: abs, degree 3; coefficients in ascending powers of x.
- * Certified: |p - f| <= 1.3975061297827405e-06, |p/f - 1| <= 1.3962524298218498e-06; located max |p - f| = 1.396020363753081e-06 at x = 1.0.
+ * Certified: |p - f| <= 1.3975061297112293e-06, |p/f - 1| <= 1.3962524297663372e-06; located max |p - f| = 1.3960203637020513e-06 at x = 0.8535533905932738.
  * The evaluators take their argument in the interval above; outside it no bound holds.
  */
 #ifndef CHEBNORM_RSQRT_D3_H
@@ -15,28 +15,28 @@
 #define CHEBNORM_RSQRT_D3_DEGREE 3
 #define CHEBNORM_RSQRT_D3_LO 0x1.b504f333f9de6p-1 /* 0.8535533905932737 */
 #define CHEBNORM_RSQRT_D3_HI 0x1.0000000000000p+0 /* 1.0 */
-#define CHEBNORM_RSQRT_D3_ABS_ERROR_BOUND 0x1.7723e3d55668ap-20 /* 1.3975061297827405e-06 */
-#define CHEBNORM_RSQRT_D3_REL_ERROR_BOUND 0x1.76cdbc82a92c5p-20 /* 1.3962524298218498e-06 */
-#define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.7723e3e995441p-20 /* 1.3975061342781525e-06 */
-#define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.0410658f9ed4dp-18 /* 3.875256325276797e-06 */
+#define CHEBNORM_RSQRT_D3_ABS_ERROR_BOUND 0x1.7723e3d503f64p-20 /* 1.3975061297112293e-06 */
+#define CHEBNORM_RSQRT_D3_REL_ERROR_BOUND 0x1.76cdbc82692bep-20 /* 1.3962524297663372e-06 */
+#define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.7723e3e942d1bp-20 /* 1.3975061342066413e-06 */
+#define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.0410658f9a383p-18 /* 3.875256325260796e-06 */
 #define CHEBNORM_RSQRT_D3_FRAC_BITS 24
 #define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.77b0ea5bf173ap-20 /* 1.3995583207789087e-06 */
 #define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.8fb0ea5bf173bp-20 /* 1.488965287941995e-06 */
 
 static const double chebnorm_rsqrt_d3_coeffs[4] = {
-    0x1.2362f4010d998p+1 /* 2.2764573102132992 */,  /* x^0 */
-    -0x1.3b51fdcceb82cp+1 /* -2.4634396792016755 */,  /* x^1 */
-    0x1.99094872a6534p+0 /* 1.5977978973299516 */,  /* x^2 */
-    -0x1.a4ad311b1c808p-2 /* -0.41081692436193906 */  /* x^3 */
+    0x1.2362f4010e0a2p+1 /* 2.2764573102140995 */,  /* x^0 */
+    -0x1.3b51fdccecf25p+1 /* -2.463439679204287 */,  /* x^1 */
+    0x1.99094872a9715p+0 /* 1.5977978973327869 */,  /* x^2 */
+    -0x1.a4ad311b21013p-2 /* -0.41081692436296285 */  /* x^3 */
 };
 
 /* Horner's rule in double; x must lie in [CHEBNORM_RSQRT_D3_LO, CHEBNORM_RSQRT_D3_HI]. */
 static inline double chebnorm_rsqrt_d3(double x)
 {
-    double acc = -0x1.a4ad311b1c808p-2 /* -0.41081692436193906 */;
-    acc = acc * x + 0x1.99094872a6534p+0 /* 1.5977978973299516 */;
-    acc = acc * x + -0x1.3b51fdcceb82cp+1 /* -2.4634396792016755 */;
-    acc = acc * x + 0x1.2362f4010d998p+1 /* 2.2764573102132992 */;
+    double acc = -0x1.a4ad311b21013p-2 /* -0.41081692436296285 */;
+    acc = acc * x + 0x1.99094872a9715p+0 /* 1.5977978973327869 */;
+    acc = acc * x + -0x1.3b51fdccecf25p+1 /* -2.463439679204287 */;
+    acc = acc * x + 0x1.2362f4010e0a2p+1 /* 2.2764573102140995 */;
     return acc;
 }
 

@@ -76,6 +76,7 @@ import numpy as np
 import sympy as sp
 from flint import arb, arb_series, ctx
 
+from . import detlinalg
 from .certify import TOL, Certificate, arb_enclose, certify
 from .expr import Function1D
 
@@ -298,8 +299,8 @@ def _models(fn, o, w, coeffs, todo, t0, rho, n, kind, tol) -> _Model:
         # |g - D| <= sum_k (rad_k + |mid_k| 2^-52) rho^k + remainder, rounded up
         powers = rho ** np.arange(n + 1)
         # (2^-1000 per coefficient: a float that underflowed)
-        coef_slack = ((rad * (1 + 2.0 ** -50) + np.abs(mids) * 2.0 ** -52 + 2.0 ** -1000)
-                      @ powers) * (1 + 2.0 ** -45)
+        coef_slack = detlinalg.matvec(rad * (1 + 2.0 ** -50) + np.abs(mids) * 2.0 ** -52
+                                      + 2.0 ** -1000, powers) * (1 + 2.0 ** -45)
         size = _grid_max(np.where(np.isfinite(mids), mids, 0.0), rho)
     # the slack is spent twice (upper and lower bound): keep it well inside tol
     budget = tol * size / 16

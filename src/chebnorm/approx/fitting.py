@@ -15,7 +15,8 @@ import mpmath
 import numpy as np
 from flint import arb, arb_mat, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
-from scipy.linalg import lapack
+
+from . import detlinalg
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish"]
@@ -302,7 +303,7 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
         """Error, ``f`` and weight at the angles ``theta`` (any shape)."""
         x = half * np.cos(theta) + mid
         fx = f(x)
-        e = np.cos(theta[..., None] * ks) @ cheb - fx
+        e = detlinalg.matvec(np.cos(theta[..., None] * ks), cheb) - fx
         if unit:
             return e, fx, None
         wx = weight(x)
@@ -317,11 +318,11 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
         A = np.empty((n + 2, n + 2))
         A[:, : n + 1] = np.cos(ref[:, None] * ks)
         A[:, n + 1] = signs if unit else signs / w_ref
-        sol, info = lapack.dgesv(A, f_ref)[2:]  # LAPACK's solve, without numpy's wrapping
-        if info != 0:  # singular
+        sol = detlinalg.solve(A, f_ref)  # not LAPACK: its kernels differ by CPU
+        if sol is None:  # singular
             break
         cheb, E = sol[: n + 1], float(abs(sol[n + 1]))
-        e_grid = v_grid @ cheb - f_grid
+        e_grid = detlinalg.matvec(v_grid, cheb) - f_grid
         if not unit:
             e_grid *= w_grid
         k_p, k_v, k_f, k_w, grid_max = _exchange(e_grid, cheb, n, grid, evaluate)
