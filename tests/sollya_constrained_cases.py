@@ -16,6 +16,7 @@ level here).
 from __future__ import annotations
 
 import re
+import sys
 import time
 
 from chebnorm.approx import fit, sollya
@@ -134,8 +135,10 @@ def remez_script(i: int, case, constant: float | None) -> str:
         dom, g, w, deg, fv = f"[{low};{ends[1]}]", f"(F(x) - {c0})", f"x^{m}", max(pw) - m, "F(x)"
     if kind == "rel":
         g, w = f"{g}/{fv}", f"{w}/{fv}"
+    back = "x^2" if par is not None or (len(pw) > 1 and pw[1] - pw[0] == 2) else "x"
     return (f"F={f};\nd={dom};\ng={g};\nw={w};\np=remez(g, {deg}, d, w);\n"
-            f"print(\"R{i}\", dirtyinfnorm(p*w - g, d));\n")
+            f"print(\"R{i}\", dirtyinfnorm(p*w - g, d));\n"
+            f"P=horner(expand(x^{m} * p({back})));\n")
 
 
 def run():
@@ -155,25 +158,43 @@ def run():
             expr, (lo, hi), n, kind="minimax", error=kind)
         tables.append((case, q, real))
     t1 = time.perf_counter()
-    cases = []
-    for case, q, _ in tables:
-        qz = q.quantized
-        cases.append(sollya.FpminimaxCase(
-            expr=q.expression, var=q.variable, lo=q.interval[0], hi=q.interval[1],
-            monomials=tuple(qz.monomials), coef_format=qz.format, frac_bits=qz.frac_bits,
-            kind=q.error_kind, constant=qz.coefficients[0] if qz.fixed_constant else None,
-            check=qz.coefficients))
-    fp = sollya.fpminimax(cases)
-    script = "prec=200!;\ndisplay=decimal!;\nverbosity=0!;\n" + "".join(
-        remez_script(i, case, q.quantized.coefficients[0] if case[5] else None)
-        if case[5] else remez_script(i, case, None) for i, (case, q, _) in enumerate(tables))
-    out = sollya._run(script)
+    parts = ["prec=300!;", "display=dyadic!;", "verbosity=0!;"]
+    for i, (case, q, _) in enumerate(tables):
+        parts.append(_fpminimax_script(i, case, q))
+    out = sollya._run("\n".join(parts) + "\n", timeout=1200)
     t2 = time.perf_counter()
     rows = []
-    for i, ((case, q, real), r) in enumerate(zip(tables, fp)):
-        m = re.search(rf"^R{i}\s+([-+0-9.e]+)\s*$", out, re.M)
-        rows.append((case, q, real, r, float(m.group(1)) if m else None))
+    num = r"[-+]?[0-9]+(?:b[-+]?[0-9]+)?"
+    for i, (case, q, real) in enumerate(tables):
+        got = {}
+        for key in "RSK":
+            m = re.search(rf"^{key}{i}\s+({num})(?:\s+({num}))?\s*$", out, re.M)
+            got[key] = None if m is None else [float(sollya._dyadic(v)) for v in m.groups() if v]
+        rows.append((case, q, real, got["S"], got["K"], got["R"] and got["R"][0]))
     return rows, t1 - t0, t2 - t1
+
+
+def _fpminimax_script(i: int, case, q) -> str:
+    """Sollya's remez (posed as a Haar problem), then fpminimax on the case's
+    powers and format given that minimax polynomial, and the supnorms of its
+    answer (``S<i> lower upper``) and of chebnorm's (``K<i> lower upper``)."""
+    expr, lo, hi, n, mons, fix, (fmt, bits), kind = case
+    qz = q.quantized
+    c0 = qz.coefficients[0] if fix else None
+    pw = _powers(case)
+    if fmt == "fixed":
+        fmts, what = [bits] * len(pw), "fixed"
+    else:
+        fmts, what = [sollya._SOLLYA_PRECISION[fmt]] * len(pw), "floating"
+    mode = "absolute" if kind == "abs" else "relative"
+    const = "0" if c0 is None else sollya._exact(c0)
+    return (remez_script(i, case, c0).replace("display=decimal!;", "")
+            + f"f=F(x);\nI={sollya.interval_text(lo, hi)};\n"
+            + f"z=fpminimax(f, [|{','.join(map(str, pw))}|], [|{','.join(map(str, fmts))}|], I, "
+            + f"{what}, {mode}, {const}, P);\n"
+            + f"r=supnorm(z, f, I, {mode}, 2^-12);\nprint(\"S{i}\", inf(r), sup(r));\n"
+            + f"k={sollya._poly(qz.coefficients)};\nr=supnorm(k, f, I, {mode}, 2^-12);\n"
+            + f"print(\"K{i}\", inf(r), sup(r));\n")
 
 
 def quantized_bound(q) -> float:
@@ -192,8 +213,8 @@ def label(case) -> str:
 
 if __name__ == "__main__":
     rows, tc, ts = run()
-    for case, q, real, r, rem in rows:
-        theirs = r["sup"].upper if r else float("nan")
+    for case, q, real, sup, ours, rem in rows:
+        theirs = sup[1] if sup else float("nan")
         print(f"{label(case)}: ours {quantized_bound(q):.4e} fpminimax {theirs:.4e} ratio "
               f"{quantized_bound(q) / theirs:.4f} | real {real_error(real):.5e} remez "
               f"{rem if rem is None else format(rem, '.5e')}")
