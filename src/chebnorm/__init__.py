@@ -110,6 +110,7 @@ _LAZY = {
     "fit_target": ("chebnorm.approx", "fit_target"),
     "CoefficientTable": ("chebnorm.approx", "CoefficientTable"),
     "FixedPoint": ("chebnorm.approx", "FixedPoint"),
+    "FitWarning": ("chebnorm.approx", "FitWarning"),
     "target": ("chebnorm.approx", "get_target"),
     "target_names": ("chebnorm.approx", "target_names"),
     "span_normals": ("chebnorm.methods", "span_normals"),
@@ -121,7 +122,7 @@ _LAZY = {
 
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
-    "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
+    "FitWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
     "symbolic", "approx", "export", "methods", "hw", "raster",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}

@@ -6,7 +6,7 @@
 True
 """
 
-from .api import MAX_DEGREE, fit, quantize, warnings_of
+from .api import MAX_DEGREE, FitWarning, fit, quantize, warnings_of
 from .certify import Certificate, certify
 from .expr import Function1D, read_expression, parse_function, parse_number
 from .files import write_atomic
@@ -16,7 +16,7 @@ from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint, Quantized
 from .targets import TARGETS, Target, get_target, target_names
 
 __all__ = [
-    "CoefficientTable", "FixedPoint", "Quantized", "COEF_FORMATS", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "MAX_DEGREE",
+    "CoefficientTable", "FixedPoint", "Quantized", "COEF_FORMATS", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "FitWarning", "MAX_DEGREE",
     "Certificate", "certify", "Function1D", "read_expression", "parse_function", "parse_number",
     "Target", "TARGETS", "get_target", "target_names", "fit_target",
     "write_atomic", "textsafe",

@@ -4,19 +4,35 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from importlib.metadata import PackageNotFoundError, version as _pkg_version
 
 import numpy as np
 import sympy as sp
 from flint import arb
 
-from . import clib
 from .certify import Certificate, _float_down, _float_up, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
-from .fitting import chebyshev_interpolant, cheb_to_monomial, polish, remez, shift_for
+from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, polish, remez,
+                      shift_for)
 from .table import CoefficientTable, FixedPoint, Quantized
 
-__all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval"]
+__all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
+           "FitWarning"]
+
+
+class FitWarning(UserWarning):
+    """A fit or a quantization that is not what it claims to be: the Remez
+    exchange did not converge, a minimax fit's error exceeds that of a
+    simpler polynomial, or a certified bound missed its tightness. The same
+    text is recorded in the table's ``provenance["warnings"]``
+    (:func:`warnings_of`); ``chebnorm fit`` prints it as
+    ``chebnorm: warning: ...``."""
+
+
+def _warn(notes) -> None:
+    for note in notes:
+        warnings.warn(note, FitWarning, stacklevel=3)
 
 MAX_DEGREE = 30
 KINDS = ("chebyshev", "minimax")
@@ -192,9 +208,13 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
                              coef_format=coef_format, monomials=monomials,
                              fix_constant=fix_constant, segments=segments,
                              segment_by=segment_by, centered=centered)
-    quantized = (frac_bits is not None or coef_format is not None or monomials is not None
-                 or fix_constant)
-    degree = _check_fit_args(degree, kind, error, basis, quantized)
+    quantized = frac_bits is not None or coef_format is not None
+    constrained = monomials is not None or fix_constant
+    degree = _check_fit_args(degree, kind, error, basis, quantized or constrained)
+    if constrained and not quantized and kind != "minimax":
+        raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
+                         f"format; accepted: kind 'minimax' (the best real polynomial in those "
+                         f"powers), or a frac_bits or coef_format to quantize")
     try:
         lo, hi = interval
     except (TypeError, ValueError):
@@ -207,10 +227,12 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
                          f"accepted for error='rel': an interval where the function has no zero")
 
     shift = shift_for(iv.lo_f, iv.hi_f) if basis == "shifted" else None
-    coeffs, notes = _fit_coefficients(fn, iv, degree, kind, error, shift)
-    cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel", shift)
-    notes += _certificate_notes(abs_error_bound=cert_abs, rel_error_bound=cert_rel)
+    coeffs, notes, extra, cert_abs, cert_rel = _real_fit(
+        fn, iv, degree, kind, error, shift, monomials if constrained and not quantized else None,
+        fix_constant and not quantized)
+    _warn(notes)
     provenance = dict(_versions())
+    provenance.update(extra)
     provenance["command"] = command or (
         f"chebnorm.fit({str(fn.expr)!r}, {iv.strings!r}, {degree}, kind={kind!r}, "
         f"error={error!r}, var={var!r})")
@@ -227,10 +249,30 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         max_rel_error=None if cert_rel is None else cert_rel.maximum,
         max_rel_at=None if cert_rel is None else cert_rel.at,
         provenance=provenance, shift=shift)
-    if frac_bits is not None or coef_format is not None or monomials is not None or fix_constant:
+    if quantized:
         table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
                          monomials=monomials, fix_constant=fix_constant)
     return table
+
+
+def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant):
+    """The real coefficients of :func:`fit` (constrained to ``monomials`` /
+    ``fix_constant`` when given), their notes, provenance entries and
+    certificates."""
+    constrained = monomials is not None or fix_constant
+    if constrained:
+        mons = _monomials(monomials, degree, fix_constant)
+        fixed = _fixed_constant(fn, "binary64", None) if fix_constant else {}
+        coeffs, notes, extra = _constrained_fit(fn, iv, degree, mons, fixed, error, report=True)
+    else:
+        coeffs, notes, extra = _fit_coefficients(fn, iv, degree, kind, error, shift)
+    cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel", shift)
+    if kind == "minimax" or constrained:
+        # a fit in fewer powers may lose to a lower-degree one: only the zero polynomial
+        notes += _simpler_fit_notes(fn, iv, degree if not constrained else 0, error, cert_abs,
+                                    cert_rel)
+    notes += _certificate_notes(abs_error_bound=cert_abs, rel_error_bound=cert_rel)
+    return coeffs, notes, extra, cert_abs, cert_rel
 
 
 def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool) -> int:
@@ -277,10 +319,25 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
 
 
 def _fit_coefficients(fn: Function1D, iv: Interval, degree: int, kind: str, error: str,
-                      shift: tuple[float, float] | None) -> tuple[list[float], list[str]]:
-    """The fitted float coefficients (in ``t = (x - c)/s`` with ``shift``)
-    and the notes on how the fit went."""
-    notes = []
+                      shift: tuple[float, float] | None):
+    """The fitted float coefficients (in ``t = (x - c)/s`` with ``shift``),
+    the notes on how the fit went and the provenance entries to add.
+
+    A minimax fit of an even or odd ``f`` on a symmetric interval is the best
+    polynomial in the powers of that parity (:func:`_constrained_fit`, which
+    fits on the half interval): the plain exchange meets ``n + 3``
+    alternation points there and need not converge."""
+    notes, extra = [], {}
+    parity = _parity(fn, iv) if kind == "minimax" and degree >= 1 else None
+    if parity is not None:
+        powers = tuple(range(0 if parity == "even" else 1, degree + 1, 2))
+        coeffs, notes, extra = _constrained_fit(fn, iv, degree, powers, {}, error, report=True)
+        extra = {"parity": f"{fn.expr} is {parity} on the symmetric interval: fitted in the "
+                           f"{parity} powers {','.join(map(str, powers))} on [0, HI] "
+                           f"(the best polynomial of degree {degree} has no other powers)"}
+        if shift is not None:   # centre 0: t = x/s, s a power of two (exact)
+            coeffs = [c * shift[1] ** k for k, c in enumerate(coeffs)]
+        return coeffs, notes, extra
     if kind == "chebyshev" and shift is not None:
         c, s = (sp.Float(v, 60) for v in shift)
         f_mp = fn.mpmath
@@ -299,12 +356,113 @@ def _fit_coefficients(fn: Function1D, iv: Interval, degree: int, kind: str, erro
             cheb = polish(fn.mpmath, iv.lo_f, iv.hi_f, res.ref, degree, relative=error == "rel")
         coeffs = cheb_to_monomial(cheb, iv.lo_f, iv.hi_f, *(shift or (0.0, 1.0)))
         if not res.converged and not polished:
-            notes.append(
-                f"the Remez exchange did not converge: the coefficients are its best iterate "
-                f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
-                f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
-                f"may be closer; the certified bounds hold")
-    return coeffs, notes
+            # degenerate alternation (a nearly even or odd f, ...): the exchange on a
+            # growing point set needs no alternation, and wins when it is better
+            other = minimax_powers(fn, iv.lo_f, iv.hi_f, degree, tuple(range(degree + 1)),
+                                   relative=error == "rel")
+            if other.converged and other.max_error < res.max_error:
+                c_s, s_s = shift or (0.0, 1.0)
+                coeffs = other.coefficients if shift is None else _shifted(
+                    other.coefficients, c_s, s_s)
+                extra["exchange"] = ("the Remez exchange did not converge; the linear-programming "
+                                     "exchange on a growing point set did")
+            else:
+                notes.append(
+                    f"the Remez exchange did not converge: the coefficients are its best iterate "
+                    f"(iteration {res.iterations}: levelled error {res.levelled:.3e}, largest "
+                    f"error {res.max_error:.3e}), not the minimax polynomial, and kind chebyshev "
+                    f"may be closer; the certified bounds hold")
+    return coeffs, notes, extra
+
+
+def _shifted(coeffs, c: float, s: float) -> list[float]:
+    """Coefficients in ``x`` re-expressed in ``t = (x - c)/s`` (exact, rounded once)."""
+    from flint import fmpq_poly
+
+    from .fitting import _exact
+
+    poly = fmpq_poly([_exact(v) for v in coeffs])
+    out = poly(fmpq_poly([_exact(c), _exact(s)])).coeffs()
+    return [int(q.p) / int(q.q) for q in out] + [0.0] * (len(coeffs) - len(out))
+
+
+def _parity(fn: Function1D, iv: Interval) -> str | None:
+    """``"even"`` or ``"odd"`` when ``f`` is (sympy proves ``f(-x) -+ f(x) = 0``)
+    and the interval is symmetric about 0 (exactly); else None."""
+    try:
+        if sp.simplify(iv.lo + iv.hi) != 0:
+            return None
+    except (TypeError, ValueError):
+        return None
+    x = fn.var
+    probe = np.array([0.3, 0.7, 0.9]) * iv.hi_f
+    with np.errstate(all="ignore"):
+        a = np.asarray(fn.numpy(probe), dtype=float) * np.ones(3)
+        b = np.asarray(fn.numpy(-probe), dtype=float) * np.ones(3)
+    scale = np.maximum(np.abs(a), 1e-300)
+    for name, diff, sign in (("even", a - b, -1), ("odd", a + b, 1)):
+        if np.all(np.abs(diff) <= 1e-12 * scale):   # quick numeric screen, then a proof
+            mirrored = fn.expr.subs(x, -x)
+            try:
+                if sp.simplify(mirrored + sign * fn.expr) == 0:
+                    return name
+            except (TypeError, ValueError, RecursionError):
+                return None
+    return None
+
+
+def _constrained_fit(fn, iv, degree, powers, fixed, error_kind, report: bool = False):
+    """Real coefficients (all powers) of the minimax fit in the given powers,
+    the ``fixed`` ones (power -> (mantissa, exponent)) held
+    (:func:`~chebnorm.approx.fitting.minimax_powers`). On a symmetric interval
+    where ``f`` and every power share a parity, it fits on ``[0, HI]`` (the
+    same best polynomial, a Haar system there). With ``report``, also the
+    notes and the provenance entries."""
+    held = {k: math.ldexp(m, e) for k, (m, e) in fixed.items()}
+    parity = _parity(fn, iv) if iv.lo_f < 0 < iv.hi_f else None
+    want = {"even": 0, "odd": 1}.get(parity)
+    half = want is not None and all(k % 2 == want for k in powers) and all(
+        k % 2 == want or c == 0 for k, c in held.items())
+    lo = 0.0 if half else iv.lo_f
+    r = minimax_powers(fn, lo, iv.hi_f, degree, powers, fixed=held, relative=error_kind == "rel")
+    if not report:
+        return r.coefficients
+    notes = [] if r.converged else [
+        f"the minimax fit in the powers {','.join(map(str, powers))} did not converge: level "
+        f"{r.level:.3e}, largest error {r.max_error:.3e} after {r.rounds} rounds; the "
+        f"certified bounds hold"]
+    extra = {"constraint": f"best polynomial in the powers {','.join(map(str, powers))}"
+             + (f", p(0) held at f(0) rounded to binary64 = {held[0]!r}" if 0 in held else "")
+             + (f" ({parity} f: fitted on [0, HI])" if half else "")}
+    return r.coefficients, notes, extra
+
+
+def _simpler_fit_notes(fn, iv, degree, error, cert_abs, cert_rel) -> list[str]:
+    """A note when a (minimax) fit's located error exceeds the sampled error of
+    the zero polynomial or of a Chebyshev interpolant of degree below ``degree``."""
+    cert = cert_abs if error == "abs" else cert_rel
+    if cert is None:
+        return []
+    x = np.cos(np.pi * np.arange(2001) / 2000)[::-1]
+    xs = 0.5 * (iv.lo_f + iv.hi_f) + 0.5 * (iv.hi_f - iv.lo_f) * x
+    with np.errstate(all="ignore"):
+        fx = np.asarray(fn.numpy(xs), dtype=float) * np.ones_like(xs)
+        w = np.ones_like(fx) if error == "abs" else 1.0 / np.abs(fx)
+        ok = np.isfinite(fx) & np.isfinite(w)
+        rivals = [("the zero polynomial", float(np.max(np.abs(w * fx)[ok])))]
+        full = np.polynomial.chebyshev.chebinterpolate(
+            lambda t: fn.numpy(0.5 * (iv.lo_f + iv.hi_f) + 0.5 * (iv.hi_f - iv.lo_f) * t)
+            * np.ones_like(t), degree)
+        for d in range(degree):
+            e = w * (np.polynomial.chebyshev.chebval(x, full[:d + 1]) - fx)
+            rivals.append((f"the degree-{d} Chebyshev interpolant", float(np.max(np.abs(e[ok])))))
+    name, best = min(rivals, key=lambda r: r[1])
+    if not cert.maximum > 1.01 * best:
+        return []
+    what = "|p - f|" if error == "abs" else "|p/f - 1|"
+    return [f"the minimax fit is not minimax: its error {what} = {cert.maximum:.3e} exceeds "
+            f"that of {name} (sampled: {best:.3e}); the exchange failed on this problem "
+            f"(try a lower degree or a narrower interval); the certified bounds hold"]
 
 
 def _certificate_notes(**certs: Certificate | None) -> list[str]:
@@ -440,14 +598,31 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     best = round_coefficients(prob, real, coef_format, fracs if coef_format == "fixed" else None,
                               greedy, plain=not reoptimize)
     if best is None:
-        raise ValueError(f"no rounding of the coefficients to {coef_format} could be certified "
-                         f"(every candidate overflowed word_bits = {word_bits} or failed)")
+        raise ValueError(_no_rounding(coef_format, real, word_bits, fracs))
     coeffs = best.coefficients
     # the certificates that ranked the candidates (tight), so the stated bound
     # is the one the monotone chain compared
     ca, cr = _certify_both(fn, list(coeffs), iv, table.error_kind == "rel", tight=True)
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
+
+
+def _no_rounding(coef_format: str, real, word_bits: int, fracs) -> str:
+    """Why no rounding to ``coef_format`` could be certified, naming the format's range."""
+    from .rounding import FLOAT_FORMATS
+
+    big = max(range(len(real)), key=lambda k: abs(real[k]))
+    if coef_format in FLOAT_FORMATS:
+        p, _, emax = FLOAT_FORMATS[coef_format]
+        top = math.ldexp(2 - 2.0 ** (1 - p), emax)
+        if abs(real[big]) > top:
+            return (f"coefficient of x^{big} = {real[big]:.6g} overflows {coef_format} (largest "
+                    f"finite {top:.6g}); accepted: coefficients within +-{top:.6g}, or another "
+                    f"coefficient format")
+        return f"no rounding of the coefficients to {coef_format} could be certified"
+    return (f"no rounding of the coefficients to fixed point could be certified (every "
+            f"candidate overflowed word_bits = {word_bits}: coefficient of x^{big} = "
+            f"{real[big]:.6g} at {fracs[big]} fractional bits, or failed)")
 
 
 def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fix_constant,
@@ -482,6 +657,7 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
                                  max_rel_error=quant.max_rel_error)
     provenance = dict(table.provenance)
     if notes:
+        _warn(notes)
         old = warnings_of(table)
         provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
     return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
@@ -499,36 +675,3 @@ def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:
     if coef_format == "fixed":
         return {0: (round(math.ldexp(c0, frac0)), -frac0)}
     return {0: round_to_float(c0, coef_format)}
-
-
-def _constrained_fit(fn, iv, degree, powers, fixed, error_kind):
-    """Real coefficients (all powers) of the discrete minimax fit in the given
-    powers, the fixed ones held (linear programming on a dense grid)."""
-    from scipy.optimize import linprog
-
-    x = np.linspace(iv.lo_f, iv.hi_f, 1500)
-    x = np.concatenate([x, 0.5 * (iv.lo_f + iv.hi_f) + 0.5 * (iv.hi_f - iv.lo_f)
-                        * np.cos(np.pi * (np.arange(500) + 0.5) / 500)])
-    f = np.asarray(fn.numpy(x), dtype=float) * np.ones_like(x)
-    w = 1.0 / np.abs(f) if error_kind == "rel" else np.ones_like(f)
-    y = f - sum(math.ldexp(m, e) * clib.power(x, k) for k, (m, e) in fixed.items())
-    cols = np.stack([clib.power(x, k) for k in powers], axis=1)
-    scale = np.max(np.abs(cols), axis=0)
-    scale[scale == 0] = 1.0
-    a = cols / scale * w[:, None]
-    b = y * w
-    m = len(powers)
-    # minimise t subject to |a c - b| <= t
-    A = np.block([[a, -np.ones((len(x), 1))], [-a, -np.ones((len(x), 1))]])
-    rhs = np.concatenate([b, -b])
-    cost = np.zeros(m + 1)
-    cost[-1] = 1.0
-    res = linprog(cost, A_ub=A, b_ub=rhs, bounds=[(None, None)] * m + [(0, None)],
-                  method="highs")
-    sol = res.x[:m] / scale if res.success else np.linalg.lstsq(a, b, rcond=None)[0] / scale
-    real = [0.0] * (degree + 1)
-    for k, c in zip(powers, sol):
-        real[k] = float(c)
-    for k, (mm, e) in fixed.items():
-        real[k] = math.ldexp(mm, e)
-    return real

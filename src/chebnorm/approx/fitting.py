@@ -13,13 +13,13 @@ from typing import Callable
 
 import mpmath
 import numpy as np
-from flint import arb, arb_mat, ctx, fmpq, fmpq_poly, fmpz_poly
+from flint import arb, arb_mat, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
 from . import detlinalg
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
-           "polish"]
+           "polish", "minimax_powers", "PowersFit"]
 
 
 def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) -> list[float]:
@@ -87,6 +87,8 @@ def _exact(v) -> fmpq:
         sign, man, exp, _ = v._mpf_  # man_exp drops the sign
         man, exp = (-1) ** sign * int(man), int(exp)
         return fmpq(man * 2 ** exp) if exp >= 0 else fmpq(man, 2 ** -exp)
+    if isinstance(v, fmpq):
+        return v
     num, den = float(v).as_integer_ratio()  # raises on inf and nan
     return fmpq(num, den)
 
@@ -419,3 +421,264 @@ def _to_arb(v) -> arb:
         raise ValueError(f"value {v} is not finite")
     sign, man, exp, _ = v._mpf_
     return arb(((-1) ** sign * int(man), int(exp)))
+
+
+# --- minimax on a set of powers ---------------------------------------------
+
+class _PowerBasis:
+    """A well-conditioned basis of the span of ``x^k`` (``k`` in ``powers``)
+    on ``[lo, hi]``: where the powers are ``m + s j`` (``j = 0..J``, an
+    arithmetic progression: all powers, the odd or the even ones)
+    ``phi_j = (x/S)^m T_j(alpha x^s + beta)``, the Chebyshev polynomials of
+    ``x^s`` mapped onto ``[-1, 1]``; otherwise ``(x/S)^k``. ``S``, ``alpha``
+    and ``beta`` are floats used exactly both in the float64 evaluation and
+    in the exact conversion to monomials (:meth:`monomial`)."""
+
+    def __init__(self, powers: tuple[int, ...], lo: float, hi: float):
+        self.powers = tuple(powers)
+        self.scale = max(abs(lo), abs(hi)) or 1.0
+        steps = {b - a for a, b in zip(self.powers, self.powers[1:])}
+        self.step = steps.pop() if len(steps) == 1 else (1 if len(self.powers) == 1 else None)
+        self.alpha = self.beta = None
+        if self.step is not None:
+            s = self.step
+            ends = sorted(((lo / self.scale) ** s, (hi / self.scale) ** s))
+            if s % 2 == 0 and lo < 0 < hi:
+                ends = [0.0, max(ends)]
+            width = ends[1] - ends[0]
+            self.alpha = 2.0 / width if width > 0 else 1.0
+            self.beta = -(ends[0] + ends[1]) / width if width > 0 else 0.0
+
+    def matrix(self, x: np.ndarray) -> np.ndarray:
+        """``phi_j(x)`` as a ``(len(x), len(powers))`` float64 matrix."""
+        u = x / self.scale
+        if self.step is None:
+            return np.stack([u ** k for k in self.powers], axis=1)
+        y = self.alpha * u ** self.step + self.beta
+        return u[:, None] ** self.powers[0] * C.chebvander(y, len(self.powers) - 1)
+
+    def monomial(self, coeffs) -> fmpq_poly:
+        """``sum_j coeffs[j] phi_j`` exactly, as a polynomial in ``x``."""
+        s_inv = 1 / _exact(self.scale)
+        x_over = fmpq_poly([0, s_inv])
+        out = fmpq_poly([])
+        if self.step is None:
+            for k, c in zip(self.powers, coeffs):
+                out += _exact(c) * x_over ** k
+            return out
+        inner = fmpq_poly([_exact(self.beta)]) + _exact(self.alpha) * x_over ** self.step
+        series = fmpq_poly([])
+        for j, c in enumerate(coeffs):
+            series += _exact(c) * _chebyshev_t(j)
+        return series(inner) * x_over ** self.powers[0]
+
+
+class PowersFit:
+    """Result of :func:`minimax_powers`: ``coefficients`` (float64, ascending
+    powers ``0..degree`` of ``x``, the fixed ones included), ``level`` (the
+    discrete minimax error on the final point set, a lower estimate),
+    ``max_error`` (the largest error found on the dense grid and at the
+    located extrema), ``converged`` (the two agree to ``rtol``)."""
+
+    def __init__(self, coefficients, level, max_error, converged, rounds):
+        self.coefficients = coefficients
+        self.level = level
+        self.max_error = max_error
+        self.converged = converged
+        self.rounds = rounds
+
+
+def _lp_minimax(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """``argmin_c max_i |(a c - b)_i|`` by linear programming (HiGHS, tight
+    tolerances, columns and right side scaled to 1); None when HiGHS fails.
+    The caller refines the answer on the residual, so HiGHS's tolerances
+    (relative to the scaled data) bound only one step's loss."""
+    from scipy.optimize import linprog
+
+    col = np.max(np.abs(a), axis=0)
+    col[col == 0] = 1.0
+    rs = float(np.max(np.abs(b))) or 1.0
+    an, bn = a / col, b / rs
+    n, m = an.shape
+    ones = np.ones((n, 1))
+    A = np.block([[an, -ones], [-an, -ones]])
+    cost = np.zeros(m + 1)
+    cost[-1] = 1.0
+    res = linprog(cost, A_ub=A, b_ub=np.concatenate([bn, -bn]),
+                  bounds=[(None, None)] * m + [(0, None)], method="highs-ds",
+                  options={"primal_feasibility_tolerance": 1e-10,
+                           "dual_feasibility_tolerance": 1e-10})
+    if not res.success:
+        return None
+    return res.x[:m] / col * rs, float(res.x[m]) * rs
+
+
+def _local_maxima(a: np.ndarray, floor: float, most: int) -> list[int]:
+    """Indices of the (at most ``most`` largest) local maxima of ``a`` above ``floor``."""
+    left = np.concatenate(([True], a[1:] >= a[:-1]))
+    right = np.concatenate((a[:-1] >= a[1:], [True]))
+    idx = np.flatnonzero(left & right & (a > floor))
+    if len(idx) > most:
+        idx = idx[np.argsort(-a[idx])[:most]]
+    return sorted(idx.tolist())
+
+
+class _Residual:
+    """``g = f - fixed`` and the weight at points, in float64 or, once a
+    polynomial ``p`` is known, the residual ``g - p`` in Arb (200 bits)."""
+
+    def __init__(self, fn, fixed: dict, relative: bool):
+        self.fn, self.fixed, self.relative = fn, fixed, relative
+        self.poly = None                      # exact fmpq_poly of the fitted part so far
+
+    def weight_and_target(self, x: np.ndarray):
+        with np.errstate(all="ignore"):
+            fx = np.asarray(self.fn.numpy(x), dtype=float) * np.ones_like(x)
+        w = 1.0 / np.abs(fx) if self.relative else np.ones_like(fx)
+        if self.poly is None:
+            g = fx - sum(c * x ** k for k, c in self.fixed.items())
+        else:
+            g = self._exact(x)
+        return w, g
+
+    def _exact(self, x: np.ndarray) -> np.ndarray:
+        old = ctx.prec
+        try:
+            ctx.prec = 200
+            total = self.poly
+            for k, c in self.fixed.items():
+                total += _exact(c) * fmpq_poly([0] * k + [1])
+            ap = arb_poly([arb(c) for c in total.coeffs()])
+            out = np.empty(len(x))
+            for i, v in enumerate(x.tolist()):
+                xa = arb(v)
+                try:
+                    r = self.fn.arb(xa) - ap(xa)
+                    out[i] = float(r.mid()) if r.is_finite() else math.nan
+                except (ValueError, ZeroDivisionError):
+                    out[i] = math.nan
+            return out
+        finally:
+            ctx.prec = old
+
+
+def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | None = None,
+                   relative: bool = False, rtol: float = 1e-6) -> PowersFit:
+    """The best polynomial ``p = sum_{k in powers} c_k x^k + fixed`` minimizing
+    ``max |w (p - f)|`` on ``[lo, hi]`` (``w = 1``, or ``1/|f|`` with
+    ``relative``), for any set of powers (Haar system or not).
+
+    ``fn`` is a :class:`~chebnorm.approx.expr.Function1D`; ``fixed`` maps a
+    power to its (float) coefficient held fixed. The discrete problem on a
+    growing set of points is a linear program (HiGHS); each round adds the
+    located extrema of the error on a dense grid (Cheney's exchange), until
+    the discrete level and the largest error agree to ``rtol``. The first
+    stage works on ``f`` in float64; the next ones on the residual ``f - p``
+    evaluated in 200-bit Arb, so the answer is not limited by float64's
+    resolution of ``f`` nor by the solver's tolerance (each stage only
+    corrects the previous one).
+
+    ``converged`` means the largest error is within ``1 + 10^-4`` of the
+    level (so within 0.01 % of the minimax error).
+
+    The best multiple of ``x`` to ``x^3`` on ``[-1, 1]`` is ``3x/4``
+    (``x^3 - 3x/4 = T_3(x)/4``, error ``1/4``); with ``p(0)`` held at 1, the
+    best ``1 + c x^2`` to ``1 + x^4`` has ``c = 2 sqrt(2) - 2`` (error
+    ``c^2/4``, at ``x^2 = c/2`` and at 1):
+
+    >>> from chebnorm.approx import parse_function
+    >>> r = minimax_powers(parse_function("x**3"), -1.0, 1.0, 3, (1,))
+    >>> r.converged, round(r.level, 7), [round(c, 7) for c in r.coefficients]
+    (True, 0.25, [0.0, 0.75, 0.0, 0.0])
+    >>> r = minimax_powers(parse_function("1 + x**4"), -1.0, 1.0, 4, (2,), fixed={0: 1.0})
+    >>> abs(r.coefficients[2] - (8 ** 0.5 - 2)) < 1e-7, r.coefficients[0]
+    (True, 1.0)
+    """
+    fixed = dict(fixed or {})
+    basis = _PowerBasis(tuple(powers), lo, hi)
+    m = len(basis.powers)
+    theta = _grid(max(degree, m))[0]
+    half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    xd = half * np.cos(theta) + mid
+    xd[0], xd[-1] = lo, hi
+    phi_d = basis.matrix(xd)
+    res = _Residual(fn, fixed, relative)
+    w_d, g_d = res.weight_and_target(xd)
+    ok = np.isfinite(w_d) & np.isfinite(g_d) & np.all(np.isfinite(phi_d), axis=1)
+    count = max(8 * m, 60)
+    start = np.unique(np.round(np.linspace(0, len(xd) - 1, count)).astype(int))
+    coeff_exact = [fmpq(0)] * m
+    level = max_err = math.inf
+    converged = False
+    rounds = 0
+    for stage in range(3):
+        c, level, max_err, stage_conv, n = _exchange_lp(
+            basis, res, theta, (xd, phi_d, w_d, g_d, ok), start, m, rtol, (lo, hi))
+        rounds += n
+        if c is None:
+            break
+        coeff_exact = [a_ + _exact(float(b_)) for a_, b_ in zip(coeff_exact, c)]
+        converged = stage_conv or max_err <= level * (1 + 1e-4)
+        correction = float(np.max(np.abs(w_d[ok] * (phi_d[ok] @ c))))
+        if max_err == 0 or (stage > 0 and correction <= 1e-3 * level):
+            break
+        # the next stage fits the residual f - p, computed exactly
+        res.poly = _sum_poly(basis, coeff_exact)
+        w_d, g_d = res.weight_and_target(xd)
+        ok &= np.isfinite(g_d)
+    poly = _sum_poly(basis, coeff_exact)
+    out = [0.0] * (degree + 1)
+    for k, c in enumerate(poly.coeffs()):
+        if k <= degree:
+            out[k] = int(c.p) / int(c.q)
+    for k, c in fixed.items():
+        out[k] = float(c)
+    return PowersFit(out, level, max_err, converged, rounds)
+
+
+def _exchange_lp(basis, res, theta, dense, start, m, rtol, ends):
+    """One stage of :func:`minimax_powers`: linear programs on a growing set of
+    points (the dense grid's indices ``start``, then the located extrema of
+    the error added), until the level and the largest error agree to
+    ``rtol`` or a round no longer raises the level. Returns the basis
+    coefficients, the level, the largest error, whether it converged and
+    the rounds taken."""
+    xd, phi_d, w_d, g_d, ok = dense
+    lo, hi = ends
+    half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    pts = [i for i in start.tolist() if ok[i]]
+    ex_x, ex_w, ex_g = np.empty(0), np.empty(0), np.empty(0)
+    best = (None, math.inf, math.inf, False)
+    last = -math.inf
+    for rounds in range(1, 31):
+        xs = np.concatenate([xd[pts], ex_x])
+        w_p, g_p = np.concatenate([w_d[pts], ex_w]), np.concatenate([g_d[pts], ex_g])
+        sol = _lp_minimax(w_p[:, None] * basis.matrix(xs), w_p * g_p)
+        if sol is None:
+            break
+        c, level = sol
+        e_d = np.where(ok, w_d * (phi_d @ c - g_d), 0.0)
+        peaks = _local_maxima(np.abs(e_d), 0.9 * level, 4 * m + 8)
+        th = theta[peaks] - (theta[0] - theta[1]) * np.array(_peaks(e_d, peaks))
+        xp = np.clip(half * np.cos(th) + mid, lo, hi)
+        wp, gp = res.weight_and_target(xp)
+        ep = wp * (basis.matrix(xp) @ c - gp)
+        good = np.isfinite(ep)
+        max_err = max(float(np.max(np.abs(e_d))),
+                      float(np.max(np.abs(ep[good]))) if good.any() else 0.0)
+        done = max_err <= level * (1 + rtol) or max_err == 0
+        if best[0] is None or max_err < best[2] or done:
+            best = (c, level, max_err, done)
+        if done or level <= last * (1 + 1e-3 * rtol):
+            break
+        last = level
+        new = good & (np.abs(ep) > level)
+        pts = sorted(set(pts) | set(peaks))
+        ex_x = np.concatenate([ex_x, xp[new]])
+        ex_w, ex_g = np.concatenate([ex_w, wp[new]]), np.concatenate([ex_g, gp[new]])
+    return (*best, rounds)
+
+
+def _sum_poly(basis: _PowerBasis, coeffs) -> fmpq_poly:
+    """``sum_j coeffs[j] phi_j`` with exact rational ``coeffs``, in ``x``."""
+    return basis.monomial(coeffs)

@@ -4,9 +4,11 @@ in the sibling modules; this one fits and certifies one polynomial."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import warnings
 
-from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, fit, warnings_of
+from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
 
 from ._common import command_line, deprecated_alias, print_json
 
@@ -53,6 +55,15 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
     p.set_defaults(func=run)
+    # a value such as -1/8 or -pi/4 (after --interval) is an argument, not an
+    # option: argparse takes a token starting with '-' for an option unless its
+    # negative-number pattern matches, and this parser's only one-dash options
+    # are -h and -o
+    p._negative_number_matcher = _NOT_AN_OPTION
+
+
+#: anything starting with one '-' except -h and -o (with or without a value)
+_NOT_AN_OPTION = re.compile(r"^-(?![-ho]|$)")
 
 
 def _int_list(text: str):
@@ -92,13 +103,24 @@ def run(args) -> int:
     mon = args.monomials
     if isinstance(mon, int):
         mon = [mon]
-    table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
+    with warnings.catch_warnings():
+        # printed below from the table's provenance, once
+        warnings.simplefilter("ignore", FitWarning)
+        table = _fit(args, mon)
+    for warning in warnings_of(table):
+        print(f"chebnorm: warning: {warning}", file=sys.stderr)
+    return _report(args, table)
+
+
+def _fit(args, mon):
+    return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
                 var=args.var, name=args.name, frac_bits=args.frac_bits,
                 command=command_line(args), basis=args.basis,
                 coef_format=args.coef_format, monomials=mon,
                 fix_constant=args.fix_constant)
-    for warning in warnings_of(table):
-        print(f"chebnorm: warning: {warning}", file=sys.stderr)
+
+
+def _report(args, table) -> int:
     if args.output:
         table.save(args.output)
     if args.json:
