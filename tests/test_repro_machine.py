@@ -205,6 +205,10 @@ for expr, iv, d in (("exp(x)", ("0", "1"), 5), ("acos(x)", ("-0.9", "0.9"), 8),
                     ("x**0.7", ("0.5", "2"), 4)):
     t = cn.fit(expr, iv, d, "minimax")
     res[f"fit {expr}"] = h(t.to_json().encode())
+# the minimax fit on a set of powers (linear programs on points found by the float64 error)
+for expr, iv, d, mons in (("sinh(x)", ("-1/2", "1/2"), 7, (1, 3, 5, 7)),
+                          ("exp(-x**2)", ("-1", "1"), 8, None)):
+    res[f"powers {expr}"] = h(cn.fit(expr, iv, d, "minimax", monomials=mons).to_json().encode())
     res[f"quantized {expr}"] = h(cn.quantize(t, 16).to_json().encode())
 # the rasterizer: mesh construction (Bernstein cubes, corner angles), the numpy reference
 # and the compiled engine (specular power, span angles, camera)
@@ -370,6 +374,10 @@ for name, d in (("rsqrt", 3), ("dichotomy", 2)):
 for expr, iv, d, err in (("exp(x)", ("0", "1"), 9, "abs"), ("acos(x)", ("-0.9", "0.9"), 12, "rel"),
                          ("1/sqrt(x)", ("1", "4"), 6, "rel")):
     res[f"fit {expr}"] = h(cn.fit(expr, iv, d, "minimax", err).to_json().encode())
+for expr, iv, d, mons in (("sin(x)", ("-1/8", "1/8"), 7, (1, 3, 5, 7)),
+                          ("atan(x)", ("0", "1"), 7, (1, 3, 5, 7)),
+                          ("cos(x)", ("-pi/4", "pi/4"), 6, None)):
+    res[f"powers {expr}"] = h(cn.fit(expr, iv, d, "minimax", monomials=mons).to_json().encode())
 pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=32, frac_bits=20)
 res["piecewise"] = h(pw.to_json().encode())
 from paper_repro.criterion import interior_min_norm

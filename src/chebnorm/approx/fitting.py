@@ -16,7 +16,7 @@ import numpy as np
 from flint import arb, arb_mat, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
-from . import detlinalg
+from . import clib, detlinalg
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish", "minimax_powers", "PowersFit"]
@@ -453,9 +453,10 @@ class _PowerBasis:
         """``phi_j(x)`` as a ``(len(x), len(powers))`` float64 matrix."""
         u = x / self.scale
         if self.step is None:
-            return np.stack([u ** k for k in self.powers], axis=1)
-        y = self.alpha * u ** self.step + self.beta
-        return u[:, None] ** self.powers[0] * C.chebvander(y, len(self.powers) - 1)
+            return np.stack([clib.power(u, k) for k in self.powers], axis=1)
+        y = self.alpha * clib.power(u, self.step) + self.beta
+        return (clib.power(u, self.powers[0])[:, None]
+                * C.chebvander(y, len(self.powers) - 1))
 
     def monomial(self, coeffs) -> fmpq_poly:
         """``sum_j coeffs[j] phi_j`` exactly, as a polynomial in ``x``."""
@@ -536,7 +537,7 @@ class _Residual:
             fx = np.asarray(self.fn.numpy(x), dtype=float) * np.ones_like(x)
         w = 1.0 / np.abs(fx) if self.relative else np.ones_like(fx)
         if self.poly is None:
-            g = fx - sum(c * x ** k for k, c in self.fixed.items())
+            g = fx - sum(c * clib.power(x, k) for k, c in self.fixed.items())
         else:
             g = self._exact(x)
         return w, g
@@ -619,7 +620,7 @@ def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | 
             break
         coeff_exact = [a_ + _exact(float(b_)) for a_, b_ in zip(coeff_exact, c)]
         converged = stage_conv or max_err <= level * (1 + 1e-4)
-        correction = float(np.max(np.abs(w_d[ok] * (phi_d[ok] @ c))))
+        correction = float(np.max(np.abs(w_d[ok] * detlinalg.matvec(phi_d[ok], c))))
         if max_err == 0 or (stage > 0 and correction <= 1e-3 * level):
             break
         # the next stage fits the residual f - p, computed exactly
@@ -657,12 +658,12 @@ def _exchange_lp(basis, res, theta, dense, start, m, rtol, ends):
         if sol is None:
             break
         c, level = sol
-        e_d = np.where(ok, w_d * (phi_d @ c - g_d), 0.0)
+        e_d = np.where(ok, w_d * (detlinalg.matvec(phi_d, c) - g_d), 0.0)
         peaks = _local_maxima(np.abs(e_d), 0.9 * level, 4 * m + 8)
         th = theta[peaks] - (theta[0] - theta[1]) * np.array(_peaks(e_d, peaks))
         xp = np.clip(half * np.cos(th) + mid, lo, hi)
         wp, gp = res.weight_and_target(xp)
-        ep = wp * (basis.matrix(xp) @ c - gp)
+        ep = wp * (detlinalg.matvec(basis.matrix(xp), c) - gp)
         good = np.isfinite(ep)
         max_err = max(float(np.max(np.abs(e_d))),
                       float(np.max(np.abs(ep[good]))) if good.any() else 0.0)
