@@ -830,8 +830,8 @@ def _establish(t, read_fields, prove, mode: str | None = None) -> None:
 
 
 def parse_json(text, what: str):
-    """``json.loads`` of a table's text; refuses what is not strict JSON, and an
-    object that gives a key twice (naming the key).
+    """``json.loads`` of a table's text; refuses what is not JSON, and an object
+    that gives a key twice (naming the key).
 
     >>> parse_json('{"a": 1, "a": 2}', "coefficient table")
     Traceback (most recent call last):
@@ -846,11 +846,8 @@ def parse_json(text, what: str):
             out[key] = value
         return out
 
-    def constant(name):
-        raise ValueError(f"{name} is not a JSON number")
-
-    try:
-        return json.loads(text, object_pairs_hook=pairs, parse_constant=constant)
+    try:  # NaN and Infinity are read, for the field's check to refuse naming the field
+        return json.loads(text, object_pairs_hook=pairs)
     except _Duplicate as exc:
         raise ValueError(f"{what} is not valid JSON: key {str(exc.key)[:60]!r} appears twice "
                          f"in one object; accepted: each key once") from None
