@@ -93,8 +93,16 @@ def test_repr_escapes_untrusted_fields(tables):
     d["provenance"] = {"command": "</table><script>alert(1)</script> | *x*"}
     t = cn.CoefficientTable.from_json(json.dumps(d))
     assert "<script" not in t._repr_html_() and "&lt;script&gt;" in t._repr_html_()
-    # a table built in Python is not validated: every field is escaped anyway
-    t = replace(tables[0], name="<img src=x onerror=alert(1)>", expression="a | b", variable="<z>")
+    # a table built in Python is validated as a file is: the name is refused there
+    with pytest.raises(ValueError, match=r"^name: '<img src=x onerror=alert\(1\)>' is not an "
+                                         r"identifier"):
+        replace(tables[0], name="<img src=x onerror=alert(1)>")
+    # and a table built past the checks (tests only) has every field escaped anyway
+    from chebnorm.approx.table import _construction
+
+    with _construction("unchecked"):
+        t = replace(tables[0], name="<img src=x onerror=alert(1)>", expression="a | b",
+                    variable="<z>")
     html_text, md = t._repr_html_(), t._repr_markdown_()
     assert "<img" not in html_text and "&lt;img" in html_text and "<z>" not in html_text
     assert "<img" not in md and "&lt;img" in md and "a \\| b" in md

@@ -92,7 +92,14 @@ class TestText:
         assert f"    acc = acc * x + {t.coefficients[0].hex()} /* {t.coefficients[0]!r} */;" in h
 
     def test_bad_name(self):
-        t = fit("x", ("0", "1"), 1, name="not a c name")
+        with pytest.raises(ValueError, match="^name: .* is not an identifier"):
+            fit("x", ("0", "1"), 1, name="not a c name")  # refused where it enters
+        from dataclasses import replace
+
+        from chebnorm.approx.table import _construction
+
+        with _construction("unchecked"):  # and by the printer on its own
+            t = replace(fit("x", ("0", "1"), 1), name="not a c name")
         with pytest.raises(ValueError, match="name: .* is not an identifier"):
             c_header(t)
 

@@ -29,7 +29,7 @@ import mpmath
 import pytest
 
 from chebnorm.approx import CoefficientTable, fit
-from chebnorm.approx.table import MAX_TEXT
+from chebnorm.approx.table import MAX_TEXT, _construction
 from chebnorm.cli import main
 from chebnorm.export import c_header
 
@@ -557,13 +557,14 @@ def test_injection_in_every_text_field(tmp_path, capsys, clean, path, valid, fie
 
 
 def _hostile_table():
-    """A table whose every text field is hostile, built in Python (no file, so
-    not verified): the printers alone must keep it inert."""
+    """A table whose every text field is hostile, built past the constructor's
+    checks (which refuse it): the printers alone must keep it inert."""
     t = CoefficientTable.load(BASE)
     bad = "1/sqrt(x) */ int injected = 1; /* \\\n??/\u2028`define injected 1\n\");"
-    return replace(t, expression=bad, variable=bad, interval=(bad, bad), kind=bad,
-                   error_kind=bad, fixed_point=replace(t.fixed_point, method=bad),
-                   provenance={"command": bad}), bad
+    with _construction("unchecked"):
+        return replace(t, expression=bad, variable=bad, interval=(bad, bad), kind=bad,
+                       error_kind=bad, fixed_point=replace(t.fixed_point, method=bad),
+                       provenance={"command": bad}), bad
 
 
 @needs_gcc
@@ -575,10 +576,14 @@ def test_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     assert strip_c_comments(header) == clean[0]
     assert "injected" in header.read_text()  # the text is there, inert in the comments
     with pytest.raises(ValueError, match=r"^name: 'a\*/b' is not an identifier"):
-        c_header(replace(t, name="a*/b"))
+        with _construction("unchecked"):
+            t_bad = replace(t, name="a*/b")
+        c_header(t_bad)
     with pytest.raises(ValueError, match=r"^fixed_point\.integers\[0\]: 4294967296 does not fit "
                                          r"the header's int32_t"):
-        c_header(replace(t, fixed_point=replace(t.fixed_point, integers=(2 ** 32, 0, 0))))
+        with _construction("unchecked"):
+            t_bad = replace(t, fixed_point=replace(t.fixed_point, integers=(2 ** 32, 0, 0)))
+        c_header(t_bad)
 
 
 @needs_iverilog

@@ -15,7 +15,7 @@ from .certify import Certificate, _float_down, _float_up, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, polish, remez,
                       shift_for)
-from .table import CoefficientTable, FixedPoint, Quantized
+from .table import CoefficientTable, FixedPoint, Quantized, _construction
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
            "FitWarning"]
@@ -202,6 +202,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
     from 0 at high degree prefer ``basis="shifted"``.
     """
+    name = _table_name(name)
     if segments is not None or segment_by is not None or centered:
         return _fit_segments(expr, interval, degree, kind, error, var=var, name=name,
                              frac_bits=frac_bits, command=command, basis=basis,
@@ -240,15 +241,16 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         provenance["binary_endpoints"] = iv.binary_note()
     if notes:
         provenance["warnings"] = " | ".join(notes)
-    table = CoefficientTable(
-        name=name or "table", expression=sp.sstr(fn.expr), variable=fn.var.name,
-        interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
-        error_kind=error, coefficients=tuple(coeffs),
-        abs_error_bound=cert_abs.bound, rel_error_bound=None if cert_rel is None else cert_rel.bound,
-        max_abs_error=cert_abs.maximum, max_abs_at=cert_abs.at,
-        max_rel_error=None if cert_rel is None else cert_rel.maximum,
-        max_rel_at=None if cert_rel is None else cert_rel.at,
-        provenance=provenance, shift=shift)
+    with _construction("fitted"):  # certified above: checked, not proved twice
+        table = CoefficientTable(
+            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+            interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
+            error_kind=error, coefficients=tuple(coeffs),
+            abs_error_bound=cert_abs.bound, rel_error_bound=None if cert_rel is None else cert_rel.bound,
+            max_abs_error=cert_abs.maximum, max_abs_at=cert_abs.at,
+            max_rel_error=None if cert_rel is None else cert_rel.maximum,
+            max_rel_at=None if cert_rel is None else cert_rel.at,
+            provenance=provenance, shift=shift)
     if quantized:
         table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
                          monomials=monomials, fix_constant=fix_constant)
@@ -315,7 +317,7 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
                          segment_by=segment_by or "uniform",
                          coef_frac_bits=24 if frac_bits is None else frac_bits,
                          centered=centered, fit=kind, error=error, var=var,
-                         name=name or "table", command=command)
+                         name=name, command=command)
 
 
 def _fit_coefficients(fn: Function1D, iv: Interval, degree: int, kind: str, error: str,
@@ -560,6 +562,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
     ((0, 0, 0), True)
     """
+    table.verify()  # a table changed behind the frozen dataclass's back is re-proved
     table.require_monomial("quantize")
 
     from .rounding import FORMATS, _Problem, greedy as greedy_integers, round_coefficients
@@ -660,7 +663,16 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
         _warn(notes)
         old = warnings_of(table)
         provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
-    return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
+    with _construction("fitted"):  # ``table`` verified, ``quant`` certified by quantize
+        return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
+
+
+def _table_name(name) -> str:
+    """``name`` checked where it enters: None is ``"table"``, anything else must be
+    an identifier (it becomes a C function, a macro, a Verilog module)."""
+    from .textsafe import identifier
+
+    return "table" if name is None else identifier(name, field="name")
 
 
 def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:

@@ -53,6 +53,7 @@ from .certify import arb_enclose, certify
 from .certify_batch import SegmentError, certify_batch
 from .expr import Function1D, parse_function, parse_number
 from .fitting import cheb_to_monomial, remez
+from .table import _construction, _establish, _sealed, check_maximum, parse_json
 
 __all__ = [
     "MAX_COEF_FRAC_BITS",
@@ -114,6 +115,11 @@ class PiecewiseTable:
     abs_error_bound: float
     rel_error_bound: float | None
     provenance: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        """Check every field and re-prove every claim (see :meth:`verify`): a table
+        built by hand or by ``dataclasses.replace`` is verified as a file is."""
+        _establish(self, _own_fields, _prove)
 
     # -- geometry ------------------------------------------------------------
     @property
@@ -208,22 +214,17 @@ class PiecewiseTable:
         write_atomic(path, self.to_json())
 
     @classmethod
-    def from_dict(cls, d: Any, *, verify: bool = True) -> PiecewiseTable:
-        """Read a table: every field checked, then (``verify``) every bound re-certified."""
-        t = _read(d)
-        return t.verify() if verify else t
+    def from_dict(cls, d: Any) -> PiecewiseTable:
+        """Read a table: every field checked, then every bound re-certified."""
+        return cls(**_fields(d))
 
     @classmethod
-    def from_json(cls, text: str, *, verify: bool = True) -> PiecewiseTable:
-        try:
-            d = json.loads(text)
-        except (ValueError, RecursionError) as exc:
-            raise ValueError(f"piecewise table is not valid JSON: "
-                             f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
-        return cls.from_dict(d, verify=verify)
+    def from_json(cls, text: str) -> PiecewiseTable:
+        """Parse strict JSON (a key given twice is refused) and read it with :meth:`from_dict`."""
+        return cls.from_dict(parse_json(text, "piecewise table"))
 
     @classmethod
-    def load(cls, path, *, verify: bool = True) -> PiecewiseTable:
+    def load(cls, path) -> PiecewiseTable:
         """Read and verify the table in ``path``; refusals start with the file name."""
         try:
             with open(path, "rb") as fh:
@@ -234,7 +235,7 @@ class PiecewiseTable:
             raise ValueError(f"piecewise table {str(path)!r} is larger than "
                              f"{MAX_PIECEWISE_BYTES} bytes")
         try:
-            return cls.from_json(raw.decode("utf-8"), verify=verify)
+            return cls.from_json(raw.decode("utf-8"))
         except UnicodeDecodeError as exc:
             raise ValueError(f"piecewise table {str(path)!r} is not UTF-8 text (byte "
                              f"{exc.start})") from None
@@ -248,52 +249,70 @@ class PiecewiseTable:
         >>> t.verify() is t
         True
         >>> from dataclasses import replace
-        >>> bad = replace(t, segments=(replace(t.segments[0], abs_error_bound=1e-9),) + t.segments[1:])
-        >>> bad.verify()
+        >>> replace(t, segments=(replace(t.segments[0], abs_error_bound=1e-9),) + t.segments[1:])
         Traceback (most recent call last):
         ...
         ValueError: segments[0].abs_error_bound: stated 1.00e-09 but the certified error of segment 0 is 2.42e-02
+
+        Every table is verified when it is constructed (a file, a hand-built
+        table, ``dataclasses.replace``): this call costs a comparison when
+        nothing changed since, and re-proves the table otherwise. The table's
+        ``abs_error_bound`` (and ``rel_error_bound``) must be the largest
+        segment bound, ``rel_error_bound`` null exactly when ``error_kind`` is
+        ``"abs"`` (the segments then certify no relative error).
         """
-        for kind in ("abs", "rel"):
-            stated = [getattr(seg, f"{kind}_error_bound") for seg in self.segments]
-            todo = [s for s, b in enumerate(stated) if b is not None]
-            if not todo:
-                continue
-            certs = dict(zip(todo, certify_segments(self, kind, segments=todo)))
-            # a bound certified more tightly than the default needs a tighter proof:
-            # the batch at 2^-14 and 2^-40 (bounds written before the batch existed
-            # can be within 1e-15 of the maximum); last, the per-segment certifier
-            # that wrote those, at its default and at 2^-14
-            steps = [lambda redo: certify_segments(self, kind, 2.0 ** -14, segments=redo),
-                     lambda redo: certify_segments(self, kind, 2.0 ** -40, segments=redo),
-                     lambda redo: _certify_alone(self, kind, None, redo),
-                     lambda redo: _certify_alone(self, kind, 2.0 ** -14, redo)]
-            for step in steps:
-                redo = [s for s in todo if stated[s] < certs[s].bound]
-                if not redo:
-                    break
-                for s, cert in zip(redo, step(redo)):
-                    if cert.bound < certs[s].bound:
-                        certs[s] = cert
-            for s in todo:
-                bound, maximum = stated[s], getattr(self.segments[s], f"max_{kind}_error")
-                if bound < certs[s].bound:
-                    raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
-                                     f"the certified error of segment {s} is "
-                                     f"{certs[s].bound:.2e}")
-                if maximum > bound:
-                    raise ValueError(f"segments[{s}].max_{kind}_error: {maximum!r} exceeds the "
-                                     f"segment's bound {bound!r}")
-        top = max(seg.abs_error_bound for seg in self.segments)
-        if self.abs_error_bound < top:
-            raise ValueError(f"abs_error_bound: stated {self.abs_error_bound!r} is below the "
-                             f"largest segment bound {top!r}")
-        if self.error_kind == "rel":
-            top_r = max(seg.rel_error_bound for seg in self.segments)
-            if self.rel_error_bound is None or self.rel_error_bound < top_r:
-                raise ValueError(f"rel_error_bound: stated {self.rel_error_bound!r} is below "
-                                 f"the largest segment bound {top_r!r}")
+        if not _sealed(self):
+            _establish(self, _own_fields, _prove, mode="prove")
         return self
+
+
+def _own_fields(cls, d) -> dict[str, Any]:
+    """:func:`_fields` of a constructed table's fields (``d`` lacks the file's kind
+    and schema)."""
+    if isinstance(d, dict):
+        d = {"kind": PIECEWISE_KIND, "schema": PIECEWISE_SCHEMA, **d}
+    return _fields(d)
+
+
+def _prove(table: PiecewiseTable) -> None:
+    """Re-certify every segment's stated bounds and located maxima (the fields,
+    and the top-level bounds' derivation from the segments, were checked by
+    :func:`_fields`)."""
+    for kind in ("abs", "rel"):
+        stated = [getattr(seg, f"{kind}_error_bound") for seg in table.segments]
+        todo = [s for s, b in enumerate(stated) if b is not None]
+        if not todo:
+            continue
+        certs = _segment_certificates(table, kind, stated, todo)
+        for s in todo:
+            bound, maximum = stated[s], getattr(table.segments[s], f"max_{kind}_error")
+            if bound < certs[s].bound:
+                raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
+                                 f"the certified error of segment {s} is "
+                                 f"{certs[s].bound:.2e}")
+            check_maximum(f"segments[{s}].max_{kind}_error", maximum,
+                          f"segments[{s}].{kind}_error_bound", bound, certs[s], "t")
+
+
+def _segment_certificates(table: PiecewiseTable, kind: str, stated, todo) -> dict:
+    """Certificates of the segments ``todo``, tightened where ``stated`` is below."""
+    certs = dict(zip(todo, certify_segments(table, kind, segments=todo)))
+    # a bound certified more tightly than the default needs a tighter proof:
+    # the batch at 2^-14 and 2^-40 (bounds written before the batch existed
+    # can be within 1e-15 of the maximum); last, the per-segment certifier
+    # that wrote those, at its default and at 2^-14
+    steps = [lambda redo: certify_segments(table, kind, 2.0 ** -14, segments=redo),
+             lambda redo: certify_segments(table, kind, 2.0 ** -40, segments=redo),
+             lambda redo: _certify_alone(table, kind, None, redo),
+             lambda redo: _certify_alone(table, kind, 2.0 ** -14, redo)]
+    for step in steps:
+        redo = [s for s in todo if stated[s] < certs[s].bound]
+        if not redo:
+            break
+        for s, cert in zip(redo, step(redo)):
+            if cert.bound < certs[s].bound:
+                certs[s] = cert
+    return certs
 
 
 # -- geometry ------------------------------------------------------------------
@@ -590,6 +609,9 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
     >>> t.segment_count, t.rel_error_bound < 1e-3
     (8, True)
     """
+    from .textsafe import identifier
+
+    name = identifier(name, field="name")
     index_bits = parse_segments(segments)
     degree = _check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
     frac_bits = _check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
@@ -658,13 +680,15 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
                                   f"({sp.sstr(lo)!r}, {sp.sstr(hi)!r}), {degree}, "
                                   f"segments={2 ** index_bits}, segment_by={segment_by!r}, "
                                   f"coef_frac_bits={frac_bits}, centered={centered})")
-    return PiecewiseTable(
-        name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
-        interval=(sp.sstr(lo), sp.sstr(hi)), segment_by=segment_by, index_bits=index_bits,
-        degree=degree, centered=centered, fit=fit, error_kind=error, coef_frac_bits=frac_bits,
-        segments=tuple(out), abs_error_bound=max(sg.abs_error_bound for sg in out),
-        rel_error_bound=max(sg.rel_error_bound for sg in out) if error == "rel" else None,
-        provenance=prov)
+    with _construction("fitted"):  # certified above: checked, not proved twice
+        return PiecewiseTable(
+            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+            interval=(sp.sstr(lo), sp.sstr(hi)), segment_by=segment_by, index_bits=index_bits,
+            degree=degree, centered=centered, fit=fit, error_kind=error,
+            coef_frac_bits=frac_bits, segments=tuple(out),
+            abs_error_bound=max(sg.abs_error_bound for sg in out),
+            rel_error_bound=max(sg.rel_error_bound for sg in out) if error == "rel" else None,
+            provenance=prov)
 
 
 # -- reading ---------------------------------------------------------------------
@@ -702,7 +726,10 @@ def _str(value, fieldname: str, max_length: int = 1000) -> str:
     return value
 
 
-def _read(d) -> PiecewiseTable:
+def _fields(d) -> dict[str, Any]:
+    """The keyword arguments of :class:`PiecewiseTable` from its JSON object, every
+    field checked (a refusal names it), the top-level bounds derived from the
+    segments' (no certification)."""
     from . import textsafe
 
     if not isinstance(d, dict):
@@ -759,7 +786,7 @@ def _read(d) -> PiecewiseTable:
     segs = d["segments"]
     if not isinstance(segs, list) or len(segs) != count:
         raise _bad("segments", f"an array of {count} segments", segs)
-    out = []
+    out, rel = [], d["error_kind"] == "rel"
     for s, seg in enumerate(segs):
         where = f"segments[{s}]"
         if not isinstance(seg, dict) or set(seg) != _SEG_FIELDS:
@@ -771,23 +798,42 @@ def _read(d) -> PiecewiseTable:
             if isinstance(q, bool) or not isinstance(q, int) or abs(q) >= 2 ** MAX_COEF_INT_BITS:
                 raise _bad(f"{where}.integers[{j}]",
                            f"an integer of magnitude below 2^{MAX_COEF_INT_BITS}", q)
-        rel = d["error_kind"] == "rel"
+        for key in ("rel_error_bound", "max_rel_error"):
+            if not rel and seg[key] is not None:
+                raise _bad(f"{where}.{key}", "null (error_kind is 'abs': the segments "
+                           "certify no relative error)", seg[key])
         out.append(PiecewiseSegment(
             tuple(ints), _num(seg["abs_error_bound"], f"{where}.abs_error_bound"),
             _num(seg["max_abs_error"], f"{where}.max_abs_error"),
             _num(seg["rel_error_bound"], f"{where}.rel_error_bound", optional=not rel),
             _num(seg["max_rel_error"], f"{where}.max_rel_error", optional=not rel)))
-        if rel and (out[-1].rel_error_bound is None):
-            raise _bad(f"{where}.rel_error_bound", "a number (error_kind is 'rel')", None)
     prov = d["provenance"]
     if not isinstance(prov, dict) or len(prov) > 32 or not all(
             isinstance(k, str) and isinstance(v, str) and len(k) <= 64 and len(v) <= 1000
             for k, v in prov.items()):
         raise _bad("provenance", "an object of at most 32 short strings", prov)
-    return PiecewiseTable(
+    return dict(
         name=name, expression=expression, variable=variable, interval=interval,
         segment_by=segment_by, index_bits=index_bits, degree=degree, centered=d["centered"],
         fit=d["fit"], error_kind=d["error_kind"], coef_frac_bits=frac_bits, segments=tuple(out),
-        abs_error_bound=_num(d["abs_error_bound"], "abs_error_bound"),
-        rel_error_bound=_num(d["rel_error_bound"], "rel_error_bound", optional=True),
+        abs_error_bound=_derived(d["abs_error_bound"], "abs", out),
+        rel_error_bound=_derived(d["rel_error_bound"], "rel" if rel else None, out),
         provenance=dict(prov))
+
+
+def _derived(value, kind: str | None, segments) -> float | None:
+    """The table's ``{kind}_error_bound``: exactly the largest segment bound
+    (null when ``kind`` is None: error_kind 'abs' certifies no relative error)."""
+    field_name = f"{kind or 'rel'}_error_bound"
+    if kind is None:
+        if value is not None:
+            raise _bad(field_name, "null (error_kind is 'abs': the segments certify no "
+                       "relative error)", value)
+        return None
+    stated = _num(value, field_name)
+    top = max(getattr(seg, field_name) for seg in segments)
+    if stated != top:
+        raise ValueError(f"{field_name}: stated {stated!r} but the largest segment bound is "
+                         f"{top!r}; accepted: exactly that (the table's bound is the "
+                         f"segments')")
+    return stated

@@ -23,9 +23,12 @@ or ``abs_error_bound: stated 4.24e-03 but the coefficients' certified error is
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import json
 import math
+import weakref
 from fractions import Fraction
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -146,6 +149,11 @@ class CoefficientTable:
     shift: tuple[float, float] | None = None
     quantized: Quantized | None = None
 
+    def __post_init__(self) -> None:
+        """Check every field and re-prove every claim (see :meth:`verify`): a table
+        built by hand or by ``dataclasses.replace`` is verified as a file is."""
+        _establish(self, _read_fields, _verify)
+
     @property
     def basis(self) -> str:
         """``"monomial"`` (powers of ``x``) or ``"shifted"`` (powers of ``(x - c)/s``)."""
@@ -205,7 +213,8 @@ class CoefficientTable:
         return d
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), sort_keys=True, indent=2) + "\n"
+        """The JSON text: keys sorted, strict JSON (no ``NaN``/``Infinity``)."""
+        return json.dumps(self.to_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "CoefficientTable":
@@ -215,17 +224,13 @@ class CoefficientTable:
         ``coefficients[2]: expected a finite number, got 'abc'``); then the
         claims are re-proved: see :meth:`verify`.
         """
-        return _verify(_read(cls, d))
+        return cls(**_read_fields(cls, d))
 
     @classmethod
     def from_json(cls, text: str) -> "CoefficientTable":
-        """Parse JSON text and read it with :meth:`from_dict` (so: verified)."""
-        try:
-            d = json.loads(text)
-        except (ValueError, RecursionError) as exc:  # JSONDecodeError, huge integers, deep nesting
-            raise ValueError(f"coefficient table is not valid JSON: "
-                             f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
-        return cls.from_dict(d)
+        """Parse JSON text and read it with :meth:`from_dict` (so: verified).
+        A key given twice in one object is refused, naming the key."""
+        return cls.from_dict(parse_json(text, "coefficient table"))
 
     @classmethod
     def load(cls, path) -> "CoefficientTable":
@@ -272,8 +277,15 @@ class CoefficientTable:
         Traceback (most recent call last):
         ...
         ValueError: abs_error_bound: stated 1.56e-02 but the coefficients' certified error is 3.12e-02; |p - f| reaches 3.12e-02 at x = 0.0
+
+        Every table is verified when it is constructed (a file, a hand-built
+        table, ``dataclasses.replace``); this call costs a comparison when
+        nothing changed since, and re-proves the table otherwise (fields set
+        behind the frozen dataclass's back, an unpickled object).
         """
-        return type(self).from_dict(self.to_dict())
+        if not _sealed(self):
+            _establish(self, _read_fields, _verify, mode="prove")
+        return self
 
     def save(self, path) -> None:
         """Write the JSON atomically (temporary file, then rename)."""
@@ -315,11 +327,12 @@ class CoefficientTable:
         """An HTML table of the fit for Jupyter; every field is HTML-escaped
         (tables may come from untrusted files).
 
-        >>> t = CoefficientTable(name="<script>", expression="x**2", variable="x",
+        >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
         ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
         ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
         ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
-        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None)
+        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None,
+        ...     provenance={"command": "<script>"})
         >>> "&lt;script&gt;" in t._repr_html_() and "<script>" not in t._repr_html_()
         True
         """
@@ -334,13 +347,14 @@ class CoefficientTable:
     def _repr_markdown_(self) -> str:
         """A Markdown table of the fit; user text is escaped for Markdown and HTML.
 
-        >>> t = CoefficientTable(name="a|b", expression="x**2", variable="x",
+        >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
         ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
         ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
         ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
-        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None)
-        >>> print(t._repr_markdown_().splitlines()[0])
-        **CoefficientTable a\\|b**
+        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None,
+        ...     provenance={"command": "a|b"})
+        >>> print(t._repr_markdown_().splitlines()[-1])
+        | provenance | command: a\\|b |
         """
         lines = [f"**CoefficientTable {_markdown_escape(self.name)}**", "", "| | |", "|---|---|"]
         lines += [f"| {_markdown_escape(k)} | {_markdown_escape(v)} |" for k, v in self._display_rows()]
@@ -631,8 +645,9 @@ def _read_quantized(q, degree: int) -> Quantized | None:
         max_rel_error=max_rel)
 
 
-def _read(cls, d) -> "CoefficientTable":
-    """Build a table from a JSON object, every field checked (no certification)."""
+def _read_fields(cls, d) -> dict[str, Any]:
+    """The fields of a table from its JSON object, every field checked (no
+    certification): the keyword arguments of ``cls``."""
     from .api import ERROR_KINDS, KINDS, MAX_DEGREE
     from .textsafe import identifier
 
@@ -672,6 +687,9 @@ def _read(cls, d) -> "CoefficientTable":
     if (rel is None) != (max_rel is None) or (rel is None) != (max_rel_at is None):
         raise ValueError("max_rel_error, max_rel_at: must be null exactly when "
                          "rel_error_bound is null")
+    if rel is None and d["error_kind"] == "rel":
+        raise ValueError("rel_error_bound: null, but error_kind is 'rel'; accepted: the "
+                         "certified relative error of a fit that minimized it")
     shift = None
     if d["shift"] is not None:
         pair = _array(d["shift"], "shift", "2 numbers [center, scale]")
@@ -680,7 +698,7 @@ def _read(cls, d) -> "CoefficientTable":
         shift = (_number(pair[0], "shift[0]"), _number(pair[1], "shift[1]", nonneg=True))
         if not shift[1] > 0:
             raise _bad("shift[1]", "a positive number (the scale s of t = (x - c)/s)", pair[1])
-    return cls(
+    return dict(
         name=identifier(d["name"], field="name"),
         expression=_text(d["expression"], "expression"),
         variable=identifier(d["variable"], field="variable"),
@@ -698,6 +716,150 @@ def _read(cls, d) -> "CoefficientTable":
         fixed_point=_read_fixed(d["fixed_point"], degree),
         provenance=dict(provenance), schema_version=SCHEMA_VERSION, shift=shift,
         quantized=_read_quantized(d["quantized"], degree))
+
+
+# -- construction: every table checked, every claim proved, once ----------------
+
+#: how a table being constructed is checked: ``"prove"`` (the default: every
+#: field checked, every claim re-proved), ``"fitted"`` (the fitter's own
+#: tables, whose bounds it has just certified: every field checked, nothing
+#: proved twice) or ``"unchecked"`` (nothing: for tests of the consumers' own
+#: defenses only; such a table is not sealed, so a consumer that verifies
+#: re-proves it). Module-private; set only through :func:`_construction`.
+_MODE: contextvars.ContextVar[str] = contextvars.ContextVar("chebnorm_table_mode",
+                                                            default="prove")
+
+
+@contextlib.contextmanager
+def _construction(mode: str):
+    """Construct tables in ``mode`` (see :data:`_MODE`) inside the block."""
+    if mode not in ("prove", "fitted", "unchecked"):
+        raise ValueError(f"mode {mode!r}")
+    token = _MODE.set(mode)
+    try:
+        yield
+    finally:
+        _MODE.reset(token)
+
+
+#: id(table) -> (weak reference, JSON text of the fields that were verified)
+_SEALS: dict[int, tuple[weakref.ref, str]] = {}
+
+
+def _seal(t) -> None:
+    """Record that ``t``'s present fields were verified."""
+    key = id(t)
+
+    def forget(ref, key=key):
+        if _SEALS.get(key, (None,))[0] is ref:
+            del _SEALS[key]
+
+    _SEALS[key] = (weakref.ref(t, forget), t.to_json())
+
+
+def _sealed(t) -> bool:
+    """True when ``t`` was verified and none of its fields (nested ones included)
+    changed since."""
+    entry = _SEALS.get(id(t))
+    if entry is None or entry[0]() is not t:
+        return False
+    try:
+        return entry[1] == t.to_json()
+    except (TypeError, ValueError, AttributeError, RecursionError):
+        return False
+
+
+def _plain(value):
+    """A value as JSON would hold it: tuples, numpy arrays and dataclasses as
+    lists and objects, numpy scalars as Python numbers; anything else as it is
+    (for the reader to refuse, naming the field)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name, None)) for f in dataclasses.fields(value)}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _first_non_finite(value, path: str = ""):
+    """``(path, value)`` of the first float in ``value`` (provenance aside) that is
+    inf or nan, or None."""
+    if isinstance(value, float):
+        return None if math.isfinite(value) else (path, value)
+    if isinstance(value, dict):
+        items = [(f"{path}.{k}" if path else str(k), v) for k, v in value.items()
+                 if k != "provenance"]
+    elif isinstance(value, list):
+        items = [(f"{path}[{k}]", v) for k, v in enumerate(value)]
+    else:
+        return None
+    for where, v in items:
+        hit = _first_non_finite(v, where)
+        if hit is not None:
+            return hit
+    return None
+
+
+def _establish(t, read_fields, prove, mode: str | None = None) -> None:
+    """Check ``t``'s fields with ``read_fields`` (normalizing them: tuples, floats),
+    re-prove its claims with ``prove`` unless the fitter built it, and seal it."""
+    mode = mode or _MODE.get()
+    if mode == "unchecked":
+        return
+    d = _plain(t)
+    if mode == "fitted":
+        bad = _first_non_finite(d)
+        if bad is not None:
+            lo, hi = (_show(str(v)).strip("'") for v in t.interval)
+            raise ValueError(f"{bad[0]}: the certified value is {bad[1]!r} for "
+                             f"{_show(str(t.expression)).strip(chr(39))} on [{lo}, {hi}], "
+                             f"beyond the float64 range; accepted: a "
+                             f"function, interval and degree whose error and coefficients "
+                             f"stay finite (below 1.8e308)")
+    fields = read_fields(type(t), d)
+    for name, value in fields.items():
+        object.__setattr__(t, name, value)
+    if mode == "prove":
+        prove(t)
+    _seal(t)
+
+
+def parse_json(text, what: str):
+    """``json.loads`` of a table's text; refuses what is not JSON, and an object
+    that gives a key twice (naming the key).
+
+    >>> parse_json('{"a": 1, "a": 2}', "coefficient table")
+    Traceback (most recent call last):
+    ...
+    ValueError: coefficient table is not valid JSON: key 'a' appears twice in one object; accepted: each key once
+    """
+    def pairs(items):
+        out = {}
+        for key, value in items:
+            if key in out:
+                raise _Duplicate(key)
+            out[key] = value
+        return out
+
+    try:  # NaN and Infinity are read, for the field's check to refuse naming the field
+        return json.loads(text, object_pairs_hook=pairs)
+    except _Duplicate as exc:
+        raise ValueError(f"{what} is not valid JSON: key {str(exc.key)[:60]!r} appears twice "
+                         f"in one object; accepted: each key once") from None
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError, huge integers, deep nesting
+        raise ValueError(f"{what} is not valid JSON: "
+                         f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
+
+
+class _Duplicate(Exception):
+    def __init__(self, key):
+        super().__init__(key)
+        self.key = key
 
 
 # -- verifying: every stated bound re-proved for exactly the stored numbers -----
@@ -798,13 +960,63 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
             if bound is None:
                 continue
             what = f"{whose} certified {'relative ' if kind == 'rel' else ''}error"
-            _prove(f"{prefix}{kind}_error_bound", bound, fn, coeffs, lo, hi, kind, what,
-                   t.shift)
-            if maximum > bound:
-                s, m = _fmt2(bound, maximum)
-                raise ValueError(f"{prefix}max_{kind}_error: the located maximum {m} exceeds "
-                                 f"{prefix}{kind}_error_bound = {s}")
+            cert = _prove(f"{prefix}{kind}_error_bound", bound, fn, coeffs, lo, hi, kind, what,
+                          t.shift)
+            check_maximum(f"{prefix}max_{kind}_error", maximum, f"{prefix}{kind}_error_bound",
+                          bound, cert, fn.var)
+    for kind, stated, at in (("abs", t.max_abs_error, t.max_abs_at),
+                             ("rel", t.max_rel_error, t.max_rel_at)):
+        if at is not None:
+            _check_at(kind, stated, at, fn, t)
     return t
+
+
+def check_maximum(field: str, stated: float, bound_field: str, bound: float, cert,
+                  var) -> None:
+    """Refuse a located maximum ``stated`` (``field``) that is not one: above its
+    stated bound, above the certified bound ``cert.bound`` of the supremum (so
+    above the supremum), or below ``cert.maximum / (1 + TOL)`` (the certifier
+    located ``|g| = cert.maximum``, and a certified located maximum is within
+    ``1 + TOL`` of the supremum)."""
+    from .certify import TOL
+
+    if stated > bound:
+        s, m = _fmt2(bound, stated)
+        raise ValueError(f"{field}: the located maximum {m} exceeds {bound_field} = {s}")
+    if stated > cert.bound:
+        m, u = _fmt2(stated, cert.bound)
+        raise ValueError(f"{field}: the located maximum {m} exceeds the certified bound {u} "
+                         f"of the supremum; accepted: a value the error reaches")
+    if stated < math.nextafter(cert.maximum / (1 + TOL), 0.0):
+        m, u = _fmt2(stated, cert.maximum)
+        raise ValueError(f"{field}: stated {m} but the error reaches {u} at {var} = "
+                         f"{cert.at!r}; accepted: the located maximum, within 1 + 2^-8 of the "
+                         f"supremum")
+
+
+def _check_at(kind: str, stated: float, at: float, fn, t) -> None:
+    """Refuse ``max_{kind}_error`` unless it is ``|g(max_{kind}_at)|`` (one ulp, and the
+    enclosure's own width, allowed)."""
+    from flint import arb, ctx
+
+    from .certify import _PolyTaylor, _error_function
+
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        g = _error_function(fn.arb, _PolyTaylor([arb(c) for c in t.coefficients], t.shift), kind)
+        v = abs(g(arb(at)))
+        if not v.is_finite():
+            raise ValueError(f"max_{kind}_at: the error cannot be evaluated at {t.variable} = "
+                             f"{at!r}; accepted: the point where max_{kind}_error is reached")
+        v = arb(v.mid(), 2 * v.rad())
+        if arb(math.nextafter(stated, math.inf)) < v or arb(math.nextafter(stated, -math.inf)) > v:
+            g_text = "|p - f|" if kind == "abs" else "|p/f - 1|"
+            s, u = _fmt2(stated, float(v.mid()))
+            raise ValueError(f"max_{kind}_error: stated {s} but {g_text} at max_{kind}_at = "
+                             f"{at!r} is {u}; accepted: the error at the stated point")
+    finally:
+        ctx.prec = old
 
 
 def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float, float]:

@@ -9,6 +9,7 @@ import sys
 import warnings
 
 from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
+from chebnorm.approx.textsafe import identifier
 
 from ._common import command_line, deprecated_alias, print_json
 
@@ -51,7 +52,8 @@ def register(sub) -> None:
                    help="monomial (default): powers of VAR; shifted: powers of t = (VAR - c)/s, "
                    "c the midpoint, s a power of two (well conditioned on narrow or offset "
                    "intervals, where monomials lose accuracy; exported to C, not to hw/shaders)")
-    p.add_argument("--name", default="table", help="table name (a C identifier)")
+    p.add_argument("--name", default="table", help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
+                   "most 63 characters (it names the C function, shader and HDL module)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
     p.set_defaults(func=run)
@@ -98,6 +100,7 @@ def _run_piecewise(args) -> int:
 
 
 def run(args) -> int:
+    identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)
     mon = args.monomials

@@ -58,6 +58,8 @@ def export_text(table: CoefficientTable, fmt: str, command: str = "") -> str:
         printer, _ = FORMATS[fmt]
     except (KeyError, TypeError):
         raise ValueError(f"unknown export format {fmt!r}; accepted: {', '.join(sorted(FORMATS))}") from None
+    if isinstance(table, CoefficientTable):
+        table.verify()  # a comparison, or a re-proof of fields changed since construction
     return printer(table, command)
 
 

@@ -150,6 +150,8 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     >>> r.measurement.total <= r.budget.total, r.synth is None
     (True, True)
     """
+    if isinstance(table, CoefficientTable):
+        table.verify()  # a comparison, or a re-proof of fields changed since construction
     design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
                            rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits)
     import shutil
