@@ -16,7 +16,6 @@ level here).
 from __future__ import annotations
 
 import re
-import sys
 import time
 
 from chebnorm.approx import fit, sollya
