@@ -408,24 +408,14 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
 
 def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None,
              abort_at: float | None = None) -> Certificate | None:
-    """:func:`certify`'s work. With ``abort_at``, None as soon as the bound is
-    proven ``>= abort_at`` (the located maximum or an accepted piece's upper
-    bound reaches it: the returned bound is their maximum, rounded up), else
-    the same certificate as without it."""
+    """:func:`certify`'s work; with ``abort_at``, None once the bound (the largest
+    of the located maximum and the accepted pieces' upper bounds) reaches it."""
     p = _PolyTaylor([arb(c) for c in floats], shift)
     g = _error_taylor(fn.arb_series, p, kind)  # (x0, n) -> Taylor coefficients
     g_point = _error_function(fn.arb, p, kind)
-    lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
-    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
-    if not lo_f <= hi_f:
-        raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
-                         f"interval wider than one float64 spacing")
+    lo_b, hi_b, lo_f, hi_f = _enclose_interval(lo, hi)
     a0, b0 = lo_b.lower(), hi_b.upper()
-    degree = max(len(floats) - 1, 0)
-    pieces = 2 * (degree + 2)
-    edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
-    # exact binary split points (the outer two keep the enclosing endpoints)
-    edges = [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
+    edges = _edges(a0, b0, max(len(floats) - 1, 0))
     if kind == "rel":
         _refuse_sign_change(fn, edges, g_point)
     work = list(zip(edges[:-1], edges[1:]))
@@ -515,6 +505,24 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None,
     bound = accepted_upper.max(arb(maximum))
     return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
                        tight=not reasons, reason="; ".join(sorted(reasons)))
+
+
+def _enclose_interval(lo, hi) -> tuple[arb, arb, float, float]:
+    """Balls of the exact endpoints and the floats nearest inside ``[lo, hi]``."""
+    lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
+    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)
+    if not lo_f <= hi_f:
+        raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
+                         f"interval wider than one float64 spacing")
+    return lo_b, hi_b, lo_f, hi_f
+
+
+def _edges(a0: arb, b0: arb, degree: int) -> list[arb]:
+    """The first pieces' ends: ``2 (degree + 2)`` equal pieces, split at exact
+    binary points (the outer two ends keep the enclosing endpoints)."""
+    pieces = 2 * (degree + 2)
+    edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
+    return [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
 
 
 def _refuse_sign_change(fn, points, g_point) -> None:

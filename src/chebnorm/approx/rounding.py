@@ -226,6 +226,26 @@ class _Sampler:
         err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
         return float(np.max(err)) if err.size else 0.0
 
+    def errors(self, rows, chunk: int = 32) -> list[float]:
+        """:meth:`error` of each coefficient list in ``rows`` (all of one
+        length), several at a time: the same operations element by element
+        (a zero coefficient adds a zero term, which changes no sum), so the
+        same floats."""
+        out: list[float] = []
+        if not self.x.size:
+            return [0.0] * len(rows)
+        for i in range(0, len(rows), chunk):
+            c = np.array(rows[i:i + chunk], dtype=float)
+            p = np.zeros((len(c), self.x.size))
+            mag = np.zeros_like(p)
+            for k in range(c.shape[1]):
+                term = c[:, k:k + 1] * self.xp[k]
+                p += term
+                mag += np.abs(term)
+            err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
+            out.extend(float(v) for v in np.max(err, axis=1))
+        return out
+
 
 #: tolerance of the certificates that rank candidates: candidates often differ
 #: by less than the certifier's default 2^-8, and a looser bound would misrank
@@ -269,8 +289,9 @@ def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | No
         if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
             continue
         seen.add(coeffs)
-        ranked.append((sampler.error(coeffs), method, ms, es, coeffs))
-    ranked.sort(key=lambda r: (r[0], r[1]))
+        ranked.append((method, ms, es, coeffs))
+    lows = sampler.errors([r[3] for r in ranked]) if ranked else []
+    ranked = sorted(((low,) + r for low, r in zip(lows, ranked)), key=lambda r: (r[0], r[1]))
     for low, method, ms, es, coeffs in ranked:
         if best is not None and low >= best.bound:
             break
@@ -438,8 +459,9 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         tried.add(quanta)
         cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
         best = _select(prob, sampler, cands, best)
-        ranked = sorted(cands.values(), key=lambda c: sampler.error(
-            [math.ldexp(m, e) for m, e in zip(*c)]))
+        values = list(cands.values())
+        lows = sampler.errors([[math.ldexp(m, e) for m, e in zip(*c)] for c in values])
+        ranked = [values[i] for i in sorted(range(len(values)), key=lows.__getitem__)]
         for ms, es in ranked[:8]:
             # a zero coefficient keeps its quantum (float_quantum(0) is the
             # format's smallest, 2^-1074 in binary64: the real one would overflow)
