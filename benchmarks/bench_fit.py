@@ -18,8 +18,18 @@ running ``supnorm`` on each segment's composed function ``f(a_s + h t)``, t in
 [0, 1], same coefficients, same tightness; and, for reference, chebnorm's
 ``certify`` run on one segment after another (one run).
 
+Quantization workload (issue 25, ``--quantize`` alone): 48 cases (fixed point
+8..28 bits, binary16/bfloat16/binary32/binary64, degrees 2..10, odd and even
+powers, a fixed constant; 1/sqrt, exp, sin, cos, atan, log(1+x), 2^x, erf, tan;
+absolute and relative error). chebnorm: ``quantize`` of a table fitted before
+the timer (the constrained real fit quantize runs itself is timed with it);
+Sollya: in one process, per case ``fpminimax`` then ``supnorm`` at 2^-20 of its
+result, each timed by Sollya's ``time()``. Prints per case the seconds, the
+ratio, both certified bounds and chebnorm's bound before issue 25's speed work
+(benchmarks/quantize_bounds_before.json); exit status 1 if any bound got worse.
+
 Usage: python benchmarks/bench_fit.py [--json] [--repeat N] [--tight T ...] [--piecewise-only]
-                                      [--high-degree]
+                                      [--high-degree] [--quantize]
 Columns of the 18-case table, seconds summed over the cases, medians of the
 ``--repeat`` runs (each run does every case once; on both sides parsing the
 expression and the interval happens outside the timers):
@@ -221,6 +231,243 @@ def piecewise_rows(tights, repeat: int) -> list[dict]:
     return rows
 
 
+# ------------------------------------------------------------ quantization (issue 25)
+ODD5, ODD7, ODD9 = (1, 3, 5), (1, 3, 5, 7), (1, 3, 5, 7, 9)
+EV4, EV6, EV8 = (0, 2, 4), (0, 2, 4, 6), (0, 2, 4, 6, 8)
+PI4 = ("-pi/4", "pi/4")
+#: (expression, interval, degree, error, format, frac bits, monomials, fix_constant)
+QUANT_WORKLOAD = [
+ ("1/sqrt(x)", ("1/4","1"), 2, "rel", "fixed", 8, None, False),
+ ("1/sqrt(x)", ("1/4","1"), 3, "rel", "fixed", 12, None, False),
+ ("1/sqrt(x)", ("1","2"), 4, "abs", "fixed", 16, None, False),
+ ("1/sqrt(x)", ("1","2"), 5, "abs", "fixed", 20, None, False),
+ ("1/sqrt(x)", ("1","2"), 10, "rel", "fixed", 28, None, False),
+ ("exp(x)", ("0","1"), 2, "abs", "fixed", 8, None, False),
+ ("exp(x)", ("0","1"), 3, "abs", "fixed", 12, None, False),
+ ("exp(x)", ("0","1"), 5, "abs", "fixed", 20, None, False),
+ ("exp(x)", ("0","1"), 7, "rel", "fixed", 28, None, False),
+ ("exp(x)", ("-1/2","1/2"), 6, "abs", "fixed", 24, None, False),
+ ("sin(x)", PI4, 7, "abs", "fixed", 16, ODD7, False),
+ ("sin(x)", PI4, 9, "abs", "fixed", 28, ODD9, False),
+ ("sin(x)", ("0","pi/4"), 5, "abs", "fixed", 24, ODD5, False),
+ ("cos(x)", PI4, 6, "abs", "fixed", 24, EV6, False),
+ ("cos(x)", ("-1/8","1/8"), 6, "abs", "fixed", 28, EV6, False),
+ ("cos(x)", PI4, 4, "abs", "fixed", 12, EV4, False),
+ ("atan(x)", ("-1","1"), 7, "abs", "fixed", 16, ODD7, False),
+ ("atan(x)", ("0","1"), 5, "abs", "fixed", 20, None, False),
+ ("atan(x)", ("0","1/4"), 9, "abs", "fixed", 28, ODD9, False),
+ ("log(1+x)", ("0","1"), 5, "abs", "fixed", 16, None, False),
+ ("log(1+x)", ("0","1"), 8, "abs", "fixed", 24, None, True),
+ ("log(1+x)/log(2)", ("0","1"), 6, "abs", "fixed", 20, None, False),
+ ("2^x", ("0","1"), 4, "abs", "fixed", 16, None, True),
+ ("2^x", ("0","1"), 6, "rel", "fixed", 24, None, False),
+ ("erf(x)", ("0","1"), 7, "abs", "fixed", 20, ODD7, False),
+ ("erf(x)", ("-1","1"), 9, "abs", "fixed", 24, ODD9, False),
+ ("exp(x)", ("0","1"), 4, "abs", "binary16", None, None, False),
+ ("exp(x)", ("0","1"), 6, "rel", "binary32", None, None, False),
+ ("exp(x)", ("0","1"), 10, "abs", "binary64", None, None, False),
+ ("1/sqrt(x)", ("1/4","1"), 4, "rel", "binary16", None, None, False),
+ ("1/sqrt(x)", ("1","2"), 6, "rel", "binary32", None, None, False),
+ ("1/sqrt(x)", ("1","2"), 8, "rel", "binary64", None, None, False),
+ ("sin(x)", ("-1/8","1/8"), 7, "abs", "binary64", None, ODD7, False),
+ ("sin(x)", ("-1/8","1/8"), 7, "abs", "binary32", None, ODD7, False),
+ ("sin(x)", PI4, 9, "abs", "binary64", None, ODD9, False),
+ ("cos(x)", PI4, 8, "abs", "binary32", None, EV8, False),
+ ("cos(x)", PI4, 6, "abs", "bfloat16", None, EV6, False),
+ ("atan(x)", ("0","1"), 8, "abs", "binary32", None, None, False),
+ ("atan(x)", ("-1","1"), 9, "abs", "binary64", None, ODD9, False),
+ ("log(1+x)", ("0","1"), 6, "abs", "bfloat16", None, None, False),
+ ("log(1+x)", ("0","1"), 9, "abs", "binary64", None, None, False),
+ ("2^x", ("0","1"), 6, "abs", "binary64", None, None, True),
+ ("2^x", ("0","1"), 5, "rel", "binary32", None, None, False),
+ ("2^x", ("0","1"), 3, "abs", "binary16", None, None, False),
+ ("erf(x)", ("0","1"), 8, "abs", "binary32", None, None, False),
+ ("erf(x)", ("-1","1"), 7, "abs", "binary64", None, ODD7, False),
+ ("tan(x)", ("-1/4","1/4"), 7, "abs", "binary64", None, ODD7, False),
+ ("exp(x)", ("0","1"), 2, "rel", "bfloat16", None, None, False),
+]
+#: quantize's bounds on QUANT_WORKLOAD before issue 25's speed work (none may get worse)
+QUANT_BEFORE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                            "quantize_bounds_before.json")
+
+
+def _quant_label(case) -> str:
+    expr, iv, d, err, fmt, bits, mons, fc = case
+    return f"{expr} {iv} d{d} {err} {fmt}{bits or ''} {mons} {fc}"
+
+
+def _sollya_fit_domain(case) -> str:
+    """The domain Sollya's fpminimax is given: the case's interval, except where
+    its Remez step meets a degenerate (non-Haar) system, as it does on every
+    case here whose powers all vanish at 0 on an interval containing 0, or that
+    has one parity on a symmetric interval ("the algorithm does not converge",
+    after 1-3 s): there the half interval ``[2^-40, hi]`` (odd powers, or no
+    constant) or ``[0, hi]`` (even powers), as a Sollya user does; the error
+    is the same by symmetry. supnorm always runs on the whole interval."""
+    expr, (lo, hi), d, err, fmt, bits, mons, fc = case
+    powers = [k for k in (mons or range(d + 1)) if not (fc and k == 0)]
+    sym = parse_number(lo) == -parse_number(hi)
+    parity = {k % 2 for k in powers}
+    if sym and len(parity) == 1:
+        lo = "0" if parity == {0} else "2^(-40)"
+    elif parse_number(lo) == 0 and 0 not in powers:
+        lo = "2^(-40)"
+    return sollya.interval_text(lo, hi).replace("2**(-40)", "2^(-40)")
+
+
+#: Sollya's precision (floating) of each floating format
+SOLLYA_PRECISION = {"binary16": 11, "bfloat16": 8, "binary32": 24, "binary64": 53}
+
+
+def run_quantize_sollya(constants, workload=QUANT_WORKLOAD, tight: float = 2.0 ** -20):
+    """One sollya process: per case ``fpminimax`` then ``supnorm`` of the result
+    (the case's error kind, at ``tight``), each timed by Sollya's ``time()``;
+    ``constants[i]``: the float p(0) is held at in a fix_constant case (f(0)
+    rounded to its format, as quantize holds it), else None.
+    Returns per case (seconds, upper bound) or (seconds, None) when Sollya failed;
+    and the wall time of the process."""
+    lines = ["prec=300!;", "display=decimal!;", "verbosity=0!;"]
+    for i, case in enumerate(workload):
+        expr, (lo, hi), d, err, fmt, bits, mons, fc = case
+        powers = [k for k in (mons or range(d + 1)) if not (fc and k == 0)]
+        mode = "absolute" if err == "abs" else "relative"
+        width = bits if fmt == "fixed" else SOLLYA_PRECISION[fmt]
+        kind = "fixed" if fmt == "fixed" else "floating"
+        cons = ""
+        if fc:  # the constrained part: p(0), exactly
+            num, den = float(constants[i]).as_integer_ratio()
+            cons = f", ({num}*2^({1 - den.bit_length()}))"
+        lines += [f"f={sollya.function_text(expr)};", f"d={sollya.interval_text(lo, hi)};",
+                  f"t1=time(p=fpminimax(f, [|{','.join(map(str, powers))}|], "
+                  f"[|{','.join([str(width)] * len(powers))}|], {_sollya_fit_domain(case)}, "
+                  f"{kind}, {mode}{cons}));",
+                  f"t2=time(r=supnorm(p, f, d, {mode}, {tight!r}));",
+                  f'print("Q{i}", t1 + t2, sup(r));']
+    lines.append("quit;")
+    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
+        fh.write("\n".join(lines) + "\n")
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
+                             stdin=subprocess.DEVNULL).stdout
+    finally:
+        os.unlink(fh.name)
+    wall = time.perf_counter() - t0
+    rows = []
+    for i in range(len(workload)):
+        m = re.search(rf"^Q{i}\s+(\S+)\s+(\S+)\s*$", out, re.M)
+        if m is None:
+            raise RuntimeError(f"sollya printed no line for case {i}; its output began: "
+                               f"{out[:200]!r}")
+        sup = None if m.group(2) == "error" else float(m.group(2))
+        rows.append((float(m.group(1)), sup))
+    return rows, wall
+
+
+def quantize_tables(workload=QUANT_WORKLOAD):
+    """The real fits (minimax, the case's error kind): made before any timer."""
+    return [fit(expr, iv, d, kind="minimax", error=err)
+            for expr, iv, d, err, fmt, bits, mons, fc in workload]
+
+
+def run_quantize_chebnorm(tables, workload=QUANT_WORKLOAD):
+    """Seconds of each ``quantize`` (the real fit excluded: ``tables`` are made
+    before; the constrained real fit that quantize runs itself for monomials or
+    fix_constant is included), the certified bound of the case's error kind and
+    both bounds, and the held constant p(0) (fix_constant) or None."""
+    from chebnorm.approx import quantize
+
+    rows = []
+    for table, (expr, iv, d, err, fmt, bits, mons, fc) in zip(tables, workload):
+        t0 = time.perf_counter()
+        q = quantize(table, bits, coef_format=fmt, monomials=mons, fix_constant=fc,
+                     word_bits=64)
+        dt = time.perf_counter() - t0
+        qq = q.quantized
+        rows.append({"seconds": dt,
+                     "bound": qq.abs_error_bound if err == "abs" else qq.rel_error_bound,
+                     "abs_error_bound": qq.abs_error_bound,
+                     "rel_error_bound": qq.rel_error_bound, "method": qq.method,
+                     "constant": qq.coefficients[0] if fc else None})
+    return rows
+
+
+def quantize_rows(repeat: int) -> dict:
+    """The quantization workload: chebnorm's quantize against Sollya's fpminimax +
+    supnorm, per case (medians of ``repeat`` runs), with the bound check."""
+    workload = QUANT_WORKLOAD
+    tables = quantize_tables(workload)
+    ours = [run_quantize_chebnorm(tables, workload) for _ in range(repeat)]
+    theirs = None
+    note = None
+    if sollya.available():
+        try:
+            constants = [r["constant"] for r in ours[0]]
+            theirs = [run_quantize_sollya(constants, workload) for _ in range(repeat)]
+        except (RuntimeError, OSError) as exc:
+            note = f"sollya run failed: {exc}"
+    else:
+        note = "not installed: apt-get install sollya to compare"
+    with open(QUANT_BEFORE) as fh:
+        before = json.load(fh)["cases"]
+    cases = []
+    for i, case in enumerate(workload):
+        label = _quant_label(case)
+        row = {"case": label,
+               "chebnorm_s": statistics.median(o[i]["seconds"] for o in ours),
+               "chebnorm_bound": ours[0][i]["bound"], "chebnorm_method": ours[0][i]["method"]}
+        old = before.get(label)
+        if old is not None:
+            row["bound_before"] = old[f"{case[3]}_error_bound"]
+            # every bound the table states: none may exceed the one before
+            row["worse_than_before"] = any(
+                old[k] is not None and (ours[0][i][k] is None or ours[0][i][k] > old[k])
+                for k in ("abs_error_bound", "rel_error_bound"))
+        if theirs:
+            row["sollya_s"] = statistics.median(t[0][i][0] for t in theirs)
+            row["sollya_bound"] = theirs[0][0][i][1]
+            row["speedup"] = row["sollya_s"] / row["chebnorm_s"]
+        cases.append(row)
+    out = {"workload": f"quantize, {len(workload)} cases", "cases": cases,
+           "chebnorm_total_s": sum(r["chebnorm_s"] for r in cases),
+           "worse_than_before": [r["case"] for r in cases if r.get("worse_than_before")],
+           "load_average_1min": os.getloadavg()[0]}
+    if theirs:
+        out["sollya_total_s"] = sum(r["sollya_s"] for r in cases)
+        out["sollya_wall_s"] = statistics.median(t[1] for t in theirs)
+        out["sollya_failed"] = [r["case"] for r in cases if r["sollya_bound"] is None]
+        out["total_speedup"] = out["sollya_total_s"] / out["chebnorm_total_s"]
+        out["median_speedup"] = statistics.median(r["speedup"] for r in cases)
+    else:
+        out["sollya"] = note
+    return out
+
+
+def print_quantize(q: dict) -> None:
+    print(f"{q['workload']} (load average {q['load_average_1min']:.2f}); seconds per case, "
+          f"bounds of the case's error kind (chebnorm certified; Sollya supnorm's upper)")
+    print(f"{'chebnorm':>9} {'sollya':>8} {'ratio':>7}  {'chebnorm bound':>14} {'before':>11} "
+          f"{'sollya bound':>12}  case")
+    for r in q["cases"]:
+        sol = (f"{r['sollya_s']:8.3f} {r['speedup']:6.2f}x" if "sollya_s" in r
+               else f"{'':8} {'':7}")
+        sb = r.get("sollya_bound")
+        sb = "failed" if "sollya_s" in r and sb is None else "" if sb is None else f"{sb:.5e}"
+        print(f"{r['chebnorm_s']:9.3f} {sol}  {r['chebnorm_bound']:14.5e} "
+              f"{r.get('bound_before', float('nan')):11.5e} {sb:>12}  {r['case']}")
+    line = f"total: chebnorm quantize {q['chebnorm_total_s']:.3f} s"
+    if "sollya_total_s" in q:
+        line += (f", Sollya fpminimax + supnorm {q['sollya_total_s']:.3f} s; speed-up "
+                 f"{q['total_speedup']:.2f}x in total, median {q['median_speedup']:.2f}x; "
+                 f"Sollya failed on {len(q['sollya_failed'])} case(s)")
+    else:
+        line += f"; {q['sollya']}"
+    print(line)
+    print("bounds: " + ("none worse than before issue 25's speed work" if not
+                        q["worse_than_before"] else "WORSE than before: "
+                        + "; ".join(q["worse_than_before"])))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
@@ -230,7 +477,17 @@ def main(argv=None) -> int:
                     help="run only the piecewise workload")
     ap.add_argument("--high-degree", action="store_true",
                     help="the workload exp(x), atan(x) on [0, 1] at degree 20, 25, 30 instead")
+    ap.add_argument("--quantize", action="store_true",
+                    help="run only the quantization workload (issue 25): quantize against "
+                         "Sollya's fpminimax + supnorm; exit status 1 if a bound got worse")
     args = ap.parse_args(argv)
+    if args.quantize:
+        q = quantize_rows(args.repeat)
+        if args.json:
+            print(json.dumps(q, indent=2, sort_keys=True))
+        else:
+            print_quantize(q)
+        return 1 if q["worse_than_before"] else 0
     workload = HIGH_DEGREE if args.high_degree else WORKLOAD
     for expr, (lo, hi), d in workload:  # warm-up: imports, compiled functions
         fit(expr, (lo, hi), 1)

@@ -133,7 +133,11 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     return y.real
 
 
-def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = False):
+def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = False,
+                  known: dict | None = None):
+    """Certificates of the absolute and relative errors (None for the relative
+    one where f vanishes, unless ``need_rel``); ``known``: kind -> a certificate
+    already computed by the same call, reused."""
     if tight:  # monomial tables only (quantize refuses the shifted basis)
         from .rounding import certify_tight
 
@@ -142,9 +146,10 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
     else:
         def cert(*a):
             return certify(*a, shift=shift)
-    cert_abs = cert(fn, coeffs, iv.lo, iv.hi, "abs")
+    known = {k: c for k, c in (known or {}).items() if c is not None}
+    cert_abs = known.get("abs") or cert(fn, coeffs, iv.lo, iv.hi, "abs")
     try:
-        cert_rel = cert(fn, coeffs, iv.lo, iv.hi, "rel")
+        cert_rel = known.get("rel") or cert(fn, coeffs, iv.lo, iv.hi, "rel")
     except ValueError:
         if need_rel:
             raise ValueError(f"relative error is undefined: {fn.expr} vanishes on "
@@ -604,8 +609,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         raise ValueError(_no_rounding(coef_format, real, word_bits, fracs))
     coeffs = best.coefficients
     # the certificates that ranked the candidates (tight), so the stated bound
-    # is the one the monotone chain compared
-    ca, cr = _certify_both(fn, list(coeffs), iv, table.error_kind == "rel", tight=True)
+    # is the one the monotone chain compared (the winner's is reused: same call)
+    ca, cr = _certify_both(fn, list(coeffs), iv, table.error_kind == "rel", tight=True,
+                           known={"abs": best.abs_cert, "rel": best.rel_cert})
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
 

@@ -348,7 +348,8 @@ def _ball(a: arb, b: arb, from_right: bool) -> arb:
 
 def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.Expr,
             kind: str = "abs", tol: float = TOL, max_subintervals: int = 200_000,
-            prec: int | None = None, shift: tuple[float, float] | None = None) -> Certificate:
+            prec: int | None = None, shift: tuple[float, float] | None = None,
+            *, abort_at: float | None = None) -> Certificate | None:
     """Certify ``sup_{x in [lo, hi]} |g(x)|`` for ``g = p - f`` or ``p/f - 1``.
 
     ``coefficients`` are the polynomial's float coefficients in ascending
@@ -359,7 +360,10 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     interval holds no float64 number (the located maximum is reported at one).
     With ``shift = (c, s)`` (floats, ``s > 0``) the coefficients are in the
     shifted variable: ``p(x) = sum_k coefficients[k] ((x - c)/s)^k``, the
-    quotient taken exactly.
+    quotient taken exactly. With ``abort_at`` (a float) it returns None as
+    soon as the bound is proven to be at least ``abort_at`` (for ranking
+    candidates against a known bound); otherwise the certificate is the one
+    computed without it.
 
     >>> from chebnorm.approx.expr import parse_function
     >>> import sympy as sp
@@ -382,7 +386,7 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
                 raise ValueError(f"shift {shift!r}: accepted: a finite center and a finite "
                                  f"positive scale")
         return _certify(fn, [float(c) for c in coefficients], lo, hi, kind, tol,
-                        max_subintervals, shift)
+                        max_subintervals, shift, abort_at)
     finally:
         ctx.prec = old_prec
 
@@ -402,21 +406,18 @@ def _scale(fn: Function1D, kind: str, points) -> arb:
     return best if best > 0 else arb(1)
 
 
-def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Certificate:
+def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None,
+             abort_at: float | None = None) -> Certificate | None:
+    """:func:`certify`'s work; with ``abort_at``, None once the bound (the largest
+    of the located maximum and the accepted pieces' upper bounds) reaches it."""
     p = _PolyTaylor([arb(c) for c in floats], shift)
     g = _error_taylor(fn.arb_series, p, kind)  # (x0, n) -> Taylor coefficients
     g_point = _error_function(fn.arb, p, kind)
-    lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
-    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)  # the floats nearest inside [lo, hi]
-    if not lo_f <= hi_f:
-        raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
-                         f"interval wider than one float64 spacing")
+    lo_b, hi_b, lo_f, hi_f = _enclose_interval(lo, hi)
     a0, b0 = lo_b.lower(), hi_b.upper()
-    degree = max(len(floats) - 1, 0)
-    pieces = 2 * (degree + 2)
-    edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
-    # exact binary split points (the outer two keep the enclosing endpoints)
-    edges = [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
+    edges = _edges(a0, b0, max(len(floats) - 1, 0))
+    if kind == "rel":
+        _refuse_sign_change(fn, edges, g_point)
     work = list(zip(edges[:-1], edges[1:]))
     min_width = (b0 - a0) * arb(2) ** -60
     # below this, |g| is rounding noise of the working precision
@@ -432,6 +433,9 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     best_lower, best_at = ((located[2], arb(located[1])) if located and located[2] > 0
                            else (arb(0), (a0 + b0) / 2))
     seeded_at = best_at
+    if abort_at is not None and located is not None and located[0] >= abort_at:
+        return None
+    limit = None if abort_at is None else arb(abort_at)
     accepted_upper = arb(0)
     count = 0
     reasons: set[str] = set()
@@ -487,6 +491,8 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
             else:
                 keep.append((upper, a, b))
         pending = []
+        if limit is not None and accepted_upper >= limit:
+            return None
         for _, a, b in keep:
             m = arb(float(((a + b) / 2).mid()))
             if not (a < m < b):
@@ -499,6 +505,46 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None) -> Cer
     bound = accepted_upper.max(arb(maximum))
     return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
                        tight=not reasons, reason="; ".join(sorted(reasons)))
+
+
+def _enclose_interval(lo, hi) -> tuple[arb, arb, float, float]:
+    """Balls of the exact endpoints and the floats nearest inside ``[lo, hi]``."""
+    lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
+    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)
+    if not lo_f <= hi_f:
+        raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
+                         f"interval wider than one float64 spacing")
+    return lo_b, hi_b, lo_f, hi_f
+
+
+def _edges(a0: arb, b0: arb, degree: int) -> list[arb]:
+    """The first pieces' ends: ``2 (degree + 2)`` equal pieces, split at exact
+    binary points (the outer two ends keep the enclosing endpoints)."""
+    pieces = 2 * (degree + 2)
+    edges = [a0 + (b0 - a0) * arb(k) / pieces for k in range(pieces + 1)]
+    return [a0] + [arb(float(e.mid())) for e in edges[1:-1]] + [b0]
+
+
+def _refuse_sign_change(fn, points, g_point) -> None:
+    """Raise :func:`certify`'s ValueError for ``p/f - 1`` at once when ``f`` is
+    proven zero at one of ``points`` (balls) or of opposite signs at two: the
+    subdivision would end in that error anyway (an enclosure of ``f`` over a
+    piece where it takes both signs, or 0, contains 0, and no piece whose
+    ratio is not finite is ever accepted), after bisecting down to ``2^-60``
+    of the interval."""
+    last = None
+    for x in points:
+        try:
+            v = fn.arb(x)
+        except (ValueError, ZeroDivisionError):
+            continue
+        if v.is_zero():
+            raise _not_finite("rel", x, None, g_point)
+        sign = 1 if v > 0 else -1 if v < 0 else 0
+        if sign and last is not None and sign != last[0]:
+            raise _not_finite("rel", (last[1] + x) / 2, None, g_point)
+        if sign:
+            last = (sign, x)
 
 
 def _not_finite(kind: str, m: arb, end: tuple[arb, arb] | None, g_point) -> ValueError:
@@ -568,6 +614,24 @@ def _locate_maximum(g, g_point, start: arb, lo: float, hi: float) -> tuple[float
 SEARCH_POINTS = 64
 
 
+@functools.lru_cache(maxsize=64)
+def _search_grid(f_np, lo: float, hi: float, n: int, shift):
+    """The grid of :func:`_float_argmax` (``x``, the variable ``t`` of the
+    polynomial, and ``f(x)``, read-only), cached: quantization certifies many
+    candidates on one interval. None when ``f`` cannot be evaluated."""
+    x = 0.5 * (lo + hi) - 0.5 * (hi - lo) * np.cos(np.pi * np.arange(n + 1) / n)
+    x[0], x[-1] = lo, hi
+    t = x if shift is None else (x - shift[0]) / shift[1]
+    with np.errstate(all="ignore"):
+        try:
+            f = np.asarray(f_np(x), dtype=float)
+        except (ArithmeticError, ValueError, TypeError):
+            return None
+    for a in (x, t, f):
+        a.flags.writeable = False
+    return x, t, f
+
+
 def _float_argmax(fn, floats: Sequence[float], kind: str, shift, lo: float, hi: float
                   ) -> float | None:
     """Where ``|g|`` is largest on a float64 grid of ``[lo, hi]`` (Chebyshev
@@ -577,15 +641,11 @@ def _float_argmax(fn, floats: Sequence[float], kind: str, shift, lo: float, hi: 
     f_np = getattr(fn, "numpy", None)
     if f_np is None or not lo < hi:
         return None
-    n = SEARCH_POINTS * (len(floats) + 1)
-    x = 0.5 * (lo + hi) - 0.5 * (hi - lo) * np.cos(np.pi * np.arange(n + 1) / n)
-    x[0], x[-1] = lo, hi
-    t = x if shift is None else (x - shift[0]) / shift[1]
+    grid = _search_grid(f_np, lo, hi, SEARCH_POINTS * (len(floats) + 1), shift)
+    if grid is None:
+        return None
+    x, t, f = grid
     with np.errstate(all="ignore"):
-        try:
-            f = np.asarray(f_np(x), dtype=float)
-        except (ArithmeticError, ValueError, TypeError):
-            return None
         p = np.polyval(np.asarray(floats[::-1], dtype=float), t) if floats else np.zeros_like(x)
         e = np.abs(p - f if kind == "abs" else p / f - 1)
     e[~np.isfinite(e)] = -1.0

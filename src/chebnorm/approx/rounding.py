@@ -23,7 +23,7 @@ Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from flint import fmpz_mat
@@ -181,6 +181,9 @@ class _Problem:
     powers: tuple[int, ...]       # free powers (fixed c0 excluded)
     fixed: dict                   # power -> (mantissa, exponent) held fixed
     word_limit: int | None        # fixed point: |integer| <= word_limit
+    #: coefficients -> their certificate (or the ValueError, or the bound it is proven
+    #: to reach: ("at least", b)); certify is deterministic, so a repeat is not re-run
+    certs: dict = field(default_factory=dict, repr=False)
 
 
 class _Sampler:
@@ -199,6 +202,7 @@ class _Sampler:
         self.x, self.f = x[ok], fx[ok]
         self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
         self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
+        self.point_sets: dict = {}            # real coefficients -> _point_sets
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
@@ -222,19 +226,57 @@ class _Sampler:
         err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
         return float(np.max(err)) if err.size else 0.0
 
+    def errors(self, rows, chunk: int = 32) -> list[float]:
+        """:meth:`error` of each coefficient list in ``rows`` (all of one
+        length), several at a time: the same operations element by element
+        (a zero coefficient adds a zero term, which changes no sum), so the
+        same floats."""
+        out: list[float] = []
+        if not self.x.size:
+            return [0.0] * len(rows)
+        for i in range(0, len(rows), chunk):
+            c = np.array(rows[i:i + chunk], dtype=float)
+            p = np.zeros((len(c), self.x.size))
+            mag = np.zeros_like(p)
+            for k in range(c.shape[1]):
+                term = c[:, k:k + 1] * self.xp[k]
+                p += term
+                mag += np.abs(term)
+            err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
+            out.extend(float(v) for v in np.max(err, axis=1))
+        return out
+
 
 #: tolerance of the certificates that rank candidates: candidates often differ
 #: by less than the certifier's default 2^-8, and a looser bound would misrank
 SELECT_TOL = 2.0 ** -20
 
 
-def certify_tight(fn, coeffs, lo, hi, kind):
-    """:func:`certify` at :data:`SELECT_TOL` (at most 20,000 subintervals)."""
-    return certify(fn, list(coeffs), lo, hi, kind, tol=SELECT_TOL, max_subintervals=20_000)
+def certify_tight(fn, coeffs, lo, hi, kind, abort_at: float | None = None):
+    """:func:`certify` at :data:`SELECT_TOL` (at most 20,000 subintervals);
+    with ``abort_at``, None once the bound is proven to reach it."""
+    return certify(fn, list(coeffs), lo, hi, kind, tol=SELECT_TOL, max_subintervals=20_000,
+                   abort_at=abort_at)
 
 
-def _certify_key(prob: _Problem, coeffs):
-    return certify_tight(prob.fn, coeffs, prob.lo, prob.hi, prob.error_kind)
+def _certify_key(prob: _Problem, coeffs, abort_at: float | None = None):
+    """The ranking certificate of ``coeffs``, or None when its bound is proven
+    ``>= abort_at`` (it cannot beat that one); raises ValueError as certify."""
+    known = prob.certs.get(coeffs)
+    if isinstance(known, ValueError):
+        raise known
+    if isinstance(known, tuple):              # ("at least", bound) from an aborted run
+        if abort_at is not None and abort_at <= known[1]:
+            return None
+    elif known is not None:
+        return known
+    try:
+        cert = certify_tight(prob.fn, coeffs, prob.lo, prob.hi, prob.error_kind, abort_at)
+    except ValueError as exc:
+        prob.certs[coeffs] = exc
+        raise
+    prob.certs[coeffs] = ("at least", abort_at) if cert is None else cert
+    return cert
 
 
 def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
@@ -247,14 +289,17 @@ def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | No
         if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
             continue
         seen.add(coeffs)
-        ranked.append((sampler.error(coeffs), method, ms, es, coeffs))
-    ranked.sort(key=lambda r: (r[0], r[1]))
+        ranked.append((method, ms, es, coeffs))
+    lows = sampler.errors([r[3] for r in ranked]) if ranked else []
+    ranked = sorted(((low,) + r for low, r in zip(lows, ranked)), key=lambda r: (r[0], r[1]))
     for low, method, ms, es, coeffs in ranked:
         if best is not None and low >= best.bound:
             break
         try:
-            cert = _certify_key(prob, coeffs)
+            cert = _certify_key(prob, coeffs, None if best is None else best.bound)
         except ValueError:
+            continue
+        if cert is None:                      # proven >= best.bound: cannot win
             continue
         if best is None or cert.bound < best.bound:
             best = Candidate(tuple(ms), tuple(es), method, cert.bound,
@@ -280,6 +325,30 @@ def _fixed_poly(prob: _Problem):
     return poly
 
 
+def _point_sets(prob, sampler, real) -> list:
+    """The lattice's point sets (Chebyshev nodes of three sizes, and the real
+    fit's interpolation points) with ``f`` and the weights there: the same at
+    every set of quanta, so computed once per ``real`` (kept on ``sampler``)."""
+    key = tuple(real)
+    if key in sampler.point_sets:
+        return sampler.point_sets[key]
+    n_free = len(prob.powers)
+    point_sets = [chebyshev_nodes(prob.lo_f, prob.hi_f, count)
+                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})]
+    zeros = sampler.zeros(real)
+    if len(zeros) >= n_free:
+        point_sets.append(zeros)
+    out = []
+    for pts in point_sets:
+        with np.errstate(all="ignore"):
+            fv = np.asarray(prob.fn.numpy(pts), dtype=float) * np.ones_like(pts)
+        if not np.all(np.isfinite(fv)) or (prob.error_kind == "rel" and np.any(fv == 0)):
+            continue
+        out.append((pts, fv, 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv)))
+    sampler.point_sets[key] = out
+    return out
+
+
 def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) -> dict:
     """Candidate (mantissas, exponents) at one set of quanta (power -> s)."""
     cands = {}
@@ -287,20 +356,8 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     # each free coefficient rounded to nearest
     cands["rounded"] = _full(prob, {k: (round(math.ldexp(real[k], -quanta[k])), quanta[k])
                                     for k in prob.powers})
-    n_free = len(prob.powers)
-    f_np = prob.fn.numpy
-    point_sets = [chebyshev_nodes(prob.lo_f, prob.hi_f, count)
-                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})] if lattice else []
-    zeros = sampler.zeros(real)
-    if lattice and len(zeros) >= n_free:
-        point_sets.append(zeros)
-    for pts in point_sets:
+    for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
-        with np.errstate(all="ignore"):
-            fv = np.asarray(f_np(pts), dtype=float) * np.ones_like(pts)
-        if not np.all(np.isfinite(fv)) or (prob.error_kind == "rel" and np.any(fv == 0)):
-            continue
-        w = 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv)
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob))
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
@@ -371,6 +428,7 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
             quanta = [-(f - level) for f in fracs]
             cands = _candidates(prob, sampler, real, quanta, greedy, fmt)
+            prev = None
             if best is not None:
                 # the answer at one bit fewer, exactly representable here
                 cands["fewer-bits"] = _full(prob, {
@@ -379,12 +437,13 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
                 if prob.word_limit is not None and max(abs(m) for m in cands["fewer-bits"][0]) \
                         > prob.word_limit:
                     del cands["fewer-bits"]
-            new = _select(prob, sampler, cands, None)
-            if new is not None and best is not None and not new.bound < best.bound:
-                m, e = cands["fewer-bits"] if "fewer-bits" in cands else (None, None)
-                if m is not None:
-                    new = Candidate(tuple(m), tuple(e), best.method, best.bound,
-                                    best.abs_cert, best.rel_cert)
+                else:
+                    m, e = cands["fewer-bits"]
+                    prev = Candidate(tuple(m), tuple(e), best.method, best.bound,
+                                     best.abs_cert, best.rel_cert)
+            # a candidate replaces the answer at one bit fewer only with a smaller
+            # bound (ranked against it: no candidate that cannot beat it is certified)
+            new = _select(prob, sampler, cands, prev)
             best = new if new is not None else best
         return best
     # floating: quanta from the real coefficients, then from the best few
@@ -400,11 +459,14 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         tried.add(quanta)
         cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
         best = _select(prob, sampler, cands, best)
-        ranked = sorted(cands.values(), key=lambda c: sampler.error(
-            [math.ldexp(m, e) for m, e in zip(*c)]))
+        values = list(cands.values())
+        lows = sampler.errors([[math.ldexp(m, e) for m, e in zip(*c)] for c in values])
+        ranked = [values[i] for i in sorted(range(len(values)), key=lows.__getitem__)]
         for ms, es in ranked[:8]:
-            q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers else quanta[k]
-                      for k, (m, e) in enumerate(zip(ms, es)))
+            # a zero coefficient keeps its quantum (float_quantum(0) is the
+            # format's smallest, 2^-1074 in binary64: the real one would overflow)
+            q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers and m
+                      else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
     return best

@@ -1,0 +1,74 @@
+"""Issue 25's speed work on ``quantize``: the shortcuts give the answers of
+the full computation (the speed itself is measured in benchmarks/bench_fit.py
+--quantize, never here)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import sympy as sp
+
+from chebnorm.approx import fit, parse_function, quantize
+from chebnorm.approx.certify import certify
+from chebnorm.approx.rounding import SELECT_TOL, representable
+
+
+def test_binary64_zero_coefficient_keeps_its_quantum():
+    """A lattice candidate with a zero coefficient set that power's floating
+    quantum to 2^-1074, and rounding the real coefficient to it overflowed
+    (OverflowError: math range error)."""
+    base = fit("1/sqrt(x)", ("1", "2"), 8, kind="minimax", error="rel")
+    q = quantize(base, coef_format="binary64")
+    assert all(representable(m, e, "binary64")
+               for m, e in zip(q.quantized.mantissas, q.quantized.exponents))
+    # at least as good as each coefficient rounded to nearest binary64
+    plain = quantize(base, coef_format="binary64", reoptimize=False)
+    assert q.quantized.rel_error_bound <= plain.quantized.rel_error_bound
+
+
+@pytest.mark.parametrize("expr, lo, hi", [("sin(x)", "-1/4", "1/4"), ("log(1+x)", "0", "1"),
+                                          ("x - 1/3", "0", "1")])
+def test_relative_error_refused_where_f_vanishes(expr, lo, hi):
+    """f of both signs, or exactly 0 at a point: p/f - 1 is refused with the
+    certifier's ValueError (at once; it bisected to 2^-60 of the interval first)."""
+    fn = parse_function(expr)
+    with pytest.raises(ValueError, match=r"p/f - 1 \(f is zero or undefined there\)"):
+        certify(fn, [0.0, 1.0], sp.sympify(lo), sp.sympify(hi), "rel")
+
+
+@pytest.mark.parametrize("expr, coeffs, kind", [
+    ("exp(x)", [1.0, 1.0, 0.5, 0.1666], "abs"),
+    ("exp(x)", [1.0, 1.0, 0.5, 0.1666], "rel"),
+    ("1/sqrt(x)", [2.0, -1.5, 0.5], "rel"),
+    ("atan(x)", [0.0, 0.995, 0.0, -0.29], "abs")])
+def test_abort_at_is_exact(expr, coeffs, kind):
+    """certify(..., abort_at=t) is either the very certificate, or None when
+    the bound is at least t (then it cannot beat a bound t)."""
+    fn = parse_function(expr)
+    lo, hi = (sp.Rational(1, 4), sp.Integer(1))
+    full = certify(fn, coeffs, lo, hi, kind, tol=SELECT_TOL)
+    for t in (0.5 * full.maximum, full.maximum, full.bound, math.nextafter(full.bound, 1.0),
+              2 * full.bound):
+        got = certify(fn, coeffs, lo, hi, kind, tol=SELECT_TOL, abort_at=t)
+        assert got == full or (got is None and full.bound >= t), (t, got)
+    assert certify(fn, coeffs, lo, hi, kind, tol=SELECT_TOL, abort_at=0.5 * full.maximum) is None
+    assert certify(fn, coeffs, lo, hi, kind, tol=SELECT_TOL, abort_at=2 * full.bound) == full
+
+
+def test_batched_sampled_errors_are_the_same_floats():
+    """The sampler's batched errors (ranking the candidates) equal its
+    one-at-a-time errors bit for bit, zero coefficients included."""
+    import random
+
+    from chebnorm.approx.rounding import _Problem, _Sampler
+
+    fn = parse_function("exp(x)")
+    prob = _Problem(fn=fn, lo=sp.Integer(0), hi=sp.Integer(1), lo_f=0.0, hi_f=1.0,
+                    error_kind="rel", degree=4, powers=(0, 1, 2, 3, 4), fixed={},
+                    word_limit=None)
+    sampler = _Sampler(prob)
+    rng = random.Random(25)
+    rows = [[rng.choice([0.0, rng.uniform(-2, 2)]) for _ in range(5)] for _ in range(70)]
+    rows.append([1.0, 1.0, 0.5, 0.16666666666666666, 0.041666666666666664])
+    assert sampler.errors(rows) == [sampler.error(r) for r in rows]
