@@ -381,7 +381,7 @@ def run_quantize_chebnorm(tables, workload=QUANT_WORKLOAD):
     for table, (expr, iv, d, err, fmt, bits, mons, fc) in zip(tables, workload):
         t0 = time.perf_counter()
         q = quantize(table, bits, coef_format=fmt, monomials=mons, fix_constant=fc,
-                     word_bits=64)
+                     word_bits=53)
         dt = time.perf_counter() - t0
         qq = q.quantized
         rows.append({"seconds": dt,

@@ -14,12 +14,6 @@ pytestmark = [pytest.mark.skipif(not sollya.available(),
                                  reason="sollya is not installed (apt-get install sollya)"),
               pytest.mark.filterwarnings("ignore::chebnorm.approx.FitWarning")]
 
-#: cases where chebnorm's lattice rounding (approx/rounding.py) still loses to
-#: fpminimax although the real fit is right (left open, see the report of issue 25)
-LATTICE_GAPS = {"cos(x) [-1/8, 1/8] d6 abs fixed28 x^0,2,4,6",
-                "tan(x) [-1/4, 1/4] d7 abs fixed28 x^1,3,5,7"}
-
-
 @pytest.fixture(scope="module")
 def rows():
     from sollya_constrained_cases import run
@@ -40,7 +34,7 @@ def test_quantized_at_least_as_good_as_fpminimax(rows):
         b = quantized_bound(q)
         if ours is not None:                       # never below Sollya's lower enclosure
             assert ours[0] <= b, label(case)
-        if b > 1.01 * sup[1] and label(case) not in LATTICE_GAPS:
+        if b > 1.01 * sup[1]:
             bad.append((label(case), b / sup[1]))
     assert not bad, bad
 

@@ -150,12 +150,21 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list
     return out
 
 
-def _lattice(points, f_vals, weights, powers, quanta, fixed_poly):
-    """Integer vectors ``n`` (one per free power) near the weighted function values."""
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
+    """Integer vectors ``n`` (one per free power) near the weighted function values.
+
+    ``base`` (integers, one per free power: the real fit rounded) is subtracted
+    from the target first and added back to the answers: the lattice then
+    resolves the residual, a few quanta, instead of f itself, whose size would
+    leave the small columns (high powers at small points) only a few bits once
+    everything is scaled to 62-bit integers.
+    """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x))
     vecs = [w * x ** e * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
+    base = [0] * len(powers) if base is None else list(base)
+    y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
+             - sum(math.ldexp(b, s) * x ** e for b, e, s in zip(base, powers, quanta)))
     big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
     shift = 62 - math.frexp(big)[1]
     def ints(v):
@@ -164,9 +173,10 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly):
     if any(all(a == 0 for a in row) for row in basis):
         return []
     try:
-        return _babai(basis, ints(y), spread=True)
+        vecs = _babai(basis, ints(y), spread=True)
     except (ValueError, ZeroDivisionError, np.linalg.LinAlgError):
         return []
+    return [[b + v for b, v in zip(base, vec)] for vec in vecs]
 
 
 @dataclass
@@ -325,6 +335,14 @@ def _fixed_poly(prob: _Problem):
     return poly
 
 
+def _symmetric_parity(prob: _Problem) -> bool:
+    """True when the interval is symmetric and every power (free and fixed)
+    has one parity (and f, being fitted by them, is taken to have it too: the
+    points on ``[0, hi]`` are then the whole problem)."""
+    powers = set(prob.powers) | set(prob.fixed)
+    return prob.lo_f == -prob.hi_f and len({k % 2 for k in powers}) == 1
+
+
 def _point_sets(prob, sampler, real) -> list:
     """The lattice's point sets (Chebyshev nodes of three sizes, and the real
     fit's interpolation points) with ``f`` and the weights there: the same at
@@ -333,9 +351,16 @@ def _point_sets(prob, sampler, real) -> list:
     if key in sampler.point_sets:
         return sampler.point_sets[key]
     n_free = len(prob.powers)
-    point_sets = [chebyshev_nodes(prob.lo_f, prob.hi_f, count)
+    lo = prob.lo_f
+    if _symmetric_parity(prob):
+        # p(-x) = +-p(x) and f likewise: points x and -x give the same row (up
+        # to sign), so nodes on [-hi, hi] hold half as many distinct equations;
+        # the lattice is posed on [0, hi] instead
+        lo = 0.0
+    point_sets = [chebyshev_nodes(lo, prob.hi_f, count)
                   for count in sorted({n_free, n_free + 1, 2 * n_free + 1})]
     zeros = sampler.zeros(real)
+    zeros = zeros[zeros > lo] if lo == 0.0 and prob.lo_f < 0 else zeros
     if len(zeros) >= n_free:
         point_sets.append(zeros)
     out = []
@@ -358,7 +383,8 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
                                     for k in prob.powers})
     for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
-        vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob))
+        vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
+                        [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers])
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
                 prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
