@@ -72,3 +72,39 @@ def test_batched_sampled_errors_are_the_same_floats():
     rows = [[rng.choice([0.0, rng.uniform(-2, 2)]) for _ in range(5)] for _ in range(70)]
     rows.append([1.0, 1.0, 0.5, 0.16666666666666666, 0.041666666666666664])
     assert sampler.errors(rows) == [sampler.error(r) for r in rows]
+
+
+def test_lattice_resolves_the_residual_cos_28_bits():
+    """cos(x) on [-1/8, 1/8], even powers, 28 fractional bits: the lattice scaled
+    f itself to 62-bit integers, leaving the x^6 column a few bits, and Babai's
+    answers were quanta off; plain rounding won with 1.023e-13. Sollya 8's
+    fpminimax (powers 0,2,4,6, fixed 28, on [0, 1/8]) returns the integers
+    below, whose supnorm on [-1/8, 1/8] is 5.18950e-14."""
+    base = fit("cos(x)", ("-1/8", "1/8"), 6, kind="minimax")
+    q = quantize(base, 28, monomials=(0, 2, 4, 6))
+    fpminimax = [1, 0, -0.5, 0, math.ldexp(11184810, -28), 0, math.ldexp(-372684, -28)]
+    fn = parse_function("cos(x)")
+    theirs = certify(fn, fpminimax, sp.Rational(-1, 8), sp.Rational(1, 8), tol=SELECT_TOL)
+    assert q.quantized.abs_error_bound <= theirs.bound * (1 + SELECT_TOL)
+
+
+def test_table_fitted_with_the_powers_is_not_refitted(monkeypatch):
+    """A table fitted with ``monomials`` (and a binary64 fixed constant) already
+    holds the constrained real fit: quantize starts from it, and the answer is
+    the one it gives after refitting itself."""
+    from chebnorm.approx import api
+
+    cases = [("sin(x)", ("-1/8", "1/8"), 7, dict(monomials=(1, 3, 5, 7))),
+             ("2^x", ("0", "1"), 6, dict(fix_constant=True))]
+    for expr, iv, d, kw in cases:
+        plain = quantize(fit(expr, iv, d, kind="minimax"), coef_format="binary64", **kw)
+        fitted = fit(expr, iv, d, kind="minimax", **kw)
+        calls = []
+        real_fit = api._constrained_fit
+        monkeypatch.setattr(api, "_constrained_fit", lambda *a, **k: calls.append(a) or
+                            real_fit(*a, **k))
+        again = quantize(fitted, coef_format="binary64", **kw)
+        monkeypatch.setattr(api, "_constrained_fit", real_fit)
+        assert calls == [], expr
+        assert again.quantized.mantissas == plain.quantized.mantissas, expr
+        assert again.quantized.abs_error_bound == plain.quantized.abs_error_bound

@@ -553,9 +553,13 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     Otherwise the coefficients are chosen as Sollya's ``fpminimax`` chooses them
     (lattice reduction and a closest vector at Chebyshev points, see
     :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
-    the lower ones refitted at Chebyshev nodes) compete, and the candidate with the
-    smallest certified bound wins (``method`` names it). Fixed formats are monotone in the bits:
-    more fractional bits never certify a worse error.
+    the lower ones refitted at Chebyshev nodes) compete: they are ranked by their
+    sampled error and certified in that order while they can still win; the one
+    with the smallest certified bound wins (``method`` names it). Fixed formats
+    are monotone in the bits: more fractional bits never certify a worse error.
+    A table fitted with the same ``monomials`` / ``fix_constant`` (same held
+    constant) is quantized from its own coefficients, otherwise the constrained
+    real fit is computed first.
 
     The result is the table with ``quantized`` (always) and ``fixed_point``
     (fixed format with one ``frac_bits``, all powers, free constant) set.
@@ -594,7 +598,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         raise ValueError("monomials: no free coefficient left (only the fixed constant)")
     real = list(table.coefficients)
     full_basis = mons == tuple(range(n + 1)) or (fix_constant and mons == tuple(range(1, n + 1)))
-    if not full_basis or fix_constant:
+    if (not full_basis or fix_constant) and not _fitted_alike(table, mons, fixed):
         real = _constrained_fit(fn, iv, n, mons, fixed, table.error_kind)
     prob = _Problem(fn=fn, lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,
                     error_kind=table.error_kind, degree=n, powers=mons, fixed=fixed,
@@ -614,6 +618,24 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                            known={"abs": best.abs_cert, "rel": best.rel_cert})
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
+
+
+def _fitted_alike(table: CoefficientTable, mons, fixed: dict) -> bool:
+    """True when ``table`` already holds the real fit quantize would compute:
+    a minimax fit in the powers ``mons`` (``fit(..., monomials=...)``, or the
+    parity fit of an even or odd ``f``: provenance ``constraint`` / ``parity``)
+    whose other coefficients are zero and whose held constant is the one
+    quantize holds (``fixed``). Only the starting point depends on it: the
+    quantized coefficients are certified whatever it is."""
+    prov = table.provenance
+    if table.kind != "minimax" or not ("constraint" in prov or "parity" in prov):
+        return False
+    if (0 in fixed) != ("held at" in prov.get("constraint", "")):
+        return False
+    c = table.coefficients
+    held = {k: math.ldexp(m, e) for k, (m, e) in fixed.items()}
+    return all(c[k] == 0 for k in range(len(c)) if k not in mons and k not in held) and all(
+        c[k] == v for k, v in held.items())
 
 
 def _no_rounding(coef_format: str, real, word_bits: int, fracs) -> str:

@@ -7,15 +7,19 @@ polynomial L-infinity approximations", ARITH 18, 2007): at a set of points
 the coefficient's quantum in its format) form a lattice point
 ``sum_k n_k * b_k`` with ``b_k = (w_i x_i^(e_k) 2^(s_k))_i``; the point closest
 to the function's (weighted) values is found approximately by LLL reduction
-(python-flint) and Babai's nearest plane. Every candidate -- the lattice
+(python-flint) and Babai's nearest plane, on the residual of the real fit
+rounded (so the small columns keep their bits). Every candidate -- the lattice
 answers for several point sets and their neighbours, each coefficient rounded
 to nearest, and the greedy refit of :func:`chebnorm.approx.quantize` -- is
-ranked by its sampled error and the best ones are certified
-(:func:`chebnorm.approx.certify.certify`); the smallest certified bound wins.
+ranked by its error sampled in float64 on a dense grid; candidates are then
+certified (:func:`chebnorm.approx.certify.certify`) in that order only while
+their sampled error (a lower bound of their supremum) is below the best bound
+certified so far: the answer is the smallest certified bound among those.
 
-Fixed formats are monotone in the bits: the answer at ``F`` fractional bits
-is chosen among the candidates at ``F`` and the (shifted) answer at ``F - 1``,
-computed by the same chain from zero bits, so more bits never certify worse.
+Fixed formats are monotone in the bits: the pool certified at ``F``
+fractional bits holds, for every ``b = 0..F`` bits, the plain rounding and the
+answer of a cheaply ranked chain (:func:`_fixed_chain`), shifted to ``F`` bits;
+the pool at ``F - 1`` bits is part of it, so more bits never certify worse.
 
 Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 """
@@ -123,8 +127,8 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list
     mat = fmpz_mat(basis)
     red, trans = mat.lll(transform=True)
     n = red.nrows()
-    rows = np.array([[float(int(red[i, j])) for j in range(red.ncols())] for i in range(n)])
-    tr = [[int(trans[i, j]) for j in range(n)] for i in range(n)]
+    rows = np.array([[float(int(v)) for v in row] for row in red.tolist()])
+    tr = [[int(v) for v in row] for row in trans.tolist()]
     # Gram-Schmidt of the reduced rows, in floats (scaled to avoid overflow)
     scale = max(np.max(np.abs(rows)), 1.0)
     b = rows / scale
@@ -138,15 +142,12 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list
         c = round(float(q[:, i] @ resid) / r[i, i])
         coords[i] = c
         resid = resid - c * b[i]
-    def to_basis(cs):
-        return [sum(cs[i] * tr[i][k] for i in range(n)) for k in range(n)]
-    out = [to_basis(coords)]
-    if spread:
+    base = [sum(coords[i] * tr[i][k] for i in range(n)) for k in range(n)]
+    out = [base]
+    if spread:                            # coords +- e_i: base +- row i of the transform
         for i in range(n):
             for d in (-1, 1):
-                cs = list(coords)
-                cs[i] += d
-                out.append(to_basis(cs))
+                out.append([a + d * v for a, v in zip(base, tr[i])])
     return out
 
 
@@ -438,45 +439,105 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
     return [ints[k] for k in range(n + 1)]
 
 
+def _rank(sampler: _Sampler, cands) -> list:
+    """``cands`` (an iterable of (method, mantissas, exponents)) with finite,
+    distinct coefficient values, as (sampled error, method, ms, es, coeffs),
+    smallest sampled error first (ties: method name, then input order)."""
+    rows, seen = [], set()
+    for method, ms, es in cands:
+        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
+        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+            continue
+        seen.add(coeffs)
+        rows.append((method, list(ms), list(es), coeffs))
+    lows = sampler.errors([r[3] for r in rows]) if rows else []
+    order = sorted(range(len(rows)), key=lambda i: (lows[i], rows[i][0], i))
+    return [(lows[i],) + rows[i] for i in order]
+
+
+def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
+    """The smallest certified bound among ``ranked`` (from :func:`_rank`):
+    candidates are certified in their sampled order, each against the best so
+    far (aborted once proven no better); one whose sampled error (a lower bound
+    of its supremum) already reaches the best bound is not certified, nor is
+    any after it. ``limit``: at most that many certifications after the first
+    success. Returns a Candidate or None (none certified)."""
+    best, tries = None, 0
+    for low, method, ms, es, coeffs in ranked:
+        if best is not None and (low >= best.bound or (limit is not None and tries >= limit)):
+            break
+        try:
+            cert = _certify_key(prob, coeffs, None if best is None else best.bound)
+        except ValueError:
+            continue
+        tries += best is not None
+        if cert is not None and (best is None or cert.bound < best.bound):
+            best = Candidate(tuple(ms), tuple(es), method, cert.bound,
+                             cert if prob.error_kind == "abs" else None,
+                             cert if prob.error_kind == "rel" else None)
+    return best
+
+
+#: sample points of the cheap ranking inside the fixed-point chain
+CHAIN_SAMPLES = 513
+#: most certifications (after the first certified candidate) of a floating format
+FLOAT_CERTIFY = None
+
+
+def _fixed_chain(prob: _Problem, real, fracs, greedy) -> list:
+    """The fixed-point pool: at every bit count ``b = 0..F`` (all powers shifted
+    alike) the plain rounding ``R_b`` and the chain's answer ``S_b`` -- the
+    candidate with the smallest cheaply sampled error among the candidates at
+    ``b`` and ``S_(b-1)`` (kept unless beaten by more than 2^-20 relative) --
+    as (method, mantissas, exponents) at ``F`` bits. The pool at ``F - 1`` bits
+    is a subset (same values) of the pool at ``F``: the certified minimum over
+    it never grows with the bits."""
+    coarse = _Sampler(prob, CHAIN_SAMPLES)
+    pool, prev = [], None
+    fq = [-f for f in fracs]
+    for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
+        quanta = [-(f - level) for f in fracs]
+        cands = _candidates(prob, coarse, real, quanta, greedy, "fixed")
+        ranked = _rank(coarse, [(m, *c) for m, c in cands.items()])
+        if ranked:
+            low, method, ms, es, _ = ranked[0]
+            if prev is None or low < prev[0] * (1 - SELECT_TOL):
+                prev = (low, method, ms, es)
+        if "rounded" in cands:
+            pool.append(("rounded",) + tuple(cands["rounded"]))
+        if prev is not None:
+            pool.append(prev[1:])
+    out = []
+    for method, ms, es in pool:               # every one shifted to F bits
+        out.append((method, [m << (e - q) if m else 0 for m, e, q in zip(ms, es, fq)], fq))
+    return out
+
+
 def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
                        plain: bool = False) -> Candidate:
     """The best certified rounding of ``real`` (coefficients of all powers);
-    with ``plain``, each coefficient rounded to nearest and nothing else."""
+    with ``plain``, each coefficient rounded to nearest and nothing else.
+
+    Candidates are ranked by their sampled error (float64, a dense grid) and
+    certified in that order only while they can still beat the best bound
+    certified (:func:`_certify_ranked`): the answer's bound is always
+    rigorous, the ranking only decides which candidates are certified."""
     sampler = _Sampler(prob)
     if plain:
         quanta = ([-f for f in frac_bits] if fmt == "fixed" else
                   [float_quantum(real[k], fmt) for k in range(prob.degree + 1)])
         cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
-        return _select(prob, sampler, cands, None)
+        return _certify_ranked(prob, _rank(sampler, [(m, *c) for m, c in cands.items()]))
     if fmt == "fixed":
-        fracs = list(frac_bits)
-        best = None
-        for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
-            quanta = [-(f - level) for f in fracs]
-            cands = _candidates(prob, sampler, real, quanta, greedy, fmt)
-            prev = None
-            if best is not None:
-                # the answer at one bit fewer, exactly representable here
-                cands["fewer-bits"] = _full(prob, {
-                    k: (best.mantissas[k] << (best.exponents[k] - quanta[k])
-                        if best.mantissas[k] else 0, quanta[k]) for k in prob.powers})
-                if prob.word_limit is not None and max(abs(m) for m in cands["fewer-bits"][0]) \
-                        > prob.word_limit:
-                    del cands["fewer-bits"]
-                else:
-                    m, e = cands["fewer-bits"]
-                    prev = Candidate(tuple(m), tuple(e), best.method, best.bound,
-                                     best.abs_cert, best.rel_cert)
-            # a candidate replaces the answer at one bit fewer only with a smaller
-            # bound (ranked against it: no candidate that cannot beat it is certified)
-            new = _select(prob, sampler, cands, prev)
-            best = new if new is not None else best
-        return best
+        pool = _fixed_chain(prob, real, list(frac_bits), greedy)
+        if prob.word_limit is not None:
+            pool = [c for c in pool if max(abs(m) for m in c[1]) <= prob.word_limit]
+        return _certify_ranked(prob, _rank(sampler, pool))
     # floating: quanta from the real coefficients, then from the best few
     # candidates' own binades (a lattice answer may leave a binade), a few rounds
     todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
     tried = set()
-    best = None
+    pool = []
     for _ in range(FLOAT_ROUNDS):
         todo = [q for q in todo if q not in tried]
         if not todo:
@@ -484,15 +545,13 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         quanta = todo.pop(0)
         tried.add(quanta)
         cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
-        best = _select(prob, sampler, cands, best)
-        values = list(cands.values())
-        lows = sampler.errors([[math.ldexp(m, e) for m, e in zip(*c)] for c in values])
-        ranked = [values[i] for i in sorted(range(len(values)), key=lows.__getitem__)]
-        for ms, es in ranked[:8]:
+        pool += [(m, *c) for m, c in cands.items()]
+        ranked = _rank(sampler, [(m, *c) for m, c in cands.items()])
+        for _, _, ms, es, _ in ranked[:8]:
             # a zero coefficient keeps its quantum (float_quantum(0) is the
             # format's smallest, 2^-1074 in binary64: the real one would overflow)
             q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers and m
                       else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
-    return best
+    return _certify_ranked(prob, _rank(sampler, pool), FLOAT_CERTIFY)
