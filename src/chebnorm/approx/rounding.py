@@ -345,7 +345,7 @@ def _symmetric_parity(prob: _Problem) -> bool:
 
 
 def _point_sets(prob, sampler, real) -> list:
-    """The lattice's point sets (Chebyshev nodes of three sizes, and the real
+    """The lattice's point sets (2n+1 Chebyshev nodes, n free powers, and the real
     fit's interpolation points) with ``f`` and the weights there: the same at
     every set of quanta, so computed once per ``real`` (kept on ``sampler``)."""
     key = tuple(real)
@@ -359,7 +359,7 @@ def _point_sets(prob, sampler, real) -> list:
         # the lattice is posed on [0, hi] instead
         lo = 0.0
     point_sets = [chebyshev_nodes(lo, prob.hi_f, count)
-                  for count in sorted({n_free, n_free + 1, 2 * n_free + 1})]
+                  for count in (2 * n_free + 1,)]
     zeros = sampler.zeros(real)
     zeros = zeros[zeros > lo] if lo == 0.0 and prob.lo_f < 0 else zeros
     if len(zeros) >= n_free:
@@ -479,7 +479,7 @@ def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
 
 
 #: sample points of the cheap ranking inside the fixed-point chain
-CHAIN_SAMPLES = 513
+CHAIN_SAMPLES = 257
 #: most certifications (after the first certified candidate) of a floating format
 FLOAT_CERTIFY = None
 
