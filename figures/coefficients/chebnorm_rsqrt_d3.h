@@ -20,8 +20,8 @@
 #define CHEBNORM_RSQRT_D3_EVAL_ERROR_BOUND 0x1.7723e3e942d1bp-20 /* 1.3975061342066413e-06 */
 #define CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND 0x1.0410658f9a383p-18 /* 3.875256325260796e-06 */
 #define CHEBNORM_RSQRT_D3_FRAC_BITS 24
-#define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.77b0ea5bf173ap-20 /* 1.3995583207789087e-06 */
-#define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.8fb0ea5bf173bp-20 /* 1.488965287941995e-06 */
+#define CHEBNORM_RSQRT_D3_Q_ABS_ERROR_BOUND 0x1.77fad0b8f3358p-20 /* 1.40063370522859e-06 */
+#define CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND 0x1.8ffad0b8f3359p-20 /* 1.4900406723916762e-06 */
 
 static const double chebnorm_rsqrt_d3_coeffs[4] = {
     0x1.2362f4010e0a2p+1 /* 2.2764573102140995 */,  /* x^0 */
@@ -52,7 +52,7 @@ static inline float chebnorm_rsqrt_d3_f(float x)
 
 /* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_rsqrt_d3_q[4] = {
-    INT32_C(38191725), INT32_C(-41326727), INT32_C(26803387), INT32_C(-6891192)
+    INT32_C(38191635), INT32_C(-41326437), INT32_C(26803076), INT32_C(-6891081)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_RSQRT_D3_LO, CHEBNORM_RSQRT_D3_HI]);
