@@ -216,11 +216,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
                              segment_by=segment_by, centered=centered)
     quantized = frac_bits is not None or coef_format is not None
     constrained = monomials is not None or fix_constant
-    degree = _check_fit_args(degree, kind, error, basis, quantized or constrained)
-    if constrained and not quantized and kind != "minimax":
-        raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
-                         f"format; accepted: kind 'minimax' (the best real polynomial in those "
-                         f"powers), or a frac_bits or coef_format to quantize")
+    degree = _check_fit_args(degree, kind, error, basis, quantized, constrained)
     try:
         lo, hi = interval
     except (TypeError, ValueError):
@@ -282,7 +278,8 @@ def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant):
     return coeffs, notes, extra, cert_abs, cert_rel
 
 
-def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool) -> int:
+def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
+                    constrained: bool = False) -> int:
     """``degree`` as an int, after checking :func:`fit`'s arguments."""
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
         raise ValueError(f"degree {degree!r} is not an integer; accepted: 0 <= degree <= {MAX_DEGREE}")
@@ -295,10 +292,14 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool) 
         raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
     if basis not in BASES:
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
-    if basis != "monomial" and quantized:
+    if basis != "monomial" and (quantized or constrained):
         raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
                          "fix-constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
+    if constrained and not quantized and kind != "minimax":
+        raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
+                         f"format; accepted: kind 'minimax' (the best real polynomial in those "
+                         f"powers), or a frac_bits or coef_format to quantize")
     return degree
 
 
