@@ -188,6 +188,9 @@ def max_coef_bits(table: CoefficientTable) -> int:
     >>> max_coef_bits(fit_target("dichotomy", 2))   # largest |c_j| ~ 0.68
     31
     """
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
+                         f"CoefficientTable (chebnorm.fit, or CoefficientTable.load)")
     table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
     limit = 2 ** (COEF_WORD_BITS - 1) - 1
     best = 0
@@ -347,6 +350,9 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     >>> bool(np.max(np.abs(y - 1 / np.sqrt(2 + x))) <= error_budget(d).total)
     True
     """
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
+                         f"CoefficientTable (chebnorm.fit, or CoefficientTable.load)")
     table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
     in_bits = check_width(in_bits, "in-bits", 1, MAX_IN_BITS)
     out_bits = check_width(out_bits, "out-bits", 1, MAX_OUT_BITS)
