@@ -393,8 +393,14 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
 
 
 def _is_real(v) -> bool:
-    return not isinstance(v, bool) and isinstance(v, (int, float, np.integer, np.floating)) \
-        and math.isfinite(v)
+    import numbers
+
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except (OverflowError, ValueError):
+        return False
 
 
 def _check_arguments(fn, coefficients, lo, hi, tol, max_subintervals, prec):
@@ -403,7 +409,7 @@ def _check_arguments(fn, coefficients, lo, hi, tol, max_subintervals, prec):
     exactly)."""
     from .expr import parse_number
 
-    if not isinstance(fn, Function1D):
+    if not (callable(getattr(fn, "arb", None)) and callable(getattr(fn, "arb_series", None))):
         raise ValueError(f"fn of type {type(fn).__name__} is not accepted; accepted: a "
                          f"Function1D (chebnorm.approx.parse_function('exp(x)'))")
     if isinstance(coefficients, (str, bytes)) or not hasattr(coefficients, "__len__") \
