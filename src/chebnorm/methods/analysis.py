@@ -65,7 +65,7 @@ MAX_SPAN = 2 ** 16
 
 def _check_m(m) -> int:
     if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or not 1 <= m <= MAX_SPAN:
-        raise ValueError(f"span length m = {m!r}; accepted: an integer 1 <= m <= {MAX_SPAN}")
+        raise ValueError(f"span length m = {m!r}; accepted: an integer m >= 1, at most {MAX_SPAN}")
     return int(m)
 
 
