@@ -181,12 +181,12 @@ def _unit(args, kind, table=None):
 def _refuse_unit_options(args, kinds) -> None:
     """--log-m and --guard size the stepper; the unit widths size a unit: refused
     where no such unit is asked for (they would do nothing)."""
-    if not kinds:
-        refuse_unused(args, "with --unit KIND", **{
-            "--vector-frac-bits": "frac_bits", "--comp-bits": "comp_bits", "--log-m": "log_m",
-            "--guard": "guard"})
     if "stepper" not in kinds:
-        refuse_unused(args, "to the stepper unit", **{"--log-m": "log_m", "--guard": "guard"})
+        refuse_unused(args, "to the stepper unit (--unit stepper)",
+                      **{"--log-m": "log_m", "--guard": "guard"})
+    if not kinds:
+        refuse_unused(args, "with --unit KIND", **{"--vector-frac-bits": "frac_bits",
+                                                   "--comp-bits": "comp_bits"})
 
 
 def run_report(args) -> int:
