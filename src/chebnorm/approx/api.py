@@ -340,8 +340,9 @@ def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
     if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
-        raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits} (coefficient "
-                         f"{biggest:.6g}); accepted: 0 <= frac-bits <= {max_f}")
+        raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: the largest "
+                         f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
+                         f"accepted: frac-bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
             raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: coefficient of "
