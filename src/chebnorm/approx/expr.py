@@ -655,7 +655,16 @@ del _name
 
 class UndefinedError(ValueError, ZeroDivisionError):
     """The function has no value at a point (a ValueError for callers, and
-    still a ZeroDivisionError for code that catches that)."""
+    still a ZeroDivisionError for code that catches that).
+
+    Examples
+    --------
+    >>> import mpmath
+    >>> parse_function("exp(-1/x**2)").mpmath(mpmath.mpf(0))
+    Traceback (most recent call last):
+    ...
+    chebnorm.approx.expr.UndefinedError: exp(-1/x**2) is undefined at x = 0.0 (a division by zero); accepted: ...
+    """
 
 
 @dataclass(frozen=True)
