@@ -5,7 +5,6 @@ workers. Each test failed on the code before the fix."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import signal
 import subprocess
