@@ -490,6 +490,13 @@ def warnings_of(table: CoefficientTable) -> list[str]:
     return [w for w in text.split(" | ") if w]
 
 
+def _check_table(table, argument: str) -> None:
+    """Refuse anything but a :class:`CoefficientTable` as ``argument``."""
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"{argument} of type {type(table).__name__} is not accepted; accepted: "
+                         f"a CoefficientTable (from chebnorm.fit or CoefficientTable.load)")
+
+
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
         raise ValueError(f"frac-bits {frac_bits!r} is not a non-negative integer")
@@ -498,6 +505,10 @@ def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if biggest == 0:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
+    if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
+        raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: the largest "
+                         f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
+                         f"accepted: frac-bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
             raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: coefficient of "
@@ -572,6 +583,11 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
     ((0, 0, 0), True)
     """
+    _check_table(table, "table")
+    if isinstance(word_bits, bool) or not isinstance(word_bits, (int, np.integer)) \
+            or not 2 <= word_bits <= 53:
+        raise ValueError(f"word_bits {word_bits!r} is not accepted; accepted: an integer "
+                         f"2 <= word_bits <= 53 (the coefficients stay exact doubles)")
     table.verify()  # a table changed behind the frozen dataclass's back is re-proved
     table.require_monomial("quantize")
 

@@ -377,10 +377,15 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     >>> c.maximum, c.maximum <= c.bound <= (1 + TOL) * c.maximum
     (0.125, True)
     """
+    lo, hi = _check_arguments(fn, coefficients, lo, hi, tol, max_subintervals, prec)
     old_prec = ctx.prec
     try:
         ctx.prec = prec or 128
         if shift is not None:
+            if not isinstance(shift, (tuple, list)) or len(shift) != 2 or not all(
+                    _is_real(v) for v in shift):
+                raise ValueError(f"shift {shift!r}: accepted: None or a pair (center, scale) "
+                                 f"of finite numbers, scale > 0")
             shift = (float(shift[0]), float(shift[1]))
             if not (math.isfinite(shift[0]) and math.isfinite(shift[1]) and shift[1] > 0):
                 raise ValueError(f"shift {shift!r}: accepted: a finite center and a finite "
@@ -389,6 +394,50 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
                         max_subintervals, shift, abort_at)
     finally:
         ctx.prec = old_prec
+
+
+def _is_real(v) -> bool:
+    import numbers
+
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except (OverflowError, ValueError):
+        return False
+
+
+def _check_arguments(fn, coefficients, lo, hi, tol, max_subintervals, prec):
+    """Refuse :func:`certify`'s arguments of the wrong type or range, naming the
+    argument; return ``(lo, hi)`` as sympy constants (int, float and text read
+    exactly)."""
+    from .expr import parse_number
+
+    if not (callable(getattr(fn, "arb", None)) and callable(getattr(fn, "arb_series", None))):
+        raise ValueError(f"fn of type {type(fn).__name__} is not accepted; accepted: a "
+                         f"Function1D (chebnorm.approx.parse_function('exp(x)'))")
+    if isinstance(coefficients, (str, bytes)) or not hasattr(coefficients, "__len__") \
+            or not 1 <= len(coefficients) or not all(_is_real(c) for c in coefficients):
+        raise ValueError(f"coefficients {coefficients!r:.80}: accepted: a non-empty sequence "
+                         f"of finite numbers (ascending powers)")
+    ends = []
+    for name, v in (("lo", lo), ("hi", hi)):
+        if isinstance(v, (str, int, float)) and not isinstance(v, bool):
+            v = parse_number(v)
+        if not isinstance(v, sp.Expr) or v.free_symbols or not v.is_finite or not v.is_real:
+            raise ValueError(f"{name} {v!r:.80}: accepted: a finite real constant (a sympy "
+                             f"constant, an int, a float or a text such as 'sqrt(2)')")
+        ends.append(v)
+    if not _is_real(tol) or tol <= 0:
+        raise ValueError(f"tol {tol!r}: accepted: a finite number > 0")
+    if isinstance(max_subintervals, bool) or not isinstance(max_subintervals, (int, np.integer)) \
+            or max_subintervals < 1:
+        raise ValueError(f"max_subintervals {max_subintervals!r}: accepted: an integer >= 1")
+    if prec is not None and (isinstance(prec, bool) or not isinstance(prec, (int, np.integer))
+                             or not 53 <= prec <= 100_000):
+        raise ValueError(f"prec {prec!r}: accepted: None or an integer 53 <= prec <= 100000 "
+                         f"(bits)")
+    return ends[0], ends[1]
 
 
 def _scale(fn: Function1D, kind: str, points) -> arb:

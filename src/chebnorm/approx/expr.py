@@ -49,6 +49,7 @@ import ast
 import builtins
 import functools
 import keyword
+import re
 import warnings
 import unicodedata
 from dataclasses import dataclass
@@ -63,7 +64,7 @@ from sympy.printing.numpy import SciPyPrinter
 
 from . import clib
 
-__all__ = ["Function1D", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
+__all__ = ["Function1D", "UndefinedError", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
 
 #: the functions an expression may call, by name (one argument each; ``log``
@@ -125,6 +126,8 @@ _NODE_KINDS = {
     ast.Dict: "dict", ast.Starred: "starred argument", ast.Await: "await", ast.Yield: "yield",
     ast.YieldFrom: "yield", ast.Slice: "slice",
 }
+#: the text of an accepted number: decimal digits, a point, an exponent
+_DECIMAL = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
 
 
@@ -184,9 +187,13 @@ class _Reader:
             kind = {str: "string", bytes: "bytes", complex: "imaginary number"}.get(
                 type(v), type(v).__name__)
             raise self.refuse(node, kind)
+        text = ast.get_source_segment(self.source, node) or ""
+        if not _DECIMAL.fullmatch(text):
+            raise _Refusal(f"the number {self.token(node)!r} is not written in decimal digits "
+                           f"(hexadecimal, octal, binary and '_' separators are not accepted: "
+                           f"write e.g. 16, 1000, 0.5 or 1e-3)")
         if isinstance(v, int):
             return self.number(sp.Integer(v), node)
-        text = (ast.get_source_segment(self.source, node) or "").replace("_", "")
         try:
             dec = Decimal(text)
         except InvalidOperation:
@@ -279,6 +286,10 @@ class _Reader:
             raise _Refusal(f"{name}() takes {' or '.join(map(str, nargs))} argument(s), "
                            f"got {len(node.args)}")
         args = [self.build(a, depth + 1) for a in node.args]
+        if len(args) == 2 and not args[1].free_symbols and not (
+                args[1].is_positive and args[1] != 1):
+            raise _Refusal(f"the base of {self.token(node)!r} is {args[1]}: a logarithm's "
+                           f"base must be a positive constant other than 1 (e.g. log(x, 2))")
         if name == "gamma" and args[0].is_Rational and abs(args[0]) > _MAX_GAMMA_ARG:
             raise _Refusal(f"gamma of a number larger than {_MAX_GAMMA_ARG} in magnitude")
         value = FUNCTIONS[name](*args)
@@ -642,6 +653,20 @@ for _name in clib.FUNCTIONS:
 del _name
 
 
+class UndefinedError(ValueError, ZeroDivisionError):
+    """The function has no value at a point (a ValueError for callers, and
+    still a ZeroDivisionError for code that catches that).
+
+    Examples
+    --------
+    >>> import mpmath
+    >>> parse_function("exp(-1/x**2)").mpmath(mpmath.mpf(0))
+    Traceback (most recent call last):
+    ...
+    chebnorm.approx.expr.UndefinedError: exp(-1/x**2) is undefined at x = 0.0 (a division by zero); accepted: ...
+    """
+
+
 @dataclass(frozen=True)
 class Function1D:
     """A real function of one variable, with its evaluators.
@@ -667,7 +692,17 @@ class Function1D:
 
     @functools.cached_property
     def mpmath(self) -> Callable:
-        return sp.lambdify(self.var, self.expr, "mpmath")
+        f = sp.lambdify(self.var, self.expr, "mpmath")
+        expr, var = self.expr, self.var
+
+        def value(x):
+            try:
+                return f(x)
+            except ZeroDivisionError:  # e.g. exp(-1/x**2) at x = 0
+                raise UndefinedError(f"{expr} is undefined at {var} = {x} (a division by "
+                                     f"zero); accepted: an interval where the function is "
+                                     f"defined, finite and real") from None
+        return value
 
     @functools.cached_property
     def arb(self) -> Callable[[arb], arb]:
@@ -696,6 +731,12 @@ def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:
     Raises ValueError for text that is not accepted, for variables other than
     ``var`` and for functions the certification engine does not support.
     """
+    if not isinstance(text, (str, sp.Expr)):
+        raise ValueError(f"expression of type {type(text).__name__} is not accepted; accepted: "
+                         f"a string such as 'exp(x)' or a sympy expression")
+    if not isinstance(var, str):
+        raise ValueError(f"var of type {type(var).__name__} is not accepted; accepted: a "
+                         f"string naming the variable, such as 'x'")
     return _parse_function(text, var)
 
 

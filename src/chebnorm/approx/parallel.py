@@ -141,7 +141,14 @@ def _run_processes(fn, items, workers, done):
             for fut in sorted(finished, key=pending.get):
                 done(pending.pop(fut), fut.result())
     except BaseException:
+        # Ctrl-C or an error: drop the queued items and stop the running ones now
+        # (shutdown alone lets them compute on, and the exit waits for them)
+        processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
+        for proc in processes:
+            proc.terminate()
+        for proc in processes:
+            proc.join(timeout=5)
         raise
     pool.shutdown(wait=True)
 

@@ -103,5 +103,5 @@ def get_target(name: str) -> Target:
     """
     try:
         return TARGETS[name]
-    except KeyError:
+    except (KeyError, TypeError):
         raise ValueError(f"unknown target {name!r}; accepted: {', '.join(target_names())}") from None

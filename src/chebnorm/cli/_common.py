@@ -39,14 +39,39 @@ def deprecated_alias(parser, old: str, new: str, dest: str, **kwargs) -> None:
                         help=f"deprecated spelling of {new}", **kwargs)
 
 
+def refuse_unused(args, where: str, **flags) -> None:
+    """Refuse options given where they do nothing: ``flags`` maps each option
+    (``"--log-m"``) to its argparse ``dest``; an option whose value is not None
+    was given (its default is None), and the error names it and ``where`` it
+    applies (one line, exit 2).
+
+    >>> import argparse
+    >>> refuse_unused(argparse.Namespace(q=None), "with --shading split-gouraud", **{"--q": "q"})
+    >>> refuse_unused(argparse.Namespace(q=0.1), "with --shading split-gouraud", **{"--q": "q"})
+    Traceback (most recent call last):
+    ...
+    ValueError: --q does nothing here; it applies only with --shading split-gouraud
+    """
+    given = [flag for flag, dest in flags.items() if getattr(args, dest, None) is not None]
+    if given:
+        verb = "does" if len(given) == 1 else "do"
+        raise ValueError(f"{', '.join(given)} {verb} nothing here; it applies only {where}")
+
+
+#: defaults of --eta-threshold and --q (None in the parser, so that a given value
+#: can be told from the default)
+ETA_THRESHOLD = 0.005
+Q_THRESHOLD = 1.0 / 255.0
+
+
 def add_lighting_options(p, engine_help: str) -> None:
     """The options ``render`` and ``render-sweep`` share: ``--half-vector``,
     ``--eta-threshold``, ``--q`` and ``--engine``."""
     p.add_argument("--half-vector", default="pixel", choices=("pixel", "triangle"),
                    help="H per pixel (default) or constant per triangle")
-    p.add_argument("--eta-threshold", type=float, default=0.005,
+    p.add_argument("--eta-threshold", type=float, default=None,
                    help="adaptive: skip normalization where eta < this (default 0.005)")
-    p.add_argument("--q", type=float, default=1.0 / 255.0,
+    p.add_argument("--q", type=float, default=None,
                    help="split-gouraud: specular threshold at edge maxima (default 1/255)")
     p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
                    help=engine_help)

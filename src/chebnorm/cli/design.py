@@ -23,8 +23,9 @@ def register(sub) -> None:
     p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
     p.add_argument("--max-error", type=float, required=True, help="bound on |y - f(x)|, > 0")
     p.add_argument("--degrees", type=int, nargs="+", default=[1, 2, 3], help="default 1 2 3")
-    p.add_argument("--max-segments", default="2^8", metavar="2^k",
-                   help="largest segment count tried (default 2^8)")
+    p.add_argument("--max-segments", default=None, metavar="2^k",
+                   help="largest segment count tried, 2^0..2^min(12, in-bits - 1) (default "
+                   "2^8, or 2^(in-bits - 1) when in-bits <= 8: at most half the input codes)")
     p.add_argument("--no-synth", action="store_true", help="model estimate instead of yosys")
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
@@ -46,8 +47,15 @@ def run(args) -> int:
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, args.max_error,
-                 degrees=args.degrees, max_index_bits=parse_segments(args.max_segments),
+                 degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
                  var=args.var, synth=not args.no_synth, name=name, **parallel_kwargs(args))
+    if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
+        best = min(res.points, key=lambda p: p.total_bound)
+        raise ValueError(f"no design meets --max-error {args.max_error:.4g}: the smallest "
+                         f"certified error reached is {best.total_bound:.4g} (degree {best.degree}, "
+                         f"{best.segments} segments, {best.coef_frac_bits} coefficient bits); "
+                         f"accepted: a larger --max-error, or more --max-segments, --degrees "
+                         f"or --out-bits")
     csv, png = res.csv(), res.plot_png()
     make_folder(out)
     write_atomic(out / f"design_{name}.csv", csv)
@@ -55,14 +63,27 @@ def run(args) -> int:
     print(out / f"design_{name}.csv")
     print(out / f"design_{name}.png")
     print("\n".join(res.explain()))
-    if res.winner is None:
-        return 1
     w = res.winner
     print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
           f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
           f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
           f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
     return 0
+
+
+def _max_index_bits(args, parse_segments) -> int:
+    """``--max-segments`` as index bits k, checked against ``--in-bits`` (a
+    segment needs two input codes at least); the default 2^8 shrinks to
+    2^(in-bits - 1) for narrow inputs."""
+    in_bits = args.in_bits if 2 <= args.in_bits <= 20 else None  # else search refuses it
+    top = 12 if in_bits is None else min(12, in_bits - 1)
+    if args.max_segments is None:
+        return min(8, top)
+    k = parse_segments(args.max_segments)
+    if in_bits is not None and not 0 <= k <= top:
+        raise ValueError(f"--max-segments {args.max_segments}: with --in-bits {in_bits} "
+                         f"accepted: 2^0 .. 2^{top} (at most half the input codes, and 2^12)")
+    return k
 
 
 def _piecewise_design(args):
@@ -92,6 +113,9 @@ def hw_verilog(args) -> int:
     if getattr(args, "pipelined", False):
         raise ValueError("--pipelined is not available for a piecewise table; accepted: the "
                          "combinational evaluator")
+    if getattr(args, "lang", "verilog") != "verilog":
+        raise ValueError(f"--lang {args.lang} is not available for a piecewise table (its "
+                         f"evaluator is written in Verilog only); accepted: --lang verilog")
     d = _piecewise_design(args)
     files = piecewise_outputs(d, version=__version__, command=command_line(args))
     out = Path(args.output)

@@ -38,7 +38,7 @@ def register(sub) -> None:
     deprecated_alias(hw, "--coef-bits", "--coef-frac-bits", "coef_bits", type=int)
     hw.add_argument("--acc-bits", type=int, default=None,
                     help="accumulator fractional bits (default: output's + 3)")
-    hw.add_argument("--rounding", default="rne", help="rne (default) or trunc")
+    hw.add_argument("--rounding", default=None, help="rne (default) or trunc")
     p.set_defaults(func=run)
 
 
@@ -50,7 +50,7 @@ def run(args) -> int:
     if is_piecewise_file(args.table):
         return _run_piecewise(args)
     flags = {"in_bits": "--in-bits", "out_bits": "--out-bits", "coef_bits": "--coef-frac-bits",
-             "acc_bits": "--acc-bits"}
+             "acc_bits": "--acc-bits", "rounding": "--rounding"}
     hw_only = [flag for dest, flag in flags.items() if getattr(args, dest) is not None]
     if args.format in FORMATS and hw_only:
         raise ValueError(f"{', '.join(hw_only)} apply to --format vhdl or verilog only, not "
@@ -67,7 +67,8 @@ def run(args) -> int:
     from chebnorm.hw.report import analyze
 
     report = analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
-                     acc_bits=args.acc_bits, rounding=args.rounding, gappa=False, synth=False)
+                     acc_bits=args.acc_bits, rounding=args.rounding or "rne", gappa=False,
+                     synth=False)
     d = report.design
     kw = dict(version=__version__, command=command_line(args), budget=report.budget)
     if args.format == "vhdl":
@@ -87,6 +88,14 @@ def _run_piecewise(args) -> int:
     from chebnorm.export.c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
 
     table = PiecewiseTable.load(args.table)
+    dests = {"--in-bits": "in_bits", "--out-bits": "out_bits", "--coef-frac-bits": "coef_bits",
+             "--acc-bits": "acc_bits", "--rounding": "rounding"}
+    takes = {"c": ("--in-bits",), "verilog": ("--in-bits", "--out-bits")}.get(args.format, ())
+    given = [flag for flag, dest in dests.items()
+             if getattr(args, dest) is not None and flag not in takes]
+    if given:
+        raise ValueError(f"{', '.join(given)} does nothing with --format {args.format} of a "
+                         f"piecewise table; accepted there: {' '.join(takes) or 'no width option'}")
     if args.format == "c":
         in_bits = DEFAULT_C_IN_BITS if args.in_bits is None else args.in_bits
         text = piecewise_c_header(table, command_line(args), in_bits=in_bits)

@@ -6,7 +6,7 @@ import json
 
 from chebnorm.approx import CoefficientTable
 
-from ._common import command_line, deprecated_alias, print_json
+from ._common import command_line, deprecated_alias, print_json, refuse_unused
 from ._parallel import add_parallel_args
 
 
@@ -26,12 +26,12 @@ def _design_args(p) -> None:
 
 
 def _unit_width_args(p) -> None:
-    p.add_argument("--vector-frac-bits", dest="frac_bits", type=int, default=14, metavar="F",
+    p.add_argument("--vector-frac-bits", dest="frac_bits", type=int, default=None, metavar="F",
                    help="unit: fractional bits F of the vector components, 1..26 (default 14)")
     deprecated_alias(p, "--frac-bits", "--vector-frac-bits", "frac_bits", type=int, metavar="F")
     p.add_argument("--comp-bits", type=int, default=None,
                    help="unit: signed component width W, 2..28 (default F + 2)")
-    p.add_argument("--log-m", type=int, default=4, help="stepper: m = 2^LOG_M pixels, 0..10")
+    p.add_argument("--log-m", type=int, default=None, help="stepper: m = 2^LOG_M pixels, 0..10")
     p.add_argument("--guard", type=int, default=None,
                    help="stepper: guard bits, 0..24 (default 2 LOG_M: exact set-up)")
 
@@ -98,8 +98,8 @@ def register(sub) -> None:
     u.set_defaults(func=run_unit)
 
     s = hsub.add_parser("sweep", help="degree x coefficient bits x datapath bits vs area")
-    s.add_argument("--target", default="dichotomy", help="registered target (default dichotomy)")
-    s.add_argument("--psi-max", default="pi/4", help="largest angle between normals (default pi/4)")
+    s.add_argument("--target", default=None, help="registered target (default dichotomy)")
+    s.add_argument("--psi-max", default=None, help="largest angle between normals (default pi/4)")
     s.add_argument("--degrees", type=int, nargs="+", default=None, help="1..4 (default 1 2 3 4)")
     s.add_argument("--coef-frac-bits", dest="coef_bits", type=int, nargs="+", default=None,
                    metavar="B", help="coefficient fractional bits to try (default 10 14 18)")
@@ -108,7 +108,7 @@ def register(sub) -> None:
     s.add_argument("--acc-bits", type=int, nargs="+", default=None, help="default 14 18")
     s.add_argument("--in-bits", type=int, default=12, help="default 12")
     s.add_argument("--out-bits", type=int, default=12, help="default 12")
-    s.add_argument("--rounding", default="rne")
+    s.add_argument("--rounding", default=None, help="rne (default) or trunc")
     s.add_argument("--no-synth", action="store_true", help="area estimate instead of yosys cells")
     s.add_argument("--segments", nargs="+", default=None, metavar="2^k",
                    help="piecewise sweep of EXPR (--expr, --interval): segment counts x "
@@ -171,9 +171,22 @@ def run_verilog(args) -> int:
 def _unit(args, kind, table=None):
     from chebnorm.hw.units import design_unit
 
-    return design_unit(kind, frac_bits=args.frac_bits, comp_bits=args.comp_bits, table=table,
+    return design_unit(kind, frac_bits=14 if args.frac_bits is None else args.frac_bits,
+                       comp_bits=args.comp_bits, table=table,
                        in_bits=args.in_bits, out_bits=args.out_bits, coef_bits=args.coef_bits,
-                       rounding=args.rounding, log_m=args.log_m, guard=args.guard)
+                       rounding=args.rounding, log_m=4 if args.log_m is None else args.log_m,
+                       guard=args.guard)
+
+
+def _refuse_unit_options(args, kinds) -> None:
+    """--log-m and --guard size the stepper; the unit widths size a unit: refused
+    where no such unit is asked for (they would do nothing)."""
+    if "stepper" not in kinds:
+        refuse_unused(args, "to the stepper unit (--unit stepper)",
+                      **{"--log-m": "log_m", "--guard": "guard"})
+    if not kinds:
+        refuse_unused(args, "with --unit KIND", **{"--vector-frac-bits": "frac_bits",
+                                                   "--comp-bits": "comp_bits"})
 
 
 def run_report(args) -> int:
@@ -181,6 +194,7 @@ def run_report(args) -> int:
 
     for kind in args.unit:
         get_unit(kind)  # refuses an unknown name, listing the registered ones
+    _refuse_unit_options(args, args.unit)
     from chebnorm.approx.piecewise import is_piecewise_file
 
     if is_piecewise_file(args.table) and not args.unit:
@@ -224,6 +238,7 @@ def run_unit(args) -> int:
     from chebnorm.hw.verilog import simulate
 
     _check_output(args.output)
+    _refuse_unit_options(args, [args.kind])
     table = CoefficientTable.load(args.table) if args.table else None
     unit = _unit(args, args.kind, table)
     rep = analyze_unit(unit, synth=args.synth)
@@ -251,13 +266,20 @@ def run_sweep(args) -> int:
     out = Path(args.output)
     _check_output(out)
     if args.segments is not None:
+        refuse_unused(args, "to the target sweep (without --segments)", **{
+            "--target": "target", "--psi-max": "psi_max", "--acc-bits": "acc_bits",
+            "--rounding": "rounding"})
         from .design import hw_sweep_piecewise
         return hw_sweep_piecewise(args)
+    refuse_unused(args, "to the piecewise sweep (with --segments)",
+                  **{"--expr": "expr", "--interval": "interval"})
+    args.target = "dichotomy" if args.target is None else args.target
+    args.psi_max = "pi/4" if args.psi_max is None else args.psi_max
     get_target(args.target).interval(args.psi_max)  # read --psi-max (exactly, safely) up front
     res = sweep(args.target, degrees=args.degrees or DEFAULT_DEGREES,
                 coef_bits=args.coef_bits or DEFAULT_COEF_BITS,
                 acc_bits=args.acc_bits or DEFAULT_ACC_BITS, in_bits=args.in_bits,
-                out_bits=args.out_bits, rounding=args.rounding, psi_max=args.psi_max,
+                out_bits=args.out_bits, rounding=args.rounding or "rne", psi_max=args.psi_max,
                 synth=not args.no_synth, workers=args.workers, scheduler=args.scheduler)
     csv, png = res.csv(), res.plot_png()
     make_folder(out)  # only now: nothing is created when the sweep fails

@@ -18,7 +18,7 @@ def register(sub) -> None:
                        "its operation counts (measured by running the kernel on a counting type).")
     p.add_argument("--angle", type=float, required=True, metavar="PSI",
                    help="angle between the end normals, radians, 0 <= PSI < pi")
-    p.add_argument("--span", type=int, required=True, metavar="M", help="span length in pixels, >= 1")
+    p.add_argument("--span", type=int, required=True, metavar="M", help="span length in pixels, 1..65536")
     p.add_argument("--dtype", default="float64", help="float64 (default) or float32")
     p.add_argument("--drift", action="store_true",
                    help="also show the float32/float64 drift of the angular recurrence over M pixels")

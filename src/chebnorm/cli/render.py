@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from ._common import add_lighting_options, print_json
+from ._common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json, refuse_unused
 
 
 def register(sub) -> None:
@@ -18,7 +18,7 @@ def register(sub) -> None:
     p.add_argument("--mesh", default="teapot",
                    help=f"{'|'.join(MESH_NAMES)} or an .obj/.ply/.stl path (default teapot)")
     p.add_argument("--shading", default="phong", help=f"{'|'.join(SHADING_MODES)} (default phong)")
-    p.add_argument("--method", default="exact",
+    p.add_argument("--method", default=None,
                    help=f"normalization method for phong/adaptive/bump: "
                    f"{'|'.join(available_methods())} (default exact; checked by render)")
     p.add_argument("--size", nargs=2, type=int, default=(512, 512), metavar=("W", "H"),
@@ -29,7 +29,7 @@ def register(sub) -> None:
                    f"than DEG degrees ({CREASE_RANGE[0]:g}..{CREASE_RANGE[1]:g}); default: an "
                    "OBJ file's own vn normals, else 30")
     p.add_argument("--shininess", type=float, default=32.0, help="specular exponent n (default 32)")
-    p.add_argument("--bump", default="full", help=f"bump variant: {'|'.join(BUMP_VARIANTS)} "
+    p.add_argument("--bump", default=None, help=f"bump variant: {'|'.join(BUMP_VARIANTS)} "
                    "(default full)")
     p.add_argument("--reference", default=None, metavar="MODE[:METHOD]",
                    help="reference render (default phong:exact; for bump, bump:full — the "
@@ -73,6 +73,24 @@ def _parse_reference(text, shading):
     return mode, rest or "exact", "full"
 
 
+def _refuse_unused(args) -> None:
+    """Options that do nothing with this --shading (or mesh) are refused, not ignored."""
+    import os
+
+    from chebnorm.raster import MESH_NAMES
+
+    if args.shading in ("gouraud", "split-gouraud"):
+        refuse_unused(args, "with --shading phong, adaptive or bump", **{"--method": "method"})
+    if args.shading != "bump":
+        refuse_unused(args, "with --shading bump", **{"--bump": "bump"})
+    if args.shading != "adaptive":
+        refuse_unused(args, "with --shading adaptive", **{"--eta-threshold": "eta_threshold"})
+    if args.shading != "split-gouraud":
+        refuse_unused(args, "with --shading split-gouraud", **{"--q": "q"})
+    if os.fspath(args.mesh) not in MESH_NAMES:
+        refuse_unused(args, f"to a generated mesh ({', '.join(MESH_NAMES)})", **{"--tess": "tess"})
+
+
 def run(args) -> int:
     import numpy as np
 
@@ -81,6 +99,7 @@ def run(args) -> int:
     from chebnorm.raster.metrics import image_format
 
     t_start = time.perf_counter()
+    _refuse_unused(args)
     ref_mode, ref_method, ref_bump = _parse_reference(args.reference, args.shading)
     for option, path in (("--out", args.out), ("--error-map", args.error_map)):
         if path:
@@ -91,8 +110,10 @@ def run(args) -> int:
     lighting = Lighting(shininess=args.shininess, half_vector=args.half_vector)
     mesh = get_mesh(args.mesh, args.tess, _crease_radians(args.crease_angle))
     common = dict(size=tuple(args.size), lighting=lighting, engine=args.engine,
-                  eta_threshold=args.eta_threshold, q=args.q)
-    result = render(mesh, args.shading, args.method, bump=args.bump, **common)
+                  eta_threshold=ETA_THRESHOLD if args.eta_threshold is None
+                  else args.eta_threshold, q=Q_THRESHOLD if args.q is None else args.q)
+    result = render(mesh, args.shading, args.method or "exact", bump=args.bump or "full",
+                    **common)
     reference = render(mesh, ref_mode, ref_method, bump=ref_bump, dtype=np.float64, **common)
     metrics, diff = compare(result, reference)
     # everything validated and computed: now write the outputs (atomically)

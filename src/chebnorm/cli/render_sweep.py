@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from ._common import add_lighting_options
+from ._common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, refuse_unused
 from ._parallel import add_parallel_args, parallel_kwargs
 
 #: the CSV and the image folder inside ``-o DIR``
@@ -35,7 +35,7 @@ def register(sub) -> None:
                    help="tessellation levels of the generated meshes (default: each mesh's own)")
     p.add_argument("--shininess", nargs="+", type=float, default=[32.0], metavar="N",
                    help="specular exponents, >= 1 (default 32)")
-    p.add_argument("--bumps", nargs="+", default=["full"], metavar="VARIANT",
+    p.add_argument("--bumps", nargs="+", default=None, metavar="VARIANT",
                    help=f"bump variants of the bump cases: {'|'.join(BUMP_VARIANTS)} "
                    "(default full)")
     p.add_argument("--reference", default=None, metavar="MODE[:METHOD]",
@@ -78,11 +78,20 @@ def run(args) -> int:
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder "
                          "(created if missing)")
+    shadings = set(args.shadings)
+    if not shadings & {"phong", "adaptive", "bump"}:
+        refuse_unused(args, "with --shadings phong, adaptive or bump", **{"--methods": "methods"})
+    if "bump" not in shadings:
+        refuse_unused(args, "with --shadings bump", **{"--bumps": "bumps"})
+    if "adaptive" not in shadings:
+        refuse_unused(args, "with --shadings adaptive", **{"--eta-threshold": "eta_threshold"})
+    if "split-gouraud" not in shadings:
+        refuse_unused(args, "with --shadings split-gouraud", **{"--q": "q"})
     reference = None if args.reference is None else _parse_reference(args.reference, "phong")
     cases = render_sweep_cases(args.meshes, args.shadings, args.methods,
                                [parse_size(s) for s in args.sizes],
                                [None] if args.tess is None else args.tess, args.shininess,
-                               args.bumps, reference)
+                               args.bumps or ["full"], reference)
     names = [c.name for c in cases]
     if args.images and len(set(names)) < len(names):
         twice = sorted({n for n in names if names.count(n) > 1})[0]
@@ -101,8 +110,10 @@ def run(args) -> int:
         write_atomic(out / CSV_NAME, RenderSweep(tuple(finished[i] for i in sorted(finished)))
                      .csv())
 
-    sweep = render_sweep(cases, half_vector=args.half_vector, eta_threshold=args.eta_threshold,
-                         q=args.q, engine=args.engine, images=args.images, progress=True,
+    sweep = render_sweep(cases, half_vector=args.half_vector,
+                         eta_threshold=ETA_THRESHOLD if args.eta_threshold is None
+                         else args.eta_threshold, q=Q_THRESHOLD if args.q is None else args.q,
+                         engine=args.engine, images=args.images, progress=True,
                          on_row=keep, **parallel_kwargs(args))
     write_atomic(out / CSV_NAME, sweep.csv())  # the same bytes as the last partial write
     print(out / CSV_NAME)

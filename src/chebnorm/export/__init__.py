@@ -54,6 +54,11 @@ def export_text(table: CoefficientTable, fmt: str, command: str = "") -> str:
     ...
     ValueError: unknown export format 'pdf'; accepted: c, ...json...
     """
+    from chebnorm.approx.piecewise import PiecewiseTable
+
+    if not isinstance(table, (CoefficientTable, PiecewiseTable)):
+        raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
+                         f"CoefficientTable or PiecewiseTable (chebnorm.fit, or .load)")
     try:
         printer, _ = FORMATS[fmt]
     except (KeyError, TypeError):

@@ -178,6 +178,14 @@ def _run(d: HornerDesign, k: np.ndarray) -> dict:
 COEF_WORD_BITS = 32
 
 
+def _check_table(table) -> None:
+    """Refuse anything but a monomial :class:`CoefficientTable` (ValueError)."""
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
+                         f"CoefficientTable (chebnorm.fit, or CoefficientTable.load)")
+    table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
+
+
 def max_coef_bits(table: CoefficientTable) -> int:
     """Largest ``coef-bits`` for which every coefficient of ``table`` still fits
     the signed 32-bit integers of :func:`chebnorm.approx.quantize` (at most
@@ -188,7 +196,7 @@ def max_coef_bits(table: CoefficientTable) -> int:
     >>> max_coef_bits(fit_target("dichotomy", 2))   # largest |c_j| ~ 0.68
     31
     """
-    table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
+    _check_table(table)
     limit = 2 ** (COEF_WORD_BITS - 1) - 1
     best = 0
     for f in range(1, MAX_FRAC_BITS + 1):
@@ -347,7 +355,7 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     >>> bool(np.max(np.abs(y - 1 / np.sqrt(2 + x))) <= error_budget(d).total)
     True
     """
-    table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
+    _check_table(table)
     in_bits = check_width(in_bits, "in-bits", 1, MAX_IN_BITS)
     out_bits = check_width(out_bits, "out-bits", 1, MAX_OUT_BITS)
     if rounding not in ROUNDINGS:

@@ -58,9 +58,14 @@ def _check_psi(psi) -> np.ndarray:
     return arr
 
 
+#: longest span the analyses accept, in pixels: 4x the widest frame ``render``
+#: draws (16384); a span of 2**16 takes ~20 s and ~0.3 GB in :func:`analyze`
+MAX_SPAN = 2 ** 16
+
+
 def _check_m(m) -> int:
-    if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or m < 1:
-        raise ValueError(f"span length m = {m!r}; accepted: an integer m >= 1")
+    if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or not 1 <= m <= MAX_SPAN:
+        raise ValueError(f"span length m = {m!r}; accepted: an integer m >= 1, at most {MAX_SPAN}")
     return int(m)
 
 

@@ -353,6 +353,10 @@ def _end_normals(n_left, n_right):
     return nl, nr, cos
 
 
+#: most pixels one call interpolates (count summed over the spans)
+MAX_PIXELS = 16384 * 16384
+
+
 def _positions(s, m, dt, t0, count):
     """Validated per-span ``m, dt, t0, count`` of ``s`` spans (defaults filled in)."""
     m_arr = _as_per_span("m", m, s, np.int64, None)
@@ -368,6 +372,9 @@ def _positions(s, m, dt, t0, count):
     cnt = _as_per_span("count", count, s, np.int64, m_arr + 1)
     if (cnt < 1).any():
         raise ValueError(f"count holds {int(cnt.min())}; accepted: count >= 1 (pixels per span)")
+    if int(cnt.sum()) > MAX_PIXELS:
+        raise ValueError(f"count: {int(cnt.sum())} pixels in all; accepted: at most {MAX_PIXELS} "
+                         f"(the pixels of the largest frame, 16384 x 16384)")
     last = t0_arr + (cnt - 1) * dt_arr
     tol = 1e-9
     if (t0_arr < -tol).any() or (last > 1 + tol).any():

@@ -567,7 +567,13 @@ def get_mesh(name_or_path, tess: int | None = None, crease_angle: float | None =
             "square": square}
     if isinstance(name_or_path, Mesh):
         return name_or_path
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise ValueError(f"mesh of type {type(name_or_path).__name__} is not accepted; accepted: "
+                         f"a Mesh, a name ({', '.join(MESH_NAMES)}) or a path to an .obj, .ply "
+                         f"or .stl file")
     name = os.fspath(name_or_path)
+    if not isinstance(name, str):
+        raise ValueError(f"mesh path {name!r} is not accepted; accepted: a text path")
     if name in gens:
         if crease_angle is not None:
             raise ValueError(f"mesh {name!r} is generated with exact normals; a crease angle "

@@ -48,6 +48,10 @@ def _as_8bit(x):
     if isinstance(x, RenderResult):
         return x.image8, x.mask
     a = np.asarray(x)
+    if a.dtype != np.uint8 and (a.dtype.kind not in "biuf" or a.ndim != 2):
+        raise ValueError(f"image of type {type(x).__name__} (dtype {a.dtype}, shape {a.shape}) "
+                         f"is not accepted; accepted: a RenderResult, or a 2-D array of numbers "
+                         f"in [0, 1] or of uint8")
     if a.dtype != np.uint8:
         a = to_8bit(a)
     return a, np.ones(a.shape, dtype=bool)

@@ -315,10 +315,11 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
 def _check_options(shading, bump, eta_threshold, q):
     if shading == "bump" and bump not in BUMP_VARIANTS:
         raise ValueError(f"unknown bump variant {bump!r}; accepted: {', '.join(BUMP_VARIANTS)}")
-    if not (np.isfinite(eta_threshold) and eta_threshold >= 0):
-        raise ValueError(f"eta_threshold must be a finite number >= 0; got {eta_threshold!r}")
-    if not (np.isfinite(q) and q >= 0):
-        raise ValueError(f"q must be a finite number >= 0; got {q!r}")
+    for name, value in (("eta_threshold", eta_threshold), ("q", q)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not ((isinstance(value, (int, np.integer)) or np.isfinite(value))
+                        and value >= 0):
+            raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
 
 
 def _interpolator(spec, span_normals, engine="numpy"):
