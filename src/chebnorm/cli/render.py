@@ -76,9 +76,9 @@ def _parse_reference(text, shading):
 def run(args) -> int:
     import numpy as np
 
-    from chebnorm.raster import (Lighting, compare, error_map_rgb, get_mesh, render,
-                                 write_image)
-    from chebnorm.raster.metrics import image_format
+    from chebnorm.approx.files import write_all
+    from chebnorm.raster import Lighting, compare, error_map_rgb, get_mesh, render
+    from chebnorm.raster.metrics import image_bytes, image_format
 
     t_start = time.perf_counter()
     ref_mode, ref_method, ref_bump = _parse_reference(args.reference, args.shading)
@@ -95,11 +95,11 @@ def run(args) -> int:
     result = render(mesh, args.shading, args.method, bump=args.bump, **common)
     reference = render(mesh, ref_mode, ref_method, bump=ref_bump, dtype=np.float64, **common)
     metrics, diff = compare(result, reference)
-    # everything validated and computed: now write the outputs (atomically)
-    if args.out:
-        write_image(args.out, result.image8)
+    # everything validated and computed: now write the outputs, both or neither
+    outputs = ([(args.out, image_bytes(result.image8, image_format(args.out)))] if args.out else [])
     if args.error_map:
-        write_image(args.error_map, error_map_rgb(diff))
+        outputs.append((args.error_map, image_bytes(error_map_rgb(diff), image_format(args.error_map))))
+    write_all(outputs)
     report = metrics.to_dict()
     report.update({
         "seconds": result.seconds,

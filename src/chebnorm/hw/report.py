@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import make_folder, write_atomic
+from chebnorm.approx.files import write_folder
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -220,8 +220,8 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
-    """Write every file atomically into ``directory`` (created if missing); the
-    caller has checked everything before, so nothing is half-written.
+    """Write every file into ``directory`` (created if missing), all or none
+    (:func:`chebnorm.approx.files.write_folder`): nothing is half-written.
 
     Examples
     --------
@@ -232,12 +232,7 @@ def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     ...     print([p.name for p in write_outputs(tmp, verilog_outputs(r))])
     ['chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v', 'chebnorm_dichotomy_d1.hex']
     """
-    folder = make_folder(directory)
-    paths = []
-    for fname, text in files.items():
-        write_atomic(folder / fname, text)
-        paths.append(folder / fname)
-    return paths
+    return write_folder(directory, files)
 
 
 class _CallableModule(types.ModuleType):
