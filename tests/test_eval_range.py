@@ -165,3 +165,16 @@ def test_float_bound_covers_underflow():
     exact = [Fraction(1, 10 ** 40) * Fraction(float(x)) for x in xs]
     worst = max(abs(Fraction(float(v)) - e) for v, e in zip(y, exact))
     assert worst > 0 and worst <= Fraction(bound)
+
+
+def test_hw_report_json_with_a_zero_of_f(tmp_path):
+    """f(0) = 0 at a valid code: the measured relative error is undefined
+    there; ``hw report --json`` failed on the NaN ('not JSON compliant')."""
+    assert cli("fit", "0.3*x", "--interval", "-0.1", "0", "--degree", "1", "-o", "L.json",
+               cwd=tmp_path).returncode == 0
+    r = cli("hw", "report", "L.json", "--in-bits", "8", "--out-bits", "8", "--coef-frac-bits",
+            "12", "--no-gappa", "--no-synth", "--json", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    import json
+    d = json.loads(r.stdout)
+    assert d["measured"]["rel_total"] is None and d["measured"]["shading_levels"] is None

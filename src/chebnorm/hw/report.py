@@ -124,7 +124,9 @@ class HardwareReport:
                 + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
                 f"  total           {b.total:.6e} | {m.total:.6e}  "
                 f"({b.total / b.y_lsb:.3f} | {m.total_lsb:.3f} LSB; ratio {b.total / m.total:.3f})",
-                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output",
+                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output"
+                if m.shading_levels is not None else
+                "  shading error   - (f is zero at a valid code: no relative error)",
                 "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]
         out += self.block.lines()
         if self.synth is not None:
