@@ -37,7 +37,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.approx.files import write_folder
     from chebnorm.approx.piecewise import parse_segments
     from chebnorm.approx.textsafe import identifier
     from chebnorm.hw.piecewise_search import search
@@ -57,9 +57,7 @@ def run(args) -> int:
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
     csv, png = res.csv(), res.plot_png()
-    make_folder(out)
-    write_atomic(out / f"design_{name}.csv", csv)
-    write_atomic(out / f"design_{name}.png", png)
+    write_folder(out, {f"design_{name}.csv": csv, f"design_{name}.png": png})
     print(out / f"design_{name}.csv")
     print(out / f"design_{name}.png")
     print("\n".join(res.explain()))
@@ -106,7 +104,7 @@ def hw_verilog(args) -> int:
     from pathlib import Path
 
     from chebnorm import __version__
-    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.approx.files import write_folder
     from chebnorm.hw.piecewise import piecewise_outputs
     from chebnorm.hw.verilog import simulate
 
@@ -119,10 +117,8 @@ def hw_verilog(args) -> int:
     d = _piecewise_design(args)
     files = piecewise_outputs(d, version=__version__, command=command_line(args))
     out = Path(args.output)
-    make_folder(out)
-    for fname, text in sorted(files.items()):
-        write_atomic(out / fname, text)
-        print(out / fname)
+    for path in write_folder(out, dict(sorted(files.items()))):
+        print(path)
     if args.simulate:
         res = simulate(out, d)
         print(res.line)
@@ -163,7 +159,7 @@ def hw_sweep_piecewise(args) -> int:
     """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot."""
     from pathlib import Path
 
-    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.approx.files import write_folder
     from chebnorm.approx.piecewise import parse_segments
     from chebnorm.hw.piecewise_search import grid
 
@@ -171,9 +167,8 @@ def hw_sweep_piecewise(args) -> int:
                args.out_bits, index_bits=[parse_segments(v) for v in args.segments],
                degrees=args.degrees or (1, 2, 3), coef_frac_bits=args.coef_bits or (12, 16, 20),
                synth=not args.no_synth, **parallel_kwargs(args))
-    out = make_folder(Path(args.output))
-    write_atomic(out / "sweep_piecewise.csv", res.csv())
-    write_atomic(out / "sweep_piecewise.png", res.plot_png())
+    out = Path(args.output)
+    write_folder(out, {"sweep_piecewise.csv": res.csv(), "sweep_piecewise.png": res.plot_png()})
     print(out / "sweep_piecewise.csv")
     print(out / "sweep_piecewise.png")
     return 0

@@ -260,7 +260,7 @@ def run_sweep(args) -> int:
     from pathlib import Path
 
     from chebnorm.approx import get_target
-    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.approx.files import write_folder
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)
@@ -282,10 +282,8 @@ def run_sweep(args) -> int:
                 out_bits=args.out_bits, rounding=args.rounding or "rne", psi_max=args.psi_max,
                 synth=not args.no_synth, workers=args.workers, scheduler=args.scheduler)
     csv, png = res.csv(), res.plot_png()
-    make_folder(out)  # only now: nothing is created when the sweep fails
-    stem = f"sweep_{args.target}"
-    write_atomic(out / f"{stem}.csv", csv)
-    write_atomic(out / f"{stem}.png", png)
+    stem = f"sweep_{args.target}"  # only now: nothing is created when the sweep fails
+    write_folder(out, {f"{stem}.csv": csv, f"{stem}.png": png})
     print(out / f"{stem}.csv")
     print(out / f"{stem}.png")
     best = res.cheapest

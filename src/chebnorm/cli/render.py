@@ -94,9 +94,9 @@ def _refuse_unused(args) -> None:
 def run(args) -> int:
     import numpy as np
 
-    from chebnorm.raster import (Lighting, compare, error_map_rgb, get_mesh, render,
-                                 write_image)
-    from chebnorm.raster.metrics import image_format
+    from chebnorm.approx.files import write_all
+    from chebnorm.raster import Lighting, compare, error_map_rgb, get_mesh, render
+    from chebnorm.raster.metrics import image_bytes, image_format
 
     t_start = time.perf_counter()
     _refuse_unused(args)
@@ -116,11 +116,11 @@ def run(args) -> int:
                     **common)
     reference = render(mesh, ref_mode, ref_method, bump=ref_bump, dtype=np.float64, **common)
     metrics, diff = compare(result, reference)
-    # everything validated and computed: now write the outputs (atomically)
-    if args.out:
-        write_image(args.out, result.image8)
+    # everything validated and computed: now write the outputs, both or neither
+    outputs = ([(args.out, image_bytes(result.image8, image_format(args.out)))] if args.out else [])
     if args.error_map:
-        write_image(args.error_map, error_map_rgb(diff))
+        outputs.append((args.error_map, image_bytes(error_map_rgb(diff), image_format(args.error_map))))
+    write_all(outputs)
     report = metrics.to_dict()
     report.update({
         "seconds": result.seconds,

@@ -53,7 +53,8 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-__all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES"]
+__all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
+           "range_problem", "underflow_bound"]
 
 # C type, literal suffix, function suffix, unit roundoff
 FLOAT_TYPES = (
@@ -100,6 +101,161 @@ def _up(x: Fraction) -> float:
     while Fraction(f) < x:
         f = math.nextafter(f, math.inf)
     return f
+
+
+#: per literal suffix: the type's name, its largest finite number and half its
+#: smallest subnormal (the absolute error of a product rounded to a subnormal)
+_RANGE = {"": ("double", Fraction(float(np.finfo(np.float64).max)), Fraction(1, 2 ** 1075)),
+          "f": ("float", Fraction(float(np.finfo(np.float32).max)), Fraction(1, 2 ** 150))}
+
+
+def inner_interval(table: CoefficientTable) -> tuple[float, float]:
+    """The table's exact interval rounded *inward* to doubles: the ``_LO`` and
+    ``_HI`` a header prints, so every input between them lies in the
+    certified interval (``interval_float``, the nearest doubles, may lie just
+    outside: ``-0.1`` is below ``-1/10``).
+
+    >>> from chebnorm.approx import fit
+    >>> t = fit("0.3*x", ("-0.1", "0"), 1)
+    >>> t.interval_float[0] < inner_interval(t)[0] == math.nextafter(-0.1, 0)
+    True
+    """
+    from chebnorm.approx.api import Interval
+
+    try:
+        iv = Interval(*table.interval)
+    except (TypeError, ValueError):
+        # text no reader accepts (a table built by hand and never verified):
+        # the stored doubles, as before
+        return tuple(float(v) for v in table.interval_float)
+    return iv.lo_in, iv.hi_in
+
+
+def _gamma(k: int, u: float) -> Fraction:
+    uf = Fraction(u)
+    return k * uf / (1 - k * uf)
+
+
+def underflow_bound(n: int, max_t: Fraction, suffix: str, u: float) -> Fraction:
+    """Bound of what gradual underflow adds to Horner's rule of degree ``n``
+    in the type of ``suffix`` for ``|t| <= max_t``: each of the ``n``
+    products may round to a subnormal with an absolute error up to half the
+    smallest subnormal ``eta`` (sums of floats are exact there), later
+    multiplied by ``|t|`` once per remaining step and by at most ``2n``
+    factors ``1 + delta``: ``eta (1 + gamma_2n) sum_{j<n} max_t^j``.
+
+    >>> underflow_bound(2, Fraction(1), "f", 2.0 ** -24) < Fraction(3, 2 ** 150)
+    True
+    """
+    eta = _RANGE[suffix][2]
+    return eta * (1 + _gamma(2 * n, u)) * sum((max_t ** j for j in range(n)), Fraction(0))
+
+
+def _inward(lo: float, hi: float, suffix: str) -> tuple[float, float]:
+    """``[lo, hi]`` rounded inward to the type of ``suffix``."""
+    if suffix != "f":
+        return lo, hi
+    with np.errstate(over="ignore"):
+        lo32, hi32 = np.float32(lo), np.float32(hi)
+    if float(lo32) < lo:
+        lo32 = np.nextafter(lo32, np.float32(np.inf), dtype=np.float32)
+    if float(hi32) > hi:
+        hi32 = np.nextafter(hi32, np.float32(-np.inf), dtype=np.float32)
+    return float(lo32), float(hi32)
+
+
+def _overflows(xs, cs, suffix: str, shift, parity):
+    """Which of the inputs ``xs`` make the evaluator (Horner's rule in the type
+    of ``suffix``, unfused, after the shift or in ``x*x``) meet a non-finite
+    intermediate."""
+    dt = np.float32 if suffix == "f" else np.float64
+    with np.errstate(all="ignore"):
+        x = np.asarray(xs, dtype=dt)
+        bad = ~np.isfinite(x)
+        t = x
+        if shift is not None:
+            c, s = dt(shift[0]), float(shift[1])
+            t = (x - c) * dt(1 / s) if _is_power_of_two(s) else (x - c) / dt(s)
+        if parity is not None:
+            t = x * x
+            cs = cs[parity::2]
+        bad |= ~np.isfinite(t)
+        acc = np.full_like(x, dt(cs[-1]))
+        for c in reversed(cs[:-1]):
+            prod = acc * t
+            acc = prod + dt(c)
+            bad |= ~np.isfinite(prod) | ~np.isfinite(acc)
+        if parity:
+            bad |= ~np.isfinite(acc * x)
+    return bad
+
+
+def _first_overflow(lo: float, hi: float, cs, suffix: str, shift=None, parity=None):
+    """The smallest input found (on 4097 evenly spread points, then by
+    bisection towards the last good one) at which the evaluator meets a
+    non-finite intermediate, or None."""
+    lo, hi = _inward(lo, hi, suffix)
+    if not lo <= hi:
+        return None
+    xs = np.unique(np.concatenate([np.linspace(lo, hi, 4097), [lo, hi]]))
+    xs = np.clip(xs.astype(np.float32 if suffix == "f" else np.float64), lo, hi)
+    bad = _overflows(xs, cs, suffix, shift, parity)
+    if not bad.any():
+        return None
+    i = int(np.argmax(bad))
+    if i == 0:
+        return float(xs[0])
+    good, worse = float(xs[i - 1]), float(xs[i])
+    for _ in range(200):
+        mid = float(np.asarray((good + worse) / 2, dtype=xs.dtype))
+        if mid in (good, worse):
+            break
+        if _overflows([mid], cs, suffix, shift, parity)[0]:
+            worse = mid
+        else:
+            good = mid
+    return worse
+
+
+def range_problem(coeffs, max_t: Fraction, suffix: str, u: float, *, where=None) -> str | None:
+    """None when Horner's rule on ``coeffs`` in the type of ``suffix`` (fused
+    or not) cannot meet a non-finite intermediate for ``|t| <= max_t``; else
+    the reason (the first offending input when ``where = (lo, hi, shift,
+    parity)`` lets it be searched for).
+
+    Every computed intermediate is at most ``(1 + gamma_2n)(1 + u)`` times the
+    exact ``sum_{j>=k} |c_j| max_t^(j-k)`` (and its product by ``max_t``),
+    plus the underflow term: the evaluator stays finite when that is at most
+    the type's largest number.
+
+    >>> range_problem([0.0, 1e30], Fraction(10 ** 10), "f", 2.0 ** -24)
+    'its intermediates may reach 1e+40 > 3.4e+38, the largest float'
+    >>> range_problem([1.0, 2.0], Fraction(4), "f", 2.0 ** -24) is None
+    True
+    """
+    tname, big, _ = _RANGE[suffix]
+    cts = []
+    for k, c in enumerate(coeffs):
+        with np.errstate(over="ignore"):
+            cts.append(float(np.float32(c)) if suffix == "f" else float(c))
+        if not math.isfinite(cts[-1]):
+            return f"coefficient {k} ({float(c):.6g}) is not finite in {tname}"
+    n = len(cts) - 1
+    a = abs(Fraction(cts[-1]))
+    worst = a
+    for c in reversed(cts[:-1]):
+        prod = a * max_t
+        a = prod + abs(Fraction(c))
+        worst = max(worst, prod, a)
+    reach = worst * (1 + _gamma(2 * n, u)) * (1 + Fraction(u)) + underflow_bound(n, max_t, suffix, u)
+    if reach <= big:
+        return None
+    found = None if where is None else _first_overflow(where[0], where[1], cts, suffix,
+                                                       *where[2:])
+    if found is not None:
+        return f"the {tname} evaluator overflows at x = {found!r}"
+    return (f"its intermediates may reach {float(reach):.3g} > {float(big):.3g}, the largest "
+            f"{tname}")
 
 
 def _max_abs_x(table: CoefficientTable) -> Fraction:
@@ -173,6 +329,9 @@ def _shift_error(table: CoefficientTable, coeffs, suffix: str, u: float):
 def _check_fixed_ranges(table: CoefficientTable, max_abs_x: Fraction) -> None:
     fp = table.fixed_point
     x_q = max_abs_x * 2 ** fp.frac_bits
+    if x_q >= 2 ** 63:
+        raise ValueError(f"table {table.name!r}: x * 2^{fp.frac_bits} does not fit int64 on the "
+                         f"interval; accepted: fewer fractional bits")
     acc = Fraction(abs(fp.integers[-1]))
     for q in reversed(fp.integers[:-1]):
         if acc * x_q + 2 ** fp.frac_bits >= 2 ** 63:
@@ -209,17 +368,27 @@ def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
 
 
 def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: Fraction
-                ) -> Fraction:
-    """Bound of ``|evaluator(x) - f(x)|`` in the type of ``suffix`` (module docstring)."""
+                ) -> tuple[Fraction | None, str | None]:
+    """``(bound, None)``: a bound of ``|evaluator(x) - f(x)|`` in the type of
+    ``suffix`` (module docstring, plus :func:`underflow_bound`); or
+    ``(None, reason)`` when the evaluator can meet a non-finite intermediate
+    on the interval (:func:`range_problem`)."""
+    problem = range_problem(coeffs, Fraction(0), suffix, u)  # a coefficient out of range
+    if problem is not None and problem.startswith("coefficient"):
+        return None, problem
     cs = [float(np.float32(c)) for c in coeffs] if suffix == "f" else list(coeffs)
     if table.shift is not None:
         max_t, t_err = _shift_error(table, cs, suffix, u)
     else:
         max_t, t_err = max_x, Fraction(0)
+    problem = range_problem(cs, max_t, suffix, u, where=(*inner_interval(table), table.shift, None))
+    if problem is not None:
+        return None, problem
     coef_err = sum(abs(Fraction(a) - Fraction(b)) * max_t ** k
                    for k, (a, b) in enumerate(zip(coeffs, cs)))
     return (Fraction(table.abs_error_bound) + coef_err + t_err
-            + horner_rounding_bound(cs, max_t, u))
+            + horner_rounding_bound(cs, max_t, u)
+            + underflow_bound(len(cs) - 1, max_t, suffix, u)), None
 
 
 def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, name: str,
@@ -270,6 +439,37 @@ def _parity_rounding_bound(coeffs, parity: int, max_abs_x: Fraction, u: float) -
     return gamma * sum(abs(Fraction(c)) * max_abs_x ** (2 * j + parity) for j, c in enumerate(b))
 
 
+def _parity_underflow_bound(coeffs, parity: int, max_abs_x: Fraction, suffix: str,
+                            u: float) -> Fraction:
+    """What gradual underflow adds to :func:`_parity_evaluator`: ``t = x*x``
+    off by ``eta`` moves ``q(t)`` by ``eta max |q'|``, Horner's rule in ``t``
+    adds :func:`underflow_bound`, and the final product by ``x`` one ``eta``;
+    all within the ``(1 + gamma)`` factors of the steps after them."""
+    eta = _RANGE[suffix][2]
+    b = coeffs[parity::2]
+    t_max = max_abs_x ** 2 * (1 + Fraction(u)) + eta
+    g = 1 + _gamma(3 * len(b) + 1, u)
+    slope = sum((j * abs(Fraction(c)) * t_max ** (j - 1) for j, c in enumerate(b) if j),
+                Fraction(0))
+    inner = underflow_bound(len(b) - 1, t_max, suffix, u) + g * eta * slope
+    return g * inner * (max_abs_x if parity else 1) + (eta if parity else 0)
+
+
+def _quantized_range(table, coeffs, parity, suffix: str, u: float, max_x: Fraction):
+    """:func:`range_problem` of the quantized evaluator (in ``x*x`` and times
+    ``x`` at the end for a parity evaluator)."""
+    where = (*inner_interval(table), None, parity)
+    if parity is None:
+        return range_problem(coeffs, max_x, suffix, u, where=where)
+    b = coeffs[parity::2]
+    t_max = max_x ** 2 * (1 + Fraction(u)) + _RANGE[suffix][2]
+    problem = range_problem(b, t_max, suffix, u, where=where)
+    if problem is None and parity:  # the final product by x
+        scaled = [0.0] + [float(c) for c in b]  # x * q(t) bounded as Horner one step on
+        problem = range_problem(scaled, max(t_max, max_x), suffix, u, where=where)
+    return problem
+
+
 def _parity_evaluator(coeffs, parity: int, ctype: str, suffix: str, name: str,
                       macro: str) -> list[str]:
     """Horner's rule in ``t = x*x`` over the odd (times ``x``) or even coefficients."""
@@ -306,11 +506,24 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
     w(f"#define {macro}_QUANT_ABS_ERROR_BOUND {_literal(q.abs_error_bound, '')}")
     if q.rel_error_bound is not None:
         w(f"#define {macro}_QUANT_REL_ERROR_BOUND {_literal(q.rel_error_bound, '')}")
-    emitted = [row for row in FLOAT_TYPES
-               if row[1] == "" or all(_to_type(c, row[1]) == c for c in coeffs)]
-    for ctype, suffix, fsuffix, u in emitted:
-        rounding = (horner_rounding_bound(coeffs, max_x, u) if parity is None
-                    else _parity_rounding_bound(coeffs, parity, max_x, u))
+    emitted = []
+    for row in FLOAT_TYPES:
+        ctype, suffix, fsuffix, u = row
+        if suffix == "f" and not all(_to_type(c, "f") == c for c in coeffs):
+            continue
+        problem = _quantized_range(table, coeffs, parity, suffix, u, max_x)
+        if problem is not None and suffix == "":
+            raise ValueError(f"table {table.name!r}: the quantized coefficients have no double "
+                             f"evaluator on the interval: {problem}; accepted: a table whose "
+                             f"Horner evaluation stays within the double range")
+        if problem is not None:
+            w(f"/* No {ctype} evaluator of the quantized coefficients: {comment_text(problem)}. */")
+            continue
+        emitted.append(row)
+        rounding = (horner_rounding_bound(coeffs, max_x, u) + underflow_bound(
+            table.degree, max_x, suffix, u) if parity is None
+            else _parity_rounding_bound(coeffs, parity, max_x, u)
+            + _parity_underflow_bound(coeffs, parity, max_x, suffix, u))
         bound = Fraction(q.abs_error_bound) + rounding
         w(f"#define {macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
     w(f"static const double {fn}_quant_coeffs[{len(coeffs)}] = {{")
@@ -386,16 +599,26 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     w("#include <stdint.h>")
     w("")
     w(f"#define {macro}_DEGREE {degree}")
-    w(f"#define {macro}_LO {_literal(table.interval_float[0], '')}")
-    w(f"#define {macro}_HI {_literal(table.interval_float[1], '')}")
+    lo_in, hi_in = inner_interval(table)  # rounded inward: every x between lies in the interval
+    w(f"#define {macro}_LO {_literal(lo_in, '')}")
+    w(f"#define {macro}_HI {_literal(hi_in, '')}")
     w(f"#define {macro}_ABS_ERROR_BOUND {_literal(table.abs_error_bound, '')}")
     if table.rel_error_bound is not None:
         w(f"#define {macro}_REL_ERROR_BOUND {_literal(table.rel_error_bound, '')}")
     if shifted:
         w(f"#define {macro}_CENTER {_literal(float(table.shift[0]), '')}")
         w(f"#define {macro}_SCALE {_literal(float(table.shift[1]), '')}")
+    emitted = []
     for ctype, suffix, fsuffix, u in FLOAT_TYPES:
-        bound = _eval_bound(table, coeffs, suffix, u, max_x)
+        bound, problem = _eval_bound(table, coeffs, suffix, u, max_x)
+        if problem is not None and suffix == "":
+            raise ValueError(f"table {table.name!r} has no double evaluator on its interval: "
+                             f"{problem}; accepted: a table whose Horner evaluation stays "
+                             f"within the double range")
+        if problem is not None:
+            w(f"/* No {ctype} evaluator: {comment_text(problem)}. */")
+            continue
+        emitted.append((ctype, suffix, fsuffix))
         w(f"#define {macro}{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
     if table.fixed_point is not None:
         fp = _checked_fixed(table)
@@ -409,7 +632,7 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     for k, c in enumerate(coeffs):
         w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* {'t' if shifted else 'x'}^{k} */")
     w("};")
-    for ctype, suffix, fsuffix, _ in FLOAT_TYPES:
+    for ctype, suffix, fsuffix in emitted:
         out += _float_evaluator(table, coeffs, ctype, suffix, f"{fn}{fsuffix}", macro)
     if table.fixed_point is not None:
         out += _fixed_evaluator(table.fixed_point, fn, macro)

@@ -33,7 +33,7 @@ from fractions import Fraction
 from chebnorm.approx.piecewise import PiecewiseTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-from .c import _up, banner_head, horner_rounding_bound
+from .c import _up, banner_head, horner_rounding_bound, range_problem, underflow_bound
 
 __all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound"]
 
@@ -61,7 +61,14 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
     tmax = Fraction(1, 2) if table.centered else Fraction(1)
     worst = Fraction(0)
     for s, seg in enumerate(table.segments):
-        b = Fraction(seg.abs_error_bound) + horner_rounding_bound(table.coefficients(s), tmax, _U)
+        cs = table.coefficients(s)
+        problem = range_problem(cs, tmax, "", _U)
+        if problem is not None:
+            raise ValueError(f"table {table.name!r}, segment {s}: no double evaluator: {problem}; "
+                             f"accepted: coefficients whose Horner evaluation stays within the "
+                             f"double range")
+        b = (Fraction(seg.abs_error_bound) + horner_rounding_bound(cs, tmax, _U)
+             + underflow_bound(len(cs) - 1, tmax, "", _U))
         worst = max(worst, b)
     return _up(worst)
 

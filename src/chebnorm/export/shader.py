@@ -71,7 +71,7 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-from .c import _max_abs_x, _up, horner_rounding_bound
+from .c import _max_abs_x, _up, horner_rounding_bound, inner_interval, range_problem
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
            "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source"]
@@ -242,8 +242,16 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     """
     table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
     coeffs, certified, _ = _coefficients(table)
-    c32 = [float(np.float32(c)) for c in coeffs]
     m = _max_abs_x(table)
+    # no bound for an evaluator that can overflow float32 on the interval (nor
+    # for one whose flushed underflows the flush term below does not cover)
+    problem = range_problem(coeffs, m, "f", float(U32),
+                            where=(*inner_interval(table), None, None))
+    if problem is not None:
+        raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
+                         f"interval: {problem}; accepted: a table whose Horner evaluation stays "
+                         f"within the float32 range (|values| < 3.4e38)")
+    c32 = [float(np.float32(c)) for c in coeffs]
     coef = sum((abs(Fraction(a) - Fraction(b)) * m ** k
                 for k, (a, b) in enumerate(zip(coeffs, c32))), Fraction(0))
     rounding = horner_rounding_bound(c32, m, float(U32))
@@ -263,7 +271,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
 def _interval32(table: CoefficientTable) -> tuple[float, float]:
     """The table's interval rounded *inward* to float32: every float32 in it
     lies in the table's interval."""
-    lo, hi = table.interval_float
+    lo, hi = inner_interval(table)
     lo32, hi32 = np.float32(lo), np.float32(hi)
     if float(lo32) < lo:
         lo32 = np.nextafter(lo32, np.float32(np.inf), dtype=np.float32)
@@ -295,6 +303,9 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
     big = f"CHEBNORM_{name.upper()}"
     coeffs, certified, source = _coefficients(table)
     bound = float32_eval_bound(table)
+    if not np.isfinite(bound.total32):
+        raise ValueError(f"table {table.name!r}: its float32 evaluation bound {bound.total:.3g} "
+                         f"exceeds the float32 range; accepted: a bound below 3.4e38")
     lo32, hi32 = _interval32(table)
     var = comment_text(table.variable, max_length=40)
     lit = lambda v: float32_literal(v, lang.suffix)  # noqa: E731

@@ -93,7 +93,8 @@ class Measurement:
     ``approximation`` (``max |p - f|``), ``quantization`` (``max |p_q - p|``)
     and ``total`` (``max |y - f|``) use float64 values of ``f`` and ``p``,
     whose own error (about 1e-16) is far below the bounds compared with.
-    ``rel_total`` is ``max |y / f - 1|``, ``shading_levels`` is
+    ``rel_total`` is ``max |y / f - 1|`` (None when ``f`` is zero at a valid
+    code: no relative error there), ``shading_levels`` is
     ``255 * rel_total``: the largest change of an 8-bit intensity
     ``I <= 1`` when the normal is scaled by ``y`` instead of ``f``.
 
@@ -110,7 +111,7 @@ class Measurement:
     codes: int
     total: float
     total_at_code: int
-    rel_total: float
+    rel_total: float | None
     approximation: float
     quantization: float
     rounding: float
@@ -123,8 +124,8 @@ class Measurement:
         return self.total / self.y_lsb
 
     @property
-    def shading_levels(self) -> float:
-        return SHADING_LEVELS * self.rel_total
+    def shading_levels(self) -> float | None:
+        return None if self.rel_total is None else SHADING_LEVELS * self.rel_total
 
     def as_dict(self) -> dict:
         return {"codes": self.codes, "total": self.total, "total_at_code": self.total_at_code,
@@ -229,7 +230,7 @@ def measure(design: HornerDesign) -> Measurement:
     e = np.abs(yv - f)
     i = int(np.argmax(e))
     return Measurement(codes=len(k), total=float(e[i]), total_at_code=int(k[i]),
-                       rel_total=float(np.max(np.abs(yv / f - 1))),
+                       rel_total=float(np.max(np.abs(yv / f - 1))) if np.all(f != 0) else None,
                        approximation=float(np.max(np.abs(p - f))),
                        quantization=float(np.max(np.abs(pq - p))), rounding=rounding,
                        step_rounding=tuple(steps), overflows=int(wires["overflow"].sum()),

@@ -414,8 +414,7 @@ def simulate_piecewise(d: PiecewiseDesign, directory):
     """Write the outputs into ``directory`` and run the bench in Icarus Verilog."""
     from pathlib import Path
 
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.approx.files import write_folder
 
-    for fname, text in piecewise_outputs(d).items():
-        write_atomic(Path(directory) / fname, text)
+    write_folder(Path(directory), piecewise_outputs(d))
     return simulate(directory, d)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import make_folder, write_atomic
+from chebnorm.approx.files import write_folder
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -124,7 +124,9 @@ class HardwareReport:
                 + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
                 f"  total           {b.total:.6e} | {m.total:.6e}  "
                 f"({b.total / b.y_lsb:.3f} | {m.total_lsb:.3f} LSB; ratio {b.total / m.total:.3f})",
-                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output",
+                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output"
+                if m.shading_levels is not None else
+                "  shading error   - (f is zero at a valid code: no relative error)",
                 "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]
         out += self.block.lines()
         if self.synth is not None:
@@ -222,8 +224,8 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
-    """Write every file atomically into ``directory`` (created if missing); the
-    caller has checked everything before, so nothing is half-written.
+    """Write every file into ``directory`` (created if missing), all or none
+    (:func:`chebnorm.approx.files.write_folder`): nothing is half-written.
 
     Examples
     --------
@@ -234,12 +236,7 @@ def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     ...     print([p.name for p in write_outputs(tmp, verilog_outputs(r))])
     ['chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v', 'chebnorm_dichotomy_d1.hex']
     """
-    folder = make_folder(directory)
-    paths = []
-    for fname, text in files.items():
-        write_atomic(folder / fname, text)
-        paths.append(folder / fname)
-    return paths
+    return write_folder(directory, files)
 
 
 class _CallableModule(types.ModuleType):

@@ -17,6 +17,7 @@ counts mismatches and prints one ``PASS:``/``FAIL:`` line.
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -389,20 +390,48 @@ def _need(tool: str) -> str:
     return exe
 
 
+def tool_env() -> dict[str, str]:
+    """The environment for a tool run in a private temporary folder (``cwd``):
+    the caller's, with ``TMPDIR`` set to ``"."`` and ``TMP``/``TEMP`` removed.
+
+    yosys pastes ``TMPDIR`` into the shell command that starts ABC, and
+    Icarus Verilog into the ``sh`` command lines of its preprocessor and
+    compiler (inside double quotes): a ``TMPDIR`` holding ``;`` or ``"``
+    would run commands. The relative ``"."`` (the private folder) carries no
+    text from the caller.
+
+    >>> tool_env()["TMPDIR"], "TMP" in tool_env()
+    ('.', False)
+    """
+    env = {k: v for k, v in os.environ.items() if k not in ("TMPDIR", "TMP", "TEMP")}
+    env["TMPDIR"] = "."
+    return env
+
+
 def simulate(directory, design, timeout: float = 600) -> SimResult:
     """Compile and run ``tb_M.v`` and ``M.v`` in ``directory`` with Icarus Verilog;
-    ``design``: anything with a ``module_name`` (a design, a unit), or the name ``M``."""
+    ``design``: anything with a ``module_name`` (a design, a unit), or the name ``M``.
+
+    The two files are compiled from copies in a private temporary folder
+    (``cwd``, with :func:`tool_env`), so no path and no environment variable
+    reaches Icarus's internal shell commands; the bench then runs in
+    ``directory`` (where its vector file is)."""
     iverilog, vvp = _need("iverilog"), _need("vvp")
     d = Path(directory)
     name = design if isinstance(design, str) else design.module_name
     with tempfile.TemporaryDirectory() as tmp:
-        exe = Path(tmp) / "sim.vvp"
-        comp = subprocess.run([iverilog, "-g2005", "-Wall", "-o", str(exe), f"tb_{name}.v",
-                               f"{name}.v"], cwd=d, capture_output=True, text=True, timeout=timeout)
+        for src, dst in ((f"tb_{name}.v", "tb.v"), (f"{name}.v", "dut.v")):
+            try:
+                (Path(tmp) / dst).write_bytes((d / src).read_bytes())
+            except OSError as exc:
+                raise ValueError(f"cannot read {str(d / src)!r}: {exc.strerror}") from None
+        comp = subprocess.run([iverilog, "-g2005", "-Wall", "-o", "sim.vvp", "tb.v", "dut.v"],
+                              cwd=tmp, env=tool_env(), capture_output=True, text=True,
+                              timeout=timeout, stdin=subprocess.DEVNULL)
         if comp.returncode != 0:
             raise ValueError(f"iverilog failed on {name}: {' '.join(comp.stderr.split())[:300]}")
-        run = subprocess.run([vvp, "-n", str(exe)], cwd=d, capture_output=True, text=True,
-                             timeout=timeout)
+        run = subprocess.run([vvp, "-n", str(Path(tmp) / "sim.vvp")], cwd=d, capture_output=True,
+                             text=True, timeout=timeout, stdin=subprocess.DEVNULL)
     m = re.search(r"^(PASS|FAIL): (\d+) vectors, (\d+) mismatches.*$", run.stdout, re.M)
     if not m:
         raise ValueError(f"the test bench of {name} printed no PASS/FAIL line: "
@@ -411,13 +440,37 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
                      mismatches=int(m.group(3)), line=m.group(0))
 
 
+_TOP = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
 def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
-    """Run ``yosys -p "read_verilog F; synth -top M; stat"`` and read the cell count."""
+    """Synthesize module ``top`` of the Verilog file ``path`` with yosys
+    (``synth -top TOP; stat``) and read the cell count.
+
+    No path and no environment variable ever reaches yosys's command text:
+    the file is copied into a fresh temporary folder as ``design.v`` and
+    yosys runs there (``cwd``, with :func:`tool_env`: its ABC step builds a
+    shell command from ``TMPDIR``) on the fixed script
+    ``read_verilog design.v; synth -top TOP; stat``, ``top`` an identifier.
+
+    Raises
+    ------
+    ValueError
+        when ``top`` is not a Verilog identifier, yosys is missing or fails
+        (its messages), or prints no cell count.
+    """
+    if not isinstance(top, str) or not _TOP.fullmatch(top):
+        raise ValueError(f"top: {str(top)[:60]!r} is not a module name; accepted: a Verilog "
+                         f"identifier [A-Za-z_][A-Za-z0-9_]*")
     yosys = _need("yosys")
-    proc = subprocess.run([yosys, "-p", f"read_verilog {path}; synth -top {top}; stat"],
-                          capture_output=True, text=True, timeout=timeout)
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "design.v").write_bytes(Path(path).read_bytes())
+        proc = subprocess.run([yosys, "-p", f"read_verilog design.v; synth -top {top}; stat"],
+                              cwd=tmp, env=tool_env(), capture_output=True, text=True,
+                              timeout=timeout, stdin=subprocess.DEVNULL)
     if proc.returncode != 0:
-        raise ValueError(f"yosys failed on {top}: {' '.join(proc.stdout[-300:].split())}")
+        reason = " ".join((proc.stdout[-300:] + " " + proc.stderr[-300:]).split())
+        raise ValueError(f"yosys failed on {top}: {reason or f'exit status {proc.returncode}'}")
     text = proc.stdout
     start = text.rfind("Number of cells:")
     if start < 0:
@@ -430,8 +483,9 @@ def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
 
 
 def synthesize_text(verilog: str, top: str, timeout: float = 600) -> SynthResult:
-    """:func:`synthesize` of Verilog text (through a temporary file)."""
+    """:func:`synthesize` of Verilog text (yosys reads it in a temporary
+    folder, by a fixed relative name)."""
     with tempfile.TemporaryDirectory() as tmp:
-        f = Path(tmp) / f"{top}.v"
+        f = Path(tmp) / "input.v"
         f.write_text(verilog, encoding="utf-8")
         return synthesize(f, top, timeout)
