@@ -72,8 +72,6 @@ def _consumers(path: Path, out: Path):
             ["export", path, "--format", "json", "-o", out / "t.json"],
             ["export", path, "--format", "verilog", "-o", out / "t.v"],
             ["hw", "verilog", path, "--in-bits", "10", "--out-bits", "10", "-o", out / "v"],
-            ["hw", "verilog", path, "--lang", "vhdl", "--in-bits", "10", "--out-bits", "10",
-             "-o", out / "h"],
             ["hw", "report", path, "--in-bits", "10", "--out-bits", "10"]]
 
 

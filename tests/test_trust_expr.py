@@ -299,9 +299,16 @@ def test_unconverged_remez_is_reported(tmp_path, capsys, monkeypatch):
     # exchange with its high-precision polish; cap its iterations to make it stop short
     import chebnorm.approx.api as api
 
+    from chebnorm.approx.fitting import PowersFit
+
     real = api.remez
     monkeypatch.setattr(api, "remez", lambda *a, **k: real(*a, **{**k, "max_iter": 2}))
-    args = ["fit", "1/(1+25*x^2)", "--interval", "-1", "1", "--degree", "30", "--kind", "minimax",
+    # the fall-back exchange on a growing point set, made to fail too
+    monkeypatch.setattr(api, "minimax_powers",
+                        lambda *a, **k: PowersFit([0.0] * 31, 1.0, 2.0, False, 1))
+    # (shifted off centre: an even function on [-1, 1] is fitted in even powers, not by remez)
+    args = ["fit", "1/(1+25*(x-1/8)^2)", "--interval", "-1", "1", "--degree", "30", "--kind",
+            "minimax",
             "-o", str(tmp_path / "t.json")]
     assert main(args) == 0
     err = capsys.readouterr().err.strip().splitlines()
@@ -309,11 +316,16 @@ def test_unconverged_remez_is_reported(tmp_path, capsys, monkeypatch):
                                                "converge")
     t = CoefficientTable.load(tmp_path / "t.json")
     assert any("Remez" in w for w in warnings_of(t))
-    monkeypatch.setattr(api, "remez", real)
+    monkeypatch.undo()
+    # the capped exchange alone is rescued by the exchange on a growing point set
+    monkeypatch.setattr(api, "remez", lambda *a, **k: real(*a, **{**k, "max_iter": 2}))
+    rescued = fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30, kind="minimax")
+    assert not warnings_of(rescued) and "exchange" in rescued.provenance
+    monkeypatch.undo()
     # uncapped, it converges and is better than Chebyshev interpolation, with no warning
-    m = fit("1/(1+25*x^2)", ("-1", "1"), 30, kind="minimax")
+    m = fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30, kind="minimax")
     assert not warnings_of(m)
-    assert m.abs_error_bound < fit("1/(1+25*x^2)", ("-1", "1"), 30).abs_error_bound
+    assert m.abs_error_bound < fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30).abs_error_bound
 
 
 def test_registered_targets_fit_as_committed():
