@@ -120,20 +120,37 @@ def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
     return 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
 
 
-def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list[int]]:
-    """LLL-reduce ``basis`` (integer rows) and return the integer coordinates
-    (in ``basis``) of Babai's nearest-plane point to ``target`` and, with
-    ``spread``, of its neighbours ``+- one reduced vector``."""
+def _reduced(basis: list[list[int]]):
+    """LLL reduction of ``basis`` (integer rows): the transform's rows, the
+    reduced rows scaled by ``scale`` (floats), their QR factors and ``scale``."""
     mat = fmpz_mat(basis)
     red, trans = mat.lll(transform=True)
-    n = red.nrows()
     rows = np.array([[float(int(v)) for v in row] for row in red.tolist()])
     tr = [[int(v) for v in row] for row in trans.tolist()]
     # Gram-Schmidt of the reduced rows, in floats (scaled to avoid overflow)
     scale = max(np.max(np.abs(rows)), 1.0)
     b = rows / scale
-    t = np.array([float(v) for v in target]) / scale
     q, r = np.linalg.qr(b.T)              # b.T = q r: row i of b has GS vector r[i,i] q[:, i]
+    return tr, b, q, r, scale
+
+
+def _babai(basis: list[list[int]], target: list[int], spread: bool,
+           cache: dict | None = None) -> list[list[int]]:
+    """LLL-reduce ``basis`` (integer rows) and return the integer coordinates
+    (in ``basis``) of Babai's nearest-plane point to ``target`` and, with
+    ``spread``, of its neighbours ``+- one reduced vector``. ``cache`` (basis ->
+    reduction) spares the reduction of a basis met before: the fixed-point
+    chain meets the same integer basis at most bit counts (the columns only
+    scale by 2, and the scaling to 62 bits undoes it)."""
+    key = tuple(map(tuple, basis))
+    red = None if cache is None else cache.get(key)
+    if red is None:
+        red = _reduced(basis)
+        if cache is not None:
+            cache[key] = red
+    tr, b, q, r, scale = red
+    n = len(tr)
+    t = np.array([float(v) for v in target]) / scale
     coords = [0] * n
     resid = t.copy()
     for i in range(n - 1, -1, -1):
@@ -151,7 +168,7 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list
     return out
 
 
-def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None):
     """Integer vectors ``n`` (one per free power) near the weighted function values.
 
     ``base`` (integers, one per free power: the real fit rounded) is subtracted
@@ -174,7 +191,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
     if any(all(a == 0 for a in row) for row in basis):
         return []
     try:
-        vecs = _babai(basis, ints(y), spread=True)
+        vecs = _babai(basis, ints(y), spread=True, cache=cache)
     except (ValueError, ZeroDivisionError, np.linalg.LinAlgError):
         return []
     return [[b + v for b, v in zip(base, vec)] for vec in vecs]
@@ -195,6 +212,10 @@ class _Problem:
     #: coefficients -> their certificate (or the ValueError, or the bound it is proven
     #: to reach: ("at least", b)); certify is deterministic, so a repeat is not re-run
     certs: dict = field(default_factory=dict, repr=False)
+    #: greedy's Chebyshev nodes, f there, powers of them (:func:`greedy`)
+    greedy_nodes: dict = field(default_factory=dict, repr=False)
+    #: integer lattice basis -> its reduction (:func:`_babai`)
+    reductions: dict = field(default_factory=dict, repr=False)
 
 
 class _Sampler:
@@ -385,7 +406,8 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
-                        [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers])
+                        [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
+                        prob.reductions)
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
                 prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
@@ -426,13 +448,22 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
         if k == 0:
             break
         high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
-
-        def residual(t, high=high):
+        nodes = prob.greedy_nodes.get(k)
+        if nodes is None:                     # the same at every set of quanta
+            cheb_deg = k - 1
+            t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
             x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
-            return f_np(x) - sum(c * x ** j for j, c in high.items())
-
+            with np.errstate(all="ignore"):
+                fx = f_np(x)
+            nodes = prob.greedy_nodes[k] = (
+                {j: x ** j for j in range(k, n + 1)}, fx,
+                np.polynomial.chebyshev.chebvander(t, cheb_deg).T)
+        xj, fx, vander_t = nodes
+        # numpy's chebinterpolate(residual, k - 1), the same operations on cached nodes
         with np.errstate(all="ignore"):
-            cheb = np.polynomial.chebyshev.chebinterpolate(residual, k - 1)
+            cheb = np.dot(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
+            cheb[0] /= k
+            cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
             return None
         current = cheb_to_monomial(cheb, lo, hi) + [high[j] for j in range(k, n + 1)]
