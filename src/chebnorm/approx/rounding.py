@@ -26,6 +26,7 @@ Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -235,6 +236,19 @@ class _Sampler:
         self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
         self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
         self.point_sets: dict = {}            # real coefficients -> _point_sets
+        self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
+        self._thin = None
+
+    def thinned(self, step: int = 16) -> "_Sampler":
+        """Every ``step``-th of these points: the error of a polynomial there
+        is computed with the same operations point by point, so it is at most
+        its error on all the points (a cheaper lower bound of that)."""
+        if self._thin is None:
+            thin = object.__new__(_Sampler)
+            thin.x, thin.f, thin.w = self.x[::step], self.f[::step], self.w[::step]
+            thin.xp = {k: v[::step] for k, v in self.xp.items()}
+            self._thin = thin
+        return self._thin
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
@@ -486,6 +500,41 @@ def _rank(sampler: _Sampler, cands) -> list:
     return [(lows[i],) + rows[i] for i in order]
 
 
+def _ranked(sampler: _Sampler, cands, batch: int = 8):
+    """:func:`_rank`'s rows in its order, generated lazily: the error on every
+    point (``sampler``) is computed only for the rows that come next once the
+    error on a thinned subset of the points (:meth:`_Sampler.thinned`, a lower
+    bound of it) says no other row can come before them."""
+    import heapq
+
+    rows, seen = [], set()
+    for method, ms, es in cands:
+        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
+        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+            continue
+        seen.add(coeffs)
+        rows.append((method, list(ms), list(es), coeffs))
+    if not rows:
+        return
+    coarse = sampler.thinned().errors([r[3] for r in rows])
+    # (error, 1 = on every point / 0 = thinned, method, index): a row whose error on
+    # every point is on top comes before every other row, as in _rank's sort
+    heap = [(sampler.lows.get(r[3], coarse[i]), int(r[3] in sampler.lows), r[0], i)
+            for i, r in enumerate(rows)]
+    heapq.heapify(heap)
+    while heap:
+        if heap[0][1]:
+            low, _, _, i = heapq.heappop(heap)
+            yield (low,) + rows[i]
+            continue
+        todo = []
+        while heap and not heap[0][1] and len(todo) < batch:
+            todo.append(heapq.heappop(heap)[3])
+        for i, low in zip(todo, sampler.errors([rows[i][3] for i in todo])):
+            sampler.lows[rows[i][3]] = low
+            heapq.heappush(heap, (low, 1, rows[i][0], i))
+
+
 def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
     """The smallest certified bound among ``ranked`` (from :func:`_rank`):
     candidates are certified in their sampled order, each against the best so
@@ -563,7 +612,7 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         pool = _fixed_chain(prob, real, list(frac_bits), greedy)
         if prob.word_limit is not None:
             pool = [c for c in pool if max(abs(m) for m in c[1]) <= prob.word_limit]
-        return _certify_ranked(prob, _rank(sampler, pool))
+        return _certify_ranked(prob, _ranked(sampler, pool))
     # floating: quanta from the real coefficients, then from the best few
     # candidates' own binades (a lattice answer may leave a binade), a few rounds
     todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
@@ -577,12 +626,12 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         tried.add(quanta)
         cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
         pool += [(m, *c) for m, c in cands.items()]
-        ranked = _rank(sampler, [(m, *c) for m, c in cands.items()])
-        for _, _, ms, es, _ in ranked[:8]:
+        ranked = _ranked(sampler, [(m, *c) for m, c in cands.items()])
+        for _, _, ms, es, _ in itertools.islice(ranked, 8):
             # a zero coefficient keeps its quantum (float_quantum(0) is the
             # format's smallest, 2^-1074 in binary64: the real one would overflow)
             q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers and m
                       else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
-    return _certify_ranked(prob, _rank(sampler, pool), FLOAT_CERTIFY)
+    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY)
