@@ -18,8 +18,11 @@ certified so far: the answer is the smallest certified bound among those.
 
 Fixed formats are monotone in the bits: the pool certified at ``F``
 fractional bits holds, for every ``b = 0..F`` bits, the plain rounding and the
-answer of a cheaply ranked chain (:func:`_fixed_chain`), shifted to ``F`` bits;
-the pool at ``F - 1`` bits is part of it, so more bits never certify worse.
+cheaply ranked best candidate at ``b`` bits (:func:`_chain_level`), shifted to
+``F`` bits; the pool at ``F - 1`` bits is part of it, so more bits never
+certify worse. The bit counts whose grid is proven (:func:`_grid_lower_bounds`)
+to hold no polynomial as good as the bound certified at ``F`` bits cannot
+change the minimum and are not built (:func:`_fixed_pool`).
 
 Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 """
@@ -564,33 +567,105 @@ CHAIN_SAMPLES = 257
 FLOAT_CERTIFY = None
 
 
-def _fixed_chain(prob: _Problem, real, fracs, greedy) -> list:
-    """The fixed-point pool: at every bit count ``b = 0..F`` (all powers shifted
-    alike) the plain rounding ``R_b`` and the chain's answer ``S_b`` -- the
-    candidate with the smallest cheaply sampled error among the candidates at
-    ``b`` and ``S_(b-1)`` (kept unless beaten by more than 2^-20 relative) --
-    as (method, mantissas, exponents) at ``F`` bits. The pool at ``F - 1`` bits
-    is a subset (same values) of the pool at ``F``: the certified minimum over
-    it never grows with the bits."""
-    coarse = _Sampler(prob, CHAIN_SAMPLES)
-    pool, prev = [], None
+def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
+    """``out[level]``: a rigorous lower bound of the error (the problem's kind,
+    sup over the interval) of EVERY polynomial whose free coefficient ``k`` is
+    an integer multiple of ``2^-(fracs[k] - level)`` (the fixed ones held),
+    for ``level = 0..min(fracs)``; 0 where nothing is proven.
+
+    At ``n`` points ``x_i`` of the interval (``n`` free powers, Chebyshev
+    nodes; on ``[0, hi]`` for one parity on a symmetric interval) with the
+    Vandermonde ``V`` and ``g = f - (fixed part)``: a polynomial of error
+    vector ``e`` (weighted by ``w = 1`` or ``1/|f|``) has coefficients ``c =
+    V^-1 (g - e/w)``, so ``c_k`` on its grid ``q Z`` needs ``|u_k . (e/w)| >=
+    dist(u_k . g, q Z)`` (``u_k`` row ``k`` of ``V^-1``), hence ``max|e| >=
+    dist(u_k . g, q Z) / sum_i |u_ki| / w_i`` -- in ball arithmetic. The
+    grids are nested (fewer bits: a subset), so the bound at a level is also
+    the largest of those at the finer levels."""
+    from flint import arb, arb_mat, ctx
+
+    levels = min(fracs) + 1
+    n = len(prob.powers)
+    lo = 0.0 if _symmetric_parity(prob) else prob.lo_f
+    pts = [float(v) for v in chebyshev_nodes(lo, prob.hi_f, n)]
+    if n == 0 or not all(prob.lo_f < v < prob.hi_f for v in pts) or len(set(pts)) < n:
+        return [0.0] * levels
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        xs = [arb(v) for v in pts]
+        fx = [prob.fn.arb(x) for x in xs]
+        g = [f - sum((arb(m) * arb(2) ** e * x ** k for k, (m, e) in prob.fixed.items()),
+                     arb(0)) for f, x in zip(fx, xs)]
+        inv = arb_mat([[x ** e for e in prob.powers] for x in xs]).inv()
+        scale = [abs(f) if prob.error_kind == "rel" else arb(1) for f in fx]
+        if not all(v.is_finite() for v in g + scale) or (
+                prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
+            return [0.0] * levels
+        rows = []
+        for k in range(n):
+            c = sum((inv[k, i] * g[i] for i in range(n)), arb(0))
+            rs = sum((abs(inv[k, i]) * scale[i] for i in range(n)), arb(0)).upper()
+            rows.append((c, rs))
+        out, best = [], 0.0
+        for level in range(levels):
+            for (c, rs), f in zip(rows, [fracs[k] for k in prob.powers]):
+                q = arb(2) ** (level - f)
+                t = c / q
+                z = math.floor(float(t.mid()))
+                dist = min((abs(t - (z + d))).lower() for d in (-1, 0, 1, 2))
+                bound = q * dist / rs
+                if bound.is_finite() and bound > 0:
+                    best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
+            out.append(best)
+        return out
+    except (ValueError, ZeroDivisionError, ArithmeticError):
+        return [0.0] * levels
+    finally:
+        ctx.prec = old
+
+
+def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
+    """The fixed-point pool's members at ``F - level`` bits (all powers shifted
+    alike): the plain rounding and the candidate with the smallest cheaply
+    sampled error, as (method, mantissas, exponents) at ``F`` bits."""
+    quanta = [-(f - level) for f in fracs]
+    cands = _candidates(prob, coarse, real, quanta, greedy, "fixed")
+    ranked = _rank(coarse, [(m, *c) for m, c in cands.items()])
+    members = [("rounded",) + tuple(cands["rounded"])] if "rounded" in cands else []
+    if ranked:
+        members.append(tuple(ranked[0][1:4]))
     fq = [-f for f in fracs]
-    for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
-        quanta = [-(f - level) for f in fracs]
-        cands = _candidates(prob, coarse, real, quanta, greedy, "fixed")
-        ranked = _rank(coarse, [(m, *c) for m, c in cands.items()])
-        if ranked:
-            low, method, ms, es, _ = ranked[0]
-            if prev is None or low < prev[0] * (1 - SELECT_TOL):
-                prev = (low, method, ms, es)
-        if "rounded" in cands:
-            pool.append(("rounded",) + tuple(cands["rounded"]))
-        if prev is not None:
-            pool.append(prev[1:])
-    out = []
-    for method, ms, es in pool:               # every one shifted to F bits
-        out.append((method, [m << (e - q) if m else 0 for m, e, q in zip(ms, es, fq)], fq))
-    return out
+    return [(method, [m << (e - q) if m else 0 for m, e, q in zip(ms, es, fq)], fq)
+            for method, ms, es in members]
+
+
+def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candidate | None:
+    """The best certified member of the fixed-point pool: at every bit count
+    ``b = 0..F`` the members of :func:`_chain_level`. The pool at ``F - 1``
+    bits is a subset (same values) of the pool at ``F``, so the certified
+    minimum over it never grows with the bits. Levels are visited from ``F``
+    bits down; once :func:`_grid_lower_bounds` proves that no polynomial on
+    the grid of a bit count (and of every coarser one) reaches the bound
+    certified at ``F`` bits, the rest of the pool cannot win and is not built:
+    the minimum is the one over the whole pool."""
+    coarse = _Sampler(prob, CHAIN_SAMPLES)
+    bounds = _grid_lower_bounds(prob, fracs)
+    pool, best = [], None
+
+    def members(level):
+        out = _chain_level(prob, coarse, real, fracs, level, greedy)
+        if prob.word_limit is not None:
+            out = [c for c in out if max(abs(m) for m in c[1]) <= prob.word_limit]
+        return out
+
+    for level in range(min(fracs) + 1):       # F bits first, then fewer
+        if best is not None and bounds[level] >= best.bound:
+            break
+        pool += members(level)
+        if level == 0:
+            best = _certify_ranked(prob, _ranked(sampler, pool))
+    return _certify_ranked(prob, _ranked(sampler, pool))
 
 
 def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
@@ -609,10 +684,7 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
         return _certify_ranked(prob, _rank(sampler, [(m, *c) for m, c in cands.items()]))
     if fmt == "fixed":
-        pool = _fixed_chain(prob, real, list(frac_bits), greedy)
-        if prob.word_limit is not None:
-            pool = [c for c in pool if max(abs(m) for m in c[1]) <= prob.word_limit]
-        return _certify_ranked(prob, _ranked(sampler, pool))
+        return _fixed_pool(prob, sampler, real, list(frac_bits), greedy)
     # floating: quanta from the real coefficients, then from the best few
     # candidates' own binades (a lattice answer may leave a binade), a few rounds
     todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
