@@ -538,21 +538,109 @@ def _ranked(sampler: _Sampler, cands, batch: int = 8):
             heapq.heappush(heap, (low, 1, rows[i][0], i))
 
 
-def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
+def _error_at(prob: _Problem, points, coeffs) -> float:
+    """A rigorous lower bound of the error of ``coeffs`` (sup over the
+    interval): its largest value at ``points`` (inside the interval), in ball
+    arithmetic at 128 bits (no float evaluation allowance, which at a
+    near-minimax binary64 error is larger than the candidates' differences)."""
+    from flint import arb, ctx
+
+    from .certify import _error_function, _float_down
+
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        g = _error_function(prob.fn.arb, [arb(c) for c in coeffs], prob.error_kind)
+        best = arb(0)
+        for x in points:
+            v = abs(g(arb(x)))
+            if v.is_finite():
+                best = best.max(v.lower())
+        return max(_float_down(best), 0.0)
+    finally:
+        ctx.prec = old
+
+
+def _peaks(prob: _Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[float]:
+    """Where the error of ``coeffs`` has its local maxima (every one: a
+    near-minimax error has ``n + 2`` of nearly one height), each found on the
+    sampler's grid and refined by ``zooms`` denser grids around it."""
+    order = np.argsort(sampler.x)
+    x = sampler.x[order]
+    if x.size < 3:
+        return []
+    thin = object.__new__(_Sampler)
+    thin.x, thin.f, thin.w = x, sampler.f[order], sampler.w[order]
+    thin.xp = {k: v[order] for k, v in sampler.xp.items()}
+    err = _point_errors(prob, x, coeffs, thin)
+    inner = np.nonzero((err[1:-1] >= err[:-2]) & (err[1:-1] >= err[2:]))[0] + 1
+    tops = [i for i in sorted(set(inner.tolist()) | {0, x.size - 1})
+            if err[i] >= 0.5 * np.max(err)]
+    # the highest few (float noise makes many tiny maxima next to each peak)
+    tops = sorted(sorted(tops, key=lambda i: (-err[i], i))[:2 * (prob.degree + 2)])
+    out = []
+    for i in tops:
+        a, b = x[max(i - 1, 0)], x[min(i + 1, x.size - 1)]
+        best = x[i]
+        for _ in range(zooms):
+            grid = np.linspace(a, b, 65)
+            e = _point_errors(prob, grid, coeffs)
+            j = int(np.argmax(e))
+            best = grid[j]
+            a, b = grid[max(j - 1, 0)], grid[min(j + 1, 64)]
+        out.append(float(best))
+    # the ends (the sampler keeps off them: lo_f and hi_f may lie a rounding
+    # outside the exact interval; their inner neighbours do not)
+    return out + [math.nextafter(prob.lo_f, math.inf), math.nextafter(prob.hi_f, -math.inf)]
+
+
+def _point_errors(prob: _Problem, x, coeffs, sampler: _Sampler | None = None) -> np.ndarray:
+    """The error of ``coeffs`` at each of ``x`` as :meth:`_Sampler.error`
+    computes it (``sampler``: one holding exactly these points, for its
+    powers); -inf where it is not finite."""
+    x = np.asarray(x, dtype=float)
+    if sampler is None:
+        with np.errstate(all="ignore"):
+            f = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
+        xp = {k: clib.power(x, k) for k, c in enumerate(coeffs) if c}
+        w = 1.0 / np.abs(f) if prob.error_kind == "rel" else np.ones_like(f)
+    else:
+        f, xp, w = sampler.f, sampler.xp, sampler.w
+    p, mag = np.zeros_like(x), np.zeros_like(x)
+    for k, c in enumerate(coeffs):
+        if c:
+            term = c * xp[k]
+            p += term
+            mag += np.abs(term)
+    with np.errstate(all="ignore"):
+        err = w * (np.abs(p - f) - 2.0 ** -50 * (mag + np.abs(f)))
+    return np.where(np.isfinite(err), err, -np.inf)
+
+
+def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None,
+                    slack: float = 0.0, sampler: _Sampler | None = None):
     """The smallest certified bound among ``ranked`` (from :func:`_rank`):
     candidates are certified in their sampled order, each against the best so
     far (aborted once proven no better); one whose sampled error (a lower bound
     of its supremum) already reaches the best bound is not certified, nor is
     any after it. ``limit``: at most that many certifications after the first
-    success. Returns a Candidate or None (none certified)."""
-    best, tries = None, 0
+    success. ``slack``: nor is one whose sampled error reaches the best bound
+    divided by ``1 + slack``: its certified bound is at least that, so the
+    answer's bound is within a factor ``1 + slack`` of the smallest certified
+    bound among all the candidates. Returns a Candidate or None (none certified)."""
+    best, tries, peaks = None, 0, []
     for low, method, ms, es, coeffs in ranked:
-        if best is not None and (low >= best.bound or (limit is not None and tries >= limit)):
+        if best is not None and (low * (1 + slack) >= best.bound
+                                 or (limit is not None and tries >= limit)):
             break
+        if slack and peaks and _error_at(prob, peaks, coeffs) * (1 + slack) >= best.bound:
+            continue                          # its error where the others peak
         try:
             cert = _certify_key(prob, coeffs, None if best is None else best.bound)
         except ValueError:
             continue
+        if slack and cert is not None and not peaks and sampler is not None:
+            peaks = _peaks(prob, sampler, coeffs)
         tries += best is not None
         if cert is not None and (best is None or cert.bound < best.bound):
             best = Candidate(tuple(ms), tuple(es), method, cert.bound,
@@ -565,6 +653,11 @@ def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
 CHAIN_SAMPLES = 257
 #: most certifications (after the first certified candidate) of a floating format
 FLOAT_CERTIFY = None
+#: a floating format's candidate is certified only while its sampled error is
+#: below the best bound / (1 + FLOAT_SLACK): binary64 candidates often differ
+#: by 1e-13 relative, far below the ranking certificates' own tolerance
+#: (SELECT_TOL), and each one certified changed the bound by less than that
+FLOAT_SLACK = SELECT_TOL
 
 
 def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
@@ -706,4 +799,4 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
                       else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
-    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY)
+    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY, FLOAT_SLACK, sampler)
