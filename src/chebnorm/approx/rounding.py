@@ -258,7 +258,7 @@ class _Sampler:
         interpolation points, linearly interpolated between samples)."""
         order = np.argsort(self.x)
         x, f = self.x[order], self.f[order]
-        p = sum(c * clib.power(x, k) for k, c in enumerate(coeffs))
+        p = sum(c * self.xp[k][order] for k, c in enumerate(coeffs))
         g = p - f
         idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
         t = g[idx] / (g[idx] - g[idx + 1])
@@ -578,17 +578,17 @@ def _peaks(prob: _Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[fl
             if err[i] >= 0.5 * np.max(err)]
     # the highest few (float noise makes many tiny maxima next to each peak)
     tops = sorted(sorted(tops, key=lambda i: (-err[i], i))[:2 * (prob.degree + 2)])
-    out = []
-    for i in tops:
-        a, b = x[max(i - 1, 0)], x[min(i + 1, x.size - 1)]
-        best = x[i]
-        for _ in range(zooms):
-            grid = np.linspace(a, b, 65)
-            e = _point_errors(prob, grid, coeffs)
-            j = int(np.argmax(e))
-            best = grid[j]
-            a, b = grid[max(j - 1, 0)], grid[min(j + 1, 64)]
-        out.append(float(best))
+    a = x[[max(i - 1, 0) for i in tops]]
+    b = x[[min(i + 1, x.size - 1) for i in tops]]
+    best = x[tops]
+    for _ in range(zooms):                    # every peak's grid at once
+        grid = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, 65)[None, :]
+        e = _point_errors(prob, grid.ravel(), coeffs).reshape(grid.shape)
+        j = np.argmax(e, axis=1)
+        rows = np.arange(len(tops))
+        best = grid[rows, j]
+        a, b = grid[rows, np.maximum(j - 1, 0)], grid[rows, np.minimum(j + 1, 64)]
+    out = [float(v) for v in best]
     # the ends (the sampler keeps off them: lo_f and hi_f may lie a rounding
     # outside the exact interval; their inner neighbours do not)
     return out + [math.nextafter(prob.lo_f, math.inf), math.nextafter(prob.hi_f, -math.inf)]
