@@ -660,11 +660,11 @@ FLOAT_CERTIFY = None
 FLOAT_SLACK = SELECT_TOL
 
 
-def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
-    """``out[level]``: a rigorous lower bound of the error (the problem's kind,
-    sup over the interval) of EVERY polynomial whose free coefficient ``k`` is
-    an integer multiple of ``2^-(fracs[k] - level)`` (the fixed ones held),
-    for ``level = 0..min(fracs)``; 0 where nothing is proven.
+def _grid_lower_bounds(prob: _Problem, fracs):
+    """A function ``level ->`` a rigorous lower bound of the error (the
+    problem's kind, sup over the interval) of EVERY polynomial whose free
+    coefficient ``k`` is an integer multiple of ``2^-(fracs[k] - level)`` (the
+    fixed ones held), for ``level = 0..min(fracs)``; 0 where nothing is proven.
 
     At ``n`` points ``x_i`` of the interval (``n`` free powers, Chebyshev
     nodes; on ``[0, hi]`` for one parity on a symmetric interval) with the
@@ -673,16 +673,18 @@ def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
     V^-1 (g - e/w)``, so ``c_k`` on its grid ``q Z`` needs ``|u_k . (e/w)| >=
     dist(u_k . g, q Z)`` (``u_k`` row ``k`` of ``V^-1``), hence ``max|e| >=
     dist(u_k . g, q Z) / sum_i |u_ki| / w_i`` -- in ball arithmetic. The
-    grids are nested (fewer bits: a subset), so the bound at a level is also
-    the largest of those at the finer levels."""
+    grids are nested (fewer bits: a subset), so a bound at a level also holds
+    at every coarser one (the caller keeps the largest)."""
     from flint import arb, arb_mat, ctx
 
-    levels = min(fracs) + 1
+    def nothing(level):
+        return 0.0
+
     n = len(prob.powers)
     lo = 0.0 if _symmetric_parity(prob) else prob.lo_f
     pts = [float(v) for v in chebyshev_nodes(lo, prob.hi_f, n)]
     if n == 0 or not all(prob.lo_f < v < prob.hi_f for v in pts) or len(set(pts)) < n:
-        return [0.0] * levels
+        return nothing
     old = ctx.prec
     try:
         ctx.prec = 128
@@ -694,15 +696,23 @@ def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
         scale = [abs(f) if prob.error_kind == "rel" else arb(1) for f in fx]
         if not all(v.is_finite() for v in g + scale) or (
                 prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
-            return [0.0] * levels
+            return nothing
         rows = []
-        for k in range(n):
+        for k, power in enumerate(prob.powers):
             c = sum((inv[k, i] * g[i] for i in range(n)), arb(0))
             rs = sum((abs(inv[k, i]) * scale[i] for i in range(n)), arb(0)).upper()
-            rows.append((c, rs))
-        out, best = [], 0.0
-        for level in range(levels):
-            for (c, rs), f in zip(rows, [fracs[k] for k in prob.powers]):
+            rows.append((c, rs, fracs[power]))
+    except (ValueError, ZeroDivisionError, ArithmeticError):
+        return nothing
+    finally:
+        ctx.prec = old
+
+    def at(level: int) -> float:
+        old = ctx.prec
+        try:
+            ctx.prec = 128
+            best = 0.0
+            for c, rs, f in rows:
                 q = arb(2) ** (level - f)
                 t = c / q
                 z = math.floor(float(t.mid()))
@@ -710,12 +720,12 @@ def _grid_lower_bounds(prob: _Problem, fracs) -> list[float]:
                 bound = q * dist / rs
                 if bound.is_finite() and bound > 0:
                     best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
-            out.append(best)
-        return out
-    except (ValueError, ZeroDivisionError, ArithmeticError):
-        return [0.0] * levels
-    finally:
-        ctx.prec = old
+            return best
+        except (ValueError, ZeroDivisionError, ArithmeticError, OverflowError):
+            return 0.0
+        finally:
+            ctx.prec = old
+    return at
 
 
 def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
@@ -743,8 +753,8 @@ def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candi
     certified at ``F`` bits, the rest of the pool cannot win and is not built:
     the minimum is the one over the whole pool."""
     coarse = _Sampler(prob, CHAIN_SAMPLES)
-    bounds = _grid_lower_bounds(prob, fracs)
-    pool, best = [], None
+    bound_at = _grid_lower_bounds(prob, fracs)
+    pool, best, lower = [], None, 0.0
 
     def members(level):
         out = _chain_level(prob, coarse, real, fracs, level, greedy)
@@ -753,8 +763,10 @@ def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candi
         return out
 
     for level in range(min(fracs) + 1):       # F bits first, then fewer
-        if best is not None and bounds[level] >= best.bound:
-            break
+        if best is not None:
+            lower = max(lower, bound_at(level))   # this grid and every coarser one
+            if lower >= best.bound:
+                break
         pool += members(level)
         if level == 0:
             best = _certify_ranked(prob, _ranked(sampler, pool))
