@@ -581,7 +581,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                          f"{', '.join(FORMATS)}")
     n = table.degree
     fn = parse_function(table.expression, table.variable)
-    iv = Interval(*table.interval)
+    iv = _table_interval(*table.interval)
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
@@ -618,6 +618,13 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                            known={"abs": best.abs_cert, "rel": best.rel_cert})
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
+
+
+@functools.lru_cache(maxsize=64)
+def _table_interval(lo: str, hi: str) -> Interval:
+    """The Interval of a table's endpoint strings (read only; kept: several
+    formats or bit counts of one table parse its endpoints once)."""
+    return Interval(lo, hi)
 
 
 def _fitted_alike(table: CoefficientTable, mons, fixed: dict) -> bool:
