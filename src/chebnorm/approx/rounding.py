@@ -449,12 +449,36 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     return out
 
 
+def _to_monomial(prob: _Problem, cheb) -> list[float]:
+    """:func:`chebnorm.approx.fitting.cheb_to_monomial` on the problem's
+    interval, the same exact rationals rounded once (so the same floats): the
+    monomial coefficients of each ``T_k(u(x))`` are kept, and each answer is
+    an exact sum of their multiples."""
+    from flint import fmpq_poly
+
+    from .fitting import _chebyshev_t, _exact
+
+    n = len(cheb)
+    key = ("mono", n)
+    rows = prob.greedy_nodes.get(key)
+    if rows is None:
+        lo_q, hi_q = _exact(float(prob.lo_f)), _exact(float(prob.hi_f))
+        sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
+        rows = prob.greedy_nodes[key] = [
+            (_chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
+    exact = [_exact(c) for c in cheb]
+    out = []
+    for j in range(n):
+        total = sum((exact[k] * rows[k][j] for k in range(j, n) if rows[k][j] != 0),
+                    _exact(0.0))
+        out.append(int(total.p) / int(total.q))
+    return out
+
+
 def greedy(prob: _Problem, real, quanta) -> list[int] | None:
     """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
     ``2**quanta[k]`` from the highest power down, the lower ones refitted after
     each rounding (interpolation of the residual at Chebyshev nodes)."""
-    from .fitting import cheb_to_monomial
-
     f_np = prob.fn.numpy
     lo, hi = prob.lo_f, prob.hi_f
     n = prob.degree
@@ -483,7 +507,7 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
             cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
             return None
-        current = cheb_to_monomial(cheb, lo, hi) + [high[j] for j in range(k, n + 1)]
+        current = _to_monomial(prob, cheb) + [high[j] for j in range(k, n + 1)]
     return [ints[k] for k in range(n + 1)]
 
 
