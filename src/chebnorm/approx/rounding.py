@@ -38,6 +38,7 @@ from flint import fmpz_mat
 
 from . import clib
 from .certify import certify
+from .detlinalg import matvec
 
 __all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
 
@@ -126,7 +127,10 @@ def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
 
 def _reduced(basis: list[list[int]]):
     """LLL reduction of ``basis`` (integer rows): the transform's rows, the
-    reduced rows scaled by ``scale`` (floats), their QR factors and ``scale``."""
+    reduced rows scaled by ``scale`` (floats), their Gram-Schmidt vectors and
+    squared norms, and ``scale``. Gram-Schmidt in a fixed order with
+    correctly rounded dot products (:func:`_dot`), not LAPACK's QR, whose
+    kernels (and last bits) depend on the CPU."""
     mat = fmpz_mat(basis)
     red, trans = mat.lll(transform=True)
     rows = np.array([[float(int(v)) for v in row] for row in red.tolist()])
@@ -134,8 +138,21 @@ def _reduced(basis: list[list[int]]):
     # Gram-Schmidt of the reduced rows, in floats (scaled to avoid overflow)
     scale = max(np.max(np.abs(rows)), 1.0)
     b = rows / scale
-    q, r = np.linalg.qr(b.T)              # b.T = q r: row i of b has GS vector r[i,i] q[:, i]
-    return tr, b, q, r, scale
+    stars, norms = [], []
+    for i in range(len(b)):                   # modified Gram-Schmidt
+        v = b[i].copy()
+        for s, nrm in zip(stars, norms):
+            if nrm > 0:
+                v = v - (_dot(v, s) / nrm) * s
+        stars.append(v)
+        norms.append(_dot(v, v))
+    return tr, b, stars, norms, scale
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)``: products correctly rounded, their sum by ``math.fsum``
+    (correctly rounded): the same float on every CPU."""
+    return math.fsum((a * b).tolist())
 
 
 def _babai(basis: list[list[int]], target: list[int], spread: bool,
@@ -152,15 +169,15 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool,
         red = _reduced(basis)
         if cache is not None:
             cache[key] = red
-    tr, b, q, r, scale = red
+    tr, b, stars, norms, scale = red
     n = len(tr)
     t = np.array([float(v) for v in target]) / scale
     coords = [0] * n
     resid = t.copy()
     for i in range(n - 1, -1, -1):
-        if r[i, i] == 0:
+        if not norms[i] > 0:
             continue
-        c = round(float(q[:, i] @ resid) / r[i, i])
+        c = round(_dot(resid, stars[i]) / norms[i])
         coords[i] = c
         resid = resid - c * b[i]
     base = [sum(coords[i] * tr[i][k] for i in range(n)) for k in range(n)]
@@ -183,10 +200,11 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    vecs = [w * x ** e * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
+    xe = {e: clib.power(x, e) for e in powers}    # libm's pow, not numpy's loop (CPU)
+    vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
     y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
-             - sum(math.ldexp(b, s) * x ** e for b, e, s in zip(base, powers, quanta)))
+             - sum(math.ldexp(b, s) * xe[e] for b, e, s in zip(base, powers, quanta)))
     big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
     shift = 62 - math.frexp(big)[1]
     def ints(v):
@@ -196,7 +214,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
         return []
     try:
         vecs = _babai(basis, ints(y), spread=True, cache=cache)
-    except (ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+    except (ValueError, ZeroDivisionError, OverflowError):
         return []
     return [[b + v for b, v in zip(base, vec)] for vec in vecs]
 
@@ -497,12 +515,13 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
             with np.errstate(all="ignore"):
                 fx = f_np(x)
             nodes = prob.greedy_nodes[k] = (
-                {j: x ** j for j in range(k, n + 1)}, fx,
+                {j: clib.power(x, j) for j in range(k, n + 1)}, fx,
                 np.polynomial.chebyshev.chebvander(t, cheb_deg).T)
         xj, fx, vander_t = nodes
-        # numpy's chebinterpolate(residual, k - 1), the same operations on cached nodes
+        # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
+        # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
         with np.errstate(all="ignore"):
-            cheb = np.dot(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
+            cheb = matvec(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
             cheb[0] /= k
             cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
