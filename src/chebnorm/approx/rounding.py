@@ -740,11 +740,21 @@ def _grid_lower_bounds(prob: _Problem, fracs):
         if not all(v.is_finite() for v in g + scale) or (
                 prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
             return nothing
+        # dual rows D_k = 2^f_k u_k: at level l the integers are 2^-l D_k . (g - e/w);
+        # any integer combination a of them is an integer too, so every row of
+        # LLL's transform of D (short combinations: small norms) gives a bound
+        dual = [[inv[k, i] * arb(2) ** fracs[power] for i in range(n)]
+                for k, power in enumerate(prob.powers)]
+        combos = [[int(j == k) for j in range(n)] for k in range(n)]
+        combos += _short_combinations([[float((d * sc).mid()) for d, sc in zip(row, scale)]
+                                       for row in dual])
         rows = []
-        for k, power in enumerate(prob.powers):
-            c = sum((inv[k, i] * g[i] for i in range(n)), arb(0))
-            rs = sum((abs(inv[k, i]) * scale[i] for i in range(n)), arb(0)).upper()
-            rows.append((c, rs, fracs[power]))
+        for a in combos:
+            u = [sum((a[k] * dual[k][i] for k in range(n) if a[k]), arb(0)) for i in range(n)]
+            v = sum((u[i] * g[i] for i in range(n)), arb(0))
+            norm = sum((abs(u[i]) * scale[i] for i in range(n)), arb(0)).upper()
+            if v.is_finite() and norm.is_finite() and norm > 0:
+                rows.append((v, norm))
     except (ValueError, ZeroDivisionError, ArithmeticError):
         return nothing
     finally:
@@ -755,12 +765,12 @@ def _grid_lower_bounds(prob: _Problem, fracs):
         try:
             ctx.prec = 128
             best = 0.0
-            for c, rs, f in rows:
-                q = arb(2) ** (level - f)
-                t = c / q
+            step = arb(2) ** level
+            for v, norm in rows:
+                t = v / step
                 z = math.floor(float(t.mid()))
                 dist = min((abs(t - (z + d))).lower() for d in (-1, 0, 1, 2))
-                bound = q * dist / rs
+                bound = step * dist / norm
                 if bound.is_finite() and bound > 0:
                     best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
             return best
@@ -769,6 +779,24 @@ def _grid_lower_bounds(prob: _Problem, fracs):
         finally:
             ctx.prec = old
     return at
+
+
+def _short_combinations(rows: list[list[float]]) -> list[list[int]]:
+    """Integer combinations of ``rows`` (floats) that are short: the rows of
+    LLL's transform of them scaled to 60-bit integers (none when they cannot
+    be reduced). Only which combinations to try depends on it."""
+    big = max((abs(v) for row in rows for v in row if math.isfinite(v)), default=0.0)
+    if not big > 0 or not all(math.isfinite(v) for row in rows for v in row):
+        return []
+    shift = 60 - math.frexp(big)[1]
+    ints = [[int(round(math.ldexp(v, shift))) for v in row] for row in rows]
+    if any(all(v == 0 for v in row) for row in ints):
+        return []
+    try:
+        _, trans = fmpz_mat(ints).lll(transform=True)
+    except (ValueError, ZeroDivisionError):
+        return []
+    return [[int(v) for v in row] for row in trans.tolist()]
 
 
 def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
