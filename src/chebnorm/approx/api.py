@@ -555,7 +555,8 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
     the lower ones refitted at Chebyshev nodes) compete: they are ranked by their
     sampled error and certified in that order while they can still win; the one
-    with the smallest certified bound wins (``method`` names it). Fixed formats
+    with the smallest certified bound wins (``method`` names it; floating
+    formats: within a factor 1 + 2^-20 of the smallest). Fixed formats
     are monotone in the bits: more fractional bits never certify a worse error.
     A table fitted with the same ``monomials`` / ``fix_constant`` (same held
     constant) is quantized from its own coefficients, otherwise the constrained

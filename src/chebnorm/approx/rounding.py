@@ -14,7 +14,10 @@ to nearest, and the greedy refit of :func:`chebnorm.approx.quantize` -- is
 ranked by its error sampled in float64 on a dense grid; candidates are then
 certified (:func:`chebnorm.approx.certify.certify`) in that order only while
 their sampled error (a lower bound of their supremum) is below the best bound
-certified so far: the answer is the smallest certified bound among those.
+certified so far: the answer is the smallest certified bound among those
+(floating formats: within a factor ``1 + 2^-20`` of it, the certificates' own
+tolerance; a candidate whose error, sampled or in ball arithmetic at the best
+one's peaks, reaches the best bound / (1 + 2^-20) is not certified).
 
 Fixed formats are monotone in the bits: the pool certified at ``F``
 fractional bits holds, for every ``b = 0..F`` bits, the plain rounding and the
