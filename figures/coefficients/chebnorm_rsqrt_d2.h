@@ -20,8 +20,8 @@
 #define CHEBNORM_RSQRT_D2_EVAL_ERROR_BOUND 0x1.524659e16d682p-15 /* 4.032549965009032e-05 */
 #define CHEBNORM_RSQRT_D2_F_EVAL_ERROR_BOUND 0x1.5aa25c505d83fp-15 /* 4.1322019231169054e-05 */
 #define CHEBNORM_RSQRT_D2_FRAC_BITS 24
-#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.5264dfef10c96p-15 /* 4.033971333019489e-05 */
-#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52e4dfef10c97p-15 /* 4.0399317974970285e-05 */
+#define CHEBNORM_RSQRT_D2_Q_ABS_ERROR_BOUND 0x1.52596c4f12ba0p-15 /* 4.033438073543856e-05 */
+#define CHEBNORM_RSQRT_D2_Q_EVAL_ERROR_BOUND 0x1.52d96c4f12ba1p-15 /* 4.039398538021396e-05 */
 
 static const double chebnorm_rsqrt_d2_coeffs[3] = {
     0x1.f38fea70e092ap+0 /* 1.9514147306040948 */,  /* x^0 */
@@ -49,7 +49,7 @@ static inline float chebnorm_rsqrt_d2_f(float x)
 
 /* Coefficients * 2^24 (lattice), ascending powers. */
 static const int32_t chebnorm_rsqrt_d2_q[3] = {
-    INT32_C(32739224), INT32_C(-23613524), INT32_C(7652192)
+    INT32_C(32739234), INT32_C(-23613545), INT32_C(7652203)
 };
 
 /* Integer Horner's rule. x_q = x * 2^24 (x in [CHEBNORM_RSQRT_D2_LO, CHEBNORM_RSQRT_D2_HI]);

@@ -567,7 +567,8 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
     the lower ones refitted at Chebyshev nodes) compete: they are ranked by their
     sampled error and certified in that order while they can still win; the one
-    with the smallest certified bound wins (``method`` names it). Fixed formats
+    with the smallest certified bound wins (``method`` names it; floating
+    formats: within a factor 1 + 2^-20 of the smallest). Fixed formats
     are monotone in the bits: more fractional bits never certify a worse error.
     A table fitted with the same ``monomials`` / ``fix_constant`` (same held
     constant) is quantized from its own coefficients, otherwise the constrained
@@ -598,7 +599,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                          f"{', '.join(FORMATS)}")
     n = table.degree
     fn = parse_function(table.expression, table.variable)
-    iv = Interval(*table.interval)
+    iv = _table_interval(*table.interval)
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
@@ -635,6 +636,13 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                            known={"abs": best.abs_cert, "rel": best.rel_cert})
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
+
+
+@functools.lru_cache(maxsize=64)
+def _table_interval(lo: str, hi: str) -> Interval:
+    """The Interval of a table's endpoint strings (read only; kept: several
+    formats or bit counts of one table parse its endpoints once)."""
+    return Interval(lo, hi)
 
 
 def _fitted_alike(table: CoefficientTable, mons, fixed: dict) -> bool:

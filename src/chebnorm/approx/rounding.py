@@ -14,18 +14,25 @@ to nearest, and the greedy refit of :func:`chebnorm.approx.quantize` -- is
 ranked by its error sampled in float64 on a dense grid; candidates are then
 certified (:func:`chebnorm.approx.certify.certify`) in that order only while
 their sampled error (a lower bound of their supremum) is below the best bound
-certified so far: the answer is the smallest certified bound among those.
+certified so far: the answer is the smallest certified bound among those
+(floating formats: within a factor ``1 + 2^-20`` of it, the certificates' own
+tolerance; a candidate whose error, sampled or in ball arithmetic at the best
+one's peaks, reaches the best bound / (1 + 2^-20) is not certified).
 
 Fixed formats are monotone in the bits: the pool certified at ``F``
 fractional bits holds, for every ``b = 0..F`` bits, the plain rounding and the
-answer of a cheaply ranked chain (:func:`_fixed_chain`), shifted to ``F`` bits;
-the pool at ``F - 1`` bits is part of it, so more bits never certify worse.
+cheaply ranked best candidate at ``b`` bits (:func:`_chain_level`), shifted to
+``F`` bits; the pool at ``F - 1`` bits is part of it, so more bits never
+certify worse. The bit counts whose grid is proven (:func:`_grid_lower_bounds`)
+to hold no polynomial as good as the bound certified at ``F`` bits cannot
+change the minimum and are not built (:func:`_fixed_pool`).
 
 Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -34,6 +41,7 @@ from flint import fmpz_mat
 
 from . import clib
 from .certify import certify
+from .detlinalg import matvec
 
 __all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
 
@@ -120,26 +128,59 @@ def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
     return 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
 
 
-def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list[int]]:
-    """LLL-reduce ``basis`` (integer rows) and return the integer coordinates
-    (in ``basis``) of Babai's nearest-plane point to ``target`` and, with
-    ``spread``, of its neighbours ``+- one reduced vector``."""
+def _reduced(basis: list[list[int]]):
+    """LLL reduction of ``basis`` (integer rows): the transform's rows, the
+    reduced rows scaled by ``scale`` (floats), their Gram-Schmidt vectors and
+    squared norms, and ``scale``. Gram-Schmidt in a fixed order with
+    correctly rounded dot products (:func:`_dot`), not LAPACK's QR, whose
+    kernels (and last bits) depend on the CPU."""
     mat = fmpz_mat(basis)
     red, trans = mat.lll(transform=True)
-    n = red.nrows()
     rows = np.array([[float(int(v)) for v in row] for row in red.tolist()])
     tr = [[int(v) for v in row] for row in trans.tolist()]
     # Gram-Schmidt of the reduced rows, in floats (scaled to avoid overflow)
     scale = max(np.max(np.abs(rows)), 1.0)
     b = rows / scale
+    stars, norms = [], []
+    for i in range(len(b)):                   # modified Gram-Schmidt
+        v = b[i].copy()
+        for s, nrm in zip(stars, norms):
+            if nrm > 0:
+                v = v - (_dot(v, s) / nrm) * s
+        stars.append(v)
+        norms.append(_dot(v, v))
+    return tr, b, stars, norms, scale
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)``: products correctly rounded, their sum by ``math.fsum``
+    (correctly rounded): the same float on every CPU."""
+    return math.fsum((a * b).tolist())
+
+
+def _babai(basis: list[list[int]], target: list[int], spread: bool,
+           cache: dict | None = None) -> list[list[int]]:
+    """LLL-reduce ``basis`` (integer rows) and return the integer coordinates
+    (in ``basis``) of Babai's nearest-plane point to ``target`` and, with
+    ``spread``, of its neighbours ``+- one reduced vector``. ``cache`` (basis ->
+    reduction) spares the reduction of a basis met before: the fixed-point
+    chain meets the same integer basis at most bit counts (the columns only
+    scale by 2, and the scaling to 62 bits undoes it)."""
+    key = tuple(map(tuple, basis))
+    red = None if cache is None else cache.get(key)
+    if red is None:
+        red = _reduced(basis)
+        if cache is not None:
+            cache[key] = red
+    tr, b, stars, norms, scale = red
+    n = len(tr)
     t = np.array([float(v) for v in target]) / scale
-    q, r = np.linalg.qr(b.T)              # b.T = q r: row i of b has GS vector r[i,i] q[:, i]
     coords = [0] * n
     resid = t.copy()
     for i in range(n - 1, -1, -1):
-        if r[i, i] == 0:
+        if not norms[i] > 0:
             continue
-        c = round(float(q[:, i] @ resid) / r[i, i])
+        c = round(_dot(resid, stars[i]) / norms[i])
         coords[i] = c
         resid = resid - c * b[i]
     base = [sum(coords[i] * tr[i][k] for i in range(n)) for k in range(n)]
@@ -151,7 +192,7 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool) -> list[list
     return out
 
 
-def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None):
     """Integer vectors ``n`` (one per free power) near the weighted function values.
 
     ``base`` (integers, one per free power: the real fit rounded) is subtracted
@@ -162,10 +203,11 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    vecs = [w * x ** e * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
+    xe = {e: clib.power(x, e) for e in powers}    # libm's pow, not numpy's loop (CPU)
+    vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
     y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
-             - sum(math.ldexp(b, s) * x ** e for b, e, s in zip(base, powers, quanta)))
+             - sum(math.ldexp(b, s) * xe[e] for b, e, s in zip(base, powers, quanta)))
     big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
     shift = 62 - math.frexp(big)[1]
     def ints(v):
@@ -174,8 +216,8 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None):
     if any(all(a == 0 for a in row) for row in basis):
         return []
     try:
-        vecs = _babai(basis, ints(y), spread=True)
-    except (ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+        vecs = _babai(basis, ints(y), spread=True, cache=cache)
+    except (ValueError, ZeroDivisionError, OverflowError):
         return []
     return [[b + v for b, v in zip(base, vec)] for vec in vecs]
 
@@ -195,6 +237,10 @@ class _Problem:
     #: coefficients -> their certificate (or the ValueError, or the bound it is proven
     #: to reach: ("at least", b)); certify is deterministic, so a repeat is not re-run
     certs: dict = field(default_factory=dict, repr=False)
+    #: greedy's Chebyshev nodes, f there, powers of them (:func:`greedy`)
+    greedy_nodes: dict = field(default_factory=dict, repr=False)
+    #: integer lattice basis -> its reduction (:func:`_babai`)
+    reductions: dict = field(default_factory=dict, repr=False)
 
 
 class _Sampler:
@@ -214,13 +260,26 @@ class _Sampler:
         self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
         self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
         self.point_sets: dict = {}            # real coefficients -> _point_sets
+        self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
+        self._thin = None
+
+    def thinned(self, step: int = 16) -> "_Sampler":
+        """Every ``step``-th of these points: the error of a polynomial there
+        is computed with the same operations point by point, so it is at most
+        its error on all the points (a cheaper lower bound of that)."""
+        if self._thin is None:
+            thin = object.__new__(_Sampler)
+            thin.x, thin.f, thin.w = self.x[::step], self.f[::step], self.w[::step]
+            thin.xp = {k: v[::step] for k, v in self.xp.items()}
+            self._thin = thin
+        return self._thin
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
         interpolation points, linearly interpolated between samples)."""
         order = np.argsort(self.x)
         x, f = self.x[order], self.f[order]
-        p = sum(c * clib.power(x, k) for k, c in enumerate(coeffs))
+        p = sum(c * self.xp[k][order] for k, c in enumerate(coeffs))
         g = p - f
         idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
         t = g[idx] / (g[idx] - g[idx + 1])
@@ -385,7 +444,8 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
-                        [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers])
+                        [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
+                        prob.reductions)
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
                 prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
@@ -410,12 +470,36 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     return out
 
 
+def _to_monomial(prob: _Problem, cheb) -> list[float]:
+    """:func:`chebnorm.approx.fitting.cheb_to_monomial` on the problem's
+    interval, the same exact rationals rounded once (so the same floats): the
+    monomial coefficients of each ``T_k(u(x))`` are kept, and each answer is
+    an exact sum of their multiples."""
+    from flint import fmpq_poly
+
+    from .fitting import _chebyshev_t, _exact
+
+    n = len(cheb)
+    key = ("mono", n)
+    rows = prob.greedy_nodes.get(key)
+    if rows is None:
+        lo_q, hi_q = _exact(float(prob.lo_f)), _exact(float(prob.hi_f))
+        sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
+        rows = prob.greedy_nodes[key] = [
+            (_chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
+    exact = [_exact(c) for c in cheb]
+    out = []
+    for j in range(n):
+        total = sum((exact[k] * rows[k][j] for k in range(j, n) if rows[k][j] != 0),
+                    _exact(0.0))
+        out.append(int(total.p) / int(total.q))
+    return out
+
+
 def greedy(prob: _Problem, real, quanta) -> list[int] | None:
     """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
     ``2**quanta[k]`` from the highest power down, the lower ones refitted after
     each rounding (interpolation of the residual at Chebyshev nodes)."""
-    from .fitting import cheb_to_monomial
-
     f_np = prob.fn.numpy
     lo, hi = prob.lo_f, prob.hi_f
     n = prob.degree
@@ -426,16 +510,26 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
         if k == 0:
             break
         high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
-
-        def residual(t, high=high):
+        nodes = prob.greedy_nodes.get(k)
+        if nodes is None:                     # the same at every set of quanta
+            cheb_deg = k - 1
+            t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
             x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
-            return f_np(x) - sum(c * x ** j for j, c in high.items())
-
+            with np.errstate(all="ignore"):
+                fx = f_np(x)
+            nodes = prob.greedy_nodes[k] = (
+                {j: clib.power(x, j) for j in range(k, n + 1)}, fx,
+                np.polynomial.chebyshev.chebvander(t, cheb_deg).T)
+        xj, fx, vander_t = nodes
+        # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
+        # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
         with np.errstate(all="ignore"):
-            cheb = np.polynomial.chebyshev.chebinterpolate(residual, k - 1)
+            cheb = matvec(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
+            cheb[0] /= k
+            cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
             return None
-        current = cheb_to_monomial(cheb, lo, hi) + [high[j] for j in range(k, n + 1)]
+        current = _to_monomial(prob, cheb) + [high[j] for j in range(k, n + 1)]
     return [ints[k] for k in range(n + 1)]
 
 
@@ -455,21 +549,144 @@ def _rank(sampler: _Sampler, cands) -> list:
     return [(lows[i],) + rows[i] for i in order]
 
 
-def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
+def _ranked(sampler: _Sampler, cands, batch: int = 8):
+    """:func:`_rank`'s rows in its order, generated lazily: the error on every
+    point (``sampler``) is computed only for the rows that come next once the
+    error on a thinned subset of the points (:meth:`_Sampler.thinned`, a lower
+    bound of it) says no other row can come before them."""
+    import heapq
+
+    rows, seen = [], set()
+    for method, ms, es in cands:
+        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
+        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+            continue
+        seen.add(coeffs)
+        rows.append((method, list(ms), list(es), coeffs))
+    if not rows:
+        return
+    coarse = sampler.thinned().errors([r[3] for r in rows])
+    # (error, 1 = on every point / 0 = thinned, method, index): a row whose error on
+    # every point is on top comes before every other row, as in _rank's sort
+    heap = [(sampler.lows.get(r[3], coarse[i]), int(r[3] in sampler.lows), r[0], i)
+            for i, r in enumerate(rows)]
+    heapq.heapify(heap)
+    while heap:
+        if heap[0][1]:
+            low, _, _, i = heapq.heappop(heap)
+            yield (low,) + rows[i]
+            continue
+        todo = []
+        while heap and not heap[0][1] and len(todo) < batch:
+            todo.append(heapq.heappop(heap)[3])
+        for i, low in zip(todo, sampler.errors([rows[i][3] for i in todo])):
+            sampler.lows[rows[i][3]] = low
+            heapq.heappush(heap, (low, 1, rows[i][0], i))
+
+
+def _error_at(prob: _Problem, points, coeffs) -> float:
+    """A rigorous lower bound of the error of ``coeffs`` (sup over the
+    interval): its largest value at ``points`` (inside the interval), in ball
+    arithmetic at 128 bits (no float evaluation allowance, which at a
+    near-minimax binary64 error is larger than the candidates' differences)."""
+    from flint import arb, ctx
+
+    from .certify import _error_function, _float_down
+
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        g = _error_function(prob.fn.arb, [arb(c) for c in coeffs], prob.error_kind)
+        best = arb(0)
+        for x in points:
+            v = abs(g(arb(x)))
+            if v.is_finite():
+                best = best.max(v.lower())
+        return max(_float_down(best), 0.0)
+    finally:
+        ctx.prec = old
+
+
+def _peaks(prob: _Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[float]:
+    """Where the error of ``coeffs`` has its local maxima (every one: a
+    near-minimax error has ``n + 2`` of nearly one height), each found on the
+    sampler's grid and refined by ``zooms`` denser grids around it."""
+    order = np.argsort(sampler.x)
+    x = sampler.x[order]
+    if x.size < 3:
+        return []
+    thin = object.__new__(_Sampler)
+    thin.x, thin.f, thin.w = x, sampler.f[order], sampler.w[order]
+    thin.xp = {k: v[order] for k, v in sampler.xp.items()}
+    err = _point_errors(prob, x, coeffs, thin)
+    inner = np.nonzero((err[1:-1] >= err[:-2]) & (err[1:-1] >= err[2:]))[0] + 1
+    tops = [i for i in sorted(set(inner.tolist()) | {0, x.size - 1})
+            if err[i] >= 0.5 * np.max(err)]
+    # the highest few (float noise makes many tiny maxima next to each peak)
+    tops = sorted(sorted(tops, key=lambda i: (-err[i], i))[:2 * (prob.degree + 2)])
+    a = x[[max(i - 1, 0) for i in tops]]
+    b = x[[min(i + 1, x.size - 1) for i in tops]]
+    best = x[tops]
+    for _ in range(zooms):                    # every peak's grid at once
+        grid = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, 65)[None, :]
+        e = _point_errors(prob, grid.ravel(), coeffs).reshape(grid.shape)
+        j = np.argmax(e, axis=1)
+        rows = np.arange(len(tops))
+        best = grid[rows, j]
+        a, b = grid[rows, np.maximum(j - 1, 0)], grid[rows, np.minimum(j + 1, 64)]
+    out = [float(v) for v in best]
+    # the ends (the sampler keeps off them: lo_f and hi_f may lie a rounding
+    # outside the exact interval; their inner neighbours do not)
+    return out + [math.nextafter(prob.lo_f, math.inf), math.nextafter(prob.hi_f, -math.inf)]
+
+
+def _point_errors(prob: _Problem, x, coeffs, sampler: _Sampler | None = None) -> np.ndarray:
+    """The error of ``coeffs`` at each of ``x`` as :meth:`_Sampler.error`
+    computes it (``sampler``: one holding exactly these points, for its
+    powers); -inf where it is not finite."""
+    x = np.asarray(x, dtype=float)
+    if sampler is None:
+        with np.errstate(all="ignore"):
+            f = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
+        xp = {k: clib.power(x, k) for k, c in enumerate(coeffs) if c}
+        w = 1.0 / np.abs(f) if prob.error_kind == "rel" else np.ones_like(f)
+    else:
+        f, xp, w = sampler.f, sampler.xp, sampler.w
+    p, mag = np.zeros_like(x), np.zeros_like(x)
+    for k, c in enumerate(coeffs):
+        if c:
+            term = c * xp[k]
+            p += term
+            mag += np.abs(term)
+    with np.errstate(all="ignore"):
+        err = w * (np.abs(p - f) - 2.0 ** -50 * (mag + np.abs(f)))
+    return np.where(np.isfinite(err), err, -np.inf)
+
+
+def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None,
+                    slack: float = 0.0, sampler: _Sampler | None = None):
     """The smallest certified bound among ``ranked`` (from :func:`_rank`):
     candidates are certified in their sampled order, each against the best so
     far (aborted once proven no better); one whose sampled error (a lower bound
     of its supremum) already reaches the best bound is not certified, nor is
     any after it. ``limit``: at most that many certifications after the first
-    success. Returns a Candidate or None (none certified)."""
-    best, tries = None, 0
+    success. ``slack``: nor is one whose sampled error reaches the best bound
+    divided by ``1 + slack``: its certified bound is at least that, so the
+    answer's bound is within a factor ``1 + slack`` of the smallest certified
+    bound among all the candidates. Returns a Candidate or None (none certified)."""
+    best, tries, peaks = None, 0, []
     for low, method, ms, es, coeffs in ranked:
-        if best is not None and (low >= best.bound or (limit is not None and tries >= limit)):
+        if best is not None and (low * (1 + slack) >= best.bound
+                                 or (limit is not None and tries >= limit)):
             break
+        if slack and peaks and _error_at(prob, peaks, coeffs) * (1 + slack) >= best.bound:
+            continue                          # its error where the others peak
         try:
             cert = _certify_key(prob, coeffs, None if best is None else best.bound)
         except ValueError:
             continue
+        if slack and cert is not None and not peaks and sampler is not None:
+            peaks = _peaks(prob, sampler, coeffs)
         tries += best is not None
         if cert is not None and (best is None or cert.bound < best.bound):
             best = Candidate(tuple(ms), tuple(es), method, cert.bound,
@@ -482,35 +699,152 @@ def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None):
 CHAIN_SAMPLES = 257
 #: most certifications (after the first certified candidate) of a floating format
 FLOAT_CERTIFY = None
+#: a floating format's candidate is certified only while its sampled error is
+#: below the best bound / (1 + FLOAT_SLACK): binary64 candidates often differ
+#: by 1e-13 relative, far below the ranking certificates' own tolerance
+#: (SELECT_TOL), and each one certified changed the bound by less than that
+FLOAT_SLACK = SELECT_TOL
 
 
-def _fixed_chain(prob: _Problem, real, fracs, greedy) -> list:
-    """The fixed-point pool: at every bit count ``b = 0..F`` (all powers shifted
-    alike) the plain rounding ``R_b`` and the chain's answer ``S_b`` -- the
-    candidate with the smallest cheaply sampled error among the candidates at
-    ``b`` and ``S_(b-1)`` (kept unless beaten by more than 2^-20 relative) --
-    as (method, mantissas, exponents) at ``F`` bits. The pool at ``F - 1`` bits
-    is a subset (same values) of the pool at ``F``: the certified minimum over
-    it never grows with the bits."""
-    coarse = _Sampler(prob, CHAIN_SAMPLES)
-    pool, prev = [], None
+def _grid_lower_bounds(prob: _Problem, fracs):
+    """A function ``level ->`` a rigorous lower bound of the error (the
+    problem's kind, sup over the interval) of EVERY polynomial whose free
+    coefficient ``k`` is an integer multiple of ``2^-(fracs[k] - level)`` (the
+    fixed ones held), for ``level = 0..min(fracs)``; 0 where nothing is proven.
+
+    At ``n`` points ``x_i`` of the interval (``n`` free powers, Chebyshev
+    nodes; on ``[0, hi]`` for one parity on a symmetric interval) with the
+    Vandermonde ``V`` and ``g = f - (fixed part)``: a polynomial of error
+    vector ``e`` (weighted by ``w = 1`` or ``1/|f|``) has coefficients ``c =
+    V^-1 (g - e/w)``, so ``c_k`` on its grid ``q Z`` needs ``|u_k . (e/w)| >=
+    dist(u_k . g, q Z)`` (``u_k`` row ``k`` of ``V^-1``), hence ``max|e| >=
+    dist(u_k . g, q Z) / sum_i |u_ki| / w_i`` -- in ball arithmetic. The
+    grids are nested (fewer bits: a subset), so a bound at a level also holds
+    at every coarser one (the caller keeps the largest)."""
+    from flint import arb, arb_mat, ctx
+
+    def nothing(level):
+        return 0.0
+
+    n = len(prob.powers)
+    lo = 0.0 if _symmetric_parity(prob) else prob.lo_f
+    pts = [float(v) for v in chebyshev_nodes(lo, prob.hi_f, n)]
+    if n == 0 or not all(prob.lo_f < v < prob.hi_f for v in pts) or len(set(pts)) < n:
+        return nothing
+    old = ctx.prec
+    try:
+        ctx.prec = 128
+        xs = [arb(v) for v in pts]
+        fx = [prob.fn.arb(x) for x in xs]
+        g = [f - sum((arb(m) * arb(2) ** e * x ** k for k, (m, e) in prob.fixed.items()),
+                     arb(0)) for f, x in zip(fx, xs)]
+        inv = arb_mat([[x ** e for e in prob.powers] for x in xs]).inv()
+        scale = [abs(f) if prob.error_kind == "rel" else arb(1) for f in fx]
+        if not all(v.is_finite() for v in g + scale) or (
+                prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
+            return nothing
+        # dual rows D_k = 2^f_k u_k: at level l the integers are 2^-l D_k . (g - e/w);
+        # any integer combination a of them is an integer too, so every row of
+        # LLL's transform of D (short combinations: small norms) gives a bound
+        dual = [[inv[k, i] * arb(2) ** fracs[power] for i in range(n)]
+                for k, power in enumerate(prob.powers)]
+        combos = [[int(j == k) for j in range(n)] for k in range(n)]
+        combos += _short_combinations([[float((d * sc).mid()) for d, sc in zip(row, scale)]
+                                       for row in dual])
+        rows = []
+        for a in combos:
+            u = [sum((a[k] * dual[k][i] for k in range(n) if a[k]), arb(0)) for i in range(n)]
+            v = sum((u[i] * g[i] for i in range(n)), arb(0))
+            norm = sum((abs(u[i]) * scale[i] for i in range(n)), arb(0)).upper()
+            if v.is_finite() and norm.is_finite() and norm > 0:
+                rows.append((v, norm))
+    except (ValueError, ZeroDivisionError, ArithmeticError):
+        return nothing
+    finally:
+        ctx.prec = old
+
+    def at(level: int) -> float:
+        old = ctx.prec
+        try:
+            ctx.prec = 128
+            best = 0.0
+            step = arb(2) ** level
+            for v, norm in rows:
+                t = v / step
+                z = math.floor(float(t.mid()))
+                dist = min((abs(t - (z + d))).lower() for d in (-1, 0, 1, 2))
+                bound = step * dist / norm
+                if bound.is_finite() and bound > 0:
+                    best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
+            return best
+        except (ValueError, ZeroDivisionError, ArithmeticError, OverflowError):
+            return 0.0
+        finally:
+            ctx.prec = old
+    return at
+
+
+def _short_combinations(rows: list[list[float]]) -> list[list[int]]:
+    """Integer combinations of ``rows`` (floats) that are short: the rows of
+    LLL's transform of them scaled to 60-bit integers (none when they cannot
+    be reduced). Only which combinations to try depends on it."""
+    big = max((abs(v) for row in rows for v in row if math.isfinite(v)), default=0.0)
+    if not big > 0 or not all(math.isfinite(v) for row in rows for v in row):
+        return []
+    shift = 60 - math.frexp(big)[1]
+    ints = [[int(round(math.ldexp(v, shift))) for v in row] for row in rows]
+    if any(all(v == 0 for v in row) for row in ints):
+        return []
+    try:
+        _, trans = fmpz_mat(ints).lll(transform=True)
+    except (ValueError, ZeroDivisionError):
+        return []
+    return [[int(v) for v in row] for row in trans.tolist()]
+
+
+def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
+    """The fixed-point pool's members at ``F - level`` bits (all powers shifted
+    alike): the plain rounding and the candidate with the smallest cheaply
+    sampled error, as (method, mantissas, exponents) at ``F`` bits."""
+    quanta = [-(f - level) for f in fracs]
+    cands = _candidates(prob, coarse, real, quanta, greedy, "fixed")
+    ranked = _rank(coarse, [(m, *c) for m, c in cands.items()])
+    members = [("rounded",) + tuple(cands["rounded"])] if "rounded" in cands else []
+    if ranked:
+        members.append(tuple(ranked[0][1:4]))
     fq = [-f for f in fracs]
-    for level in range(min(fracs), -1, -1):   # zero bits (at the lowest) up to frac_bits
-        quanta = [-(f - level) for f in fracs]
-        cands = _candidates(prob, coarse, real, quanta, greedy, "fixed")
-        ranked = _rank(coarse, [(m, *c) for m, c in cands.items()])
-        if ranked:
-            low, method, ms, es, _ = ranked[0]
-            if prev is None or low < prev[0] * (1 - SELECT_TOL):
-                prev = (low, method, ms, es)
-        if "rounded" in cands:
-            pool.append(("rounded",) + tuple(cands["rounded"]))
-        if prev is not None:
-            pool.append(prev[1:])
-    out = []
-    for method, ms, es in pool:               # every one shifted to F bits
-        out.append((method, [m << (e - q) if m else 0 for m, e, q in zip(ms, es, fq)], fq))
-    return out
+    return [(method, [m << (e - q) if m else 0 for m, e, q in zip(ms, es, fq)], fq)
+            for method, ms, es in members]
+
+
+def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candidate | None:
+    """The best certified member of the fixed-point pool: at every bit count
+    ``b = 0..F`` the members of :func:`_chain_level`. The pool at ``F - 1``
+    bits is a subset (same values) of the pool at ``F``, so the certified
+    minimum over it never grows with the bits. Levels are visited from ``F``
+    bits down; once :func:`_grid_lower_bounds` proves that no polynomial on
+    the grid of a bit count (and of every coarser one) reaches the bound
+    certified at ``F`` bits, the rest of the pool cannot win and is not built:
+    the minimum is the one over the whole pool."""
+    coarse = _Sampler(prob, CHAIN_SAMPLES)
+    bound_at = _grid_lower_bounds(prob, fracs)
+    pool, best, lower = [], None, 0.0
+
+    def members(level):
+        out = _chain_level(prob, coarse, real, fracs, level, greedy)
+        if prob.word_limit is not None:
+            out = [c for c in out if max(abs(m) for m in c[1]) <= prob.word_limit]
+        return out
+
+    for level in range(min(fracs) + 1):       # F bits first, then fewer
+        if best is not None:
+            lower = max(lower, bound_at(level))   # this grid and every coarser one
+            if lower >= best.bound:
+                break
+        pool += members(level)
+        if level == 0:
+            best = _certify_ranked(prob, _ranked(sampler, pool))
+    return _certify_ranked(prob, _ranked(sampler, pool))
 
 
 def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
@@ -529,10 +863,7 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
         return _certify_ranked(prob, _rank(sampler, [(m, *c) for m, c in cands.items()]))
     if fmt == "fixed":
-        pool = _fixed_chain(prob, real, list(frac_bits), greedy)
-        if prob.word_limit is not None:
-            pool = [c for c in pool if max(abs(m) for m in c[1]) <= prob.word_limit]
-        return _certify_ranked(prob, _rank(sampler, pool))
+        return _fixed_pool(prob, sampler, real, list(frac_bits), greedy)
     # floating: quanta from the real coefficients, then from the best few
     # candidates' own binades (a lattice answer may leave a binade), a few rounds
     todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
@@ -546,12 +877,12 @@ def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=No
         tried.add(quanta)
         cands = _candidates(prob, sampler, real, list(quanta), greedy, fmt)
         pool += [(m, *c) for m, c in cands.items()]
-        ranked = _rank(sampler, [(m, *c) for m, c in cands.items()])
-        for _, _, ms, es, _ in ranked[:8]:
+        ranked = _ranked(sampler, [(m, *c) for m, c in cands.items()])
+        for _, _, ms, es, _ in itertools.islice(ranked, 8):
             # a zero coefficient keeps its quantum (float_quantum(0) is the
             # format's smallest, 2^-1074 in binary64: the real one would overflow)
             q = tuple(float_quantum(math.ldexp(m, e), fmt) if k in prob.powers and m
                       else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
-    return _certify_ranked(prob, _rank(sampler, pool), FLOAT_CERTIFY)
+    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY, FLOAT_SLACK, sampler)
