@@ -18,7 +18,7 @@ running ``supnorm`` on each segment's composed function ``f(a_s + h t)``, t in
 [0, 1], same coefficients, same tightness; and, for reference, chebnorm's
 ``certify`` run on one segment after another (one run).
 
-Quantization workload (issue 25, ``--quantize`` alone): 48 cases (fixed point
+Quantization workload (issue 25; printed last by the plain text run, ``--quantize`` runs it alone): 48 cases (fixed point
 8..28 bits, binary16/bfloat16/binary32/binary64, degrees 2..10, odd and even
 powers, a fixed constant; 1/sqrt, exp, sin, cos, atan, log(1+x), 2^x, erf, tan;
 absolute and relative error). chebnorm: ``quantize`` of a table fitted before
@@ -571,6 +571,11 @@ def main(argv=None) -> int:
                       f"speed-up {r['certify_speedup']:.1f}x")
             else:
                 print(f"  {r['sollya']}")
+    if not (args.json or args.piecewise_only or args.high_degree):
+        # the whole text run prints issue 25's quantization workload last
+        q = quantize_rows(args.repeat)
+        print_quantize(q)
+        return 1 if q["worse_than_before"] else 0
     return 0
 
 
