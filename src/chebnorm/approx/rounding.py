@@ -533,10 +533,9 @@ def greedy(prob: _Problem, real, quanta) -> list[int] | None:
     return [ints[k] for k in range(n + 1)]
 
 
-def _rank(sampler: _Sampler, cands) -> list:
-    """``cands`` (an iterable of (method, mantissas, exponents)) with finite,
-    distinct coefficient values, as (sampled error, method, ms, es, coeffs),
-    smallest sampled error first (ties: method name, then input order)."""
+def _distinct(cands) -> list:
+    """``cands`` (method, mantissas, exponents) as (method, ms, es, coefficient values),
+    the first of each set of values kept, non-finite ones dropped."""
     rows, seen = [], set()
     for method, ms, es in cands:
         coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
@@ -544,6 +543,14 @@ def _rank(sampler: _Sampler, cands) -> list:
             continue
         seen.add(coeffs)
         rows.append((method, list(ms), list(es), coeffs))
+    return rows
+
+
+def _rank(sampler: _Sampler, cands) -> list:
+    """``cands`` (an iterable of (method, mantissas, exponents)) with finite,
+    distinct coefficient values, as (sampled error, method, ms, es, coeffs),
+    smallest sampled error first (ties: method name, then input order)."""
+    rows = _distinct(cands)
     lows = sampler.errors([r[3] for r in rows]) if rows else []
     order = sorted(range(len(rows)), key=lambda i: (lows[i], rows[i][0], i))
     return [(lows[i],) + rows[i] for i in order]
@@ -556,13 +563,7 @@ def _ranked(sampler: _Sampler, cands, batch: int = 8):
     bound of it) says no other row can come before them."""
     import heapq
 
-    rows, seen = [], set()
-    for method, ms, es in cands:
-        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
-        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
-            continue
-        seen.add(coeffs)
-        rows.append((method, list(ms), list(es), coeffs))
+    rows = _distinct(cands)
     if not rows:
         return
     coarse = sampler.thinned().errors([r[3] for r in rows])

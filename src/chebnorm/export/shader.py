@@ -71,7 +71,7 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.textsafe import comment_text, identifier
 
-from .c import _max_abs_x, _up, horner_rounding_bound, inner_interval, range_problem
+from .c import _inward, _max_abs_x, _up, horner_rounding_bound, inner_interval, range_problem
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
            "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source"]
@@ -271,13 +271,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
 def _interval32(table: CoefficientTable) -> tuple[float, float]:
     """The table's interval rounded *inward* to float32: every float32 in it
     lies in the table's interval."""
-    lo, hi = inner_interval(table)
-    lo32, hi32 = np.float32(lo), np.float32(hi)
-    if float(lo32) < lo:
-        lo32 = np.nextafter(lo32, np.float32(np.inf), dtype=np.float32)
-    if float(hi32) > hi:
-        hi32 = np.nextafter(hi32, np.float32(-np.inf), dtype=np.float32)
-    return float(lo32), float(hi32)
+    return _inward(*inner_interval(table), "f")
 
 
 def shader_source(table: CoefficientTable, language: str, command: str = "") -> str:
