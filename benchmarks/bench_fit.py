@@ -106,6 +106,20 @@ def run_chebnorm(tight: float, workload=WORKLOAD):
     return sum(fits), sum(certs), sum(ends), worst_ratio
 
 
+def _run_sollya(lines: list[str]) -> tuple[str, float]:
+    """Run one Sollya script (its lines) in one process: its output and wall seconds."""
+    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
+        fh.write("\n".join(lines) + "\n")
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
+                             stdin=subprocess.DEVNULL).stdout
+    finally:
+        os.unlink(fh.name)
+    wall = time.perf_counter() - t0
+    return out, wall
+
+
 def run_sollya(tight: float, workload=WORKLOAD):
     lines = ["prec=200!;", "display=decimal!;", "tr=0; ts=0; w=0;"]
     for k, (expr, (lo, hi), d) in enumerate(workload):
@@ -116,15 +130,7 @@ def run_sollya(tight: float, workload=WORKLOAD):
                   f"t=time(r=supnorm(p, f, d, absolute, {tight!r})); ts=ts+t;",
                   "w=max(w, sup(r)/inf(r)-1);"]
     lines += ['print("TIMES", tr, ts, w);', "quit;"]
-    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
-        fh.write("\n".join(lines) + "\n")
-    t0 = time.perf_counter()
-    try:
-        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
-                             stdin=subprocess.DEVNULL).stdout
-    finally:
-        os.unlink(fh.name)
-    wall = time.perf_counter() - t0
+    out, wall = _run_sollya(lines)
     m = re.search(r"TIMES\s+(\S+)\s+(\S+)\s+(\S+)", out)
     if m is None:
         raise RuntimeError(f"sollya printed no timing line; its output began: {out[:200]!r}")
@@ -188,15 +194,7 @@ def run_piecewise_sollya(table, tight: float):
                   f"t=time(r=supnorm(p, g, [0;1], absolute, {tight!r})); ts=ts+t;",
                   "w=max(w, sup(r)/inf(r)-1); b=max(b, sup(r));"]
     lines += ['print("TIMES", ts, w, b);', "quit;"]
-    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
-        fh.write("\n".join(lines) + "\n")
-    t0 = time.perf_counter()
-    try:
-        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
-                             stdin=subprocess.DEVNULL).stdout
-    finally:
-        os.unlink(fh.name)
-    wall = time.perf_counter() - t0
+    out, wall = _run_sollya(lines)
     m = re.search(r"TIMES\s+(\S+)\s+(\S+)\s+(\S+)", out)
     if m is None:
         raise RuntimeError(f"sollya printed no timing line; its output began: {out[:200]!r}")
@@ -354,15 +352,7 @@ def run_quantize_sollya(constants, workload=QUANT_WORKLOAD, tight: float = 2.0 *
                   f"t2=time(r=supnorm(p, f, d, {mode}, {tight!r}));",
                   f'print("Q{i}", t1 + t2, sup(r));']
     lines.append("quit;")
-    with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
-        fh.write("\n".join(lines) + "\n")
-    t0 = time.perf_counter()
-    try:
-        out = subprocess.run(["sollya", "--warnonstderr", fh.name], capture_output=True, text=True,
-                             stdin=subprocess.DEVNULL).stdout
-    finally:
-        os.unlink(fh.name)
-    wall = time.perf_counter() - t0
+    out, wall = _run_sollya(lines)
     rows = []
     for i in range(len(workload)):
         m = re.search(rf"^Q{i}\s+(\S+)\s+(\S+)\s*$", out, re.M)
