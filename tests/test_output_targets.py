@@ -168,6 +168,18 @@ class TestCommands:
         assert r.stdout == table.read_text()
         assert os.path.islink("/dev/stdout") and os.readlink("/dev/stdout") == before
 
+    def test_dev_stdout_appended_to_a_file_keeps_its_content(self, tmp_path, table,
+                                                             system_links):
+        # `chebnorm export ... -o /dev/stdout >> log`: the file is appended to, not truncated
+        log = tmp_path / "log.txt"
+        log.write_text("earlier line\n")
+        with open(log, "a") as out:
+            r = subprocess.run([sys.executable, "-m", "chebnorm", "export", str(table), "--format",
+                                "json", "-o", "/dev/stdout"], stdout=out, stderr=subprocess.PIPE,
+                               text=True, check=False)
+        assert r.returncode == 0, r.stderr
+        assert log.read_text() == "earlier line\n" + table.read_text()
+
     def test_export_to_dev_null(self, table, system_links):
         st = os.stat("/dev/null")
         r = cli("export", table, "--format", "c", "-o", "/dev/null")

@@ -162,8 +162,12 @@ def _write_through(given: Path, data: bytes) -> None:
     process's open file) and write ``data`` into it; never creates or
     replaces it. A FIFO without a reader blocks until one opens it, as a
     shell redirection does."""
+    flags = os.O_WRONLY | os.O_NOCTTY | getattr(os, "O_CLOEXEC", 0)
     try:
-        fd = os.open(given, os.O_WRONLY | os.O_TRUNC | os.O_NOCTTY | getattr(os, "O_CLOEXEC", 0))
+        # a regular file reached through /dev/stdout (``-o /dev/stdout >> log``) is
+        # appended to, never truncated: the shell's redirection decides what it holds
+        regular = stat.S_ISREG(os.stat(given).st_mode)
+        fd = os.open(given, flags | (os.O_APPEND if regular else os.O_TRUNC))
     except OSError as exc:
         raise _refuse(given, _reason(exc)) from None
     try:
