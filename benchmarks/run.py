@@ -998,7 +998,7 @@ def verdict_changes(previous: Path, new: dict) -> list[str]:
 
 
 def _atomic_write(path: Path, text: str):
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.core.files import write_atomic
 
     write_atomic(path, text)
 

@@ -17,7 +17,7 @@
   made machine-independent where they are computed, see
   :mod:`chebnorm.methods.detmath`).
 
-Every file goes through :func:`chebnorm.approx.files.write_atomic` (temporary
+Every file goes through :func:`chebnorm.core.files.write_atomic` (temporary
 file, then rename).
 """
 
@@ -36,7 +36,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from chebnorm.approx.files import write_atomic
+from chebnorm.core.files import write_atomic
 
 __all__ = ["RC", "FLOAT_FORMAT", "figure", "save_figure", "stable_svg_ids", "write_csv",
            "write_json", "write_text", "fmt", "COLORS", "METHOD_STYLE", "ERROR_MAP", "ERROR_CMAP",

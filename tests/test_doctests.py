@@ -25,8 +25,8 @@ def test_docstring_examples(name):
 # ------------------------------------------------ every public callable shows an example
 #: the modules whose public callables must carry a runnable example (``>>>``)
 EXAMPLE_PACKAGES = ("chebnorm.symbolic", "chebnorm.export", "chebnorm.hw", "chebnorm.methods")
-EXAMPLE_MODULES = ("chebnorm.approx.expr", "chebnorm.approx.files", "chebnorm.approx.textsafe",
-                   "chebnorm.approx.parallel", "chebnorm.approx.method_registry",
+EXAMPLE_MODULES = ("chebnorm.approx.expr", "chebnorm.core.files", "chebnorm.core.textsafe",
+                   "chebnorm.core.parallel", "chebnorm.approx.method_registry",
                    "chebnorm.approx.targets")
 #: a design-space search whose smallest run takes minutes; its types have examples elsewhere
 EXAMPLE_SKIPPED_MODULES = ("chebnorm.hw.piecewise_search",)

@@ -14,7 +14,7 @@ import threading
 
 import pytest
 
-from chebnorm.approx.files import WriteError, write_all, write_atomic, write_folder
+from chebnorm.core.files import WriteError, write_all, write_atomic, write_folder
 
 ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
@@ -82,7 +82,7 @@ class TestWriter:
         out = tmp_path / "captured.txt"
         link = tmp_path / "my_stdout"
         link.symlink_to("/proc/self/fd/1")
-        code = ("import sys; from chebnorm.approx.files import write_atomic; "
+        code = ("import sys; from chebnorm.core.files import write_atomic; "
                 "write_atomic(sys.argv[1], 'through\\n')")
         with open(out, "w") as fh:
             inode = os.fstat(fh.fileno()).st_ino

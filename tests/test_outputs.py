@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from chebnorm.approx.files import WriteError, make_folder, write_atomic
+from chebnorm.core.files import WriteError, make_folder, write_atomic
 from chebnorm.raster import IMAGE_FORMATS, get_mesh, load_mesh, write_image, write_png
 
 

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from chebnorm.approx.parallel import check_workers, map_ordered
+from chebnorm.core.parallel import check_workers, map_ordered
 
 
 def _square_slow_first(x):

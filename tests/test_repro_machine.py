@@ -409,7 +409,7 @@ def _blas_core_types() -> list[str]:
 @pytest.mark.slow
 def test_fits_do_not_depend_on_the_blas_kernels():
     """The Remez exchange, the batched certifier and the criterion's interior minimum
-    use no BLAS/LAPACK (chebnorm.approx.detlinalg): the same bytes whichever OpenBLAS
+    use no BLAS/LAPACK (chebnorm.core.detlinalg): the same bytes whichever OpenBLAS
     kernels the CPU selects (on an AMD Zen 4 OpenBLAS picks SkylakeX, on a Zen 5 Zen)."""
     kinds = _blas_core_types()
     if len(kinds) < 2:

@@ -40,7 +40,7 @@ import numpy as np
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.files import write_atomic
-from chebnorm.approx.textsafe import csv_cell
+from chebnorm.core.textsafe import csv_cell
 from chebnorm.export import glsl_source
 from chebnorm.export.gpu import gl_context
 from chebnorm.methods import span_normals

@@ -20,18 +20,23 @@ The package is split by pipeline stage, and a stage imports only the stages
 ``importlib.import_module``/``__import__`` with a literal name, and attribute
 access such as ``chebnorm.raster.render`` after ``import chebnorm``):
 
-1. ``chebnorm.symbolic`` -- sympy closed forms of the papers; imports no stage.
+0. ``chebnorm.core``     -- the floor every stage may import: atomic
+   files, the ordered parallel map, safe text for generated sources, the
+   C-library math and fixed-order linear algebra that keep outputs
+   byte-identical, small numeric helpers written once.
+1. ``chebnorm.symbolic`` -- sympy closed forms of the papers; imports core.
 2. ``chebnorm.approx``   -- targets, fitting (Chebyshev, Remez), certified
-   error bounds, fixed-point quantization, :class:`CoefficientTable`.
-3. ``chebnorm.export`` (C, JSON printers), ``chebnorm.methods`` (span
-   interpolators, operation counting), ``chebnorm.hw`` (fixed-point
-   datapaths, Verilog) -- siblings: each imports symbolic and approx, none
-   imports another.
-4. ``chebnorm.raster``   -- meshes, spans, shading modes, image metrics;
-   imports symbolic, approx and methods (not hw, not export).
-5. ``chebnorm.cli``      -- the command line; imports any stage.
+   error bounds, fixed-point quantization, the table contract.
+3. ``chebnorm.methods`` (span interpolators, operation counting) and
+   ``chebnorm.hw`` (fixed-point datapaths, the HDL printers) -- siblings:
+   each imports core, symbolic and approx, neither imports the other.
+4. ``chebnorm.export``   -- one place per output format (C, JSON, shaders,
+   and through hw the Verilog and VHDL); imports core, symbolic, approx, hw.
+5. ``chebnorm.raster``   -- meshes, spans, shading modes, image metrics;
+   imports core, symbolic, approx and methods (not hw, not export).
+6. ``chebnorm.cli``      -- the command line; imports any stage.
 
-This module (the package root) is stage 0: at import time it loads no stage.
+This module (the package root) loads no stage at import time.
 A lazy facade is allowed: names resolved by a module-level ``__getattr__``
 that imports a stage only when the attribute is first used; no stage may
 reach a later one through such a name (stages import stage modules, never
@@ -89,18 +94,19 @@ except PackageNotFoundError:  # pragma: no cover - running from a bare checkout
 #: The layer rule: each stage of the package and the stages it may import
 #: (besides itself). Read by ``tests/test_architecture.py``; keep it a literal.
 LAYERS = {
-    "symbolic": (),
-    "approx": ("symbolic",),
-    "export": ("symbolic", "approx"),
-    "methods": ("symbolic", "approx"),
-    "hw": ("symbolic", "approx"),
-    "raster": ("symbolic", "approx", "methods"),
-    "cli": ("symbolic", "approx", "export", "methods", "hw", "raster"),
+    "core": (),
+    "symbolic": ("core",),
+    "approx": ("core", "symbolic"),
+    "methods": ("core", "symbolic", "approx"),
+    "hw": ("core", "symbolic", "approx"),
+    "export": ("core", "symbolic", "approx", "hw"),
+    "raster": ("core", "symbolic", "approx", "methods"),
+    "cli": ("core", "symbolic", "approx", "methods", "hw", "export", "raster"),
 }
 
 
 #: the stage subpackages, imported on first attribute access
-_SUBPACKAGES = ("symbolic", "approx", "export", "methods", "hw", "raster")
+_SUBPACKAGES = ("core", "symbolic", "approx", "export", "methods", "hw", "raster")
 
 #: facade name -> (module, attribute); imported on first use
 _LAZY = {
@@ -123,7 +129,7 @@ _LAZY = {
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
     "FitWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
-    "symbolic", "approx", "export", "methods", "hw", "raster",
+    "core", "symbolic", "approx", "export", "methods", "hw", "raster",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}
 

@@ -9,8 +9,6 @@ True
 from .api import MAX_DEGREE, FitWarning, fit, quantize, warnings_of
 from .certify import Certificate, certify
 from .expr import Function1D, read_expression, parse_function, parse_number
-from .files import write_atomic
-from . import textsafe
 from .rounding import FORMATS as COEF_FORMATS
 from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint, Quantized
 from .targets import TARGETS, Target, get_target, target_names
@@ -19,7 +17,6 @@ __all__ = [
     "CoefficientTable", "FixedPoint", "Quantized", "COEF_FORMATS", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "FitWarning", "MAX_DEGREE",
     "Certificate", "certify", "Function1D", "read_expression", "parse_function", "parse_number",
     "Target", "TARGETS", "get_target", "target_names", "fit_target",
-    "write_atomic", "textsafe",
 ]
 
 

@@ -11,7 +11,9 @@ import numpy as np
 import sympy as sp
 from flint import arb
 
-from .certify import Certificate, _float_down, _float_up, certify
+from chebnorm.core.numeric import ball_float_down, ball_float_up
+
+from .certify import Certificate, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, polish, remez,
                       shift_for)
@@ -82,7 +84,7 @@ class Interval:
             raise ValueError(f"interval [{self.lo}, {self.hi}] is empty or reversed: "
                              f"LO must be strictly less than HI")
         self.lo_f, self.hi_f = (_nearest_float(b) for b in balls)
-        self.lo_in, self.hi_in = _float_up(balls[0]), _float_down(balls[1])
+        self.lo_in, self.hi_in = ball_float_up(balls[0]), ball_float_down(balls[1])
         if not self.lo_in <= self.hi_in:
             raise ValueError(f"interval [{self.lo}, {self.hi}] holds no float64 number; "
                              f"accepted: an interval wider than one float64 spacing")
@@ -723,7 +725,7 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
 def _table_name(name) -> str:
     """``name`` checked where it enters: None is ``"table"``, anything else must be
     an identifier (it becomes a C function, a macro, a Verilog module)."""
-    from .textsafe import identifier
+    from chebnorm.core.textsafe import identifier
 
     return "table" if name is None else identifier(name, field="name")
 

@@ -57,6 +57,8 @@ import numpy as np
 import sympy as sp
 from flint import arb, arb_poly, arb_series, ctx
 
+from chebnorm.core.numeric import arb_precision, ball_float_down, ball_float_up
+
 from .expr import Function1D, _compile_arb
 
 __all__ = ["Certificate", "certify", "arb_enclose"]
@@ -94,29 +96,8 @@ def arb_enclose(value: sp.Expr) -> arb:
 @functools.lru_cache(maxsize=1024)
 def _enclose(value: sp.Expr, prec: int) -> arb:
     """:func:`arb_enclose` at ``prec`` bits, cached (balls are immutable)."""
-    old = ctx.prec
-    try:
-        ctx.prec = prec
+    with arb_precision(prec):
         return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
-    finally:
-        ctx.prec = old
-
-
-def _float_up(x: arb) -> float:
-    """The smallest float >= every point of the ball ``x``."""
-    u = x.upper()
-    f = float(u)
-    while arb(f) < u:
-        f = math.nextafter(f, math.inf)
-    return f
-
-
-def _float_down(x: arb) -> float:
-    lo = x.lower()
-    f = float(lo)
-    while arb(f) > lo:
-        f = math.nextafter(f, -math.inf)
-    return f
 
 
 def _coeffs(series: arb_series, n: int) -> list[arb]:
@@ -378,9 +359,7 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     (0.125, True)
     """
     lo, hi = _check_arguments(fn, coefficients, lo, hi, tol, max_subintervals, prec)
-    old_prec = ctx.prec
-    try:
-        ctx.prec = prec or 128
+    with arb_precision(prec or 128):
         if shift is not None:
             if not isinstance(shift, (tuple, list)) or len(shift) != 2 or not all(
                     _is_real(v) for v in shift):
@@ -392,8 +371,6 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
                                  f"positive scale")
         return _certify(fn, [float(c) for c in coefficients], lo, hi, kind, tol,
                         max_subintervals, shift, abort_at)
-    finally:
-        ctx.prec = old_prec
 
 
 def _is_real(v) -> bool:
@@ -552,14 +529,14 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None,
         located = again if located is None or again[0] > located[0] else located
     maximum, at = located[0], located[1]
     bound = accepted_upper.max(arb(maximum))
-    return Certificate(bound=_float_up(bound), maximum=maximum, at=at, subintervals=count,
+    return Certificate(bound=ball_float_up(bound), maximum=maximum, at=at, subintervals=count,
                        tight=not reasons, reason="; ".join(sorted(reasons)))
 
 
 def _enclose_interval(lo, hi) -> tuple[arb, arb, float, float]:
     """Balls of the exact endpoints and the floats nearest inside ``[lo, hi]``."""
     lo_b, hi_b = arb_enclose(lo), arb_enclose(hi)
-    lo_f, hi_f = _float_up(lo_b), _float_down(hi_b)
+    lo_f, hi_f = ball_float_up(lo_b), ball_float_down(hi_b)
     if not lo_f <= hi_f:
         raise ValueError(f"interval [{lo}, {hi}] holds no float64 number; accepted: an "
                          f"interval wider than one float64 spacing")

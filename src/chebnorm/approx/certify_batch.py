@@ -76,7 +76,7 @@ import numpy as np
 import sympy as sp
 from flint import arb, arb_series, ctx
 
-from . import detlinalg
+from chebnorm.core import detlinalg
 from .certify import TOL, Certificate, arb_enclose, certify
 from .expr import Function1D
 

@@ -62,7 +62,8 @@ import sympy as sp
 from flint import arb, arb_series, ctx, fmpq
 from sympy.printing.numpy import SciPyPrinter
 
-from . import clib
+from chebnorm.core import clib
+from chebnorm.core.numeric import arb_precision
 
 __all__ = ["Function1D", "UndefinedError", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
@@ -422,16 +423,12 @@ def enclose(value: sp.Expr, prec: int = 64) -> arb | None:
     constant the Arb compiler knows."""
     if value.free_symbols or value.has(sp.I, sp.zoo, sp.nan, sp.oo):
         return None
-    old = ctx.prec
-    try:
-        ctx.prec = prec
+    with arb_precision(prec):
         try:
             ball = _compile_arb(value, sp.Dummy(), series=False)(arb(0))
         except (ValueError, ZeroDivisionError):
             return None
         return ball if ball.is_finite() else None
-    finally:
-        ctx.prec = old
 
 
 def compare(a: sp.Expr, b: sp.Expr) -> int:

@@ -16,7 +16,7 @@ import numpy as np
 from flint import arb, arb_mat, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
-from . import clib, detlinalg
+from chebnorm.core import clib, detlinalg
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish", "minimax_powers", "PowersFit"]

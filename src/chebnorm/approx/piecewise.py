@@ -47,7 +47,9 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from flint import arb, ctx
+from flint import arb
+
+from chebnorm.core.numeric import arb_precision, check_int, signed_bits
 
 from .certify import arb_enclose, certify
 from .certify_batch import SegmentError, certify_batch
@@ -159,7 +161,7 @@ class PiecewiseTable:
         out = []
         for j in range(self.degree + 1):
             vals = [seg.integers[j] for seg in self.segments]
-            out.append(_signed_bits(min(vals), max(vals)))
+            out.append(signed_bits(min(vals), max(vals)))
         return tuple(out)
 
     def __call__(self, x) -> np.ndarray:
@@ -209,7 +211,7 @@ class PiecewiseTable:
 
     def save(self, path) -> None:
         """Write the JSON atomically."""
-        from .files import write_atomic
+        from chebnorm.core.files import write_atomic
 
         write_atomic(path, self.to_json())
 
@@ -317,11 +319,6 @@ def _segment_certificates(table: PiecewiseTable, kind: str, stated, todo) -> dic
 
 # -- geometry ------------------------------------------------------------------
 
-def _signed_bits(lo: int, hi: int) -> int:
-    n = 1
-    while not (-(1 << (n - 1)) <= lo and hi <= (1 << (n - 1)) - 1):
-        n += 1
-    return n
 
 
 def _exact_log2(value: sp.Expr) -> int | None:
@@ -448,9 +445,7 @@ class _ArbLocal:
 def _segment_balls(segment_by, lo, hi, index_bits, centered, segments):
     """Arb balls ``(o_s, w_s)`` with segment ``s`` = ``o_s + w_s t``, ``t`` in
     the local range (128 bits; exact for binary ends), without sympy per segment."""
-    old = ctx.prec
-    try:
-        ctx.prec = 128
+    with arb_precision(128):
         origins, widths = [], []
         if segment_by == "uniform":
             n = 2 ** index_bits
@@ -470,8 +465,6 @@ def _segment_balls(segment_by, lo, hi, index_bits, centered, segments):
         if centered:
             origins = [o + w / 2 for o, w in zip(origins, widths)]
         return origins, widths
-    finally:
-        ctx.prec = old
 
 
 def is_piecewise_file(path) -> bool:
@@ -488,12 +481,6 @@ def is_piecewise_file(path) -> bool:
 
 # -- fitting -------------------------------------------------------------------
 
-def _check_int(value, name: str, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
-    if not lo <= int(value) <= hi:
-        raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
-    return int(value)
 
 
 def _fit_segment(g: Function1D, degree: int, lo: float, hi: float, fit: str, error: str):
@@ -609,12 +596,12 @@ def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = 
     >>> t.segment_count, t.rel_error_bound < 1e-3
     (8, True)
     """
-    from .textsafe import identifier
+    from chebnorm.core.textsafe import identifier
 
     name = identifier(name, field="name")
     index_bits = parse_segments(segments)
-    degree = _check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
-    frac_bits = _check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
+    degree = check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
+    frac_bits = check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
     if segment_by not in SEGMENT_BY:
         raise ValueError(f"segment-by {segment_by!r} is unknown; accepted: {', '.join(SEGMENT_BY)}")
     if fit not in FITS:
@@ -730,7 +717,7 @@ def _fields(d) -> dict[str, Any]:
     """The keyword arguments of :class:`PiecewiseTable` from its JSON object, every
     field checked (a refusal names it), the top-level bounds derived from the
     segments' (no certification)."""
-    from . import textsafe
+    from chebnorm.core import textsafe
 
     if not isinstance(d, dict):
         raise _bad("table", "a JSON object", d)

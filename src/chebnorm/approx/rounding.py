@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from flint import fmpz_mat
 
-from . import clib
+from chebnorm.core import clib
 from .certify import certify
-from .detlinalg import matvec
+from chebnorm.core.detlinalg import matvec
 
 __all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
 
@@ -592,7 +592,9 @@ def _error_at(prob: _Problem, points, coeffs) -> float:
     near-minimax binary64 error is larger than the candidates' differences)."""
     from flint import arb, ctx
 
-    from .certify import _error_function, _float_down
+    from chebnorm.core.numeric import ball_float_down
+
+    from .certify import _error_function
 
     old = ctx.prec
     try:
@@ -603,7 +605,7 @@ def _error_at(prob: _Problem, points, coeffs) -> float:
             v = abs(g(arb(x)))
             if v.is_finite():
                 best = best.max(v.lower())
-        return max(_float_down(best), 0.0)
+        return max(ball_float_down(best), 0.0)
     finally:
         ctx.prec = old
 

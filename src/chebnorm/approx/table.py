@@ -289,7 +289,7 @@ class CoefficientTable:
 
     def save(self, path) -> None:
         """Write the JSON atomically (temporary file, then rename)."""
-        from .files import write_atomic
+        from chebnorm.core.files import write_atomic
 
         write_atomic(path, self.to_json())
 
@@ -649,7 +649,7 @@ def _read_fields(cls, d) -> dict[str, Any]:
     """The fields of a table from its JSON object, every field checked (no
     certification): the keyword arguments of ``cls``."""
     from .api import ERROR_KINDS, KINDS, MAX_DEGREE
-    from .textsafe import identifier
+    from chebnorm.core.textsafe import identifier
 
     if not isinstance(d, dict):
         raise ValueError(f"a coefficient table must be a JSON object, got {_show(d)}")

@@ -3,7 +3,7 @@
 Each subcommand lives in its own module of this package and exposes
 ``register(subparsers)``, which adds its parser and sets ``func`` to a
 function ``(args) -> int``. Errors the user can fix (``ValueError``,
-``OSError``, among them :class:`chebnorm.approx.files.WriteError` for an
+``OSError``, among them :class:`chebnorm.core.files.WriteError` for an
 output that cannot be written) end the program with status 2 and one line on
 stderr, never a traceback.
 """

@@ -1,5 +1,5 @@
 """``--workers N`` and ``--scheduler ADDRESS``: the options of every parallel command
-(they map onto :func:`chebnorm.approx.parallel.map_ordered`)."""
+(they map onto :func:`chebnorm.core.parallel.map_ordered`)."""
 
 from __future__ import annotations
 

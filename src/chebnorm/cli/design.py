@@ -37,9 +37,9 @@ def register(sub) -> None:
 def run(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx.files import write_folder
+    from chebnorm.core.files import write_folder
     from chebnorm.approx.piecewise import parse_segments
-    from chebnorm.approx.textsafe import identifier
+    from chebnorm.core.textsafe import identifier
     from chebnorm.hw.piecewise_search import search
 
     name = identifier(args.name, field="name")
@@ -104,7 +104,7 @@ def hw_verilog(args) -> int:
     from pathlib import Path
 
     from chebnorm import __version__
-    from chebnorm.approx.files import write_folder
+    from chebnorm.core.files import write_folder
     from chebnorm.hw.piecewise import piecewise_outputs
     from chebnorm.hw.verilog import simulate
 
@@ -159,7 +159,7 @@ def hw_sweep_piecewise(args) -> int:
     """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot."""
     from pathlib import Path
 
-    from chebnorm.approx.files import write_folder
+    from chebnorm.core.files import write_folder
     from chebnorm.approx.piecewise import parse_segments
     from chebnorm.hw.piecewise_search import grid
 

@@ -63,7 +63,7 @@ def run(args) -> int:
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
                          f"output code widths); accepted: 1..20 and 1..32")
     from chebnorm import __version__
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.core.files import write_atomic
     from chebnorm.hw.report import analyze
 
     report = analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
@@ -83,7 +83,7 @@ def run(args) -> int:
 
 
 def _run_piecewise(args) -> int:
-    from chebnorm.approx.files import write_atomic
+    from chebnorm.core.files import write_atomic
     from chebnorm.approx.piecewise import PiecewiseTable
     from chebnorm.export.c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
 

@@ -9,7 +9,7 @@ import sys
 import warnings
 
 from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
-from chebnorm.approx.textsafe import identifier
+from chebnorm.core.textsafe import identifier
 
 from ._common import command_line, deprecated_alias, print_json
 

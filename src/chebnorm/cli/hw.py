@@ -260,7 +260,7 @@ def run_sweep(args) -> int:
     from pathlib import Path
 
     from chebnorm.approx import get_target
-    from chebnorm.approx.files import write_folder
+    from chebnorm.core.files import write_folder
     from chebnorm.hw.sweep import DEFAULT_ACC_BITS, DEFAULT_COEF_BITS, DEFAULT_DEGREES, sweep
 
     out = Path(args.output)

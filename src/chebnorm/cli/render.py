@@ -94,7 +94,7 @@ def _refuse_unused(args) -> None:
 def run(args) -> int:
     import numpy as np
 
-    from chebnorm.approx.files import write_all
+    from chebnorm.core.files import write_all
     from chebnorm.raster import Lighting, compare, error_map_rgb, get_mesh, render
     from chebnorm.raster.metrics import image_bytes, image_format
 

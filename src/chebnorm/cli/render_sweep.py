@@ -69,7 +69,7 @@ def parse_size(text: str) -> tuple[int, int]:
 def run(args) -> int:
     from pathlib import Path
 
-    from chebnorm.approx.files import make_folder, write_atomic
+    from chebnorm.core.files import make_folder, write_atomic
     from chebnorm.raster import RenderSweep, render_sweep, render_sweep_cases
 
     from .render import _parse_reference

@@ -30,9 +30,9 @@ from importlib.metadata import PackageNotFoundError, entry_points, version
 from pathlib import Path
 
 from chebnorm.approx import TARGETS, fit_target, target_names
-from chebnorm.approx.files import write_atomic
+from chebnorm.core.files import write_atomic
 from chebnorm.export import c_header, json_text
-from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
+from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 
 from ._parallel import add_parallel_args, parallel_kwargs
 

@@ -11,7 +11,7 @@ import sys
 import types
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import write_atomic
+from chebnorm.core.files import write_atomic
 
 from .c import c_header, horner_rounding_bound
 from .shader import float32_eval_bound, glsl_source, hlsl_source, shader_source, wgsl_source

@@ -36,9 +36,9 @@ evaluation bounds then add the error of ``t`` (``c`` rounded to the type, the
 subtraction unless Sterbenz's lemma makes it exact) times ``max |p'|``.
 
 Text from the table or the command line never reaches the header raw: the
-name must be an identifier (:func:`chebnorm.approx.textsafe.identifier`, it
+name must be an identifier (:func:`chebnorm.core.textsafe.identifier`, it
 makes every symbol and macro), every other text goes through
-:func:`~chebnorm.approx.textsafe.comment_text` (it cannot end the comment,
+:func:`~chebnorm.core.textsafe.comment_text` (it cannot end the comment,
 continue a line or hold a trigraph), and numbers are printed from ``float``
 and ``int`` values.
 """
@@ -51,7 +51,8 @@ from fractions import Fraction
 import numpy as np
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.numeric import float_up
+from chebnorm.core.textsafe import comment_text, identifier
 
 __all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
            "range_problem", "underflow_bound"]
@@ -93,14 +94,6 @@ def _literal(value: float, suffix: str) -> str:
     if suffix == "f":
         value = float(np.float32(value))
     return f"{value.hex()}{suffix} /* {value!r} */"
-
-
-def _up(x: Fraction) -> float:
-    """Smallest float >= the rational ``x``."""
-    f = float(x)
-    while Fraction(f) < x:
-        f = math.nextafter(f, math.inf)
-    return f
 
 
 #: per literal suffix: the type's name, its largest finite number and half its
@@ -525,7 +518,7 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
             else _parity_rounding_bound(coeffs, parity, max_x, u)
             + _parity_underflow_bound(coeffs, parity, max_x, suffix, u))
         bound = Fraction(q.abs_error_bound) + rounding
-        w(f"#define {macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
+        w(f"#define {macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(float_up(bound), '')}")
     w(f"static const double {fn}_quant_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
         w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* x^{k} */")
@@ -540,7 +533,7 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
 def banner_head(fn: str, table, command: str) -> list[str]:
     """The first lines of a generated header's banner comment: the file, the
     tool and version, the generating command and the table's own provenance
-    (all text through :func:`~chebnorm.approx.textsafe.comment_text`).
+    (all text through :func:`~chebnorm.core.textsafe.comment_text`).
 
     >>> from chebnorm.approx import fit
     >>> head = banner_head("chebnorm_d1", fit("x", ("0", "1"), 1), "make */ evil")
@@ -619,14 +612,14 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
             w(f"/* No {ctype} evaluator: {comment_text(problem)}. */")
             continue
         emitted.append((ctype, suffix, fsuffix))
-        w(f"#define {macro}{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(_up(bound), '')}")
+        w(f"#define {macro}{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(float_up(bound), '')}")
     if table.fixed_point is not None:
         fp = _checked_fixed(table)
         _check_fixed_ranges(table, max_x)
         w(f"#define {macro}_FRAC_BITS {fp.frac_bits}")
         w(f"#define {macro}_Q_ABS_ERROR_BOUND {_literal(fp.abs_error_bound, '')}")
         qb = Fraction(fp.abs_error_bound) + _fixed_rounding_bound(table.degree, fp.frac_bits, max_x)
-        w(f"#define {macro}_Q_EVAL_ERROR_BOUND {_literal(_up(qb), '')}")
+        w(f"#define {macro}_Q_EVAL_ERROR_BOUND {_literal(float_up(qb), '')}")
     w("")
     w(f"static const double {fn}_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):

@@ -17,7 +17,7 @@ The local variable is computed exactly in both, so the bounds are
 ``<P>_EVAL_ERROR_BOUND``: ``max_s`` of the segment's certified bound plus
 the double Horner rounding bound ``gamma_2n sum |c_j| |t|^j`` (Higham eq. 5.3)
 -- the same bounds as :func:`chebnorm.export.c_header`. Names pass through
-:func:`chebnorm.approx.textsafe.identifier`, other text through
+:func:`chebnorm.core.textsafe.identifier`, other text through
 ``comment_text``; numbers are printed from floats and ints.
 
 >>> from chebnorm.approx.piecewise import fit_piecewise
@@ -31,9 +31,11 @@ from __future__ import annotations
 from fractions import Fraction
 
 from chebnorm.approx.piecewise import PiecewiseTable
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.textsafe import comment_text, identifier
 
-from .c import _up, banner_head, horner_rounding_bound, range_problem, underflow_bound
+from chebnorm.core.numeric import float_up
+
+from .c import banner_head, horner_rounding_bound, range_problem, underflow_bound
 
 __all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound"]
 
@@ -70,7 +72,7 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
         b = (Fraction(seg.abs_error_bound) + horner_rounding_bound(cs, tmax, _U)
              + underflow_bound(len(cs) - 1, tmax, "", _U))
         worst = max(worst, b)
-    return _up(worst)
+    return float_up(worst)
 
 
 def piecewise_c_header(table: PiecewiseTable, command: str = "", *,

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.textsafe import identifier
+from chebnorm.core.textsafe import identifier
 
 from .shader import _interval32, shader_source
 

@@ -69,9 +69,11 @@ from fractions import Fraction
 import numpy as np
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.textsafe import comment_text, identifier
 
-from .c import _inward, _max_abs_x, _up, horner_rounding_bound, inner_interval, range_problem
+from chebnorm.core.numeric import float_up
+
+from .c import _inward, _max_abs_x, horner_rounding_bound, inner_interval, range_problem
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
            "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source"]
@@ -260,7 +262,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
                           + sum((k * abs(Fraction(c)) * m ** (k - 1)
                                  for k, c in enumerate(c32) if k), Fraction(0)))
     total = certified + coef + rounding + flush
-    up = _up(total)
+    up = float_up(total)
     up32 = float(np.float32(up))
     if up32 < up:
         up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
@@ -328,7 +330,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
         w(line.format(P=big))
     w(lang.const.format(name=f"{big}_LO", value=lit(lo32)))
     w(lang.const.format(name=f"{big}_HI", value=lit(hi32)))
-    w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND", value=lit(_up_f32(_up(certified)))))
+    w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND", value=lit(_up_f32(float_up(certified)))))
     w(lang.const.format(name=f"{big}_EVAL_ERROR_BOUND", value=lit(bound.total32)))
     w("")
     w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")

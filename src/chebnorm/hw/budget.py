@@ -34,6 +34,8 @@ import sympy as sp
 from chebnorm.approx import parse_function, parse_number
 from chebnorm.approx.certify import certify
 
+from chebnorm.core.numeric import float_up
+
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
 
@@ -42,13 +44,6 @@ __all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "gappa_scrip
 
 #: an 8-bit shading output has 255 steps between black and full intensity
 SHADING_LEVELS = 255
-
-
-def _up(x: Fraction) -> float:
-    f = float(x)
-    while Fraction(f) < x:
-        f = math.nextafter(f, math.inf)
-    return f
 
 
 @dataclass(frozen=True)
@@ -178,8 +173,8 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     poly = min(Fraction(approx) + Fraction(quant), Fraction(quantized))
     g = gappa_bound(design) if gappa else None
     return ErrorBudget(approximation=approx, quantization=quant, quantized=quantized,
-                       rounding_steps=tuple(_up(s) for s in steps), output_rounding=_up(out),
-                       rounding=_up(rounding), total=_up(poly + rounding),
+                       rounding_steps=tuple(float_up(s) for s in steps), output_rounding=float_up(out),
+                       rounding=float_up(rounding), total=float_up(poly + rounding),
                        y_lsb=float(design.y_format.lsb), gappa_rounding=g)
 
 
@@ -217,7 +212,7 @@ def measure(design: HornerDesign) -> Measurement:
         diff = yn - num * 2 ** (fy - den)
         scale = fy
     worst = max(abs(int(diff.max())), abs(int(diff.min())))
-    rounding = _up(Fraction(worst, 2 ** scale))
+    rounding = float_up(Fraction(worst, 2 ** scale))
     steps = []
     xs = wires["xs"]
     acc = np.full(k.shape, design.integers[-1], dtype=np.int64)
@@ -329,4 +324,4 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
     if proc.returncode != 0 or "in [" not in out:
         raise ValueError(f"gappa could not bound the datapath of {design.module_name}: "
                          f"{' '.join(out.split())[:300]}")
-    return _up(parse_gappa_upper(out))
+    return float_up(parse_gappa_upper(out))

@@ -36,6 +36,9 @@ from fractions import Fraction
 
 import numpy as np
 
+from chebnorm.core.numeric import check_int as check_width
+from chebnorm.core.numeric import signed_bits, unsigned_bits
+
 __all__ = ["QFormat", "ROUNDINGS", "OVERFLOWS", "shift_round", "fit_bits", "signed_bits",
            "unsigned_bits", "rounding_error_bound", "check_int64", "check_width"]
 
@@ -149,25 +152,8 @@ def fit_bits(v, bits: int, *, signed: bool, overflow: str):
     return out, over
 
 
-def signed_bits(lo: int, hi: int) -> int:
-    """Smallest two's-complement width holding every integer of ``[lo, hi]``.
-
-    >>> signed_bits(-4, 3), signed_bits(0, 4), signed_bits(-5, 0)
-    (3, 4, 4)
-    """
-    n = 1
-    while not (-(1 << (n - 1)) <= lo and hi <= (1 << (n - 1)) - 1):
-        n += 1
-    return n
 
 
-def unsigned_bits(hi: int) -> int:
-    """Smallest unsigned width holding ``0..hi`` (at least 1).
-
-    >>> unsigned_bits(0), unsigned_bits(255), unsigned_bits(256)
-    (1, 8, 9)
-    """
-    return max(1, int(hi).bit_length())
 
 
 def rounding_error_bound(frac_bits: int, mode: str, dropped_bits: int | None = None) -> Fraction:
@@ -203,19 +189,3 @@ def check_int64(bits: int, what: str) -> None:
                          f"model; accepted: at most {INT64_BITS} bits (use fewer input, "
                          f"coefficient or datapath bits)")
 
-
-def check_width(value, name: str, lo: int, hi: int) -> int:
-    """Validate a bit width given by the user: an integer in ``[lo, hi]``.
-
-    >>> check_width(12, "in_bits", 1, 31)
-    12
-    >>> check_width(40, "in_bits", 1, 31)
-    Traceback (most recent call last):
-    ...
-    ValueError: in_bits = 40 is out of range; accepted: 1 <= in_bits <= 31
-    """
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
-    if not lo <= int(value) <= hi:
-        raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
-    return int(value)

@@ -37,7 +37,7 @@ import numpy as np
 import sympy as sp
 
 from chebnorm.approx import CoefficientTable, parse_number, quantize
-from chebnorm.approx.textsafe import identifier
+from chebnorm.core.textsafe import identifier
 
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)

@@ -38,7 +38,8 @@ import numpy as np
 
 from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise import PiecewiseTable
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.numeric import float_up
+from chebnorm.core.textsafe import comment_text, identifier
 
 from .fixed import (
     QFormat,
@@ -148,8 +149,8 @@ class PiecewiseDesign:
         approx = Fraction(self.table.abs_error_bound)
         total = approx + sum(steps, Fraction(0)) + out
         return {"approximation": self.table.abs_error_bound,
-                "horner_rounding": _up(sum(steps, Fraction(0))), "output_rounding": _up(out),
-                "total": _up(total), "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
+                "horner_rounding": float_up(sum(steps, Fraction(0))), "output_rounding": float_up(out),
+                "total": float_up(total), "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
 
     def measure(self, codes=None) -> dict:
         """Exact ``max |y - f(x)|`` over ``codes`` (default all), f at 40 digits."""
@@ -176,13 +177,6 @@ def _exact(text: str) -> Fraction:
         raise ValueError(f"interval endpoint {text!r} is not rational; accepted for hardware: "
                          f"a rational endpoint (the input code maps onto [lo, hi) exactly)")
     return Fraction(int(v.p), int(v.q))
-
-
-def _up(x: Fraction) -> float:
-    f = float(x)
-    while Fraction(f) < x:
-        f = math.nextafter(f, math.inf)
-    return f
 
 
 def _run(d, k, fa, fy) -> dict:
@@ -414,7 +408,7 @@ def simulate_piecewise(d: PiecewiseDesign, directory):
     """Write the outputs into ``directory`` and run the bench in Icarus Verilog."""
     from pathlib import Path
 
-    from chebnorm.approx.files import write_folder
+    from chebnorm.core.files import write_folder
 
     write_folder(Path(directory), piecewise_outputs(d))
     return simulate(directory, d)

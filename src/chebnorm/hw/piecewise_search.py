@@ -27,9 +27,9 @@ import math
 import threading
 from dataclasses import dataclass, replace
 
-from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
+from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.approx.piecewise import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE, fit_piecewise
-from chebnorm.approx.textsafe import csv_cell
+from chebnorm.core.textsafe import csv_cell
 
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
@@ -227,7 +227,7 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
-    Dask ``scheduler`` (:func:`chebnorm.approx.parallel.map_ordered`). The
+    Dask ``scheduler`` (:func:`chebnorm.core.parallel.map_ordered`). The
     candidates evaluated, and so the result and its CSV, do not depend on which.
 
     >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2), max_index_bits=4,

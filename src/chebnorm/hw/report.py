@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import write_folder
+from chebnorm.core.files import write_folder
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -225,7 +225,7 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     """Write every file into ``directory`` (created if missing), all or none
-    (:func:`chebnorm.approx.files.write_folder`): nothing is half-written.
+    (:func:`chebnorm.core.files.write_folder`): nothing is half-written.
 
     Examples
     --------

@@ -14,7 +14,7 @@ import shutil
 from dataclasses import dataclass
 
 from chebnorm.approx import fit_target, get_target
-from chebnorm.approx.parallel import check_scheduler, check_workers, map_ordered
+from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -208,7 +208,7 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     Degree-1 designs have no intermediate accumulator, so ``acc_bits`` does
     not apply to them (one point per coefficient width).  The designs run on
     ``workers`` local processes (default: the core count) or on a Dask
-    ``scheduler`` (:func:`chebnorm.approx.parallel.map_ordered`); the result is
+    ``scheduler`` (:func:`chebnorm.core.parallel.map_ordered`); the result is
     the same whatever runs it.
 
     Examples

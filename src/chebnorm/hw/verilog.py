@@ -25,7 +25,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.textsafe import comment_text, identifier
 
 from .hdltext import bench_verdict, round_lines, saturating_output, signed_literal
 from .horner import HornerDesign
@@ -47,7 +47,7 @@ def _vectors_name(name: str, vectors: str | None) -> str:
 
 def _banner(design: HornerDesign, version: str, command: str | None, budget=None) -> list[str]:
     """The header comment. Text from the table, the version and the command
-    line goes through :func:`~chebnorm.approx.textsafe.comment_text` (no line
+    line goes through :func:`~chebnorm.core.textsafe.comment_text` (no line
     break, no backslash, no ``*/``, no backquote directive can start a line:
     every line starts with ``//``); names through ``identifier``."""
     t = design.table

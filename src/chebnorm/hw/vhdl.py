@@ -34,7 +34,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from chebnorm.approx.textsafe import comment_text, identifier
+from chebnorm.core.textsafe import comment_text, identifier
 
 from .horner import HornerDesign
 from .verilog import SimResult, pipelined_name

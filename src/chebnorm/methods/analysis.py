@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from chebnorm.approx.parallel import map_ordered
+from chebnorm.core.parallel import map_ordered
 
 from . import detmath
 from .counting import OpCounts, _generic_pair, count_ops
@@ -243,7 +243,7 @@ def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np
     ``max(psis)``, else the degree-2 tables fitted for ``psi_max = max(psis)``.
 
     ``workers``, ``scheduler``: the (method, dtype, m) cells run on local processes or
-    a Dask scheduler (:func:`chebnorm.approx.parallel.map_ordered`; default: here);
+    a Dask scheduler (:func:`chebnorm.core.parallel.map_ordered`; default: here);
     the result is the same.
 
     >>> s = error_sweep(("none",), [0.2], (4,), (np.float64,))

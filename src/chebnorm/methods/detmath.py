@@ -48,7 +48,7 @@ import math
 import mpmath
 import numpy as np
 
-from chebnorm.approx import clib
+from chebnorm.core import clib
 
 __all__ = ["sin", "cos", "arccos", "arctan2", "power", "log2", "powers"]
 
@@ -158,7 +158,7 @@ def power(x, y: float) -> np.ndarray:
     """``x ** y`` (float64, ``y`` a real scalar) as numpy's ``**`` computes it where its
     float64 power loop is the C library's ``pow`` (x86-64 without AVX-512): ``y`` = 2,
     0.5, -1, 1, 0 by ``square``, ``sqrt``, ``reciprocal``, a copy and ones (correctly
-    rounded), any other ``y`` by ``pow`` element by element (:func:`chebnorm.approx.clib.power`).
+    rounded), any other ``y`` by ``pow`` element by element (:func:`chebnorm.core.clib.power`).
 
     Examples
     --------

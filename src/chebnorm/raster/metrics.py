@@ -164,8 +164,8 @@ def image_format(path) -> str:
 def write_image(path, array) -> None:
     """Write a uint8 image ``(H, W)`` or ``(H, W, 3)`` in the format its
     extension names (:data:`IMAGE_FORMATS`), atomically and with mode 0644
-    (:func:`chebnorm.approx.files.write_atomic`)."""
-    from chebnorm.approx.files import write_atomic
+    (:func:`chebnorm.core.files.write_atomic`)."""
+    from chebnorm.core.files import write_atomic
 
     data = image_bytes(array, image_format(path))
     write_atomic(path, data)

@@ -207,7 +207,7 @@ def write_bump_figures(cases, directory) -> list[str]:
     ...     [os.path.basename(p) for p in write_bump_figures(cases, d)]
     ['bump_square_full.png', 'bump_square_square.png', 'bump_square_object.png', 'bump_square_square_error.png', 'bump_square_object_error.png']
     """
-    from chebnorm.approx.files import make_folder
+    from chebnorm.core.files import make_folder
 
     directory = os.fspath(make_folder(directory))
     scale = max([1.0] + [float(np.abs(c.images[key]).max()) for c in cases
@@ -312,8 +312,8 @@ class RenderSweep:
 
     def csv(self) -> str:
         """The rows as CSV text: a header line, then one line per row (text
-        fields through :func:`chebnorm.approx.textsafe.csv_cell`)."""
-        from chebnorm.approx.textsafe import csv_cell
+        fields through :func:`chebnorm.core.textsafe.csv_cell`)."""
+        from chebnorm.core.textsafe import csv_cell
 
         lines = [",".join(RENDER_SWEEP_COLUMNS)]
         lines += [",".join(csv_cell(v) for v in r.cells()) for r in self.rows]
@@ -445,7 +445,7 @@ def render_sweep(cases, *, half_vector: str = "pixel", eta_threshold: float = 0.
 
     Each case is one parallel item: on ``workers`` local processes (default: the
     core count; 1: here) or a Dask ``scheduler``
-    (:func:`chebnorm.approx.parallel.map_ordered`); the rows, and so the CSV, are
+    (:func:`chebnorm.core.parallel.map_ordered`); the rows, and so the CSV, are
     the same whatever runs them. ``on_row(index, row)`` sees each row as it
     finishes (``index`` into ``cases``), so a caller can keep finished rows when
     interrupted. ``half_vector``, ``eta_threshold``, ``q``, ``engine``: as
@@ -459,7 +459,7 @@ def render_sweep(cases, *, half_vector: str = "pixel", eta_threshold: float = 0.
     >>> sweep.csv().splitlines()[0].startswith("mesh,tess,width,height,shininess")
     True
     """
-    from chebnorm.approx.parallel import map_ordered
+    from chebnorm.core.parallel import map_ordered
 
     from .meshes import MESH_NAMES
     from .render import _check_options

@@ -25,7 +25,7 @@ from types import MappingProxyType
 import numpy as np
 
 from chebnorm.approx.method_registry import TableSpec, unit_tables
-from chebnorm.approx.textsafe import identifier
+from chebnorm.core.textsafe import identifier
 
 from ..cost import Block
 from ..horner import HornerDesign

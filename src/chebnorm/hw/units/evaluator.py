@@ -11,7 +11,7 @@ from __future__ import annotations
 from abc import abstractmethod
 
 from chebnorm.approx import CoefficientTable, fit_target
-from chebnorm.approx.textsafe import identifier
+from chebnorm.core.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
 from ..horner import HornerDesign, design_horner

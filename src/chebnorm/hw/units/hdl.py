@@ -3,7 +3,7 @@ restoring square root."""
 
 from __future__ import annotations
 
-from chebnorm.approx.textsafe import comment_text
+from chebnorm.core.textsafe import comment_text
 
 from .base import UnitDesign
 
@@ -21,7 +21,7 @@ def banner(unit: UnitDesign, version: str, command: str | None, what: list[str])
     """Comment lines heading the unit: ``what`` (its description), the tool,
     the command, the component format, the evaluator's table and the notes.
     Text a user controls (command, table expression and interval) goes through
-    :func:`~chebnorm.approx.textsafe.comment_text`.
+    :func:`~chebnorm.core.textsafe.comment_text`.
 
     Examples
     --------

@@ -24,7 +24,7 @@
 >>> write_atomic(folder, "x")
 Traceback (most recent call last):
 ...
-chebnorm.approx.files.WriteError: cannot write '...': it is a directory
+chebnorm.core.files.WriteError: cannot write '...': it is a directory
 """
 
 from __future__ import annotations

@@ -1,0 +1,22 @@
+"""Stage 0, the floor: what every stage may import and none may hold alone.
+
+* :mod:`chebnorm.core.files`     -- atomic writes (``write_atomic``,
+  ``write_all``, ``write_folder``); ``-o`` through devices, FIFOs, symlinks.
+* :mod:`chebnorm.core.parallel`  -- ``map_ordered``: a process pool whose
+  results come back in input order (byte-identical to one worker).
+* :mod:`chebnorm.core.textsafe`  -- identifiers, comments and CSV cells that
+  cannot inject text into generated C, HDL, shaders or tables.
+* :mod:`chebnorm.core.clib`      -- float64 ``exp``/``log``/``pow``/trig from
+  the C library element by element (numpy's SIMD ufuncs differ per CPU).
+* :mod:`chebnorm.core.detlinalg` -- linear solves and products in a fixed
+  order (BLAS and LAPACK kernels differ per CPU).
+* :mod:`chebnorm.core.numeric`   -- small exact helpers written once: floats
+  rounded up or down from a rational or a ball, two's-complement widths,
+  integer argument checks, a scoped Arb working precision.
+
+This stage imports no other stage of chebnorm.
+"""
+
+from . import clib, detlinalg, files, numeric, parallel, textsafe
+
+__all__ = ["clib", "detlinalg", "files", "numeric", "parallel", "textsafe"]

@@ -1,0 +1,151 @@
+"""Small exact helpers that several stages need, written once.
+
+Floats rounded outward from exact values (a bound printed as a float must not
+be below the proved rational or ball it stands for), two's-complement
+widths, the integer argument check every width and degree goes through, and
+a scoped Arb working precision (``flint.ctx.prec`` is process-global, so a
+function that raises it must restore it on every exit).
+
+>>> from fractions import Fraction
+>>> float_up(Fraction(1, 3)) >= Fraction(1, 3) >= float_down(Fraction(1, 3))
+True
+>>> signed_bits(-4, 3), unsigned_bits(256)
+(3, 9)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from fractions import Fraction
+
+import numpy as np
+
+__all__ = ["float_up", "float_down", "ball_float_up", "ball_float_down", "signed_bits",
+           "unsigned_bits", "check_int", "arb_precision"]
+
+
+def float_up(x: Fraction) -> float:
+    """The smallest float64 ``>= x`` (``x`` a rational, or an int or float).
+
+    >>> float_up(Fraction(1, 10)) == math.nextafter(0.1, 1.0) or float_up(Fraction(1, 10)) == 0.1
+    True
+    >>> Fraction(float_up(Fraction(1, 10))) >= Fraction(1, 10)
+    True
+    """
+    x = Fraction(x)
+    f = float(x)
+    while Fraction(f) < x:
+        f = math.nextafter(f, math.inf)
+    return f
+
+
+def float_down(x: Fraction) -> float:
+    """The largest float64 ``<= x``.
+
+    >>> Fraction(float_down(Fraction(1, 10))) <= Fraction(1, 10)
+    True
+    """
+    x = Fraction(x)
+    f = float(x)
+    while Fraction(f) > x:
+        f = math.nextafter(f, -math.inf)
+    return f
+
+
+def ball_float_up(x) -> float:
+    """The smallest float64 ``>=`` every point of the Arb ball ``x``.
+
+    >>> from flint import arb
+    >>> ball_float_up(arb(1) / 3) >= 1 / 3
+    True
+    """
+    from flint import arb
+
+    u = x.upper()
+    f = float(u)
+    while arb(f) < u:
+        f = math.nextafter(f, math.inf)
+    return f
+
+
+def ball_float_down(x) -> float:
+    """The largest float64 ``<=`` every point of the Arb ball ``x``.
+
+    >>> from flint import arb
+    >>> ball_float_down(arb(1) / 3) <= 1 / 3
+    True
+    """
+    from flint import arb
+
+    lo = x.lower()
+    f = float(lo)
+    while arb(f) > lo:
+        f = math.nextafter(f, -math.inf)
+    return f
+
+
+def signed_bits(lo: int, hi: int) -> int:
+    """Smallest two's-complement width holding every integer of ``[lo, hi]``.
+
+    >>> signed_bits(-4, 3), signed_bits(0, 4), signed_bits(-5, 0)
+    (3, 4, 4)
+    """
+    n = 1
+    while not (-(1 << (n - 1)) <= lo and hi <= (1 << (n - 1)) - 1):
+        n += 1
+    return n
+
+
+def unsigned_bits(hi: int) -> int:
+    """Smallest unsigned width holding ``0..hi`` (at least 1).
+
+    >>> unsigned_bits(0), unsigned_bits(255), unsigned_bits(256)
+    (1, 8, 9)
+    """
+    return max(1, int(hi).bit_length())
+
+
+def check_int(value, name: str, lo: int, hi: int) -> int:
+    """``value`` as an int when it is an integer (not a bool) in ``[lo, hi]``;
+    otherwise a ValueError naming ``name`` and the accepted range.
+
+    >>> check_int(12, "in_bits", 1, 31)
+    12
+    >>> check_int(40, "in_bits", 1, 31)
+    Traceback (most recent call last):
+    ...
+    ValueError: in_bits = 40 is out of range; accepted: 1 <= in_bits <= 31
+    >>> check_int(2.0, "degree", 0, 30)
+    Traceback (most recent call last):
+    ...
+    ValueError: degree 2.0 is not an integer; accepted: 0 <= degree <= 30
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} {value!r} is not an integer; accepted: {lo} <= {name} <= {hi}")
+    if not lo <= int(value) <= hi:
+        raise ValueError(f"{name} = {value} is out of range; accepted: {lo} <= {name} <= {hi}")
+    return int(value)
+
+
+@contextlib.contextmanager
+def arb_precision(prec: int):
+    """Run a block at Arb working precision ``prec`` bits, restoring the
+    previous ``flint.ctx.prec`` on every exit (return, exception).
+
+    >>> from flint import ctx
+    >>> before = ctx.prec
+    >>> with arb_precision(200):
+    ...     ctx.prec
+    200
+    >>> ctx.prec == before
+    True
+    """
+    from flint import ctx
+
+    old = ctx.prec
+    try:
+        ctx.prec = prec
+        yield
+    finally:
+        ctx.prec = old
