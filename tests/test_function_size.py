@@ -1,11 +1,14 @@
-"""No function in src/ reaches 100 lines (issue 12: a function that long hides
-switches and duplicated cases). Measured with ast: ``end_lineno - lineno + 1``,
+"""Functions of 100 lines or more in src/ are reported for review (issue 12: a
+function that long often hides switches and duplicated cases), as a warning,
+not a failure (issue 27: a hard limit got functions split to pass a number,
+not along the problem). Measured with ast: ``end_lineno - lineno + 1``,
 decorators excluded, nested functions counted on their own and inside their
-parent. One test per module, so a failure names the file."""
+parent. One test per module, so a warning names the file."""
 
 from __future__ import annotations
 
 import ast
+import warnings
 from pathlib import Path
 
 import pytest
@@ -36,5 +39,9 @@ def test_every_module_is_found():
 
 
 @pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(SRC)))
-def test_functions_under_100_lines(path):
-    assert long_functions(path) == [], f"{path.relative_to(SRC)}: functions of 100+ lines"
+def test_long_functions_are_reported(path):
+    """A warning for review (``pytest -rw`` lists them), never a failure."""
+    long = long_functions(path)
+    if long:
+        warnings.warn(f"{path.relative_to(SRC)}: functions of 100+ lines, for review: "
+                      + ", ".join(f"{name}: {n}" for name, n in long), UserWarning, stacklevel=1)
