@@ -288,7 +288,7 @@ INJECTIONS = [
     ("src/chebnorm/hw/fixed.py", "class K:\n    def f(self):\n        import chebnorm.methods\n",
      "chebnorm.methods"),
     ("src/chebnorm/symbolic/symbols.py", "from chebnorm.approx import fit", "chebnorm.approx.fit"),
-    ("src/chebnorm/approx/files.py", "from ..symbolic import _algebra", "chebnorm.symbolic._algebra"),
+    ("src/chebnorm/approx/targets.py", "from ..symbolic import _algebra", "chebnorm.symbolic._algebra"),
     ("src/chebnorm/raster/spans.py", "from chebnorm.hw import fixed", "chebnorm.hw.fixed"),
     ("src/chebnorm/raster/spans.py", "from chebnorm import fit", "chebnorm.fit"),
     ("src/chebnorm/methods/ops.py", "import paper_repro.style", "paper_repro"),

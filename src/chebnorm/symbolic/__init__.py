@@ -47,7 +47,7 @@ True
 """
 
 from . import symbols
-from ._checks import DOT_ATOL, UNIT_RTOL
+from .checks import DOT_ATOL, UNIT_RTOL
 from .bump import (
     bump_coefficients,
     bump_coefficients_expr,

@@ -10,7 +10,7 @@ Derivation (:func:`bump_coefficients_expr`): ``P_u, P_v`` are generic symbolic
 3-vectors; ``|N|`` and ``|P_u|`` are kept as the positive symbols
 ``PuxPv_norm`` and ``Pu_norm``, and each coefficient is rewritten modulo
 ``PuxPv_norm^2 = N.N``, ``Pu_norm^2 = P_u.P_u``, ``Pu_dot_Pv = P_u.P_v``
-(exact Groebner normal forms, see :mod:`chebnorm.symbolic._algebra`).  This
+(exact Groebner normal forms, see :mod:`chebnorm.symbolic.algebra`).  This
 gives, in terms of the three invariants,
 
     ``a = -F_u |P_u x P_v| / |P_u|``,
@@ -36,8 +36,8 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from . import _checks
-from ._algebra import reduce_modulo, vector
+from . import checks
+from .algebra import reduce_modulo, vector
 from .symbols import F_u, F_v, Pu_dot_Pv, Pu_norm, PuxPv_norm, k
 
 __all__ = [
@@ -153,24 +153,24 @@ def bump_coefficients(P_u, P_v, F_u, F_v) -> np.ndarray:
     array([-1. , -0.5,  4. ])
     """
     func = "bump_coefficients"
-    pu, pu_len = _checks.nonzero_vectors(P_u, "P_u", func)
-    pv, pv_len = _checks.nonzero_vectors(P_v, "P_v", func)
-    pu, pv = _checks.broadcast(func, "P_u and P_v", pu, pv)
-    fu = _checks.real_array(F_u, "F_u", func)
-    fv = _checks.real_array(F_v, "F_v", func)
+    pu, pu_len = checks.nonzero_vectors(P_u, "P_u", func)
+    pv, pv_len = checks.nonzero_vectors(P_v, "P_v", func)
+    pu, pv = checks.broadcast(func, "P_u and P_v", pu, pv)
+    fu = checks.real_array(F_u, "F_u", func)
+    fv = checks.real_array(F_v, "F_v", func)
     cross = np.cross(pu, pv)
     cross_len = np.linalg.norm(cross, axis=-1)
     bad = cross_len <= np.finfo(float).eps * pu_len * pv_len
     if bad.any():
         raise ValueError(
-            f"{func}: P_u and P_v are parallel{_checks.where_text(bad)}: "
+            f"{func}: P_u and P_v are parallel{checks.where_text(bad)}: "
             f"|P_u x P_v| = {cross_len[bad].flat[0]!r} must exceed "
             f"eps |P_u| |P_v| (there is no surface normal)"
         )
-    shape = _checks.broadcast(
+    shape = checks.broadcast(
         func, "F_u, F_v and the leading shape of P_u, P_v", fu, fv, cross_len
     )[0].shape
-    values = _kernel()(fu, fv, np.linalg.norm(pu, axis=-1), cross_len, _checks.dot(pu, pv))
+    values = _kernel()(fu, fv, np.linalg.norm(pu, axis=-1), cross_len, checks.dot(pu, pv))
     return _stack(values, shape)
 
 
@@ -185,13 +185,13 @@ def bump_coefficients_square(F_u, F_v, k) -> np.ndarray:
     array([-0.25 , -0.125,  1.   ])
     """
     func = "bump_coefficients_square"
-    fu = _checks.real_array(F_u, "F_u", func)
-    fv = _checks.real_array(F_v, "F_v", func)
-    kk = _checks.real_array(k, "k", func)
+    fu = checks.real_array(F_u, "F_u", func)
+    fv = checks.real_array(F_v, "F_v", func)
+    kk = checks.real_array(k, "k", func)
     bad = kk <= 0
     if bad.any():
         raise ValueError(
-            f"{func}: k must lie in (0, inf); got {kk[bad].flat[0]!r}{_checks.where_text(bad)}"
+            f"{func}: k must lie in (0, inf); got {kk[bad].flat[0]!r}{checks.where_text(bad)}"
         )
-    shape = _checks.broadcast(func, "F_u, F_v and k", fu, fv, kk)[0].shape
+    shape = checks.broadcast(func, "F_u, F_v and k", fu, fv, kk)[0].shape
     return _stack(_square_kernel()(fu, fv, kk), shape)

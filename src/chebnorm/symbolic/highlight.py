@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from . import _checks
-from ._algebra import reduce_modulo, vector
+from . import checks
+from .algebra import reduce_modulo, vector
 from .interpolation import norm2_linear_expr
 from .symbols import a, b, c, t
 
@@ -43,7 +43,7 @@ __all__ = [
     "edge_highlight", "edge_highlight_unclipped", "GRAM_ATOL",
 ]
 
-GRAM_ATOL = 12 * _checks.DOT_ATOL
+GRAM_ATOL = 12 * checks.DOT_ATOL
 """Slack on the Gram determinant ``1 + 2abc - a^2 - b^2 - c^2 >= 0`` of
 ``H, N_A, N_B``: each partial derivative is at most 4 in size on
 ``[-1, 1]^3``, so ``DOT_ATOL`` of error in each of ``a, b, c`` moves it by at
@@ -126,18 +126,18 @@ def _kernels():
 
 
 def _validate(a, b, c, func: str):
-    aa = _checks.cosine(a, "a = H.N_A", func)
-    bb = _checks.cosine(b, "b = H.N_B", func)
-    cc = _checks.cosine(c, "c = N_A.N_B", func)
-    aa, bb, cc = _checks.broadcast(func, "a, b and c", aa, bb, cc)
-    _checks.not_antiparallel(cc, "N_A and N_B", func)
+    aa = checks.cosine(a, "a = H.N_A", func)
+    bb = checks.cosine(b, "b = H.N_B", func)
+    cc = checks.cosine(c, "c = N_A.N_B", func)
+    aa, bb, cc = checks.broadcast(func, "a, b and c", aa, bb, cc)
+    checks.not_antiparallel(cc, "N_A and N_B", func)
     gram = 1 + 2 * aa * bb * cc - aa**2 - bb**2 - cc**2
     bad = gram < -GRAM_ATOL
     if bad.any():
         raise ValueError(
             f"{func}: a, b, c are not the dot products of three unit vectors "
             f"H, N_A, N_B: their Gram determinant 1 + 2abc - a^2 - b^2 - c^2 = "
-            f"{gram[bad].flat[0]!r}{_checks.where_text(bad)} must be >= "
+            f"{gram[bad].flat[0]!r}{checks.where_text(bad)} must be >= "
             f"-GRAM_ATOL = {-GRAM_ATOL:g}"
         )
     return aa, bb, cc
@@ -165,7 +165,7 @@ def edge_highlight(a, b, c) -> EdgeHighlight:
     """
     aa, bb, cc = _validate(a, b, c, "edge_highlight")
     t_kernel, value_kernel, h_kernel = _kernels()
-    parallel = 1 - cc <= _checks.DOT_ATOL
+    parallel = 1 - cc <= checks.DOT_ATOL
     rising = (aa + bb > 0) & ~parallel
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t_star = np.asarray(t_kernel(aa, bb, cc), dtype=float)
@@ -176,7 +176,7 @@ def edge_highlight(a, b, c) -> EdgeHighlight:
     at_clipped = np.asarray(h_kernel(t_clipped, aa, bb, cc), dtype=float)
     value = np.where(interior, peak, at_clipped)
     return EdgeHighlight(
-        t=_checks.scalar_or_array(t_clipped), value=_checks.scalar_or_array(value)
+        t=checks.scalar_or_array(t_clipped), value=checks.scalar_or_array(value)
     )
 
 
@@ -197,12 +197,12 @@ def edge_highlight_unclipped(a, b, c) -> EdgeHighlight:
     """
     aa, bb, cc = _validate(a, b, c, "edge_highlight_unclipped")
     t_kernel, value_kernel, _ = _kernels()
-    parallel = 1 - cc <= _checks.DOT_ATOL
+    parallel = 1 - cc <= checks.DOT_ATOL
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t_star = np.asarray(t_kernel(aa, bb, cc), dtype=float)
         peak = np.asarray(value_kernel(aa, bb, cc), dtype=float)
     t_star = np.where(parallel | (aa + bb == 0), np.nan, t_star)
     peak = np.where(parallel, np.nan, peak)
     return EdgeHighlight(
-        t=_checks.scalar_or_array(t_star), value=_checks.scalar_or_array(peak)
+        t=checks.scalar_or_array(t_star), value=checks.scalar_or_array(peak)
     )

@@ -9,7 +9,7 @@ derivations are cached), and exposed twice:
 * a numpy function evaluates it.  Scalar closed forms are evaluated by
   ``sympy.lambdify`` of the derived expression; vector results are assembled
   from lambdified scalar factors.  The numpy functions validate their input
-  (see :mod:`chebnorm.symbolic._checks` for the tolerances) and return a numpy
+  (see :mod:`chebnorm.symbolic.checks` for the tolerances) and return a numpy
   scalar for scalar input, an array otherwise.
 
 Derivations
@@ -41,8 +41,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from . import _checks
-from ._algebra import reduce_modulo, vector
+from . import checks
+from .algebra import reduce_modulo, vector
 from .symbols import N_c, N_l, N_r, c, c_ab, c_ac, c_bc, n, phi, t
 
 __all__ = [
@@ -95,11 +95,11 @@ def norm2_linear_np(t, c):
     0.500
     """
     func = "norm2_linear_np"
-    tt = _checks.real_array(t, "t", func)
-    cc = _checks.cosine(c, "c", func)
-    tt, cc = _checks.broadcast(func, "t and c", tt, cc)
+    tt = checks.real_array(t, "t", func)
+    cc = checks.cosine(c, "c", func)
+    tt, cc = checks.broadcast(func, "t and c", tt, cc)
     out = np.asarray(_norm2_linear_kernel()(tt, cc), dtype=float)
-    return _checks.scalar_or_array(np.broadcast_to(out, tt.shape).copy())
+    return checks.scalar_or_array(np.broadcast_to(out, tt.shape).copy())
 
 
 # ------------------------------------------------------ 2. midpoint normal
@@ -148,11 +148,11 @@ def midpoint_normal(na, nb) -> np.ndarray:
     [0.707107 0.707107 0.      ]
     """
     func = "midpoint_normal"
-    a = _checks.unit_vectors(na, "na", func)
-    b = _checks.unit_vectors(nb, "nb", func)
-    a, b = _checks.broadcast(func, "na and nb", a, b)
-    cc = _checks.dot(a, b)
-    _checks.not_antiparallel(cc, "na and nb", func)
+    a = checks.unit_vectors(na, "na", func)
+    b = checks.unit_vectors(nb, "nb", func)
+    a, b = checks.broadcast(func, "na and nb", a, b)
+    cc = checks.dot(a, b)
+    checks.not_antiparallel(cc, "na and nb", func)
     scale = np.asarray(_midpoint_scale_kernel()(cc), dtype=float)
     return (a + b) * scale[..., None]
 
@@ -231,7 +231,7 @@ def _delta_d_kernel():
 
 
 def _check_phi(x, func: str) -> np.ndarray:
-    return _checks.in_range(x, "phi", func, 0.0, np.pi, "[0, pi] (radians)")
+    return checks.in_range(x, "phi", func, 0.0, np.pi, "[0, pi] (radians)")
 
 
 def delta_d(phi):
@@ -246,7 +246,7 @@ def delta_d(phi):
     0.0049958
     """
     x = _check_phi(phi, "delta_d")
-    return _checks.scalar_or_array(np.asarray(_delta_d_kernel()(x), dtype=float))
+    return checks.scalar_or_array(np.asarray(_delta_d_kernel()(x), dtype=float))
 
 
 # ----------------------------------------------------------- 4. delta_s
@@ -278,10 +278,10 @@ def delta_s(phi, n):
     """
     func = "delta_s"
     x = _check_phi(phi, func)
-    m = _checks.in_range(n, "n", func, 0.0, np.inf, "[0, inf)")
-    x, m = _checks.broadcast(func, "phi and n", x, m)
+    m = checks.in_range(n, "n", func, 0.0, np.inf, "[0, inf)")
+    x, m = checks.broadcast(func, "phi and n", x, m)
     out = np.asarray(_delta_s_kernel()(x, m), dtype=float)
-    return _checks.scalar_or_array(out)
+    return checks.scalar_or_array(out)
 
 
 # ---------------------------------------------------------------- 5. eta
@@ -331,12 +331,12 @@ def eta(na, nb, nc):
     0.000
     """
     func = "eta"
-    va = _checks.unit_vectors(na, "na", func)
-    vb = _checks.unit_vectors(nb, "nb", func)
-    vc = _checks.unit_vectors(nc, "nc", func)
-    va, vb, vc = _checks.broadcast(func, "na, nb and nc", va, vb, vc)
-    cos = [np.clip(_checks.dot(x, y), -1.0, 1.0) for x, y in ((va, vb), (vb, vc), (va, vc))]
-    return _checks.scalar_or_array(np.asarray(_eta_kernel()(*cos), dtype=float))
+    va = checks.unit_vectors(na, "na", func)
+    vb = checks.unit_vectors(nb, "nb", func)
+    vc = checks.unit_vectors(nc, "nc", func)
+    va, vb, vc = checks.broadcast(func, "na, nb and nc", va, vb, vc)
+    cos = [np.clip(checks.dot(x, y), -1.0, 1.0) for x, y in ((va, vb), (vb, vc), (va, vc))]
+    return checks.scalar_or_array(np.asarray(_eta_kernel()(*cos), dtype=float))
 
 
 # ----------------------------------------------- 7. quadratic interpolation
@@ -425,15 +425,15 @@ def quadratic_coefficients(nl, nr, nc=None) -> QuadraticCoefficients:
     [0.707107 0.707107 0.      ]
     """
     func = "quadratic_coefficients"
-    left = _checks.unit_vectors(nl, "nl", func)
-    right = _checks.unit_vectors(nr, "nr", func)
-    left, right = _checks.broadcast(func, "nl and nr", left, right)
+    left = checks.unit_vectors(nl, "nl", func)
+    right = checks.unit_vectors(nr, "nr", func)
+    left, right = checks.broadcast(func, "nl and nr", left, right)
     if nc is None:
-        _checks.not_antiparallel(_checks.dot(left, right), "nl and nr", func)
+        checks.not_antiparallel(checks.dot(left, right), "nl and nr", func)
         centre = midpoint_normal(left, right)
     else:
-        centre = _checks.vectors(nc, "nc", func)
-    left, centre, right = _checks.broadcast(func, "nl, nc and nr", left, centre, right)
+        centre = checks.vectors(nc, "nc", func)
+    left, centre, right = checks.broadcast(func, "nl, nc and nr", left, centre, right)
     shape = left.shape
     gg, pp, qq = (
         np.broadcast_to(np.asarray(k(left, centre, right), dtype=float), shape).copy()
