@@ -19,7 +19,7 @@ pytest.importorskip("numpydoc", reason="numpydoc not installed (pip install -e '
 pytest.importorskip("myst_nb", reason="myst-nb not installed (pip install -e '.[docs]')")
 
 REPO = Path(__file__).resolve().parent.parent
-STAGES = ["chebnorm.symbolic", "chebnorm.approx", "chebnorm.export", "chebnorm.methods",
+STAGES = ["chebnorm.core", "chebnorm.symbolic", "chebnorm.approx", "chebnorm.export", "chebnorm.methods",
           "chebnorm.hw", "chebnorm.raster"]
 
 
