@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from chebnorm.approx import fit, fit_target
-from chebnorm.export import FORMATS, c_header, export_table
+from chebnorm.export import EXPORT_FORMATS, FORMATS, c_header, export_table
 
 GCC = shutil.which("gcc")
 needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc is not installed (apt-get install gcc)")
@@ -105,11 +105,15 @@ class TestText:
 
     def test_formats_and_atomic_write(self, tmp_path):
         t = fit_target("eta_term", 1)
-        assert sorted(FORMATS) == ["c", "glsl", "hlsl", "json", "wgsl"]  # vhdl: the CLI asks hw
+        assert sorted(FORMATS) == ["c", "glsl", "hlsl", "json", "wgsl"]  # need only the table
+        assert EXPORT_FORMATS == ("c", "glsl", "hlsl", "json", "verilog", "vhdl", "wgsl")
         out = tmp_path / "t.json"
         export_table(t, "json", out)
         assert out.read_text() == t.to_json()
-        with pytest.raises(ValueError, match="unknown export format 'vhdl'"):
+        with pytest.raises(ValueError, match="unknown export format 'spirv'"):
+            export_table(t, "spirv", tmp_path / "x")
+        # vhdl is exported here now (issue 27), but only with its widths
+        with pytest.raises(ValueError, match="^format 'vhdl' needs in_bits and out_bits"):
             export_table(t, "vhdl", tmp_path / "x")
         with pytest.raises(ValueError, match="does not exist"):
             export_table(t, "c", tmp_path / "missing" / "x.h")

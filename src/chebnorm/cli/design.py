@@ -106,16 +106,18 @@ def hw_verilog(args) -> int:
     from chebnorm import __version__
     from chebnorm.core.files import write_folder
     from chebnorm.hw.piecewise import piecewise_outputs
-    from chebnorm.hw.verilog import simulate
 
     if getattr(args, "pipelined", False):
         raise ValueError("--pipelined is not available for a piecewise table; accepted: the "
                          "combinational evaluator")
-    if getattr(args, "lang", "verilog") != "verilog":
-        raise ValueError(f"--lang {args.lang} is not available for a piecewise table (its "
-                         f"evaluator is written in Verilog only); accepted: --lang verilog")
+    language = getattr(args, "lang", "verilog")  # VHDL: the same design, simulated by GHDL
+    if language == "vhdl":
+        from chebnorm.hw.vhdl import simulate_vhdl as simulate
+    else:
+        from chebnorm.hw.verilog import simulate
     d = _piecewise_design(args)
-    files = piecewise_outputs(d, version=__version__, command=command_line(args))
+    files = piecewise_outputs(d, version=__version__, command=command_line(args),
+                              language=language)
     out = Path(args.output)
     for path in write_folder(out, dict(sorted(files.items()))):
         print(path)

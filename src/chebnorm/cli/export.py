@@ -1,25 +1,29 @@
 """``chebnorm export TABLE.json --format c|json|glsl|wgsl|hlsl|vhdl|verilog -o FILE``.
 
-The software formats come from :mod:`chebnorm.export`; ``vhdl`` and
-``verilog`` are fixed-point hardware, which the ``export`` stage does not
-know (``export`` and ``hw`` are sibling stages), so the command dispatches
-them to :mod:`chebnorm.hw` with the widths given by ``--in-bits`` and
-``--out-bits``: FILE then holds the combinational evaluator and, for degree
->= 1, the pipelined one (``hw verilog --lang vhdl`` writes the benches too).
+Every format is printed by :mod:`chebnorm.export` (the one place per output
+format); this command reads the table (either kind), refuses flags the
+format does not take (naming the flags), and writes the text atomically.
+``vhdl`` and ``verilog`` are fixed-point hardware sized by ``--in-bits`` and
+``--out-bits``: FILE then holds the combinational evaluator and, for a
+coefficient table of degree >= 1, the pipelined one (``hw verilog`` writes
+the benches too).
 """
 
 from __future__ import annotations
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.export import FORMATS, export_table
+from chebnorm.export import EXPORT_FORMATS, HDL_FORMATS, export_table, options_for
 
 from ._common import command_line, deprecated_alias
 
-HW_FORMATS = ("vhdl", "verilog")
+#: export option -> (argparse dest, flag)
+_FLAGS = {"in_bits": ("in_bits", "--in-bits"), "out_bits": ("out_bits", "--out-bits"),
+          "coef_frac_bits": ("coef_bits", "--coef-frac-bits"),
+          "acc_bits": ("acc_bits", "--acc-bits"), "rounding": ("rounding", "--rounding")}
 
 
 def _all_formats() -> str:
-    return ", ".join(sorted((*FORMATS, *HW_FORMATS)))
+    return ", ".join(EXPORT_FORMATS)
 
 
 def register(sub) -> None:
@@ -42,76 +46,35 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _given(args) -> dict:
+    """The export options whose flags were given (option name -> value)."""
+    return {opt: getattr(args, dest) for opt, (dest, _) in _FLAGS.items()
+            if getattr(args, dest) is not None}
+
+
 def run(args) -> int:
-    if args.format not in FORMATS and args.format not in HW_FORMATS:
+    if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
-    from chebnorm.approx.piecewise import is_piecewise_file
+    from chebnorm.approx.piecewise import PiecewiseTable, is_piecewise_file
 
+    given = _given(args)
     if is_piecewise_file(args.table):
-        return _run_piecewise(args)
-    flags = {"in_bits": "--in-bits", "out_bits": "--out-bits", "coef_bits": "--coef-frac-bits",
-             "acc_bits": "--acc-bits", "rounding": "--rounding"}
-    hw_only = [flag for dest, flag in flags.items() if getattr(args, dest) is not None]
-    if args.format in FORMATS and hw_only:
-        raise ValueError(f"{', '.join(hw_only)} apply to --format vhdl or verilog only, not "
-                         f"{args.format!r}")
-    table = CoefficientTable.load(args.table)
-    if args.format in FORMATS:
-        export_table(table, args.format, args.output, command_line(args))
-        return 0
-    if args.in_bits is None or args.out_bits is None:
+        table = PiecewiseTable.load(args.table)
+        takes = options_for(table, args.format) if args.format in ("c", "json", *HDL_FORMATS) \
+            else ()
+        extra = [_FLAGS[o][1] for o in given if o not in takes]
+        if extra:
+            raise ValueError(f"{', '.join(extra)} does nothing with --format {args.format} of a "
+                             f"piecewise table; accepted there: "
+                             f"{' '.join(_FLAGS[o][1] for o in takes) or 'no width option'}")
+    else:
+        if args.format not in HDL_FORMATS and given:
+            raise ValueError(f"{', '.join(_FLAGS[o][1] for o in given)} apply to --format vhdl "
+                             f"or verilog only, not {args.format!r}")
+        table = CoefficientTable.load(args.table)
+    if args.format in HDL_FORMATS and ("in_bits" not in given or "out_bits" not in given):
+        accepted = "" if isinstance(table, PiecewiseTable) else "; accepted: 1..20 and 1..32"
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
-                         f"output code widths); accepted: 1..20 and 1..32")
-    from chebnorm import __version__
-    from chebnorm.core.files import write_atomic
-    from chebnorm.hw.report import analyze
-
-    report = analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
-                     acc_bits=args.acc_bits, rounding=args.rounding or "rne", gappa=False,
-                     synth=False)
-    d = report.design
-    kw = dict(version=__version__, command=command_line(args), budget=report.budget)
-    if args.format == "vhdl":
-        from chebnorm.hw.vhdl import vhdl_module as comb, vhdl_pipelined_module as pipe
-    else:
-        from chebnorm.hw.verilog import verilog_module as comb, verilog_pipelined_module as pipe
-    text = comb(d, **kw)
-    if d.degree >= 1:
-        text += "\n" + pipe(d, **kw)
-    write_atomic(args.output, text)
-    return 0
-
-
-def _run_piecewise(args) -> int:
-    from chebnorm.core.files import write_atomic
-    from chebnorm.approx.piecewise import PiecewiseTable
-    from chebnorm.export.c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
-
-    table = PiecewiseTable.load(args.table)
-    dests = {"--in-bits": "in_bits", "--out-bits": "out_bits", "--coef-frac-bits": "coef_bits",
-             "--acc-bits": "acc_bits", "--rounding": "rounding"}
-    takes = {"c": ("--in-bits",), "verilog": ("--in-bits", "--out-bits")}.get(args.format, ())
-    given = [flag for flag, dest in dests.items()
-             if getattr(args, dest) is not None and flag not in takes]
-    if given:
-        raise ValueError(f"{', '.join(given)} does nothing with --format {args.format} of a "
-                         f"piecewise table; accepted there: {' '.join(takes) or 'no width option'}")
-    if args.format == "c":
-        in_bits = DEFAULT_C_IN_BITS if args.in_bits is None else args.in_bits
-        text = piecewise_c_header(table, command_line(args), in_bits=in_bits)
-    elif args.format == "json":
-        text = table.to_json()
-    elif args.format == "verilog":
-        from chebnorm import __version__
-        from chebnorm.hw.piecewise import design_piecewise, piecewise_verilog
-
-        if args.in_bits is None or args.out_bits is None:
-            raise ValueError("--format verilog needs --in-bits and --out-bits (input and output "
-                             "code widths)")
-        text = piecewise_verilog(design_piecewise(table, args.in_bits, args.out_bits),
-                                 version=__version__, command=command_line(args))
-    else:
-        raise ValueError(f"format {args.format!r} is not available for a piecewise table; "
-                         f"accepted: c, json, verilog")
-    write_atomic(args.output, text)
+                         f"output code widths){accepted}")
+    export_table(table, args.format, args.output, command_line(args), **given)
     return 0

@@ -50,7 +50,8 @@ def register(sub) -> None:
     _design_args(v)
     v.add_argument("--lang", choices=("verilog", "vhdl"), default="verilog",
                    help="HDL of the module and bench: verilog (default; iverilog) or vhdl "
-                   "(VHDL-2008, numeric_std, bit-identical; ghdl)")
+                   "(VHDL-2008, numeric_std, bit-identical; ghdl); both for coefficient and "
+                   "piecewise tables")
     v.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
     v.add_argument("--simulate", action="store_true",
                    help="also run the test bench in iverilog (ghdl with --lang vhdl)")
@@ -130,10 +131,19 @@ def _analyze(args, synth: bool, gappa: bool):
                    y_frac_bits=args.y_frac_bits, gappa=gappa, synth=synth)
 
 
+def _simulator(language: str):
+    """The runner of ``language``'s benches: Icarus Verilog or GHDL."""
+    if language == "vhdl":
+        from chebnorm.hw.vhdl import simulate_vhdl
+        return simulate_vhdl
+    from chebnorm.hw.verilog import simulate
+    return simulate
+
+
 def run_verilog(args) -> int:
     from chebnorm import __version__
-    from chebnorm.hw.report import verilog_outputs, write_outputs
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.hdl import pipelined_name
+    from chebnorm.hw.report import hdl_outputs, write_outputs
 
     _check_output(args.output)
     from chebnorm.approx.piecewise import is_piecewise_file
@@ -145,18 +155,15 @@ def run_verilog(args) -> int:
     if args.pipelined and report.design.degree < 1:
         raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
                          f"pipeline; accepted: --pipelined with degree >= 1")
-    outputs = verilog_outputs
-    if args.lang == "vhdl":  # the same design as VHDL, simulated by GHDL
-        from chebnorm.hw.vhdl import simulate_vhdl as simulate, vhdl_outputs as outputs
-    files = outputs(report, version=__version__, command=command_line(args),
-                            pipelined=args.pipelined)
+    # --lang vhdl: the same design as VHDL, simulated by GHDL
+    files = hdl_outputs(report, args.lang, version=__version__, command=command_line(args),
+                        pipelined=args.pipelined)
     files[f"{report.design.module_name}_report.json"] = json.dumps(
         report.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
     for path in write_outputs(args.output, files):
         print(path)
     if args.simulate:
-        from chebnorm.hw.verilog import pipelined_name
-
+        simulate = _simulator(args.lang)
         names = [report.design.module_name] + \
             ([pipelined_name(report.design)] if args.pipelined else [])
         ok = True

@@ -1,8 +1,19 @@
-"""Stage 3: printers of a CoefficientTable, one per target format.
+"""Stage 3: the one place that prints a table in an output format.
 
-``FORMATS`` maps a format name to ``(printer, file suffix)``; a printer takes
-the table and the generating command and returns text. Use
-:func:`export_table` to print and write atomically.
+Every format ``chebnorm export`` offers is printed here, for both kinds of
+table (:data:`EXPORT_FORMATS`, :func:`formats_for`):
+
+* a :class:`~chebnorm.approx.CoefficientTable`: ``c``, ``json``, ``glsl``,
+  ``wgsl``, ``hlsl`` (:data:`FORMATS`: printers that need only the table) and
+  ``verilog``, ``vhdl`` (:data:`HDL_FORMATS`: a fixed-point evaluator, sized
+  by ``in_bits`` and ``out_bits``, printed by :mod:`chebnorm.hw.hdl`);
+* a :class:`~chebnorm.approx.piecewise.PiecewiseTable`: ``c``, ``json``,
+  ``verilog``, ``vhdl`` (:data:`PIECEWISE_FORMATS`).
+
+:func:`export_text` prints; :func:`export_table` prints and writes
+atomically; the package itself is callable: ``chebnorm.export(table, fmt,
+**options)`` is :func:`export_text`. The keyword options a format takes are
+:func:`options_for`'s.
 """
 
 from __future__ import annotations
@@ -11,14 +22,17 @@ import sys
 import types
 
 from chebnorm.approx import CoefficientTable
+from chebnorm.approx.piecewise import PiecewiseTable
 from chebnorm.core.files import write_atomic
 
 from .c import c_header, horner_rounding_bound
+from .c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
 from .shader import float32_eval_bound, glsl_source, hlsl_source, shader_source, wgsl_source
 
 
-def json_text(table: CoefficientTable, command: str = "") -> str:
-    """The table's JSON contract (sorted keys, shortest float repr).
+def json_text(table, command: str = "") -> str:
+    """The table's JSON contract (sorted keys, shortest float repr), of
+    either kind of table.
 
     >>> from chebnorm.approx import CoefficientTable, fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z")
@@ -28,21 +42,154 @@ def json_text(table: CoefficientTable, command: str = "") -> str:
     return table.to_json()
 
 
+#: the printers that need only the table: format -> (printer(table, command), file suffix)
 FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json"), "glsl": (glsl_source, ".glsl"),
            "wgsl": (wgsl_source, ".wgsl"), "hlsl": (hlsl_source, ".hlsl")}
+#: the fixed-point hardware formats (``in_bits`` and ``out_bits`` needed): format -> suffix
+HDL_FORMATS = {"verilog": ".v", "vhdl": ".vhd"}
+#: every format ``chebnorm export`` offers (for some kind of table)
+EXPORT_FORMATS = tuple(sorted({*FORMATS, *HDL_FORMATS}))
+#: the formats of a piecewise table
+PIECEWISE_FORMATS = ("c", "json", "verilog", "vhdl")
+#: the keyword options of a Horner evaluator in an HDL
+HDL_OPTIONS = ("in_bits", "out_bits", "coef_frac_bits", "acc_bits", "rounding")
 
-__all__ = ["FORMATS", "c_header", "json_text", "export_text", "export_table",
-           "horner_rounding_bound", "glsl_source", "wgsl_source", "hlsl_source", "shader_source",
-           "float32_eval_bound"]
+__all__ = ["FORMATS", "HDL_FORMATS", "EXPORT_FORMATS", "PIECEWISE_FORMATS", "HDL_OPTIONS",
+           "formats_for", "options_for", "c_header", "json_text", "export_text", "export_table",
+           "hdl_export", "horner_rounding_bound", "glsl_source", "wgsl_source", "hlsl_source",
+           "shader_source", "float32_eval_bound", "piecewise_c_header", "DEFAULT_C_IN_BITS"]
 
 
-def export_text(table: CoefficientTable, fmt: str, command: str = "") -> str:
-    """The text of ``table`` in format ``fmt`` (a key of :data:`FORMATS`).
+def _kind(table) -> str:
+    if isinstance(table, PiecewiseTable):
+        return "piecewise table"
+    if isinstance(table, CoefficientTable):
+        return "coefficient table"
+    raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
+                     f"CoefficientTable or PiecewiseTable (chebnorm.fit, or .load)")
 
-    The package itself is callable with the same arguments, so
-    ``chebnorm.export(table, "c")`` is ``export_text(table, "c")``.
-    Dispatch is by the :data:`FORMATS` table: a new printer is one entry.
 
+def formats_for(table) -> tuple[str, ...]:
+    """The formats ``table`` can be exported in (sorted).
+
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> formats_for(fit("x**2", ("0", "1"), 1))
+    ('c', 'glsl', 'hlsl', 'json', 'verilog', 'vhdl', 'wgsl')
+    >>> formats_for(fit_piecewise("x**2", ("0", "1"), 1, segments=2))
+    ('c', 'json', 'verilog', 'vhdl')
+    """
+    return PIECEWISE_FORMATS if _kind(table) == "piecewise table" else EXPORT_FORMATS
+
+
+def options_for(table, fmt: str) -> tuple[str, ...]:
+    """The keyword options :func:`export_text` takes for ``table`` in ``fmt``
+    (``fmt`` one of :func:`formats_for`'s).
+
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> options_for(fit("x**2", ("0", "1"), 1), "vhdl")
+    ('in_bits', 'out_bits', 'coef_frac_bits', 'acc_bits', 'rounding')
+    >>> pw = fit_piecewise("x**2", ("0", "1"), 1, segments=2)
+    >>> options_for(pw, "c"), options_for(pw, "verilog"), options_for(pw, "json")
+    (('in_bits',), ('in_bits', 'out_bits'), ())
+    """
+    _check_format(table, fmt)
+    if fmt in HDL_FORMATS:
+        return ("in_bits", "out_bits") if isinstance(table, PiecewiseTable) else HDL_OPTIONS
+    return ("in_bits",) if isinstance(table, PiecewiseTable) and fmt == "c" else ()
+
+
+def _check_format(table, fmt) -> str:
+    kind = _kind(table)
+    if not isinstance(fmt, str) or fmt not in EXPORT_FORMATS:
+        raise ValueError(f"unknown export format {str(fmt)[:40]!r}; accepted: "
+                         f"{', '.join(EXPORT_FORMATS)}")
+    accepted = formats_for(table)
+    if fmt not in accepted:
+        raise ValueError(f"format {fmt!r} is not available for a {kind}; accepted: "
+                         f"{', '.join(accepted)}")
+    return fmt
+
+
+def _check_width(value, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{name} = {str(value)[:40]!r} is not an integer; accepted: an int "
+                         f"(a code width in bits)")
+    return value
+
+
+def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bits: int,
+               coef_frac_bits: int | None = None, acc_bits: int | None = None,
+               rounding: str | None = None) -> str:
+    """The fixed-point evaluator of ``table`` in ``language`` (``"verilog"`` or
+    ``"vhdl"``), as ``chebnorm export --format verilog|vhdl`` writes it.
+
+    A :class:`~chebnorm.approx.CoefficientTable` becomes a Horner design
+    (:func:`chebnorm.hw.report.analyze`: sized, checked over every input code,
+    its error budget in the banner): the combinational module and, for degree
+    >= 1, the pipelined one. A :class:`~chebnorm.approx.piecewise.PiecewiseTable`
+    becomes its ROM + Horner design (:func:`chebnorm.hw.piecewise.design_piecewise`;
+    ``coef_frac_bits``, ``acc_bits`` and ``rounding`` do not apply to it).
+
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+    language : {"verilog", "vhdl"}
+    command : str
+        The command line stated in the banner.
+    in_bits, out_bits : int
+        Input and output code widths.
+    coef_frac_bits, acc_bits : int, optional
+        Coefficient and accumulator fractional bits (default: the table's
+        own; output's + 3).
+    rounding : {"rne", "trunc"}, optional
+        After each multiply-add (default ``"rne"``).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> v = hdl_export(fit_target("dichotomy", 1), "vhdl", in_bits=8, out_bits=8, coef_frac_bits=12)
+    >>> [line for line in v.splitlines() if line.startswith("entity")]
+    ['entity chebnorm_dichotomy_d1 is', 'entity chebnorm_dichotomy_d1_pipe is']
+    """
+    from chebnorm import __version__
+    from chebnorm.hw.hdl import check_language, hdl_text
+
+    check_language(language)
+    in_bits, out_bits = _check_width(in_bits, "in_bits"), _check_width(out_bits, "out_bits")
+    if _kind(table) == "piecewise table":
+        extra = [n for n, v in (("coef_frac_bits", coef_frac_bits), ("acc_bits", acc_bits),
+                                ("rounding", rounding)) if v is not None]
+        if extra:
+            raise ValueError(f"{', '.join(extra)} does nothing with a piecewise table; accepted "
+                             f"there: in_bits, out_bits")
+        from chebnorm.hw.piecewise import design_piecewise
+
+        table.verify()
+        return hdl_text(design_piecewise(table, in_bits, out_bits), language,
+                        version=__version__, command=command)
+    from chebnorm.hw.report import analyze
+
+    report = analyze(table, in_bits, out_bits, coef_bits=coef_frac_bits, acc_bits=acc_bits,
+                     rounding="rne" if rounding is None else rounding, gappa=False, synth=False)
+    return hdl_text(report.design, language, version=__version__, command=command,
+                    budget=report.budget)
+
+
+def export_text(table, fmt: str, command: str = "", **options) -> str:
+    """The text of ``table`` in format ``fmt`` (one of :func:`formats_for`).
+
+    ``options`` are the format's keyword options (:func:`options_for`; a
+    ``None`` value is not given): ``in_bits`` and ``out_bits`` (required)
+    and ``coef_frac_bits``, ``acc_bits``, ``rounding`` for ``verilog`` and
+    ``vhdl`` (:func:`hdl_export`); ``in_bits`` for a piecewise table's ``c``
+    (default :data:`DEFAULT_C_IN_BITS`). The package itself is callable with
+    the same arguments: ``chebnorm.export(table, "c")`` is
+    ``export_text(table, "c")``.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="dich")
     >>> "static inline double chebnorm_dich(double" in export_text(t, "c")
@@ -53,23 +200,45 @@ def export_text(table: CoefficientTable, fmt: str, command: str = "") -> str:
     Traceback (most recent call last):
     ...
     ValueError: unknown export format 'pdf'; accepted: c, ...json...
+    >>> export_text(t, "vhdl")
+    Traceback (most recent call last):
+    ...
+    ValueError: format 'vhdl' needs in_bits and out_bits (input and output code widths); ...
+    >>> export_text(t, "glsl", in_bits=8)
+    Traceback (most recent call last):
+    ...
+    ValueError: in_bits does nothing with format 'glsl' of a coefficient table; accepted there: no option
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> pw = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, name="rs")
+    >>> "static inline double chebnorm_rs(uint32_t k)" in export_text(pw, "c", in_bits=12)
+    True
     """
-    from chebnorm.approx.piecewise import PiecewiseTable
-
-    if not isinstance(table, (CoefficientTable, PiecewiseTable)):
-        raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
-                         f"CoefficientTable or PiecewiseTable (chebnorm.fit, or .load)")
-    try:
-        printer, _ = FORMATS[fmt]
-    except (KeyError, TypeError):
-        raise ValueError(f"unknown export format {fmt!r}; accepted: {', '.join(sorted(FORMATS))}") from None
-    if isinstance(table, CoefficientTable):
-        table.verify()  # a comparison, or a re-proof of fields changed since construction
+    kind = _kind(table)
+    accepted = options_for(table, fmt)
+    given = {k: v for k, v in options.items() if v is not None}
+    unknown = [k for k in given if k not in accepted]
+    if unknown:
+        raise ValueError(f"{', '.join(unknown)} does nothing with format {fmt!r} of a {kind}; "
+                         f"accepted there: {', '.join(accepted) or 'no option'}")
+    if fmt in HDL_FORMATS:
+        if "in_bits" not in given or "out_bits" not in given:
+            raise ValueError(f"format {fmt!r} needs in_bits and out_bits (input and output code "
+                             f"widths); accepted: ints, e.g. in_bits=12, out_bits=12")
+        return hdl_export(table, fmt, command, **given)
+    table.verify()  # a comparison, or a re-proof of fields changed since construction
+    if kind == "piecewise table":
+        if fmt == "c":
+            return piecewise_c_header(table, command, in_bits=given.get("in_bits",
+                                                                         DEFAULT_C_IN_BITS))
+        return json_text(table, command)
+    printer, _ = FORMATS[fmt]
     return printer(table, command)
 
 
-def export_table(table: CoefficientTable, fmt: str, path, command: str = "") -> str:
-    """Print ``table`` in format ``fmt`` and write it to ``path`` atomically.
+def export_table(table, fmt: str, path, command: str = "", **options) -> str:
+    """Print ``table`` in format ``fmt`` (:func:`export_text`, with the same
+    ``options``) and write it to ``path`` atomically; nothing is written when
+    printing fails.
 
     >>> import os, tempfile
     >>> from chebnorm.approx import fit
@@ -79,7 +248,7 @@ def export_table(table: CoefficientTable, fmt: str, path, command: str = "") -> 
     ...     open(os.path.join(d, "dich.h")).read() == text
     True
     """
-    text = export_text(table, fmt, command)
+    text = export_text(table, fmt, command, **options)
     write_atomic(path, text)
     return text
 
@@ -87,8 +256,8 @@ def export_table(table: CoefficientTable, fmt: str, path, command: str = "") -> 
 class _CallableModule(types.ModuleType):
     """``chebnorm.export`` is callable: ``chebnorm.export(table, "c")``."""
 
-    def __call__(self, table: CoefficientTable, fmt: str, command: str = "") -> str:
-        return export_text(table, fmt, command)
+    def __call__(self, table, fmt: str, command: str = "", **options) -> str:
+        return export_text(table, fmt, command, **options)
 
 
 sys.modules[__name__].__class__ = _CallableModule

@@ -55,7 +55,7 @@ from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import comment_text, identifier
 
 __all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
-           "range_problem", "underflow_bound"]
+           "range_problem", "underflow_bound", "round_inward", "interval_max_abs"]
 
 # C type, literal suffix, function suffix, unit roundoff
 FLOAT_TYPES = (
@@ -144,8 +144,14 @@ def underflow_bound(n: int, max_t: Fraction, suffix: str, u: float) -> Fraction:
     return eta * (1 + _gamma(2 * n, u)) * sum((max_t ** j for j in range(n)), Fraction(0))
 
 
-def _inward(lo: float, hi: float, suffix: str) -> tuple[float, float]:
-    """``[lo, hi]`` rounded inward to the type of ``suffix``."""
+def round_inward(lo: float, hi: float, suffix: str) -> tuple[float, float]:
+    """``[lo, hi]`` rounded inward to the type of ``suffix`` (``"f"``: float32,
+    every float32 between the results lies in ``[lo, hi]``; otherwise the
+    doubles themselves).
+
+    >>> round_inward(0.1, 0.2, "f")[0] >= 0.1, round_inward(0.1, 0.2, "")
+    (True, (0.1, 0.2))
+    """
     if suffix != "f":
         return lo, hi
     with np.errstate(over="ignore"):
@@ -187,7 +193,7 @@ def _first_overflow(lo: float, hi: float, cs, suffix: str, shift=None, parity=No
     """The smallest input found (on 4097 evenly spread points, then by
     bisection towards the last good one) at which the evaluator meets a
     non-finite intermediate, or None."""
-    lo, hi = _inward(lo, hi, suffix)
+    lo, hi = round_inward(lo, hi, suffix)
     if not lo <= hi:
         return None
     xs = np.unique(np.concatenate([np.linspace(lo, hi, 4097), [lo, hi]]))
@@ -251,7 +257,15 @@ def range_problem(coeffs, max_t: Fraction, suffix: str, u: float, *, where=None)
             f"{tname}")
 
 
-def _max_abs_x(table: CoefficientTable) -> Fraction:
+def interval_max_abs(table: CoefficientTable) -> Fraction:
+    """A bound of ``|x|`` over the table's interval: the larger endpoint
+    magnitude of its doubles, each padded outward by one ulp (they may lie
+    just inside irrational true endpoints). The rounding bounds use it.
+
+    >>> from chebnorm.approx import fit
+    >>> interval_max_abs(fit("x", ("-2", "1"), 1)) > 2
+    True
+    """
     lo, hi = table.interval_float
     # the float endpoints may lie just inside irrational true endpoints: pad by one ulp
     lo = math.nextafter(lo, -math.inf)
@@ -565,7 +579,7 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     if len(coeffs) != degree + 1:
         raise ValueError(f"coefficients: {len(coeffs)} numbers for degree {degree}; expected "
                          f"degree + 1 = {degree + 1}")
-    max_x = _max_abs_x(table)
+    max_x = interval_max_abs(table)
     shifted = table.shift is not None
     if shifted and table.fixed_point is not None:
         raise ValueError(f"table {table.name!r}: a fixed-point part in the shifted basis has no "

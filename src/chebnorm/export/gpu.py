@@ -30,7 +30,7 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import identifier
 
-from .shader import _interval32, shader_source
+from .shader import interval32, shader_source
 
 __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
            "wgsl_evaluate", "gl_context", "compute_shader_source", "MAX_SAMPLES"]
@@ -61,7 +61,7 @@ def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> n
     >>> float32_inputs(t).size  # 2^-20 / 2^-23 steps, both ends
     9
     """
-    lo, hi = _interval32(table)
+    lo, hi = interval32(table)
     a = _ordered(np.float32(lo))
     b = _ordered(np.float32(hi))
     if b - a + 1 <= max_samples:

@@ -73,10 +73,12 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from chebnorm.core.numeric import float_up
 
-from .c import _inward, _max_abs_x, horner_rounding_bound, inner_interval, range_problem
+from .c import (horner_rounding_bound, inner_interval, interval_max_abs, range_problem,
+                round_inward)
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
-           "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source"]
+           "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source",
+           "interval32"]
 
 U32 = Fraction(1, 2 ** 24)
 _FLUSH = Fraction(1, 2 ** 126)  # largest magnitude a flushed subnormal float32 loses
@@ -244,7 +246,7 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     """
     table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
     coeffs, certified, _ = _coefficients(table)
-    m = _max_abs_x(table)
+    m = interval_max_abs(table)
     # no bound for an evaluator that can overflow float32 on the interval (nor
     # for one whose flushed underflows the flush term below does not cover)
     problem = range_problem(coeffs, m, "f", float(U32),
@@ -270,10 +272,18 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
                        rounding=rounding, flush=flush, total=up, total32=up32)
 
 
-def _interval32(table: CoefficientTable) -> tuple[float, float]:
+def interval32(table: CoefficientTable) -> tuple[float, float]:
     """The table's interval rounded *inward* to float32: every float32 in it
-    lies in the table's interval."""
-    return _inward(*inner_interval(table), "f")
+    lies in the table's interval (the shaders' ``_LO``/``_HI`` and the GPU
+    checks' input range).
+
+    >>> from fractions import Fraction
+    >>> from chebnorm.approx import fit
+    >>> lo, hi = interval32(fit("x", ("-0.1", "0"), 1))
+    >>> Fraction(-1, 10) <= Fraction(lo) and hi == 0.0
+    True
+    """
+    return round_inward(*inner_interval(table), "f")
 
 
 def shader_source(table: CoefficientTable, language: str, command: str = "") -> str:
@@ -302,7 +312,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
     if not np.isfinite(bound.total32):
         raise ValueError(f"table {table.name!r}: its float32 evaluation bound {bound.total:.3g} "
                          f"exceeds the float32 range; accepted: a bound below 3.4e38")
-    lo32, hi32 = _interval32(table)
+    lo32, hi32 = interval32(table)
     var = comment_text(table.variable, max_length=40)
     lit = lambda v: float32_literal(v, lang.suffix)  # noqa: E731
     out = []

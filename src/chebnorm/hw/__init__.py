@@ -1,5 +1,12 @@
 """Stage 3 (hardware): bit-accurate fixed-point datapaths, error budgets,
-Verilog export checked in Icarus Verilog and sized by Yosys.
+Verilog and VHDL checked in Icarus Verilog and GHDL and sized by Yosys.
+
+Where things are: :mod:`.horner` and :mod:`.piecewise` size a design (the
+bit-accurate model); :mod:`.hdl` prints any design in Verilog or VHDL (the
+one HDL printer, with the benches and vector files); :mod:`.verilog` and
+:mod:`.vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
+checks a design against its error budget; :mod:`.units` are the
+normalization units (Verilog).
 
 Imports only from :mod:`chebnorm.approx` (and :mod:`chebnorm.symbolic`).
 Fixed-point conventions are those of :mod:`chebnorm.hw.fixed`: a code ``k``
@@ -20,14 +27,16 @@ from .units import (UNIT_KINDS, UNITS, UnitDesign, UnitKind, UnitReport, analyze
                     get_unit, unit_names, unit_outputs, unit_verilog)
 from .report import HardwareReport, analyze, verilog_outputs, write_outputs
 from .sweep import SweepPoint, SweepResult, sweep
-from .verilog import (SimResult, SynthResult, simulate, synthesize, verilog_module,
-                      verilog_testbench, vector_file)
+from .hdl import hdl_files, hdl_text, module_text, testbench_text, vector_file
+from .hdl.verilog import verilog_module, verilog_testbench
+from .verilog import SimResult, SynthResult, simulate, synthesize
 
 __all__ = [
     "QFormat", "shift_round", "fit_bits",
     "HornerDesign", "design_horner",
     "ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script", "gappa_bound",
     "verilog_module", "verilog_testbench", "vector_file", "simulate", "synthesize",
+    "module_text", "testbench_text", "hdl_text", "hdl_files",
     "SimResult", "SynthResult",
     "Cost", "Block", "horner_block", "classic_unit", "dichotomy_unit", "quadratic_midpoint_unit",
     "forward_difference_stepper", "eta_unit", "phong_pipeline", "bump_pipeline",

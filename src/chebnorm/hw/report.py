@@ -1,5 +1,6 @@
 """One call from a table to a checked design: budget, exhaustive
-measurement, gappa, yosys, costs; and the writer of the Verilog outputs.
+measurement, gappa, yosys, costs; and the files of its HDL outputs
+(printed by :mod:`chebnorm.hw.hdl`).
 
 The module is callable: ``chebnorm.hw.report(table, in_bits, out_bits, ...)``
 is :func:`analyze` (what ``chebnorm hw report`` prints).
@@ -27,9 +28,8 @@ from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
 from .datapaths import horner_block
 from .horner import HornerDesign, design_horner
-from .verilog import (SynthResult, pipelined_name, synthesize_text, vector_file,
-                      verilog_module, verilog_pipelined_module, verilog_pipelined_testbench,
-                      verilog_testbench)
+from .hdl import hdl_files, module_text
+from .verilog import SynthResult, synthesize_text
 
 __all__ = ["HardwareReport", "analyze", "hdl_outputs", "verilog_outputs", "write_outputs"]
 
@@ -161,21 +161,8 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     meas = measure(design)
     syn = None
     if synth and shutil.which("yosys") is not None:
-        syn = synthesize_text(verilog_module(design), design.module_name)
+        syn = synthesize_text(module_text(design), design.module_name)
     return HardwareReport(design, budget, meas, horner_block(design), syn)
-
-
-def _printers(language: str):
-    """Suffix and the four printers of one HDL (module, bench, pipelined module
-    and bench), each taking the design."""
-    if language == "verilog":
-        return (".v", verilog_module, verilog_testbench, verilog_pipelined_module,
-                verilog_pipelined_testbench)
-    if language == "vhdl":
-        from .vhdl import (vhdl_module, vhdl_pipelined_module, vhdl_pipelined_testbench,
-                           vhdl_testbench)
-        return ".vhd", vhdl_module, vhdl_testbench, vhdl_pipelined_module, vhdl_pipelined_testbench
-    raise ValueError(f"unknown HDL {language!r}; accepted: verilog, vhdl")
 
 
 def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: str = "",
@@ -183,7 +170,8 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
     """File name -> text of the module, its test bench and its vector file in
     ``language`` (``"verilog"``: ``NAME.v``; ``"vhdl"``: ``NAME.vhd``); with
     ``pipelined`` also those of the pipelined variant ``chebnorm_NAME_pipe``.
-    Both languages' benches read the same vector file ``NAME.hex``.
+    Both languages' benches read the same vector file ``NAME.hex``
+    (:func:`chebnorm.hw.hdl.hdl_files` of the report's design and budget).
 
     >>> from chebnorm.approx import fit_target
     >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
@@ -194,19 +182,8 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
     >>> hdl_outputs(r, "vhdl")["chebnorm_dichotomy_d1.hex"] == hdl_outputs(r)["chebnorm_dichotomy_d1.hex"]
     True
     """
-    ext, module, bench, pipe_module, pipe_bench = _printers(language)
-    d = report.design
-    name = d.module_name
-    files = {f"{name}{ext}": module(d, version=version, command=command, budget=report.budget),
-             f"tb_{name}{ext}": bench(d),
-             f"{name}.hex": vector_file(d)}
-    if pipelined:
-        pipe = pipelined_name(d)
-        files[f"{pipe}{ext}"] = pipe_module(d, version=version, command=command,
-                                            budget=report.budget)
-        files[f"tb_{pipe}{ext}"] = pipe_bench(d)
-        files[f"{pipe}.hex"] = files[f"{name}.hex"]
-    return files
+    return hdl_files(report.design, language, version=version, command=command,
+                     budget=report.budget, pipelined=pipelined)
 
 
 def verilog_outputs(report: HardwareReport, *, version: str = "", command: str | None = None,

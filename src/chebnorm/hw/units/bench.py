@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fixed import check_width
-from ..hdltext import bench_verdict
+from ..hdl.verilog import bench_verdict
 from .base import EXHAUSTIVE_BITS, Port, UnitDesign
 
 __all__ = ["unit_vectors", "combinational_rows", "unit_vector_file", "unit_testbench",

@@ -15,8 +15,8 @@ from chebnorm.core.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
 from ..horner import HornerDesign, design_horner
-from ..hdltext import round_lines, signed_literal
-from ..verilog import verilog_module
+from ..hdl.verilog import round_lines, signed_literal
+from ..hdl.verilog import verilog_module
 from .base import UnitDesign, UnitKind, get_unit
 from .bench import codes, combinational_rows, near
 

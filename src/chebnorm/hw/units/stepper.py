@@ -12,7 +12,7 @@ from ..cost import Block
 from ..datapaths import (forward_difference_codes, forward_difference_setup,
                          forward_difference_stepper)
 from ..fixed import check_int64, check_width, signed_bits
-from ..hdltext import round_lines
+from ..hdl.verilog import round_lines
 from .base import MAX_GUARD, MAX_LOG_M, Port, UnitDesign, UnitKind, put, register, vec, vec_ports
 from .hdl import banner, ports_decl
 

@@ -1,0 +1,441 @@
+"""Verilog printers: the evaluator of a :class:`~chebnorm.hw.horner.HornerDesign`
+(combinational and pipelined) and of a
+:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), their
+self-checking test benches, and the text fragments they (and the
+normalization units of :mod:`chebnorm.hw.units`) share.
+
+The module follows the port contract of issue 5::
+
+    module chebnorm_NAME #(parameter IN_BITS = W, parameter OUT_BITS = V)
+        (input wire [IN_BITS-1:0] x, output wire [OUT_BITS-1:0] y);
+
+combinational, unsigned codes, formats in the header comment
+(:mod:`chebnorm.hw.hdl.common`). The widths are parameters so that
+instantiations read naturally, but the constants inside were sized for the
+generated values: regenerate to change them.
+
+The test bench reads the expected output of every input code, made by the
+Python bit-accurate model, from ``chebnorm_NAME.hex`` (``$readmemh``),
+counts mismatches and prints one ``PASS:``/``FAIL:`` line. The fragments
+return Verilog-2005 source lines (indented four spaces, no trailing
+newline); the widths are the callers' (sized from exact ranges), the
+fragments only range-check the constants they print.
+"""
+
+from __future__ import annotations
+
+from ..fixed import QFormat
+from ..horner import HornerDesign
+from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
+                     vectors_name)
+
+__all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
+           "verilog_module", "verilog_pipelined_module", "verilog_testbench",
+           "verilog_pipelined_testbench", "piecewise_verilog"]
+
+
+# -- fragments -------------------------------------------------------------------
+def signed_literal(value: int, bits: int) -> str:
+    """A sized signed decimal literal ``[-]BITS'sdMAGNITUDE``.
+
+    Raises ValueError when ``value`` does not fit a signed ``bits``-bit word.
+
+    >>> signed_literal(5, 4), signed_literal(-8, 4)
+    ("4'sd5", "-4'sd8")
+    >>> signed_literal(8, 4)
+    Traceback (most recent call last):
+    ...
+    ValueError: constant 8 does not fit a signed 4-bit literal
+    """
+    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
+        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
+    return f"{'-' if value < 0 else ''}{bits}'sd{abs(value)}"
+
+
+def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
+                mode: str) -> list[str]:
+    """Lines declaring ``dst = R(src / 2^shift)``: ``mode`` ``"trunc"`` (floor,
+    an arithmetic shift) or ``"rne"`` (round to nearest, ties to even, from
+    the guard bit, the sticky bits and the kept LSB), as
+    :func:`chebnorm.hw.fixed.shift_round` computes it. ``shift >= 1``.
+
+    >>> print("\\n".join(round_lines("s", "a", 12, 3, 10, "rne")))
+        wire signed [11:0] a_q = s >>> 3;
+        wire a_inc = s[2] & ((|s[1:0]) | a_q[0]);
+        wire signed [9:0] a = a_q + $signed({1'b0, a_inc});
+    >>> round_lines("s", "a", 12, 1, 11, "trunc")[-1]
+    '    wire signed [10:0] a = a_q;'
+    """
+    lines = [f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};"]
+    if mode == "trunc":
+        lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q;")
+        return lines
+    sticky = f"(|{src}[{shift - 2}:0]) | " if shift >= 2 else ""
+    lines.append(f"    wire {dst}_inc = {src}[{shift - 1}] & ({sticky}{dst}_q[0]);")
+    lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q + $signed({{1'b0, {dst}_inc}});")
+    return lines
+
+
+def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat, out_bits: int,
+                      rounding: str, *, min_bits: int = 0) -> list[str]:
+    """The evaluator's last lines, through ``endmodule``: round the signed
+    wire ``top`` (``top_bits`` wide, ``top_frac`` fractional bits) to
+    ``y_format``'s fractional bits, subtract its offset code and saturate
+    into the ``OUT_BITS``-wide unsigned port ``y``. The working width is the
+    smallest that holds every step, and at least ``min_bits``.
+
+    >>> lines = saturating_output("t0", 14, 12, QFormat(8, 8, offset_code=256), 8, "rne")
+    >>> print("\\n".join(lines[-4:-2]))
+        wire signed [14:0] raw = r - KY;
+        assign y = raw[14] ? {OUT_BITS{1'b0}} : (raw > YMAX) ? {OUT_BITS{1'b1}} : raw[OUT_BITS-1:0];
+    """
+    shift = top_frac - y_format.frac_bits
+    rw = max(min_bits, top_bits + max(0, -shift) + 1, out_bits + 2,
+             y_format.offset_code.bit_length() + 2)
+    if shift > 0:
+        out = round_lines(top, "r", top_bits, shift, rw, rounding)
+    elif shift == 0:
+        out = [f"    wire signed [{rw - 1}:0] r = {top};"]
+    else:
+        out = [f"    wire signed [{rw - 1}:0] r = {top} <<< {-shift};"]
+    out += [f"    localparam signed [{rw - 1}:0] KY = {signed_literal(y_format.offset_code, rw)};",
+            f"    localparam signed [{rw - 1}:0] YMAX = {signed_literal(y_format.max_code, rw)};",
+            f"    wire signed [{rw - 1}:0] raw = r - KY;",
+            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
+            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
+            "endmodule", ""]
+    return out
+
+
+def bench_verdict(name: str) -> list[str]:
+    """The last lines of an exhaustive test bench of ``name`` that counted
+    ``errors`` over ``COUNT`` vectors: print the one ``PASS:``/``FAIL:`` line
+    the simulation runners read, then ``$finish``.
+
+    >>> print("\\n".join(bench_verdict("chebnorm_f")[:2]))
+            if (errors == 0)
+                $display("PASS: %0d vectors, 0 mismatches (chebnorm_f)", COUNT);
+    """
+    return ["        if (errors == 0)",
+            f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
+            "        else",
+            f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
+            "        $finish;",
+            "    end",
+            "endmodule", ""]
+
+
+# -- Horner evaluator ---------------------------------------------------------------
+
+def verilog_module(design: HornerDesign, *, version: str = "", command: str | None = None,
+                   budget=None) -> str:
+    """The synthesizable Verilog-2005 module of ``design``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = verilog_module(d)
+    >>> [line for line in v.splitlines() if line.startswith(("module", "    input", "    output"))]
+    ['module chebnorm_dichotomy_d1 #(', '    input  wire [IN_BITS-1:0]  x,', '    output wire [OUT_BITS-1:0] y']
+    """
+    xf, yf = design.x_format, design.y_format
+    n = design.degree
+    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
+                                     budget=budget), "verilog")
+    out += [f"module {module_name(design)} #(",
+            f"    parameter IN_BITS = {design.in_bits},",
+            f"    parameter OUT_BITS = {design.out_bits}",
+            ") (",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");"]
+    xw = design.xs_bits
+    out += [f"    // x value times 2^{xf.frac_bits}",
+            f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
+            f"    wire signed [{xw - 1}:0] xs = $signed({{1'b0, x}}) + K0;"]
+    if n == 0:
+        top_bits = max(design.top_bits, 2)
+        out.append(f"    wire signed [{top_bits - 1}:0] top = {signed_literal(design.integers[0], top_bits)};")
+        top_frac = design.coef_frac_bits
+    else:
+        aw = max(design.stages[0].acc_bits, 2)
+        out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
+        prev = f"A{n}"
+        for st in design.stages:
+            j = st.power
+            out.append(f"    // step {j}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})"
+                       f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
+            out += _horner_step(design, st, prev, "xs")
+            if j > 0:
+                prev = f"a{j}"
+        top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
+        out.append(f"    wire signed [{top_bits - 1}:0] top = t0;")
+    out += _output_stage(design, yf, top_bits, top_frac)
+    return "\n".join(out)
+
+
+
+def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
+    """One Horner step ``a_j = R(a_{j+1} * x + q_j)``, shared by the
+    combinational and pipelined evaluators (``prev``: a_{j+1}; ``xs``: x)."""
+    j = st.power
+    shift = f" <<< {st.product_shift}" if st.product_shift else ""
+    out = [f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * {xs};",
+           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {signed_literal(st.coef_shifted, st.sum_bits)};",
+           f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};"]
+    if j > 0:
+        out += round_lines(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
+    return out
+
+def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
+    """The evaluator's last lines, shared by the combinational and pipelined
+    modules: round ``top`` to y's fractional bits, remove y's offset, saturate."""
+    return ([f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate"]
+            + saturating_output("top", top_bits, top_frac, yf, design.out_bits, design.rounding,
+                                min_bits=design.raw_bits))
+
+
+def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
+                             command: str | None = None, budget=None) -> str:
+    """The pipelined variant of :func:`verilog_module`: the same datapath, bit
+    for bit, with ``clk`` and one register stage after each Horner step (the
+    delayed ``x`` travels beside the accumulator). Latency: ``degree`` cycles
+    -- ``y`` after the ``degree``-th rising edge belongs to the ``x`` applied
+    before the first; a new ``x`` can be applied every cycle.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> v = verilog_pipelined_module(d)
+    >>> [line.strip() for line in v.splitlines() if "LATENCY =" in line or "posedge" in line]
+    ['parameter LATENCY = 1', 'always @(posedge clk) top <= t0;']
+    """
+    n = design.degree
+    if n < 1:
+        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
+                         f"degree >= 1")
+    xf, yf = design.x_format, design.y_format
+    name = pipelined_name(design)
+    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
+                                     budget=budget, pipelined=True), "verilog")
+    out += [f"module {name} #(",
+            f"    parameter IN_BITS = {design.in_bits},",
+            f"    parameter OUT_BITS = {design.out_bits},",
+            f"    parameter LATENCY = {n}",
+            ") (",
+            "    input  wire                clk,",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");"]
+    xw = design.xs_bits
+    out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
+            f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
+    aw = max(design.stages[0].acc_bits, 2)
+    out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
+    prev = f"A{n}"
+    for s, st in enumerate(design.stages):
+        j = st.power
+        out.append(f"    // stage {s + 1}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})")
+        out += _horner_step(design, st, prev, f"xs{s}")
+        if j > 0:
+            out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
+                    f"    reg signed [{xw - 1}:0] xs{s + 1};",
+                    "    always @(posedge clk) begin",
+                    f"        a{j}_r <= a{j};",
+                    f"        xs{s + 1} <= xs{s};",
+                    "    end"]
+            prev = f"a{j}_r"
+    top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
+    out += [f"    reg signed [{top_bits - 1}:0] top;",
+            "    always @(posedge clk) top <= t0;"]
+    out += _output_stage(design, yf, top_bits, top_frac)
+    return "\n".join(out)
+
+
+def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
+    """Exhaustive self-checking bench of the pipelined variant: one new input
+    code per cycle; the output after edge ``i`` is checked against the model's
+    answer for code ``i - LATENCY + 1`` (the first ``LATENCY - 1`` edges are
+    the pipeline filling and are not checked).
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> verilog_pipelined_testbench(d).splitlines()[0]
+    '// tb_chebnorm_dichotomy_d1_pipe: exhaustive self-checking test bench of chebnorm_dichotomy_d1_pipe, latency 1.'
+    """
+    name = pipelined_name(design)
+    vectors = vectors_name(name, vectors)
+    count = 2 ** design.in_bits
+    n = design.degree
+    return "\n".join([
+        f"// tb_{name}: exhaustive self-checking test bench of {name}, latency {n}.",
+        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
+        "`timescale 1ns/1ps",
+        f"module tb_{name};",
+        f"    localparam IN_BITS = {design.in_bits};",
+        f"    localparam OUT_BITS = {design.out_bits};",
+        f"    localparam LATENCY = {n};",
+        f"    localparam COUNT = {count};",
+        "    reg clk;",
+        "    reg  [IN_BITS-1:0]  x;",
+        "    wire [OUT_BITS-1:0] y;",
+        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
+        "    integer i, errors, checked;",
+        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS), .LATENCY(LATENCY)) dut "
+        "(.clk(clk), .x(x), .y(y));",
+        "    initial begin",
+        f"        $readmemh(\"{vectors}\", expected);",
+        "        errors = 0;",
+        "        checked = 0;",
+        "        clk = 0;",
+        "        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin",
+        "            x = (i < COUNT) ? i : 0;",
+        "            #1 clk = 1;",
+        "            #1;",
+        "            if (i >= LATENCY - 1) begin",
+        "                checked = checked + 1;",
+        "                if (y !== expected[i - LATENCY + 1]) begin",
+        "                    errors = errors + 1;",
+        "                    if (errors <= 10)",
+        "                        $display(\"MISMATCH x=%h y=%h expected=%h\", i - LATENCY + 1, y,",
+        "                                 expected[i - LATENCY + 1]);",
+        "                end",
+        "            end",
+        "            clk = 0;",
+        "        end",
+        "        if (errors == 0)",
+        f"            $display(\"PASS: %0d vectors, 0 mismatches ({name}, latency %0d)\", "
+        "checked, LATENCY);",
+        "        else",
+        f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", checked, errors);",
+        "        $finish;",
+        "    end",
+        "endmodule", ""])
+
+
+def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
+    """A self-checking test bench comparing every input code with the model.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
+    >>> tb = verilog_testbench(d)
+    >>> tb.splitlines()[0]
+    '// tb_chebnorm_dichotomy_d1: exhaustive self-checking test bench of chebnorm_dichotomy_d1.'
+    >>> '$readmemh("chebnorm_dichotomy_d1.hex", expected);' in tb
+    True
+    """
+    name = module_name(design)
+    vectors = vectors_name(name, vectors)
+    count = 2 ** design.in_bits
+    return "\n".join([
+        f"// tb_{name}: exhaustive self-checking test bench of {name}.",
+        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
+        "`timescale 1ns/1ps",
+        f"module tb_{name};",
+        f"    localparam IN_BITS = {design.in_bits};",
+        f"    localparam OUT_BITS = {design.out_bits};",
+        f"    localparam COUNT = {count};",
+        "    reg  [IN_BITS-1:0]  x;",
+        "    wire [OUT_BITS-1:0] y;",
+        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
+        "    integer i, errors;",
+        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS)) dut (.x(x), .y(y));",
+        "    initial begin",
+        f"        $readmemh(\"{vectors}\", expected);",
+        "        errors = 0;",
+        "        for (i = 0; i < COUNT; i = i + 1) begin",
+        "            x = i;",
+        "            #1;",
+        "            if (y !== expected[i]) begin",
+        "                errors = errors + 1;",
+        "                if (errors <= 10)",
+        "                    $display(\"MISMATCH x=%h y=%h expected=%h\", x, y, expected[i]);",
+        "            end",
+        "        end",
+        *bench_verdict(name)])
+
+
+# -- piecewise evaluator -------------------------------------------------------------
+
+def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> str:
+    """The synthesizable Verilog-2005 module of a piecewise design ``d``
+    (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`): ROM (a case on the
+    index) + Horner.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8)
+    >>> v = piecewise_verilog(d)
+    >>> v.count("2'd"), "module chebnorm_rs" in v   # one ROM row per segment
+    (4, True)
+    """
+    t = d.table
+    n, L, K, fc = t.degree, d.local_bits, t.index_bits, t.coef_frac_bits
+    yf = d.y_format
+    mod = module_name(d)
+    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
+    out += [f"module {mod} #(",
+            f"    parameter IN_BITS = {d.in_bits},",
+            f"    parameter OUT_BITS = {d.out_bits}",
+            ") (",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");",
+            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
+    tw = d.t_bits
+    if t.centered:
+        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}) - "
+                   f"{signed_literal(1 << (L - 1), tw)};")
+    else:
+        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
+    regs = [f"c{j}" for j in range(n + 1)]
+    if K == 0:  # one segment: constants (an always block with no input would never run)
+        for j in range(n + 1):
+            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
+                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
+    else:
+        for j in range(n + 1):
+            out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
+        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
+                "    always @(*) begin",
+                "        case (idx)"]
+        for s, seg in enumerate(t.segments):
+            body = " ".join(f"{regs[j]} = {signed_literal(q, d.rom_bits[j])};"
+                            for j, q in enumerate(seg.integers))
+            out.append(f"            {K}'d{s}: begin {body} end")
+        out += ["        endcase", "    end"]
+    prev, prev_frac = f"c{n}", fc
+    for i, j in enumerate(range(n - 1, -1, -1)):
+        pw, sw, ow = d.widths[i]
+        pf = prev_frac + L
+        sf = max(pf, fc)
+        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
+        out.append(f"    wire signed [{pw - 1}:0] p{j} = {prev} * t;")
+        sh_p = f" <<< {sf - pf}" if sf > pf else ""
+        sh_c = f" <<< {sf - fc}" if sf > fc else ""
+        out.append(f"    wire signed [{sw - 1}:0] s{j} = (p{j}{sh_p}) + (c{j}{sh_c});")
+        if j > 0:
+            f_out = min(d.acc_frac_bits, sf)
+            if sf > f_out:
+                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
+            else:
+                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
+            prev, prev_frac = f"a{j}", f_out
+        else:
+            prev, prev_frac = f"s{j}", sf
+    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
+    out += saturating_output(prev, top_bits, prev_frac, yf, d.out_bits, d.rounding)
+    return "\n".join(out)
