@@ -125,12 +125,20 @@ def test_api_wrong_types_raise_value_error_naming_the_argument(table):
 
 
 # ----------------------------------------------------------------- item 10
-def test_piecewise_vhdl_refused_nothing_written(capsys, piecewise_file, tmp_path):
+def test_piecewise_vhdl_written_pipelined_refused_nothing_written(capsys, piecewise_file, tmp_path):
+    """Piecewise tables print as VHDL (issue 27); the pipelined evaluator, which
+    piecewise tables do not have, is refused with nothing written."""
     out = tmp_path / "V"
     status, stdout, err = _run(["hw", "verilog", piecewise_file, "--in-bits", "10",
-                                "--out-bits", "10", "--lang", "vhdl", "-o", out], capsys)
-    assert status == 2 and "accepted: --lang verilog" in _one_line(err)
+                                "--out-bits", "10", "--lang", "vhdl", "--pipelined", "-o", out],
+                               capsys)
+    assert status == 2 and "--pipelined is not available for a piecewise table" in _one_line(err)
     assert not out.exists() and stdout == ""
+    status, _, err = _run(["hw", "verilog", piecewise_file, "--in-bits", "10",
+                           "--out-bits", "10", "--lang", "vhdl", "-o", out], capsys)
+    assert status == 0 and err == ""
+    assert sorted(p.suffix for p in out.iterdir()) == [".hex", ".vhd", ".vhd"]
+    assert "entity chebnorm_table is" in (out / "chebnorm_table.vhd").read_text()
 
 
 def test_design_narrow_input_default_segments(capsys, tmp_path):
