@@ -1,4 +1,4 @@
-"""Piecewise polynomial tables: fit, quantize and certify one polynomial per segment.
+"""Piecewise polynomial tables: the :class:`PiecewiseTable` contract, its file, its verification.
 
 A :class:`PiecewiseTable` splits ``[lo, hi]`` into segments and stores, for
 each, a polynomial in a *local* variable, with integer coefficients in one
@@ -27,9 +27,12 @@ segment in Arb, a vectorised branch and bound in float64 with every rounding
 error accounted for; :func:`chebnorm.approx.certify` for a segment it cannot
 settle); the table's bound is the maximum over the segments. Reading a table (:meth:`PiecewiseTable.load`,
 ``from_dict``) checks every field (a refusal names it) and re-certifies every
-stated bound, as :class:`chebnorm.approx.CoefficientTable` does.
+stated bound, as :class:`chebnorm.approx.CoefficientTable` does (both are kinds
+of :class:`chebnorm.approx.contract.Table`). The fitter is
+:func:`chebnorm.approx.piecewise_fit.piecewise_fit`.
 
->>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+>>> from chebnorm.approx.piecewise_fit import piecewise_fit
+>>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
 >>> t.segment_count, t.degree, t.abs_error_bound < 2e-2
 (4, 1, True)
 >>> [str(e) for e in t.segment_bounds(0)]
@@ -49,13 +52,17 @@ import sympy as sp
 
 from flint import arb
 
-from chebnorm.core.numeric import arb_precision, check_int, signed_bits
+from chebnorm.core.numeric import arb_precision, signed_bits
 
 from .certify import arb_enclose, certify
-from .certify_batch import SegmentError, certify_batch
-from .expr import Function1D, parse_function, parse_number
-from .fitting import cheb_to_monomial, remez
-from .table import _construction, _establish, _sealed, check_maximum, parse_json
+from .certify_batch import certify_batch
+from .contract import Table
+from .expr import parse_function, parse_number
+from .schema import (ERROR_KINDS, MAX_COEF_FRAC_BITS, MAX_COEF_INT_BITS, MAX_EXPONENT_SPAN,
+                     MAX_INDEX_BITS, MAX_PIECEWISE_BYTES, MAX_PIECEWISE_DEGREE, PIECEWISE_FITS,
+                     PIECEWISE_KIND, PIECEWISE_SCHEMA, SEGMENT_BY, array, bad, boolean,
+                     check_object, choice, integer, number, provenance, text)
+from .table import check_maximum
 
 __all__ = [
     "MAX_COEF_FRAC_BITS",
@@ -66,25 +73,18 @@ __all__ = [
     "SEGMENT_BY",
     "PiecewiseSegment",
     "PiecewiseTable",
-    "fit_piecewise",
+    "certify_segments",
+    "exact_log2",
     "is_piecewise_file",
     "parse_segments",
+    "segment_balls",
+    "segment_bounds",
+    "segment_count",
 ]
 
-PIECEWISE_KIND = "chebnorm.piecewise_table"
-PIECEWISE_SCHEMA = 1
-#: at most 2**12 segments (a ROM of 4096 words)
-MAX_INDEX_BITS = 12
-MAX_PIECEWISE_DEGREE = 8
-#: coefficients are integers / 2**F; |integer| < 2**52 keeps them exact doubles
-MAX_COEF_FRAC_BITS = 48
-MAX_COEF_INT_BITS = 52
-SEGMENT_BY = ("uniform", "exponent")
-FITS = ("minimax", "chebyshev")
-ERRORS = ("abs", "rel")
-MAX_EXPONENT_SPAN = 64
-MAX_PIECEWISE_BYTES = 8 << 20
-_DENSE = 257
+#: the names these constants had here (they live in :mod:`chebnorm.approx.schema`)
+FITS = PIECEWISE_FITS
+ERRORS = ERROR_KINDS
 
 
 @dataclass(frozen=True)
@@ -99,8 +99,43 @@ class PiecewiseSegment:
 
 
 @dataclass(frozen=True)
-class PiecewiseTable:
-    """The piecewise-table contract (see the module docstring)."""
+class PiecewiseTable(Table):
+    """A piecewise polynomial table with certified error bounds (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+        An identifier, used to name generated code.
+    expression : str
+        The approximated function ``f`` (sympy syntax).
+    variable : str
+        Its variable.
+    interval : tuple of str
+        The exact endpoints ``(lo, hi)`` as sympy strings.
+    segment_by : str
+        ``"uniform"`` (``2**index_bits`` equal segments) or ``"exponent"``
+        (``2**index_bits`` segments per binade of ``[2**e0, 2**e1]``).
+    index_bits : int
+        The bits that select a segment (per binade for ``"exponent"``).
+    degree : int
+        The degree of every segment's polynomial.
+    centered : bool
+        Each polynomial is in ``u = t - 1/2`` in ``[-1/2, 1/2]`` instead of ``t`` in ``[0, 1]``.
+    fit : str
+        ``"minimax"`` or ``"chebyshev"``: how each segment was fitted.
+    error_kind : str
+        ``"abs"`` or ``"rel"``: the error minimized (``"rel"`` certifies both).
+    coef_frac_bits : int
+        Coefficient ``j`` of segment ``s`` is ``segments[s].integers[j] / 2**coef_frac_bits``.
+    segments : tuple of PiecewiseSegment
+        Each segment's integers and certified bounds and located maxima.
+    abs_error_bound : float
+        The largest segment ``abs_error_bound``: a rigorous bound of ``sup |p - f|``.
+    rel_error_bound : float or None
+        The largest segment ``rel_error_bound``; None when ``error_kind`` is ``"abs"``.
+    provenance : dict of str to str
+        Where the table came from (command, library versions).
+    """
 
     name: str
     expression: str
@@ -118,10 +153,9 @@ class PiecewiseTable:
     rel_error_bound: float | None
     provenance: dict = field(default_factory=dict)
 
-    def __post_init__(self) -> None:
-        """Check every field and re-prove every claim (see :meth:`verify`): a table
-        built by hand or by ``dataclasses.replace`` is verified as a file is."""
-        _establish(self, _own_fields, _prove)
+    WHAT = "piecewise table"
+    MAX_BYTES = MAX_PIECEWISE_BYTES
+    JSON_INDENT = 1
 
     # -- geometry ------------------------------------------------------------
     @property
@@ -141,7 +175,7 @@ class PiecewiseTable:
         """``(e0, e1)`` with ``[lo, hi] = [2**e0, 2**e1]`` for exponent tables, else None."""
         if self.segment_by != "exponent":
             return None
-        return _exact_log2(self.lo), _exact_log2(self.hi)
+        return exact_log2(self.lo), exact_log2(self.hi)
 
     @property
     def local_range(self) -> tuple[Fraction, Fraction]:
@@ -150,7 +184,7 @@ class PiecewiseTable:
 
     def segment_bounds(self, s: int) -> tuple[sp.Expr, sp.Expr]:
         """Exact endpoints ``(a_s, b_s)`` of segment ``s``."""
-        return _segment_bounds(self.segment_by, self.lo, self.hi, self.index_bits, s)
+        return segment_bounds(self.segment_by, self.lo, self.hi, self.index_bits, s)
 
     def coefficients(self, s: int) -> tuple[float, ...]:
         """Coefficients of segment ``s`` in its local variable (exact doubles)."""
@@ -166,21 +200,7 @@ class PiecewiseTable:
 
     def __call__(self, x) -> np.ndarray:
         """Float64 evaluation at ``x`` (inside ``[lo, hi]``), for plots and checks."""
-        x = np.asarray(x, dtype=float)
-        lo_f, hi_f = float(self.lo), float(self.hi)
-        if self.segment_by == "uniform":
-            n = self.segment_count
-            pos = (x - lo_f) / (hi_f - lo_f) * n
-            s = np.clip(np.floor(pos), 0, n - 1).astype(int)
-            t = pos - s
-        else:
-            m, e = np.frexp(x)
-            e0 = int(math.log2(lo_f))
-            per = 2 ** self.index_bits
-            scaled = (2 * m - 1) * per
-            j = np.clip(np.floor(scaled), 0, per - 1).astype(int)
-            s = np.clip((e - 1 - e0) * per + j, 0, self.segment_count - 1)
-            t = scaled - j
+        s, t = self._locate(np.asarray(x, dtype=float))
         if self.centered:
             t = t - 0.5
         coeffs = np.array([self.coefficients(i) for i in range(self.segment_count)])
@@ -188,6 +208,143 @@ class PiecewiseTable:
         for j in range(self.degree - 1, -1, -1):
             acc = acc * t + coeffs[s, j]
         return acc
+
+    def _locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(s, t)``: the segment of each ``x`` and its local variable in ``[0, 1]``, in float64."""
+        lo_f, hi_f = float(self.lo), float(self.hi)
+        if self.segment_by == "uniform":
+            n = self.segment_count
+            pos = (x - lo_f) / (hi_f - lo_f) * n
+            s = np.clip(np.floor(pos), 0, n - 1).astype(int)
+            return s, pos - s
+        m, e = np.frexp(x)
+        e0 = int(math.log2(lo_f))
+        per = 2 ** self.index_bits
+        scaled = (2 * m - 1) * per
+        j = np.clip(np.floor(scaled), 0, per - 1).astype(int)
+        s = np.clip((e - 1 - e0) * per + j, 0, self.segment_count - 1)
+        return s, scaled - j
+
+    # -- display and plots -------------------------------------------------------
+    def _display_rows(self) -> list[tuple[str, str]]:
+        """(label, plain text) pairs shown by the HTML and Markdown reprs."""
+        lo, hi = self.interval
+        local = "u = t - 1/2 in [-1/2, 1/2]" if self.centered else "t in [0, 1]"
+        per = " per binade" if self.segment_by == "exponent" else ""
+        rows = [
+            ("function", f"{self.expression} of {self.variable}"),
+            ("interval", f"[{lo}, {hi}]"),
+            ("segments", f"{self.segment_count} ({self.segment_by}, 2^{self.index_bits}{per}); "
+                         f"each in its local variable {local}"),
+            ("degree, fit", f"{self.degree}, {self.fit} ({self.error_kind} error)"),
+            ("coefficients", f"integers / 2^{self.coef_frac_bits}; signed widths "
+                             + ", ".join(str(w) for w in self.coefficient_word_bits())),
+            ("max |p - f|", self._worst("abs")),
+        ]
+        if self.rel_error_bound is not None:
+            rows.append(("max |p/f - 1|", self._worst("rel")))
+        if self.provenance:
+            rows.append(("provenance", "; ".join(f"{k}: {v}"
+                                                 for k, v in sorted(self.provenance.items()))))
+        return rows
+
+    def _worst(self, kind: str) -> str:
+        """The largest located maximum over the segments, and the certified bound."""
+        located = [getattr(seg, f"max_{kind}_error") for seg in self.segments]
+        s = max(range(len(located)), key=located.__getitem__)
+        return (f"{located[s]:.6e} in segment {s}; certified bound "
+                f"{getattr(self, f'{kind}_error_bound'):.6e}")
+
+    def error_curve(self, points: int = 801, error: str = "abs"):
+        """``(x, g)``: the error ``g = p - f`` (``error="abs"``) or ``p/f - 1``
+        (``"rel"``) at ``points`` equally spaced floats of the interval, each
+        evaluated with the exact coefficients of its segment in mpmath at 40
+        significant digits.
+
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+        >>> x, g = t.error_curve(201)
+        >>> bool(abs(g).max() <= t.abs_error_bound)
+        True
+        """
+        import mpmath
+
+        if error not in ("abs", "rel"):
+            raise ValueError(f"error must be 'abs' or 'rel'; got {error!r}")
+        if not isinstance(points, int) or isinstance(points, bool) or points < 2:
+            raise ValueError(f"points must be an integer >= 2; got {points!r}")
+        f_mp = parse_function(self.expression, self.variable).mpmath
+        x = np.linspace(float(self.lo), float(self.hi), points)
+        g = np.empty(points)
+        with mpmath.workdps(40):
+            ends = {}
+            for i, xi in enumerate(x):
+                s = self._segment_of(float(xi))
+                if s not in ends:
+                    a, b = self.segment_bounds(s)
+                    ends[s] = (mpmath.mpf(sp.N(a, 45)), mpmath.mpf(sp.N(b - a, 45)))
+                a, w = ends[s]
+                xm = mpmath.mpf(float(xi))
+                t = (xm - a) / w - (mpmath.mpf(0.5) if self.centered else 0)
+                p = mpmath.mpf(0)
+                for c in reversed(self.coefficients(s)):
+                    p = p * t + mpmath.mpf(c)
+                f = f_mp(xm)
+                g[i] = float(p - f) if error == "abs" else float(p / f - 1)
+        return x, g
+
+    def _segment_of(self, x: float) -> int:
+        """The segment whose closed interval holds ``x`` (located in float64 as
+        :meth:`__call__` does, then checked exactly)."""
+        s = int(self._locate(np.array([x]))[0][0])
+        xq = sp.Rational(x)
+        for _ in range(self.segment_count):
+            a, b = self.segment_bounds(s)
+            if xq < a and s > 0:
+                s -= 1
+            elif xq > b and s < self.segment_count - 1:
+                s += 1
+            else:
+                return s
+        return s
+
+    def plot(self, ax=None, error: str = "abs", points: int = 801):
+        """Plot the error curve ``p - f`` (``error="rel"``: ``p/f - 1``) over the
+        interval with the table's certified bound ``+-bound`` and each segment's
+        own bound. Returns the matplotlib Axes.
+
+        >>> import matplotlib
+        >>> matplotlib.use("Agg")
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+        >>> type(t.plot(points=101)).__name__
+        'Axes'
+        """
+        if error == "rel" and self.rel_error_bound is None:
+            raise ValueError(f"table {self.name!r} has no relative error (error_kind is 'abs')")
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            _, ax = plt.subplots(figsize=(6.4, 3.6))
+        x, g = self.error_curve(points, error)
+        bound = self.abs_error_bound if error == "abs" else self.rel_error_bound
+        label = "p - f" if error == "abs" else "p/f - 1"
+        ax.plot(x, g, color="C0", lw=1.0,
+                label=f"{label} ({self.segment_count} segments of degree {self.degree})")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {bound:.3e}")
+        ax.axhline(-bound, color="C0", ls="--", lw=0.8)
+        for s, seg in enumerate(self.segments):
+            a, b = (float(v) for v in self.segment_bounds(s))
+            own = getattr(seg, f"{error}_error_bound")
+            ax.hlines([own, -own], a, b, color="C1", ls=":", lw=0.8,
+                      label="segment bounds" if s == 0 else None)
+        ax.axhline(0.0, color="0.6", lw=0.5)
+        ax.set_xlabel(self.variable)
+        ax.set_ylabel(label)
+        ax.set_title(f"{self.name}: {self.expression} on [{self.interval[0]}, "
+                     f"{self.interval[1]}]", fontsize="medium")
+        ax.legend(fontsize="small", loc="best")
+        return ax
 
     # -- serialization -------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -206,48 +363,25 @@ class PiecewiseTable:
              "provenance": dict(self.provenance)}
         return d
 
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict(), sort_keys=True, indent=1, allow_nan=False) + "\n"
-
-    def save(self, path) -> None:
-        """Write the JSON atomically."""
-        from chebnorm.core.files import write_atomic
-
-        write_atomic(path, self.to_json())
+    @classmethod
+    def _file_fields(cls, d) -> dict[str, Any]:
+        return _fields(d)
 
     @classmethod
-    def from_dict(cls, d: Any) -> PiecewiseTable:
-        """Read a table: every field checked, then every bound re-certified."""
-        return cls(**_fields(d))
+    def _own_fields(cls, d) -> dict[str, Any]:
+        """``d`` lacks the file's kind and schema."""
+        if isinstance(d, dict):
+            d = {"kind": PIECEWISE_KIND, "schema": PIECEWISE_SCHEMA, **d}
+        return _fields(d)
 
-    @classmethod
-    def from_json(cls, text: str) -> PiecewiseTable:
-        """Parse strict JSON (a key given twice is refused) and read it with :meth:`from_dict`."""
-        return cls.from_dict(parse_json(text, "piecewise table"))
-
-    @classmethod
-    def load(cls, path) -> PiecewiseTable:
-        """Read and verify the table in ``path``; refusals start with the file name."""
-        try:
-            with open(path, "rb") as fh:
-                raw = fh.read(MAX_PIECEWISE_BYTES + 1)
-        except OSError as exc:
-            raise ValueError(f"cannot read piecewise table {str(path)!r}: {exc.strerror}") from None
-        if len(raw) > MAX_PIECEWISE_BYTES:
-            raise ValueError(f"piecewise table {str(path)!r} is larger than "
-                             f"{MAX_PIECEWISE_BYTES} bytes")
-        try:
-            return cls.from_json(raw.decode("utf-8"))
-        except UnicodeDecodeError as exc:
-            raise ValueError(f"piecewise table {str(path)!r} is not UTF-8 text (byte "
-                             f"{exc.start})") from None
-        except ValueError as exc:
-            raise ValueError(f"piecewise table {str(path)!r}: {exc}") from None
+    def _prove_claims(self) -> None:
+        _prove(self)
 
     def verify(self) -> PiecewiseTable:
         """Re-certify every segment's stated bounds and the table's maxima; return self or raise.
 
-        >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> t = piecewise_fit("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
         >>> t.verify() is t
         True
         >>> from dataclasses import replace
@@ -263,17 +397,7 @@ class PiecewiseTable:
         segment bound, ``rel_error_bound`` null exactly when ``error_kind`` is
         ``"abs"`` (the segments then certify no relative error).
         """
-        if not _sealed(self):
-            _establish(self, _own_fields, _prove, mode="prove")
-        return self
-
-
-def _own_fields(cls, d) -> dict[str, Any]:
-    """:func:`_fields` of a constructed table's fields (``d`` lacks the file's kind
-    and schema)."""
-    if isinstance(d, dict):
-        d = {"kind": PIECEWISE_KIND, "schema": PIECEWISE_SCHEMA, **d}
-    return _fields(d)
+        return super().verify()
 
 
 def _prove(table: PiecewiseTable) -> None:
@@ -321,8 +445,12 @@ def _segment_certificates(table: PiecewiseTable, kind: str, stated, todo) -> dic
 
 
 
-def _exact_log2(value: sp.Expr) -> int | None:
-    """``e`` when ``value == 2**e`` exactly, else None."""
+def exact_log2(value: sp.Expr) -> int | None:
+    """``e`` when ``value == 2**e`` exactly, else None.
+
+    >>> exact_log2(sp.Rational(1, 4)), exact_log2(sp.Integer(3))
+    (-2, None)
+    """
     r = sp.nsimplify(value) if not value.is_Rational else value
     if not r.is_Rational or r <= 0:
         return None
@@ -334,43 +462,32 @@ def _exact_log2(value: sp.Expr) -> int | None:
     return None
 
 
-def _segment_bounds(segment_by, lo, hi, index_bits, s):
+def segment_bounds(segment_by, lo, hi, index_bits, s):
+    """Exact endpoints ``(a_s, b_s)`` of segment ``s`` of ``[lo, hi]`` (sympy numbers).
+
+    >>> segment_bounds("exponent", sp.Integer(1), sp.Integer(4), 1, 3)
+    (3, 4)
+    """
     if segment_by == "uniform":
         n = 2 ** index_bits
         h = (hi - lo) / n
         return (lo + s * h, lo + (s + 1) * h)
     per = 2 ** index_bits
-    e0 = _exact_log2(lo)
+    e0 = exact_log2(lo)
     e, j = divmod(s, per)
     base = sp.Integer(2) ** (e0 + e)
     return (base * (1 + sp.Rational(j, per)), base * (1 + sp.Rational(j + 1, per)))
 
 
-def _segment_count(segment_by, lo, hi, index_bits) -> int:
+def segment_count(segment_by, lo, hi, index_bits) -> int:
+    """How many segments ``index_bits`` make of ``[lo, hi]`` (per binade for ``"exponent"``).
+
+    >>> segment_count("exponent", sp.Rational(1, 4), sp.Integer(4), 2)
+    16
+    """
     if segment_by == "uniform":
         return 2 ** index_bits
-    return (_exact_log2(hi) - _exact_log2(lo)) * 2 ** index_bits
-
-
-class _LocalFunction:
-    """``t -> f(a + (b - a) t)`` (``t + 1/2`` when centred) in float64, for
-    fitting and quantizing (certification composes in Arb, see
-    :func:`_segment_balls`)."""
-
-    def __init__(self, fn: Function1D, a, b, centered: bool):
-        self.fn = fn
-        self.expr = fn.expr
-        sh = 0.5 if centered else 0.0
-        af, wf = float(sp.N(a, 20)), float(sp.N(b - a, 20))
-        f_np = fn.numpy
-        self.numpy = lambda t: f_np(af + wf * (np.asarray(t, dtype=float) + sh))
-
-    def __str__(self) -> str:
-        return f"{self.fn.expr} on a segment"
-
-
-def _local_function(fn: Function1D, a, b, *, centered: bool) -> _LocalFunction:
-    return _LocalFunction(fn, a, b, centered)
+    return (exact_log2(hi) - exact_log2(lo)) * 2 ** index_bits
 
 
 def parse_segments(text) -> int:
@@ -404,13 +521,14 @@ def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None
     tightness ``tol`` (default the certifier's), all segments in one batch
     (:func:`chebnorm.approx.certify_batch.certify_batch`).
 
-    >>> t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
     >>> [c.bound <= s.abs_error_bound for c, s in zip(certify_segments(t), t.segments)]
     [True, True]
     """
     fn = parse_function(table.expression, table.variable)
     idx = list(range(table.segment_count)) if segments is None else [int(s) for s in segments]
-    origins, widths = _segment_balls(table.segment_by, table.lo, table.hi, table.index_bits,
+    origins, widths = segment_balls(table.segment_by, table.lo, table.hi, table.index_bits,
                                      table.centered, idx)
     opts = {} if tol is None else {"tol": tol}
     return certify_batch(fn, origins, widths, [table.coefficients(s) for s in idx],
@@ -442,9 +560,15 @@ class _ArbLocal:
         self.arb_series, self.arb = series, point
 
 
-def _segment_balls(segment_by, lo, hi, index_bits, centered, segments):
+def segment_balls(segment_by, lo, hi, index_bits, centered, segments):
     """Arb balls ``(o_s, w_s)`` with segment ``s`` = ``o_s + w_s t``, ``t`` in
-    the local range (128 bits; exact for binary ends), without sympy per segment."""
+    the local range (128 bits; exact for binary ends), without sympy per segment,
+    for the segments ``segments`` (indices).
+
+    >>> o, w = segment_balls("uniform", sp.Integer(1), sp.Integer(2), 1, False, [1])
+    >>> float(o[0].mid()), float(w[0].mid())
+    (1.5, 0.5)
+    """
     with arb_precision(128):
         origins, widths = [], []
         if segment_by == "uniform":
@@ -456,7 +580,7 @@ def _segment_balls(segment_by, lo, hi, index_bits, centered, segments):
                 widths.append(w)
         else:
             per = 2 ** index_bits
-            e0 = _exact_log2(lo)
+            e0 = exact_log2(lo)
             for s in segments:
                 e, j = divmod(s, per)
                 base = arb(2) ** (e0 + e)
@@ -479,205 +603,6 @@ def is_piecewise_file(path) -> bool:
     return isinstance(d, dict) and d.get("kind") == PIECEWISE_KIND
 
 
-# -- fitting -------------------------------------------------------------------
-
-
-
-def _fit_segment(g: Function1D, degree: int, lo: float, hi: float, fit: str, error: str):
-    """Float coefficients in the local variable on ``[lo, hi]``."""
-    f_np = g.numpy
-    if degree == 0 or fit == "chebyshev":
-        nodes = np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))
-        x = 0.5 * (hi - lo) * nodes + 0.5 * (hi + lo)
-        cheb = np.polynomial.chebyshev.chebfit(nodes, f_np(x), degree)
-        if degree == 0 and fit == "minimax":
-            grid = f_np(np.linspace(lo, hi, _DENSE))
-            cheb = np.array([0.5 * (grid.max() + grid.min())])
-    else:
-        weight = (lambda v: np.ones_like(v)) if error == "abs" else (lambda v: 1 / np.abs(f_np(v)))
-        # a few exchanges reach the minimax error to 1e-4; the rounding to the
-        # common format dominates past that
-        cheb = remez(f_np, weight, lo, hi, degree, max_iter=12, rtol=1e-4).cheb
-    return cheb_to_monomial(cheb, lo, hi)
-
-
-def _quantize_segment(g: Function1D, coeffs, frac_bits: int, lo: float, hi: float, error: str):
-    """Integers: plain rounding, and rounding with the constant term re-centred
-    on the dense error of the rounded higher terms; the better on a grid."""
-    scale = 2.0 ** frac_bits
-    plain = [int(round(c * scale)) for c in coeffs]
-    v = np.linspace(lo, hi, _DENSE)
-    f = g.numpy(v)
-
-    def err(ints):
-        p = np.polynomial.polynomial.polyval(v, np.array(ints, dtype=float) / scale)
-        e = p - f if error == "abs" else p / f - 1
-        return float(np.max(np.abs(e)))
-
-    best = plain
-    if len(coeffs) > 1:
-        high = np.polynomial.polynomial.polyval(v, np.array([0] + plain[1:], dtype=float) / scale)
-        if error == "abs":
-            r = f - high
-            c0 = 0.5 * (r.max() + r.min())
-        else:  # minimise max |(c0 + high)/f - 1|: c0 levels (f - high)/f weighted by 1/f
-            c0 = _level_rel(f, high)
-        recentred = [int(round(c0 * scale))] + plain[1:]
-        if err(recentred) < err(plain):
-            best = recentred
-    return best
-
-
-def _level_rel(f, high) -> float:
-    """The constant ``c`` minimising ``max |(c + high)/f - 1|`` (bisection on the level)."""
-    lo_c, hi_c = float(np.min(f - high)) - 1.0, float(np.max(f - high)) + 1.0
-    for _ in range(80):
-        mid = 0.5 * (lo_c + hi_c)
-        e = (mid + high) / f - 1
-        if e.max() + e.min() > 0:
-            hi_c = mid
-        else:
-            lo_c = mid
-    return 0.5 * (lo_c + hi_c)
-
-
-def _certify_fitted(fn, ints_all, frac_bits: int, error: str, balls, loc):
-    """The segments fitted (integers ``ints_all``), certified all at once:
-    ``(segments, None)``, or ``(None, s)`` with ``s`` the first segment where
-    the error is not finite."""
-    certs, bad_seg = {}, None
-    qs = [[math.ldexp(i, -frac_bits) for i in ints] for ints in ints_all]
-    for kind in ("abs", "rel") if error == "rel" else ("abs",):
-        try:
-            certs[kind] = certify_batch(fn, *balls, qs, loc, kind)
-        except SegmentError as exc:
-            bad_seg = exc.segment if bad_seg is None else min(bad_seg, exc.segment)
-    if bad_seg is not None:
-        return None, bad_seg
-    out = []
-    for s, ints in enumerate(ints_all):
-        ca, cr = certs["abs"][s], certs["rel"][s] if error == "rel" else None
-        out.append(PiecewiseSegment(tuple(ints), ca.bound, ca.maximum,
-                                    None if cr is None else cr.bound,
-                                    None if cr is None else cr.maximum))
-    return out, None
-
-
-def _check_binades(lo, hi, index_bits: int) -> None:
-    """Refuse an exponent-indexed interval that is not [2^e0, 2^e1] of a few binades."""
-    e0, e1 = _exact_log2(lo), _exact_log2(hi)
-    if e0 is None or e1 is None:
-        raise ValueError(f"segment-by exponent needs an interval [2^e0, 2^e1] of powers of "
-                         f"two, got [{lo}, {hi}]; accepted: e.g. --interval 1/4 4")
-    if not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
-        raise ValueError(f"segment-by exponent: {e1 - e0} binades; accepted: 1 to "
-                         f"{MAX_EXPONENT_SPAN}")
-    if (e1 - e0) * 2 ** index_bits > 2 ** MAX_INDEX_BITS:
-        raise ValueError(f"segment-by exponent: {e1 - e0} binades x 2^{index_bits} = "
-                         f"{(e1 - e0) * 2 ** index_bits} segments; accepted: at most "
-                         f"2^{MAX_INDEX_BITS}")
-
-
-def fit_piecewise(expr, interval, degree: int, *, segments=1, segment_by: str = "uniform",
-                  coef_frac_bits: int = 24, centered: bool = False, fit: str = "minimax",
-                  error: str = "abs", var: str = "x", name: str = "table",
-                  command: str | None = None, progress=None) -> PiecewiseTable:
-    """Fit, quantize and certify a piecewise polynomial table (module docstring).
-
-    ``segments``: ``2**k`` (an int or ``"2^k"``) -- the whole interval's
-    count for ``segment_by="uniform"``, the count per binade for
-    ``"exponent"`` (then ``interval`` must be ``[2**e0, 2**e1]``).
-    ``coef_frac_bits``: the common fixed-point format of all coefficients.
-    ``progress``: optional callable run once per fitted segment (the
-    certification of all segments together follows).
-
-    >>> t = fit_piecewise("1/sqrt(x)", ("1/4", "4"), 2, segments=2, segment_by="exponent",
-    ...                   coef_frac_bits=20, error="rel")
-    >>> t.segment_count, t.rel_error_bound < 1e-3
-    (8, True)
-    """
-    from chebnorm.core.textsafe import identifier
-
-    name = identifier(name, field="name")
-    index_bits = parse_segments(segments)
-    degree = check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
-    frac_bits = check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
-    if segment_by not in SEGMENT_BY:
-        raise ValueError(f"segment-by {segment_by!r} is unknown; accepted: {', '.join(SEGMENT_BY)}")
-    if fit not in FITS:
-        raise ValueError(f"fit kind {fit!r} is unknown; accepted: {', '.join(FITS)}")
-    if error not in ERRORS:
-        raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERRORS)}")
-    if not isinstance(centered, bool):
-        raise ValueError(f"centered {centered!r} is not a boolean")
-    try:
-        lo_t, hi_t = interval
-    except (TypeError, ValueError):
-        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
-    fn = expr if isinstance(expr, Function1D) else parse_function(expr, var)
-    lo, hi = parse_number(lo_t), parse_number(hi_t)
-    if not arb_enclose(lo) < arb_enclose(hi):
-        raise ValueError(f"interval [{lo}, {hi}] is empty or reversed; accepted: LO < HI")
-    if segment_by == "exponent":
-        _check_binades(lo, hi, index_bits)
-    count = _segment_count(segment_by, lo, hi, index_bits)
-    loc = (-0.5, 0.5) if centered else (0.0, 1.0)
-    limit = 2 ** MAX_COEF_INT_BITS
-    ints_all, bad_seg = [], None
-    for s in range(count):
-        a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
-        g = _local_function(fn, a, b, centered=centered)
-        with np.errstate(all="ignore"):
-            try:
-                probe = g.numpy(np.linspace(*loc, 65))
-            except (ZeroDivisionError, OverflowError, TypeError):
-                probe = np.array([np.nan])
-        if not np.all(np.isfinite(probe)) or (error == "rel" and np.any(probe == 0)):
-            bad_seg = s
-            break
-        with np.errstate(all="ignore"):
-            coeffs = _fit_segment(g, degree, *loc, fit, error)
-        big = max(abs(c) for c in coeffs)
-        if big * 2.0 ** frac_bits >= limit:
-            max_f = max(0, math.floor(math.log2(limit / big)) - 1)
-            raise ValueError(f"coef-frac-bits {frac_bits} overflows the {MAX_COEF_INT_BITS}-bit "
-                             f"coefficient integers (segment {s}: |c| = {big:.6g}); accepted: "
-                             f"coef-frac-bits <= {max_f}")
-        with np.errstate(all="ignore"):
-            ints_all.append(_quantize_segment(g, coeffs, frac_bits, *loc, error))
-        if progress is not None:
-            progress()
-    # the segments fitted so far, certified together; the first segment that
-    # fails (or that the probe refused) is reported
-    out, failed = _certify_fitted(fn, ints_all, frac_bits, error,
-                                  _segment_balls(segment_by, lo, hi, index_bits, centered,
-                                                 range(len(ints_all))), loc)
-    if failed is not None and (bad_seg is None or failed < bad_seg):
-        bad_seg = failed
-    if bad_seg is not None:
-        s = bad_seg
-        a, b = _segment_bounds(segment_by, lo, hi, index_bits, s)
-        what = "finite, real and nonzero" if error == "rel" else "finite and real"
-        raise ValueError(f"{fn.expr} is not {what} on segment {s} = [{a}, {b}] of "
-                         f"[{lo}, {hi}]; accepted: an interval where the function is {what}")
-    from .api import _versions
-
-    prov = dict(_versions())
-    prov["command"] = command or (f"chebnorm.approx.fit_piecewise({str(fn.expr)!r}, "
-                                  f"({sp.sstr(lo)!r}, {sp.sstr(hi)!r}), {degree}, "
-                                  f"segments={2 ** index_bits}, segment_by={segment_by!r}, "
-                                  f"coef_frac_bits={frac_bits}, centered={centered})")
-    with _construction("fitted"):  # certified above: checked, not proved twice
-        return PiecewiseTable(
-            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
-            interval=(sp.sstr(lo), sp.sstr(hi)), segment_by=segment_by, index_bits=index_bits,
-            degree=degree, centered=centered, fit=fit, error_kind=error,
-            coef_frac_bits=frac_bits, segments=tuple(out),
-            abs_error_bound=max(sg.abs_error_bound for sg in out),
-            rel_error_bound=max(sg.rel_error_bound for sg in out) if error == "rel" else None,
-            provenance=prov)
-
-
 # -- reading ---------------------------------------------------------------------
 
 _FIELDS = {"kind", "schema", "name", "expression", "variable", "interval", "segment_by",
@@ -686,126 +611,108 @@ _FIELDS = {"kind", "schema", "name", "expression", "variable", "interval", "segm
 _SEG_FIELDS = {"integers", "abs_error_bound", "max_abs_error", "rel_error_bound", "max_rel_error"}
 
 
-def _bad(fieldname: str, expected: str, value) -> ValueError:
-    shown = repr(value)
-    shown = shown if len(shown) <= 60 else shown[:57] + "..."
-    return ValueError(f"{fieldname}: expected {expected}, got {shown}")
+def _either(choices) -> str:
+    return " or ".join(map(repr, choices))
 
 
-def _num(value, fieldname: str, *, optional: bool = False) -> float | None:
-    if value is None and optional:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or value < 0:
-        raise _bad(fieldname, "a finite number >= 0", value)
-    return float(value)
+def _bits(value, field: str, hi: int) -> int:
+    return integer(value, field, 0, hi, expected=f"an integer in [0, {hi}]")
 
 
-def _int(value, fieldname: str, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-        raise _bad(fieldname, f"an integer in [{lo}, {hi}]", value)
-    return value
+def _read_header(d) -> dict[str, Any]:
+    """The scalar fields of a piecewise table's JSON object, checked in file order."""
+    from chebnorm.core.textsafe import identifier
+
+    if not isinstance(d, dict):
+        raise bad("table", "a JSON object", d)
+    if d.get("kind") != PIECEWISE_KIND:
+        raise bad("kind", repr(PIECEWISE_KIND), d.get("kind"))
+    integer(d.get("schema"), "schema", PIECEWISE_SCHEMA, PIECEWISE_SCHEMA,
+            expected=str(PIECEWISE_SCHEMA))
+    check_object(d, "", _FIELDS, what="table")
+    name = identifier(d["name"], field="name")
+    expression = text(d["expression"], "expression")
+    variable = text(d["variable"], "variable", 64)
+    if not variable.isidentifier():
+        raise bad("variable", "an identifier", variable)
+    iv = array(d["interval"], "interval", "2 strings", length=2)
+    return dict(
+        name=name, expression=expression, variable=variable,
+        interval=(text(iv[0], "interval[0]"), text(iv[1], "interval[1]")),
+        segment_by=choice(d["segment_by"], "segment_by", SEGMENT_BY,
+                          expected=_either(SEGMENT_BY)),
+        index_bits=_bits(d["index_bits"], "index_bits", MAX_INDEX_BITS),
+        degree=_bits(d["degree"], "degree", MAX_PIECEWISE_DEGREE),
+        centered=boolean(d["centered"], "centered"),
+        fit=choice(d["fit"], "fit", PIECEWISE_FITS, expected=_either(PIECEWISE_FITS)),
+        error_kind=choice(d["error_kind"], "error_kind", ERROR_KINDS,
+                          expected=_either(ERROR_KINDS)),
+        coef_frac_bits=_bits(d["coef_frac_bits"], "coef_frac_bits", MAX_COEF_FRAC_BITS))
 
 
-def _str(value, fieldname: str, max_length: int = 1000) -> str:
-    if not isinstance(value, str) or not value or len(value) > max_length:
-        raise _bad(fieldname, f"a non-empty string of at most {max_length} characters", value)
-    return value
+def _segment_total(h) -> int:
+    """How many segments the header ``h`` describes (its expression, interval and,
+    for ``"exponent"``, binades checked)."""
+    try:
+        parse_function(h["expression"], h["variable"])
+    except ValueError as exc:
+        raise ValueError(f"expression: {exc}") from None
+    ends = []
+    for i, end in enumerate(h["interval"]):
+        try:
+            ends.append(parse_number(end))
+        except ValueError as exc:
+            raise ValueError(f"interval[{i}]: {exc}") from None
+    if not arb_enclose(ends[0]) < arb_enclose(ends[1]):
+        raise ValueError(f"interval: [{h['interval'][0]}, {h['interval'][1]}] is empty or "
+                         f"reversed")
+    if h["segment_by"] == "exponent":
+        e0, e1 = exact_log2(ends[0]), exact_log2(ends[1])
+        if e0 is None or e1 is None or not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
+            raise bad("interval", "powers of two [2^e0, 2^e1] for segment_by 'exponent'",
+                      list(h["interval"]))
+    return segment_count(h["segment_by"], ends[0], ends[1], h["index_bits"])
+
+
+def _read_segment(seg, where: str, degree: int, rel: bool) -> PiecewiseSegment:
+    """Segment ``where``: its integers, and its relative claims null unless ``rel``."""
+    if not isinstance(seg, dict) or set(seg) != _SEG_FIELDS:
+        raise bad(where, f"an object with fields {', '.join(sorted(_SEG_FIELDS))}", seg)
+    ints = array(seg["integers"], f"{where}.integers", f"{degree + 1} integers",
+                 length=degree + 1)
+    top = 2 ** MAX_COEF_INT_BITS - 1
+    integers = tuple(integer(q, f"{where}.integers[{j}]", -top, top,
+                             expected=f"an integer of magnitude below 2^{MAX_COEF_INT_BITS}")
+                     for j, q in enumerate(ints))
+    for key in ("rel_error_bound", "max_rel_error"):
+        if not rel and seg[key] is not None:
+            raise bad(f"{where}.{key}", "null (error_kind is 'abs': the segments "
+                      "certify no relative error)", seg[key])
+    return PiecewiseSegment(
+        integers, number(seg["abs_error_bound"], f"{where}.abs_error_bound", nonneg=True),
+        number(seg["max_abs_error"], f"{where}.max_abs_error", nonneg=True),
+        number(seg["rel_error_bound"], f"{where}.rel_error_bound", nonneg=True,
+               optional=not rel),
+        number(seg["max_rel_error"], f"{where}.max_rel_error", nonneg=True, optional=not rel))
 
 
 def _fields(d) -> dict[str, Any]:
     """The keyword arguments of :class:`PiecewiseTable` from its JSON object, every
     field checked (a refusal names it), the top-level bounds derived from the
     segments' (no certification)."""
-    from chebnorm.core import textsafe
-
-    if not isinstance(d, dict):
-        raise _bad("table", "a JSON object", d)
-    if d.get("kind") != PIECEWISE_KIND:
-        raise _bad("kind", repr(PIECEWISE_KIND), d.get("kind"))
-    if d.get("schema") != PIECEWISE_SCHEMA:
-        raise _bad("schema", str(PIECEWISE_SCHEMA), d.get("schema"))
-    missing = sorted(_FIELDS - set(d))
-    extra = sorted(set(d) - _FIELDS)
-    if missing:
-        raise ValueError(f"{missing[0]}: missing field")
-    if extra:
-        raise ValueError(f"{extra[0]}: unknown field; accepted: {', '.join(sorted(_FIELDS))}")
-    name = textsafe.identifier(_str(d["name"], "name", 64), field="name")
-    expression = _str(d["expression"], "expression")
-    variable = _str(d["variable"], "variable", 64)
-    if not variable.isidentifier():
-        raise _bad("variable", "an identifier", variable)
-    iv = d["interval"]
-    if not isinstance(iv, list) or len(iv) != 2:
-        raise _bad("interval", "an array of 2 strings", iv)
-    interval = (_str(iv[0], "interval[0]"), _str(iv[1], "interval[1]"))
-    segment_by = d["segment_by"]
-    if segment_by not in SEGMENT_BY:
-        raise _bad("segment_by", " or ".join(map(repr, SEGMENT_BY)), segment_by)
-    index_bits = _int(d["index_bits"], "index_bits", 0, MAX_INDEX_BITS)
-    degree = _int(d["degree"], "degree", 0, MAX_PIECEWISE_DEGREE)
-    if not isinstance(d["centered"], bool):
-        raise _bad("centered", "true or false", d["centered"])
-    if d["fit"] not in FITS:
-        raise _bad("fit", " or ".join(map(repr, FITS)), d["fit"])
-    if d["error_kind"] not in ERRORS:
-        raise _bad("error_kind", " or ".join(map(repr, ERRORS)), d["error_kind"])
-    frac_bits = _int(d["coef_frac_bits"], "coef_frac_bits", 0, MAX_COEF_FRAC_BITS)
-    try:
-        fn = parse_function(expression, variable)
-        del fn
-    except ValueError as exc:
-        raise ValueError(f"expression: {exc}") from None
-    ends = []
-    for i, text in enumerate(interval):
-        try:
-            ends.append(parse_number(text))
-        except ValueError as exc:
-            raise ValueError(f"interval[{i}]: {exc}") from None
-    if not arb_enclose(ends[0]) < arb_enclose(ends[1]):
-        raise ValueError(f"interval: [{interval[0]}, {interval[1]}] is empty or reversed")
-    if segment_by == "exponent":
-        e0, e1 = _exact_log2(ends[0]), _exact_log2(ends[1])
-        if e0 is None or e1 is None or not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
-            raise _bad("interval", "powers of two [2^e0, 2^e1] for segment_by 'exponent'", iv)
-    count = _segment_count(segment_by, ends[0], ends[1], index_bits)
+    h = _read_header(d)
+    count = _segment_total(h)
     segs = d["segments"]
     if not isinstance(segs, list) or len(segs) != count:
-        raise _bad("segments", f"an array of {count} segments", segs)
-    out, rel = [], d["error_kind"] == "rel"
-    for s, seg in enumerate(segs):
-        where = f"segments[{s}]"
-        if not isinstance(seg, dict) or set(seg) != _SEG_FIELDS:
-            raise _bad(where, f"an object with fields {', '.join(sorted(_SEG_FIELDS))}", seg)
-        ints = seg["integers"]
-        if not isinstance(ints, list) or len(ints) != degree + 1:
-            raise _bad(f"{where}.integers", f"an array of {degree + 1} integers", ints)
-        for j, q in enumerate(ints):
-            if isinstance(q, bool) or not isinstance(q, int) or abs(q) >= 2 ** MAX_COEF_INT_BITS:
-                raise _bad(f"{where}.integers[{j}]",
-                           f"an integer of magnitude below 2^{MAX_COEF_INT_BITS}", q)
-        for key in ("rel_error_bound", "max_rel_error"):
-            if not rel and seg[key] is not None:
-                raise _bad(f"{where}.{key}", "null (error_kind is 'abs': the segments "
-                           "certify no relative error)", seg[key])
-        out.append(PiecewiseSegment(
-            tuple(ints), _num(seg["abs_error_bound"], f"{where}.abs_error_bound"),
-            _num(seg["max_abs_error"], f"{where}.max_abs_error"),
-            _num(seg["rel_error_bound"], f"{where}.rel_error_bound", optional=not rel),
-            _num(seg["max_rel_error"], f"{where}.max_rel_error", optional=not rel)))
-    prov = d["provenance"]
-    if not isinstance(prov, dict) or len(prov) > 32 or not all(
-            isinstance(k, str) and isinstance(v, str) and len(k) <= 64 and len(v) <= 1000
-            for k, v in prov.items()):
-        raise _bad("provenance", "an object of at most 32 short strings", prov)
-    return dict(
-        name=name, expression=expression, variable=variable, interval=interval,
-        segment_by=segment_by, index_bits=index_bits, degree=degree, centered=d["centered"],
-        fit=d["fit"], error_kind=d["error_kind"], coef_frac_bits=frac_bits, segments=tuple(out),
-        abs_error_bound=_derived(d["abs_error_bound"], "abs", out),
-        rel_error_bound=_derived(d["rel_error_bound"], "rel" if rel else None, out),
-        provenance=dict(prov))
+        raise bad("segments", f"an array of {count} segments", segs)
+    rel = h["error_kind"] == "rel"
+    out = tuple(_read_segment(seg, f"segments[{s}]", h["degree"], rel)
+                for s, seg in enumerate(segs))
+    prov = provenance(d["provenance"])
+    return dict(h, segments=out,
+                abs_error_bound=_derived(d["abs_error_bound"], "abs", out),
+                rel_error_bound=_derived(d["rel_error_bound"], "rel" if rel else None, out),
+                provenance=prov)
 
 
 def _derived(value, kind: str | None, segments) -> float | None:
@@ -814,10 +721,10 @@ def _derived(value, kind: str | None, segments) -> float | None:
     field_name = f"{kind or 'rel'}_error_bound"
     if kind is None:
         if value is not None:
-            raise _bad(field_name, "null (error_kind is 'abs': the segments certify no "
-                       "relative error)", value)
+            raise bad(field_name, "null (error_kind is 'abs': the segments certify no "
+                      "relative error)", value)
         return None
-    stated = _num(value, field_name)
+    stated = number(value, field_name, nonneg=True)
     top = max(getattr(seg, field_name) for seg in segments)
     if stated != top:
         raise ValueError(f"{field_name}: stated {stated!r} but the largest segment bound is "
