@@ -222,8 +222,10 @@ class PiecewiseTable(Table):
         per = 2 ** self.index_bits
         scaled = (2 * m - 1) * per
         j = np.clip(np.floor(scaled), 0, per - 1).astype(int)
-        s = np.clip((e - 1 - e0) * per + j, 0, self.segment_count - 1)
-        return s, scaled - j
+        raw = (e - 1 - e0) * per + j
+        s = np.clip(raw, 0, self.segment_count - 1)
+        # x = hi = 2**e1 opens the next binade: it is the last segment's t = 1
+        return s, np.where(raw > self.segment_count - 1, 1.0, scaled - j)
 
     # -- display and plots -------------------------------------------------------
     def _display_rows(self) -> list[tuple[str, str]]:
