@@ -61,7 +61,7 @@ def test_batched_sampled_errors_are_the_same_floats():
     one-at-a-time errors bit for bit, zero coefficients included."""
     import random
 
-    from chebnorm.approx.rounding import _Problem, _Sampler
+    from chebnorm.approx.rounding import Problem as _Problem, _Sampler
 
     fn = parse_function("exp(x)")
     prob = _Problem(fn=fn, lo=sp.Integer(0), hi=sp.Integer(1), lo_f=0.0, hi_f=1.0,
@@ -112,7 +112,7 @@ def test_table_fitted_with_the_powers_is_not_refitted(monkeypatch):
 
 def _problem(expr, lo, hi, degree, kind, powers, fixed=None):
     from chebnorm.approx.api import Interval
-    from chebnorm.approx.rounding import _Problem
+    from chebnorm.approx.rounding import Problem as _Problem
 
     iv = Interval(lo, hi)
     return _Problem(fn=parse_function(expr), lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,

@@ -56,8 +56,9 @@ from its stage (nothing is moved) and imported only when first used
 * ``cn.fit``, ``cn.quantize``, ``cn.certify``: fit and certify a polynomial,
   round it to fixed point and re-certify, bound ``sup|p - f|`` of given
   coefficients (:mod:`chebnorm.approx`).
-* ``cn.CoefficientTable``, ``cn.FixedPoint``: the table contract (JSON,
-  rich display in Jupyter, ``table.plot()``).
+* ``cn.CoefficientTable``, ``cn.FixedPoint``, ``cn.PiecewiseTable``: the two
+  kinds of table (JSON, verification, rich display in Jupyter, ``table.plot()``);
+  ``cn.load_table(path)`` reads a file of either kind.
 * ``cn.target(name)``, ``cn.target_names()``, ``cn.fit_target(name, degree)``:
   the registered targets of the papers.
 * ``cn.span_normals(method, ...)``, ``cn.method_names()``: run a
@@ -116,6 +117,8 @@ _LAZY = {
     "fit_target": ("chebnorm.approx", "fit_target"),
     "CoefficientTable": ("chebnorm.approx", "CoefficientTable"),
     "FixedPoint": ("chebnorm.approx", "FixedPoint"),
+    "PiecewiseTable": ("chebnorm.approx", "PiecewiseTable"),
+    "load_table": ("chebnorm.approx", "load_table"),
     "FitWarning": ("chebnorm.approx", "FitWarning"),
     "target": ("chebnorm.approx", "get_target"),
     "target_names": ("chebnorm.approx", "target_names"),
@@ -128,6 +131,7 @@ _LAZY = {
 
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
+    "PiecewiseTable", "load_table",
     "FitWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
     "core", "symbolic", "approx", "export", "methods", "hw", "raster",
 ]

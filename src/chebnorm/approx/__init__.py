@@ -1,5 +1,12 @@
 """Stage 2: targets, fitting, certified error bounds, fixed point, tables.
 
+Where things are: ``schema`` (kinds, limits, versions, the JSON field readers),
+``contract`` (:class:`Table`, what both kinds of table are and do), ``table``
+(:class:`CoefficientTable`), ``piecewise_table`` (:class:`PiecewiseTable`),
+``load`` (:func:`load_table`: a file of either kind); the fitters ``api``
+(:func:`fit`, :func:`quantize`) and ``piecewise_fit`` (:func:`piecewise_fit`), on
+``fitting``, ``rounding``, ``certify`` and ``certify_batch``.
+
 >>> from chebnorm.approx import fit
 >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, kind="minimax", var="z")
 >>> t.max_abs_error <= t.abs_error_bound <= 1.01 * t.max_abs_error
@@ -8,7 +15,11 @@ True
 
 from .api import MAX_DEGREE, FitWarning, fit, quantize, warnings_of
 from .certify import Certificate, certify
+from .contract import ErrorBounds, Table
 from .expr import Function1D, read_expression, parse_function, parse_number
+from .load import load_table, table_from_json
+from .piecewise_fit import piecewise_fit
+from .piecewise_table import PiecewiseSegment, PiecewiseTable
 from .rounding import FORMATS as COEF_FORMATS
 from .table import SCHEMA_VERSION, CoefficientTable, FixedPoint, Quantized
 from .targets import TARGETS, Target, get_target, target_names
@@ -17,6 +28,8 @@ __all__ = [
     "CoefficientTable", "FixedPoint", "Quantized", "COEF_FORMATS", "SCHEMA_VERSION", "fit", "quantize", "warnings_of", "FitWarning", "MAX_DEGREE",
     "Certificate", "certify", "Function1D", "read_expression", "parse_function", "parse_number",
     "Target", "TARGETS", "get_target", "target_names", "fit_target",
+    "Table", "ErrorBounds", "PiecewiseTable", "PiecewiseSegment", "piecewise_fit", "load_table",
+    "table_from_json",
 ]
 
 

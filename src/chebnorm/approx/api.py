@@ -5,7 +5,6 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from importlib.metadata import PackageNotFoundError, version as _pkg_version
 
 import numpy as np
 import sympy as sp
@@ -17,7 +16,9 @@ from .certify import Certificate, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
 from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, polish, remez,
                       shift_for)
-from .table import CoefficientTable, FixedPoint, Quantized, _construction
+from .contract import construction
+from .schema import BASES, ERROR_KINDS, KINDS, MAX_DEGREE, versions
+from .table import CoefficientTable, FixedPoint, Quantized
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
            "FitWarning"]
@@ -36,21 +37,8 @@ def _warn(notes) -> None:
     for note in notes:
         warnings.warn(note, FitWarning, stacklevel=3)
 
-MAX_DEGREE = 30
-KINDS = ("chebyshev", "minimax")
-ERROR_KINDS = ("abs", "rel")
-BASES = ("monomial", "shifted")
-
-
-@functools.lru_cache(maxsize=1)
-def _versions() -> dict[str, str]:
-    out = {}
-    for name in ("chebnorm", "numpy", "mpmath", "sympy", "python-flint"):
-        try:
-            out[name] = _pkg_version(name)
-        except PackageNotFoundError:
-            out[name] = "unknown"
-    return out
+# MAX_DEGREE, KINDS, ERROR_KINDS and BASES live in .schema (imported above, still
+# importable from here)
 
 
 class Interval:
@@ -190,7 +178,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     or ``centered`` make a piecewise table instead (a
     :class:`~chebnorm.approx.piecewise.PiecewiseTable`, coefficients in one
     fixed-point format of ``frac_bits``, default 24, see
-    :func:`~chebnorm.approx.piecewise.fit_piecewise`):
+    :func:`~chebnorm.approx.piecewise_fit.piecewise_fit`):
 
     >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
     >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
@@ -235,7 +223,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         fn, iv, degree, kind, error, shift, monomials if constrained and not quantized else None,
         fix_constant and not quantized)
     _warn(notes)
-    provenance = dict(_versions())
+    provenance = dict(versions())
     provenance.update(extra)
     provenance["command"] = command or (
         f"chebnorm.fit({str(fn.expr)!r}, {iv.strings!r}, {degree}, kind={kind!r}, "
@@ -244,7 +232,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         provenance["binary_endpoints"] = iv.binary_note()
     if notes:
         provenance["warnings"] = " | ".join(notes)
-    with _construction("fitted"):  # certified above: checked, not proved twice
+    with construction("fitted"):  # certified above: checked, not proved twice
         table = CoefficientTable(
             name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
             interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
@@ -308,7 +296,7 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
 def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, command, basis,
                   coef_format, monomials, fix_constant, segments, segment_by, centered):
     """:func:`fit` with ``segments``/``segment_by``/``centered``: a piecewise table."""
-    from .piecewise import fit_piecewise
+    from .piecewise_fit import piecewise_fit
 
     if basis != "monomial":
         raise ValueError(f"basis {basis} applies to one polynomial; accepted with segments, "
@@ -321,7 +309,7 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
     if isinstance(frac_bits, (list, tuple)):
         raise ValueError(f"frac-bits {','.join(map(str, frac_bits))}: piecewise tables share "
                          f"one format; accepted: one integer")
-    return fit_piecewise(expr, tuple(interval), degree, segments=segments or 1,
+    return piecewise_fit(expr, tuple(interval), degree, segments=segments or 1,
                          segment_by=segment_by or "uniform",
                          coef_frac_bits=24 if frac_bits is None else frac_bits,
                          centered=centered, fit=kind, error=error, var=var,
@@ -389,10 +377,10 @@ def _shifted(coeffs, c: float, s: float) -> list[float]:
     """Coefficients in ``x`` re-expressed in ``t = (x - c)/s`` (exact, rounded once)."""
     from flint import fmpq_poly
 
-    from .fitting import _exact
+    from .fitting import exact_rational
 
-    poly = fmpq_poly([_exact(v) for v in coeffs])
-    out = poly(fmpq_poly([_exact(c), _exact(s)])).coeffs()
+    poly = fmpq_poly([exact_rational(v) for v in coeffs])
+    out = poly(fmpq_poly([exact_rational(c), exact_rational(s)])).coeffs()
     return [int(q.p) / int(q.q) for q in out] + [0.0] * (len(coeffs) - len(out))
 
 
@@ -594,7 +582,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     table.verify()  # a table changed behind the frozen dataclass's back is re-proved
     table.require_monomial("quantize")
 
-    from .rounding import FORMATS, _Problem, greedy as greedy_integers, round_coefficients
+    from .rounding import FORMATS, Problem, greedy as greedy_integers, round_coefficients
 
     if coef_format not in FORMATS:
         raise ValueError(f"coefficient format {coef_format!r} is unknown; accepted: "
@@ -620,7 +608,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     full_basis = mons == tuple(range(n + 1)) or (fix_constant and mons == tuple(range(1, n + 1)))
     if (not full_basis or fix_constant) and not _fitted_alike(table, mons, fixed):
         real = _constrained_fit(fn, iv, n, mons, fixed, table.error_kind)
-    prob = _Problem(fn=fn, lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,
+    prob = Problem(fn=fn, lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,
                     error_kind=table.error_kind, degree=n, powers=mons, fixed=fixed,
                     word_limit=2 ** (word_bits - 1) - 1 if coef_format == "fixed" else None)
     greedy = None
@@ -688,7 +676,7 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
     """The table with its ``quantized`` (and, where it fits, ``fixed_point``) part."""
     from dataclasses import replace
 
-    from .rounding import _normal
+    from .rounding import normal_pair
 
     method = "lattice" if best.method.startswith("lattice") else best.method
     # tight=False there means missing 2^-20; warn only when 1 + 2^-8 is missed
@@ -704,7 +692,7 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
         max_abs_error=ca.maximum, max_rel_error=None if cr is None else cr.maximum)
     if coef_format != "fixed":
         # odd mantissas (zero: 0 * 2^0): one spelling per number, within 2^53
-        pairs = [_normal(m, e) for m, e in zip(quant.mantissas, quant.exponents)]
+        pairs = [normal_pair(m, e) for m, e in zip(quant.mantissas, quant.exponents)]
         quant = replace(quant, mantissas=tuple(m for m, _ in pairs),
                         exponents=tuple(e for _, e in pairs))
     fixed_point = None
@@ -718,7 +706,7 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
         _warn(notes)
         old = warnings_of(table)
         provenance["warnings"] = " | ".join(old + [n for n in notes if n not in old])
-    with _construction("fitted"):  # ``table`` verified, ``quant`` certified by quantize
+    with construction("fitted"):  # ``table`` verified, ``quant`` certified by quantize
         return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
 
 

@@ -59,7 +59,7 @@ from flint import arb, arb_poly, arb_series, ctx
 
 from chebnorm.core.numeric import arb_precision, ball_float_down, ball_float_up
 
-from .expr import Function1D, _compile_arb
+from .expr import Function1D, compile_arb
 
 __all__ = ["Certificate", "certify", "arb_enclose"]
 
@@ -97,7 +97,7 @@ def arb_enclose(value: sp.Expr) -> arb:
 def _enclose(value: sp.Expr, prec: int) -> arb:
     """:func:`arb_enclose` at ``prec`` bits, cached (balls are immutable)."""
     with arb_precision(prec):
-        return _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+        return compile_arb(value, sp.Dummy(), series=False)(arb(0))
 
 
 def _coeffs(series: arb_series, n: int) -> list[arb]:
@@ -113,7 +113,7 @@ def _horner(coeffs: Sequence[arb], x):
     return acc
 
 
-class _PolyTaylor:
+class PolyTaylor:
     """``p`` and its Taylor expansions ``p(x0 + h)``, by Horner in C.
 
     The k-th Taylor coefficient at ``x0`` is ``q_k(x0)`` with ``q_k =
@@ -169,11 +169,11 @@ class _PolyTaylor:
         return self._q(0)(self._t(s))
 
 
-def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
+def error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     """``g = p - f`` or ``p/f - 1`` for ``f`` an arb or arb_series function;
     nan wherever Arb cannot evaluate it (a division by a ball containing 0).
     With ``shift = (c, s)``, ``p(x) = sum coeffs[k] ((x - c)/s)^k``."""
-    p = coeffs if isinstance(coeffs, _PolyTaylor) else _PolyTaylor(coeffs, shift)
+    p = coeffs if isinstance(coeffs, PolyTaylor) else PolyTaylor(coeffs, shift)
     if kind == "abs":
         def g(s):
             return p(s) - f(s)
@@ -193,10 +193,10 @@ def _error_function(f, coeffs: Sequence[arb], kind: str, shift=None):
     return safe
 
 
-def _error_taylor(f_series, p: _PolyTaylor, kind: str):
+def _error_taylor(f_series, p: PolyTaylor, kind: str):
     """``(x0, n) ->`` the first ``n`` Taylor coefficients of ``g`` at the ball
     ``x0`` (all nan where Arb cannot evaluate it): the error function of
-    :func:`_error_function` without building the series of ``p``, for the
+    :func:`error_function` without building the series of ``p``, for the
     subdivision's inner loop. Its attribute ``over(x0, n)`` gives the
     second and the last of them alone (over a piece: an enclosure of ``g'``,
     and the remainder term)."""
@@ -436,9 +436,9 @@ def _certify(fn, floats, lo, hi, kind, tol, max_subintervals, shift=None,
              abort_at: float | None = None) -> Certificate | None:
     """:func:`certify`'s work; with ``abort_at``, None once the bound (the largest
     of the located maximum and the accepted pieces' upper bounds) reaches it."""
-    p = _PolyTaylor([arb(c) for c in floats], shift)
+    p = PolyTaylor([arb(c) for c in floats], shift)
     g = _error_taylor(fn.arb_series, p, kind)  # (x0, n) -> Taylor coefficients
-    g_point = _error_function(fn.arb, p, kind)
+    g_point = error_function(fn.arb, p, kind)
     lo_b, hi_b, lo_f, hi_f = _enclose_interval(lo, hi)
     a0, b0 = lo_b.lower(), hi_b.upper()
     edges = _edges(a0, b0, max(len(floats) - 1, 0))

@@ -425,7 +425,7 @@ def enclose(value: sp.Expr, prec: int = 64) -> arb | None:
         return None
     with arb_precision(prec):
         try:
-            ball = _compile_arb(value, sp.Dummy(), series=False)(arb(0))
+            ball = compile_arb(value, sp.Dummy(), series=False)(arb(0))
         except (ValueError, ZeroDivisionError):
             return None
         return ball if ball.is_finite() else None
@@ -554,7 +554,7 @@ def _rational_power(v, q: sp.Rational, exponent: Callable):
     return arb(0).union(top)
 
 
-def _compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
+def compile_arb(expr: sp.Expr, var: sp.Symbol, series: bool) -> Callable:
     """Compile ``expr`` to a function of one arb (or arb_series) argument.
 
     Constant subtrees are evaluated at the current ``flint.ctx.prec`` when
@@ -703,11 +703,11 @@ class Function1D:
 
     @functools.cached_property
     def arb(self) -> Callable[[arb], arb]:
-        return _compile_arb(self.expr, self.var, series=False)
+        return compile_arb(self.expr, self.var, series=False)
 
     @functools.cached_property
     def arb_series(self) -> Callable[[arb_series], arb_series]:
-        return _compile_arb(self.expr, self.var, series=True)
+        return compile_arb(self.expr, self.var, series=True)
 
     def __str__(self) -> str:
         return str(self.expr)

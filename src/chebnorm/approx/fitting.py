@@ -62,10 +62,10 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
         return []
     series = fmpq_poly([])
     for k, ck in enumerate(cheb):
-        series += _exact(ck) * _chebyshev_t(k)
+        series += exact_rational(ck) * chebyshev_t(k)
     # substitute u = alpha t + beta (x = center + scale t), exactly
-    lo_q, hi_q = _exact(float(lo)), _exact(float(hi))
-    c_q, s_q = _exact(float(center)), _exact(float(scale))
+    lo_q, hi_q = exact_rational(float(lo)), exact_rational(float(hi))
+    c_q, s_q = exact_rational(float(center)), exact_rational(float(scale))
     alpha = 2 * s_q / (hi_q - lo_q)
     beta = (2 * c_q - lo_q - hi_q) / (hi_q - lo_q)
     coeffs = series(fmpq_poly([beta, alpha])).coeffs()
@@ -74,12 +74,12 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
 
 
 @functools.lru_cache(maxsize=None)
-def _chebyshev_t(k: int) -> fmpq_poly:
+def chebyshev_t(k: int) -> fmpq_poly:
     """``T_k`` with exact rational coefficients."""
     return fmpq_poly(fmpz_poly.chebyshev_t(k))
 
 
-def _exact(v) -> fmpq:
+def exact_rational(v) -> fmpq:
     """A float or an mpmath number as an exact rational."""
     if isinstance(v, mpmath.mpf):
         if not mpmath.isfinite(v):
@@ -460,17 +460,18 @@ class _PowerBasis:
 
     def monomial(self, coeffs) -> fmpq_poly:
         """``sum_j coeffs[j] phi_j`` exactly, as a polynomial in ``x``."""
-        s_inv = 1 / _exact(self.scale)
+        s_inv = 1 / exact_rational(self.scale)
         x_over = fmpq_poly([0, s_inv])
         out = fmpq_poly([])
         if self.step is None:
             for k, c in zip(self.powers, coeffs):
-                out += _exact(c) * x_over ** k
+                out += exact_rational(c) * x_over ** k
             return out
-        inner = fmpq_poly([_exact(self.beta)]) + _exact(self.alpha) * x_over ** self.step
+        inner = (fmpq_poly([exact_rational(self.beta)])
+                 + exact_rational(self.alpha) * x_over ** self.step)
         series = fmpq_poly([])
         for j, c in enumerate(coeffs):
-            series += _exact(c) * _chebyshev_t(j)
+            series += exact_rational(c) * chebyshev_t(j)
         return series(inner) * x_over ** self.powers[0]
 
 
@@ -548,7 +549,7 @@ class _Residual:
             ctx.prec = 200
             total = self.poly
             for k, c in self.fixed.items():
-                total += _exact(c) * fmpq_poly([0] * k + [1])
+                total += exact_rational(c) * fmpq_poly([0] * k + [1])
             ap = arb_poly([arb(c) for c in total.coeffs()])
             out = np.empty(len(x))
             for i, v in enumerate(x.tolist()):
@@ -618,7 +619,7 @@ def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | 
         rounds += n
         if c is None:
             break
-        coeff_exact = [a_ + _exact(float(b_)) for a_, b_ in zip(coeff_exact, c)]
+        coeff_exact = [a_ + exact_rational(float(b_)) for a_, b_ in zip(coeff_exact, c)]
         converged = stage_conv or max_err <= level * (1 + 1e-4)
         correction = float(np.max(np.abs(w_d[ok] * detlinalg.matvec(phi_d[ok], c))))
         if max_err == 0 or (stage > 0 and correction <= 1e-3 * level):

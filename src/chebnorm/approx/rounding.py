@@ -99,10 +99,15 @@ def round_to_float(value: float, fmt: str) -> tuple[int, int]:
     if s > emax - p + 1:
         raise ValueError(f"coefficient {value:.6g} overflows {fmt}; accepted: |c| below "
                          f"{math.ldexp(2 - 2.0 ** (1 - p), emax):.6g}")
-    return _normal(m, s)
+    return normal_pair(m, s)
 
 
-def _normal(m: int, s: int) -> tuple[int, int]:
+def normal_pair(m: int, s: int) -> tuple[int, int]:
+    """``(m', s')`` with ``m' * 2**s' == m * 2**s`` and ``m'`` odd (``(0, 0)`` for zero).
+
+    >>> normal_pair(12, -4)
+    (3, -2)
+    """
     if m == 0:
         return 0, 0
     while m % 2 == 0:
@@ -116,7 +121,7 @@ def representable(m: int, s: int, fmt: str) -> bool:
     if m == 0:
         return True
     p, emin, emax = FLOAT_FORMATS[fmt]
-    m, s = _normal(m, s)
+    m, s = normal_pair(m, s)
     bits = abs(m).bit_length()
     top = s + bits - 1                    # exponent of the leading bit
     return bits <= p and top <= emax and s >= emin - p + 1
@@ -223,7 +228,13 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
 
 
 @dataclass
-class _Problem:
+class Problem:
+    """A quantization problem: round the free ``powers`` of a degree-``degree`` fit of
+    ``fn`` on ``[lo, hi]`` (``error_kind`` error) to integers, the ``fixed`` ones held,
+    each within ``word_limit`` in fixed point; with the caches of its certificates,
+    nodes and lattice reductions (the candidates :func:`greedy` and the lattice
+    search compare)."""
+
     fn: object
     lo: object                    # exact sympy endpoints
     hi: object
@@ -247,7 +258,7 @@ class _Sampler:
     """Sampled weighted error of candidate polynomials (a lower bound of the
     supremum up to the float evaluation error, which is accounted for)."""
 
-    def __init__(self, prob: _Problem, samples: int = 4097):
+    def __init__(self, prob: Problem, samples: int = 4097):
         lo, hi = prob.lo_f, prob.hi_f
         x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
         x = np.clip(x, lo, hi)
@@ -329,7 +340,7 @@ def certify_tight(fn, coeffs, lo, hi, kind, abort_at: float | None = None):
                    abort_at=abort_at)
 
 
-def _certify_key(prob: _Problem, coeffs, abort_at: float | None = None):
+def _certify_key(prob: Problem, coeffs, abort_at: float | None = None):
     """The ranking certificate of ``coeffs``, or None when its bound is proven
     ``>= abort_at`` (it cannot beat that one); raises ValueError as certify."""
     known = prob.certs.get(coeffs)
@@ -349,7 +360,7 @@ def _certify_key(prob: _Problem, coeffs, abort_at: float | None = None):
     return cert
 
 
-def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
+def _select(prob: Problem, sampler: _Sampler, cands: dict, best: Candidate | None):
     """The candidate (among ``cands``: method -> (mantissas, exponents)) with the
     smallest certified bound, or ``best`` when none beats it."""
     ranked = []
@@ -378,7 +389,7 @@ def _select(prob: _Problem, sampler: _Sampler, cands: dict, best: Candidate | No
     return best
 
 
-def _full(prob: _Problem, free: dict) -> tuple[list[int], list[int]]:
+def _full(prob: Problem, free: dict) -> tuple[list[int], list[int]]:
     """Mantissas/exponents of all powers 0..degree from the free and fixed ones."""
     ms, es = [0] * (prob.degree + 1), [0] * (prob.degree + 1)
     for k, (m, e) in {**free, **prob.fixed}.items():
@@ -386,7 +397,7 @@ def _full(prob: _Problem, free: dict) -> tuple[list[int], list[int]]:
     return ms, es
 
 
-def _fixed_poly(prob: _Problem):
+def _fixed_poly(prob: Problem):
     def poly(x):
         out = np.zeros_like(x)
         for k, (m, e) in prob.fixed.items():
@@ -395,7 +406,7 @@ def _fixed_poly(prob: _Problem):
     return poly
 
 
-def _symmetric_parity(prob: _Problem) -> bool:
+def _symmetric_parity(prob: Problem) -> bool:
     """True when the interval is symmetric and every power (free and fixed)
     has one parity (and f, being fitted by them, is taken to have it too: the
     points on ``[0, hi]`` are then the whole problem)."""
@@ -470,33 +481,33 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     return out
 
 
-def _to_monomial(prob: _Problem, cheb) -> list[float]:
+def _to_monomial(prob: Problem, cheb) -> list[float]:
     """:func:`chebnorm.approx.fitting.cheb_to_monomial` on the problem's
     interval, the same exact rationals rounded once (so the same floats): the
     monomial coefficients of each ``T_k(u(x))`` are kept, and each answer is
     an exact sum of their multiples."""
     from flint import fmpq_poly
 
-    from .fitting import _chebyshev_t, _exact
+    from .fitting import chebyshev_t, exact_rational
 
     n = len(cheb)
     key = ("mono", n)
     rows = prob.greedy_nodes.get(key)
     if rows is None:
-        lo_q, hi_q = _exact(float(prob.lo_f)), _exact(float(prob.hi_f))
+        lo_q, hi_q = exact_rational(float(prob.lo_f)), exact_rational(float(prob.hi_f))
         sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
         rows = prob.greedy_nodes[key] = [
-            (_chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
-    exact = [_exact(c) for c in cheb]
+            (chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
+    exact = [exact_rational(c) for c in cheb]
     out = []
     for j in range(n):
         total = sum((exact[k] * rows[k][j] for k in range(j, n) if rows[k][j] != 0),
-                    _exact(0.0))
+                    exact_rational(0.0))
         out.append(int(total.p) / int(total.q))
     return out
 
 
-def greedy(prob: _Problem, real, quanta) -> list[int] | None:
+def greedy(prob: Problem, real, quanta) -> list[int] | None:
     """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
     ``2**quanta[k]`` from the highest power down, the lower ones refitted after
     each rounding (interpolation of the residual at Chebyshev nodes)."""
@@ -585,7 +596,7 @@ def _ranked(sampler: _Sampler, cands, batch: int = 8):
             heapq.heappush(heap, (low, 1, rows[i][0], i))
 
 
-def _error_at(prob: _Problem, points, coeffs) -> float:
+def _error_at(prob: Problem, points, coeffs) -> float:
     """A rigorous lower bound of the error of ``coeffs`` (sup over the
     interval): its largest value at ``points`` (inside the interval), in ball
     arithmetic at 128 bits (no float evaluation allowance, which at a
@@ -594,12 +605,12 @@ def _error_at(prob: _Problem, points, coeffs) -> float:
 
     from chebnorm.core.numeric import ball_float_down
 
-    from .certify import _error_function
+    from .certify import error_function
 
     old = ctx.prec
     try:
         ctx.prec = 128
-        g = _error_function(prob.fn.arb, [arb(c) for c in coeffs], prob.error_kind)
+        g = error_function(prob.fn.arb, [arb(c) for c in coeffs], prob.error_kind)
         best = arb(0)
         for x in points:
             v = abs(g(arb(x)))
@@ -610,7 +621,7 @@ def _error_at(prob: _Problem, points, coeffs) -> float:
         ctx.prec = old
 
 
-def _peaks(prob: _Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[float]:
+def _peaks(prob: Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[float]:
     """Where the error of ``coeffs`` has its local maxima (every one: a
     near-minimax error has ``n + 2`` of nearly one height), each found on the
     sampler's grid and refined by ``zooms`` denser grids around it."""
@@ -643,7 +654,7 @@ def _peaks(prob: _Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[fl
     return out + [math.nextafter(prob.lo_f, math.inf), math.nextafter(prob.hi_f, -math.inf)]
 
 
-def _point_errors(prob: _Problem, x, coeffs, sampler: _Sampler | None = None) -> np.ndarray:
+def _point_errors(prob: Problem, x, coeffs, sampler: _Sampler | None = None) -> np.ndarray:
     """The error of ``coeffs`` at each of ``x`` as :meth:`_Sampler.error`
     computes it (``sampler``: one holding exactly these points, for its
     powers); -inf where it is not finite."""
@@ -666,7 +677,7 @@ def _point_errors(prob: _Problem, x, coeffs, sampler: _Sampler | None = None) ->
     return np.where(np.isfinite(err), err, -np.inf)
 
 
-def _certify_ranked(prob: _Problem, ranked: list, limit: int | None = None,
+def _certify_ranked(prob: Problem, ranked: list, limit: int | None = None,
                     slack: float = 0.0, sampler: _Sampler | None = None):
     """The smallest certified bound among ``ranked`` (from :func:`_rank`):
     candidates are certified in their sampled order, each against the best so
@@ -709,7 +720,7 @@ FLOAT_CERTIFY = None
 FLOAT_SLACK = SELECT_TOL
 
 
-def _grid_lower_bounds(prob: _Problem, fracs):
+def _grid_lower_bounds(prob: Problem, fracs):
     """A function ``level ->`` a rigorous lower bound of the error (the
     problem's kind, sup over the interval) of EVERY polynomial whose free
     coefficient ``k`` is an integer multiple of ``2^-(fracs[k] - level)`` (the
@@ -805,7 +816,7 @@ def _short_combinations(rows: list[list[float]]) -> list[list[int]]:
     return [[int(v) for v in row] for row in trans.tolist()]
 
 
-def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
+def _chain_level(prob: Problem, coarse: _Sampler, real, fracs, level: int, greedy) -> list:
     """The fixed-point pool's members at ``F - level`` bits (all powers shifted
     alike): the plain rounding and the candidate with the smallest cheaply
     sampled error, as (method, mantissas, exponents) at ``F`` bits."""
@@ -820,7 +831,7 @@ def _chain_level(prob: _Problem, coarse: _Sampler, real, fracs, level: int, gree
             for method, ms, es in members]
 
 
-def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candidate | None:
+def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy) -> Candidate | None:
     """The best certified member of the fixed-point pool: at every bit count
     ``b = 0..F`` the members of :func:`_chain_level`. The pool at ``F - 1``
     bits is a subset (same values) of the pool at ``F``, so the certified
@@ -850,7 +861,7 @@ def _fixed_pool(prob: _Problem, sampler: _Sampler, real, fracs, greedy) -> Candi
     return _certify_ranked(prob, _ranked(sampler, pool))
 
 
-def round_coefficients(prob: _Problem, real, fmt: str, frac_bits=None, greedy=None,
+def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=None,
                        plain: bool = False) -> Candidate:
     """The best certified rounding of ``real`` (coefficients of all powers);
     with ``plain``, each coefficient rounded to nearest and nothing else.

@@ -23,22 +23,25 @@ or ``abs_error_bound: stated 4.24e-03 but the coefficients' certified error is
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import dataclasses
-import json
 import math
-import weakref
 from fractions import Fraction
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 
+from .contract import Table, construction
+from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
+                     MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
+                     SCHEMA_VERSION, array, bad, boolean, check_object, choice, integer, number,
+                     provenance, show, text)
+
 __all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint",
            "Quantized"]
 
-SCHEMA_VERSION = 1
+#: :func:`chebnorm.approx.contract.construction` under the name the tests import
+_construction = construction
 
 
 @dataclass(frozen=True)
@@ -106,7 +109,7 @@ class Quantized:
 
 
 @dataclass(frozen=True)
-class CoefficientTable:
+class CoefficientTable(Table):
     """A fitted polynomial with certified error bounds (see module docstring).
 
     ``interval`` holds the exact endpoints as sympy strings; ``interval_float``
@@ -149,10 +152,10 @@ class CoefficientTable:
     shift: tuple[float, float] | None = None
     quantized: Quantized | None = None
 
-    def __post_init__(self) -> None:
-        """Check every field and re-prove every claim (see :meth:`verify`): a table
-        built by hand or by ``dataclasses.replace`` is verified as a file is."""
-        _establish(self, _read_fields, _verify)
+    WHAT = "coefficient table"
+    MAX_BYTES = MAX_TABLE_BYTES
+    TOO_LARGE_HINT = "; accepted: a table written by chebnorm (a few kB)"
+    JSON_INDENT = 2
 
     @property
     def basis(self) -> str:
@@ -212,47 +215,14 @@ class CoefficientTable:
             del d["quantized"]
         return d
 
-    def to_json(self) -> str:
-        """The JSON text: keys sorted, strict JSON (no ``NaN``/``Infinity``)."""
-        return json.dumps(self.to_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
-
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "CoefficientTable":
-        """Read a table from its JSON object, checking every field, and verify it.
+    def _file_fields(cls, d) -> dict[str, Any]:
+        """Each field is checked for type and range (a refusal names the field:
+        ``coefficients[2]: expected a finite number, got 'abc'``)."""
+        return _read_fields(cls, d)
 
-        Each field is checked for type and range (a refusal names the field:
-        ``coefficients[2]: expected a finite number, got 'abc'``); then the
-        claims are re-proved: see :meth:`verify`.
-        """
-        return cls(**_read_fields(cls, d))
-
-    @classmethod
-    def from_json(cls, text: str) -> "CoefficientTable":
-        """Parse JSON text and read it with :meth:`from_dict` (so: verified).
-        A key given twice in one object is refused, naming the key."""
-        return cls.from_dict(parse_json(text, "coefficient table"))
-
-    @classmethod
-    def load(cls, path) -> "CoefficientTable":
-        """Read and verify the table in file ``path`` (at most 1 MiB of JSON).
-
-        A refusal starts with the file name and names the field.
-        """
-        try:
-            with open(path, "rb") as fh:
-                raw = fh.read(MAX_TABLE_BYTES + 1)
-        except OSError as exc:
-            raise ValueError(f"cannot read coefficient table {str(path)!r}: {exc.strerror}") from None
-        if len(raw) > MAX_TABLE_BYTES:
-            raise ValueError(f"coefficient table {str(path)!r} is larger than {MAX_TABLE_BYTES} "
-                             f"bytes; accepted: a table written by chebnorm (a few kB)")
-        try:
-            return cls.from_json(raw.decode("utf-8"))
-        except UnicodeDecodeError as exc:
-            raise ValueError(f"coefficient table {str(path)!r} is not UTF-8 text (byte "
-                             f"{exc.start})") from None
-        except ValueError as exc:
-            raise ValueError(f"coefficient table {str(path)!r}: {exc}") from None
+    def _prove_claims(self) -> None:
+        _verify(self)
 
     def verify(self) -> "CoefficientTable":
         """Re-prove every claim of the table; return it unchanged, or raise.
@@ -283,15 +253,7 @@ class CoefficientTable:
         nothing changed since, and re-proves the table otherwise (fields set
         behind the frozen dataclass's back, an unpickled object).
         """
-        if not _sealed(self):
-            _establish(self, _read_fields, _verify, mode="prove")
-        return self
-
-    def save(self, path) -> None:
-        """Write the JSON atomically (temporary file, then rename)."""
-        from chebnorm.core.files import write_atomic
-
-        write_atomic(path, self.to_json())
+        return super().verify()
 
     # -- display (Jupyter) ----------------------------------------------------
     def _display_rows(self) -> list[tuple[str, str]]:
@@ -322,43 +284,6 @@ class CoefficientTable:
         if self.provenance:
             rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
         return rows
-
-    def _repr_html_(self) -> str:
-        """An HTML table of the fit for Jupyter; every field is HTML-escaped
-        (tables may come from untrusted files).
-
-        >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
-        ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
-        ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
-        ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
-        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None,
-        ...     provenance={"command": "<script>"})
-        >>> "&lt;script&gt;" in t._repr_html_() and "<script>" not in t._repr_html_()
-        True
-        """
-        from html import escape
-
-        body = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th>"
-                       f"<td style='text-align:left'>{escape(v)}</td></tr>"
-                       for k, v in self._display_rows())
-        return (f"<table><caption style='text-align:left'><b>CoefficientTable "
-                f"{escape(self.name)}</b></caption>{body}</table>")
-
-    def _repr_markdown_(self) -> str:
-        """A Markdown table of the fit; user text is escaped for Markdown and HTML.
-
-        >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
-        ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
-        ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),
-        ...     abs_error_bound=0.0, rel_error_bound=None, max_abs_error=0.0,
-        ...     max_abs_at=0.0, max_rel_error=None, max_rel_at=None,
-        ...     provenance={"command": "a|b"})
-        >>> print(t._repr_markdown_().splitlines()[-1])
-        | provenance | command: a\\|b |
-        """
-        lines = [f"**CoefficientTable {_markdown_escape(self.name)}**", "", "| | |", "|---|---|"]
-        lines += [f"| {_markdown_escape(k)} | {_markdown_escape(v)} |" for k, v in self._display_rows()]
-        return "\n".join(lines) + "\n"
 
     def error_curve(self, points: int = 801, error: str = "abs", fixed: bool = False):
         """``(x, g)``: the error ``g = p - f`` (``error="abs"``) or
@@ -444,185 +369,80 @@ class CoefficientTable:
 
 # -- reading: every field checked, each refusal naming its field ---------------
 
-#: largest table file :meth:`CoefficientTable.load` reads (a table is a few kB)
-MAX_TABLE_BYTES = 1 << 20
-#: longest free text accepted in a field (expression, endpoint, provenance value)
-MAX_TEXT = 1000
-#: most provenance entries, and the longest provenance key
-MAX_PROVENANCE = 32
-_MAX_KEY = 64
-#: exactness of the fixed-point coefficients: ``q / 2**frac_bits`` must be a
-#: double (the certifier evaluates the stored doubles exactly), so ``|q| < 2**53``
-#: (``word_bits <= 53``) and ``frac_bits <= 1074`` (the smallest subnormal)
-MAX_WORD_BITS = 53
-MAX_FRAC_BITS = 1074
-FIXED_METHODS = ("rounded", "reoptimized", "lattice")
-QUANT_FORMATS = ("fixed", "binary16", "bfloat16", "binary32", "binary64")
 _OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None, "quantized": None}
 
 
-def _show(value) -> str:
-    """A value as the user wrote it in JSON, cut to a readable length."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, dict):
-        return "an object"
-    if isinstance(value, (list, tuple)):
-        return f"an array of {len(value)}"
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+def _claims(d, prefix: str = "") -> dict[str, float | None]:
+    """The error claims of ``d`` (a table, ``fixed_point`` or ``quantized``): the
+    bounds and located maxima, the relative ones null together."""
+    rel = number(d["rel_error_bound"], f"{prefix}rel_error_bound", optional=True, nonneg=True)
+    max_rel = number(d["max_rel_error"], f"{prefix}max_rel_error", optional=True, nonneg=True)
+    if (rel is None) != (max_rel is None):
+        raise ValueError(f"{prefix}max_rel_error: must be null exactly when "
+                         f"{prefix}rel_error_bound is null")
+    return dict(abs_error_bound=number(d["abs_error_bound"], f"{prefix}abs_error_bound",
+                                       nonneg=True),
+                rel_error_bound=rel,
+                max_abs_error=number(d["max_abs_error"], f"{prefix}max_abs_error", nonneg=True),
+                max_rel_error=max_rel)
 
 
-def _bad(field: str, expected: str, value) -> ValueError:
-    return ValueError(f"{field}: expected {expected}, got {_show(value)}")
+def _per_power(value, field: str, degree: int, read) -> tuple:
+    """An array of degree + 1 integers, each read with ``read(item, name)``."""
+    items = array(value, field, "integers")
+    if len(items) != degree + 1:
+        raise ValueError(f"{field}: {len(items)} integers for degree {degree}; "
+                         f"expected degree + 1 = {degree + 1}")
+    return tuple(read(v, f"{field}[{k}]") for k, v in enumerate(items))
 
 
-def _number(value, field: str, *, optional: bool = False, nonneg: bool = False) -> float | None:
-    if value is None and optional:
-        return None
-    what = "a finite number" + (" >= 0" if nonneg else "") + (" or null" if optional else "")
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _bad(field, what, value)
-    try:
-        out = float(value)
-    except OverflowError:
-        raise _bad(field, what, value) from None
-    if not math.isfinite(out) or (nonneg and out < 0):
-        raise _bad(field, what, value)
-    return out
-
-
-def _integer(value, field: str, lo: int | None = None, hi: int | None = None) -> int:
-    what = "an integer" if lo is None else f"an integer in {lo}..{hi}"
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise _bad(field, what, value)
-    if lo is not None and not lo <= value <= hi:
-        raise _bad(field, what, value)
-    return int(value)
-
-
-def _text(value, field: str, max_length: int = MAX_TEXT, *, empty: bool = False) -> str:
-    if not isinstance(value, str):
-        raise _bad(field, "a string", value)
-    if not value and not empty:
-        raise _bad(field, "a non-empty string", value)
-    if len(value) > max_length:
-        raise ValueError(f"{field}: {len(value)} characters; accepted: at most {max_length}")
-    return value
-
-
-def _choice(value, field: str, choices) -> str:
-    if not isinstance(value, str) or value not in choices:
-        raise _bad(field, "one of " + ", ".join(repr(c) for c in choices), value)
-    return value
-
-
-def _array(value, field: str, what: str) -> list:
-    if not isinstance(value, list):
-        raise _bad(field, f"an array of {what}", value)
-    return value
-
-
-def _object(d, field: str, allowed, optional=()) -> None:
-    """Refuse unknown and missing keys of the JSON object ``d``."""
-    if not isinstance(d, dict):
-        raise _bad(field or "coefficient table", "a JSON object", d)
-    prefix = f"{field}." if field else ""
-    unknown = sorted(k for k in d if k not in allowed)
-    if unknown:
-        raise ValueError(f"{prefix}{str(unknown[0])[:60]}: unknown field; accepted: "
-                         f"{', '.join(sorted(allowed))}")
-    for key in sorted(allowed):
-        if key not in d and key not in optional:
-            raise ValueError(f"{prefix}{key}: missing (a required field)")
+def _check_word(field: str, word_bits: int, values, values_field: str) -> None:
+    """Refuse a value of ``values`` that ``word_bits``-bit two's complement cannot hold."""
+    for k, q in enumerate(values):
+        if not -(1 << (word_bits - 1)) <= q < (1 << (word_bits - 1)):
+            need = max(q.bit_length() + 1, (-q - 1).bit_length() + 1)
+            raise ValueError(f"{field}: {word_bits} bits cannot hold {values_field}[{k}] = {q} "
+                             f"(two's complement); accepted: word_bits >= {need}")
 
 
 def _read_fixed(fp, degree: int) -> FixedPoint | None:
     if fp is None:
         return None
-    allowed = [f.name for f in dataclasses.fields(FixedPoint)]
-    _object(fp, "fixed_point", allowed)
-    frac_bits = _integer(fp["frac_bits"], "fixed_point.frac_bits", 0, MAX_FRAC_BITS)
-    word_bits = _integer(fp["word_bits"], "fixed_point.word_bits", 2, MAX_WORD_BITS)
-    ints = _array(fp["integers"], "fixed_point.integers", "integers")
-    integers = tuple(_integer(q, f"fixed_point.integers[{k}]") for k, q in enumerate(ints))
+    check_object(fp, "fixed_point", [f.name for f in dataclasses.fields(FixedPoint)])
+    frac_bits = integer(fp["frac_bits"], "fixed_point.frac_bits", 0, MAX_FRAC_BITS)
+    word_bits = integer(fp["word_bits"], "fixed_point.word_bits", 2, MAX_WORD_BITS)
+    ints = array(fp["integers"], "fixed_point.integers", "integers")
+    integers = tuple(integer(q, f"fixed_point.integers[{k}]") for k, q in enumerate(ints))
     if len(integers) != degree + 1:
         raise ValueError(f"fixed_point.integers: {len(integers)} integers for degree {degree}; "
                          f"expected degree + 1 = {degree + 1}")
-    for k, q in enumerate(integers):
-        if not -(1 << (word_bits - 1)) <= q < (1 << (word_bits - 1)):
-            need = max(q.bit_length() + 1, (-q - 1).bit_length() + 1)
-            raise ValueError(f"fixed_point.word_bits: {word_bits} bits cannot hold "
-                             f"fixed_point.integers[{k}] = {q} (two's complement); accepted: "
-                             f"word_bits >= {need}")
-    rel = _number(fp["rel_error_bound"], "fixed_point.rel_error_bound", optional=True, nonneg=True)
-    max_rel = _number(fp["max_rel_error"], "fixed_point.max_rel_error", optional=True, nonneg=True)
-    if (rel is None) != (max_rel is None):
-        raise ValueError("fixed_point.max_rel_error: must be null exactly when "
-                         "fixed_point.rel_error_bound is null")
-    return FixedPoint(
-        frac_bits=frac_bits, integers=integers, word_bits=word_bits,
-        method=_choice(fp["method"], "fixed_point.method", FIXED_METHODS),
-        abs_error_bound=_number(fp["abs_error_bound"], "fixed_point.abs_error_bound", nonneg=True),
-        rel_error_bound=rel,
-        max_abs_error=_number(fp["max_abs_error"], "fixed_point.max_abs_error", nonneg=True),
-        max_rel_error=max_rel)
+    _check_word("fixed_point.word_bits", word_bits, integers, "fixed_point.integers")
+    claims = _claims(fp, "fixed_point.")
+    return FixedPoint(frac_bits=frac_bits, integers=integers, word_bits=word_bits,
+                      method=choice(fp["method"], "fixed_point.method", FIXED_METHODS), **claims)
 
 
-def _read_quantized(q, degree: int) -> Quantized | None:
-    if q is None:
-        return None
-    from .rounding import representable
-
-    allowed = [f.name for f in dataclasses.fields(Quantized)]
-    _object(q, "quantized", allowed)
-    fmt = _choice(q["format"], "quantized.format", QUANT_FORMATS)
-    mon = _array(q["monomials"], "quantized.monomials", "integers")
-    monomials = tuple(_integer(k, f"quantized.monomials[{i}]", 0, degree) for i, k in enumerate(mon))
-    if not monomials or list(monomials) != sorted(set(monomials)):
-        raise _bad("quantized.monomials", f"increasing distinct powers in 0..{degree}", list(mon))
-    lists = {}
-    for key in ("mantissas", "exponents"):
-        arr = _array(q[key], f"quantized.{key}", "integers")
-        if len(arr) != degree + 1:
-            raise ValueError(f"quantized.{key}: {len(arr)} integers for degree {degree}; "
-                             f"expected degree + 1 = {degree + 1}")
-        lim = (1 << 53) - 1 if key == "mantissas" else 1100
-        lists[key] = tuple(_integer(v, f"quantized.{key}[{k}]", -lim, lim)
-                           for k, v in enumerate(arr))
-    mants, exps = lists["mantissas"], lists["exponents"]
+def _read_binary(q, degree: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """``quantized.mantissas`` and ``quantized.exponents``: each ``m * 2**e`` a double."""
+    lim_m, lim_e = (1 << 53) - 1, 1100
+    mants = _per_power(q["mantissas"], "quantized.mantissas", degree,
+                       lambda v, f: integer(v, f, -lim_m, lim_m))
+    exps = _per_power(q["exponents"], "quantized.exponents", degree,
+                      lambda v, f: integer(v, f, -lim_e, lim_e))
     for k, (m, e) in enumerate(zip(mants, exps)):
         c = math.ldexp(m, e) if e < 1024 else math.inf
         if m and (not math.isfinite(c) or Fraction(c) != Fraction(m) * Fraction(2) ** e):
             raise ValueError(f"quantized.mantissas[{k}]: {m} * 2^{e} is not a double; accepted: "
                              f"a finite double (the certifier evaluates it exactly)")
-    fixed_constant = q["fixed_constant"]
-    if not isinstance(fixed_constant, bool):
-        raise _bad("quantized.fixed_constant", "true or false", fixed_constant)
-    for k in range(degree + 1):
-        if k not in monomials and mants[k] != 0 and not (k == 0 and fixed_constant):
-            raise ValueError(f"quantized.mantissas[{k}]: x^{k} is not among quantized.monomials "
-                             f"{list(monomials)}, so its mantissa must be 0")
-    frac_bits, word_bits = None, None
-    if fmt == "fixed":
-        fb = _array(q["frac_bits"], "quantized.frac_bits", "integers")
-        if len(fb) != degree + 1:
-            raise ValueError(f"quantized.frac_bits: {len(fb)} integers for degree {degree}; "
-                             f"expected degree + 1 = {degree + 1}")
-        frac_bits = tuple(_integer(v, f"quantized.frac_bits[{k}]", 0, MAX_FRAC_BITS)
-                          for k, v in enumerate(fb))
-        word_bits = _integer(q["word_bits"], "quantized.word_bits", 2, MAX_WORD_BITS)
-        for k in range(degree + 1):
-            if mants[k] and exps[k] != -frac_bits[k]:
-                raise ValueError(f"quantized.exponents[{k}]: {exps[k]} for a fixed-point "
-                                 f"coefficient with {frac_bits[k]} fractional bits; expected "
-                                 f"{-frac_bits[k]}")
-            if not -(1 << (word_bits - 1)) <= mants[k] < (1 << (word_bits - 1)):
-                raise ValueError(f"quantized.word_bits: {word_bits} bits cannot hold "
-                                 f"quantized.mantissas[{k}] = {mants[k]}")
-    else:
+    return mants, exps
+
+
+def _read_format(q, fmt: str, degree: int, mants, exps):
+    """``(frac_bits, word_bits)`` of a fixed format (None, None for a floating
+    one), each coefficient checked against its format."""
+    from .rounding import representable
+
+    if fmt != "fixed":
         if q["frac_bits"] is not None or q["word_bits"] is not None:
             raise ValueError(f"quantized.frac_bits, quantized.word_bits: must be null for "
                              f"format {fmt}")
@@ -630,236 +450,125 @@ def _read_quantized(q, degree: int) -> Quantized | None:
             if not representable(mants[k], exps[k], fmt):
                 raise ValueError(f"quantized.mantissas[{k}]: {mants[k]} * 2^{exps[k]} is not "
                                  f"a finite {fmt} number")
-    rel = _number(q["rel_error_bound"], "quantized.rel_error_bound", optional=True, nonneg=True)
-    max_rel = _number(q["max_rel_error"], "quantized.max_rel_error", optional=True, nonneg=True)
-    if (rel is None) != (max_rel is None):
-        raise ValueError("quantized.max_rel_error: must be null exactly when "
-                         "quantized.rel_error_bound is null")
-    return Quantized(
-        format=fmt, monomials=monomials, mantissas=mants, exponents=exps, frac_bits=frac_bits,
-        word_bits=word_bits, fixed_constant=fixed_constant,
-        method=_choice(q["method"], "quantized.method", FIXED_METHODS),
-        abs_error_bound=_number(q["abs_error_bound"], "quantized.abs_error_bound", nonneg=True),
-        rel_error_bound=rel,
-        max_abs_error=_number(q["max_abs_error"], "quantized.max_abs_error", nonneg=True),
-        max_rel_error=max_rel)
+        return None, None
+    frac_bits = _per_power(q["frac_bits"], "quantized.frac_bits", degree,
+                           lambda v, f: integer(v, f, 0, MAX_FRAC_BITS))
+    word_bits = integer(q["word_bits"], "quantized.word_bits", 2, MAX_WORD_BITS)
+    for k in range(degree + 1):
+        if mants[k] and exps[k] != -frac_bits[k]:
+            raise ValueError(f"quantized.exponents[{k}]: {exps[k]} for a fixed-point "
+                             f"coefficient with {frac_bits[k]} fractional bits; expected "
+                             f"{-frac_bits[k]}")
+        if not -(1 << (word_bits - 1)) <= mants[k] < (1 << (word_bits - 1)):
+            raise ValueError(f"quantized.word_bits: {word_bits} bits cannot hold "
+                             f"quantized.mantissas[{k}] = {mants[k]}")
+    return frac_bits, word_bits
 
 
-def _read_fields(cls, d) -> dict[str, Any]:
-    """The fields of a table from its JSON object, every field checked (no
-    certification): the keyword arguments of ``cls``."""
-    from .api import ERROR_KINDS, KINDS, MAX_DEGREE
-    from chebnorm.core.textsafe import identifier
+def _read_quantized(q, degree: int) -> Quantized | None:
+    if q is None:
+        return None
+    check_object(q, "quantized", [f.name for f in dataclasses.fields(Quantized)])
+    fmt = choice(q["format"], "quantized.format", QUANT_FORMATS)
+    mon = array(q["monomials"], "quantized.monomials", "integers")
+    monomials = tuple(integer(k, f"quantized.monomials[{i}]", 0, degree) for i, k in enumerate(mon))
+    if not monomials or list(monomials) != sorted(set(monomials)):
+        raise bad("quantized.monomials", f"increasing distinct powers in 0..{degree}", list(mon))
+    mants, exps = _read_binary(q, degree)
+    fixed_constant = boolean(q["fixed_constant"], "quantized.fixed_constant")
+    for k in range(degree + 1):
+        if k not in monomials and mants[k] != 0 and not (k == 0 and fixed_constant):
+            raise ValueError(f"quantized.mantissas[{k}]: x^{k} is not among quantized.monomials "
+                             f"{list(monomials)}, so its mantissa must be 0")
+    frac_bits, word_bits = _read_format(q, fmt, degree, mants, exps)
+    claims = _claims(q, "quantized.")
+    return Quantized(format=fmt, monomials=monomials, mantissas=mants, exponents=exps,
+                     frac_bits=frac_bits, word_bits=word_bits, fixed_constant=fixed_constant,
+                     method=choice(q["method"], "quantized.method", FIXED_METHODS), **claims)
 
+
+def _check_version(d) -> None:
     if not isinstance(d, dict):
-        raise ValueError(f"a coefficient table must be a JSON object, got {_show(d)}")
+        raise ValueError(f"a coefficient table must be a JSON object, got {show(d)}")
     version = d.get("schema_version")
     if isinstance(version, bool) or not isinstance(version, int) or version != SCHEMA_VERSION:
-        raise ValueError(f"schema_version: schema version {_show(version)} is not supported; accepted: "
-                         f"{SCHEMA_VERSION}")
-    allowed = [f.name for f in dataclasses.fields(cls)]
-    _object(d, "", allowed, optional=_OPTIONAL)
-    d = {**_OPTIONAL, **d}
-    degree = _integer(d["degree"], "degree", 0, MAX_DEGREE)
-    coeffs = _array(d["coefficients"], "coefficients", "numbers")
-    coefficients = tuple(_number(c, f"coefficients[{k}]") for k, c in enumerate(coeffs))
-    if len(coefficients) != degree + 1:
-        raise ValueError(f"coefficients: {len(coefficients)} numbers for degree {degree}; "
-                         f"expected degree + 1 = {degree + 1}")
-    interval = _array(d["interval"], "interval", "2 strings")
-    if len(interval) != 2:
-        raise _bad("interval", "an array of 2 strings (exact constants such as \"sqrt(2)\")",
-                   interval)
-    interval_float = _array(d["interval_float"], "interval_float", "2 numbers")
-    if len(interval_float) != 2:
-        raise _bad("interval_float", "an array of 2 numbers", interval_float)
-    provenance = d["provenance"]
-    if not isinstance(provenance, dict):
-        raise _bad("provenance", "an object of strings", provenance)
-    if len(provenance) > MAX_PROVENANCE:
-        raise ValueError(f"provenance: {len(provenance)} entries; accepted: at most {MAX_PROVENANCE}")
-    for key, value in provenance.items():
-        _text(key, f"provenance key {key[:60]!r}", _MAX_KEY)
-        _text(value, f"provenance.{key}", empty=True)
-    rel = _number(d["rel_error_bound"], "rel_error_bound", optional=True, nonneg=True)
-    max_rel = _number(d["max_rel_error"], "max_rel_error", optional=True, nonneg=True)
-    max_rel_at = _number(d["max_rel_at"], "max_rel_at", optional=True)
+        raise ValueError(f"schema_version: schema version {show(version)} is not supported; "
+                         f"accepted: {SCHEMA_VERSION}")
+
+
+def _pair(value, field: str, what: str, explained: str) -> list:
+    """A JSON array of two items (``what``; ``explained`` in the refusal of another length)."""
+    items = array(value, field, what)
+    if len(items) != 2:
+        raise bad(field, explained, items)
+    return items
+
+
+def _read_rel(d) -> tuple[float | None, float | None, float | None]:
+    """``rel_error_bound``, ``max_rel_error``, ``max_rel_at``: null together, and
+    not null when the fit minimized the relative error."""
+    rel = number(d["rel_error_bound"], "rel_error_bound", optional=True, nonneg=True)
+    max_rel = number(d["max_rel_error"], "max_rel_error", optional=True, nonneg=True)
+    max_rel_at = number(d["max_rel_at"], "max_rel_at", optional=True)
     if (rel is None) != (max_rel is None) or (rel is None) != (max_rel_at is None):
         raise ValueError("max_rel_error, max_rel_at: must be null exactly when "
                          "rel_error_bound is null")
     if rel is None and d["error_kind"] == "rel":
         raise ValueError("rel_error_bound: null, but error_kind is 'rel'; accepted: the "
                          "certified relative error of a fit that minimized it")
-    shift = None
-    if d["shift"] is not None:
-        pair = _array(d["shift"], "shift", "2 numbers [center, scale]")
-        if len(pair) != 2:
-            raise _bad("shift", "an array of 2 numbers [center, scale]", pair)
-        shift = (_number(pair[0], "shift[0]"), _number(pair[1], "shift[1]", nonneg=True))
-        if not shift[1] > 0:
-            raise _bad("shift[1]", "a positive number (the scale s of t = (x - c)/s)", pair[1])
+    return rel, max_rel, max_rel_at
+
+
+def _read_shift(value) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    pair = _pair(value, "shift", "2 numbers [center, scale]", "an array of 2 numbers [center, scale]")
+    shift = (number(pair[0], "shift[0]"), number(pair[1], "shift[1]", nonneg=True))
+    if not shift[1] > 0:
+        raise bad("shift[1]", "a positive number (the scale s of t = (x - c)/s)", pair[1])
+    return shift
+
+
+def _read_fields(cls, d) -> dict[str, Any]:
+    """The fields of a table from its JSON object, every field checked (no
+    certification): the keyword arguments of ``cls``. The checks run in a fixed
+    order, so a table with several faults is refused for the same one each time."""
+    from chebnorm.core.textsafe import identifier
+
+    _check_version(d)
+    check_object(d, "", [f.name for f in dataclasses.fields(cls)], optional=_OPTIONAL)
+    d = {**_OPTIONAL, **d}
+    degree = integer(d["degree"], "degree", 0, MAX_DEGREE)
+    coeffs = array(d["coefficients"], "coefficients", "numbers")
+    coefficients = tuple(number(c, f"coefficients[{k}]") for k, c in enumerate(coeffs))
+    if len(coefficients) != degree + 1:
+        raise ValueError(f"coefficients: {len(coefficients)} numbers for degree {degree}; "
+                         f"expected degree + 1 = {degree + 1}")
+    interval = _pair(d["interval"], "interval", "2 strings",
+                     "an array of 2 strings (exact constants such as \"sqrt(2)\")")
+    interval_float = _pair(d["interval_float"], "interval_float", "2 numbers",
+                           "an array of 2 numbers")
+    prov = provenance(d["provenance"])
+    rel, max_rel, max_rel_at = _read_rel(d)
+    shift = _read_shift(d["shift"])
     return dict(
         name=identifier(d["name"], field="name"),
-        expression=_text(d["expression"], "expression"),
+        expression=text(d["expression"], "expression"),
         variable=identifier(d["variable"], field="variable"),
-        interval=tuple(_text(v, f"interval[{i}]") for i, v in enumerate(interval)),
-        interval_float=tuple(_number(v, f"interval_float[{i}]")
+        interval=tuple(text(v, f"interval[{i}]") for i, v in enumerate(interval)),
+        interval_float=tuple(number(v, f"interval_float[{i}]")
                              for i, v in enumerate(interval_float)),
-        degree=degree, kind=_choice(d["kind"], "kind", KINDS),
-        error_kind=_choice(d["error_kind"], "error_kind", ERROR_KINDS),
+        degree=degree, kind=choice(d["kind"], "kind", KINDS),
+        error_kind=choice(d["error_kind"], "error_kind", ERROR_KINDS),
         coefficients=coefficients,
-        abs_error_bound=_number(d["abs_error_bound"], "abs_error_bound", nonneg=True),
+        abs_error_bound=number(d["abs_error_bound"], "abs_error_bound", nonneg=True),
         rel_error_bound=rel,
-        max_abs_error=_number(d["max_abs_error"], "max_abs_error", nonneg=True),
-        max_abs_at=_number(d["max_abs_at"], "max_abs_at"),
+        max_abs_error=number(d["max_abs_error"], "max_abs_error", nonneg=True),
+        max_abs_at=number(d["max_abs_at"], "max_abs_at"),
         max_rel_error=max_rel, max_rel_at=max_rel_at,
         fixed_point=_read_fixed(d["fixed_point"], degree),
-        provenance=dict(provenance), schema_version=SCHEMA_VERSION, shift=shift,
+        provenance=prov, schema_version=SCHEMA_VERSION, shift=shift,
         quantized=_read_quantized(d["quantized"], degree))
-
-
-# -- construction: every table checked, every claim proved, once ----------------
-
-#: how a table being constructed is checked: ``"prove"`` (the default: every
-#: field checked, every claim re-proved), ``"fitted"`` (the fitter's own
-#: tables, whose bounds it has just certified: every field checked, nothing
-#: proved twice) or ``"unchecked"`` (nothing: for tests of the consumers' own
-#: defenses only; such a table is not sealed, so a consumer that verifies
-#: re-proves it). Module-private; set only through :func:`_construction`.
-_MODE: contextvars.ContextVar[str] = contextvars.ContextVar("chebnorm_table_mode",
-                                                            default="prove")
-
-
-@contextlib.contextmanager
-def _construction(mode: str):
-    """Construct tables in ``mode`` (see :data:`_MODE`) inside the block."""
-    if mode not in ("prove", "fitted", "unchecked"):
-        raise ValueError(f"mode {mode!r}")
-    token = _MODE.set(mode)
-    try:
-        yield
-    finally:
-        _MODE.reset(token)
-
-
-#: id(table) -> (weak reference, JSON text of the fields that were verified)
-_SEALS: dict[int, tuple[weakref.ref, str]] = {}
-
-
-def _seal(t) -> None:
-    """Record that ``t``'s present fields were verified."""
-    key = id(t)
-
-    def forget(ref, key=key):
-        if _SEALS.get(key, (None,))[0] is ref:
-            del _SEALS[key]
-
-    _SEALS[key] = (weakref.ref(t, forget), t.to_json())
-
-
-def _sealed(t) -> bool:
-    """True when ``t`` was verified and none of its fields (nested ones included)
-    changed since."""
-    entry = _SEALS.get(id(t))
-    if entry is None or entry[0]() is not t:
-        return False
-    try:
-        return entry[1] == t.to_json()
-    except (TypeError, ValueError, AttributeError, RecursionError):
-        return False
-
-
-def _plain(value):
-    """A value as JSON would hold it: tuples, numpy arrays and dataclasses as
-    lists and objects, numpy scalars as Python numbers; anything else as it is
-    (for the reader to refuse, naming the field)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name, None)) for f in dataclasses.fields(value)}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return [_plain(v) for v in value.tolist()]
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    return value
-
-
-def _first_non_finite(value, path: str = ""):
-    """``(path, value)`` of the first float in ``value`` (provenance aside) that is
-    inf or nan, or None."""
-    if isinstance(value, float):
-        return None if math.isfinite(value) else (path, value)
-    if isinstance(value, dict):
-        items = [(f"{path}.{k}" if path else str(k), v) for k, v in value.items()
-                 if k != "provenance"]
-    elif isinstance(value, list):
-        items = [(f"{path}[{k}]", v) for k, v in enumerate(value)]
-    else:
-        return None
-    for where, v in items:
-        hit = _first_non_finite(v, where)
-        if hit is not None:
-            return hit
-    return None
-
-
-def _establish(t, read_fields, prove, mode: str | None = None) -> None:
-    """Check ``t``'s fields with ``read_fields`` (normalizing them: tuples, floats),
-    re-prove its claims with ``prove`` unless the fitter built it, and seal it."""
-    mode = mode or _MODE.get()
-    if mode == "unchecked":
-        return
-    d = _plain(t)
-    if mode == "fitted":
-        bad = _first_non_finite(d)
-        if bad is not None:
-            lo, hi = (_show(str(v)).strip("'") for v in t.interval)
-            raise ValueError(f"{bad[0]}: the certified value is {bad[1]!r} for "
-                             f"{_show(str(t.expression)).strip(chr(39))} on [{lo}, {hi}], "
-                             f"beyond the float64 range; accepted: a "
-                             f"function, interval and degree whose error and coefficients "
-                             f"stay finite (below 1.8e308)")
-    fields = read_fields(type(t), d)
-    for name, value in fields.items():
-        object.__setattr__(t, name, value)
-    if mode == "prove":
-        prove(t)
-    _seal(t)
-
-
-def parse_json(text, what: str):
-    """``json.loads`` of a table's text; refuses what is not JSON, and an object
-    that gives a key twice (naming the key).
-
-    >>> parse_json('{"a": 1, "a": 2}', "coefficient table")
-    Traceback (most recent call last):
-    ...
-    ValueError: coefficient table is not valid JSON: key 'a' appears twice in one object; accepted: each key once
-    """
-    def pairs(items):
-        out = {}
-        for key, value in items:
-            if key in out:
-                raise _Duplicate(key)
-            out[key] = value
-        return out
-
-    try:  # NaN and Infinity are read, for the field's check to refuse naming the field
-        return json.loads(text, object_pairs_hook=pairs)
-    except _Duplicate as exc:
-        raise ValueError(f"{what} is not valid JSON: key {str(exc.key)[:60]!r} appears twice "
-                         f"in one object; accepted: each key once") from None
-    except (ValueError, RecursionError) as exc:  # JSONDecodeError, huge integers, deep nesting
-        raise ValueError(f"{what} is not valid JSON: "
-                         f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
-
-
-class _Duplicate(Exception):
-    def __init__(self, key):
-        super().__init__(key)
-        self.key = key
 
 
 # -- verifying: every stated bound re-proved for exactly the stored numbers -----
@@ -928,9 +637,9 @@ def _verify(t: "CoefficientTable") -> "CoefficientTable":
     except ValueError as exc:
         raise ValueError(f"expression: {exc}") from None
     ends = []
-    for i, text in enumerate(t.interval):
+    for i, end in enumerate(t.interval):
         try:
-            ends.append(parse_number(text))
+            ends.append(parse_number(end))
         except ValueError as exc:
             raise ValueError(f"interval[{i}]: {exc}") from None
     lo, hi = ends
@@ -999,12 +708,12 @@ def _check_at(kind: str, stated: float, at: float, fn, t) -> None:
     enclosure's own width, allowed)."""
     from flint import arb, ctx
 
-    from .certify import _PolyTaylor, _error_function
+    from .certify import PolyTaylor, error_function
 
     old = ctx.prec
     try:
         ctx.prec = 128
-        g = _error_function(fn.arb, _PolyTaylor([arb(c) for c in t.coefficients], t.shift), kind)
+        g = error_function(fn.arb, PolyTaylor([arb(c) for c in t.coefficients], t.shift), kind)
         v = abs(g(arb(at)))
         if not v.is_finite():
             raise ValueError(f"max_{kind}_at: the error cannot be evaluated at {t.variable} = "
@@ -1033,26 +742,3 @@ def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float,
             p = p * xm + mpmath.mpf(c)
         f = f_mp(xm)
         return at, float(p - f) if error == "abs" else float(p / f - 1)
-
-
-_MARKDOWN_SPECIAL = "\\`*_[]|~"
-
-
-def _markdown_escape(text: str) -> str:
-    """Backslash-escape Markdown's inline punctuation (a table cell is
-    inline), so user text is shown, not interpreted (``<`` and ``&`` also become HTML entities)."""
-    out = []
-    for ch in str(text):
-        if ch == "&":
-            out.append("&amp;")
-        elif ch == "<":
-            out.append("&lt;")
-        elif ch == ">":
-            out.append("&gt;")
-        elif ch in _MARKDOWN_SPECIAL:
-            out.append("\\" + ch)
-        elif ch in "\r\n":
-            out.append(" ")
-        else:
-            out.append(ch)
-    return "".join(out)

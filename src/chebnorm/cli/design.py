@@ -84,8 +84,8 @@ def _max_index_bits(args, parse_segments) -> int:
     return k
 
 
-def _piecewise_design(args):
-    from chebnorm.approx.piecewise import PiecewiseTable
+def _piecewise_design(args, table):
+    """The hardware design of the piecewise ``table`` (read from ``args.table``)."""
     from chebnorm.hw.piecewise import design_piecewise
 
     for opt in ("coef_bits", "acc_bits", "x_frac_bits", "y_frac_bits"):
@@ -96,10 +96,10 @@ def _piecewise_design(args):
     if getattr(args, "rounding", "rne") != "rne":
         raise ValueError(f"rounding {args.rounding!r}: a piecewise evaluator rounds to nearest "
                          f"even; accepted: rne")
-    return design_piecewise(PiecewiseTable.load(args.table), args.in_bits, args.out_bits)
+    return design_piecewise(table, args.in_bits, args.out_bits)
 
 
-def hw_verilog(args) -> int:
+def hw_verilog(args, table) -> int:
     """``chebnorm hw verilog`` of a piecewise table (called by :mod:`chebnorm.cli.hw`)."""
     from pathlib import Path
 
@@ -115,7 +115,7 @@ def hw_verilog(args) -> int:
         from chebnorm.hw.vhdl import simulate_vhdl as simulate
     else:
         from chebnorm.hw.verilog import simulate
-    d = _piecewise_design(args)
+    d = _piecewise_design(args, table)
     files = piecewise_outputs(d, version=__version__, command=command_line(args),
                               language=language)
     out = Path(args.output)
@@ -128,12 +128,12 @@ def hw_verilog(args) -> int:
     return 0
 
 
-def hw_report(args) -> int:
+def hw_report(args, table) -> int:
     """``chebnorm hw report`` of a piecewise table: error budget by part, measured error, cells."""
     from chebnorm.hw.piecewise import piecewise_cells
     from chebnorm.hw.piecewise_search import model_cost
 
-    d = _piecewise_design(args)
+    d = _piecewise_design(args, table)
     b, m = d.budget(), d.measure()
     cells = None if args.no_synth else piecewise_cells(d).cells
     rep = {"module": d.module_name, "segments": d.table.segment_count, "degree": d.degree,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from chebnorm.approx import CoefficientTable
+from chebnorm.approx import CoefficientTable, PiecewiseTable, load_table
 
 from ._common import command_line, deprecated_alias, print_json, refuse_unused
 from ._parallel import add_parallel_args
@@ -122,10 +122,19 @@ def register(sub) -> None:
     s.set_defaults(func=run_sweep)
 
 
-def _analyze(args, synth: bool, gappa: bool):
+def _coefficient_table(table, path, command: str) -> CoefficientTable:
+    """``table`` (read from ``path``), refused naming ``command`` when it is a
+    piecewise table."""
+    if not isinstance(table, CoefficientTable):
+        raise ValueError(f"piecewise table {str(path)!r}: {command} reads a coefficient "
+                         f"table; accepted: a table fitted without --segments, --segment-by "
+                         f"and --centered")
+    return table
+
+
+def _analyze(args, table, synth: bool, gappa: bool):
     from chebnorm.hw.report import analyze
 
-    table = CoefficientTable.load(args.table)
     return analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
                    acc_bits=args.acc_bits, rounding=args.rounding, x_frac_bits=args.x_frac_bits,
                    y_frac_bits=args.y_frac_bits, gappa=gappa, synth=synth)
@@ -146,12 +155,11 @@ def run_verilog(args) -> int:
     from chebnorm.hw.report import hdl_outputs, write_outputs
 
     _check_output(args.output)
-    from chebnorm.approx.piecewise import is_piecewise_file
-
-    if is_piecewise_file(args.table):
+    table = load_table(args.table)
+    if isinstance(table, PiecewiseTable):
         from .design import hw_verilog
-        return hw_verilog(args)
-    report = _analyze(args, synth=False, gappa=False)
+        return hw_verilog(args, table)
+    report = _analyze(args, table, synth=False, gappa=False)
     if args.pipelined and report.design.degree < 1:
         raise ValueError(f"table {report.design.table.name!r} has degree 0: nothing to "
                          f"pipeline; accepted: --pipelined with degree >= 1")
@@ -202,12 +210,12 @@ def run_report(args) -> int:
     for kind in args.unit:
         get_unit(kind)  # refuses an unknown name, listing the registered ones
     _refuse_unit_options(args, args.unit)
-    from chebnorm.approx.piecewise import is_piecewise_file
-
-    if is_piecewise_file(args.table) and not args.unit:
+    table = load_table(args.table)
+    if isinstance(table, PiecewiseTable) and not args.unit:
         from .design import hw_report
-        return hw_report(args)
-    report = _analyze(args, synth=not args.no_synth, gappa=not args.no_gappa)
+        return hw_report(args, table)
+    table = _coefficient_table(table, args.table, "hw report --unit")
+    report = _analyze(args, table, synth=not args.no_synth, gappa=not args.no_gappa)
     units = []
     for kind in dict.fromkeys(args.unit):
         has_evaluator = get_unit(kind).target is not None
@@ -246,7 +254,8 @@ def run_unit(args) -> int:
 
     _check_output(args.output)
     _refuse_unit_options(args, [args.kind])
-    table = CoefficientTable.load(args.table) if args.table else None
+    table = (_coefficient_table(load_table(args.table), args.table, "hw unit --table")
+             if args.table else None)
     unit = _unit(args, args.kind, table)
     rep = analyze_unit(unit, synth=args.synth)
     files = unit_outputs(unit, count=args.vectors, seed=args.seed, version=__version__,
