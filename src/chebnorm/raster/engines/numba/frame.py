@@ -600,6 +600,44 @@ def supports(spec) -> bool:
             and calibrated() is not None)
 
 
+def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
+    """The per-span arrays of method ``mode`` the frame's kernels take: ``(dtype, A, B,
+    C, sc, sc2, levels, R, off, kd)`` (placeholders of size 1 where the mode has none;
+    ``dtype`` the computation's, checked as the reference checks it where spans use it)."""
+    S = len(sp.count)
+    dt_ = np.float64    # the computation's dtype, checked (as the reference) where spans use it
+    if mode and S:
+        dt_, coeffs, lv, A, B, start_left, count_max = span_input(
+            spec, sp, tables, dtype, ends, mode <= 3)
+    else:
+        A = B = np.zeros((3, 1), dt_)
+    C = np.zeros((3, 1), dt_)
+    sc = sc2 = np.zeros(1, dt_)
+    levels = np.zeros(1, np.int64)
+    R = np.zeros((1, 1), dt_)
+    off = np.zeros(1, np.bool_)
+    kd = np.zeros(1, dt_)
+    if mode and S:
+        dtype = dt_
+        ops = DetOps(dtype)    # modes 1-3: B is N_r - N_l (K.vsub(b, a)) in the dtype
+        if mode == 4:       # K.SLERP.setup, compiled
+            sc, sc2 = method_setup(mode, A, B, None, None, coeffs, start_left, count_max,
+                                   ops, work)
+        elif mode == 5:     # quadratic_setup, compiled
+            A, B, C = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
+                                   coeffs, start_left, count_max, ops, work)
+        elif mode == 6:     # angular_setup, compiled
+            A, B, sc = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
+                                    coeffs, start_left, count_max, ops, work)
+        elif mode == 7:     # dichotomy
+            cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
+            kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
+            levels = np.ascontiguousarray(lv, np.int64)
+            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
+                                     sp.count)
+    return dt_, A, B, C, sc, sc2, levels, R, off, kd
+
+
 def phong(st, spec, lighting, tables, dtype):
     """The ``phong`` frame of ``render`` as a
     :class:`~chebnorm.raster.engines.base.ModeResult`: set-up ``st`` (with ``L``),
@@ -634,38 +672,8 @@ def phong(st, spec, lighting, tables, dtype):
     ends, dot_min = (widest_dot(sp, spec, dtype, mode <= 3, work)
                      if S and (mode or spec.table is not None) else (None, None))
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats, dot_min=dot_min)
-    dt_ = np.float64    # the computation's dtype, checked (as the reference) where spans use it
-    if mode and S:
-        dt_, coeffs, lv, A, B, start_left, count_max = span_input(
-            spec, sp, tables, dtype, ends, mode <= 3)
-    else:
-        A = B = np.zeros((3, 1), dt_)
-    C = np.zeros((3, 1), dt_)
-    sc = sc2 = np.zeros(1, dt_)
-    levels = np.zeros(1, np.int64)
-    R = np.zeros((1, 1), dt_)
-    off = np.zeros(1, np.bool_)
-    kd = np.zeros(1, dt_)
-    if mode and S:
-        dtype = dt_
-        ops = DetOps(dtype)    # modes 1-3: B is N_r - N_l (K.vsub(b, a)) in the dtype
-        if mode == 4:       # K.SLERP.setup, compiled
-            sc, sc2 = method_setup(mode, A, B, None, None, coeffs, start_left,
-                                              count_max, ops, work)
-        elif mode == 5:     # quadratic_setup, compiled
-            A, B, C = method_setup(mode, A, B, sp.t0.astype(dtype),
-                                              sp.dt.astype(dtype), coeffs, start_left,
-                                              count_max, ops, work)
-        elif mode == 6:     # angular_setup, compiled
-            A, B, sc = method_setup(mode, A, B, sp.t0.astype(dtype),
-                                               sp.dt.astype(dtype), coeffs, start_left,
-                                               count_max, ops, work)
-        elif mode == 7:     # dichotomy
-            cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
-            kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
-            levels = np.ascontiguousarray(lv, np.int64)
-            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
-                                     sp.count)
+    dt_, A, B, C, sc, sc2, levels, R, off, kd = _mode_arrays(mode, spec, sp, tables, dtype,
+                                                             ends, work)
     kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
     C = np.ascontiguousarray(C)
     Htri = (np.ascontiguousarray(triangle_half_vectors(st), np.float64) if not per_pixel_h
