@@ -41,6 +41,8 @@ def dot3(a0, a1, a2, b0, b1, b2, order):
 
 @njit()
 def dots(N, H, order):
+    """Row-wise ``N[i] . H[i]`` of two (n, 3) arrays, summed in order ``order`` of
+    :func:`dot3`."""
     out = np.empty(N.shape[0])
     for i in range(N.shape[0]):
         out[i] = dot3(N[i, 0], N[i, 1], N[i, 2], H[i, 0], H[i, 1], H[i, 2], order)

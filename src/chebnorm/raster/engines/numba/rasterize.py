@@ -24,6 +24,9 @@ __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gathe
 # --------------------------------------------------------------- span set-up
 @njit
 def count_rows(ys, height):
+    """``(r0, nrows)``: the first pixel row and the number of rows (clipped to
+    ``[0, height]``) of each triangle whose corner ``y`` are ``ys (T, 3)``, pixel centres
+    at ``r + 0.5`` as :func:`chebnorm.raster.spans.setup_spans` counts them."""
     T = ys.shape[0]
     r0 = np.empty(T, np.int64)
     nrows = np.empty(T, np.int64)

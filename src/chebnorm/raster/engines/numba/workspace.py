@@ -104,6 +104,8 @@ def keep_maps(maps):
 
 
 def scratch(work, name, shape, dtype=np.float64):
+    """An uninitialised array ``name`` of ``work`` (a :class:`Workspace`), or a new one
+    when ``work`` is None."""
     return np.empty(shape, dtype) if work is None else work.empty(name, shape, dtype)
 
 
