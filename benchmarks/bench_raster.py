@@ -8,7 +8,7 @@ frame relative to a bare numpy normalization of the same number of vectors
 Uses the public API only.  Times are the best of ``--repeat`` runs (after one
 warm-up run that also fills caches: sympy kernels, tables, numba's compiled
 code, so the figures are steady state).  The numpy engine is single-threaded;
-the numba engine's ``phong`` frame (chebnorm.raster.fused) splits its scan lines
+the numba engine's ``phong`` frame (chebnorm.raster.engines.numba.frame) splits its scan lines
 over the CPUs the process may use (``threads`` in the output), the other modes
 run single-threaded, so ``speedup`` (numpy time / numba time, same frame) is the
 speedup a user sees, not a per-core figure.  ``cpu_s`` is the process CPU time

@@ -12,7 +12,7 @@ from chebnorm.approx import fit_target
 from chebnorm.cli import main
 from chebnorm.methods import (METHODS, analyze, angular_drift, count_ops, default_tables,
                               error_sweep, normalization_ops, span_normals)
-from chebnorm.methods.counting import _generic_pair
+from chebnorm.methods.counting import generic_pair as _generic_pair
 
 EPS64 = np.finfo(np.float64).eps
 EPS32 = float(np.finfo(np.float32).eps)

@@ -251,3 +251,30 @@ class TestCLI:
         err = capsys.readouterr().err
         assert rc == 2 and message in err and err.count("\n") == 1
         assert not out.exists()
+
+
+def test_render_is_a_front_end():
+    """render.py validates, picks an engine once (engines.get_engine) and dispatches the
+    mode: it imports no engine module and compares nothing with an engine's name."""
+    import ast
+    import importlib
+    import inspect
+
+    R = importlib.import_module("chebnorm.raster.render")   # the module, not the function
+    tree = ast.parse(inspect.getsource(R))
+    imported = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = "chebnorm.raster" if node.level == 1 else ""
+            mod = ".".join(p for p in (base, node.module or "") if p)
+            imported.update(f"{mod}.{a.name}" for a in node.names)
+        elif isinstance(node, ast.Import):
+            imported.update(a.name for a in node.names)
+    assert "chebnorm.raster.engines.get_engine" in imported
+    assert not [m for m in imported if m.startswith("chebnorm.raster.engines.")
+                and m != "chebnorm.raster.engines.get_engine"], imported
+    names = {"numba", "numpy", "fast", "fused"}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            consts = {c.value for c in ast.walk(node) if isinstance(c, ast.Constant)}
+            assert not consts & names, ast.unparse(node)

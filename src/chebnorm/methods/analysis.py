@@ -39,9 +39,9 @@ import numpy as np
 from chebnorm.core.parallel import map_ordered
 
 from . import detmath
-from .counting import OpCounts, _generic_pair, count_ops
+from .counting import OpCounts, count_ops, generic_pair
 from .registry import default_tables, method_names
-from .spans import _check_dtype, _check_method, _levels, span_normals
+from .spans import check_dtype, check_method, span_levels, span_normals
 
 __all__ = ["MethodReport", "analyze", "ErrorSweep", "error_sweep", "DriftReport", "angular_drift",
            "N_SPECULAR", "reference_normals", "slerp_normals", "length_error_bound"]
@@ -172,11 +172,11 @@ def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
     >>> round(r.max_length_error, 6), r.ops.per_pixel["sqrt"]
     (0.008471, 0)
     """
-    method = _check_method(method).name
-    dt = _check_dtype(dtype)
+    method = check_method(method).name
+    dt = check_dtype(dtype)
     (psi_v,) = _check_psi(psi)
     m = _check_m(m)
-    nl, nr = _generic_pair(psi_v)
+    nl, nr = generic_pair(psi_v)
     tab = _tables_for(tables, psi_v)
     res = span_normals(method, nl[None], nr[None], [m], dtype=dt, tables=tab,
                        angular_reanchor=angular_reanchor)
@@ -250,16 +250,16 @@ def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np
     >>> round(float(s.get("diffuse_error", "none", m=4)[0]), 7)   # delta_d(0.2), claim C1
     0.0049958
     """
-    specs = tuple(_check_method(mm) for mm in (method_names() if methods is None else methods))
+    specs = tuple(check_method(mm) for mm in (method_names() if methods is None else methods))
     methods = tuple(sp.name for sp in specs)
     psis = np.linspace(0.0, math.pi / 2, 33) if psis is None else _check_psi(psis)
     ms = tuple(_check_m(mm) for mm in ms)
-    dts = tuple(_check_dtype(d) for d in dtypes)
+    dts = tuple(check_dtype(d) for d in dtypes)
     tab = _tables_for(tables, float(psis.max()))
     shape = (len(methods), len(dts), len(psis), len(ms))
     out = {k: np.zeros(shape) for k in ("length", "angle", "angle_slerp", "vector", "diffuse")}
     spec_out = np.zeros(shape + (N_SPECULAR,))
-    pairs = [_generic_pair(p) for p in psis]
+    pairs = [generic_pair(p) for p in psis]
     nl = np.array([a for a, _ in pairs])
     nr = np.array([b for _, b in pairs])
     cells = [(i, d, k) for i in range(len(specs)) for d in range(len(dts)) for k in range(len(ms))]
@@ -313,9 +313,9 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
     >>> round(length_error_bound("none", math.pi / 4, 64), 7)
     0.0761205
     """
-    spec = _check_method(method)
+    spec = check_method(method)
     method = spec.name
-    eps = float(np.finfo(_check_dtype(dtype)).eps)
+    eps = float(np.finfo(check_dtype(dtype)).eps)
     (psi,) = _check_psi(psi)
     m = _check_m(m)
     r = math.cos(psi / 2)
@@ -333,7 +333,7 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
     if method == "lyon":
         return 1 - r * (15 - 10 * r ** 2 + 3 * r ** 4) / 8 + 16 * eps
     if method == "dichotomy":
-        lv = int(_levels(np.array([1.0 / m]), np.array([0.0]), np.array([m + 1]),
+        lv = int(span_levels(np.array([1.0 / m]), np.array([0.0]), np.array([m + 1]),
                          np.array([math.cos(psi)]))[0])
         b = sum(e * (1 + (1 - 4.0 ** -k) / 3) for k in range(lv)) + (lv * e) ** 2
         if 2 ** _levels_of(m) != m:  # off the dyadic grid: the linear pick between nodes
@@ -393,10 +393,10 @@ def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,
     """
     if frac_bits is not None:
         return _angular_drift_fixed(psi, m, frac_bits, reanchor)
-    dt = _check_dtype(dtype)
+    dt = check_dtype(dtype)
     (psi_v,) = _check_psi(psi)
     m = _check_m(m)
-    nl, nr = _generic_pair(psi_v)
+    nl, nr = generic_pair(psi_v)
     res = span_normals("angular", nl[None], nr[None], [m], dtype=dt, angular_reanchor=reanchor)
     n = res.normals.astype(np.float64)
     length = np.abs(np.linalg.norm(n, axis=1) - 1.0)
@@ -419,7 +419,7 @@ def _angular_drift_fixed(psi, m, frac_bits, reanchor) -> DriftReport:
     m = _check_m(m)
     F = int(frac_bits)
     one = 1 << F
-    nl, nr = _generic_pair(psi_v)
+    nl, nr = generic_pair(psi_v)
     t = np.arange(m + 1) / m
     exact = slerp_normals(nl, nr, psi_v, t)
     q = lambda v: np.round(np.asarray(v) * one).astype(np.int64)

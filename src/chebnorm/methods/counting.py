@@ -45,9 +45,10 @@ import numpy as np
 
 from .ops import OP_KINDS, Counted, Counter, CountingOps
 from .registry import method_kernel, method_kernels
-from .spans import _check_method, _levels, _resolve_table, span_normals
+from .spans import check_method, resolve_table, span_levels, span_normals
 
-__all__ = ["OpCounts", "count_ops", "NormalizationCounts", "normalization_ops", "PAPER_COUNTS"]
+__all__ = ["OpCounts", "count_ops", "NormalizationCounts", "normalization_ops", "PAPER_COUNTS",
+           "generic_pair"]
 
 #: the counts the papers state (claim C9); missing kinds are not stated
 PAPER_COUNTS = {
@@ -139,8 +140,14 @@ def normalization_ops(method: str) -> NormalizationCounts:
     return NormalizationCounts(method, dict(c.counts["setup"]), c.pow2["setup"])
 
 
-def _generic_pair(psi: float):
-    """Unit normals at angle psi in a generic plane (no component zero or equal)."""
+def generic_pair(psi: float):
+    """Unit normals at angle ``psi`` in a generic plane (no component zero or equal):
+    the end normals the counting and analysis functions run one span on.
+
+    >>> nl, nr = generic_pair(0.5)
+    >>> round(float(nl @ nr), 12) == round(math.cos(0.5), 12)
+    True
+    """
     e1 = np.array([2.0, 3.0, 6.0]) / 7.0
     e2 = np.array([3.0, -6.0, 2.0]) / 7.0
     return e1, math.cos(psi) * e1 + math.sin(psi) * e2
@@ -199,9 +206,9 @@ def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
     >>> count_ops("quadratic", 64).per_pixel
     {'add': 6, 'mul': 0, 'div': 0, 'sqrt': 0, 'trig': 0, 'cmp': 0}
     """
-    spec = _check_method(method)
+    spec = check_method(method)
     kern = method_kernel(spec)
-    nl, nr = _generic_pair(psi)
+    nl, nr = generic_pair(psi)
     if isinstance(m, bool) or not isinstance(m, (int, np.integer)):
         raise ValueError(f"span length m = {m!r} is not an integer; accepted: m >= 1")
     m = int(m)
@@ -211,11 +218,11 @@ def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
     dt = 1.0 / m if dt is None else float(dt)
     count = m + 1 if count is None else int(count)
     tree = kern.shape == "tree"
-    levels = (int(_levels(np.array([dt]), np.array([float(t0)]), np.array([count]),
+    levels = (int(span_levels(np.array([dt]), np.array([float(t0)]), np.array([count]),
                           np.array([float(nl @ nr)]))[0]) if tree else 0)
     coeffs = None
     if spec.table is not None:
-        table = _resolve_table(spec, tables, np.array([float(nl @ nr)]),
+        table = resolve_table(spec, tables, np.array([float(nl @ nr)]),
                                np.array([levels]) if tree else None)
         coeffs = None if table is None else table.coefficients
     c, values = _run_counting(kern, nl, nr, float(t0), dt, count, coeffs, levels, angular_reanchor)

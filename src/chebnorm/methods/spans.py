@@ -19,7 +19,8 @@ from .ops import NumpyOps
 from .registry import default_tables, method_kernel
 
 __all__ = ["SpanNormals", "span_normals", "UNIT_TOL", "ANTIPARALLEL_TOL", "MAX_LEVELS", "DTYPES",
-           "SpanInput", "check_span_input"]
+           "SpanInput", "check_span_input", "check_method", "check_dtype", "resolve_table",
+           "span_levels", "COVER_SLACK"]
 
 #: accepted | |N| - 1 | of an end normal
 UNIT_TOL = 1e-5
@@ -30,7 +31,7 @@ MAX_LEVELS = 20
 DTYPES = (np.float32, np.float64)
 #: slack on a table's interval when checking that it covers the spans' range
 #: (rounding of N_l.N_r; the polynomial is smooth just outside its interval)
-_COVER_SLACK = 1e-9
+COVER_SLACK = 1e-9
 
 
 @dataclass(frozen=True)
@@ -98,12 +99,23 @@ def _as_per_span(name, a, s, dtype, default):
     return out
 
 
-def _check_method(method) -> MethodSpec:
-    """The registry entry of ``method`` (a name, or an entry already looked up)."""
+def check_method(method) -> MethodSpec:
+    """The registry entry of ``method`` (a name, or an entry already looked up); an
+    unknown name is the registry's ValueError naming the accepted methods.
+
+    >>> check_method("exact").name
+    'exact'
+    """
     return method if isinstance(method, MethodSpec) else get_method(method)
 
 
-def _check_dtype(dtype):
+def check_dtype(dtype):
+    """The numpy scalar type of ``dtype`` if it is one of :data:`DTYPES` (float32,
+    float64); ValueError naming the accepted ones otherwise.
+
+    >>> check_dtype("float32")
+    <class 'numpy.float32'>
+    """
     try:
         dt = np.dtype(dtype).type
     except TypeError:
@@ -133,9 +145,19 @@ def _needed_range(scale, cosines, levels):
     return scale * float(np.min(c[levels > 0])), scale * float(np.max(np.cos(deepest[levels > 0])))
 
 
-def _resolve_table(spec, tables, cosines, levels):
+def resolve_table(spec, tables, cosines, levels):
     """The table for method ``spec`` (None: exact), checked to cover what the spans need
-    (``levels``: the tree kernel's depth per span, None for the others)."""
+    (``levels``: the tree kernel's depth per span, None for the others): the caller's
+    ``tables[spec.name]`` if given, else the registry's default; ValueError when it does
+    not cover the end normals' cosines ``cosines``.
+
+    >>> import numpy as np
+    >>> spec = check_method("dichotomy")
+    >>> type(resolve_table(spec, None, np.array([0.9]), np.array([2]))).__name__
+    'CoefficientTable'
+    >>> resolve_table(spec, {"dichotomy": None}, np.array([0.9]), np.array([2])) is None
+    True
+    """
     method = spec.name
     defaults = tables is None or method not in tables
     table = default_tables()[method] if defaults else tables[method]
@@ -152,7 +174,7 @@ def _resolve_table(spec, tables, cosines, levels):
     small, big = _angle_range_of_table(scale, table)
     var = f"{get_target(spec.table.target).variable} = {'' if scale == 1 else f'{scale:g} '}cos(psi)"
     where = "the default" if defaults else "the given"
-    if lo > need_lo + _COVER_SLACK:
+    if lo > need_lo + COVER_SLACK:
         psi = detmath.arccos(np.clip(cosines, -1.0, 1.0))
         raise ValueError(
             f"largest span angle {float(np.max(psi)):.9g} rad exceeds {where} {method} table "
@@ -160,7 +182,7 @@ def _resolve_table(spec, tables, cosines, levels):
             f"{small:.9g} to {big:.9g} rad; pass tables={{{method!r}: fit_target("
             f"{spec.table.target!r}, {spec.table.degree}, psi_max=...)}} covering the spans, "
             f"or None for exact")
-    if hi < need_hi - _COVER_SLACK:
+    if hi < need_hi - COVER_SLACK:
         raise ValueError(
             f"smallest angle the {method} method needs, "
             f"{math.acos(min(1.0, need_hi / scale)):.9g} rad, "
@@ -174,7 +196,7 @@ def _resolve_table(spec, tables, cosines, levels):
 PICK_TOL = 2.0 ** -12
 
 
-def _levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
+def span_levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
     """Dichotomy depth per span.
 
     The base depth is the smallest ``L >= 0`` with ``2**-L <= dt`` (within 1e-12). With
@@ -183,6 +205,9 @@ def _levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
     keeps the linear pick's length error ``1 - cos(theta/2)`` within :data:`PICK_TOL`
     (a one-pixel span between normals 34 degrees apart would otherwise be short by
     ``1 - cos(17 deg) = 4.4 %``, as bad as no normalization).
+
+    >>> span_levels([0.25, 0.1]).tolist()      # ceil(log2(1/dt))
+    [2, 4]
     """
     dt = np.asarray(dt, dtype=np.float64)
     with np.errstate(divide="ignore"):
@@ -325,16 +350,16 @@ def check_span_input(method, n_left, n_right, m, *, t0=None, dt=None, count=None
     >>> inp.levels.tolist(), inp.count.tolist()
     ([2], [5])
     """
-    spec = _check_method(method)
-    dtype = _check_dtype(dtype)
+    spec = check_method(method)
+    dtype = check_dtype(dtype)
     kern = method_kernel(spec)
     nl, nr, cos = _end_normals(n_left, n_right)
     m_arr, dt_arr, t0_arr, cnt = _positions(nl.shape[0], m, dt, t0, count)
-    levels = _levels(dt_arr, t0_arr, cnt, cos) if kern.shape == "tree" else None
+    levels = span_levels(dt_arr, t0_arr, cnt, cos) if kern.shape == "tree" else None
     if levels is not None and (levels > MAX_LEVELS).any():
         raise ValueError(f"{spec.name} step dt = {float(dt_arr.min()):.3g} needs more than "
                          f"{MAX_LEVELS} halvings; accepted: dt >= 2**-{MAX_LEVELS}")
-    table = _resolve_table(spec, tables, cos, levels) if spec.table is not None else None
+    table = resolve_table(spec, tables, cos, levels) if spec.table is not None else None
     coeffs = None if table is None else table.coefficients
     return SpanInput(spec, kern, dtype, nl, nr, cos, m_arr, dt_arr, t0_arr, cnt, levels, coeffs)
 
@@ -405,11 +430,3 @@ def _tree(kern, ops, a, b, levels, coeffs, t, sid, out, dtype):
         for c in range(3):
             out[pix, c] = res[c]
 
-
-# names a compiled twin of check_span_input (chebnorm.raster.fusedsetup) reuses, so
-# that it raises exactly these functions' errors
-COVER_SLACK = _COVER_SLACK
-span_levels = _levels
-resolve_table = _resolve_table
-check_dtype = _check_dtype
-check_method = _check_method

@@ -15,6 +15,14 @@ and the signed 8-bit difference), :func:`error_map_rgb`, :func:`write_image`
 generators); studies for the paper reproduction (:func:`eta_study`, :func:`split_gouraud_study`,
 :func:`bump_comparison`, :func:`write_bump_figures`); render sweeps over a grid of cases
 (:func:`render_sweep_cases`, :func:`render_sweep`: one CSV of metrics, run in parallel).
+
+Where a change goes: ``render.py`` is the front end (validates, picks an engine once,
+dispatches the mode); ``shading.py`` holds the shading modes, written once against the
+engine interface of ``engines/base.py``; ``engines/numpy.py`` is the reference engine
+and ``engines/numba/`` the compiled one (``jit`` < ``calibration``, ``workspace`` <
+``rasterize``, ``kernels`` < ``setup`` < ``frame``: the fused ``phong`` frame), which
+must give the reference's bytes; ``spans.py`` the numpy span set-up and camera;
+``meshes.py``, ``metrics.py``, ``display.py`` and ``studies.py`` what their names say.
 """
 
 from .meshes import (MESH_NAMES, Mesh, crease_normals, get_mesh, icosphere, load_mesh, square,

@@ -26,8 +26,7 @@ from html import escape
 
 import numpy as np
 
-from .metrics import ImageMetrics, compare, error_map_rgb
-from .render import RenderResult
+from .metrics import ImageFrame, ImageMetrics, compare, error_map_rgb
 
 __all__ = ["RenderComparison", "png_data_uri", "render_html"]
 
@@ -69,11 +68,11 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def _describe(r: RenderResult) -> str:
+def _describe(r: ImageFrame) -> str:
     return f"{r.mesh}, {r.shading}" + (f" ({r.method})" if r.method else "")
 
 
-def render_html(result: RenderResult) -> str:
+def render_html(result: ImageFrame) -> str:
     """The HTML shown for a :class:`RenderResult`: image, length-error map
     (when the mode has pixel normals) and the render's numbers.
 
@@ -105,8 +104,8 @@ class RenderComparison:
     ``flip``: compute the FLIP metric too (slower). See the module example.
     """
 
-    test: RenderResult
-    reference: RenderResult
+    test: ImageFrame
+    reference: ImageFrame
     flip: bool = True
     metrics: ImageMetrics = field(init=False)
     diff: np.ndarray = field(init=False, repr=False)

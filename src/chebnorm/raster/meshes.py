@@ -31,7 +31,7 @@ from chebnorm.methods import detmath
 
 __all__ = [
     "Mesh", "MESH_NAMES", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
-    "teapot", "load_mesh", "crease_normals",
+    "teapot", "load_mesh", "crease_normals", "unit",
 ]
 
 MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")
@@ -143,7 +143,13 @@ def _face_cross(pos, faces):
     return np.cross(b - a, c - a)
 
 
-def _unit(v):
+def unit(v):
+    """``v / |v|`` along the last axis (``np.linalg.norm``: its summation order is part
+    of the renderer's reference bytes).
+
+    >>> unit(np.array([3.0, 4.0])).tolist()
+    [0.6, 0.8]
+    """
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
@@ -214,7 +220,7 @@ def uv_sphere(tess: int = 16) -> Mesh:
     P_u = (2 * np.pi * np.stack([-st_frame * sp, st_frame * cp, np.zeros_like(st)], -1)).reshape(-1, 3)
     P_v = (-np.pi * np.stack([ct * cp, ct * sp, -st], -1)).reshape(-1, 3)
     faces = _drop_degenerate(pos, _grid_faces(nu, nv))
-    nrm = _unit(pos)
+    nrm = unit(pos)
     return Mesh("sphere", pos, nrm, _orient(pos, nrm, faces), np.stack([U, V], -1).reshape(-1, 2),
                 P_u, P_v)
 
@@ -235,7 +241,7 @@ def icosphere(tess: int = 3) -> Mesh:
     k = _check_tess(tess, 0, 7, "icosphere")
     tm = trimesh.creation.icosphere(subdivisions=k)
     pos = np.asarray(tm.vertices, dtype=np.float64)
-    nrm = _unit(pos)
+    nrm = unit(pos)
     return Mesh("icosphere", pos, nrm, _orient(pos, nrm, np.asarray(tm.faces, dtype=np.int64)))
 
 
@@ -348,7 +354,7 @@ def teapot(tess: int = 20) -> Mesh:
         pv2 = np.einsum("na,nb,nabk->nk", bu, dbv, ctrl[p])
         cr[p, i, j] = np.cross(pu2, pv2)
         Pu[p, i, j], Pv[p, i, j] = pu2, pv2  # a tangent frame for bump mapping
-    nrm = _unit(cr)
+    nrm = unit(cr)
     nrm *= _TEAPOT_SIGN
     n_p = len(ctrl)
     pos = P.reshape(-1, 3)
@@ -389,7 +395,7 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     faces = np.asarray(faces, dtype=np.int64)
     if not (0 <= crease_angle <= np.pi):
         raise ValueError(f"crease angle must lie in [0, pi] radians; got {crease_angle!r}")
-    fn = _unit(_face_cross(pos, faces))
+    fn = unit(_face_cross(pos, faces))
     # angle weighting (Thuermer-Wuethrich): a face's weight at a vertex is its
     # corner angle there, so a quad split into triangles counts as one face
     tri_pos = pos[faces]
@@ -413,7 +419,7 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     acc = np.zeros((len(cv), 3))
     weight = corner_angle[order][other]
     np.add.at(acc, rep[keep], weight[keep, None] * fn[fb[keep]])
-    cn = _unit(acc)
+    cn = unit(acc)
     corner_normals = np.empty_like(cn)
     corner_normals[order] = cn
     # one vertex per (old vertex, distinct normal)
@@ -546,7 +552,7 @@ def load_mesh(path, crease_angle: float | None = None) -> Mesh:
                          f"{int(bad.sum())} such triangle(s)")
     name = os.path.basename(path)
     if nrm is not None and crease_angle is None:
-        nrm = _unit(nrm)
+        nrm = unit(nrm)
         return Mesh(name, pos, nrm, _orient(pos, nrm, faces))
     angle = np.radians(DEFAULT_CREASE_DEG) if crease_angle is None else crease_angle
     p, n, f = crease_normals(pos, faces, angle)

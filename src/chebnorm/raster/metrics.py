@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 __all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_image", "write_png", "image_bytes",
-           "image_format", "IMAGE_FORMATS"]
+           "image_format", "IMAGE_FORMATS", "ImageFrame", "to_8bit"]
 
 
 @dataclass(frozen=True)
@@ -42,10 +42,27 @@ class ImageMetrics:
         return asdict(self)
 
 
-def _as_8bit(x):
-    from .render import RenderResult, to_8bit
+class ImageFrame:
+    """A rendered frame as :func:`compare` takes it whole: its 8-bit image ``image8``
+    and its coverage ``mask`` (both (H, W)).  :class:`chebnorm.raster.RenderResult` is
+    the one kind; this base class lets the metrics recognize it without importing
+    the renderer."""
 
-    if isinstance(x, RenderResult):
+    __slots__ = ()
+
+
+def to_8bit(image) -> np.ndarray:
+    """Intensities in ``[0, 1]`` to 8-bit levels, ``round(255 I)`` after
+    clipping.
+
+    >>> to_8bit([-0.5, 0.0, 0.5, 1.0, 2.0]).tolist()
+    [0, 0, 128, 255, 255]
+    """
+    return np.round(np.clip(image, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def _as_8bit(x):
+    if isinstance(x, ImageFrame):
         return x.image8, x.mask
     a = np.asarray(x)
     if a.dtype != np.uint8 and (a.dtype.kind not in "biuf" or a.ndim != 2):

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from .engines import ENGINES
 from .meshes import get_mesh
 from .metrics import compare, error_map_rgb, write_png
 from .render import HeightMap, Lighting, render
@@ -235,8 +236,6 @@ RENDER_SWEEP_COLUMNS = ("mesh", "tess", "width", "height", "shininess", "shading
 _CASE_LOCK = threading.Lock()
 #: largest image side a sweep accepts (as :func:`render`)
 MAX_SIZE = 16384
-#: the render engines (:func:`render`'s ``engine``)
-ENGINES = ("auto", "numpy", "numba")
 
 
 @dataclass(frozen=True)
@@ -462,11 +461,11 @@ def render_sweep(cases, *, half_vector: str = "pixel", eta_threshold: float = 0.
     from chebnorm.core.parallel import map_ordered
 
     from .meshes import MESH_NAMES
-    from .render import _check_options
+    from .render import check_options
 
     cases = list(cases)
     Lighting(half_vector=half_vector).validate()
-    _check_options("phong", "full", eta_threshold, q)
+    check_options("phong", "full", eta_threshold, q)
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r}; accepted: {', '.join(ENGINES)}")
     opts = dict(half_vector=half_vector, eta_threshold=float(eta_threshold), q=float(q),

@@ -1,4 +1,4 @@
-"""The compiled render path (chebnorm.raster.fast, numba) against the numpy reference:
+"""The compiled engine (chebnorm.raster.engines.numba) against the numpy reference:
 the same bytes, for spans, visibility, span normals and whole images."""
 
 import numpy as np
@@ -6,9 +6,11 @@ import pytest
 
 from chebnorm.methods import detmath, method_names, span_normals
 from chebnorm.raster import get_mesh, render, setup_spans, zbuffer
-from chebnorm.raster import fast
+from chebnorm.raster.engines import resolve_engine
+from chebnorm.raster.engines.numba import calibration, frame, kernels, rasterize
+from chebnorm.raster.engines.numba.jit import HAVE_NUMBA
 
-pytestmark = pytest.mark.skipif(not fast.HAVE_NUMBA, reason="numba is not installed "
+pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba is not installed "
                                 "(the compiled path is optional; CI installs it)")
 
 SIZE = (96, 80)
@@ -25,10 +27,10 @@ def test_spans_and_zbuffer_identical():
     xy = rng.random((T, 3, 2)) * [70, 60] - 5   # some off screen, some degenerate rows
     xy[:5, 1, 1] = xy[:5, 0, 1]                 # horizontal edges
     attrs = rng.standard_normal((T, 3, 4))
-    a, b = fast.fast_setup_spans(xy, attrs, 64, 50), setup_spans(xy, attrs, 64, 50)
+    a, b = rasterize.fast_setup_spans(xy, attrs, 64, 50), setup_spans(xy, attrs, 64, 50)
     for name in a.__dataclass_fields__:
         assert _same(getattr(a, name), getattr(b, name)), name
-    assert _same(fast.fast_zbuffer(a, 64 * 50), zbuffer(b.frag_pixel, b.lerp([0])[:, 0], 64 * 50))
+    assert _same(rasterize.fast_zbuffer(a, 64 * 50), zbuffer(b.frag_pixel, b.lerp([0])[:, 0], 64 * 50))
     assert a.n_fragments > 1000
 
 
@@ -53,12 +55,12 @@ def test_span_normals_identical(method, dtype):
     nl, nr, m, pos = _random_spans(7)
     for kw in (pos, {}):
         ref = span_normals(method, nl, nr, m, dtype=dtype, **kw)
-        got = fast.fast_span_normals(method, nl, nr, m, dtype=dtype, **kw)
+        got = kernels.fast_span_normals(method, nl, nr, m, dtype=dtype, **kw)
         assert _same(got.normals, ref.normals) and _same(got.offsets, ref.offsets)
         assert _same(got.t, ref.t)
     # exact denominators (tables None) for the table methods
     ref = span_normals(method, nl, nr, m, dtype=dtype, tables={method: None}, **pos)
-    got = fast.fast_span_normals(method, nl, nr, m, dtype=dtype, tables={method: None}, **pos)
+    got = kernels.fast_span_normals(method, nl, nr, m, dtype=dtype, tables={method: None}, **pos)
     assert _same(got.normals, ref.normals)
 
 
@@ -68,7 +70,7 @@ def test_span_normals_same_errors():
         with pytest.raises(ValueError) as e1:
             span_normals("dichotomy", nl, bad, [4])
         with pytest.raises(ValueError) as e2:
-            fast.fast_span_normals("dichotomy", nl, bad, [4])
+            kernels.fast_span_normals("dichotomy", nl, bad, [4])
         assert str(e1.value) == str(e2.value)
 
 
@@ -92,7 +94,7 @@ def test_render_identical(mesh, mode, method, dtype):
 
 
 def test_engine_names():
-    assert fast.resolve_engine("auto") == "numba"
+    assert resolve_engine("auto") == "numba"
     with pytest.raises(ValueError, match="accepted: auto, numpy, numba"):
         render("sphere", size=(8, 8), tess=4, engine="gpu")
 
@@ -108,8 +110,8 @@ def test_render_identical_other_lighting():
         assert _same(got.triangle, ref.triangle)
 
 
-# ------------------------------------------------- fused phong (raster.fused)
-from chebnorm.raster import fused  # noqa: E402
+# ------------------------------------------------- fused phong (engines.numba.frame)
+import raster_oracles  # noqa: E402
 
 
 def test_fused_spans_identical():
@@ -119,7 +121,7 @@ def test_fused_spans_identical():
     xy[:5, 1, 1] = xy[:5, 0, 1]
     attrs = rng.standard_normal((T, 3, 7))
     ref = setup_spans(xy, attrs, 64, 50)
-    got = fused.spans(xy, attrs, 64, 50)
+    got = raster_oracles.spans(xy, attrs, 64, 50)
     for name in ("tri", "row", "x0", "count", "m", "t0", "dt", "left", "right"):
         assert _same(getattr(got, name), getattr(ref, name)), name
     # the row buckets list every span once, in span order within a row
@@ -135,10 +137,10 @@ def test_row_spans_are_spans_renumbered_by_row(monkeypatch):
     xy = rng.random((T, 3, 2)) * [70, 60] - 5
     xy[:5, 1, 1] = xy[:5, 0, 1]
     attrs = rng.standard_normal((T, 3, 7))
-    ref = fused.spans(xy, attrs, 64, 50)
+    ref = raster_oracles.spans(xy, attrs, 64, 50)
     for threads in (1, 2, 3):
-        monkeypatch.setattr(fused, "_threads", lambda: threads)
-        got = fused.row_spans(xy, attrs, 64, 50)
+        monkeypatch.setattr(raster_oracles, "threads", lambda: threads)
+        got = raster_oracles.row_spans(xy, attrs, 64, 50)
         old = np.lexsort((got.row, got.tri))     # the spans() numbering
         for name in ("tri", "row", "x0", "count", "m", "t0", "dt", "left", "right"):
             assert _same(getattr(got, name)[old], getattr(ref, name)), name
@@ -157,28 +159,28 @@ def test_det_matches_detmath():
             x = rng.uniform(lo, hi, 200_000).astype(dtype)
             x[:4] = [0.0, -0.0, 1.0, -1.0]
             with np.errstate(invalid="ignore"):
-                assert _same(fused.det(name, x), getattr(detmath, name)(x)), (name, dtype)
+                assert _same(calibration.det(name, x), getattr(detmath, name)(x)), (name, dtype)
 
 
 def test_calibrated_orders_reproduce_numpy():
-    orders = fused.calibrated()
+    orders = calibration.calibrated()
     assert orders is not None  # on the machines chebnorm is tested on
     rng = np.random.default_rng(2)
     N, H = rng.standard_normal((999, 3)), rng.standard_normal((999, 3))
-    assert _same(fused._dots(N, np.broadcast_to(H[0], N.shape).copy(), orders[0]), N @ H[0])
-    assert _same(fused._dots(N, H, orders[1]), np.einsum("...k,...k->...", N, H))
-    assert _same(np.sqrt(fused._dots(N, N, orders[2])), np.linalg.norm(N, axis=1))
+    assert _same(calibration.dots(N, np.broadcast_to(H[0], N.shape).copy(), orders[0]), N @ H[0])
+    assert _same(calibration.dots(N, H, orders[1]), np.einsum("...k,...k->...", N, H))
+    assert _same(np.sqrt(calibration.dots(N, N, orders[2])), np.linalg.norm(N, axis=1))
 
 
 def _spy(monkeypatch, name):
     calls = []
-    real = getattr(fused, name)
+    real = getattr(frame, name)
 
     def spy(*args, **kw):
         out = real(*args, **kw)
         calls.append(out)
         return out
-    monkeypatch.setattr(fused, name, spy)
+    monkeypatch.setattr(frame, name, spy)
     return calls
 
 
@@ -223,7 +225,7 @@ def test_fused_phong_tiny_frames(size):
 
 
 def test_fused_falls_back_without_calibration(monkeypatch):
-    monkeypatch.setattr(fused, "calibrated", lambda: None)
+    monkeypatch.setattr(frame, "calibrated", lambda: None)
     calls = _spy(monkeypatch, "_frame")
     _check_identical(get_mesh("teapot"), "lyon", SIZE)
     assert not calls
@@ -247,7 +249,7 @@ def _render_bytes(size):
 def _powers(b, sh, fast):
     n = len(b)
     out, hh, ll, ok = np.empty(n), np.empty(n), np.empty(n), np.empty(n, np.bool_)
-    fused._powers(b, float(sh), fast, hh, ll, ok, out, n)
+    calibration.powers(b, float(sh), fast, hh, ll, ok, out, n)
     return out, ok
 
 
@@ -288,7 +290,7 @@ def test_pow_shortcut_is_correctly_rounded_where_taken():
 def _trig(kind, x):
     n = len(x)
     out, ok = np.empty(n), np.empty(n, np.bool_)
-    fused._trig64(kind, np.ascontiguousarray(x, np.float64), out, ok, np.empty((5, n)), n)
+    calibration.trig64(kind, np.ascontiguousarray(x, np.float64), out, ok, np.empty((5, n)), n)
     return out, ok
 
 
@@ -335,13 +337,13 @@ def test_trig_shortcut_is_correctly_rounded_where_taken():
 
 
 def test_trig_calibrated():
-    assert fused.trig_calibrated() == fused.HAVE_NUMBA
+    assert calibration.trig_calibrated() == HAVE_NUMBA
 
 
 def test_pow_calibrated():
-    assert fused.pow_calibrated(32.0) and fused.pow_calibrated(3.0)
-    assert not fused.pow_calibrated(2.0)       # numpy squares; the frame does too
-    assert not fused.pow_calibrated(32.5) and not fused.pow_calibrated(1e6)
+    assert calibration.pow_calibrated(32.0) and calibration.pow_calibrated(3.0)
+    assert not calibration.pow_calibrated(2.0)       # numpy squares; the frame does too
+    assert not calibration.pow_calibrated(32.5) and not calibration.pow_calibrated(1e6)
 
 
 @pytest.mark.parametrize("shininess", [3.0, 17.0, 32.0, 200.0, 31.9])

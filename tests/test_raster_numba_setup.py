@@ -1,5 +1,5 @@
-"""The compiled set-up of the fused phong frame (chebnorm.raster.fusedsetup) against the
-numpy reference it replaces: check_span_input on the unit span ends, render._auto_tables'
+"""The compiled set-up of the fused phong frame (chebnorm.raster.engines.numba.setup) against the
+numpy reference it replaces: check_span_input on the unit span ends, auto_tables'
 widest angle, the per-method span set-up (bit for bit), the same errors through render,
 and the remembered default camera."""
 
@@ -13,13 +13,20 @@ import pytest
 from chebnorm.methods import get_method, method_names
 from chebnorm.methods import kernels as K
 from chebnorm.methods.spans import PICK_TOL, check_span_input
-from chebnorm.raster import Mesh, fast, get_mesh, render
+from chebnorm.raster import Mesh, get_mesh, render
+from chebnorm.raster.engines import get_engine
+from chebnorm.raster.engines.base import auto_tables, dot
+from chebnorm.raster.engines.numba.jit import HAVE_NUMBA
 
-pytestmark = pytest.mark.skipif(not fast.HAVE_NUMBA, reason="numba is not installed "
+pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba is not installed "
                                 "(the compiled path is optional; CI installs it)")
 
-from chebnorm.raster import fused, fusedsetup  # noqa: E402
-from chebnorm.raster.meshes import _unit  # noqa: E402
+import raster_oracles  # noqa: E402
+
+from chebnorm.raster.engines.numba import calibration, frame, kernels, rasterize, setup  # noqa: E402
+from chebnorm.raster.engines.numba import workspace  # noqa: E402
+from chebnorm.raster.meshes import unit as _unit  # noqa: E402
+from chebnorm.raster.spans import fit_camera  # noqa: E402
 
 R = importlib.import_module("chebnorm.raster.render")
 SPAN_METHODS = [m for m in method_names() if m != "none"]
@@ -38,10 +45,10 @@ def _outcome(fn):
 
 
 def _reference(spec, sp, tables, dtype, diff):
-    """What fused.phong computed before fusedsetup: numpy, the reference functions."""
+    """What the fused frame computed before its compiled set-up: numpy, the reference functions."""
     cols = [1, 2, 3]
     nl, nr = _unit(sp.left[:, cols]), _unit(sp.right[:, cols])
-    dmin = np.min(R._dot(nl, nr))
+    dmin = np.min(dot(nl, nr))
     inp = check_span_input(spec, nl, nr, sp.m, t0=sp.t0, dt=sp.dt, count=sp.count, tables=tables,
                            dtype=dtype)
     A = np.ascontiguousarray(inp.n_left.astype(inp.dtype).T)
@@ -54,15 +61,15 @@ def _reference(spec, sp, tables, dtype, diff):
 
 
 def _compiled(spec, sp, tables, dtype, diff):
-    ends, dmin = fusedsetup.widest_dot(sp, spec, dtype, diff)
-    dt, coeffs, levels, A, B, start_left, count_max = fusedsetup.span_input(
+    ends, dmin = setup.widest_dot(sp, spec, dtype, diff)
+    dt, coeffs, levels, A, B, start_left, count_max = setup.span_input(
         spec, sp, tables, dtype, ends, diff)
     return dict(dmin=dmin, cos=ends.cos, dtype=dt, coeffs=coeffs, levels=levels, A=A, B=B,
                 start_left=start_left, count_max=count_max)
 
 
 def _check_same(spec, sp, tables, dtype):
-    diff = fused.MODES[id(K.__dict__[spec.name.upper()])] <= 3
+    diff = frame.MODES[id(K.__dict__[spec.name.upper()])] <= 3
     ref = _outcome(lambda: _reference(spec, sp, tables, dtype, diff))
     got = _outcome(lambda: _compiled(spec, sp, tables, dtype, diff))
     if isinstance(ref, str):
@@ -80,9 +87,9 @@ def _check_same(spec, sp, tables, dtype):
 
 def _teapot_spans(size, per_pixel_h=True):
     mesh = get_mesh("teapot")
-    st = R._setup(mesh, None, size, True, "numba")
+    st = get_engine("numba").setup(mesh, None, size, True)
     attrs = st.attrs if per_pixel_h else np.ascontiguousarray(st.attrs[..., :4])
-    return fused.row_spans(st.xy, attrs, *size)
+    return raster_oracles.row_spans(st.xy, attrs, *size)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -91,7 +98,7 @@ def test_teapot_setup_values_identical(dtype):
     for method in SPAN_METHODS:
         spec = get_method(method)
         stats = {}
-        tables = R._auto_tables(spec, sp, [[1, 2, 3]], None, stats)   # wide spout spans
+        tables = auto_tables(spec, sp, [[1, 2, 3]], None, stats)   # wide spout spans
         for tb in (tables, {method: None}) if spec.table is not None else (None,):
             assert _check_same(spec, sp, tb, dtype), method
         if tables is not None:
@@ -149,7 +156,7 @@ def test_edge_spans_values_identical(method, dtype):
         if spec.table is not None:   # angles beyond the default table: the same error
             assert not _check_same(spec, sp, None, dtype)
     if method == "dichotomy":   # the thresholds of _levels were met
-        ends, _ = fusedsetup.widest_dot(_edge_spans(1), spec, dtype, False)
+        ends, _ = setup.widest_dot(_edge_spans(1), spec, dtype, False)
         assert ends.hard.sum() > 100
 
 
@@ -173,7 +180,7 @@ def test_bad_span_values_same_errors():
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_method_setup_identical(dtype):
-    """slerp, quadratic, angular set-up against fast's numpy set-up with fused._DetOps;
+    """slerp, quadratic, angular set-up against the kernels' numpy set-up with DetOps;
     200 000 spans: in float32 some sines, cosines and arc cosines are rounding cases
     that go back to numpy."""
     rng = np.random.default_rng(17)
@@ -187,20 +194,20 @@ def test_method_setup_identical(dtype):
     B = np.ascontiguousarray(nr.astype(dtype).T)
     dt = (1.0 / rng.uniform(1, 60, S)).astype(dtype)
     t0 = (rng.random(S) * dt).astype(dtype)
-    ops = fused._DetOps(dtype)
+    ops = calibration.DetOps(dtype)
     a, b = tuple(A), tuple(B)
     ref = K.SLERP.setup(ops, a, b)
-    got = fusedsetup.method_setup(4, A, B, None, None, None, False, 5, ops)
+    got = setup.method_setup(4, A, B, None, None, None, False, 5, ops)
     assert _same(got[0], ref["psi"]) and _same(got[1], ref["inv"])
     for start_left in (False, True):
         t = np.zeros(S, dtype) if start_left else t0
         for coeffs in (None, (0.7, -0.12, 0.014)):
-            ref = fast._quadratic_setup(ops, a, b, t, dt, coeffs, start_left)
-            got = fusedsetup.method_setup(5, A, B, t, dt, coeffs, start_left, 5, ops)
+            ref = kernels.quadratic_setup(ops, a, b, t, dt, coeffs, start_left)
+            got = setup.method_setup(5, A, B, t, dt, coeffs, start_left, 5, ops)
             assert all(_same(g, r) for g, r in zip(got, ref))
         for n in (1, 2, 7):
-            ref = fast._angular_setup(ops, a, b, t, dt, n, start_left)
-            got = fusedsetup.method_setup(6, A, B, t, dt, None, start_left, n, ops)
+            ref = kernels.angular_setup(ops, a, b, t, dt, n, start_left)
+            got = setup.method_setup(6, A, B, t, dt, None, start_left, n, ops)
             assert all(_same(g, r) for g, r in zip(got, ref))
 
 
@@ -255,8 +262,8 @@ def test_default_camera_follows_the_positions():
     b = render(mesh, "phong", "exact", size=size, engine="numba")
     ref = render(mesh, "phong", "exact", size=size, engine="numpy")
     assert _same(b.image, ref.image) and not _same(a.image, b.image)
-    cam = R.fit_camera(mesh.positions, *size)
-    assert fusedsetup.default_camera_of(mesh.positions, *size) == cam
+    cam = fit_camera(mesh.positions, *size)
+    assert rasterize.default_camera_of(mesh.positions, *size) == cam
 
 
 def test_project_identical_and_same_error():
@@ -264,19 +271,19 @@ def test_project_identical_and_same_error():
 
     mesh = get_mesh("teapot")
     for size in ((1024, 1024), (37, 91)):
-        cam = R.fit_camera(mesh.positions, *size)
-        got, ref = fusedsetup.project(cam, mesh.positions, *size), project(cam, mesh.positions,
+        cam = fit_camera(mesh.positions, *size)
+        got, ref = rasterize.project(cam, mesh.positions, *size), project(cam, mesh.positions,
                                                                             *size)
         assert all(_same(g, r) for g, r in zip(got, ref))
     rng = np.random.default_rng(4)
     cam = default_camera((0.0, 0.0, 0.0), 1.0)
     for n in (1, 2, 3, 7, 1000):
         pts = rng.standard_normal((n, 3))
-        got, ref = fusedsetup.project(cam, pts, 64, 48), project(cam, pts, 64, 48)
+        got, ref = rasterize.project(cam, pts, 64, 48), project(cam, pts, 64, 48)
         assert all(_same(g, r) for g, r in zip(got, ref))
     behind = Camera((0.0, 0.0, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
     pts = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 5.0], [1.0, 0.0, 0.0]])
-    assert _outcome(lambda: fusedsetup.project(behind, pts, 8, 8)) == _outcome(
+    assert _outcome(lambda: rasterize.project(behind, pts, 8, 8)) == _outcome(
         lambda: project(behind, pts, 8, 8))
     assert "behind the camera" in _outcome(lambda: project(behind, pts, 8, 8))
 
@@ -324,11 +331,11 @@ def test_end_pass_on_row_spans(dtype):
     attrs[4:6, 1, 2] = np.nan
     attrs[6, 2, 3] = np.inf
     attrs[7:10, 1, 1:4] = -attrs[7:10, 0, 1:4]
-    st = R._setup(get_mesh("teapot"), None, (300, 260), True, "numba")
+    st = get_engine("numba").setup(get_mesh("teapot"), None, (300, 260), True)
     seen = set()
     for args in ((xy, attrs, 64, 50), (xy[10:], attrs[10:], 64, 50),
                  (st.xy, st.attrs, 300, 260)):
-        rs = fusedsetup.row_spans(*args)
+        rs = rasterize.row_spans(*args)
         assert len(rs.count) > 1000
         # in (triangle, row) order, the order by which the errors name spans
         o = np.lexsort((rs.row, rs.tri))
@@ -340,8 +347,8 @@ def test_end_pass_on_row_spans(dtype):
 
 
 def test_row_spans_identical():
-    """fusedsetup.row_spans (geometry kept between the passes, workspace arrays) against
-    fused.row_spans: random triangles (off screen, horizontal edges, degenerate rows)
+    """rasterize.row_spans (geometry kept between the passes, workspace arrays) against
+    the oracle row_spans: random triangles (off screen, horizontal edges, degenerate rows)
     and the teapot."""
     rng = np.random.default_rng(5)
     T = 600
@@ -349,12 +356,12 @@ def test_row_spans_identical():
     xy[:5, 1, 1] = xy[:5, 0, 1]
     xy[5:9, 2] = xy[5:9, 0]
     attrs = rng.standard_normal((T, 3, 7))
-    st = R._setup(get_mesh("teapot"), None, (300, 260), True, "numba")
-    work = fusedsetup.Workspace()
+    st = get_engine("numba").setup(get_mesh("teapot"), None, (300, 260), True)
+    work = workspace.Workspace()
     for args in ((xy, attrs, 64, 50), (st.xy, st.attrs, 300, 260), (xy, attrs[..., :4], 64, 50)):
-        ref = fused.row_spans(*args)
+        ref = raster_oracles.row_spans(*args)
         for w in (None, work, work):
-            got = fusedsetup.row_spans(*args, work=w)
+            got = rasterize.row_spans(*args, work=w)
             for name in ("tri", "row", "x0", "count", "m", "t0", "dt", "left", "right",
                          "row_start", "by_row"):
                 assert _same(getattr(got, name), getattr(ref, name)), name

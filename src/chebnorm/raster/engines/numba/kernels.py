@@ -1,17 +1,13 @@
-"""Compiled fast path of the rasterizer (numba, optional).
+"""Span-normal, half-vector and shading kernels of the compiled engine (numba).
 
-The numpy code of :mod:`.spans`, :mod:`.render` and :func:`chebnorm.methods.span_normals`
-is the reference; this module computes the same arrays, byte for byte, with loops
-compiled by numba (``cache=True``; no ``fastmath``, no ``parallel``: every float
-operation is the reference's, in the reference's order and dtype, and LLVM does not
-contract a multiply-add into an FMA without fast-math flags).  Transcendental
-functions (``sin``, ``cos``, ``arccos``, ``log2``) are left to the same numpy ufuncs
-the reference calls, on per-span (or per-pixel) arrays, so libm differences cannot
-enter.  ``tests/test_raster_fast.py`` checks the identity on several meshes, modes,
-methods and dtypes.
-
-Without numba (:data:`HAVE_NUMBA` False) nothing here is used and :func:`render`
-runs the numpy path.
+The numpy code of :func:`chebnorm.methods.span_normals` and of the numpy engine
+(:mod:`chebnorm.raster.engines.numpy`) is the reference; this module computes the same
+arrays, byte for byte, with loops compiled by :func:`.jit.njit`: every float operation
+is the reference's, in the reference's order and dtype.  Transcendental functions
+(``sin``, ``cos``, ``arccos``, ``log2``) are left to the same numpy ufuncs the reference
+calls, on per-span (or per-pixel) arrays, so libm differences cannot enter.
+``tests/test_raster_fast.py`` checks the identity on several meshes, modes, methods and
+dtypes.
 
 Kernels are matched by the registry's kernel *objects*
 (:func:`chebnorm.methods.registry.method_kernel`), not by method names: a method
@@ -25,234 +21,17 @@ import numpy as np
 from chebnorm.methods import kernels as K
 from chebnorm.methods.ops import NumpyOps
 from chebnorm.methods.registry import method_kernel
-from chebnorm.methods.spans import MAX_LEVELS, SpanNormals, check_span_input
+from chebnorm.methods.spans import MAX_LEVELS, SpanNormals, check_span_input, span_normals
 
-from .spans import Spans
+from ...spans import Spans
+from .jit import HAVE_NUMBA, njit
 
-try:  # pragma: no cover - exercised by whichever environment runs the tests
-    import numba
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover
-    numba = None
-    HAVE_NUMBA = False
-
-__all__ = ["HAVE_NUMBA", "ENGINES", "resolve_engine", "supports", "fast_setup_spans",
-           "fast_zbuffer", "fast_span_normals", "fast_lerp"]
-
-#: accepted values of ``render(engine=...)``
-ENGINES = ("auto", "numpy", "numba")
-
-
-def resolve_engine(engine) -> str:
-    """``"numpy"`` or ``"numba"``: what ``engine`` (``"auto"``, None, ``"numpy"``,
-    ``"numba"``) means here; ``"numba"`` without numba installed is an error.
-
-    >>> resolve_engine("numpy")
-    'numpy'
-    """
-    if engine is None:
-        engine = "auto"
-    if engine not in ENGINES:
-        raise ValueError(f"unknown engine {engine!r}; accepted: {', '.join(ENGINES)}")
-    if engine == "auto":
-        return "numba" if HAVE_NUMBA else "numpy"
-    if engine == "numba" and not HAVE_NUMBA:
-        raise ValueError("engine 'numba' needs the numba package (pip install numba); "
-                         "accepted without it: auto, numpy")
-    return engine
-
-
-def _njit(fn):
-    if not HAVE_NUMBA:
-        return fn
-    return numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(fn)
-
-
-# --------------------------------------------------------------- span set-up
-@_njit
-def _count_rows(ys, height):
-    T = ys.shape[0]
-    r0 = np.empty(T, np.int64)
-    nrows = np.empty(T, np.int64)
-    for i in range(T):
-        ymin = min(ys[i, 0], ys[i, 1], ys[i, 2])
-        ymax = max(ys[i, 0], ys[i, 1], ys[i, 2])
-        a = min(max(np.ceil(ymin - 0.5), 0.0), float(height))
-        b = min(max(np.ceil(ymax - 0.5), 0.0), float(height))
-        r0[i] = np.int64(a)
-        nrows[i] = max(np.int64(b) - np.int64(a), 0)
-    return r0, nrows
-
-
-@_njit
-def _spans_kernel(xy, attrs, width, r0, nrows, n_max):
-    T, _, Kc = attrs.shape
-    tri = np.empty(n_max, np.int64)
-    row = np.empty(n_max, np.int64)
-    c0 = np.empty(n_max, np.int64)
-    count = np.empty(n_max, np.int64)
-    m = np.empty(n_max, np.int64)
-    t0 = np.empty(n_max, np.float64)
-    dt = np.empty(n_max, np.float64)
-    left = np.empty((n_max, Kc), np.float64)
-    right = np.empty((n_max, Kc), np.float64)
-    ei = (0, 1, 2)
-    ej = (1, 2, 0)
-    aa = np.empty(Kc, np.float64)
-    ab = np.empty(Kc, np.float64)
-    n = 0
-    for i in range(T):
-        for r in range(r0[i], r0[i] + nrows[i]):
-            y = r + 0.5
-            nhit = 0
-            e1 = -1
-            e2 = -1
-            for e in range(3):
-                yi = xy[i, ei[e], 1]
-                yj = xy[i, ej[e], 1]
-                if min(yi, yj) <= y and y < max(yi, yj):
-                    nhit += 1
-                    if e1 < 0:
-                        e1 = e
-                    e2 = e
-            if nhit != 2:
-                continue
-            # crossing of edge e1 (a) and e2 (b)
-            p, q = ei[e1], ej[e1]
-            s = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
-            xa = xy[i, p, 0] + s * (xy[i, q, 0] - xy[i, p, 0])
-            for k in range(Kc):
-                aa[k] = attrs[i, p, k] + s * (attrs[i, q, k] - attrs[i, p, k])
-            p, q = ei[e2], ej[e2]
-            s = (y - xy[i, p, 1]) / (xy[i, q, 1] - xy[i, p, 1])
-            xb = xy[i, p, 0] + s * (xy[i, q, 0] - xy[i, p, 0])
-            for k in range(Kc):
-                ab[k] = attrs[i, p, k] + s * (attrs[i, q, k] - attrs[i, p, k])
-            swap = xb < xa
-            xl = xb if swap else xa
-            xr = xa if swap else xb
-            a = np.int64(min(max(np.ceil(xl - 0.5), 0.0), float(width)))
-            b = np.int64(min(max(np.ceil(xr - 0.5), 0.0), float(width)))
-            c = max(b - a, 0)
-            if c <= 0:
-                continue
-            tri[n] = i
-            row[n] = r
-            c0[n] = a
-            count[n] = c
-            for k in range(Kc):
-                left[n, k] = ab[k] if swap else aa[k]
-                right[n, k] = aa[k] if swap else ab[k]
-            ws = xr - xl
-            d = 1.0 / ws
-            dt[n] = d
-            t0[n] = ((a + 0.5) - xl) * d
-            m[n] = np.int64(max(1.0, np.ceil(ws)))
-            n += 1
-    return (tri[:n], row[:n], c0[:n], count[:n], m[:n], t0[:n], dt[:n],
-            left[:n].copy(), right[:n].copy())
-
-
-@_njit
-def _fragments(row, c0, count, t0, dt, width):
-    S = count.shape[0]
-    offsets = np.zeros(S + 1, np.int64)
-    for i in range(S):
-        offsets[i + 1] = offsets[i] + count[i]
-    P = offsets[S]
-    frag_span = np.empty(P, np.int64)
-    frag_pixel = np.empty(P, np.int64)
-    frag_t = np.empty(P, np.float64)
-    for i in range(S):
-        base = row[i] * width + c0[i]
-        for j in range(count[i]):
-            f = offsets[i] + j
-            frag_span[f] = i
-            frag_pixel[f] = base + j
-            t = t0[i] + j * dt[i]
-            frag_t[f] = min(max(t, 0.0), 1.0)
-    return offsets, frag_span, frag_pixel, frag_t
-
-
-def fast_setup_spans(xy, attrs, width: int, height: int) -> Spans:
-    """:func:`chebnorm.raster.setup_spans`, compiled; the same arrays.
-
-    >>> import numpy as np
-    >>> from chebnorm.raster import setup_spans
-    >>> xy = np.array([[[1.0, 1.0], [9.0, 2.0], [3.0, 8.0]]]); at = np.ones((1, 3, 1))
-    >>> a, b = fast_setup_spans(xy, at, 10, 10), setup_spans(xy, at, 10, 10)
-    >>> bool((a.frag_pixel == b.frag_pixel).all() and (a.frag_t == b.frag_t).all())
-    True
-    """
-    xy = np.ascontiguousarray(xy, dtype=np.float64)
-    attrs = np.ascontiguousarray(attrs, dtype=np.float64)
-    r0, nrows = _count_rows(np.ascontiguousarray(xy[..., 1]), int(height))
-    tri, row, c0, count, m, t0, dt, left, right = _spans_kernel(
-        xy, attrs, int(width), r0, nrows, int(nrows.sum()))
-    offsets, frag_span, frag_pixel, frag_t = _fragments(row, c0, count, t0, dt, int(width))
-    return Spans(tri, row, c0, count, m, t0, dt, left, right, offsets, frag_span, frag_pixel,
-                 frag_t)
-
-
-# ----------------------------------------------------------------- z-buffer
-@_njit
-def _zbuffer_kernel(frag_span, frag_pixel, frag_t, left, right, n_pixels):
-    best = np.full(n_pixels, -1, np.int64)
-    bw = np.empty(n_pixels, np.float64)
-    P = frag_pixel.shape[0]
-    for f in range(P):
-        s = frag_span[f]
-        lo = left[s, 0]
-        w = lo + frag_t[f] * (right[s, 0] - lo)
-        p = frag_pixel[f]
-        if best[p] < 0 or w > bw[p]:
-            best[p] = f
-            bw[p] = w
-    n = 0
-    for p in range(n_pixels):
-        if best[p] >= 0:
-            n += 1
-    vis = np.empty(n, np.int64)
-    n = 0
-    for p in range(n_pixels):
-        if best[p] >= 0:
-            vis[n] = best[p]
-            n += 1
-    return vis
-
-
-def fast_zbuffer(sp: Spans, n_pixels: int) -> np.ndarray:
-    """``zbuffer(sp.frag_pixel, sp.lerp([0])[:, 0], n_pixels)``, compiled (depth in
-    attribute column 0; finite depths)."""
-    return _zbuffer_kernel(sp.frag_span, sp.frag_pixel, sp.frag_t,
-                           np.ascontiguousarray(sp.left), np.ascontiguousarray(sp.right),
-                           int(n_pixels))
-
-
-@_njit
-def _lerp_kernel(frag_span, frag_t, left, right, cols, sel):
-    n = sel.shape[0]
-    out = np.empty((n, cols.shape[0]), np.float64)
-    for i in range(n):
-        f = sel[i]
-        s = frag_span[f]
-        t = frag_t[f]
-        for k in range(cols.shape[0]):
-            c = cols[k]
-            lo = left[s, c]
-            out[i, k] = lo + t * (right[s, c] - lo)
-    return out
-
-
-def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
-    """``sp.lerp(cols)[sel]``, compiled, without interpolating the other fragments."""
-    return _lerp_kernel(sp.frag_span, sp.frag_t, np.ascontiguousarray(sp.left),
-                        np.ascontiguousarray(sp.right), np.asarray(cols, np.int64),
-                        np.asarray(sel, np.int64))
+__all__ = ["supports", "fast_span_normals", "dichotomy_denominators", "quadratic_setup",
+           "angular_setup", "fast_half_vectors", "fast_shade"]
 
 
 # ------------------------------------------------------------ span normals
-@_njit
+@njit
 def _pixel_t(offsets, t0, dt, tc):
     """Pixel positions ``t0 + j dt`` (float64) and cast to the kernel's dtype (``tc``)."""
     S = offsets.shape[0] - 1
@@ -266,7 +45,7 @@ def _pixel_t(offsets, t0, dt, tc):
     return t
 
 
-@_njit
+@njit
 def _linear_kernel(offsets, a, d, tc, mode, kc, out):
     # mode 0: none, 1: classic N/sqrt(N.N), 2: Newton, 3: Lyon; kc: constants in the dtype
     S = offsets.shape[0] - 1
@@ -299,7 +78,7 @@ def _linear_kernel(offsets, a, d, tc, mode, kc, out):
             out[f, 2] = n2 * s
 
 
-@_njit
+@njit
 def _slerp_args(offsets, psi, tc, one, arg_a, arg_b):
     S = offsets.shape[0] - 1
     for i in range(S):
@@ -310,7 +89,7 @@ def _slerp_args(offsets, psi, tc, one, arg_a, arg_b):
             arg_b[f] = t * p
 
 
-@_njit
+@njit
 def _slerp_combine(offsets, a, b, inv, sa, sb, out):
     S = offsets.shape[0] - 1
     for i in range(S):
@@ -323,7 +102,7 @@ def _slerp_combine(offsets, a, b, inv, sa, sb, out):
             out[f, 2] = a[2, i] * wa + b[2, i] * wb
 
 
-@_njit
+@njit
 def _quadratic_kernel(offsets, v, d1, d2, out):
     S = offsets.shape[0] - 1
     for i in range(S):
@@ -346,7 +125,7 @@ def _quadratic_kernel(offsets, v, d1, d2, out):
             out[f, 2] = v2
 
 
-@_njit
+@njit
 def _angular_kernel(offsets, p0, p1, k2, out):
     S = offsets.shape[0] - 1
     for i in range(S):
@@ -374,7 +153,7 @@ def _angular_kernel(offsets, p0, p1, k2, out):
             out[g, 2] = b2
 
 
-@_njit
+@njit
 def _dichotomy_node(nl, nr, r, i, L, k, res):
     """Node ``k`` of ``2**L + 1`` of span ``i`` (by descending the halving tree)."""
     top = np.int64(1) << L
@@ -409,8 +188,8 @@ def _dichotomy_node(nl, nr, r, i, L, k, res):
             A0, A1, A2 = M0, M1, M2
 
 
-@_njit
-def _dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
+@njit
+def dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
     """``(r, Lmax)``: ``r[i, lev]`` the reciprocal length of span ``i``'s
     midpoint sum at depth ``lev`` (``1/sqrt(z + 2)``, exact or by the table's
     polynomial in ``z``), stepped as ``z <- (z + 2) r``; ``Lmax`` the deepest
@@ -438,10 +217,10 @@ def _dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
     return r, Lmax
 
 
-@_njit
+@njit
 def _dichotomy_kernel(offsets, nl, nr, levels, coeffs, exact, kc, tc, out):
     S = offsets.shape[0] - 1
-    r, Lmax = _dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
+    r, Lmax = dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
     # per level: does any pixel fall off the grid (then every pixel of the level is picked)
     off = np.zeros(Lmax + 1, np.bool_)
     for i in range(S):
@@ -497,7 +276,6 @@ def fast_span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=Non
     True
     """
     if not supports(method):
-        from chebnorm.methods import span_normals
         return span_normals(method, n_left, n_right, m, t0=t0, dt=dt, count=count, tables=tables,
                             dtype=dtype)
     inp = check_span_input(method, n_left, n_right, m, t0=t0, dt=dt, count=count, tables=tables,
@@ -524,11 +302,11 @@ def fast_span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=Non
         _slerp_combine(offsets, a, b, np.asarray(st["inv"], dtype), ops.sin(arg_a),
                        ops.sin(arg_b), out)
     elif kern is K.QUADRATIC:
-        v, d1, d2 = _quadratic_setup(ops, tuple(a), tuple(b), t0_arr.astype(dtype),
+        v, d1, d2 = quadratic_setup(ops, tuple(a), tuple(b), t0_arr.astype(dtype),
                                      dt_arr.astype(dtype), coeffs, bool((t0_arr == 0).all()))
         _quadratic_kernel(offsets, v, d1, d2, out)
     elif kern is K.ANGULAR:
-        p0, p1, k2 = _angular_setup(ops, tuple(a), tuple(b), t0_arr.astype(dtype),
+        p0, p1, k2 = angular_setup(ops, tuple(a), tuple(b), t0_arr.astype(dtype),
                                     dt_arr.astype(dtype), int(cnt.max()),
                                     bool((t0_arr == 0).all()))
         _angular_kernel(offsets, p0, p1, k2, out)
@@ -543,7 +321,7 @@ def _stack(v):
     return np.ascontiguousarray(np.stack([np.broadcast_to(c, v[0].shape) for c in v]))
 
 
-def _quadratic_setup(ops, nl, nr, t0, dt, coeffs, start_at_left):
+def quadratic_setup(ops, nl, nr, t0, dt, coeffs, start_at_left):
     """The set-up of :func:`chebnorm.methods.kernels.quadratic_steps`, in its operation order."""
     x = K.dot(nl, nr)
     s = K.vadd(nl, nr)
@@ -562,7 +340,7 @@ def _quadratic_setup(ops, nl, nr, t0, dt, coeffs, start_at_left):
     return _stack(v), _stack(d1), _stack(d2)
 
 
-def _angular_setup(ops, nl, nr, t0, dt, n, start_at_left):
+def angular_setup(ops, nl, nr, t0, dt, n, start_at_left):
     """The first two pixels of :func:`chebnorm.methods.kernels.angular_steps` (run by the
     kernel itself) and its recurrence factor ``2 cos(phi)``, in its operation order."""
     gen = K.angular_steps(ops, nl, nr, t0, dt, n, start_at_left=start_at_left)
@@ -574,7 +352,7 @@ def _angular_setup(ops, nl, nr, t0, dt, n, start_at_left):
 
 
 # ---------------------------------------------------------------- shading
-@_njit
+@njit
 def _half_vectors_kernel(frag_span, frag_t, left, right, c0, sel, L, eye):
     """``_unit(L + _unit(eye - P))`` at the fragments ``sel``, ``P`` interpolated from
     attribute columns ``c0 .. c0+2`` (the reference's operation order)."""
@@ -601,14 +379,14 @@ def _half_vectors_kernel(frag_span, frag_t, left, right, c0, sel, L, eye):
 
 def fast_half_vectors(sp: Spans, col: int, vis, L, eye) -> np.ndarray:
     """Per-pixel Blinn half vectors at the visible fragments (positions in attribute
-    columns ``col .. col+2``), as :mod:`.render` computes them."""
+    columns ``col .. col+2``), as the numpy engine computes them."""
     return _half_vectors_kernel(sp.frag_span, sp.frag_t, np.ascontiguousarray(sp.left),
                                 np.ascontiguousarray(sp.right), int(col),
                                 np.asarray(vis, np.int64), np.asarray(L, np.float64),
                                 np.asarray(eye, np.float64))
 
 
-@_njit
+@njit
 def _shade_kernel(ndotl, ndoth, N, pixel, tri_of, light, n_pixels):
     # light: I0, ka, kd, ks, shininess
     img = np.zeros(n_pixels, np.float64)

@@ -1,0 +1,56 @@
+"""Rendering engines: one interface (:class:`~chebnorm.raster.engines.base.Engine`), two
+implementations with the same image bytes: :mod:`.numpy` (the reference) and
+:mod:`.numba` (compiled, optional).  ``render`` picks one with :func:`get_engine`.
+"""
+
+from __future__ import annotations
+
+from .base import Engine, FrameUnsupported
+from .numba import HAVE_NUMBA, NumbaEngine
+from .numpy import NumpyEngine
+
+__all__ = ["ENGINES", "HAVE_NUMBA", "Engine", "FrameUnsupported", "resolve_engine",
+           "get_engine"]
+
+#: accepted values of ``render(engine=...)``
+ENGINES = ("auto", "numpy", "numba")
+
+_ENGINES = {"numpy": NumpyEngine(), "numba": NumbaEngine()}
+
+
+def resolve_engine(engine) -> str:
+    """``"numpy"`` or ``"numba"``: what ``engine`` (``"auto"``, None, ``"numpy"``,
+    ``"numba"``) means here; ``"numba"`` without numba installed is an error.
+
+    >>> resolve_engine("numpy")
+    'numpy'
+    """
+    if engine is None:
+        engine = "auto"
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; accepted: {', '.join(ENGINES)}")
+    if engine == "auto":
+        return "numba" if HAVE_NUMBA else "numpy"
+    if engine == "numba" and not HAVE_NUMBA:
+        raise ValueError("engine 'numba' needs the numba package (pip install numba); "
+                         "accepted without it: auto, numpy")
+    return engine
+
+
+def get_engine(engine="auto") -> Engine:
+    """The engine ``render(engine=...)`` means (see :func:`resolve_engine`).
+
+    Parameters
+    ----------
+    engine : {"auto", "numpy", "numba"} or None
+        ``"auto"`` (and None): numba when installed, else numpy.
+
+    Returns
+    -------
+    Engine
+        The engine object (one per process and name).
+
+    >>> get_engine("numpy").name
+    'numpy'
+    """
+    return _ENGINES[resolve_engine(engine)]

@@ -1,0 +1,74 @@
+"""The compiled engine (numba, optional): the numpy reference's bytes, faster.
+
+Modules, each importing only those above it: :mod:`.jit` (the numba import guard,
+``njit``, LLVM intrinsics, the one thread pool), :mod:`.calibration` (the library
+reductions' summation orders and the shortcuts checked once per process),
+:mod:`.workspace` (scratch memory kept between frames), :mod:`.rasterize` (spans,
+z-buffer, triangle gather, projection), :mod:`.kernels` (span normals, half vectors,
+shading), :mod:`.setup` (the fused frame's per-span set-up) and :mod:`.frame` (the
+fused, threaded ``phong`` frame).  :class:`NumbaEngine` is what ``render`` uses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..base import Setup, dot
+from ..numpy import NumpyEngine
+from . import frame
+from .jit import HAVE_NUMBA
+from .kernels import fast_half_vectors, fast_shade, fast_span_normals
+from .kernels import supports as kernels_support
+from .rasterize import (default_camera_of, fast_lerp, fast_setup_spans, fast_zbuffer,
+                        gather_setup, project)
+
+__all__ = ["HAVE_NUMBA", "NumbaEngine"]
+
+
+class NumbaEngine(NumpyEngine):
+    """The compiled engine: the steps of :class:`~chebnorm.raster.engines.numpy.NumpyEngine`
+    compiled (the same bytes), and for ``phong`` the fused, threaded frame of
+    :mod:`.frame`."""
+
+    name = "numba"
+
+    def setup(self, mesh, camera, size, cull) -> Setup:
+        w, h = size
+        # the same camera (remembered per mesh positions) and gathers, compiled
+        cam = camera or default_camera_of(mesh.positions, w, h)
+        xy, inv_w = project(cam, mesh.positions, w, h)
+        tri, txy, iw, pos, nrm, attrs = gather_setup(mesh, xy, inv_w, cull)
+        return Setup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, attrs)
+
+    def rasterize(self, xy, attrs, width, height):
+        sp = fast_setup_spans(xy, attrs, width, height)
+        return sp, fast_zbuffer(sp, width * height)
+
+    def lerp(self, sp, cols, sel):
+        return fast_lerp(sp, cols, sel)
+
+    def plain_normals(self, sp, cols, idx, sel):
+        frags = np.arange(sp.n_fragments) if sel is None else np.flatnonzero(sel[sp.frag_span])
+        return fast_lerp(sp, cols, frags)
+
+    def span_normals(self, spec, *args, **kw):
+        if kernels_support(spec):
+            return fast_span_normals(spec, *args, **kw)
+        return super().span_normals(spec, *args, **kw)
+
+    def half_vectors(self, st, sp, vis):
+        return fast_half_vectors(sp, 4, vis, st.L, st.camera.eye)
+
+    def shade(self, st, sp, vis, N, H, lighting):
+        # dot products stay numpy's (their summation order is numpy's and BLAS's)
+        img, mask, tri, nlen = fast_shade(N @ st.L, dot(N, H), N, sp.frag_pixel[vis],
+                                          st.tri[sp.tri[sp.frag_span[vis]]], lighting,
+                                          st.width * st.height)
+        shape = (st.height, st.width)
+        return img.reshape(shape), mask.reshape(shape), tri.reshape(shape), nlen.reshape(shape)
+
+    def supports_frame(self, spec) -> bool:
+        return kernels_support(spec) and frame.supports(spec)
+
+    def phong_frame(self, st, spec, lighting, tables, dtype):
+        return frame.phong(st, spec, lighting, tables, dtype)

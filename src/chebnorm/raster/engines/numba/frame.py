@@ -1,0 +1,711 @@
+"""The fused, parallel ``phong`` frame of the compiled engine: visibility per scan line,
+then deferred shading.
+
+The numpy engine (:mod:`chebnorm.raster.engines.numpy`) is the reference and the
+compiled engine's step-by-step path (:mod:`.rasterize`, :mod:`.kernels`) its twin
+operation by operation; this module computes the same ``phong`` frame, byte for byte,
+without the full-frame intermediate arrays of those two paths (fragment lists, a
+frame-sized z-buffer, per-fragment normals, half vectors and dot products):
+
+1. triangle set-up and span set-up, compiled, the spans split over threads
+   (:func:`.rasterize.row_spans`, the arithmetic of :func:`chebnorm.raster.spans.setup_spans`);
+2. the method's checks and per-span set-up, the values and errors of
+   :func:`chebnorm.methods.span_normals`'s, compiled and split over threads in
+   :mod:`.setup` (the reference functions run where a check fails; sine, cosine
+   and arc cosine with the bits of :mod:`chebnorm.methods.detmath`, see
+   :func:`.calibration.det`);
+3. one pass per scan line, rows split across the cores (threads running the compiled
+   kernels without the GIL, rows interleaved): a z-test of the
+   line's spans in span order into a line buffer (the winning span of every pixel,
+   ties to the earliest fragment as in :func:`chebnorm.raster.spans.zbuffer`), then each
+   span's pixel normals by the method's kernel (stepping kernels step through every
+   pixel of the span, the others are evaluated only where the span won) and, for the
+   winners only, half vector, Blinn-Phong intensity, ``|N|`` and the triangle id,
+   each output pixel written once.
+
+Every float operation is the reference's, in its order and dtype (no ``fastmath``).
+The library reductions (``N @ L``, ``einsum``, ``norm``) are summed in the orders
+:func:`.calibration.calibrated` found; :func:`supports` says whether the frame can
+promise the reference's bytes for a method, and :func:`phong` raises
+:class:`chebnorm.raster.engines.base.FrameUnsupported` when a frame turns out not to
+(then the caller takes the step-by-step path).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from chebnorm.methods import detmath
+from chebnorm.methods import kernels as K
+from chebnorm.methods.registry import method_kernel
+from chebnorm.methods.spans import MAX_LEVELS
+
+from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
+from .calibration import (DetOps, calibrated, dot3, f32_round, pow_calibrated, powers, trig64,
+                          trig_calibrated)
+from .jit import HAVE_NUMBA, njit, run, threads
+from .kernels import dichotomy_denominators
+from .rasterize import row_spans
+from .setup import method_setup, span_input, widest_dot
+from .workspace import give, keep_maps, output_maps, take
+
+__all__ = ["MODES", "supports", "phong"]
+
+
+#: kernel -> mode number of the fused kernel
+MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLERP): 4,
+         id(K.QUADRATIC): 5, id(K.ANGULAR): 6, id(K.DICHOTOMY): 7}
+
+
+# ------------------------------------------------------------ dichotomy prep
+@njit()
+def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
+    """Per-span denominators of every level and, per depth, whether any pixel of any
+    span is off the dyadic grid (then every pixel of that depth is picked), as
+    the dichotomy kernel of :mod:`.kernels` computes them."""
+    S = levels.shape[0]
+    r, Lmax = dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
+    off = np.zeros(Lmax + 1, np.bool_)
+    tcb = np.empty(1, nl.dtype)
+    for i in range(S):
+        L = levels[i]
+        if off[L]:
+            continue
+        scale = kc[2 + L]
+        for j in range(count[i]):
+            tcb[0] = t0[i] + j * dt[i]
+            u = tcb[0] * scale
+            if u - np.floor(u) != 0:
+                off[L] = True
+                break
+    return r, off
+
+
+# ---------------------------------------------------------------- shading
+@njit(inline=True)
+def _half(p0, p1, p2, e0, e1, e2, l0, l1, l2, order):
+    """``_unit(L + _unit(eye - P))`` (:func:`chebnorm.raster.engines.base.half_vectors`; ``|v|`` as
+    ``np.linalg.norm`` sums, ``order``)."""
+    v0, v1, v2 = e0 - p0, e1 - p1, e2 - p2
+    r = np.sqrt(dot3(v0, v1, v2, v0, v1, v2, order))
+    v0, v1, v2 = v0 / r, v1 / r, v2 / r
+    h0, h1, h2 = l0 + v0, l1 + v1, l2 + v2
+    r = np.sqrt(dot3(h0, h1, h2, h0, h1, h2, order))
+    return h0 / r, h1 / r, h2 / r
+
+
+@njit(inline=True)
+def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd, ks, sh):
+    """``Lighting.intensity(N @ L, _dot(N, H))`` clipped to [0, 1] (``N @ L`` and the
+    einsum summed in their calibrated orders)."""
+    a = dot3(N0, N1, N2, l0, l1, l2, order_l)
+    b = dot3(N0, N1, N2, h0, h1, h2, order_h)
+    a = a if (a >= 0.0 or a != a) else 0.0      # np.maximum(a, 0.0)
+    b = b if (b >= 0.0 or b != b) else 0.0
+    # numpy squares for the exponent 2 (its fast scalar power), calls pow otherwise
+    v = I0 * (ka + kd * a + ks * (b * b if sh == 2.0 else b ** sh))
+    if v < 0.0:
+        v = 0.0
+    elif v > 1.0:
+        v = 1.0
+    return v
+
+
+@njit()
+def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs):
+    """Row ``rr``: in ``bs`` the winning span of each pixel (largest ``1/w``, ties to the
+    earliest span; -1: none)."""
+    for x in range(width):
+        bs[x] = -1
+    for k in range(row_start[rr], row_start[rr + 1]):
+        s = by_row[k]
+        lo = left[s, 0]
+        dw = right[s, 0] - lo
+        for j in range(count[s]):
+            t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+            w = lo + t * dw
+            x = c0[s] + j
+            if bs[x] < 0 or w > bw[x]:
+                bs[x] = s
+                bw[x] = w
+
+
+@njit(inline=True)
+def _linear(mode, a0, a1, a2, d0, d1, d2, t, k0, k1, k2, k3, k4):
+    """``N_l + t (N_r - N_l)`` normalized by mode 1 (``N/sqrt(N.N)``), 2 (Newton) or 3
+    (Lyon), or not (0), as the linear kernel of :mod:`.kernels` (constants ``k`` in the dtype)."""
+    n0 = a0 + t * d0
+    n1 = a1 + t * d1
+    n2 = a2 + t * d2
+    if mode == 0:
+        return n0, n1, n2
+    if mode == 1:
+        r = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        return n0 / r, n1 / r, n2 / r
+    x = n0 * n0 + n1 * n1 + n2 * n2
+    q = (k0 - x) * k1 if mode == 2 else (x * k2 - k3) * x + k4
+    return n0 * q, n1 * q, n2 * q
+
+
+@njit(inline=True)
+def _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1, f2, k2):
+    """One step (``j >= 1``) of the stepping kernels: quadratic (mode 5, value ``v``,
+    first and second differences ``e``, ``f``) or angular (mode 6, current ``v`` and
+    previous ``e`` pixel, factor ``k2 = 2 cos(phi)``; at ``j = 1`` the second pixel is
+    the given one)."""
+    if mode == 5:
+        return v0 + e0, v1 + e1, v2 + e2, e0 + f0, e1 + f1, e2 + f2
+    if j == 1:
+        return e0, e1, e2, v0, v1, v2
+    return v0 * k2 - e0, v1 * k2 - e1, v2 * k2 - e2, v0, v1, v2
+
+
+# ---------------------------------------------------------------- shading rows
+@njit(inline=True)
+def _clamp0(a):
+    """``np.maximum(a, 0.0)`` (NaN kept)."""
+    return a if (a >= 0.0 or a != a) else 0.0
+
+
+@njit()
+def _dots_row(x0, x1, x2, y0, y1, y2, out, nw, order):
+    """``out[k] = x[k] . y[k]`` in summation order ``order`` (one loop per order, so
+    each vectorizes)."""
+    if order == 0:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 0)
+    elif order == 1:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 1)
+    else:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 2)
+
+
+@njit()
+def _dotc_row(x0, x1, x2, c0, c1, c2, out, nw, order):
+    """``out[k] = x[k] . c`` (``c`` one vector), in summation order ``order``."""
+    if order == 0:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 0)
+    elif order == 1:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 1)
+    else:
+        for k in range(nw):
+            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 2)
+
+
+@njit()
+def _half_row(h0, h1, h2, e0, e1, e2, l0, l1, l2, nw, order):
+    """``h[k] = _half(P[k])`` in place (``h`` holds the positions ``P`` on entry)."""
+    if order == 0:
+        for k in range(nw):
+            h0[k], h1[k], h2[k] = _half(h0[k], h1[k], h2[k], e0, e1, e2, l0, l1, l2, 0)
+    elif order == 1:
+        for k in range(nw):
+            h0[k], h1[k], h2[k] = _half(h0[k], h1[k], h2[k], e0, e1, e2, l0, l1, l2, 1)
+    else:
+        for k in range(nw):
+            h0[k], h1[k], h2[k] = _half(h0[k], h1[k], h2[k], e0, e1, e2, l0, l1, l2, 2)
+
+
+@njit()
+def _linear_row(mode, n0, n1, n2, a0, a1, a2, d0, d1, d2, tc, kc, out0, out1, out2, nw):
+    """Modes 1 (``N/sqrt(N.N)``), 2 (Newton), 3 (Lyon) of :func:`_linear` on the row's
+    winners (gathered ends ``a``, differences ``d`` and ``t`` in the dtype), results
+    widened to float64 (one loop per mode, so each vectorizes)."""
+    if mode == 1:
+        for k in range(nw):
+            m0, m1, m2 = _linear(1, a0[k], a1[k], a2[k], d0[k], d1[k], d2[k], tc[k], kc[0],
+                                 kc[1], kc[2], kc[3], kc[4])
+            out0[k], out1[k], out2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+    elif mode == 2:
+        for k in range(nw):
+            m0, m1, m2 = _linear(2, a0[k], a1[k], a2[k], d0[k], d1[k], d2[k], tc[k], kc[0],
+                                 kc[1], kc[2], kc[3], kc[4])
+            out0[k], out1[k], out2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+    else:
+        for k in range(nw):
+            m0, m1, m2 = _linear(3, a0[k], a1[k], a2[k], d0[k], d1[k], d2[k], tc[k], kc[0],
+                                 kc[1], kc[2], kc[3], kc[4])
+            out0[k], out1[k], out2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+
+
+@njit()
+def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
+           A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
+           light, orders, part, parts, img, mask, tri_map, nlen):
+    """The visibility and shading passes, one scan line at a time, on the rows
+    ``part, part + parts, ...`` (threads run the parts at once: each writes every pixel
+    of its own rows of the four output maps, the background where no fragment lands:
+    0, False, -1, NaN). Returns the number of slerp float32 pixels whose
+    sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
+
+    Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
+    then each quantity of the shading for all of them in one loop (gathers first, then
+    loops of arithmetic alone, which LLVM vectorizes: ``sqrt`` and division are
+    correctly rounded in every lane, so the bits are the scalar ones)."""
+    hard = 0
+    l0, l1, l2 = L[0], L[1], L[2]
+    ey0, ey1, ey2 = eye[0], eye[1], eye[2]
+    o2 = orders[2]
+    W = width
+    bw = np.empty(W)
+    bs = np.empty(W, np.int64)
+    wx = np.empty(W, np.int64)
+    ws = np.empty(W, np.int64)
+    wt = np.empty(W)
+    tc = np.empty(W, A.dtype)
+    ga = np.empty((6, W), A.dtype)
+    sx = np.empty((3, W), A.dtype)
+    n0, n1, n2 = np.empty(W), np.empty(W), np.empty(W)
+    h0, h1, h2 = np.empty(W), np.empty(W), np.empty(W)
+    av, bv, nl, pw = np.empty(W), np.empty(W), np.empty(W), np.empty(W)
+    hh, ll = np.empty(W), np.empty(W)
+    ok = np.empty(W, np.bool_)
+    skip = np.zeros(W, np.bool_)
+    nd = np.empty((3, _TREE_MAX + 1), A.dtype)
+    sab = np.empty(2, A.dtype)
+    sw = np.empty((9, W) if mode == 4 else (9, 1))
+    for rr in range(part, height, parts):
+        base = rr * W
+        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
+        nw = 0
+        for x in range(W):
+            # the background (overwritten where a fragment lands), the winners listed
+            img[base + x] = 0.0
+            mask[base + x] = False
+            tri_map[base + x] = -1
+            nlen[base + x] = np.nan
+            if bs[x] >= 0:
+                wx[nw] = x
+                ws[nw] = bs[x]
+                nw += 1
+        if nw == 0:
+            continue
+        for k in range(nw):
+            s = ws[k]
+            tu = t0[s] + (wx[k] - c0[s]) * dt[s]
+            tc[k] = tu                       # the reference's t.astype(dtype)
+            wt[k] = min(max(tu, 0.0), 1.0)
+        # the method's normals, widened to float64
+        if mode == 0:
+            for k in range(nw):
+                s = ws[k]
+                t = wt[k]
+                lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
+                n0[k] = lo1 + t * (right[s, 1] - lo1)
+                n1[k] = lo2 + t * (right[s, 2] - lo2)
+                n2[k] = lo3 + t * (right[s, 3] - lo3)
+        elif mode <= 3:
+            for k in range(nw):
+                s = ws[k]
+                for c in range(3):
+                    ga[c, k] = A[c, s]
+                    ga[3 + c, k] = B[c, s]
+            _linear_row(mode, n0, n1, n2, ga[0], ga[1], ga[2], ga[3], ga[4], ga[5], tc, kc, n0,
+                        n1, n2, nw)
+        elif mode == 5 or mode == 6:
+            _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1,
+                      n2, nw)
+        elif mode == 4:
+            hard += _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, light[6] != 0.0, sw, ok,
+                               sab, skip, n0, n1, n2, nw)
+        else:
+            _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw)
+        # half vectors
+        if per_pixel_h:
+            for k in range(nw):
+                s = ws[k]
+                t = wt[k]
+                q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
+                h0[k] = q0 + t * (right[s, 4] - q0)
+                h1[k] = q1 + t * (right[s, 5] - q1)
+                h2[k] = q2 + t * (right[s, 6] - q2)
+            _half_row(h0, h1, h2, ey0, ey1, ey2, l0, l1, l2, nw, o2)
+        else:
+            _tri_half_row(ws, stri, Htri, h0, h1, h2, nw)
+        _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
+                   bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
+    return hard
+
+
+@njit()
+def _tri_half_row(ws, stri, Htri, h0, h1, h2, nw):
+    """The per-triangle ``H`` of each winner's span, looked up once per run of a span's
+    winners (they are adjacent)."""
+    last = -1
+    g0 = g1 = g2 = 0.0
+    for k in range(nw):
+        if ws[k] != last:
+            last = ws[k]
+            ft = stri[last]
+            g0, g1, g2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+        h0[k], h1[k], h2[k] = g0, g1, g2
+
+
+@njit()
+def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv, nl,
+               pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw):
+    """``Lighting.intensity(N @ L, N . H)`` clipped, and ``|N|``, at the row's winners, into
+    the four maps (row offset ``base``)."""
+    l0, l1, l2 = L[0], L[1], L[2]
+    I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
+    fastpow = light[5] != 0.0
+    o0, o1, o2 = orders[0], orders[1], orders[2]
+    _dotc_row(n0, n1, n2, l0, l1, l2, av, nw, o0)
+    _dots_row(n0, n1, n2, h0, h1, h2, bv, nw, o1)
+    _dots_row(n0, n1, n2, n0, n1, n2, nl, nw, o2)
+    for k in range(nw):
+        av[k] = _clamp0(av[k])
+        bv[k] = _clamp0(bv[k])
+        nl[k] = np.sqrt(nl[k])
+    powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
+    for k in range(nw):
+        v = I0 * (ka + kdif * av[k] + ks * pw[k])
+        av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
+    for k in range(nw):
+        p = base + wx[k]
+        if skip[k]:
+            skip[k] = False
+            tri_map[p] = -2 - ws[k]
+            continue
+        img[p] = av[k]
+        mask[p] = True
+        tri_map[p] = face_id[stri[ws[k]]]
+        nlen[p] = nl[k]
+
+
+@njit()
+def _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw):
+    """Stepping kernels (5 quadratic, 6 angular) on row ``rr``: every pixel of each span
+    in order, the winners' normals (in ``x`` order) widened to float64."""
+    for q in range(row_start[rr], row_start[rr + 1]):
+        s = by_row[q]
+        x0 = c0[s]
+        v0, v1, v2 = A[0, s], A[1, s], A[2, s]
+        e0, e1, e2 = B[0, s], B[1, s], B[2, s]
+        f0, f1, f2 = C[0, s], C[1, s], C[2, s]
+        for j in range(count[s]):
+            if j > 0:
+                v0, v1, v2, e0, e1, e2 = _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1,
+                                               f2, sc[s])
+            if bs[x0 + j] == s:
+                sx[0, x0 + j] = v0
+                sx[1, x0 + j] = v1
+                sx[2, x0 + j] = v2
+    for k in range(nw):
+        x = wx[k]
+        n0[k] = np.float64(sx[0, x])
+        n1[k] = np.float64(sx[1, x])
+        n2[k] = np.float64(sx[2, x])
+
+
+@njit()
+def _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, fastsin, sw, ok, sab, skip, n0, n1, n2, nw):
+    """Slerp (mode 4) at the row's winners; the number of float32 pixels whose sine is in
+    doubt (``skip``: for :mod:`detmath`, see :func:`phong`). ``fastsin``: float64 sines
+    by :func:`trig64` (rows 0-3 of ``sw`` the arguments and sines, 4-8 its scratch)."""
+    if is64 and fastsin:
+        for k in range(nw):
+            s = ws[k]
+            sw[0, k] = (kc[5] - tc[k]) * sc[s]
+            sw[1, k] = tc[k] * sc[s]
+        trig64(0, sw[0], sw[2], ok, sw[4:], nw)
+        trig64(0, sw[1], sw[3], ok, sw[4:], nw)
+        for k in range(nw):
+            s = ws[k]
+            wa = sw[2, k] * sc2[s]
+            wb = sw[3, k] * sc2[s]
+            n0[k] = np.float64(A[0, s] * wa + B[0, s] * wb)
+            n1[k] = np.float64(A[1, s] * wa + B[1, s] * wb)
+            n2[k] = np.float64(A[2, s] * wa + B[2, s] * wb)
+        return 0
+    hard = 0
+    for k in range(nw):
+        s = ws[k]
+        t_ = tc[k]
+        arg_a = (kc[5] - t_) * sc[s]
+        arg_b = t_ * sc[s]
+        if is64:
+            sab[0] = np.sin(arg_a)
+            sab[1] = np.sin(arg_b)
+        else:
+            ra, ha = f32_round(np.sin(np.float64(arg_a)))
+            rb, hb = f32_round(np.sin(np.float64(arg_b)))
+            if ha or hb:     # a float32 sine for detmath (see phong)
+                skip[k] = True
+                hard += 1
+                n0[k] = n1[k] = n2[k] = 0.0
+                continue
+            sab[0] = ra
+            sab[1] = rb
+        wa = sab[0] * sc2[s]
+        wb = sab[1] * sc2[s]
+        n0[k] = np.float64(A[0, s] * wa + B[0, s] * wb)
+        n1[k] = np.float64(A[1, s] * wa + B[1, s] * wb)
+        n2[k] = np.float64(A[2, s] * wa + B[2, s] * wb)
+    return hard
+
+
+@njit()
+def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
+    """Dichotomy (mode 7) at the row's winners."""
+    cur = -1
+    tree = False
+    for k in range(nw):
+        s = ws[k]
+        lv = levels[s]
+        if s != cur:    # a span's winners are adjacent: its tree once
+            cur = s
+            tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
+            if tree:
+                _dichotomy_tree(A, B, R, s, lv, nd)
+        if tree:
+            m0, m1, m2 = _dichotomy_pick(nd, lv, off[lv], kd[2 + lv], tc[k])
+        else:
+            m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                       B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
+        n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+
+
+#: the dichotomy builds a span's whole halving tree when it has at most this many nodes
+#: (and not many more than the span has pixels); deeper spans descend per pixel
+_TREE_MAX = 1 << 12
+
+
+@njit(inline=True)
+def _dichotomy_tree(A, B, R, i, L, nd):
+    """Every node of span ``i``'s halving tree of depth ``L`` into ``nd[:, 0 .. 2**L]``:
+    the midpoint of an interval at depth ``d`` is ``(A + B) R[i, d]`` of its ends, as
+    :func:`_dichotomy_px` computes it on its way down."""
+    top = np.int64(1) << L
+    for c in range(3):
+        nd[c, 0] = A[c, i]
+        nd[c, top] = B[c, i]
+    step = top
+    for d in range(L):
+        half = step >> 1
+        r = R[i, d]
+        for m in range(half, top, step):
+            for c in range(3):
+                nd[c, m] = (nd[c, m - half] + nd[c, m + half]) * r
+        step = half
+
+
+@njit(inline=True)
+def _dichotomy_pick(nd, L, need_b, scale, tc):
+    """:func:`_dichotomy_px` from the span's whole tree ``nd``."""
+    u = tc * scale
+    kf = np.floor(u)
+    fr = u - kf
+    k = np.int64(kf)
+    if not need_b:
+        return nd[0, k], nd[1, k], nd[2, k]
+    kb = min(k + 1, np.int64(1) << L)
+    return (nd[0, k] + fr * (nd[0, kb] - nd[0, k]), nd[1, k] + fr * (nd[1, kb] - nd[1, k]),
+            nd[2, k] + fr * (nd[2, kb] - nd[2, k]))
+
+
+@njit(inline=True)
+def _dichotomy_px(a0, a1, a2, b0, b1, b2, R, i, L, need_b, scale, tc):
+    """The pixel at ``tc`` of dichotomy span ``i`` (ends ``a``, ``b``, depth ``L``, ``scale =
+    2**L`` in the dtype, denominators ``R[i]``): node ``k = floor(tc 2**L)`` of the
+    halving tree, or (``need_b``: depth ``L`` off the grid in the frame) the linear pick
+    between nodes ``k`` and ``min(k + 1, 2**L)``, as the dichotomy kernel of :mod:`.kernels`.
+    Both nodes come from one descent of the tree: every midpoint on the way is
+    ``(A + B) r`` of its interval's ends with the level's ``r``, as in the reference."""
+    u = tc * scale
+    kf = np.floor(u)
+    fr = u - kf
+    k = np.int64(kf)
+    top = np.int64(1) << L
+    lo = np.int64(0)
+    hi = top
+    lev = 0
+    target = k
+    n0 = n1 = n2 = a0        # node k, once found
+    while True:
+        if target == lo:
+            v0, v1, v2 = a0, a1, a2
+        elif target == hi:
+            v0, v1, v2 = b0, b1, b2
+        else:
+            mid = (lo + hi) >> 1
+            rr = R[i, lev]
+            lev += 1
+            m0 = (a0 + b0) * rr
+            m1 = (a1 + b1) * rr
+            m2 = (a2 + b2) * rr
+            if target < mid:
+                hi = mid
+                b0, b1, b2 = m0, m1, m2
+                continue
+            lo = mid
+            a0, a1, a2 = m0, m1, m2
+            if target > mid:
+                continue
+            v0, v1, v2 = m0, m1, m2
+        # the node ``target`` is v; [lo, hi] still holds target + 1 (or target == top)
+        if target == k:
+            n0, n1, n2 = v0, v1, v2
+            if not need_b:
+                return n0, n1, n2
+            target = min(k + 1, top)
+            continue
+        return n0 + fr * (v0 - n0), n1 + fr * (v1 - n1), n2 + fr * (v2 - n2)
+
+
+@njit()
+def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, per_pixel_h,
+                 Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen, face_id):
+    """Shade the slerp pixels whose sines :mod:`detmath` gave (``sa``, ``sb``), as
+    :func:`_frame` does the others."""
+    for q in range(pix.shape[0]):
+        p = pix[q]
+        s = span[q]
+        j = p % width - c0[s]
+        t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+        wa = sa[q] * sc2[s]
+        wb = sb[q] * sc2[s]
+        N0 = np.float64(A[0, s] * wa + B[0, s] * wb)
+        N1 = np.float64(A[1, s] * wa + B[1, s] * wb)
+        N2 = np.float64(A[2, s] * wa + B[2, s] * wb)
+        if per_pixel_h:
+            q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
+            h0, h1, h2 = _half(q0 + t * (right[s, 4] - q0), q1 + t * (right[s, 5] - q1),
+                               q2 + t * (right[s, 6] - q2), eye[0], eye[1], eye[2], L[0], L[1],
+                               L[2], orders[2])
+        else:
+            ft = stri[s]
+            h0, h1, h2 = Htri[ft, 0], Htri[ft, 1], Htri[ft, 2]
+        img[p] = _intensity(N0, N1, N2, h0, h1, h2, L[0], L[1], L[2], orders[0], orders[1],
+                            light[0], light[1], light[2], light[3], light[4])
+        mask[p] = True
+        tri_map[p] = face_id[stri[s]]
+        nlen[p] = np.sqrt(dot3(N0, N1, N2, N0, N1, N2, orders[2]))
+
+
+# ------------------------------------------------------------------ driver
+def supports(spec) -> bool:
+    """Whether :func:`phong` renders method ``spec`` (its kernel has a fused twin, numba is
+    installed and :func:`calibrated` found the reductions' orders).
+
+    >>> from chebnorm.methods import get_method
+    >>> supports(get_method("dichotomy")) == (HAVE_NUMBA and calibrated() is not None)
+    True
+    """
+    return (HAVE_NUMBA and id(method_kernel(spec)) in MODES
+            and calibrated() is not None)
+
+
+def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
+    """The per-span arrays of method ``mode`` the frame's kernels take: ``(dtype, A, B,
+    C, sc, sc2, levels, R, off, kd)`` (placeholders of size 1 where the mode has none;
+    ``dtype`` the computation's, checked as the reference checks it where spans use it)."""
+    S = len(sp.count)
+    dt_ = np.float64    # the computation's dtype, checked (as the reference) where spans use it
+    if mode and S:
+        dt_, coeffs, lv, A, B, start_left, count_max = span_input(
+            spec, sp, tables, dtype, ends, mode <= 3)
+    else:
+        A = B = np.zeros((3, 1), dt_)
+    C = np.zeros((3, 1), dt_)
+    sc = sc2 = np.zeros(1, dt_)
+    levels = np.zeros(1, np.int64)
+    R = np.zeros((1, 1), dt_)
+    off = np.zeros(1, np.bool_)
+    kd = np.zeros(1, dt_)
+    if mode and S:
+        dtype = dt_
+        ops = DetOps(dtype)    # modes 1-3: B is N_r - N_l (K.vsub(b, a)) in the dtype
+        if mode == 4:       # K.SLERP.setup, compiled
+            sc, sc2 = method_setup(mode, A, B, None, None, coeffs, start_left, count_max,
+                                   ops, work)
+        elif mode == 5:     # quadratic_setup, compiled
+            A, B, C = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
+                                   coeffs, start_left, count_max, ops, work)
+        elif mode == 6:     # angular_setup, compiled
+            A, B, sc = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
+                                    coeffs, start_left, count_max, ops, work)
+        elif mode == 7:     # dichotomy
+            cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
+            kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
+            levels = np.ascontiguousarray(lv, np.int64)
+            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
+                                     sp.count)
+    return dt_, A, B, C, sc, sc2, levels, R, off, kd
+
+
+def phong(st, spec, lighting, tables, dtype):
+    """The ``phong`` frame of ``render`` as a
+    :class:`~chebnorm.raster.engines.base.ModeResult`: set-up ``st`` (with ``L``),
+    method entry ``spec`` (:func:`supports` holds for it), ``lighting``, and ``tables``,
+    ``dtype`` as ``render`` passes them to the span interpolator.
+
+    Raises
+    ------
+    chebnorm.raster.engines.base.FrameUnsupported
+        Where this path cannot promise the reference's bytes (the caller then draws the
+        frame step by step).
+    """
+    orders = calibrated()
+    if orders is None or id(method_kernel(spec)) not in MODES:
+        raise FrameUnsupported("no calibrated reduction orders or no fused kernel")
+    per_pixel_h = lighting.half_vector == "pixel"
+    attrs = getattr(st, "attrs", None)   # [1/w, normal, position] of gather_setup
+    if attrs is None:
+        attrs = np.concatenate([st.inv_w[..., None], st.nrm, st.pos], axis=2)
+    if not per_pixel_h:
+        attrs = attrs[..., :4]
+    work = take()    # scratch arrays of an earlier frame (pages mapped)
+    sp = row_spans(st.xy, attrs, st.width, st.height, work)
+    # the output maps: the memory of an earlier frame's once the user dropped it (else
+    # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows
+    maps = output_maps(st.width * st.height)
+    S = len(sp.count)
+    stats = {}
+    mode = MODES[id(method_kernel(spec))]
+    # the unit end normals, the checks of check_span_input and the values it derives,
+    # compiled (.setup: the reference runs where a check fails)
+    ends, dot_min = (widest_dot(sp, spec, dtype, mode <= 3, work)
+                     if S and (mode or spec.table is not None) else (None, None))
+    tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats, dot_min=dot_min)
+    dt_, A, B, C, sc, sc2, levels, R, off, kd = _mode_arrays(mode, spec, sp, tables, dtype,
+                                                             ends, work)
+    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
+    C = np.ascontiguousarray(C)
+    Htri = (np.ascontiguousarray(triangle_half_vectors(st), np.float64) if not per_pixel_h
+            else np.zeros((1, 3)))
+    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess,
+                      float(pow_calibrated(float(lighting.shininess))),
+                      float(mode == 4 and trig_calibrated())], np.float64)
+    L = np.ascontiguousarray(st.L, np.float64)
+    eye = np.asarray(st.camera.eye, np.float64)
+    ords = np.array(orders, np.int64)
+    face_id = np.ascontiguousarray(st.tri, np.int64)
+    args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
+    img, mask, tri_map, nlen = maps
+    common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
+              *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
+              per_pixel_h, Htri, L, eye, light, ords)
+    k = min(threads(), st.height)
+    nh = sum(run([(_frame, (*common, q, k, *maps)) for q in range(k)]))
+    if nh:
+        pix = np.flatnonzero(tri_map < -1)
+        span = -2 - tri_map[pix]
+        j = pix % st.width - sp.x0[span]
+        tc = (sp.t0[span] + j * sp.dt[span]).astype(dt_)
+        psi = sc[span]
+        sa, sb = detmath.sin((kc[5] - tc) * psi), detmath.sin(tc * psi)
+        _slerp_fixup(pix, span, sa, sb, st.width, *args, A, B, sc2, per_pixel_h, Htri, sp.tri,
+                     L, eye, light, ords, img, mask, tri_map, nlen, face_id)
+    give(work)
+    keep_maps(maps)
+    if np.count_nonzero(mask) < 2:
+        # numpy computes N @ L for one row by another route than BLAS
+        raise FrameUnsupported("fewer than two pixels covered")
+    shape = (st.height, st.width)
+    return ModeResult(img.reshape(shape), mask.reshape(shape), int(sp.count.sum()), stats,
+                      triangle=tri_map.reshape(shape), normal_length=nlen.reshape(shape))

@@ -1,0 +1,133 @@
+"""The compiled engine's floor: the numba import guard, :func:`njit`, three LLVM
+intrinsics (:func:`fma`, :func:`f2i`, :func:`i2f`) and the one thread pool of the process.
+
+Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
+cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
+its order and dtype; LLVM does not contract a multiply-add into an FMA without
+fast-math flags).  Without numba (:data:`HAVE_NUMBA` False) :func:`njit` returns the
+Python function and the engine is not offered (:func:`chebnorm.raster.engines.get_engine`).
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+try:  # pragma: no cover - exercised by whichever environment runs the tests
+    import numba
+    from llvmlite import ir as _ir
+    from numba.core import types as _types
+    from numba.core.extending import intrinsic as _intrinsic
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover
+    numba = None
+    HAVE_NUMBA = False
+
+__all__ = ["HAVE_NUMBA", "njit", "fma", "f2i", "i2f", "threads", "pool", "run",
+           "run_with_caller"]
+
+
+def njit(fn=None, *, inline=False):
+    """numba's ``njit`` (cached, ``nogil``, no fast-math, numpy's error model), usable
+    as ``@njit`` or ``@njit(inline=True)``; ``inline``: inlined into its callers in
+    numba's IR (per-pixel helpers: no call, no reference counting of the arrays passed
+    in the inner loop).  Without numba, the function itself.
+
+    Parameters
+    ----------
+    fn : callable, optional
+        The function to compile (``@njit``); None for ``@njit(...)``.
+    inline : bool
+        Inline into callers (``inline="always"``) instead of calling.
+    """
+    def deco(f):
+        if not HAVE_NUMBA:
+            return f
+        return numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy",
+                          inline="always" if inline else "never")(f)
+    return deco(fn) if fn is not None else deco
+
+
+if HAVE_NUMBA:
+    @_intrinsic
+    def fma(typingctx, a, b, c):
+        """``a * b + c`` rounded once (LLVM's ``fma``)."""
+        sig = _types.float64(_types.float64, _types.float64, _types.float64)
+
+        def codegen(context, builder, signature, args):
+            d = _ir.DoubleType()
+            fn = builder.module.declare_intrinsic("llvm.fma", [d], _ir.FunctionType(d, [d, d, d]))
+            return builder.call(fn, args)
+        return sig, codegen
+else:  # pragma: no cover
+    def fma(a, b, c):
+        raise RuntimeError("numba is not installed")
+
+
+if HAVE_NUMBA:
+    @_intrinsic
+    def f2i(typingctx, x):
+        """The bits of a float64 as an int64."""
+        sig = _types.int64(_types.float64)
+
+        def codegen(context, builder, signature, args):
+            return builder.bitcast(args[0], _ir.IntType(64))
+        return sig, codegen
+
+    @_intrinsic
+    def i2f(typingctx, i):
+        """The float64 whose bits are the int64 ``i``."""
+        sig = _types.float64(_types.int64)
+
+        def codegen(context, builder, signature, args):
+            return builder.bitcast(args[0], _ir.DoubleType())
+        return sig, codegen
+else:  # pragma: no cover
+    def f2i(x):
+        raise RuntimeError("numba is not installed")
+
+    def i2f(i):
+        raise RuntimeError("numba is not installed")
+
+
+def threads() -> int:
+    """Threads to split a frame over: the CPUs this process may run on (at most 8)."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        n = os.cpu_count() or 1
+    return max(1, min(8, n))
+
+
+#: the thread pool of this process: {pid: executor} (a forked child makes its own)
+_POOL: dict = {}
+
+
+def pool():
+    """This process's thread pool (a forked child makes its own)."""
+    ex = _POOL.get(os.getpid())
+    if ex is None:
+        _POOL.clear()
+        ex = _POOL[os.getpid()] = ThreadPoolExecutor(max_workers=threads(),
+                                                      thread_name_prefix="chebnorm-raster")
+    return ex
+
+
+def run(jobs):
+    """Run ``[(kernel, args), ...]`` (compiled with ``nogil``) at once on :func:`pool`;
+    their results in order."""
+    if len(jobs) == 1:
+        return [jobs[0][0](*jobs[0][1])]
+    futures = [pool().submit(fn, *args) for fn, args in jobs]
+    return [f.result() for f in futures]
+
+
+def run_with_caller(jobs):
+    """Run ``[(kernel, args), ...]`` (compiled with ``nogil``): the first on this thread,
+    the others on :func:`pool` (whose threads may be busy with the frame's
+    background); their results in order."""
+    if len(jobs) == 1:
+        return [jobs[0][0](*jobs[0][1])]
+    futures = [pool().submit(fn, *args) for fn, args in jobs[1:]]
+    first = jobs[0][0](*jobs[0][1])
+    return [first] + [f.result() for f in futures]
