@@ -143,7 +143,7 @@ PIECEWISE = ("1/sqrt(x)", ("1", "4"), 2, 256, 24)
 def run_piecewise_chebnorm(table, tight: float):
     """Seconds to certify every segment (the batch, ``certify_segments``);
     worst bound/max - 1; the table's bound."""
-    from chebnorm.approx.piecewise import certify_segments
+    from chebnorm.approx.piecewise_table import certify_segments
 
     t0 = time.perf_counter()
     certs = certify_segments(table, tol=tight)
@@ -202,10 +202,10 @@ def run_piecewise_sollya(table, tight: float):
 
 
 def piecewise_rows(tights, repeat: int) -> list[dict]:
-    from chebnorm.approx.piecewise import fit_piecewise
+    from chebnorm.approx.piecewise_fit import piecewise_fit
 
     expr, interval, degree, segments, frac = PIECEWISE
-    table = fit_piecewise(expr, interval, degree, segments=segments, coef_frac_bits=frac)
+    table = piecewise_fit(expr, interval, degree, segments=segments, coef_frac_bits=frac)
     rows = []
     for tight in tights:
         # ours takes tens of milliseconds: more repeats steady the median on a loaded machine

@@ -98,9 +98,9 @@ def test_repr_escapes_untrusted_fields(tables):
                                          r"identifier"):
         replace(tables[0], name="<img src=x onerror=alert(1)>")
     # and a table built past the checks (tests only) has every field escaped anyway
-    from chebnorm.approx.table import _construction
+    from chebnorm.approx.contract import construction
 
-    with _construction("unchecked"):
+    with construction("unchecked"):
         t = replace(tables[0], name="<img src=x onerror=alert(1)>", expression="a | b",
                     variable="<z>")
     html_text, md = t._repr_html_(), t._repr_markdown_()

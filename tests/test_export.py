@@ -96,9 +96,9 @@ class TestText:
             fit("x", ("0", "1"), 1, name="not a c name")  # refused where it enters
         from dataclasses import replace
 
-        from chebnorm.approx.table import _construction
+        from chebnorm.approx.contract import construction
 
-        with _construction("unchecked"):  # and by the printer on its own
+        with construction("unchecked"):  # and by the printer on its own
             t = replace(fit("x", ("0", "1"), 1), name="not a c name")
         with pytest.raises(ValueError, match="name: .* is not an identifier"):
             c_header(t)

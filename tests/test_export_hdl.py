@@ -15,7 +15,8 @@ import pytest
 
 import chebnorm as cn
 from chebnorm.approx import fit_target
-from chebnorm.approx.piecewise import PiecewiseTable, fit_piecewise
+from chebnorm.approx.piecewise_table import PiecewiseTable
+from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.cli import main
 from chebnorm.core.files import write_folder
 from chebnorm.hw import hdl
@@ -51,7 +52,7 @@ def tables():
     out = {}
     for name, spec in PIECEWISE.items():
         spec = dict(spec)
-        out[name] = fit_piecewise(spec.pop("expr"), spec.pop("interval"), spec.pop("degree"),
+        out[name] = piecewise_fit(spec.pop("expr"), spec.pop("interval"), spec.pop("degree"),
                                   name=name, **spec)
     return out
 

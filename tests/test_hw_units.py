@@ -251,7 +251,7 @@ class TestPipelined:
         assert not simulate(tmp_path, name).passed
 
     def test_degree_zero_refused(self):
-        from chebnorm.hw.verilog import verilog_pipelined_module
+        from chebnorm.hw.hdl.verilog import verilog_pipelined_module
 
         d = design_horner(fit_target("dichotomy", 1), 8, 8, coef_bits=12)
         d0 = d.__class__(**{**d.__dict__, "integers": d.integers[:1], "stages": ()})

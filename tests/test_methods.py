@@ -147,8 +147,8 @@ class TestRaises:
     def test_table_missing_small_angles(self):
         t = fit_target("dichotomy", 2)
         from dataclasses import replace
-        from chebnorm.approx.table import _construction
-        with _construction("unchecked"):  # the constructor refuses it: test span_normals alone
+        from chebnorm.approx.contract import construction
+        with construction("unchecked"):  # the constructor refuses it: test span_normals alone
             short = replace(t, interval_float=(t.interval_float[0], 1.9))
         with pytest.raises(ValueError, match="below the range"):
             span_normals("dichotomy", *pair(0.3), [16], tables={"dichotomy": short})

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from chebnorm.approx.expr import parse_function
-from chebnorm.approx.piecewise import PiecewiseTable, fit_piecewise, parse_segments
+from chebnorm.approx.piecewise_table import PiecewiseTable, parse_segments
+from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.export.c_piecewise import piecewise_c_header, piecewise_eval_bound
 from chebnorm.hw.piecewise import design_piecewise, simulate_piecewise
 
@@ -39,7 +40,7 @@ def _dense_check(table, points=2001):
 @pytest.mark.parametrize("k", range(9))
 @pytest.mark.parametrize("degree", [1, 2, 3])
 def test_rsqrt_every_segment_certified(k, degree):
-    t = fit_piecewise("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=24)
+    t = piecewise_fit("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=24)
     assert t.segment_count == 2 ** k
     assert t.abs_error_bound == max(s.abs_error_bound for s in t.segments)
     if k in (0, 4, 8):
@@ -47,14 +48,14 @@ def test_rsqrt_every_segment_certified(k, degree):
 
 
 def test_more_segments_tighter():
-    bounds = [fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=2 ** k,
+    bounds = [piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=2 ** k,
                             coef_frac_bits=34).abs_error_bound for k in (0, 2, 4, 6)]
     # degree 2: the error falls like h^3 (64x per 4x segments) once h is small
     assert bounds[0] > bounds[1] > bounds[2] > 40 * bounds[3]
 
 
 def test_centered_and_exponent_rel():
-    t = fit_piecewise("1/sqrt(x)", ("1/4", "4"), 2, segments=4, segment_by="exponent",
+    t = piecewise_fit("1/sqrt(x)", ("1/4", "4"), 2, segments=4, segment_by="exponent",
                       centered=True, error="rel", coef_frac_bits=24)
     assert t.segment_count == 16 and t.rel_error_bound is not None
     x = np.linspace(0.25, 4, 5001, endpoint=False)
@@ -63,7 +64,7 @@ def test_centered_and_exponent_rel():
 
 
 def test_load_reproves_and_names_fields(tmp_path):
-    t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="r")
+    t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="r")
     path = tmp_path / "r.json"
     t.save(path)
     assert PiecewiseTable.load(path) == t
@@ -99,7 +100,7 @@ def test_bad_input(kwargs, match):
     args.update(kwargs)
     interval, degree = args.pop("interval"), args.pop("degree")
     with pytest.raises(ValueError, match=match):
-        fit_piecewise("1/sqrt(x)", interval, degree, **args)
+        piecewise_fit("1/sqrt(x)", interval, degree, **args)
 
 
 def test_cli_errors_one_line(tmp_path):
@@ -116,7 +117,7 @@ def test_cli_errors_one_line(tmp_path):
 @pytest.mark.parametrize("segment_by", ["uniform", "exponent"])
 def test_c_export_within_eval_bound(tmp_path, segment_by):
     interval = ("1", "4") if segment_by == "uniform" else ("1/4", "4")
-    t = fit_piecewise("1/sqrt(x)", interval, 2, segments=8, segment_by=segment_by,
+    t = piecewise_fit("1/sqrt(x)", interval, 2, segments=8, segment_by=segment_by,
                       coef_frac_bits=30, name="pw", centered=segment_by == "exponent")
     (tmp_path / "chebnorm_pw.h").write_text(piecewise_c_header(t, in_bits=12))
     if segment_by == "uniform":
@@ -148,7 +149,7 @@ def test_c_export_within_eval_bound(tmp_path, segment_by):
 def test_rsqrt_256_segments_hardware_bit_exact(tmp_path):
     """Acceptance: 8-bit index, degree 2, 16-bit in / 16-bit out: iverilog matches the
     model on all 65,536 inputs and the measured error stays within the stated bound."""
-    t = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=256, coef_frac_bits=24, name="rs")
+    t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=256, coef_frac_bits=24, name="rs")
     d = design_piecewise(t, 16, 16)
     sim = simulate_piecewise(d, tmp_path)
     assert sim.passed and sim.vectors == 65536 and sim.mismatches == 0, sim.line
@@ -164,7 +165,7 @@ def test_rsqrt_256_segments_hardware_bit_exact(tmp_path):
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
 @pytest.mark.parametrize("k, degree, centered", [(0, 3, False), (3, 1, True), (5, 2, True)])
 def test_small_designs_bit_exact(tmp_path, k, degree, centered):
-    t = fit_piecewise("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=18,
+    t = piecewise_fit("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=18,
                       centered=centered, name="sm")
     d = design_piecewise(t, 10, 12)
     sim = simulate_piecewise(d, tmp_path)

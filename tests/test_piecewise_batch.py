@@ -18,7 +18,8 @@ from chebnorm.approx import certify, sollya
 from chebnorm.approx.certify import TOL, arb_enclose
 from chebnorm.approx.certify_batch import SegmentError, certify_batch
 from chebnorm.approx.expr import parse_function
-from chebnorm.approx.piecewise import certify_segments, fit_piecewise
+from chebnorm.approx.piecewise_table import certify_segments
+from chebnorm.approx.piecewise_fit import piecewise_fit
 
 
 class _Composed:
@@ -70,7 +71,7 @@ TABLES = [
 @pytest.fixture(scope="module", params=range(len(TABLES)), ids=lambda i: TABLES[i][0])
 def case(request):
     expr, interval, degree, segments, opts, kind = TABLES[request.param]
-    return fit_piecewise(expr, interval, degree, segments=segments, **opts), kind
+    return piecewise_fit(expr, interval, degree, segments=segments, **opts), kind
 
 
 @pytest.mark.parametrize("tol", [TOL, 2.0 ** -20])
@@ -164,7 +165,7 @@ def test_flint_context_restored():
 def test_against_sollya_supnorm():
     """Sollya's certified enclosure of sup |p_s - f| (accuracy 2^-20) on a few
     segments of the 256-segment benchmark table meets ours."""
-    table = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=256, coef_frac_bits=24)
+    table = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=256, coef_frac_bits=24)
     tol = 2.0 ** -20
     certs = certify_segments(table, "abs", tol)
     t = sp.Symbol("t")
@@ -183,7 +184,7 @@ def test_tables_certified_one_segment_at_a_time_still_load():
     batch) can be tighter than the batch's at its default: verify escalates."""
     from dataclasses import replace
 
-    table = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=16, coef_frac_bits=24)
+    table = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=16, coef_frac_bits=24)
     fn = parse_function(table.expression)
     segs = []
     for s, seg in enumerate(table.segments):

@@ -26,7 +26,7 @@ import pytest
 import sympy as sp
 
 from chebnorm.approx import CoefficientTable, fit
-from chebnorm.approx.table import _construction
+from chebnorm.approx.contract import construction
 from chebnorm.export import c_header
 from chebnorm.export.shader import (SHADER_LANGUAGES, float32_eval_bound, float32_literal,
                                     shader_source)
@@ -218,7 +218,7 @@ HOSTILE = ["1/sqrt(z)\n#define chebnorm_evil 1\nvoid evil() {}",
 @pytest.mark.parametrize("language", list(SHADER_LANGUAGES))
 @pytest.mark.parametrize("hostile", HOSTILE)
 def test_hostile_text_stays_in_comments(language, hostile):
-    with _construction("unchecked"):  # the constructor refuses it: test the printer alone
+    with construction("unchecked"):  # the constructor refuses it: test the printer alone
         t = replace(_tiny(), expression=hostile, provenance={"command": hostile})
     text = shader_source(t, language, command=hostile)
     clean = shader_source(_tiny(), language)
@@ -235,7 +235,7 @@ def test_hostile_text_stays_in_comments(language, hostile):
 def test_hostile_names_refused(name):
     with pytest.raises(ValueError, match="^name: .* is not an identifier"):
         _tiny(name=name)  # the table's constructor refuses it
-    with _construction("unchecked"):  # and the printers do on their own
+    with construction("unchecked"):  # and the printers do on their own
         t = _tiny(name=name)
     for language in SHADER_LANGUAGES:
         with pytest.raises(ValueError, match="is not an identifier"):
@@ -275,7 +275,7 @@ def test_glslang_rejects_broken_code():
 def test_glslang_compiles_hostile_tables(hostile):
     from chebnorm.export.gpu import compute_shader_source, glslang_validate
 
-    with _construction("unchecked"):  # the constructor refuses it: test the printer alone
+    with construction("unchecked"):  # the constructor refuses it: test the printer alone
         t = replace(_tiny(), expression=hostile, provenance={"command": hostile})
     glslang_validate(compute_shader_source(t, "glsl"), "glsl")
     glslang_validate(compute_shader_source(t, "hlsl"), "hlsl")
@@ -474,13 +474,13 @@ def test_vhdl_bench_detects_a_wrong_vector(tmp_path):
 @pytest.mark.parametrize("hostile", HOSTILE)
 def test_vhdl_hostile_expression_stays_in_comments(tmp_path, hostile):
     from chebnorm.hw.report import analyze
-    from chebnorm.hw.vhdl import vhdl_module
+    from chebnorm.hw.hdl.vhdl import vhdl_module
 
     clean = CoefficientTable.load(ROOT / "figures" / "coefficients" / "dichotomy_d1.json")
     d = analyze(clean, 6, 6, gappa=False, synth=False).design
     # the design step parses the expression and would refuse most of these: put the
     # hostile text into the designed table, as a hand-edited table file would
-    with _construction("unchecked"):  # the constructor refuses it: test the printer alone
+    with construction("unchecked"):  # the constructor refuses it: test the printer alone
         d = replace(d, table=replace(clean, expression=hostile, provenance={"command": hostile}))
     text = vhdl_module(d, command=hostile)
     head = text.split("library ieee;")[0]
@@ -494,7 +494,7 @@ def test_vhdl_hostile_expression_stays_in_comments(tmp_path, hostile):
 @pytest.mark.parametrize("name", ["a__b", "ab_"])
 def test_vhdl_refuses_names_vhdl_cannot_spell(name):
     from chebnorm.hw.report import analyze
-    from chebnorm.hw.vhdl import vhdl_module
+    from chebnorm.hw.hdl.vhdl import vhdl_module
 
     t = replace(CoefficientTable.load(ROOT / "figures" / "coefficients" / "dichotomy_d1.json"),
                 name=name)

@@ -22,7 +22,8 @@ import pytest
 import chebnorm as cn
 import chebnorm.hw
 from chebnorm.approx import CoefficientTable, fit
-from chebnorm.approx.piecewise import PiecewiseTable, fit_piecewise
+from chebnorm.approx.piecewise_table import PiecewiseTable
+from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -173,7 +174,7 @@ def test_hand_built_table_is_verified():
 
 
 def test_piecewise_replace_with_a_forged_segment_is_refused():
-    t = fit_piecewise("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
+    t = piecewise_fit("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
     seg = dataclasses.replace(t.segments[1], abs_error_bound=1e-9)
     with pytest.raises(ValueError, match=r"^abs_error_bound: stated"):
         dataclasses.replace(t, segments=(t.segments[0], seg))  # the top bound is derived
@@ -197,10 +198,10 @@ def test_non_finite_bound_refused_at_fit(expr, lo, hi, tmp_path, capsys):
 
 
 def test_json_is_written_strictly():
-    from chebnorm.approx.table import _construction
+    from chebnorm.approx.contract import construction
 
     t = CoefficientTable.load(BASE)
-    with _construction("unchecked"):
+    with construction("unchecked"):
         bad = dataclasses.replace(t, abs_error_bound=math.inf)
     with pytest.raises(ValueError, match="JSON compliant"):
         bad.to_json()
@@ -219,7 +220,7 @@ def test_fit_name_refused_at_the_source(name, tmp_path, capsys):
                                          r"\[A-Za-z_\]\[A-Za-z0-9_\]\*"):
         fit("exp(x)", ("0", "1"), 1, name=name)
     with pytest.raises(ValueError, match=r"^name: "):
-        fit_piecewise("exp(x)", ("0", "1"), 1, name=name)
+        piecewise_fit("exp(x)", ("0", "1"), 1, name=name)
     with pytest.raises(ValueError, match=r"^name: "):
         dataclasses.replace(CoefficientTable.load(BASE), name=name)
 

@@ -29,7 +29,8 @@ import mpmath
 import pytest
 
 from chebnorm.approx import CoefficientTable, fit
-from chebnorm.approx.table import MAX_TEXT, _construction
+from chebnorm.approx.contract import construction
+from chebnorm.approx.table import MAX_TEXT
 from chebnorm.cli import main
 from chebnorm.export import c_header
 
@@ -561,7 +562,7 @@ def _hostile_table():
     checks (which refuse it): the printers alone must keep it inert."""
     t = CoefficientTable.load(BASE)
     bad = "1/sqrt(x) */ int injected = 1; /* \\\n??/\u2028`define injected 1\n\");"
-    with _construction("unchecked"):
+    with construction("unchecked"):
         return replace(t, expression=bad, variable=bad, interval=(bad, bad), kind=bad,
                        error_kind=bad, fixed_point=replace(t.fixed_point, method=bad),
                        provenance={"command": bad}), bad
@@ -576,12 +577,12 @@ def test_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     assert strip_c_comments(header) == clean[0]
     assert "injected" in header.read_text()  # the text is there, inert in the comments
     with pytest.raises(ValueError, match=r"^name: 'a\*/b' is not an identifier"):
-        with _construction("unchecked"):
+        with construction("unchecked"):
             t_bad = replace(t, name="a*/b")
         c_header(t_bad)
     with pytest.raises(ValueError, match=r"^fixed_point\.integers\[0\]: 4294967296 does not fit "
                                          r"the header's int32_t"):
-        with _construction("unchecked"):
+        with construction("unchecked"):
             t_bad = replace(t, fixed_point=replace(t.fixed_point, integers=(2 ** 32, 0, 0)))
         c_header(t_bad)
 
@@ -589,7 +590,7 @@ def test_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
 @needs_iverilog
 def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     from chebnorm.hw.horner import design_horner
-    from chebnorm.hw.verilog import (
+    from chebnorm.hw.hdl.verilog import (
         verilog_module,
         verilog_pipelined_module,
         verilog_testbench,

@@ -176,7 +176,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
 
     ``segments`` (``2**k``), ``segment_by`` (``"uniform"`` or ``"exponent"``)
     or ``centered`` make a piecewise table instead (a
-    :class:`~chebnorm.approx.piecewise.PiecewiseTable`, coefficients in one
+    :class:`~chebnorm.approx.PiecewiseTable`, coefficients in one
     fixed-point format of ``frac_bits``, default 24, see
     :func:`~chebnorm.approx.piecewise_fit.piecewise_fit`):
 

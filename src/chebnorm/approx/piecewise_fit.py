@@ -35,7 +35,7 @@ from .schema import (ERROR_KINDS as ERRORS, MAX_COEF_FRAC_BITS, MAX_COEF_INT_BIT
                      MAX_EXPONENT_SPAN, MAX_INDEX_BITS, MAX_PIECEWISE_DEGREE,
                      PIECEWISE_FITS as FITS, SEGMENT_BY, versions)
 
-__all__ = ["fit_piecewise", "piecewise_fit"]
+__all__ = ["piecewise_fit"]
 
 #: points of the grid a segment's rounding is judged on
 _DENSE = 257
@@ -291,7 +291,7 @@ def piecewise_fit(expr, interval, degree: int, *, segments=1, segment_by: str = 
         raise ValueError(f"{fn.expr} is not {what} on segment {s} = [{a}, {b}] of "
                          f"[{lo}, {hi}]; accepted: an interval where the function is {what}")
     prov = dict(versions())
-    prov["command"] = command or (f"chebnorm.approx.fit_piecewise({str(fn.expr)!r}, "
+    prov["command"] = command or (f"chebnorm.approx.piecewise_fit({str(fn.expr)!r}, "
                                   f"({sp.sstr(lo)!r}, {sp.sstr(hi)!r}), {degree}, "
                                   f"segments={2 ** index_bits}, segment_by={segment_by!r}, "
                                   f"coef_frac_bits={frac_bits}, centered={centered})")
@@ -304,7 +304,3 @@ def piecewise_fit(expr, interval, degree: int, *, segments=1, segment_by: str = 
             abs_error_bound=max(sg.abs_error_bound for sg in out),
             rel_error_bound=max(sg.rel_error_bound for sg in out) if error == "rel" else None,
             provenance=prov)
-
-
-#: the name the fitter always had (``chebnorm.approx.piecewise.fit_piecewise``)
-fit_piecewise = piecewise_fit

@@ -41,7 +41,6 @@ of :class:`chebnorm.approx.contract.Table`). The fitter is
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -75,7 +74,6 @@ __all__ = [
     "PiecewiseTable",
     "certify_segments",
     "exact_log2",
-    "is_piecewise_file",
     "parse_segments",
     "segment_balls",
     "segment_bounds",
@@ -591,18 +589,6 @@ def segment_balls(segment_by, lo, hi, index_bits, centered, segments):
         if centered:
             origins = [o + w / 2 for o, w in zip(origins, widths)]
         return origins, widths
-
-
-def is_piecewise_file(path) -> bool:
-    """True when the JSON file ``path`` declares ``kind`` = :data:`PIECEWISE_KIND`
-    (so a consumer reads it with :meth:`PiecewiseTable.load`)."""
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_PIECEWISE_BYTES + 1)
-        d = json.loads(raw.decode("utf-8"))
-    except (OSError, ValueError, RecursionError):
-        return False
-    return isinstance(d, dict) and d.get("kind") == PIECEWISE_KIND
 
 
 # -- reading ---------------------------------------------------------------------

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .contract import Table, construction
+from .contract import Table
 from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
                      MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
                      SCHEMA_VERSION, array, bad, boolean, check_object, choice, integer, number,
@@ -39,9 +39,6 @@ from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BIT
 
 __all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint",
            "Quantized"]
-
-#: :func:`chebnorm.approx.contract.construction` under the name the tests import
-_construction = construction
 
 
 @dataclass(frozen=True)

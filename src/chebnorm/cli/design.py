@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 
-from ._common import command_line, print_json
-from ._parallel import add_parallel_args, parallel_kwargs
+from .common import command_line, print_json
+from .parallel_options import add_parallel_args, parallel_kwargs
 
 
 def register(sub) -> None:
@@ -38,7 +38,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from chebnorm.core.files import write_folder
-    from chebnorm.approx.piecewise import parse_segments
+    from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.core.textsafe import identifier
     from chebnorm.hw.piecewise_search import search
 
@@ -162,7 +162,7 @@ def hw_sweep_piecewise(args) -> int:
     from pathlib import Path
 
     from chebnorm.core.files import write_folder
-    from chebnorm.approx.piecewise import parse_segments
+    from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.hw.piecewise_search import grid
 
     res = grid(args.expr or "1/sqrt(x)", tuple(args.interval or ("1", "4")), args.in_bits,

@@ -11,10 +11,10 @@ the benches too).
 
 from __future__ import annotations
 
-from chebnorm.approx import CoefficientTable
+from chebnorm.approx import PiecewiseTable, load_table
 from chebnorm.export import EXPORT_FORMATS, HDL_FORMATS, export_table, options_for
 
-from ._common import command_line, deprecated_alias
+from .common import command_line, deprecated_alias
 
 #: export option -> (argparse dest, flag)
 _FLAGS = {"in_bits": ("in_bits", "--in-bits"), "out_bits": ("out_bits", "--out-bits"),
@@ -55,11 +55,9 @@ def _given(args) -> dict:
 def run(args) -> int:
     if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
-    from chebnorm.approx.piecewise import PiecewiseTable, is_piecewise_file
-
     given = _given(args)
-    if is_piecewise_file(args.table):
-        table = PiecewiseTable.load(args.table)
+    table = load_table(args.table)
+    if isinstance(table, PiecewiseTable):
         takes = options_for(table, args.format) if args.format in ("c", "json", *HDL_FORMATS) \
             else ()
         extra = [_FLAGS[o][1] for o in given if o not in takes]
@@ -71,7 +69,6 @@ def run(args) -> int:
         if args.format not in HDL_FORMATS and given:
             raise ValueError(f"{', '.join(_FLAGS[o][1] for o in given)} apply to --format vhdl "
                              f"or verilog only, not {args.format!r}")
-        table = CoefficientTable.load(args.table)
     if args.format in HDL_FORMATS and ("in_bits" not in given or "out_bits" not in given):
         accepted = "" if isinstance(table, PiecewiseTable) else "; accepted: 1..20 and 1..32"
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "

@@ -11,7 +11,7 @@ import warnings
 from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
 from chebnorm.core.textsafe import identifier
 
-from ._common import command_line, deprecated_alias, print_json
+from .common import command_line, deprecated_alias, print_json
 
 
 def register(sub) -> None:

@@ -6,8 +6,8 @@ import json
 
 from chebnorm.approx import CoefficientTable, PiecewiseTable, load_table
 
-from ._common import command_line, deprecated_alias, print_json, refuse_unused
-from ._parallel import add_parallel_args
+from .common import command_line, deprecated_alias, print_json, refuse_unused
+from .parallel_options import add_parallel_args
 
 
 def _design_args(p) -> None:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ._common import print_json
+from .common import print_json
 
 _KEYS = ("add", "mul", "div", "sqrt", "trig", "cmp")
 

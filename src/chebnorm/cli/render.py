@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from ._common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json, refuse_unused
+from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json, refuse_unused
 
 
 def register(sub) -> None:
@@ -59,7 +59,10 @@ def _crease_radians(deg):
     return math.radians(deg)
 
 
-def _parse_reference(text, shading):
+def parse_reference(text, shading):
+    """The ``--reference`` option of ``render`` and ``render-sweep``: None, or a
+    ``MODE[:METHOD]`` text checked against the shading modes (ValueError naming
+    the option and the accepted values otherwise)."""
     from chebnorm.raster import SHADING_MODES
 
     if text is None:
@@ -100,7 +103,7 @@ def run(args) -> int:
 
     t_start = time.perf_counter()
     _refuse_unused(args)
-    ref_mode, ref_method, ref_bump = _parse_reference(args.reference, args.shading)
+    ref_mode, ref_method, ref_bump = parse_reference(args.reference, args.shading)
     for option, path in (("--out", args.out), ("--error-map", args.error_map)):
         if path:
             try:

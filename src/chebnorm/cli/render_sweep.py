@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import re
 
-from ._common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, refuse_unused
-from ._parallel import add_parallel_args, parallel_kwargs
+from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, refuse_unused
+from .parallel_options import add_parallel_args, parallel_kwargs
 
 #: the CSV and the image folder inside ``-o DIR``
 CSV_NAME = "render_sweep.csv"
@@ -72,7 +72,7 @@ def run(args) -> int:
     from chebnorm.core.files import make_folder, write_atomic
     from chebnorm.raster import RenderSweep, render_sweep, render_sweep_cases
 
-    from .render import _parse_reference
+    from .render import parse_reference
 
     out = Path(args.output)
     if out.exists() and not out.is_dir():
@@ -87,7 +87,7 @@ def run(args) -> int:
         refuse_unused(args, "with --shadings adaptive", **{"--eta-threshold": "eta_threshold"})
     if "split-gouraud" not in shadings:
         refuse_unused(args, "with --shadings split-gouraud", **{"--q": "q"})
-    reference = None if args.reference is None else _parse_reference(args.reference, "phong")
+    reference = None if args.reference is None else parse_reference(args.reference, "phong")
     cases = render_sweep_cases(args.meshes, args.shadings, args.methods,
                                [parse_size(s) for s in args.sizes],
                                [None] if args.tess is None else args.tess, args.shininess,

@@ -34,7 +34,7 @@ from chebnorm.core.files import write_atomic
 from chebnorm.export import c_header, json_text
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 
-from ._parallel import add_parallel_args, parallel_kwargs
+from .parallel_options import add_parallel_args, parallel_kwargs
 
 #: fractional bits of the fixed-point part of the exported tables
 EXPORT_FRAC_BITS = 24

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from chebnorm.approx import TARGETS, target_names
 
-from ._common import print_json
+from .common import print_json
 
 
 def register(sub) -> None:

@@ -7,7 +7,7 @@ table (:data:`EXPORT_FORMATS`, :func:`formats_for`):
   ``wgsl``, ``hlsl`` (:data:`FORMATS`: printers that need only the table) and
   ``verilog``, ``vhdl`` (:data:`HDL_FORMATS`: a fixed-point evaluator, sized
   by ``in_bits`` and ``out_bits``, printed by :mod:`chebnorm.hw.hdl`);
-* a :class:`~chebnorm.approx.piecewise.PiecewiseTable`: ``c``, ``json``,
+* a :class:`~chebnorm.approx.PiecewiseTable`: ``c``, ``json``,
   ``verilog``, ``vhdl`` (:data:`PIECEWISE_FORMATS`).
 
 :func:`export_text` prints; :func:`export_table` prints and writes
@@ -22,7 +22,7 @@ import sys
 import types
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.piecewise import PiecewiseTable
+from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.files import write_atomic
 
 from .c import c_header, horner_rounding_bound
@@ -73,10 +73,10 @@ def formats_for(table) -> tuple[str, ...]:
     """The formats ``table`` can be exported in (sorted).
 
     >>> from chebnorm.approx import fit
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> formats_for(fit("x**2", ("0", "1"), 1))
     ('c', 'glsl', 'hlsl', 'json', 'verilog', 'vhdl', 'wgsl')
-    >>> formats_for(fit_piecewise("x**2", ("0", "1"), 1, segments=2))
+    >>> formats_for(piecewise_fit("x**2", ("0", "1"), 1, segments=2))
     ('c', 'json', 'verilog', 'vhdl')
     """
     return PIECEWISE_FORMATS if _kind(table) == "piecewise table" else EXPORT_FORMATS
@@ -87,10 +87,10 @@ def options_for(table, fmt: str) -> tuple[str, ...]:
     (``fmt`` one of :func:`formats_for`'s).
 
     >>> from chebnorm.approx import fit
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> options_for(fit("x**2", ("0", "1"), 1), "vhdl")
     ('in_bits', 'out_bits', 'coef_frac_bits', 'acc_bits', 'rounding')
-    >>> pw = fit_piecewise("x**2", ("0", "1"), 1, segments=2)
+    >>> pw = piecewise_fit("x**2", ("0", "1"), 1, segments=2)
     >>> options_for(pw, "c"), options_for(pw, "verilog"), options_for(pw, "json")
     (('in_bits',), ('in_bits', 'out_bits'), ())
     """
@@ -128,7 +128,7 @@ def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bit
     A :class:`~chebnorm.approx.CoefficientTable` becomes a Horner design
     (:func:`chebnorm.hw.report.analyze`: sized, checked over every input code,
     its error budget in the banner): the combinational module and, for degree
-    >= 1, the pipelined one. A :class:`~chebnorm.approx.piecewise.PiecewiseTable`
+    >= 1, the pipelined one. A :class:`~chebnorm.approx.PiecewiseTable`
     becomes its ROM + Horner design (:func:`chebnorm.hw.piecewise.design_piecewise`;
     ``coef_frac_bits``, ``acc_bits`` and ``rounding`` do not apply to it).
 
@@ -208,8 +208,8 @@ def export_text(table, fmt: str, command: str = "", **options) -> str:
     Traceback (most recent call last):
     ...
     ValueError: in_bits does nothing with format 'glsl' of a coefficient table; accepted there: no option
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> pw = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> pw = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, name="rs")
     >>> "static inline double chebnorm_rs(uint32_t k)" in export_text(pw, "c", in_bits=12)
     True
     """

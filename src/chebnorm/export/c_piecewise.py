@@ -1,4 +1,4 @@
-"""C99 header printer for a :class:`~chebnorm.approx.piecewise.PiecewiseTable`.
+"""C99 header printer for a :class:`~chebnorm.approx.PiecewiseTable`.
 
 The header holds a ``static const double`` coefficient array (one row per
 segment, exact: every coefficient is an integer times ``2**-F``), the index
@@ -20,8 +20,8 @@ the double Horner rounding bound ``gamma_2n sum |c_j| |t|^j`` (Higham eq. 5.3)
 :func:`chebnorm.core.textsafe.identifier`, other text through
 ``comment_text``; numbers are printed from floats and ints.
 
->>> from chebnorm.approx.piecewise import fit_piecewise
->>> h = piecewise_c_header(fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, name="r"))
+>>> from chebnorm.approx.piecewise_fit import piecewise_fit
+>>> h = piecewise_c_header(piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, name="r"))
 >>> "static inline double chebnorm_r(uint32_t k)" in h
 True
 """
@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from chebnorm.approx.piecewise import PiecewiseTable
+from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.textsafe import comment_text, identifier
 
 from chebnorm.core.numeric import float_up
@@ -53,8 +53,8 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 2, segments=4, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, name="rs")
     >>> b = piecewise_eval_bound(t)
     >>> worst = max(s.abs_error_bound for s in t.segments)  # + Horner rounding in double
     >>> worst < b < worst + 1e-15
@@ -81,8 +81,8 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> h = piecewise_c_header(fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=2, name="rs"))
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> h = piecewise_c_header(piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=2, name="rs"))
     >>> [line for line in h.splitlines() if line.startswith(("#ifndef", "static inline"))]
     ['#ifndef CHEBNORM_RS_H', 'static inline double chebnorm_rs(uint32_t k)']
     """

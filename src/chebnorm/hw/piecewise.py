@@ -20,8 +20,8 @@ against ``f(x)`` is bounded by the table's certified bound plus
 ``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
 compares it, code by code and in 40-digit arithmetic, with ``f``.
 
->>> from chebnorm.approx.piecewise import fit_piecewise
->>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+>>> from chebnorm.approx.piecewise_fit import piecewise_fit
+>>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
 >>> d = design_piecewise(t, 8, 8)
 >>> d.y_format.frac_bits, d.budget()["total"] >= d.measure()["max_error"]
 (9, True)
@@ -37,7 +37,7 @@ import mpmath
 import numpy as np
 
 from chebnorm.approx.expr import parse_function, parse_number
-from chebnorm.approx.piecewise import PiecewiseTable
+from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import identifier
 
@@ -74,8 +74,8 @@ class PiecewiseDesign:
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> d.index_bits, d.local_bits, d.module_name
     (2, 6, 'chebnorm_rs')
@@ -213,8 +213,8 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> d.measure()["max_error"] <= d.budget()["total"]
     True
@@ -279,8 +279,8 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> v = piecewise_verilog(d)
     >>> v.count("2'd"), "module chebnorm_rs" in v   # one ROM row per segment
@@ -294,8 +294,8 @@ def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> piecewise_testbench(d).splitlines()[0]
     '// tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs.'
@@ -311,8 +311,8 @@ def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | N
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> files = piecewise_outputs(d)
     >>> sorted(files), len(files["chebnorm_rs.hex"].split()) == 2 ** 8

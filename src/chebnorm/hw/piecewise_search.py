@@ -28,7 +28,8 @@ import threading
 from dataclasses import dataclass, replace
 
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
-from chebnorm.approx.piecewise import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE, fit_piecewise
+from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE
+from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.core.textsafe import csv_cell
 
 from .fixed import check_width
@@ -52,8 +53,8 @@ def model_cost(d: PiecewiseDesign) -> float:
     """Area estimate in Yosys-cell units: ROM bits x :data:`ROM_CELLS_PER_BIT`,
     plus ``a * b`` per ``a x b``-bit multiplier and the width of each adder.
 
-    >>> from chebnorm.approx.piecewise import fit_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=12)
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=12)
     >>> round(model_cost(design_piecewise(t, 8, 8)))
     136
     """
@@ -185,7 +186,7 @@ def _evaluate_chain(item) -> list:
     def evaluate(k, f):
         key = (d, k, f)
         if key not in designs:
-            t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
+            t = piecewise_fit(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
                               name=name)
             designs[key] = design_piecewise(t, in_bits, out_bits)
             p = _point(designs[key])
@@ -247,7 +248,7 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
     # the first fit reports a bad expression or interval as it is (one clear error), here
     with _FIT_LOCK:
-        fit_piecewise(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var,
+        piecewise_fit(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var,
                       name=name)
     items = [(expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name)
              for d in degrees]
@@ -297,7 +298,7 @@ def _grid_point(item) -> tuple[DesignPoint, PiecewiseDesign]:
     meet, or None for none."""
     expr, interval, (d, k, f), in_bits, out_bits, limit, var, name, synth = item
     with _FIT_LOCK:
-        t = fit_piecewise(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
+        t = piecewise_fit(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
                           name=name)
         des = design_piecewise(t, in_bits, out_bits)
     p = _point(des)

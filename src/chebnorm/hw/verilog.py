@@ -2,8 +2,7 @@
 (:func:`synthesize`), each in a private temporary folder.
 
 The Verilog text itself comes from :mod:`chebnorm.hw.hdl` (the printers of
-every design and language); the Verilog printers are re-exported here under
-their old names (``verilog_module``, ``verilog_testbench``, ...).
+every design and language).
 """
 
 from __future__ import annotations
@@ -16,13 +15,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from .hdl.common import pipelined_name, vector_file
-from .hdl.verilog import (verilog_module, verilog_pipelined_module, verilog_pipelined_testbench,
-                          verilog_testbench)
 
-__all__ = ["verilog_module", "verilog_testbench", "vector_file", "SimResult", "SynthResult",
-           "simulate", "synthesize", "synthesize_text", "verilog_pipelined_module",
-           "verilog_pipelined_testbench", "pipelined_name", "tool_env"]
+__all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_text", "tool_env"]
 
 
 @dataclass(frozen=True)

@@ -3,8 +3,7 @@ the VHDL files of a :class:`~chebnorm.hw.report.HardwareReport`
 (:func:`vhdl_outputs`).
 
 The VHDL text itself comes from :mod:`chebnorm.hw.hdl` (the printers of
-every design and language, bit-identical to the Verilog); the VHDL printers
-are re-exported here under their old names (``vhdl_module``, ...).
+every design and language, bit-identical to the Verilog).
 """
 
 from __future__ import annotations
@@ -15,13 +14,10 @@ import subprocess
 from pathlib import Path
 
 from .hdl import hdl_files
-from .hdl.vhdl import (VHDL_STD, piecewise_vhdl, piecewise_vhdl_testbench, vhdl_module,
-                       vhdl_pipelined_module, vhdl_pipelined_testbench, vhdl_testbench)
+from .hdl.vhdl import VHDL_STD
 from .verilog import SimResult
 
-__all__ = ["vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
-           "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
-           "simulate_vhdl", "vhdl_outputs", "VHDL_STD"]
+__all__ = ["simulate_vhdl", "vhdl_outputs"]
 
 
 def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:

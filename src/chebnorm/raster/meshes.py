@@ -301,7 +301,7 @@ def _bernstein(t):
 
 
 def _teapot_patches():
-    from ._teapot_data import PATCHES, POINTS
+    from .teapot_data import PATCHES, POINTS
 
     pts = np.array([[float(x) for x in s.split()] for s in POINTS.replace("\n", ";").split(";")
                     if s.strip()])

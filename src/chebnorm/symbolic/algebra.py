@@ -17,9 +17,15 @@ from collections.abc import Iterable, Sequence
 
 import sympy as sp
 
+__all__ = ["vector", "reduce_modulo"]
+
 
 def vector(name: str) -> sp.Matrix:
-    """A generic real 3-vector ``[name_x, name_y, name_z]`` as a column."""
+    """A generic real 3-vector ``[name_x, name_y, name_z]`` as a column.
+
+    >>> vector("N").T
+    Matrix([[N_x, N_y, N_z]])
+    """
     return sp.Matrix(sp.symbols(f"{name}_x {name}_y {name}_z", real=True))
 
 
@@ -46,6 +52,12 @@ def reduce_modulo(
     denominator does not vanish.
 
     Raises ``ArithmeticError`` if the denominator reduces to zero.
+
+    >>> a = vector("a")
+    >>> c = sp.Symbol("c", real=True)
+    >>> unit = (a.T * a)[0] - 1          # |a|^2 = 1
+    >>> reduce_modulo((a.T * a)[0] ** 2 + c, [unit], a)
+    c + 1
     """
     eliminate = list(eliminate)
     numer, denom = sp.fraction(sp.together(sp.expand(expr)))

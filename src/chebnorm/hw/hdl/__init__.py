@@ -7,7 +7,7 @@ A *design* is a sized, bit-accurate evaluator of a table:
   or pipelined;
 * a :class:`~chebnorm.hw.piecewise.PiecewiseDesign` (``design_piecewise``:
   coefficient ROM + one Horner datapath of a uniform
-  :class:`~chebnorm.approx.piecewise.PiecewiseTable`), combinational.
+  :class:`~chebnorm.approx.PiecewiseTable`), combinational.
 
 Each is printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008 (:mod:`.vhdl`),
 bit for bit the design's model, with an exhaustive self-checking bench that
@@ -27,7 +27,7 @@ are run by :mod:`chebnorm.hw.verilog` (Icarus Verilog, Yosys) and
 
 from __future__ import annotations
 
-from chebnorm.approx.piecewise import PiecewiseTable
+from chebnorm.approx.piecewise_table import PiecewiseTable
 
 from ..horner import HornerDesign
 from .common import (LANGUAGES, SUFFIX, check_language, comment_lines, horner_facts,
@@ -164,9 +164,9 @@ def hdl_files(design, language: str = "verilog", *, version: str = "",
     with ``pipelined`` also those of ``chebnorm_NAME_pipe``. Both languages'
     benches read the same vector file.
 
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> list(hdl_files(design_piecewise(t, 8, 8), "vhdl"))
     ['chebnorm_rs.vhd', 'tb_chebnorm_rs.vhd', 'chebnorm_rs.hex']
     """

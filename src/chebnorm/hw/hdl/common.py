@@ -147,9 +147,9 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> print("\\n".join(piecewise_facts(design_piecewise(t, 8, 8))[:2]))
     chebnorm_rs: piecewise degree-1 evaluator of 1/sqrt(x) on [1, 4),
       2^2 uniform segments (table 'rs'), uncentred local variable.

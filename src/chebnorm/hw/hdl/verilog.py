@@ -374,9 +374,9 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> d = design_piecewise(t, 8, 8)
     >>> v = piecewise_verilog(d)
     >>> v.count("2'd"), "module chebnorm_rs" in v   # one ROM row per segment

@@ -212,7 +212,7 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
                           command: str | None = None, budget=None) -> str:
     """The pipelined VHDL evaluator ``chebnorm_NAME_pipe``: the datapath of
     :func:`vhdl_module` with one register stage after each Horner step, as
-    :func:`~chebnorm.hw.verilog.verilog_pipelined_module` (latency ``degree``).
+    :func:`~chebnorm.hw.hdl.verilog.verilog_pipelined_module` (latency ``degree``).
 
     Examples
     --------
@@ -429,9 +429,9 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> v = piecewise_vhdl(design_piecewise(t, 8, 8))
     >>> v.count("-- segment "), "entity chebnorm_rs is" in v   # one ROM row per segment and power
     (8, True)
@@ -483,9 +483,9 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
 
     Examples
     --------
-    >>> from chebnorm.approx.piecewise import fit_piecewise
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = fit_piecewise("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> piecewise_vhdl_testbench(design_piecewise(t, 8, 8)).splitlines()[0]
     '-- tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs.'
     """
