@@ -119,3 +119,6 @@ def _write_figure_gallery() -> None:
 
 _copy_notebooks()
 _write_figure_gallery()
+# autosummary's pages are a build product: a module that moved or was removed must not
+# leave its page behind (a stale page imports a name that no longer exists)
+shutil.rmtree(DOCS / "generated", ignore_errors=True)

@@ -36,6 +36,15 @@ access such as ``chebnorm.raster.render`` after ``import chebnorm``):
    imports core, symbolic, approx and methods (not hw, not export).
 6. ``chebnorm.cli``      -- the command line; imports any stage.
 
+Where a change goes: the table format in ``approx/schema.py`` and the
+contract both kinds of table share in ``approx/contract.py`` (read either
+with :func:`chebnorm.approx.load_table`); an output format in ``export/``
+(HDL text in ``hw/hdl/``); the Phong frame in ``raster/shading.py`` over
+the engines of ``raster/engines/`` (numpy, the reference; numba, compiled);
+a helper two stages need in ``core/``. Within the package the module graph
+has no import cycle and a ``_name`` never leaves its module
+(``tests/test_import_graph.py``).
+
 This module (the package root) loads no stage at import time.
 A lazy facade is allowed: names resolved by a module-level ``__getattr__``
 that imports a stage only when the attribute is first used; no stage may
