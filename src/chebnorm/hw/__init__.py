@@ -30,7 +30,8 @@ from .sweep import SweepPoint, SweepResult, sweep
 from .hdl import hdl_files, hdl_text, module_text, testbench_text, vector_file
 from .hdl.verilog import verilog_module, verilog_testbench
 from .verilog import SimResult, SynthResult, simulate, synthesize
-from .multipartite import MultipartiteDesign, OffsetTable, design_multipartite
+from .multipartite import (MultipartiteDesign, OffsetTable, design_multipartite,
+                           multipartite_candidates)
 from .plain_table import PlainTableDesign, design_plain_table
 from .hdl.tables import table_files, table_module
 from .table_run import simulate_table
@@ -50,6 +51,7 @@ __all__ = [
     "analyze_unit", "UNITS", "UnitKind", "get_unit", "unit_names",
     "HardwareReport", "analyze", "verilog_outputs", "write_outputs",
     "SweepPoint", "SweepResult", "sweep",
-    "MultipartiteDesign", "OffsetTable", "design_multipartite", "PlainTableDesign",
+    "MultipartiteDesign", "OffsetTable", "design_multipartite", "multipartite_candidates",
+    "PlainTableDesign",
     "design_plain_table", "table_module", "table_files", "simulate_table",
 ]

@@ -65,7 +65,7 @@ from .exhaustive import ExhaustiveCheck, reference
 from .fixed import QFormat
 
 __all__ = ["MAX_MP_IN_BITS", "MAX_MP_OUT_BITS", "OffsetTable", "MultipartiteDesign",
-           "design_multipartite", "output_format", "lut_cost", "table_luts"]
+           "design_multipartite", "multipartite_candidates", "output_format", "lut_cost", "table_luts"]
 
 #: the widest input of a multipartite design (the search fits every code)
 MAX_MP_IN_BITS = 20
@@ -295,13 +295,17 @@ def output_format(mid: np.ndarray, out_bits: int, frac_bits: int | None = None) 
 # -- cost model --------------------------------------------------------------------
 
 def table_luts(address_bits: int, width: int) -> int:
-    """LUT6 estimate of a ROM: one LUT per output bit up to 6 address bits,
-    ``2**(a - 6)`` per bit above (the F7/F8 muxes are free).
+    """LUT6 estimate of a ROM on xc7: per output bit one LUT6 up to 6 address
+    bits, ``2**(a - 6)`` above (MUXF7/MUXF8 join two and four of them for
+    free), plus the LUTs that multiplex the MUXF8 outputs beyond 8 bits (a
+    LUT6 is a 4:1 mux).
 
-    >>> table_luts(6, 10), table_luts(8, 10)
-    (10, 40)
+    >>> table_luts(6, 10), table_luts(8, 10), table_luts(9, 10), table_luts(10, 1)
+    (10, 40, 90, 17)
     """
-    return width * (1 if address_bits <= 6 else 2 ** (address_bits - 6))
+    if address_bits <= 8:
+        return width * (1 if address_bits <= 6 else 2 ** (address_bits - 6))
+    return width * (2 ** (address_bits - 6) + math.ceil((2 ** (address_bits - 8) - 1) / 3))
 
 
 def lut_cost(tiv_bits: int, sum_bits: int, offsets) -> int:
@@ -312,7 +316,7 @@ def lut_cost(tiv_bits: int, sum_bits: int, offsets) -> int:
     ``offsets``: ``(address_bits, width, field_bits, symmetric)`` per table.
 
     >>> lut_cost(8, 18, [(6, 8, 4, False)])
-    102
+    98
     """
     cost = table_luts(tiv_bits, sum_bits)
     widths = []
@@ -588,8 +592,8 @@ def _tune(p: _Problem, alpha: int, guard: int, tiv, ints, widths, looks):
 def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_error=None,
                         faithful: bool = True, var: str = "x", name: str = "multipartite",
                         out_frac_bits: int | None = None, symmetric: bool | None = None,
-                        max_tables: int = MAX_OFFSET_TABLES, tries: int = 40
-                        ) -> MultipartiteDesign:
+                        max_tables: int = MAX_OFFSET_TABLES, tries: int = 30,
+                        select=None, count: int = 6) -> MultipartiteDesign:
     """The cheapest multipartite evaluator of ``expr`` on ``interval`` meeting
     the error target, proved over every input code.
 
@@ -609,14 +613,19 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     symmetric
         Offset tables stored halved (True), whole (False) or either (None).
     max_tables, tries
-        At most ``max_tables`` offset tables; ``tries`` structures are built
-        and checked, cheapest estimate first.
+        At most ``max_tables`` offset tables; up to ``tries`` structures are
+        built and checked, cheapest estimate first.
+    select, count
+        ``select``: a function of a design returning its cost (e.g. LUTs
+        from a synthesis run); it is called on the ``count`` certified
+        candidates of least estimated cost (:func:`multipartite_candidates`)
+        and the cheapest is returned. Default: the least estimate
+        (:func:`lut_cost`).
 
     Returns
     -------
     MultipartiteDesign
-        The design of least estimated LUT count (:func:`lut_cost`) among the
-        structures that passed, with its exhaustive certificate.
+        With its exhaustive certificate.
 
     Raises
     ------
@@ -629,10 +638,35 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     >>> d.certificate.upper < 2.0 ** -d.y_format.frac_bits, len(d.evaluate())
     (True, 1024)
     """
+    found = multipartite_candidates(expr, interval, in_bits, out_bits, max_error=max_error,
+                                    faithful=faithful, var=var, name=name,
+                                    out_frac_bits=out_frac_bits, symmetric=symmetric,
+                                    max_tables=max_tables, tries=tries,
+                                    count=count if select is not None else 1)
+    if select is None:
+        return found[0]
+    return min(found, key=lambda d: (select(d), _design_luts(d)))
+
+
+def multipartite_candidates(expr, interval, in_bits: int, out_bits: int, *, max_error=None,
+                            faithful: bool = True, var: str = "x", name: str = "multipartite",
+                            out_frac_bits: int | None = None, symmetric: bool | None = None,
+                            max_tables: int = MAX_OFFSET_TABLES, tries: int = 30,
+                            count: int = 6) -> list[MultipartiteDesign]:
+    """Up to ``count`` certified multipartite designs (arguments as
+    :func:`design_multipartite`), least estimated LUT count first -- for a
+    caller that prices each by synthesis (the estimate ranks them only
+    roughly: yosys's ABC compresses some tables more than others).
+
+    >>> ds = multipartite_candidates("1/sqrt(1+3*x)", ("0", "1"), 10, 10, count=2)
+    >>> len(ds) >= 1 and all(d.certificate.upper < 2.0 ** -10 for d in ds)
+    True
+    """
     in_bits = check_int(in_bits, "in_bits", 2, MAX_MP_IN_BITS)
     out_bits = check_int(out_bits, "out_bits", 1, MAX_MP_OUT_BITS)
     max_tables = check_int(max_tables, "max_tables", 1, MAX_OFFSET_TABLES)
     tries = check_int(tries, "tries", 1, 10_000)
+    count = check_int(count, "count", 1, 1000)
     name = identifier(name, field="name")
     if symmetric not in (None, True, False):
         raise ValueError("symmetric: accepted: None, True or False")
@@ -642,28 +676,29 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     F = output_format(ref.mid, out_bits, out_frac_bits)
     limit, strict = _target(F, max_error, faithful)
     p = _problem(ref, out_bits, F, limit, strict)
-    found = None
+    found = []
     for cand in _structures(p, symmetric, max_tables)[:tries]:
         _, alpha, bits, gammas, syms, _ = cand
+        if found and cand[0] > 1.15 * found[0][0]:
+            break   # ranked by estimate: the rest will not do better
         fitted = _backfit(p, alpha, bits, gammas, syms)
         if fitted[0] + 0.5 >= p.limit:
             continue
-        for guard in range(0, 6):
+        for guard in range(1, 6):
             built = _build(p, alpha, bits, gammas, syms, guard, fitted)
             if built is None:
                 continue
             d = _assemble(ref, p, name, str(expr), var, interval, out_bits, alpha, guard,
                           built, limit, strict, max_error, faithful)
             if d is not None:
-                luts = _design_luts(d)
-                if found is None or luts < found[0]:
-                    found = (luts, d)
+                found.append((_design_luts(d), d.rom_bits, len(found), d))
+                found.sort(key=lambda t: t[:3])
                 break
-    if found is None:
+    if not found:
         raise ValueError(f"no multipartite design of {in_bits} input bits meets the target "
                          f"{limit * 2.0 ** -F:.4e} at output LSB 2^-{F}; accepted: a larger "
                          f"max_error, fewer out_bits or more tries")
-    return found[1]
+    return [t[3] for t in found[:count]]
 
 
 def _target(F: int, max_error, faithful: bool):
