@@ -130,7 +130,7 @@ def reference(expression, interval, in_bits: int, var: str = "x") -> Reference:
                       str(fn.expr))
 
 
-@functools.lru_cache(maxsize=8)
+@functools.lru_cache(maxsize=4)
 def _reference(expression: str, var: str, interval: tuple[str, str], in_bits: int,
                _canonical: str) -> Reference:
     from flint import arb
