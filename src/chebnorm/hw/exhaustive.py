@@ -68,6 +68,10 @@ class Reference:
     rigorous enclosure ``lo <= f(x_k) <= hi`` (float64 arrays).
 
     ``x(k)`` is the exact rational input of code ``k``.
+
+    >>> r = reference("x*x", ("1", "2"), 2)
+    >>> r.x(1), float(r.mid[1]), bool(r.lo[1] <= 25 / 16 <= r.hi[1])
+    (Fraction(5, 4), 1.5625, True)
     """
 
     expression: str

@@ -133,6 +133,11 @@ class MultipartiteDesign:
     the rounding constant folded in, taken modulo ``2**sum_bits``);
     ``certificate`` is the exhaustive proof of ``max |y - f(x)|``; ``parts``
     the a priori error decomposition (floats, rounded up).
+
+    >>> d = design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 10, 10)
+    >>> d.module_name, d.rom_bits < 2 ** 10 * 10, bool(d.evaluate([0])[0] == d.y_format.max_code
+    ...                                                  or d.evaluate([0])[0] > 0)
+    ('chebnorm_multipartite', True, True)
     """
 
     name: str

@@ -41,6 +41,10 @@ class PlainTableDesign:
     rounding could not be proved (then ``correctly_rounded`` is False and
     the entry is the nearest by the float64 value; ``certificate`` still
     bounds the error rigorously).
+
+    >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
+    >>> [int(v) for v in d.values[:3]], d.y_format.offset_code, d.y_format.frac_bits
+    ([8, 7, 6], 8, 4)
     """
 
     name: str

@@ -250,7 +250,13 @@ def table_testbench(design, language: str = "verilog") -> str:
 def table_files(design, language: str = "verilog", *, version: str = "",
                 command: str | None = None) -> dict[str, str]:
     """File name -> text: the module, its bench and the expected-output
-    vectors (``NAME.v|.vhd``, ``tb_NAME.v|.vhd``, ``NAME.hex``)."""
+    vectors (``NAME.v|.vhd``, ``tb_NAME.v|.vhd``, ``NAME.hex``).
+
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
+    >>> list(table_files(d))
+    ['chebnorm_table.v', 'tb_chebnorm_table.v', 'chebnorm_table.hex']
+    """
     ext = SUFFIX[check_language(language)]
     name = module_name(design)
     return {f"{name}{ext}": table_module(design, language, version=version, command=command),
