@@ -21,7 +21,8 @@ Carry cells (``CARRY4``, ``SB_CARRY``) and the wide multiplexers
 (``MUXF7``/``MUXF8``) are reported but score 0: they sit in the slice (logic
 cell) beside the LUTs that feed them, which are already counted. Input/output
 buffers (``IBUF``/``OBUF``, inserted by ``synth_xilinx``) are not logic and
-score 0. ``generic`` scores its cell count. A score compares designs on one
+score 0, nor does ``INV`` (yosys's 7-series inverter, which the vendor flow
+folds into the neighbouring LUT). ``generic`` scores its cell count. A score compares designs on one
 target; comparing against a peer's design, never spend more DSPs than the peer
 (a DSP-rich design can win on score while not fitting beside the rest).
 
@@ -53,6 +54,7 @@ from pathlib import Path
 from .verilog import tool_env
 
 __all__ = ["Target", "TargetCost", "TARGETS", "target_names", "get_target", "synthesize_target",
+           "target_figures", "cost_from_types",
            "fmax_ice40", "module_ports", "register_wrapper", "DEVICE_WEIGHTS"]
 
 _ID = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -444,3 +446,33 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
     if not fmax:
         raise ValueError(f"nextpnr-ice40 reported no clock frequency for {top}")
     return float(min(v["achieved"] for v in fmax.values()))
+
+
+def target_figures(verilog_text: str, top: str, target: str, *, clocked: bool = False,
+                   latency: int = 0) -> dict:
+    """Everything ``hw report --target`` and ``design --target`` print of module
+    ``top`` on ``target``: the :class:`TargetCost` fields, the timing (ice40:
+    nextpnr-ice40 Fmax, ``fmax_source`` "nextpnr-ice40"; xc7: the ``sta``
+    cell-delay model, an upper bound ``fmax_mhz`` labelled "model"; generic: the
+    gate depth only) and the latency in clock cycles; ``line`` and ``timing``
+    are the text lines.
+    """
+    t = get_target(target)
+    cost = synthesize_target(verilog_text, top, t.name, timing=True)
+    d = cost.as_dict()
+    d["latency_cycles"] = int(latency)
+    if t.timing == "nextpnr":
+        d["fmax_mhz"] = round(fmax_ice40(verilog_text, top, clocked=clocked), 2)
+        d["fmax_source"] = "nextpnr-ice40: iCE40 HX8K ct256, placed and routed, seed 1"
+        timing = f"Fmax {d['fmax_mhz']:.2f} MHz ({d['fmax_source']})"
+    elif t.timing == "sta":
+        d["fmax_mhz"] = round(1000.0 / cost.delay_ns, 2) if cost.delay_ns else None
+        d["fmax_source"] = "model: yosys sta cell delays without routing (an upper bound)"
+        timing = (f"Fmax <= {d['fmax_mhz']:.2f} MHz ({d['fmax_source']}; {cost.delay_ns:.3f} ns "
+                  f"over {cost.levels} cells)")
+    else:
+        d["fmax_mhz"], d["fmax_source"] = None, "none: generic cells have no device"
+        timing = f"{cost.levels} gate levels (model: yosys ltp -noff; no device, no MHz)"
+    timing += f", latency {int(latency)} cycles"
+    d["line"], d["timing"] = cost.line(), timing
+    return d

@@ -1,0 +1,151 @@
+"""A cost model per FPGA target, calibrated against yosys, so a design search
+need not synthesize every candidate.
+
+A design is described by its :class:`DesignFeatures`: its ROMs (index bits
+``k``, word bits ``w``), its multipliers (operand widths ``a x b``), its
+adders (widths) and its register bits. :func:`model_score` predicts the
+target's score (:mod:`chebnorm.hw.targets`: yosys cells on ``generic``, LUT
+equivalents on the FPGA targets) as a sum of per-block terms whose *shape*
+follows the device and whose *constants* were fitted against yosys 0.23:
+
+* ``generic``: ``c_rom * w * 2**k + c_mul * a * b + c_add * width + bits``;
+* ``xc7``: a ROM output bit of ``k`` address bits is ``max(1, 2**(k-6))``
+  LUT6 (``c_rom`` of them survive constant folding); a multiplier goes to
+  ``ceil(a/25) * ceil(b/18)`` DSP48E1 (the 25 x 18 signed ports, wider operand
+  on A) scored at the device weight (264.2 LUTs each); adders ``c_add`` LUT
+  per bit (beside their CARRY4); registers 0.5 LUT per bit;
+* ``xc7-nodsp``: as ``xc7`` with multipliers in LUTs, ``c_mul * a * b``;
+* ``ice40``: as ``xc7-nodsp`` with LUT4 (``max(1, 2**(k-4))`` per ROM bit)
+  and 1 LUT per register bit.
+
+The constants (:data:`CALIBRATION`) come from ``benchmarks/calibrate_targets.py``:
+a fixed set of piecewise designs (three functions, degrees 1 to 3, 4 to 128
+segments, 12- and 16-bit) and single Horner designs (degrees 1 to 3), each
+synthesized on every target, fitted by non-negative least squares on the
+relative error. :data:`MODEL_SPREAD` is the largest ratio ``max(model/yosys,
+yosys/model)`` measured on that set per target: the test
+``tests/test_targets_fpga.py`` re-synthesizes designs and holds the model to it.
+It is a model for ranking candidates; the winner is always synthesized.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .targets import DEVICE_WEIGHTS, get_target
+
+__all__ = ["DesignFeatures", "piecewise_features", "horner_features", "model_score",
+           "model_terms", "CALIBRATION", "MODEL_SPREAD", "dsp_count"]
+
+
+@dataclass(frozen=True)
+class DesignFeatures:
+    """What the cost model reads of a design.
+
+    ``roms``: ``((index_bits, word_bits), ...)``; ``multipliers``: ``((a, b), ...)``
+    operand widths (two's complement); ``adders``: widths; ``register_bits``:
+    flip-flops (0 for a combinational design).
+    """
+
+    roms: tuple[tuple[int, int], ...] = ()
+    multipliers: tuple[tuple[int, int], ...] = ()
+    adders: tuple[int, ...] = ()
+    register_bits: int = 0
+
+    def __post_init__(self):
+        for name, items, n in (("roms", self.roms, 2), ("multipliers", self.multipliers, 2)):
+            for it in items:
+                if len(it) != n or any(isinstance(v, bool) or not isinstance(v, int) or
+                                       not 0 <= v <= 4096 for v in it):
+                    raise ValueError(f"{name}: {it!r} is not a pair of widths; accepted: "
+                                     f"integers 0..4096")
+        for w in self.adders + (self.register_bits,):
+            if isinstance(w, bool) or not isinstance(w, int) or not 0 <= w <= 1 << 20:
+                raise ValueError(f"adders/register_bits: {w!r}; accepted: integers 0..2^20")
+
+
+#: fitted constants per target (benchmarks/calibrate_targets.py; module docstring)
+CALIBRATION = {
+    "generic": {"rom": 0.15, "mul": 1.0, "add": 1.0},
+    "xc7": {"rom": 1.0, "mul": 0.0, "add": 1.0},
+    "xc7-nodsp": {"rom": 1.0, "mul": 0.5, "add": 1.0},
+    "ice40": {"rom": 1.0, "mul": 1.0, "add": 1.0},
+}
+#: largest max(model/yosys, yosys/model) on the calibration set, per target
+MODEL_SPREAD = {"generic": 2.0, "xc7": 2.0, "xc7-nodsp": 2.0, "ice40": 2.0}
+
+
+def dsp_count(a: int, b: int) -> int:
+    """DSP48E1 blocks of an ``a x b`` signed multiplier: ``ceil(max/25) * ceil(min/18)``.
+
+    >>> dsp_count(17, 19), dsp_count(30, 19), dsp_count(8, 8)
+    (2, 2, 1)
+    """
+    hi, lo = max(a, b), min(a, b)
+    return math.ceil(hi / 25) * math.ceil(lo / 18)
+
+
+def model_terms(f: DesignFeatures, target: str) -> dict:
+    """The uncalibrated terms of ``target``'s model: ROM, multiplier and adder
+    sizes (each multiplied by its constant in :func:`model_score`), and the
+    fixed part (DSPs and registers at their device weights)."""
+    t = get_target(target)
+    add = float(sum(f.adders))
+    if t.name == "generic":
+        rom = float(sum(w * 2 ** k for k, w in f.roms))
+        return {"rom": rom, "mul": float(sum(a * b for a, b in f.multipliers)), "add": add,
+                "fixed": float(f.register_bits)}
+    lut_in = 6 if t.name.startswith("xc7") else 4
+    rom = float(sum(w * max(1, 2 ** (k - lut_in)) for k, w in f.roms))
+    wts = DEVICE_WEIGHTS[t.device]
+    fixed = wts["ff"] * f.register_bits
+    mul = float(sum(a * b for a, b in f.multipliers))
+    if t.name == "xc7":
+        fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b in f.multipliers)
+        mul = 0.0
+    return {"rom": rom, "mul": mul, "add": add, "fixed": fixed}
+
+
+def model_score(features: DesignFeatures, target: str) -> float:
+    """Predicted score of a design on ``target`` (yosys cells on ``generic``, LUT
+    equivalents otherwise), within :data:`MODEL_SPREAD` of yosys on the
+    calibration set.
+
+    >>> f = DesignFeatures(roms=((5, 42),), multipliers=((17, 13), (19, 13)), adders=(20, 22, 18))
+    >>> model_score(f, "xc7") > 2 * 264
+    True
+    """
+    if not isinstance(features, DesignFeatures):
+        raise ValueError("features: not a DesignFeatures; accepted: piecewise_features(d), "
+                         "horner_features(d) or a DesignFeatures")
+    terms = model_terms(features, target)
+    c = CALIBRATION[get_target(target).name]
+    return float(c["rom"] * terms["rom"] + c["mul"] * terms["mul"] + c["add"] * terms["add"]
+                 + terms["fixed"])
+
+
+def piecewise_features(d) -> DesignFeatures:
+    """Features of a :class:`~chebnorm.hw.piecewise.PiecewiseDesign`: its
+    coefficient ROM (index bits x word bits), one ``acc x t`` multiplier and
+    one adder per Horner step, the output rounding and saturation."""
+    n = d.degree
+    mults, adds = [], []
+    acc_w = d.rom_bits[n] if n > 0 else 0
+    for _pw, sw, ow in d.widths:
+        mults.append((int(acc_w), int(d.t_bits)))
+        adds.append(int(sw))
+        acc_w = ow
+    adds += [d.out_bits + 2, d.out_bits + 2]  # rounding increment and saturation compare
+    return DesignFeatures(roms=((int(d.index_bits), int(sum(d.rom_bits))),),
+                          multipliers=tuple(mults), adders=tuple(adds))
+
+
+def horner_features(d) -> DesignFeatures:
+    """Features of a single-polynomial :class:`~chebnorm.hw.horner.HornerDesign`
+    (coefficients are constants: no ROM)."""
+    mults = tuple((int(st.acc_bits), int(d.xs_bits)) for st in d.stages)
+    adds = [int(d.xs_bits)] + [int(st.sum_bits) for st in d.stages]
+    adds += [int(st.out_bits) for st in d.stages[:-1] if st.round_shift]
+    adds += [int(d.raw_bits), int(d.raw_bits)]
+    return DesignFeatures(multipliers=mults, adders=tuple(adds))
