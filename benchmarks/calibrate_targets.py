@@ -58,12 +58,20 @@ def designs():
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--write", default=None)
+    ap.add_argument("--reuse", default=None,
+                    help="refit on the yosys scores recorded in this JSON (no synthesis)")
     args = ap.parse_args(argv)
     rows = []
     t0 = time.time()
+    known = {}
+    if args.reuse:
+        with open(args.reuse, encoding="utf-8") as fh:
+            known = {(r["design"], r["target"]): r["yosys"] for r in json.load(fh)["rows"]}
     for label, text, top, feat in designs():
         for target in target_names():
-            score = synthesize_target(text, top, target).score
+            score = known.get((label, target))
+            if score is None:
+                score = synthesize_target(text, top, target).score
             rows.append((label, target, model_terms(feat, target), score))
             print(f"{label:40s} {target:10s} {score:9.1f}", file=sys.stderr)
     out = {"constants": {}, "spread": {}, "rows": []}
