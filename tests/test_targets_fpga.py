@@ -172,7 +172,7 @@ def test_cli_design_target_xc7(tmp_path):
                          "ffs", "brams"]
     win = [dict(zip(head, x.split(","))) for x in rows[1:] if x.split(",")[12] == "1"]
     assert len(win) == 1 and win[0]["target"] == "xc7" and win[0]["target_score"]
-    assert "winner on xc7:" in r.stdout and "Fmax <=" in r.stdout
+    assert "winner xc7: " in r.stdout and "Fmax <=" in r.stdout
 
 
 @no_yosys

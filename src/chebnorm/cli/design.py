@@ -86,7 +86,7 @@ def winner_figures(res) -> list[str]:
     key = next(k for k, p in zip(sorted(res.designs), res.points) if p is res.winner)
     d = res.designs[key]
     fig = target_figures(_module_text(d), d.module_name, res.target)
-    return [f"winner on {res.target}: {fig['line']}", f"timing: {fig['timing']}"]
+    return [f"winner {fig['line']}", f"timing: {fig['timing']}"]
 
 
 def _module_text(d) -> str:

@@ -17,7 +17,10 @@ With ``target`` other than ``"generic"`` (:mod:`chebnorm.hw.targets`) every
 point is priced by that target's calibrated model
 (:func:`chebnorm.hw.target_model.model_score`), the Pareto front is taken over
 (model score, bound), and its meeting points are synthesized on the target
-(``synth_xilinx``, ``synth_ice40``): the winner is the lowest target score.
+(``synth_xilinx``, ``synth_ice40``) -- except those whose model score exceeds
+``MODEL_SPREAD**2`` times the best one's (the model is within
+:data:`~chebnorm.hw.target_model.MODEL_SPREAD` of yosys, so they cannot win):
+the winner is the lowest target score.
 
 >>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
 ...            progress=False, workers=1)
@@ -331,6 +334,12 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
                 for key, n in zip(chosen, cells):
                     points[key] = replace(points[key], yosys_cells=n)
             else:
+                # the model is within MODEL_SPREAD s of yosys: a point whose model score
+                # exceeds s^2 times the best one's cannot beat it, and is not synthesized
+                from .target_model import MODEL_SPREAD
+
+                bound = mc(points[chosen[0]]) * MODEL_SPREAD[target] ** 2
+                chosen = [k for k in chosen if mc(points[k]) <= bound]
                 cost_source = f"yosys {get_target(target).synth.split(' -top')[0]}"
                 costs = map_ordered(_target_cost, [(designs[k], target) for k in chosen],
                                     desc=f"yosys {target}", **par)
