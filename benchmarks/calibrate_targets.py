@@ -41,15 +41,22 @@ PIECEWISE = [
 ]
 #: (target, degree, in/out bits, coefficient bits) of single Horner designs
 HORNER = [("dichotomy", 1, 12, 14), ("dichotomy", 2, 12, 16), ("dichotomy", 3, 16, 20)]
+#: held out of the fit: the model's ratio to yosys on designs it never saw
+HOLDOUT = [
+    ("exp(x)", ("0", "1"), 14, 2, 4, 16),
+    ("sin(x)", ("0", "1"), 16, 1, 6, 18),
+    ("1/sqrt(1+3*x)", ("0", "1"), 20, 2, 7, 21),
+    ("1/(1+x)", ("0", "1"), 12, 3, 1, 14),
+]
 
 
-def designs():
-    for expr, iv, bits, deg, k, f in PIECEWISE:
+def designs(piecewise=PIECEWISE, horner=HORNER):
+    for expr, iv, bits, deg, k, f in piecewise:
         t = piecewise_fit(expr, iv, deg, segments=2 ** k, coef_frac_bits=f, name="cal")
         d = design_piecewise(t, bits, bits)
         yield f"pw {expr} d{deg} 2^{k} {bits}b", module_text(d, "verilog"), d.module_name, \
             piecewise_features(d)
-    for tgt, deg, bits, cb in HORNER:
+    for tgt, deg, bits, cb in horner:
         d = design_horner(fit_target(tgt, deg), bits, bits, coef_bits=cb)
         yield f"horner {tgt} d{deg} {bits}b", module_text(d, "verilog"), d.module_name, \
             horner_features(d)
@@ -91,6 +98,17 @@ def main(argv=None) -> int:
         for r, p in zip(rs, pred):
             out["rows"].append({"design": r[0], "target": target, "yosys": r[3],
                                 "model": round(float(p), 1)})
+    out["holdout"] = []
+    for label, text, top, feat in designs(HOLDOUT, ()):
+        for target in target_names():
+            real = synthesize_target(text, top, target).score
+            c = out["constants"][target]
+            t = model_terms(feat, target)
+            pred = c["rom"] * t["rom"] + c["mul"] * t["mul"] + c["add"] * t["add"] + t["fixed"]
+            out["holdout"].append({"design": label, "target": target, "yosys": real,
+                                   "model": round(pred, 1),
+                                   "ratio": round(max(pred / real, real / pred), 3)})
+            print(f"holdout {label:32s} {target:10s} {real:9.1f}", file=sys.stderr)
     out["seconds"] = round(time.time() - t0, 1)
     text = json.dumps(out, indent=2, sort_keys=True) + "\n"
     print(text)
