@@ -189,3 +189,20 @@ def test_cli_hw_report_target_json(tmp_path):
     r = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--target", "xc7",
             "--no-synth", cwd=tmp_path)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_search_default_target_is_generic_and_other_targets_add_columns():
+    from chebnorm.hw.piecewise_search import COLUMNS, search
+
+    kw = dict(degrees=(1, 2), max_index_bits=4, synth=False, progress=False, workers=1)
+    base = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, **kw)
+    assert search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, target="generic", **kw).csv() == base.csv()
+    assert base.csv().splitlines()[0] == ",".join(COLUMNS)
+    assert all(p.target_model is None for p in base.points)
+    r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, target="ice40", **kw)
+    assert all(p.target_model > 0 for p in r.points)
+    # without synthesis the ice40 winner is the lowest ice40 model score that meets the error
+    ok = [p for p in r.points if p.meets]
+    assert r.winner.target_model == min(p.target_model for p in ok)
+    with pytest.raises(ValueError, match="target"):
+        search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, target="xc9", **kw)
