@@ -54,6 +54,13 @@ class DesignFeatures:
     constant with ``naf`` nonzero digits (:func:`naf_weight`): ``naf - 1``
     adders of ``a + b`` bits in LUTs, but a DSP48E1 on ``xc7`` (yosys maps
     every ``$mul`` there).
+
+    >>> DesignFeatures(roms=((5, 42),), multipliers=((10, 13),)).roms
+    ((5, 42),)
+    >>> DesignFeatures(adders=(-1,))
+    Traceback (most recent call last):
+    ...
+    ValueError: adders/register_bits: -1; accepted: integers 0..2^20
     """
 
     roms: tuple[tuple[int, int], ...] = ()
@@ -99,7 +106,14 @@ def dsp_count(a: int, b: int) -> int:
 def model_terms(f: DesignFeatures, target: str) -> dict:
     """The uncalibrated terms of ``target``'s model: ROM, multiplier and adder
     sizes (each multiplied by its constant in :func:`model_score`), and the
-    fixed part (DSPs and registers at their device weights)."""
+    fixed part (DSPs and registers at their device weights).
+
+    >>> f = DesignFeatures(roms=((8, 10),), multipliers=((20, 12),), adders=(30,))
+    >>> model_terms(f, "xc7") == {"rom": 40.0, "mul": 0.0, "add": 30.0, "fixed": 63400 / 240}
+    True
+    >>> model_terms(f, "ice40")["rom"], model_terms(f, "generic")["rom"]
+    (160.0, 2560.0)
+    """
     t = get_target(target)
     add = float(sum(f.adders))
     if t.name != "xc7":
@@ -141,7 +155,15 @@ def model_score(features: DesignFeatures, target: str) -> float:
 def piecewise_features(d) -> DesignFeatures:
     """Features of a :class:`~chebnorm.hw.piecewise.PiecewiseDesign`: its
     coefficient ROM (index bits x word bits), one ``acc x t`` multiplier and
-    one adder per Horner step, the output rounding and saturation."""
+    one adder per Horner step, the output rounding and saturation.
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=12)
+    >>> f = piecewise_features(design_piecewise(t, 8, 8))
+    >>> f.roms[0][0], len(f.multipliers)
+    (2, 1)
+    """
     n = d.degree
     mults, adds = [], []
     acc_w = d.rom_bits[n] if n > 0 else 0
@@ -173,7 +195,14 @@ def naf_weight(q: int) -> int:
 def horner_features(d) -> DesignFeatures:
     """Features of a single-polynomial :class:`~chebnorm.hw.horner.HornerDesign`
     (coefficients are constants: no ROM; the first step multiplies ``x`` by the
-    constant top coefficient, priced as the adders of its non-adjacent form)."""
+    constant top coefficient, priced as the adders of its non-adjacent form).
+
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> f = horner_features(design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14))
+    >>> f.roms, len(f.multipliers), len(f.const_multipliers)
+    ((), 1, 1)
+    """
     st0 = d.stages[0]
     mults = tuple((int(st.acc_bits), int(d.xs_bits)) for st in d.stages[1:])
     top = int(d.integers[-1])

@@ -63,7 +63,12 @@ _ID = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 @dataclass(frozen=True)
 class Target:
     """One synthesis flow: its name, the yosys command that maps the design, what
-    its statistics mean, and the score weights (LUT equivalents per block)."""
+    its statistics mean, and the score weights (LUT equivalents per block).
+
+    >>> t = get_target("xc7-nodsp")
+    >>> t.script("m"), round(t.weights["dsp"], 1), t.timing
+    ('synth_xilinx -family xc7 -nodsp -top m', 264.2, 'sta')
+    """
 
     name: str
     synth: str          # the yosys command, "{top}" replaced by the module name
@@ -156,7 +161,12 @@ class TargetCost:
     """Yosys's mapping of one module on one target: cells by class and type, the
     score (module docstring: LUT equivalents, or cells on ``generic``) and,
     when asked, the timing model (``levels``, ``delay_ns``; ``fmax_mhz`` only
-    from nextpnr, see :func:`fmax_ice40`)."""
+    from nextpnr, see :func:`fmax_ice40`).
+
+    >>> c = cost_from_types("ice40", {"SB_LUT4": 90, "SB_CARRY": 12, "SB_RAM40_4K": 1})
+    >>> c.line()
+    'ice40: 90 LUT, 0 DSP, 12 carry, 0 mux, 0 FF, 1 RAM; score 330.0 LUT equivalents'
+    """
 
     target: str
     cells: int
