@@ -172,7 +172,7 @@ def test_cli_design_target_xc7(tmp_path):
                          "ffs", "brams"]
     win = [dict(zip(head, x.split(","))) for x in rows[1:] if x.split(",")[12] == "1"]
     assert len(win) == 1 and win[0]["target"] == "xc7" and win[0]["target_score"]
-    assert "winner xc7: " in r.stdout and "Fmax <=" in r.stdout
+    assert "winner xc7: " in r.stdout and "Fmax ~" in r.stdout
 
 
 @no_yosys
@@ -206,3 +206,21 @@ def test_search_default_target_is_generic_and_other_targets_add_columns():
     assert r.winner.target_model == min(p.target_model for p in ok)
     with pytest.raises(ValueError, match="target"):
         search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, target="xc9", **kw)
+
+
+@no_yosys
+def test_cli_hw_report_target_coefficient_table(tmp_path):
+    r = cli("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", "--coef-frac-bits", "14",
+            "-o", "t.json",
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    plain = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--no-gappa",
+                cwd=tmp_path)
+    r = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--no-gappa",
+            "--target", "generic", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    extra = r.stdout[len(plain.stdout):].splitlines()
+    assert r.stdout.startswith(plain.stdout)        # the report as before, then the target
+    cells = int(plain.stdout.split("yosys: ")[1].split()[0])
+    assert extra[0] == f"target generic: {cells} cells"
+    assert extra[1].startswith("timing: ") and "gate levels" in extra[1]
