@@ -85,7 +85,7 @@ def winner_figures(res) -> list[str]:
 
     key = next(k for k, p in zip(sorted(res.designs), res.points) if p is res.winner)
     d = res.designs[key]
-    fig = target_figures(_module_text(d), d.module_name, res.target)
+    fig = target_figures(_module_text(d), d.module_name, res.target, cost=res.winner.target_cost)
     return [f"winner {fig['line']}", f"timing: {fig['timing']}"]
 
 

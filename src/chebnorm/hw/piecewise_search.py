@@ -358,12 +358,14 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
 
 
 def _target_cost(item) -> TargetCost:
-    """Yosys's mapping of one design on a target (run by ``map_ordered`` on a worker)."""
+    """Yosys's mapping of one design on a target, with its delay model (run by
+    ``map_ordered`` on a worker)."""
     from .hdl import module_text
     from .targets import synthesize_target
 
     design, target = item
-    return synthesize_target(module_text(design, "verilog"), design.module_name, target)
+    return synthesize_target(module_text(design, "verilog"), design.module_name, target,
+                             timing=True)
 
 
 def _grid_point(item) -> tuple[DesignPoint, PiecewiseDesign]:

@@ -22,9 +22,10 @@ Carry cells (``CARRY4``, ``SB_CARRY``) and the wide multiplexers
 cell) beside the LUTs that feed them, which are already counted. Input/output
 buffers (``IBUF``/``OBUF``, inserted by ``synth_xilinx``) are not logic and
 score 0, nor does ``INV`` (yosys's 7-series inverter, which the vendor flow
-folds into the neighbouring LUT). ``generic`` scores its cell count. A score compares designs on one
-target; comparing against a peer's design, never spend more DSPs than the peer
-(a DSP-rich design can win on score while not fitting beside the rest).
+folds into the neighbouring LUT). ``generic`` scores its cell count. A score
+compares designs on one target; comparing against a peer's design, never
+spend more DSPs than the peer (a DSP-rich design can win on score while not
+fitting beside the rest).
 
 **Timing**: on ``ice40`` the real figure, place and route by nextpnr-ice40
 (:func:`fmax_ice40`, HX8K ``ct256``, the module between input and output
@@ -34,8 +35,9 @@ X-Ray's Artix-7 timing database, maximum delays) of the synthesized netlist --
 the sum of the cell delays along the longest path, **without routing**: an
 optimistic figure for that netlist (``delay_ns``), with the number of cells on
 that path (``levels``); real routing adds a net delay per level, and the vendor
-tool maps differently. It ranks designs; it is not a sign-off. On ``generic`` the model is the depth in
-gates (``ltp -noff``: the longest topological path, flip-flops cut), no time.
+tool maps differently. It ranks designs; it is not a sign-off. On ``generic``
+the model is the depth in gates (``ltp -noff``: the longest topological path,
+flip-flops cut), no time.
 
 Every tool runs in a private temporary folder (``cwd``) with
 :func:`chebnorm.hw.verilog.tool_env`, on argument lists and fixed relative file
@@ -336,7 +338,8 @@ def _with_timing(cost: TargetCost, levels, ns, model: str) -> TargetCost:
     return replace(cost, levels=levels, delay_ns=ns, timing_model=model)
 
 
-def module_ports(verilog_text: str, top: str, *, timeout: float = 600) -> list[tuple[str, str, int]]:
+def module_ports(verilog_text: str, top: str, *,
+                 timeout: float = 600) -> list[tuple[str, str, int]]:
     """``[(name, "input"|"output", width)]`` of module ``top``, as yosys elaborates it
     (parameters at their defaults), in declaration order.
 
@@ -460,16 +463,18 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
 
 
 def target_figures(verilog_text: str, top: str, target: str, *, clocked: bool = False,
-                   latency: int = 0) -> dict:
+                   latency: int = 0, cost: TargetCost | None = None) -> dict:
     """Everything ``hw report --target`` and ``design --target`` print of module
     ``top`` on ``target``: the :class:`TargetCost` fields, the timing (ice40:
     nextpnr-ice40 Fmax, ``fmax_source`` "nextpnr-ice40"; xc7: the ``sta``
     cell-delay model, ``fmax_mhz`` labelled "model" (no routing); generic: the
     gate depth only) and the latency in clock cycles; ``line`` and ``timing``
-    are the text lines.
+    are the text lines. ``cost``: this module's :func:`synthesize_target` on
+    ``target`` with ``timing``, when already known (not synthesized again).
     """
     t = get_target(target)
-    cost = synthesize_target(verilog_text, top, t.name, timing=True)
+    if cost is None or cost.target != t.name or cost.levels is None:
+        cost = synthesize_target(verilog_text, top, t.name, timing=True)
     d = cost.as_dict()
     d["latency_cycles"] = int(latency)
     if t.timing == "nextpnr":
