@@ -64,13 +64,15 @@ def run(args) -> int:
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
     csv, png = res.csv(), res.plot_png()
+    # the winner's place and route may fail (too large for the device): before writing
+    figures = winner_figures(res) if res.winner.target_cost is not None else []
     write_folder(out, {f"design_{name}.csv": csv, f"design_{name}.png": png})
     print(out / f"design_{name}.csv")
     print(out / f"design_{name}.png")
     print("\n".join(res.explain()))
     w = res.winner
-    if target != "generic" and not args.no_synth:
-        print("\n".join(winner_figures(res)))
+    if figures:
+        print("\n".join(figures))
     print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
           f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
           f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
