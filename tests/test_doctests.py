@@ -46,6 +46,10 @@ EXAMPLE_EXEMPT = {
     "chebnorm.hw.vhdl.simulate_vhdl": _TOOL,
     "chebnorm.hw.piecewise.piecewise_cells": _TOOL,
     "chebnorm.hw.piecewise.simulate_piecewise": _TOOL,
+    "chebnorm.hw.targets.synthesize_target": _TOOL,
+    "chebnorm.hw.targets.module_ports": _TOOL,
+    "chebnorm.hw.targets.target_figures": _TOOL,
+    "chebnorm.hw.targets.fmax_ice40": _TOOL + " (and nextpnr-ice40)",
     "chebnorm.hw.verilog.SimResult": _RESULT,
     "chebnorm.hw.verilog.SynthResult": _RESULT,
 }

@@ -27,6 +27,10 @@ def register(sub) -> None:
                    help="largest segment count tried, 2^0..2^min(12, in-bits - 1) (default "
                    "2^8, or 2^(in-bits - 1) when in-bits <= 8: at most half the input codes)")
     p.add_argument("--no-synth", action="store_true", help="model estimate instead of yosys")
+    p.add_argument("--target", default="generic", metavar="T",
+                   help="price by this target's mapping: generic (yosys cells; default), xc7, "
+                   "xc7-nodsp (LUT equivalents: a DSP48E1 = 264.2 LUTs) or ice40 (with "
+                   "nextpnr-ice40 Fmax of the winner)")
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
@@ -41,14 +45,17 @@ def run(args) -> int:
     from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.core.textsafe import identifier
     from chebnorm.hw.piecewise_search import search
+    from chebnorm.hw.targets import get_target
 
     name = identifier(args.name, field="name")
+    target = get_target(args.target).name
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, args.max_error,
                  degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
-                 var=args.var, synth=not args.no_synth, name=name, **parallel_kwargs(args))
+                 var=args.var, synth=not args.no_synth, name=name, target=target,
+                 **parallel_kwargs(args))
     if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {args.max_error:.4g}: the smallest "
@@ -57,16 +64,37 @@ def run(args) -> int:
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
     csv, png = res.csv(), res.plot_png()
+    # the winner's place and route may fail (too large for the device): before writing
+    figures = winner_figures(res) if res.winner.target_cost is not None else []
     write_folder(out, {f"design_{name}.csv": csv, f"design_{name}.png": png})
     print(out / f"design_{name}.csv")
     print(out / f"design_{name}.png")
     print("\n".join(res.explain()))
     w = res.winner
+    if figures:
+        print("\n".join(figures))
     print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
           f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
           f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
           f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
     return 0
+
+
+def winner_figures(res) -> list[str]:
+    """The winner's figures on the search's target: its mapping and its timing
+    (nextpnr-ice40 Fmax on ice40, the yosys sta model on xc7)."""
+    from chebnorm.hw.targets import target_figures
+
+    key = next(k for k, p in zip(sorted(res.designs), res.points) if p is res.winner)
+    d = res.designs[key]
+    fig = target_figures(_module_text(d), d.module_name, res.target, cost=res.winner.target_cost)
+    return [f"winner {fig['line']}", f"timing: {fig['timing']}"]
+
+
+def _module_text(d) -> str:
+    from chebnorm.hw.hdl import module_text
+
+    return module_text(d, "verilog")
 
 
 def _max_index_bits(args, parse_segments) -> int:
@@ -142,6 +170,12 @@ def hw_report(args, table) -> int:
            "acc_frac_bits": d.acc_frac_bits, "y_format": d.y_format.as_dict(), "budget": b,
            "measured": m, "within_budget": m["max_error"] <= b["total"],
            "model_cost": model_cost(d), "yosys_cells": cells}
+    fig = None
+    if getattr(args, "target", None) is not None:
+        from chebnorm.hw.targets import target_figures
+
+        fig = target_figures(_module_text(d), d.module_name, args.target)
+        rep["target"] = {k: v for k, v in fig.items() if k not in ("line", "timing")}
     if args.json:
         rep["y_format"]["offset"] = float(rep["y_format"]["offset"])
         print_json(rep)
@@ -154,6 +188,9 @@ def hw_report(args, table) -> int:
     print(f"measured over all {m['codes']} codes: max |y - f(x)| = {m['max_error']:.4e} at code "
           f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
     print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
+    if fig is not None:
+        print(f"target {fig['line']}")
+        print(f"timing: {fig['timing']}")
     return 0
 
 

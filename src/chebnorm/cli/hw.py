@@ -65,6 +65,10 @@ def register(sub) -> None:
     r.add_argument("--json", action="store_true", help="print the report as JSON")
     r.add_argument("--no-synth", action="store_true", help="skip yosys")
     r.add_argument("--no-gappa", action="store_true", help="skip gappa")
+    r.add_argument("--target", default=None, metavar="T",
+                   help="also map the evaluator on an FPGA target: generic, xc7, xc7-nodsp or "
+                   "ice40: LUT/DSP/carry/RAM/FF, Fmax (ice40: nextpnr-ice40; xc7: a model) "
+                   "and latency")
     r.add_argument("--unit", action="append", default=[], metavar="KIND",
                    help=f"also cost a normalization unit ({', '.join(unit_names())}; "
                    "repeatable): model area beside yosys cells; units with an evaluator "
@@ -210,12 +214,20 @@ def run_report(args) -> int:
     for kind in args.unit:
         get_unit(kind)  # refuses an unknown name, listing the registered ones
     _refuse_unit_options(args, args.unit)
+    check_report_target(args)
     table = load_table(args.table)
     if isinstance(table, PiecewiseTable) and not args.unit:
         from .design import hw_report
         return hw_report(args, table)
     table = _coefficient_table(table, args.table, "hw report --unit")
     report = _analyze(args, table, synth=not args.no_synth, gappa=not args.no_gappa)
+    fig = None
+    if args.target is not None:
+        from chebnorm.hw.hdl import module_text
+        from chebnorm.hw.targets import target_figures
+
+        fig = target_figures(module_text(report.design), report.design.module_name,
+                             args.target)
     units = []
     for kind in dict.fromkeys(args.unit):
         has_evaluator = get_unit(kind).target is not None
@@ -231,12 +243,29 @@ def run_report(args) -> int:
         d = report.as_dict()
         if units:
             d["units"] = [u.as_dict() for u in units]
+        if fig is not None:
+            d["target"] = {k: v for k, v in fig.items() if k not in ("line", "timing")}
         print_json(d)
     else:
         print("\n".join(report.lines()))
+        if fig is not None:
+            print(f"target {fig['line']}")
+            print(f"timing: {fig['timing']}")
         for u in units:
             print("\n".join(u.lines()))
     return 0
+
+
+def check_report_target(args) -> None:
+    """``hw report --target T``: a registered target, and synthesis allowed."""
+    if getattr(args, "target", None) is None:
+        return
+    from chebnorm.hw.targets import get_target
+
+    get_target(args.target)
+    if args.no_synth:
+        raise ValueError(f"--target {args.target} maps the design with yosys; accepted: "
+                         f"--target without --no-synth")
 
 
 def argparse_ns(args, **changes):

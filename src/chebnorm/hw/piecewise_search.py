@@ -13,6 +13,15 @@ first the model estimate (:func:`model_cost`), and Yosys counts cells only on
 the Pareto front's points that meet ``E`` (so the search stays bounded: at
 most ``len(degrees) * (max_index_bits + 1) + 2 * len(degrees) * 16`` fits).
 
+With ``target`` other than ``"generic"`` (:mod:`chebnorm.hw.targets`) every
+point is priced by that target's calibrated model
+(:func:`chebnorm.hw.target_model.model_score`), the Pareto front is taken over
+(model score, bound), and its meeting points are synthesized on the target
+(``synth_xilinx``, ``synth_ice40``) -- except those whose model score exceeds
+``MODEL_SPREAD**2`` times the best one's (the model is within
+:data:`~chebnorm.hw.target_model.MODEL_SPREAD` of yosys, so they cannot win):
+the winner is the lowest target score.
+
 >>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
 ...            progress=False, workers=1)
 >>> w = r.winner
@@ -35,12 +44,17 @@ from chebnorm.core.textsafe import csv_cell
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
 from .sweep import pareto_png
+from .targets import TargetCost, get_target
 
-__all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS"]
+__all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
+           "TARGET_COLUMNS"]
 
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
            "rom_bits", "approx_bound", "total_bound", "meets", "model_cost", "yosys_cells",
            "pareto", "winner")
+#: the columns a non-generic ``target`` adds to the search CSV
+TARGET_COLUMNS = ("target", "target_model", "target_score", "luts", "dsps", "carries", "ffs",
+                  "brams")
 #: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
 ROM_CELLS_PER_BIT = 0.15
 MAX_SYNTH = 6
@@ -86,14 +100,22 @@ class DesignPoint:
     model_cost: float
     yosys_cells: int | None = None
     pareto: bool = False
+    target_model: float | None = None   # the target's model score (non-generic target)
+    target_cost: TargetCost | None = None   # yosys on the target (non-generic target)
 
     @property
     def cost(self) -> float:
+        if self.target_model is not None:
+            return self.target_cost.score if self.target_cost is not None else self.target_model
         return float(self.yosys_cells) if self.yosys_cells is not None else self.model_cost
 
     def describe(self) -> str:
         cells = (f"{self.yosys_cells} yosys cells" if self.yosys_cells is not None
                  else f"~{self.model_cost:.0f} cells (model)")
+        if self.target_cost is not None:
+            cells = self.target_cost.line()
+        elif self.target_model is not None:
+            cells = f"~{self.target_model:.0f} LUT equivalents (model)"
         return (f"degree {self.degree}, {self.segments} segments, {self.coef_frac_bits} "
                 f"coefficient bits (ROM {self.rom_bits} bits): {cells}, certified error "
                 f"<= {self.total_bound:.4e}")
@@ -115,15 +137,24 @@ class SearchResult:
     winner: DesignPoint | None
     cost_source: str
     designs: dict
+    target: str = "generic"
 
     def csv(self) -> str:
+        """The CSV of every point (:data:`COLUMNS`; a non-generic target adds
+        :data:`TARGET_COLUMNS`)."""
         out = io.StringIO()
-        out.write(",".join(COLUMNS) + "\n")
+        extra = self.target != "generic"
+        out.write(",".join(COLUMNS + (TARGET_COLUMNS if extra else ())) + "\n")
         for p in self.points:
             row = [p.degree, p.segments, p.coef_frac_bits, p.acc_frac_bits, p.y_frac_bits,
                    p.rom_bits, f"{p.approx_bound:.6e}", f"{p.total_bound:.6e}", int(p.meets),
                    f"{p.model_cost:.1f}", "" if p.yosys_cells is None else p.yosys_cells,
                    int(p.pareto), int(p is self.winner)]
+            if extra:
+                c = p.target_cost
+                row += [self.target, f"{p.target_model:.1f}"] + (
+                    ["", "", "", "", "", ""] if c is None else
+                    [f"{c.score:.1f}", c.luts, c.dsps, c.carries, c.ffs, c.brams])
             out.write(",".join(csv_cell(str(v)) for v in row) + "\n")
         return out.getvalue()
 
@@ -147,7 +178,12 @@ class SearchResult:
             if b is w:
                 continue
             # compare like with like: yosys cells when both were synthesized, else the model
-            if b.yosys_cells is not None and w.yosys_cells is not None:
+            if self.target != "generic":
+                both = b.target_cost is not None and w.target_cost is not None
+                diff = (b.target_cost.score - w.target_cost.score if both
+                        else b.target_model - w.target_model)
+                unit = f"{self.target} {'score' if both else 'model score'}"
+            elif b.yosys_cells is not None and w.yosys_cells is not None:
                 diff, unit = b.yosys_cells - w.yosys_cells, "yosys cells"
             else:
                 diff, unit = b.model_cost - w.model_cost, "model cells"
@@ -158,10 +194,13 @@ class SearchResult:
 
     def plot_png(self) -> bytes:
         """The Pareto plot of the search (cost against certified error), as PNG bytes."""
+        generic = self.target == "generic"
         return pareto_png(
-            self.points, lambda p: p.model_cost, lambda p: p.total_bound,
+            self.points, (lambda p: p.model_cost) if generic else (lambda p: p.target_model),
+            lambda p: p.total_bound,
             hline=(self.max_error, "max error"), best=(self.winner, "winner"),
-            xlabel="model cost (Yosys-cell units)", ylabel="certified max |y - f(x)|",
+            xlabel="model cost (Yosys-cell units)" if generic else
+            f"{self.target} model score (LUT equivalents)", ylabel="certified max |y - f(x)|",
             title=f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out",
             xlog=True)
 
@@ -223,8 +262,10 @@ def _check_max_error(max_error) -> float:
 def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
            degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
            progress: bool = True, name: str = "design", workers: int | None = None,
-           scheduler=None) -> SearchResult:
-    """Cheapest certified piecewise design meeting ``max_error`` (module docstring).
+           scheduler=None, target: str = "generic") -> SearchResult:
+    """Cheapest certified piecewise design meeting ``max_error`` (module docstring);
+    ``target`` (:func:`chebnorm.hw.targets.target_names`) prices the points by that
+    target's model and synthesizes the front's meeting points on it.
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
@@ -242,6 +283,7 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     degrees = tuple(sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees}))
     if not degrees:
         raise ValueError("degrees: empty; accepted: one or more of 0..8")
+    target = get_target(target).name
     kmax = check_width(max_index_bits, "max-index-bits", 0, min(12, in_bits - 1))
     workers = check_workers(workers)
     check_scheduler(scheduler)
@@ -259,37 +301,71 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
         for key, p, des in chain:
             points[key], designs[key] = p, des
     keys = sorted(points)
+    if target != "generic":
+        from .target_model import model_score, piecewise_features
+
+        for key in keys:
+            points[key] = replace(points[key], target_model=model_score(
+                piecewise_features(designs[key]), target))
+        mc = lambda p: p.target_model  # noqa: E731
+    else:
+        mc = lambda p: p.model_cost  # noqa: E731
     # Pareto front over (model cost, total bound)
     front = set()
     for key in keys:
         p = points[key]
-        dominated = any(q.model_cost <= p.model_cost and q.total_bound <= p.total_bound
-                        and (q.model_cost, q.total_bound) != (p.model_cost, p.total_bound)
+        dominated = any(mc(q) <= mc(p) and q.total_bound <= p.total_bound
+                        and (mc(q), q.total_bound) != (mc(p), p.total_bound)
                         for q in points.values())
         if not dominated:
             front.add(key)
     for key in front:
         points[key] = replace(points[key], pareto=True)
     cost_source = "model estimate"
-    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: points[k].model_cost)
+    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: mc(points[k]))
     if synth and meeting:
         import shutil
 
         if shutil.which("yosys") is not None:
-            cost_source = "yosys cells"
             chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
-            cells = map_ordered(_cells, [designs[k] for k in chosen], desc="yosys", **par)
-            for key, n in zip(chosen, cells):
-                points[key] = replace(points[key], yosys_cells=n)
+            if target == "generic":
+                cost_source = "yosys cells"
+                cells = map_ordered(_cells, [designs[k] for k in chosen], desc="yosys", **par)
+                for key, n in zip(chosen, cells):
+                    points[key] = replace(points[key], yosys_cells=n)
+            else:
+                # the model is within MODEL_SPREAD s of yosys: a point whose model score
+                # exceeds s^2 times the best one's cannot beat it, and is not synthesized
+                from .target_model import MODEL_SPREAD
+
+                bound = mc(points[chosen[0]]) * MODEL_SPREAD[target] ** 2
+                chosen = [k for k in chosen if mc(points[k]) <= bound]
+                cost_source = f"yosys {get_target(target).synth.split(' -top')[0]}"
+                costs = map_ordered(_target_cost, [(designs[k], target) for k in chosen],
+                                    desc=f"yosys {target}", **par)
+                for key, c in zip(chosen, costs):
+                    points[key] = replace(points[key], target_cost=c)
     ordered = tuple(points[k] for k in keys)
     winner = None
     if meeting:
         pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
+                                                   or p.target_cost is not None
                                                    or cost_source == "model estimate")]
         winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
                         max_error, ordered, winner, cost_source,
-                        {k: designs[k] for k in keys})
+                        {k: designs[k] for k in keys}, target)
+
+
+def _target_cost(item) -> TargetCost:
+    """Yosys's mapping of one design on a target, with its delay model (run by
+    ``map_ordered`` on a worker)."""
+    from .hdl import module_text
+    from .targets import synthesize_target
+
+    design, target = item
+    return synthesize_target(module_text(design, "verilog"), design.module_name, target,
+                             timing=True)
 
 
 def _grid_point(item) -> tuple[DesignPoint, PiecewiseDesign]:

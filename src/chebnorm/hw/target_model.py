@@ -1,0 +1,213 @@
+"""A cost model per FPGA target, calibrated against yosys, so a design search
+need not synthesize every candidate.
+
+A design is described by its :class:`DesignFeatures`: its ROMs (index bits
+``k``, word bits ``w``), its multipliers (operand widths ``a x b``), its
+adders (widths) and its register bits. :func:`model_score` predicts the
+target's score (:mod:`chebnorm.hw.targets`: yosys cells on ``generic``, LUT
+equivalents on the FPGA targets) as a sum of per-block terms whose *shape*
+follows the device and whose *constants* were fitted against yosys 0.23:
+
+* ``generic``: ``c_rom * w * 2**k + c_mul * a * b + c_add * width + bits``;
+* ``xc7``: a ROM output bit of ``k`` address bits is ``max(1, 2**(k-6))``
+  LUT6 (``c_rom`` of them survive constant folding); a multiplier goes to
+  ``ceil(a/25) * ceil(b/18)`` DSP48E1 (the 25 x 18 signed ports, wider operand
+  on A) scored at the device weight (264.2 LUTs each); adders ``c_add`` LUT
+  per bit (beside their CARRY4); registers 0.5 LUT per bit;
+* ``xc7-nodsp``: as ``xc7`` with multipliers in LUTs, ``c_mul * a * b``;
+* ``ice40``: as ``xc7-nodsp`` with LUT4 (``max(1, 2**(k-4))`` per ROM bit)
+  and 1 LUT per register bit.
+
+The constants (:data:`CALIBRATION`) come from ``benchmarks/calibrate_targets.py``:
+a fixed set of piecewise designs (three functions, degrees 1 to 3, 4 to 128
+segments, 12- and 16-bit) and single Horner designs (degrees 1 to 3), each
+synthesized on every target, fitted by non-negative least squares on the
+relative error (13 designs x 4 targets, ``benchmarks/target_calibration.json``).
+:data:`MODEL_SPREAD` is the largest ratio ``max(model/yosys, yosys/model)``
+measured per target on that set (generic 1.165, xc7 1.056, xc7-nodsp 1.257,
+ice40 1.254) and on four held-out designs the fit never saw (exp, sin, a
+20-bit 1/sqrt, a degree-3 1/(1+x): 1.049, 1.063, 1.249, 1.094), whichever is
+larger; the test ``tests/test_targets_fpga.py`` re-synthesizes designs of the
+set and holds the model to it. It is a model for ranking candidates; the winner is always
+synthesized.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .targets import DEVICE_WEIGHTS, get_target
+
+__all__ = ["DesignFeatures", "piecewise_features", "horner_features", "model_score",
+           "model_terms", "CALIBRATION", "MODEL_SPREAD", "dsp_count", "naf_weight"]
+
+
+@dataclass(frozen=True)
+class DesignFeatures:
+    """What the cost model reads of a design.
+
+    ``roms``: ``((index_bits, word_bits), ...)``; ``multipliers``: ``((a, b), ...)``
+    operand widths (two's complement); ``adders``: widths; ``register_bits``:
+    flip-flops (0 for a combinational design); ``const_multipliers``:
+    ``((a, b, naf), ...)``, a variable ``b``-bit operand times an ``a``-bit
+    constant with ``naf`` nonzero digits (:func:`naf_weight`): ``naf - 1``
+    adders of ``a + b`` bits in LUTs, but a DSP48E1 on ``xc7`` (yosys maps
+    every ``$mul`` there).
+
+    >>> DesignFeatures(roms=((5, 42),), multipliers=((10, 13),)).roms
+    ((5, 42),)
+    >>> DesignFeatures(adders=(-1,))
+    Traceback (most recent call last):
+    ...
+    ValueError: adders/register_bits: -1; accepted: integers 0..2^20
+    """
+
+    roms: tuple[tuple[int, int], ...] = ()
+    multipliers: tuple[tuple[int, int], ...] = ()
+    adders: tuple[int, ...] = ()
+    register_bits: int = 0
+    const_multipliers: tuple[tuple[int, int, int], ...] = ()
+
+    def __post_init__(self):
+        for name, items, n in (("roms", self.roms, 2), ("multipliers", self.multipliers, 2),
+                               ("const_multipliers", self.const_multipliers, 3)):
+            for it in items:
+                if len(it) != n or any(isinstance(v, bool) or not isinstance(v, int) or
+                                       not 0 <= v <= 4096 for v in it):
+                    raise ValueError(f"{name}: {it!r} is not a pair of widths; accepted: "
+                                     f"integers 0..4096")
+        for w in self.adders + (self.register_bits,):
+            if isinstance(w, bool) or not isinstance(w, int) or not 0 <= w <= 1 << 20:
+                raise ValueError(f"adders/register_bits: {w!r}; accepted: integers 0..2^20")
+
+
+#: fitted constants per target (benchmarks/calibrate_targets.py; module docstring)
+CALIBRATION = {
+    "generic": {"rom": 0.1105, "mul": 5.317, "add": 4.2394},
+    "xc7": {"rom": 1.0068, "mul": 0.0, "add": 0.2125},
+    "xc7-nodsp": {"rom": 1.5723, "mul": 1.9433, "add": 0.8552},
+    "ice40": {"rom": 1.2842, "mul": 2.0591, "add": 1.3325},
+}
+#: largest max(model/yosys, yosys/model) on the calibration set and the held-out designs
+MODEL_SPREAD = {"generic": 1.165, "xc7": 1.063, "xc7-nodsp": 1.257, "ice40": 1.254}
+
+
+def dsp_count(a: int, b: int) -> int:
+    """DSP48E1 blocks of an ``a x b`` signed multiplier: ``ceil(max/25) * ceil(min/18)``.
+
+    >>> dsp_count(17, 19), dsp_count(30, 19), dsp_count(8, 8)
+    (1, 4, 1)
+    """
+    hi, lo = max(a, b), min(a, b)
+    return math.ceil(hi / 25) * math.ceil(lo / 18)
+
+
+def model_terms(f: DesignFeatures, target: str) -> dict:
+    """The uncalibrated terms of ``target``'s model: ROM, multiplier and adder
+    sizes (each multiplied by its constant in :func:`model_score`), and the
+    fixed part (DSPs and registers at their device weights).
+
+    >>> f = DesignFeatures(roms=((8, 10),), multipliers=((20, 12),), adders=(30,))
+    >>> model_terms(f, "xc7") == {"rom": 40.0, "mul": 0.0, "add": 30.0, "fixed": 63400 / 240}
+    True
+    >>> model_terms(f, "ice40")["rom"], model_terms(f, "generic")["rom"]
+    (160.0, 2560.0)
+    """
+    t = get_target(target)
+    add = float(sum(f.adders))
+    if t.name != "xc7":
+        add += float(sum((n - 1) * (a + b) for a, b, n in f.const_multipliers if n > 1))
+    if t.name == "generic":
+        rom = float(sum(w * 2 ** k for k, w in f.roms))
+        return {"rom": rom, "mul": float(sum(a * b for a, b in f.multipliers)), "add": add,
+                "fixed": float(f.register_bits)}
+    lut_in = 6 if t.name.startswith("xc7") else 4
+    rom = float(sum(w * max(1, 2 ** (k - lut_in)) for k, w in f.roms))
+    wts = DEVICE_WEIGHTS[t.device]
+    fixed = wts["ff"] * f.register_bits
+    mul = float(sum(a * b for a, b in f.multipliers))
+    if t.name == "xc7":
+        fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b in f.multipliers)
+        fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b, n in f.const_multipliers if n > 1)
+        mul = 0.0
+    return {"rom": rom, "mul": mul, "add": add, "fixed": fixed}
+
+
+def model_score(features: DesignFeatures, target: str) -> float:
+    """Predicted score of a design on ``target`` (yosys cells on ``generic``, LUT
+    equivalents otherwise), within :data:`MODEL_SPREAD` of yosys on the
+    calibration set.
+
+    >>> f = DesignFeatures(roms=((5, 42),), multipliers=((17, 13), (19, 13)), adders=(20, 22, 18))
+    >>> model_score(f, "xc7") > 2 * 264
+    True
+    """
+    if not isinstance(features, DesignFeatures):
+        raise ValueError("features: not a DesignFeatures; accepted: piecewise_features(d), "
+                         "horner_features(d) or a DesignFeatures")
+    terms = model_terms(features, target)
+    c = CALIBRATION[get_target(target).name]
+    return float(c["rom"] * terms["rom"] + c["mul"] * terms["mul"] + c["add"] * terms["add"]
+                 + terms["fixed"])
+
+
+def piecewise_features(d) -> DesignFeatures:
+    """Features of a :class:`~chebnorm.hw.piecewise.PiecewiseDesign`: its
+    coefficient ROM (index bits x word bits), one ``acc x t`` multiplier and
+    one adder per Horner step, the output rounding and saturation.
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=12)
+    >>> f = piecewise_features(design_piecewise(t, 8, 8))
+    >>> f.roms[0][0], len(f.multipliers)
+    (2, 1)
+    """
+    n = d.degree
+    mults, adds = [], []
+    acc_w = d.rom_bits[n] if n > 0 else 0
+    for _pw, sw, ow in d.widths:
+        mults.append((int(acc_w), int(d.t_bits)))
+        adds.append(int(sw))
+        acc_w = ow
+    adds += [d.out_bits + 2, d.out_bits + 2]  # rounding increment and saturation compare
+    return DesignFeatures(roms=((int(d.index_bits), int(sum(d.rom_bits))),),
+                          multipliers=tuple(mults), adders=tuple(adds))
+
+
+def naf_weight(q: int) -> int:
+    """Nonzero digits of the non-adjacent form of ``q`` (a constant multiplier
+    ``q * x`` is that many shifted copies of ``x`` added).
+
+    >>> naf_weight(7), naf_weight(0), naf_weight(-10)
+    (2, 0, 2)
+    """
+    q, n = abs(int(q)), 0
+    while q:
+        if q & 1:
+            q -= 2 - (q & 3)   # digit +1 (q = 1 mod 4) or -1 (q = 3 mod 4)
+            n += 1
+        q >>= 1
+    return n
+
+
+def horner_features(d) -> DesignFeatures:
+    """Features of a single-polynomial :class:`~chebnorm.hw.horner.HornerDesign`
+    (coefficients are constants: no ROM; the first step multiplies ``x`` by the
+    constant top coefficient, priced as the adders of its non-adjacent form).
+
+    >>> from chebnorm.approx import fit_target
+    >>> from chebnorm.hw.horner import design_horner
+    >>> f = horner_features(design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14))
+    >>> f.roms, len(f.multipliers), len(f.const_multipliers)
+    ((), 1, 1)
+    """
+    st0 = d.stages[0]
+    mults = tuple((int(st.acc_bits), int(d.xs_bits)) for st in d.stages[1:])
+    top = int(d.integers[-1])
+    const = ((int(st0.acc_bits), int(d.xs_bits), naf_weight(top)),)
+    adds = [int(d.xs_bits)] + [int(st.sum_bits) for st in d.stages]
+    adds += [int(st.out_bits) for st in d.stages[:-1] if st.round_shift]
+    adds += [int(d.raw_bits), int(d.raw_bits)]
+    return DesignFeatures(multipliers=mults, adders=tuple(adds), const_multipliers=const)
