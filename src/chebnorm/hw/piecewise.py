@@ -30,8 +30,9 @@ compares it, code by code and in 40-digit arithmetic, with ``f``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
+from typing import NamedTuple
 
 import mpmath
 import numpy as np
@@ -100,6 +101,13 @@ class PiecewiseDesign:
     widths: tuple[tuple[int, int, int], ...]   # per step j=n-1..0: (product, sum, out)
     top_frac_bits: int
     rounding: str = ROUNDING
+    # the sized architecture (empty: one width for every coefficient, RNE after each step)
+    coef_frac: tuple[int, ...] = ()      # F_j, j = 0..n: fractional bits of ROM column j
+    t_keep: tuple[int, ...] = ()         # T_j, j = 0..n-1: top bits of t step j multiplies by
+    acc_frac: tuple[int, ...] = ()       # G_j, j = 0..n: fractional bits of a_j (G_0 = y's)
+    coefficients: tuple[tuple[int, ...], ...] = ()   # per segment, c_j / 2^F_j
+    cuts: tuple[int, ...] = ()           # pipeline registers: 0 after the ROM, i after step i
+    bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
 
     @property
     def module_name(self) -> str:
@@ -110,10 +118,35 @@ class PiecewiseDesign:
         return self.table.degree
 
     @property
+    def sized(self) -> bool:
+        """True for the sized architecture (a width per coefficient, truncated steps)."""
+        return bool(self.coef_frac)
+
+    @property
+    def latency(self) -> int:
+        """Clock cycles from ``x`` to ``y``: the number of pipeline registers (0: combinational)."""
+        return len(self.cuts)
+
+    @property
     def index_bits(self) -> int:
         return self.table.index_bits
 
+    def sized_signals(self) -> list[dict]:
+        """The sized datapath's steps ``j = n-1 .. 0`` for the HDL printers:
+        :func:`sized_steps`' shifts plus the widths of ``t_j`` (``tw``),
+        ``p_j``, ``q_j``, ``s_j`` and ``a_j`` (``pw``, ``qw``, ``sw``, ``aw``)."""
+        out = []
+        for st, (pw, sw, ow) in zip(sized_steps(_shape(self)), self.widths):
+            T = self.t_keep[st["j"]]
+            ps = st["pshift"]
+            qw = max(pw - ps, 2) if ps >= 0 else pw - ps
+            out.append(dict(st, T=T, tw=T if self.table.centered else T + 1, pw=pw, qw=qw,
+                            sw=sw, aw=ow))
+        return out
+
     def _rom(self, dtype=np.int64) -> np.ndarray:
+        if self.sized:
+            return np.array(self.coefficients, dtype=dtype)
         return np.array([seg.integers for seg in self.table.segments], dtype=dtype)
 
     def _t(self, k: np.ndarray) -> np.ndarray:
@@ -124,7 +157,10 @@ class PiecewiseDesign:
         """Output codes for input ``codes`` (default: all ``2**in_bits``)."""
         k = np.arange(2 ** self.in_bits, dtype=np.int64) if codes is None \
             else np.asarray(codes, dtype=np.int64)
-        w = _run(self, k, self.acc_frac_bits, self.y_format.frac_bits)
+        if self.sized:
+            w = _run_sized(self._rom(k.dtype), k, _shape(self))
+        else:
+            w = _run(self, k, self.acc_frac_bits, self.y_format.frac_bits)
         raw = w["rounded"] - self.y_format.offset_code
         w["raw"] = raw
         w["y"] = np.clip(raw, 0, self.y_format.max_code)
@@ -135,7 +171,24 @@ class PiecewiseDesign:
         return [lo + (hi - lo) * Fraction(int(c), 2 ** self.in_bits) for c in codes]
 
     def budget(self) -> dict:
-        """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up)."""
+        """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up).
+
+        The sized architecture's bound is per segment (:func:`sized_bound`):
+        ``total`` is the largest over the segments of the segment's certified
+        approximation bound plus its datapath bound (coefficient re-rounding,
+        truncated ``t``, truncated products and sums, the output truncation);
+        ``datapath`` the largest datapath bound; ``output_rounding`` is
+        ``2^-(Fy+1)`` and ``horner_rounding`` the rest of ``datapath``, so
+        that the parts add up to at least ``total``.
+        """
+        if self.sized:
+            approx, path, total = self.bound
+            out = Fraction(1, 2 ** (self.y_format.frac_bits + 1))
+            return {"approximation": float_up(approx),
+                    "horner_rounding": float_up(max(path - out, Fraction(0))),
+                    "output_rounding": float_up(out), "datapath": float_up(path),
+                    "total": float_up(total),
+                    "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
         tmax = Fraction(1, 2) if self.table.centered else Fraction(1)
         fa = self.acc_frac_bits
         steps = [rounding_error_bound(fa, self.rounding) * tmax ** j
@@ -203,13 +256,311 @@ def _run(d, k, fa, fy) -> dict:
     return w
 
 
+# -- the sized architecture: a width per coefficient, truncated Horner steps ---------
+
+class _Shape(NamedTuple):
+    """The sized datapath's widths: local bits ``L``, degree ``n``, centred
+    ``t``, and ``F`` (per ROM column), ``T`` (per step), ``G`` (per accumulator)."""
+
+    L: int
+    n: int
+    centered: bool
+    F: tuple[int, ...]
+    T: tuple[int, ...]
+    G: tuple[int, ...]
+
+
+def _shape(d: PiecewiseDesign) -> _Shape:
+    return _Shape(d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac)
+
+
+def sized_steps(shape) -> list[dict]:
+    """The shifts of each step ``j = n-1 .. 0`` of the sized datapath::
+
+        t_j = low >> tshift (- 2^(T_j - 1) when centred)   T_j fractional bits
+        p_j = a_{j+1} * t_j                                 pf = G_{j+1} + T_j
+        q_j = p_j >> pshift  (<< -pshift when negative)     X = max(G_j, F_j)
+        s_j = q_j + (c_j << cshift)                          X
+        a_j = s_j >> ashift                                  G_j
+
+    every shift a floor (drops bits, no rounding adder); the bias is paid for
+    in the coefficients (:func:`sized_bound` centres each segment's error).
+
+    >>> sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]["pshift"]
+    2
+    """
+    L, n, _, F, T, G = shape
+    out = []
+    for j in range(n - 1, -1, -1):
+        pf = G[j + 1] + T[j]
+        X = max(G[j], F[j])
+        out.append({"j": j, "tshift": L - T[j], "pf": pf, "X": X, "pshift": pf - X,
+                    "cshift": X - F[j], "ashift": X - G[j]})
+    return out
+
+
+def _shift(v, sh: int):
+    return v >> sh if sh >= 0 else v << -sh
+
+
+def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
+    """Wires of the sized datapath for codes ``k`` (ROM ``rom[segment, j]``);
+    ``upto``: stop after the step computing ``a_upto``."""
+    L, n, centered, F, T, G = shape
+    s = k >> L
+    low = k & ((1 << L) - 1)
+    acc = rom[s, n]
+    w = {"s": s, f"a{n}": acc}
+    for st in sized_steps(shape):
+        j = st["j"]
+        tj = low >> st["tshift"]
+        if centered:
+            tj = tj - (1 << (T[j] - 1))
+        p = acc * tj
+        q = _shift(p, st["pshift"])
+        sm = q + (rom[s, j] << st["cshift"])
+        acc = sm >> st["ashift"]
+        w.update({f"t{j}": tj, f"p{j}": p, f"q{j}": q, f"s{j}": sm, f"a{j}": acc})
+        if j == upto:
+            return w
+    if n == 0:
+        acc = _shift(acc, F[0] - G[0])
+        w["a0"] = acc
+    w["rounded"] = acc
+    return w
+
+
+_P2 = Fraction(2)
+
+
+def _imul(a, b):
+    """Interval product of ``a = (lo, hi)`` and ``b = (lo, hi)`` (Fractions)."""
+    c = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
+    return min(c), max(c)
+
+
+def sized_bound(table: PiecewiseTable, shape, codes=None):
+    """Choose the ROM and certify the sized datapath, segment by segment.
+
+    Returns ``(rom, (approximation, datapath, total))``: ``rom[s][j]`` the
+    coefficient ``c_j`` of segment ``s`` with ``F_j`` fractional bits, and
+    exact (Fraction) bounds. For each segment the error ``e_j = a_j - â_j``
+    of each accumulator against the exact Horner value ``â_j`` of the table's
+    polynomial (coefficients ``q_j / 2^Fc``, local variable ``t``) is enclosed
+    in an interval, from the top::
+
+        e_n = c_n / 2^F_n - q_n / 2^Fc
+        e_j = e_{j+1} * t - a_{j+1} * tau_j - pi_j - sigma_j + delta_j
+
+    with ``t`` in its segment range, ``a_{j+1}`` in its exact range over the
+    segment's codes (the model's wires), ``tau_j`` in ``[0, 2^-T_j - 2^-L]``
+    (``t`` truncated), ``pi_j`` in ``[0, 2^-X - 2^-pf]`` (the product
+    truncated), ``sigma_j`` in ``[0, 2^-G_j - 2^-X]`` (the sum truncated)
+    and ``delta_j = c_j / 2^F_j - q_j / 2^Fc``, where ``c_j`` is chosen as
+    the ``F_j``-bit value nearest ``q_j / 2^Fc`` minus the middle of the rest
+    of ``e_j``'s interval (the truncations' bias is paid in the ROM, for
+    free). ``a_0`` is y's code: ``|y - f| <= approx_s + max |e_0|`` on
+    segment ``s``, rigorously (every term is enclosed; no floating point).
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+    >>> rom, (a, p, tot) = sized_bound(t, _Shape(6, 1, False, (10, 8), (6,), (8, 8)))
+    >>> len(rom), tot <= a + p, p < Fraction(1, 2 ** 8)
+    (4, True, True)
+    """
+    L, n, centered, F, T, G = shape
+    fc = table.coef_frac_bits
+    nseg = table.segment_count
+    k = np.arange(nseg << L, dtype=np.int64) if codes is None else codes
+    q = [[Fraction(v, 2 ** fc) for v in seg.integers] for seg in table.segments]
+    half = Fraction(1, 2) if centered else Fraction(0)
+    tint = (-half, 1 - half - _P2 ** -L)
+    rom = np.zeros((nseg, n + 1), dtype=object)
+    e = []
+    for s in range(nseg):
+        c = round(q[s][n] * _P2 ** F[n])
+        rom[s, n] = c
+        d = c * _P2 ** -F[n] - q[s][n]
+        e.append((d, d))
+    for st in sized_steps(shape):
+        j = st["j"]
+        rom_i = _int_rom(rom)
+        w = _run_sized(rom_i, k, shape, upto=j + 1) if j + 1 < n else {f"a{n}": rom_i[k >> L, n]}
+        a = w[f"a{j + 1}"].reshape(nseg, -1)
+        amin, amax = a.min(axis=1), a.max(axis=1)
+        tau = _P2 ** -T[j] - _P2 ** -L
+        pi = max(Fraction(0), _P2 ** -st["X"] - _P2 ** -st["pf"])
+        sigma = _P2 ** -G[j] - _P2 ** -st["X"]
+        ulp_a = _P2 ** -G[j + 1]
+        for s in range(nseg):
+            lo, hi = _imul(e[s], tint)
+            at = _imul((int(amin[s]) * ulp_a, int(amax[s]) * ulp_a), (Fraction(0), tau))
+            lo, hi = lo - at[1] - pi - sigma, hi - at[0]
+            c = round((q[s][j] - (lo + hi) / 2) * _P2 ** F[j])
+            rom[s, j] = c
+            d = c * _P2 ** -F[j] - q[s][j]
+            e[s] = (lo + d, hi + d)
+    if n == 0:  # y = c_0 shifted to G_0 bits: a truncation when F_0 > G_0
+        sigma = max(Fraction(0), _P2 ** -G[0] - _P2 ** -F[0])
+        for s in range(nseg):
+            c = round((q[s][0] + sigma / 2) * _P2 ** F[0])
+            rom[s, 0] = c
+            d = c * _P2 ** -F[0] - q[s][0]
+            e[s] = (d - sigma, d)
+    approx = [Fraction(seg.abs_error_bound) for seg in table.segments]
+    path = [max(-lo, hi) for lo, hi in e]
+    total = max(a_ + p_ for a_, p_ in zip(approx, path))
+    return [tuple(int(v) for v in row) for row in rom], (max(approx), max(path), total)
+
+
+def _int_rom(rom) -> np.ndarray:
+    """The ROM as int64 when every value fits (the model's fast path), else Python ints."""
+    vals = [int(v) for v in rom.ravel()]
+    if vals and max(abs(v) for v in vals) < 2 ** 40:
+        return np.array(vals, dtype=np.int64).reshape(rom.shape)
+    return np.array(vals, dtype=object).reshape(rom.shape)
+
+
+def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int) -> _Shape:
+    """``widths`` (a mapping with ``coef_frac``, ``t_keep``, ``acc_frac``) as a shape."""
+    if not isinstance(widths, dict) or set(widths) != {"coef_frac", "t_keep", "acc_frac"}:
+        raise ValueError("widths: expected None, 'auto' or a dict with keys coef_frac (n+1 "
+                         "values), t_keep (n values), acc_frac (n-1 values, for a_1..a_{n-1})")
+    F = tuple(check_width(v, "widths coef_frac", -8, 62) for v in widths["coef_frac"])
+    T = tuple(check_width(v, "widths t_keep", 1, L) for v in widths["t_keep"])
+    A = tuple(check_width(v, "widths acc_frac", -8, 62) for v in widths["acc_frac"])
+    if len(F) != n + 1 or len(T) != n or len(A) != max(n - 1, 0):
+        raise ValueError(f"widths: degree {n} needs {n + 1} coef_frac, {n} t_keep and "
+                         f"{max(n - 1, 0)} acc_frac values; got {len(F)}, {len(T)}, {len(A)}")
+    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()))
+
+
+def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDesign | None:
+    """The sized design of ``shape``, or None when y's range does not fit ``out_bits``."""
+    t = proto.table
+    rom, bound = sized_bound(t, shape)
+    rom_i = _int_rom(np.array(rom, dtype=object))
+    k = np.arange(2 ** proto.in_bits, dtype=np.int64)
+    w = _run_sized(rom_i, k, shape)
+    r = w["rounded"]
+    y_off = int(r.min())
+    if int(r.max()) - y_off > 2 ** proto.out_bits - 1:
+        return None
+    n, L = shape.n, shape.L
+    widths = []
+    for st in sized_steps(shape):
+        j = st["j"]
+        p, sm, a = w[f"p{j}"], w[f"s{j}"], w[f"a{j}"]
+        for key in ("p", "q", "s"):
+            v = w[f"{key}{j}"]
+            check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
+                        f"wire {key}{j} of the sized Horner datapath")
+        widths.append((max(signed_bits(int(p.min()), int(p.max())), 2),
+                       max(signed_bits(int(sm.min()), int(sm.max())), 2),
+                       max(signed_bits(int(a.min()), int(a.max())), 2)))
+    cols = np.array(rom, dtype=object).reshape(len(rom), n + 1)
+    rom_bits = tuple(max(signed_bits(int(min(cols[:, j])), int(max(cols[:, j]))), 2)
+                     for j in range(n + 1))
+    return replace(proto, acc_frac_bits=max(shape.G[1:n], default=shape.G[0]),
+                   y_format=QFormat(proto.out_bits, shape.G[0], offset_code=y_off),
+                   rom_bits=rom_bits, t_bits=max(shape.T, default=L) + 1,
+                   widths=tuple(widths), top_frac_bits=shape.G[0], rounding="trunc",
+                   coef_frac=shape.F, t_keep=shape.T, acc_frac=shape.G,
+                   coefficients=tuple(rom), cuts=tuple(cuts), bound=bound)
+
+
+def _meets(bound, max_error: Fraction, strict: bool) -> bool:
+    return bound[2] < max_error if strict else bound[2] <= max_error
+
+
+def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool) -> _Shape:
+    """Greedy widths: start generous (the table's ``Fc`` for every column, every
+    bit of ``t``, ``Fy + 8`` accumulator bits), then lower each width by one
+    while the certified bound still meets ``max_error`` -- highest order first
+    (``F_n .. F_1``, ``T_{n-1} .. T_0``, ``G_{n-1} .. G_1``, ``F_0``), twice over."""
+    t = proto.table
+    n, L, fc = t.degree, proto.local_bits, t.coef_frac_bits
+    F = [max(fc, fy + 2)] * (n + 1)
+    T = [L] * n
+    G = [fy] + [fy + 8] * (n - 1) + ([F[n]] if n > 0 else [])
+
+    def shape():
+        g = list(G)
+        if n > 0:
+            g[n] = F[n]
+        return _Shape(L, n, t.centered, tuple(F), tuple(T), tuple(g))
+
+    def ok():
+        return _meets(sized_bound(t, shape())[1], max_error, strict)
+
+    if not ok():
+        b = sized_bound(t, shape())[1]
+        raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
+                         f"(certified {float(b[2]):.6e}; approximation {float(b[0]):.6e}); "
+                         f"accepted: a table whose approximation bound leaves room for rounding")
+    order = ([(F, j, -8) for j in range(n, 0, -1)] + [(T, j, 1) for j in range(n - 1, -1, -1)]
+             + [(G, j, -8) for j in range(n - 1, 0, -1)] + [(F, 0, -8)])
+    for _ in range(2):
+        for vec, j, floor in order:
+            while vec[j] > floor:
+                vec[j] -= 1
+                if not ok():
+                    vec[j] += 1
+                    break
+    return shape()
+
+
+def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
+    if pipeline is None:
+        return ()
+    if pipeline == "full":
+        return tuple(range(n + 1))
+    if isinstance(pipeline, (str, bytes)) or not hasattr(pipeline, "__iter__"):
+        raise ValueError(f"pipeline: {pipeline!r}; accepted: None, 'full' or cut points in "
+                         f"0..{n} (0 after the ROM, i after the i-th multiply-add)")
+    cuts = sorted({check_width(c, "pipeline cut", 0, n) for c in pipeline})
+    return tuple(cuts)
+
+
 def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
-                     guard_bits: int = 2, name: str | None = None) -> PiecewiseDesign:
+                     guard_bits: int = 2, name: str | None = None, widths=None,
+                     max_error=None, pipeline=None) -> PiecewiseDesign:
     """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
 
     ``in_bits`` must exceed the table's index bits (the rest is the local
-    variable); the accumulators carry ``y_frac_bits + guard_bits`` fractional
-    bits. Raises ValueError naming the value and the accepted range.
+    variable). Raises ValueError naming the value and the accepted range.
+
+    Parameters
+    ----------
+    table : PiecewiseTable
+        A uniform table (its coefficients ``q_j / 2^Fc``).
+    in_bits, out_bits : int
+        Widths of the input code and of the output code.
+    guard_bits : int
+        ``widths=None`` only: the accumulators carry ``y_frac_bits +
+        guard_bits`` fractional bits, rounded to nearest after each step.
+    name : str, optional
+        Module name stem (default: the table's name).
+    widths : None, "auto" or dict
+        None (default, today's architecture): one ROM width for every
+        coefficient, an exact product and a rounding after each step.
+        Otherwise the *sized* architecture (:func:`sized_steps`): ROM column
+        ``j`` with its own ``F_j`` fractional bits, step ``j`` multiplying by
+        the top ``T_j`` bits of ``t``, products and sums truncated (floors;
+        the bias is paid in the ROM coefficients) to ``G_j`` accumulator
+        bits, the last one to y's. ``"auto"``: the greedy search of
+        :func:`_auto_shape` under ``max_error``; a dict ``{"coef_frac":
+        (F_0..F_n), "t_keep": (T_0..T_{n-1}), "acc_frac": (G_1..G_{n-1})}``
+        gives them. Every width change enters the certified bound
+        (:func:`sized_bound`).
+    max_error : float or str, optional
+        ``widths="auto"``: the certified total must be ``<= max_error``;
+        default: faithful, ``< 2^-Fy`` (one unit of y's last place).
+    pipeline : None, "full" or iterable of int
+        Sized architecture only: register cut points, ``0`` after the ROM
+        read, ``i`` after the ``i``-th multiply-add; ``"full"``: all
+        ``degree + 1``. ``latency`` is their number; the values are those of
+        the combinational datapath, ``latency`` cycles later.
 
     Examples
     --------
@@ -252,6 +603,11 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         y_off = int(r.min())
         if int(r.max()) - y_off <= 2 ** out_bits - 1:
             break
+    if widths is not None:
+        return _design_sized(proto, fy, widths, max_error, pipeline)
+    if pipeline is not None:
+        raise ValueError("pipeline: needs the sized architecture; accepted: widths='auto' or a "
+                         "widths dict with pipeline, or pipeline=None")
     for key, v in w.items():
         if key[0] in "psa" and key != "s":
             check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
@@ -269,6 +625,40 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     return PiecewiseDesign(name, table, in_bits, out_bits, L, fa,
                            QFormat(out_bits, fy, offset_code=y_off), rom_bits, L + 2,
                            tuple(widths), int(w["top_frac"]))
+
+
+def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline) -> PiecewiseDesign:
+    """:func:`design_piecewise` with ``widths`` given: y's fractional bits
+    lowered from the uniform design's ``fy`` until y's range fits."""
+    t = proto.table
+    n, L = t.degree, proto.local_bits
+    cuts = _check_cuts(pipeline, n)
+    if max_error is None:
+        limit, strict = None, True
+    else:
+        limit, strict = _error_limit(max_error), False
+    for f in range(fy, fy - 8, -1):
+        lim = Fraction(1, 2 ** f) if limit is None else limit
+        if widths == "auto":
+            shape = _auto_shape(proto, f, lim, strict)
+        else:
+            shape = _check_sized_widths(widths, n, L, t.centered, f)
+        d = _sized_design(proto, shape, cuts)
+        if d is not None:
+            return d
+    raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+
+
+def _error_limit(max_error) -> Fraction:
+    if isinstance(max_error, str):
+        v = parse_number(max_error)
+        if not v.is_Rational or v <= 0:
+            raise ValueError(f"max_error {max_error!r}: accepted a positive rational (2^-16, 1e-5)")
+        return Fraction(int(v.p), int(v.q))
+    if isinstance(max_error, bool) or not isinstance(max_error, (int, float, Fraction)) or \
+            not math.isfinite(max_error) or max_error <= 0:
+        raise ValueError(f"max_error {max_error!r}: accepted a positive finite number")
+    return Fraction(max_error)
 
 
 # -- HDL (printed by chebnorm.hw.hdl) ----------------------------------------------
