@@ -330,15 +330,6 @@ def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
     return w
 
 
-_P2 = Fraction(2)
-
-
-def _imul(a, b):
-    """Interval product of ``a = (lo, hi)`` and ``b = (lo, hi)`` (Fractions)."""
-    c = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
-    return min(c), max(c)
-
-
 def sized_bound(table: PiecewiseTable, shape, codes=None):
     """Choose the ROM and certify the sized datapath, segment by segment.
 
@@ -372,43 +363,51 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
     fc = table.coef_frac_bits
     nseg = table.segment_count
     k = np.arange(nseg << L, dtype=np.int64) if codes is None else codes
-    q = [[Fraction(v, 2 ** fc) for v in seg.integers] for seg in table.segments]
-    half = Fraction(1, 2) if centered else Fraction(0)
-    tint = (-half, 1 - half - _P2 ** -L)
+    # every interval end is an integer in units of 2^-D (D above every fractional
+    # width in play); products with t are rounded outward back to 2^-D (rigorous)
+    D = max([fc, L, *F, *G] + [G[j + 1] + T[j] for j in range(n)]) + 4
+    Q = [np.array([seg.integers[j] for seg in table.segments], dtype=object) << (D - fc)
+         for j in range(n + 1)]
+    tl = -(1 << (L - 1)) if centered else 0          # t's range in units of 2^-L
+    th = (1 << L) - 1 + tl
     rom = np.zeros((nseg, n + 1), dtype=object)
-    e = []
-    for s in range(nseg):
-        c = round(q[s][n] * _P2 ** F[n])
-        rom[s, n] = c
-        d = c * _P2 ** -F[n] - q[s][n]
-        e.append((d, d))
+
+    def nearest(v, sh):  # round(v / 2^sh), ties up; sh >= 1
+        return (v + (1 << (sh - 1))) >> sh
+
+    lo = hi = None
+    if n > 0:
+        rom[:, n] = nearest(Q[n], D - F[n])
+        lo = hi = (rom[:, n] << (D - F[n])) - Q[n]
     for st in sized_steps(shape):
         j = st["j"]
         rom_i = _int_rom(rom)
         w = _run_sized(rom_i, k, shape, upto=j + 1) if j + 1 < n else {f"a{n}": rom_i[k >> L, n]}
         a = w[f"a{j + 1}"].reshape(nseg, -1)
-        amin, amax = a.min(axis=1), a.max(axis=1)
-        tau = _P2 ** -T[j] - _P2 ** -L
-        pi = max(Fraction(0), _P2 ** -st["X"] - _P2 ** -st["pf"])
-        sigma = _P2 ** -G[j] - _P2 ** -st["X"]
-        ulp_a = _P2 ** -G[j + 1]
-        for s in range(nseg):
-            lo, hi = _imul(e[s], tint)
-            at = _imul((int(amin[s]) * ulp_a, int(amax[s]) * ulp_a), (Fraction(0), tau))
-            lo, hi = lo - at[1] - pi - sigma, hi - at[0]
-            c = round((q[s][j] - (lo + hi) / 2) * _P2 ** F[j])
-            rom[s, j] = c
-            d = c * _P2 ** -F[j] - q[s][j]
-            e[s] = (lo + d, hi + d)
+        amin, amax = a.min(axis=1).astype(object), a.max(axis=1).astype(object)
+        prods = (lo * tl, lo * th, hi * tl, hi * th)
+        plo = np.minimum(np.minimum(prods[0], prods[1]), np.minimum(prods[2], prods[3])) >> L
+        phi = -(-np.maximum(np.maximum(prods[0], prods[1]), np.maximum(prods[2], prods[3])) >> L)
+        taum = (1 << (L - T[j])) - 1                      # tau_j's top in units of 2^-L
+        at_lo, at_hi = np.minimum(amin * taum, 0), np.maximum(amax * taum, 0)
+        sh = D - G[j + 1] - L
+        if sh >= 0:
+            at_lo, at_hi = at_lo << sh, at_hi << sh
+        else:
+            at_lo, at_hi = at_lo >> -sh, -(-at_hi >> -sh)
+        pi = max(0, (1 << (D - st["X"])) - (1 << (D - st["pf"])))
+        sigma = (1 << (D - G[j])) - (1 << (D - st["X"]))
+        lo, hi = plo - at_hi - pi - sigma, phi - at_lo
+        rom[:, j] = nearest(2 * Q[j] - (lo + hi), D + 1 - F[j])
+        d = (rom[:, j] << (D - F[j])) - Q[j]
+        lo, hi = lo + d, hi + d
     if n == 0:  # y = c_0 shifted to G_0 bits: a truncation when F_0 > G_0
-        sigma = max(Fraction(0), _P2 ** -G[0] - _P2 ** -F[0])
-        for s in range(nseg):
-            c = round((q[s][0] + sigma / 2) * _P2 ** F[0])
-            rom[s, 0] = c
-            d = c * _P2 ** -F[0] - q[s][0]
-            e[s] = (d - sigma, d)
+        sigma = max(0, (1 << (D - G[0])) - (1 << (D - F[0])))
+        rom[:, 0] = nearest(Q[0] + sigma // 2, D - F[0])
+        d = (rom[:, 0] << (D - F[0])) - Q[0]
+        lo, hi = d - sigma, d
     approx = [Fraction(seg.abs_error_bound) for seg in table.segments]
-    path = [max(-lo, hi) for lo, hi in e]
+    path = [Fraction(max(-int(x), int(y)), 2 ** D) for x, y in zip(lo, hi)]
     total = max(a_ + p_ for a_, p_ in zip(approx, path))
     return [tuple(int(v) for v in row) for row in rom], (max(approx), max(path), total)
 
@@ -473,41 +472,78 @@ def _meets(bound, max_error: Fraction, strict: bool) -> bool:
     return bound[2] < max_error if strict else bound[2] <= max_error
 
 
+#: the greedy's area proxy: Yosys cells per ROM bit (as hw.piecewise_search's model)
+_ROM_WEIGHT = 0.15
+
+
+def shape_cost(table: PiecewiseTable, shape, rom) -> float:
+    """Area proxy of a sized datapath with ROM ``rom`` (:func:`sized_bound`):
+    ROM bits x 0.15 plus ``a x b`` per ``a x b`` multiplier plus each sum's
+    width, the widths from the exact wire ranges over all codes (one model run).
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+    >>> sh = _Shape(6, 1, False, (10, 8), (6,), (8, 8))
+    >>> shape_cost(t, sh, sized_bound(t, sh)[0]) > 0
+    True
+    """
+    L, n = shape.L, shape.n
+    rom_i = _int_rom(np.array(rom, dtype=object))
+    w = _run_sized(rom_i, np.arange(table.segment_count << L, dtype=np.int64), shape)
+
+    def bits(v) -> int:
+        return signed_bits(int(v.min()), int(v.max()))
+
+    cost = _ROM_WEIGHT * len(rom) * sum(bits(rom_i[:, j]) for j in range(n + 1))
+    for st in sized_steps(shape):
+        j = st["j"]
+        cost += bits(w[f"a{j + 1}"]) * bits(w[f"t{j}"]) + bits(w[f"s{j}"])
+    return float(cost)
+
+
 def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool) -> _Shape:
     """Greedy widths: start generous (the table's ``Fc`` for every column, every
-    bit of ``t``, ``Fy + 8`` accumulator bits), then lower each width by one
-    while the certified bound still meets ``max_error`` -- highest order first
-    (``F_n .. F_1``, ``T_{n-1} .. T_0``, ``G_{n-1} .. G_1``, ``F_0``), twice over."""
+    bit of ``t``, ``Fy + 8`` accumulator bits); then, round after round, try
+    each width one bit lower and keep the change that saves most area
+    (:func:`shape_cost`; ties: the highest-order width first) among those
+    whose certified bound still meets ``max_error``, until none does."""
     t = proto.table
     n, L, fc = t.degree, proto.local_bits, t.coef_frac_bits
-    F = [max(fc, fy + 2)] * (n + 1)
-    T = [L] * n
-    G = [fy] + [fy + 8] * (n - 1) + ([F[n]] if n > 0 else [])
+    start = {("F", j): max(fc, fy + 2) for j in range(n + 1)}
+    start.update({("T", j): L for j in range(n)})
+    start.update({("G", j): fy + 8 for j in range(1, n)})
+    floors = {"F": -8, "T": 1, "G": -8}
 
-    def shape():
-        g = list(G)
-        if n > 0:
-            g[n] = F[n]
-        return _Shape(L, n, t.centered, tuple(F), tuple(T), tuple(g))
+    def shape(v):
+        F = tuple(v["F", j] for j in range(n + 1))
+        G = (fy,) + tuple(v["G", j] for j in range(1, n)) + ((F[n],) if n > 0 else ())
+        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G)
 
-    def ok():
-        return _meets(sized_bound(t, shape())[1], max_error, strict)
-
-    if not ok():
-        b = sized_bound(t, shape())[1]
+    cur = dict(start)
+    rom, b = sized_bound(t, shape(cur))
+    if not _meets(b, max_error, strict):
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
                          f"(certified {float(b[2]):.6e}; approximation {float(b[0]):.6e}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
-    order = ([(F, j, -8) for j in range(n, 0, -1)] + [(T, j, 1) for j in range(n - 1, -1, -1)]
-             + [(G, j, -8) for j in range(n - 1, 0, -1)] + [(F, 0, -8)])
-    for _ in range(2):
-        for vec, j, floor in order:
-            while vec[j] > floor:
-                vec[j] -= 1
-                if not ok():
-                    vec[j] += 1
-                    break
-    return shape()
+    cost = shape_cost(t, shape(cur), rom)
+    # highest order first: F_n .. F_0, then T_{n-1} .. T_0, then G_{n-1} .. G_1
+    order = sorted(cur, key=lambda key: ("FTG".index(key[0]), -key[1]))
+    while True:
+        best = None
+        for key in order:
+            if cur[key] <= floors[key[0]]:
+                continue
+            trial = dict(cur)
+            trial[key] -= 1
+            rom, b = sized_bound(t, shape(trial))
+            if not _meets(b, max_error, strict):
+                continue
+            c = shape_cost(t, shape(trial), rom)
+            if best is None or c < best[0]:
+                best = (c, trial)
+        if best is None:
+            return shape(cur)
+        cost, cur = best
 
 
 def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
