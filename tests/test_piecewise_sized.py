@@ -27,7 +27,7 @@ def _datapath_error(d) -> list[Fraction]:
     """Exact max over each segment's codes of |y - p_s(t)|, p_s the table's polynomial
     in exact rationals -- computed independently of the interval analysis."""
     t = d.table
-    L, n = d.local_bits, t.degree
+    L = d.local_bits
     y = d.evaluate()
     worst = [Fraction(0)] * t.segment_count
     for k in range(2 ** d.in_bits):

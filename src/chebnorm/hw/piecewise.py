@@ -286,8 +286,9 @@ def sized_steps(shape) -> list[dict]:
     every shift a floor (drops bits, no rounding adder); the bias is paid for
     in the coefficients (:func:`sized_bound` centres each segment's error).
 
-    >>> sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]["pshift"]
-    2
+    >>> st = sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]
+    >>> st["pf"], st["X"], st["pshift"], st["cshift"], st["ashift"]   # pf = G_1 + T_0
+    (11, 10, 1, 0, 1)
     """
     L, n, _, F, T, G = shape
     out = []

@@ -462,7 +462,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=16, name="rs")
-    >>> d = design_piecewise(t, 8, 8, widths="auto", pipeline="full")
+    >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline="full")
     >>> v = sized_piecewise_verilog(d)
     >>> v.count("always @(posedge clk)"), "parameter LATENCY = 3" in v
     (3, True)
@@ -560,7 +560,7 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
-    >>> d = design_piecewise(t, 8, 8, widths="auto", pipeline=(0,))
+    >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline=(0,))
     >>> piecewise_clocked_testbench(d).splitlines()[0]
     '// tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs, latency 1.'
     """

@@ -508,7 +508,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=16, name="rs")
-    >>> v = sized_piecewise_vhdl(design_piecewise(t, 8, 8, widths="auto", pipeline=(0, 2)))
+    >>> v = sized_piecewise_vhdl(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline=(0, 2)))
     >>> v.count("rising_edge(clk)"), "LATENCY  : natural := 2" in v
     (2, True)
     """
@@ -607,7 +607,7 @@ def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
-    >>> d = design_piecewise(t, 8, 8, widths="auto", pipeline="full")
+    >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline="full")
     >>> [ln.strip() for ln in piecewise_vhdl_clocked_testbench(d).splitlines() if "LATENCY  :" in ln]
     ['constant LATENCY  : natural := 2;']
     """
