@@ -40,6 +40,7 @@ def _datapath_error(d) -> list[Fraction]:
     return worst
 
 
+@pytest.mark.parametrize("multipliers", ["full", "truncated"])
 @pytest.mark.parametrize("expr, interval, degree, segments, centered, in_bits, out_bits", [
     ("1/sqrt(x)", ("1", "4"), 2, 8, False, 10, 10),
     ("1/sqrt(x)", ("1", "4"), 3, 4, True, 10, 12),
@@ -48,15 +49,17 @@ def _datapath_error(d) -> list[Fraction]:
     ("exp(x)", ("0", "1"), 0, 64, False, 8, 8),
 ])
 def test_datapath_bound_covers_exact_error(expr, interval, degree, segments, centered,
-                                           in_bits, out_bits):
+                                           in_bits, out_bits, multipliers):
     """The per-segment interval bound of the truncated datapath encloses the exact
     error against the table's polynomial on every code; the total covers |y - f|."""
     t = _table(expr, interval, degree, segments, centered=centered)
     approx = max(s.abs_error_bound for s in t.segments)
     limit = approx + 2 ** -(out_bits - 2)
-    d = design_piecewise(t, in_bits, out_bits, widths="auto", max_error=limit)
+    d = design_piecewise(t, in_bits, out_bits, widths="auto", max_error=limit,
+                         multipliers=multipliers)
+    assert d.multipliers == multipliers
     _, (_, path, total) = sized_bound(t, (d.local_bits, degree, centered, d.coef_frac,
-                                          d.t_keep, d.acc_frac))
+                                          d.t_keep, d.acc_frac, multipliers == "truncated"))
     exact = _datapath_error(d)
     assert max(exact) <= path
     assert d.measure()["max_error"] <= d.budget()["total"] <= limit
@@ -116,6 +119,8 @@ def test_pipeline_does_not_change_values():
     (dict(widths="auto", max_error=1e-3, pipeline=(4,)), "pipeline cut"),
     (dict(widths="auto", max_error=1e-3, pipeline="all"), "pipeline"),
     (dict(pipeline="full"), "pipeline"),
+    (dict(multipliers="truncated"), "multipliers"),
+    (dict(widths="auto", max_error=1e-3, multipliers="booth"), "multipliers"),
 ])
 def test_bad_input(kwargs, match):
     t = _table("1/sqrt(x)", ("1", "4"), 2, 4)
@@ -136,21 +141,26 @@ _HAVE = {"verilog": shutil.which("iverilog") is not None, "vhdl": shutil.which("
 
 
 @pytest.mark.parametrize("language", ["verilog", "vhdl"])
-@pytest.mark.parametrize("expr, interval, degree, segments, centered, pipeline", [
-    ("1/sqrt(x)", ("1", "4"), 2, 8, False, None),
-    ("1/sqrt(x)", ("1", "4"), 3, 4, True, (0, 2)),
-    ("exp(x)", ("0", "1"), 1, 1, False, "full"),
-    ("exp(x)", ("0", "1"), 0, 64, False, (0,)),
-    ("sin(x)", ("-1", "1"), 2, 16, True, (2,)),
+@pytest.mark.parametrize("expr, interval, degree, segments, centered, pipeline, multipliers", [
+    ("1/sqrt(x)", ("1", "4"), 2, 8, False, None, "full"),
+    ("1/sqrt(x)", ("1", "4"), 2, 8, False, None, "truncated"),
+    ("1/sqrt(x)", ("1", "4"), 3, 4, True, (0, 2), "full"),
+    ("1/sqrt(x)", ("1", "4"), 3, 4, True, (1,), "truncated"),
+    ("exp(x)", ("0", "1"), 1, 1, False, "full", "full"),
+    ("exp(x)", ("0", "1"), 0, 64, False, (0,), "full"),
+    ("sin(x)", ("-1", "1"), 2, 16, True, (2,), "full"),
+    ("sin(x)", ("-1", "1"), 2, 16, True, "full", "truncated"),
 ])
 def test_hdl_bit_exact_small(tmp_path, language, expr, interval, degree, segments, centered,
-                             pipeline):
+                             pipeline, multipliers):
     if not _HAVE[language]:
         pytest.skip(f"{language} simulator not installed")
     t = _table(expr, interval, degree, segments, centered=centered)
     approx = max(s.abs_error_bound for s in t.segments)
     d = design_piecewise(t, 10, 10, widths="auto", max_error=approx + 2 ** -9,
-                         pipeline=pipeline)
+                         pipeline=pipeline, multipliers=multipliers)
+    if multipliers == "truncated":  # the truncated multiplier is really printed
+        assert any(st["rows"] for st in d.sized_signals())
     sim = _simulate(d, tmp_path, language)
     assert sim.passed and sim.vectors == 1024 and sim.mismatches == 0, sim.line
 

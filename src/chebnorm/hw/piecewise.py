@@ -107,6 +107,8 @@ class PiecewiseDesign:
     acc_frac: tuple[int, ...] = ()       # G_j, j = 0..n: fractional bits of a_j (G_0 = y's)
     coefficients: tuple[tuple[int, ...], ...] = ()   # per segment, c_j / 2^F_j
     cuts: tuple[int, ...] = ()           # pipeline registers: 0 after the ROM, i after step i
+    multipliers: str = "full"            # "truncated": partial-product columns below X dropped
+    q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
     bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
 
     @property
@@ -139,7 +141,8 @@ class PiecewiseDesign:
         for st, (pw, sw, ow) in zip(sized_steps(_shape(self)), self.widths):
             T = self.t_keep[st["j"]]
             ps = st["pshift"]
-            qw = max(pw - ps, 2) if ps >= 0 else pw - ps
+            qw = self.q_bits[len(out)] if self.q_bits else (
+                max(pw - ps, 2) if ps >= 0 else pw - ps)
             out.append(dict(st, T=T, tw=T if self.table.centered else T + 1, pw=pw, qw=qw,
                             sw=sw, aw=ow))
         return out
@@ -268,10 +271,12 @@ class _Shape(NamedTuple):
     F: tuple[int, ...]
     T: tuple[int, ...]
     G: tuple[int, ...]
+    truncated: bool = False   # truncated multipliers: partial-product columns dropped
 
 
 def _shape(d: PiecewiseDesign) -> _Shape:
-    return _Shape(d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac)
+    return _Shape(d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac,
+                  d.multipliers == "truncated")
 
 
 def sized_steps(shape) -> list[dict]:
@@ -290,14 +295,34 @@ def sized_steps(shape) -> list[dict]:
     >>> st["pf"], st["X"], st["pshift"], st["cshift"], st["ashift"]   # pf = G_1 + T_0
     (11, 10, 1, 0, 1)
     """
-    L, n, _, F, T, G = shape
+    L, n, _, F, T, G = shape[:6]
     out = []
     for j in range(n - 1, -1, -1):
         pf = G[j + 1] + T[j]
         X = max(G[j], F[j])
-        out.append({"j": j, "tshift": L - T[j], "pf": pf, "X": X, "pshift": pf - X,
-                    "cshift": X - F[j], "ashift": X - G[j]})
+        st = {"j": j, "tshift": L - T[j], "pf": pf, "X": X, "pshift": pf - X,
+              "cshift": X - F[j], "ashift": X - G[j], "rows": ()}
+        if len(shape) > 6 and shape[6] and pf > X:
+            # row i of the multiplier: bit i of t's code times a_{j+1} * 2^i, every bit
+            # below column X dropped (a floor: a >> (pshift - i)); centred, the top row
+            # is -a_{j+1} * 2^(T-1) gated by the inverted top bit (t = code - 2^(T-1))
+            st["rows"] = tuple((i, pf - X - i, bool(shape[2]) and i == T[j] - 1)
+                               for i in range(T[j]))
+        out.append(st)
     return out
+
+
+def truncated_product(a, bits, rows):
+    """``sum_i bit_i * floor(+-a * 2^-shift_i)`` over ``rows = (i, shift, negated)``:
+    the truncated multiplier (``bits(i)`` gives row i's enabling bit, 0 or 1).
+
+    >>> truncated_product(7, lambda i: 1, ((0, 2, False), (1, 1, False)))   # 7>>2 + 7>>1
+    4
+    """
+    q = 0
+    for i, sh, neg in rows:
+        q = q + bits(i) * _shift(-a if neg else a, sh)
+    return q
 
 
 def _shift(v, sh: int):
@@ -307,7 +332,7 @@ def _shift(v, sh: int):
 def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
     """Wires of the sized datapath for codes ``k`` (ROM ``rom[segment, j]``);
     ``upto``: stop after the step computing ``a_upto``."""
-    L, n, centered, F, T, G = shape
+    L, n, centered, F, T, G = shape[:6]
     s = k >> L
     low = k & ((1 << L) - 1)
     acc = rom[s, n]
@@ -318,7 +343,17 @@ def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
         if centered:
             tj = tj - (1 << (T[j] - 1))
         p = acc * tj
-        q = _shift(p, st["pshift"])
+        if st["rows"]:
+            code = low >> st["tshift"]
+            top = T[j] - 1
+
+            def bit(i, code=code, top=top):
+                b = (code >> i) & 1
+                return 1 - b if centered and i == top else b
+
+            q = truncated_product(acc, bit, st["rows"])
+        else:
+            q = _shift(p, st["pshift"])
         sm = q + (rom[s, j] << st["cshift"])
         acc = sm >> st["ashift"]
         w.update({f"t{j}": tj, f"p{j}": p, f"q{j}": q, f"s{j}": sm, f"a{j}": acc})
@@ -360,7 +395,7 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
     >>> len(rom), tot <= a + p, p < Fraction(1, 2 ** 8)
     (4, True, True)
     """
-    L, n, centered, F, T, G = shape
+    L, n, centered, F, T, G = shape[:6]
     fc = table.coef_frac_bits
     nseg = table.segment_count
     k = np.arange(nseg << L, dtype=np.int64) if codes is None else codes
@@ -396,7 +431,11 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
             at_lo, at_hi = at_lo << sh, at_hi << sh
         else:
             at_lo, at_hi = at_lo >> -sh, -(-at_hi >> -sh)
-        pi = max(0, (1 << (D - st["X"])) - (1 << (D - st["pf"])))
+        if st["rows"]:  # each truncated row floors: error in (-(1 - 2^-shift), 0] ulps of X
+            pi = sum((1 << (D - st["X"])) - (1 << (D - st["X"] - sh))
+                     for _, sh, _ in st["rows"] if sh > 0)
+        else:
+            pi = max(0, (1 << (D - st["X"])) - (1 << (D - st["pf"])))
         sigma = (1 << (D - G[j])) - (1 << (D - st["X"]))
         lo, hi = plo - at_hi - pi - sigma, phi - at_lo
         rom[:, j] = nearest(2 * Q[j] - (lo + hi), D + 1 - F[j])
@@ -421,7 +460,8 @@ def _int_rom(rom) -> np.ndarray:
     return np.array(vals, dtype=object).reshape(rom.shape)
 
 
-def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int) -> _Shape:
+def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int,
+                        truncated: bool = False) -> _Shape:
     """``widths`` (a mapping with ``coef_frac``, ``t_keep``, ``acc_frac``) as a shape."""
     if not isinstance(widths, dict) or set(widths) != {"coef_frac", "t_keep", "acc_frac"}:
         raise ValueError("widths: expected None, 'auto' or a dict with keys coef_frac (n+1 "
@@ -432,7 +472,7 @@ def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int) -> _Sha
     if len(F) != n + 1 or len(T) != n or len(A) != max(n - 1, 0):
         raise ValueError(f"widths: degree {n} needs {n + 1} coef_frac, {n} t_keep and "
                          f"{max(n - 1, 0)} acc_frac values; got {len(F)}, {len(T)}, {len(A)}")
-    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()))
+    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()), truncated)
 
 
 def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDesign | None:
@@ -447,10 +487,11 @@ def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDe
     if int(r.max()) - y_off > 2 ** proto.out_bits - 1:
         return None
     n, L = shape.n, shape.L
-    widths = []
+    widths, q_bits = [], []
     for st in sized_steps(shape):
         j = st["j"]
         p, sm, a = w[f"p{j}"], w[f"s{j}"], w[f"a{j}"]
+        q_bits.append(max(signed_bits(int(w[f"q{j}"].min()), int(w[f"q{j}"].max())), 2))
         for key in ("p", "q", "s"):
             v = w[f"{key}{j}"]
             check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
@@ -466,7 +507,9 @@ def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDe
                    rom_bits=rom_bits, t_bits=max(shape.T, default=L) + 1,
                    widths=tuple(widths), top_frac_bits=shape.G[0], rounding="trunc",
                    coef_frac=shape.F, t_keep=shape.T, acc_frac=shape.G,
-                   coefficients=tuple(rom), cuts=tuple(cuts), bound=bound)
+                   coefficients=tuple(rom), cuts=tuple(cuts), bound=bound,
+                   multipliers="truncated" if len(shape) > 6 and shape[6] else "full",
+                   q_bits=tuple(q_bits))
 
 
 def _meets(bound, max_error: Fraction, strict: bool) -> bool:
@@ -498,16 +541,22 @@ def shape_cost(table: PiecewiseTable, shape, rom) -> float:
     cost = _ROM_WEIGHT * len(rom) * sum(bits(rom_i[:, j]) for j in range(n + 1))
     for st in sized_steps(shape):
         j = st["j"]
-        cost += bits(w[f"a{j + 1}"]) * bits(w[f"t{j}"]) + bits(w[f"s{j}"])
+        aw = bits(w[f"a{j + 1}"])
+        mul = (sum(max(aw - sh, 1) for _, sh, _ in st["rows"]) if st["rows"]
+               else aw * bits(w[f"t{j}"]))
+        cost += mul + bits(w[f"s{j}"])
     return float(cost)
 
 
-def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool) -> _Shape:
+def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool,
+                truncated: bool = False) -> _Shape:
     """Greedy widths: start generous (the table's ``Fc`` for every column, every
     bit of ``t``, ``Fy + 8`` accumulator bits); then, round after round, try
-    each width one bit lower and keep the change that saves most area
-    (:func:`shape_cost`; ties: the highest-order width first) among those
-    whose certified bound still meets ``max_error``, until none does."""
+    each width one bit lower and keep, among the changes whose certified bound
+    still meets ``max_error``, the one that saves the most area
+    (:func:`shape_cost`) per unit of error budget it spends (a change that
+    saves nothing only when no other is left; ties: the highest-order width
+    first), until none is left."""
     t = proto.table
     n, L, fc = t.degree, proto.local_bits, t.coef_frac_bits
     start = {("F", j): max(fc, fy + 2) for j in range(n + 1)}
@@ -518,7 +567,7 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     def shape(v):
         F = tuple(v["F", j] for j in range(n + 1))
         G = (fy,) + tuple(v["G", j] for j in range(1, n)) + ((F[n],) if n > 0 else ())
-        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G)
+        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G, truncated)
 
     cur = dict(start)
     rom, b = sized_bound(t, shape(cur))
@@ -526,7 +575,7 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
                          f"(certified {float(b[2]):.6e}; approximation {float(b[0]):.6e}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
-    cost = shape_cost(t, shape(cur), rom)
+    cost, bound = shape_cost(t, shape(cur), rom), b[2]
     # highest order first: F_n .. F_0, then T_{n-1} .. T_0, then G_{n-1} .. G_1
     order = sorted(cur, key=lambda key: ("FTG".index(key[0]), -key[1]))
     while True:
@@ -540,11 +589,15 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
             if not _meets(b, max_error, strict):
                 continue
             c = shape_cost(t, shape(trial), rom)
-            if best is None or c < best[0]:
-                best = (c, trial)
+            # area saved per unit of the error budget spent (free moves last)
+            saved, spent = cost - c, b[2] - bound
+            score = (saved > 0, saved / spent if spent > 0 else math.inf) if saved > 0 \
+                else (False, -spent)
+            if best is None or score > best[0]:
+                best = (score, c, b[2], trial)
         if best is None:
             return shape(cur)
-        cost, cur = best
+        _, cost, bound, cur = best
 
 
 def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
@@ -561,7 +614,7 @@ def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
 
 def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                      guard_bits: int = 2, name: str | None = None, widths=None,
-                     max_error=None, pipeline=None) -> PiecewiseDesign:
+                     max_error=None, pipeline=None, multipliers: str = "full") -> PiecewiseDesign:
     """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
 
     ``in_bits`` must exceed the table's index bits (the rest is the local
@@ -598,6 +651,11 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         read, ``i`` after the ``i``-th multiply-add; ``"full"``: all
         ``degree + 1``. ``latency`` is their number; the values are those of
         the combinational datapath, ``latency`` cycles later.
+    multipliers : "full" or "truncated"
+        Sized architecture only: ``"full"`` multiplies exactly and then drops
+        the product's bits below ``X_j``; ``"truncated"`` never forms them:
+        each partial-product row is floored at column ``X_j``
+        (:func:`truncated_product`), the rows' errors enter the bound.
 
     Examples
     --------
@@ -641,10 +699,12 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         if int(r.max()) - y_off <= 2 ** out_bits - 1:
             break
     if widths is not None:
-        return _design_sized(proto, fy, widths, max_error, pipeline)
-    if pipeline is not None:
-        raise ValueError("pipeline: needs the sized architecture; accepted: widths='auto' or a "
-                         "widths dict with pipeline, or pipeline=None")
+        if multipliers not in ("full", "truncated"):
+            raise ValueError(f"multipliers {multipliers!r}; accepted: 'full', 'truncated'")
+        return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated")
+    if pipeline is not None or multipliers != "full":
+        raise ValueError("pipeline, multipliers: need the sized architecture; accepted: "
+                         "widths='auto' or a widths dict with them, or their defaults")
     for key, v in w.items():
         if key[0] in "psa" and key != "s":
             check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
@@ -664,7 +724,8 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                            tuple(widths), int(w["top_frac"]))
 
 
-def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline) -> PiecewiseDesign:
+def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
+                  truncated: bool = False) -> PiecewiseDesign:
     """:func:`design_piecewise` with ``widths`` given: y's fractional bits
     lowered from the uniform design's ``fy`` until y's range fits."""
     t = proto.table
@@ -677,9 +738,9 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline) 
     for f in range(fy, fy - 8, -1):
         lim = Fraction(1, 2 ** f) if limit is None else limit
         if widths == "auto":
-            shape = _auto_shape(proto, f, lim, strict)
+            shape = _auto_shape(proto, f, lim, strict, truncated)
         else:
-            shape = _check_sized_widths(widths, n, L, t.centered, f)
+            shape = _check_sized_widths(widths, n, L, t.centered, f, truncated)
         d = _sized_design(proto, shape, cuts)
         if d is not None:
             return d

@@ -499,7 +499,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     # live signals: name -> (width, signed); registered at each cut point
     live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
     cur = {k: k for k in live}
-    acc = f"c{n}"
+    acc, accw = f"c{n}", d.rom_bits[n]
 
     def cut(stage: int) -> None:
         regs = []
@@ -522,10 +522,13 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
             out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = {bits};")
         else:
             out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = $signed({{1'b0, {lo}[{L - 1}:{L - T}]}});")
-        out.append(f"    wire signed [{st['pw'] - 1}:0] p{j} = {cur[acc]} * t{j};")
-        ps = st["pshift"]
-        shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
-        out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
+        if st["rows"]:
+            out += _truncated_rows(st, cur[acc], accw, lo)
+        else:
+            out.append(f"    wire signed [{st['pw'] - 1}:0] p{j} = {cur[acc]} * t{j};")
+            ps = st["pshift"]
+            shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
+            out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
         cs = f" <<< {st['cshift']}" if st["cshift"] else ""
         out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = q{j} + ({cur[f'c{j}']}{cs});")
         ash = f" >>> {st['ashift']}" if st["ashift"] else ""
@@ -533,7 +536,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
         del live[f"c{j}"], cur[f"c{j}"]
         live.pop(acc, None)
         cur.pop(acc, None)
-        acc = f"a{j}"
+        acc, accw = f"a{j}", st["aw"]
         live[acc], cur[acc] = (st["aw"], True), acc
         if j == 0:
             del live["low"]
@@ -550,6 +553,26 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     out += saturating_output(cur[acc], top_bits, d.y_format.frac_bits, d.y_format, d.out_bits,
                              "trunc")
     return "\n".join(out)
+
+
+def _truncated_rows(st: dict, a: str, aw: int, low: str) -> list[str]:
+    """The truncated multiplier ``q_j`` of a sized step: one row per bit of
+    ``t_j``'s code, ``a`` floored at column ``X`` (an arithmetic shift), gated by
+    the bit (the inverted top bit, negated row, when ``t`` is centred), all
+    rows added modulo ``2^qw`` (the exact sum fits ``qw`` bits)."""
+    j, qw = st["j"], st["qw"]
+    out, terms = [], []
+    if any(neg for _, _, neg in st["rows"]):
+        out.append(f"    wire signed [{aw}:0] na{j} = -{a};")
+    for i, sh, neg in st["rows"]:
+        src = f"na{j}" if neg else a
+        expr = f"{src} >>> {sh}" if sh > 0 else (f"{src} <<< {-sh}" if sh < 0 else src)
+        bit = f"{low}[{st['tshift'] + i}]"
+        out += [f"    wire signed [{qw - 1}:0] r{j}_{i} = {expr};",
+                f"    wire [{qw - 1}:0] m{j}_{i} = r{j}_{i} & {{{qw}{{{'~' if neg else ''}{bit}}}}};"]
+        terms.append(f"m{j}_{i}")
+    out.append(f"    wire signed [{qw - 1}:0] q{j} = {' + '.join(terms)};")
+    return out
 
 
 def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:

@@ -535,7 +535,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
             b.wire(f"c{j}", w, f"ROM{j}(to_integer(idx))")
     live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
     cur = {k: k for k in live}
-    acc = f"c{n}"
+    acc, accw = f"c{n}", d.rom_bits[n]
 
     def cut(stage: int) -> None:
         regs = []
@@ -561,9 +561,12 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
         else:
             b.wire(f"t{j}", tw, f"signed(\"0\" & {lo}({L - 1} downto {L - T}))")
         pw, qw, sw, aw = st["pw"], st["qw"], st["sw"], st["aw"]
-        b.wire(f"p{j}", pw, f"wrap({cur[acc]} * t{j}, {pw})")
         ps = st["pshift"]
-        if ps > 0:
+        if not st["rows"]:
+            b.wire(f"p{j}", pw, f"wrap({cur[acc]} * t{j}, {pw})")
+        if st["rows"]:
+            _truncated_rows(b, st, cur[acc], accw, lo)
+        elif ps > 0:
             b.wire(f"q{j}", qw, f"wrap(shift_right(p{j}, {ps}), {qw})")
         elif ps < 0:
             b.wire(f"q{j}", qw, f"shift_left(wrap(p{j}, {qw}), {-ps})")
@@ -578,7 +581,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
         del live[f"c{j}"], cur[f"c{j}"]
         live.pop(acc, None)
         cur.pop(acc, None)
-        acc = f"a{j}"
+        acc, accw = f"a{j}", aw
         live[acc], cur[acc] = (aw, True), acc
         if j == 0:
             del live["low"]
@@ -597,6 +600,31 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
             "end architecture rtl;", ""]
     return "\n".join(out)
+
+
+def _truncated_rows(b: _Body, st: dict, a: str, aw: int, low: str) -> None:
+    """The truncated multiplier ``q_j``, as the Verilog printer writes it: one
+    row per bit of ``t_j``'s code, floored at column ``X``, gated, summed
+    modulo ``2^qw``."""
+    j, qw = st["j"], st["qw"]
+    if any(neg for _, _, neg in st["rows"]):
+        b.wire(f"na{j}", aw + 1, f"-wrap({a}, {aw + 1})")
+    terms = []
+    for i, sh, neg in st["rows"]:
+        src = f"na{j}" if neg else a
+        sw = max(aw + 1 if neg else aw, qw)
+        if sh > 0:
+            expr = f"wrap(shift_right(wrap({src}, {sw}), {sh}), {qw})"
+        elif sh < 0:
+            expr = f"shift_left(wrap({src}, {qw}), {-sh})"
+        else:
+            expr = f"wrap({src}, {qw})"
+        b.wire(f"r{j}_{i}", qw, expr)
+        bit = f"{low}({st['tshift'] + i})"
+        on = "'0'" if neg else "'1'"
+        b.wire(f"m{j}_{i}", qw, f"r{j}_{i} when {bit} = {on} else (others => '0')")
+        terms.append(f"m{j}_{i}")
+    b.wire(f"q{j}", qw, " + ".join(terms))
 
 
 def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
