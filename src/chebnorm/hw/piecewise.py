@@ -20,6 +20,22 @@ against ``f(x)`` is bounded by the table's certified bound plus
 ``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
 compares it, code by code and in 40-digit arithmetic, with ``f``.
 
+The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``,
+issue 28) gives every ROM column its own fractional bits ``F_j`` (the
+coefficients re-rounded from the table's ``Fc``), multiplies step ``j`` by
+the top ``T_j`` bits of ``t`` only, and truncates (floors) products and sums
+to ``G_j`` fractional bits -- with ``multipliers="truncated"`` the
+partial-product columns below the kept ones are never formed. No rounding
+adder anywhere: each segment's ROM coefficients are chosen to centre that
+segment's error interval (the truncations' bias is paid in the ROM).
+:func:`sized_bound` certifies it per segment in exact integer interval
+arithmetic; ``widths="auto"`` lowers the widths greedily while the certified
+total meets ``max_error`` (default: faithful). ``pipeline=`` puts registers
+after the ROM and after chosen multiply-adds (``latency`` cycles, one result
+per cycle); Verilog and VHDL of every variant are bit-identical to
+:meth:`PiecewiseDesign.evaluate`. ``widths=None`` (the default) keeps the
+one-width design and its outputs unchanged.
+
 >>> from chebnorm.approx.piecewise_fit import piecewise_fit
 >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
 >>> d = design_piecewise(t, 8, 8)
@@ -61,7 +77,11 @@ __all__ = [
     "piecewise_outputs",
     "piecewise_testbench",
     "piecewise_verilog",
+    "shape_cost",
     "simulate_piecewise",
+    "sized_bound",
+    "sized_steps",
+    "truncated_product",
 ]
 
 MAX_PW_IN_BITS = 20
@@ -550,8 +570,10 @@ def shape_cost(table: PiecewiseTable, shape, rom) -> float:
 
 def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool,
                 truncated: bool = False) -> _Shape:
-    """Greedy widths: start generous (the table's ``Fc`` for every column, every
-    bit of ``t``, ``Fy + 8`` accumulator bits); then, round after round, try
+    """Greedy widths: start from ``Fy + 6`` fractional bits for every column and
+    accumulator and every bit of ``t`` (or, when that misses ``max_error``,
+    generous: the table's ``Fc`` for every column, ``Fy + 8`` accumulator
+    bits); then, round after round, try
     each width one bit lower and keep, among the changes whose certified bound
     still meets ``max_error``, the one that saves the most area
     (:func:`shape_cost`) per unit of error budget it spends (a change that
@@ -569,8 +591,13 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
         G = (fy,) + tuple(v["G", j] for j in range(1, n)) + ((F[n],) if n > 0 else ())
         return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G, truncated)
 
-    cur = dict(start)
+    # a moderate start (6 guard bits everywhere) saves most of the walk down when it meets
+    moderate = {key: (min(v, fy + 6) if key[0] in "FG" else v) for key, v in start.items()}
+    cur = moderate
     rom, b = sized_bound(t, shape(cur))
+    if not _meets(b, max_error, strict):
+        cur = dict(start)
+        rom, b = sized_bound(t, shape(cur))
     if not _meets(b, max_error, strict):
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
                          f"(certified {float(b[2]):.6e}; approximation {float(b[0]):.6e}); "
@@ -645,7 +672,9 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         (:func:`sized_bound`).
     max_error : float or str, optional
         ``widths="auto"``: the certified total must be ``<= max_error``;
-        default: faithful, ``< 2^-Fy`` (one unit of y's last place).
+        default: faithful, ``< 2^-Fy`` (one unit of y's last place), with
+        ``Fy`` the most fractional bits of y at which that is reachable and
+        y's range fits ``out_bits``.
     pipeline : None, "full" or iterable of int
         Sized architecture only: register cut points, ``0`` after the ROM
         read, ``i`` after the ``i``-th multiply-add; ``"full"``: all
@@ -735,15 +764,22 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
         limit, strict = None, True
     else:
         limit, strict = _error_limit(max_error), False
+    failed = None
     for f in range(fy, fy - 8, -1):
         lim = Fraction(1, 2 ** f) if limit is None else limit
         if widths == "auto":
-            shape = _auto_shape(proto, f, lim, strict, truncated)
+            try:  # faithful at fewer fractional bits of y may still be reachable
+                shape = _auto_shape(proto, f, lim, strict, truncated)
+            except ValueError as exc:
+                failed = failed or exc
+                continue
         else:
             shape = _check_sized_widths(widths, n, L, t.centered, f, truncated)
         d = _sized_design(proto, shape, cuts)
         if d is not None:
             return d
+    if failed is not None:
+        raise failed
     raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
 
 
