@@ -182,3 +182,12 @@ def test_spec_16_bit_faithful_pipelined_exhaustive(tmp_path, language, degree, s
     assert m["max_error"] <= d.budget()["total"] and m["saturated"] == 0
     sim = _simulate(d, tmp_path, language)
     assert sim.passed and sim.vectors == 65536 and sim.mismatches == 0, sim.line
+
+
+def test_faithful_default_out_of_reach_names_it():
+    """The default target is faithful at y's last place; a table too coarse for it is
+    refused (y's format is not silently coarsened to make the bound)."""
+    t = _table("1/sqrt(x)", ("1", "4"), 2, 4)
+    assert t.abs_error_bound > 2 ** -11
+    with pytest.raises(ValueError, match="faithful"):
+        design_piecewise(t, 12, 12, widths="auto")

@@ -730,10 +730,19 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     if widths is not None:
         if multipliers not in ("full", "truncated"):
             raise ValueError(f"multipliers {multipliers!r}; accepted: 'full', 'truncated'")
-        return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated")
+        return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated",
+                             span)
     if pipeline is not None or multipliers != "full":
         raise ValueError("pipeline, multipliers: need the sized architecture; accepted: "
                          "widths='auto' or a widths dict with them, or their defaults")
+    return _uniform_design(proto, w, fa, fy, y_off)
+
+
+def _uniform_design(proto: PiecewiseDesign, w: dict, fa: int, fy: int,
+                    y_off: int) -> PiecewiseDesign:
+    """The one-width design from the wires ``w`` of its datapath at ``fa``
+    accumulator and ``fy`` output fractional bits (each wire checked for int64)."""
+    table, L = proto.table, proto.local_bits
     for key, v in w.items():
         if key[0] in "psa" and key != "s":
             check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
@@ -748,15 +757,15 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                        max(signed_bits(int(s.min()), int(s.max())), 2),
                        max(signed_bits(int(out.min()), int(out.max())), 2)))
         check_int64(widths[-1][1], f"the sum of Horner step {j}")
-    return PiecewiseDesign(name, table, in_bits, out_bits, L, fa,
-                           QFormat(out_bits, fy, offset_code=y_off), rom_bits, L + 2,
-                           tuple(widths), int(w["top_frac"]))
+    return replace(proto, acc_frac_bits=fa, y_format=QFormat(proto.out_bits, fy, offset_code=y_off),
+                   widths=tuple(widths), top_frac_bits=int(w["top_frac"]))
 
 
 def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
-                  truncated: bool = False) -> PiecewiseDesign:
+                  truncated: bool = False, span: Fraction = Fraction(0)) -> PiecewiseDesign:
     """:func:`design_piecewise` with ``widths`` given: y's fractional bits
-    lowered from the uniform design's ``fy`` until y's range fits."""
+    lowered from the uniform design's ``fy`` until y's range fits (``span``:
+    the exact polynomial's range of values)."""
     t = proto.table
     n, L = t.degree, proto.local_bits
     cuts = _check_cuts(pipeline, n)
@@ -771,6 +780,13 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
             try:  # faithful at fewer fractional bits of y may still be reachable
                 shape = _auto_shape(proto, f, lim, strict, truncated)
             except ValueError as exc:
+                # only where y's range is tight at f bits is f given up for fewer bits
+                # (else max_error is out of reach and y keeps its last place)
+                if span * 2 ** f + 2 <= 2 ** proto.out_bits - 1:
+                    if limit is None:
+                        raise ValueError(f"max_error None (faithful: error < 2^-{f}, y's last "
+                                         f"place): {exc}") from None
+                    raise
                 failed = failed or exc
                 continue
         else:
