@@ -13,7 +13,7 @@ import pytest
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.core.files import write_folder
 from chebnorm.hw.hdl import hdl_files
-from chebnorm.hw.piecewise import design_piecewise, sized_bound
+from chebnorm.hw.piecewise import design_piecewise, shape_cost, sized_bound
 
 SPEC = ("1/sqrt(1+3*x)", ("0", "1"))
 
@@ -59,7 +59,8 @@ def test_datapath_bound_covers_exact_error(expr, interval, degree, segments, cen
                          multipliers=multipliers)
     assert d.multipliers == multipliers
     _, (_, path, total) = sized_bound(t, (d.local_bits, degree, centered, d.coef_frac,
-                                          d.t_keep, d.acc_frac, multipliers == "truncated"))
+                                          d.t_keep, d.acc_frac, multipliers == "truncated",
+                                          d.prod_frac))
     exact = _datapath_error(d)
     assert max(exact) <= path
     assert d.measure()["max_error"] <= d.budget()["total"] <= limit
@@ -67,24 +68,28 @@ def test_datapath_bound_covers_exact_error(expr, interval, degree, segments, cen
 
 
 def test_auto_widths_are_locally_minimal():
-    """Greedy: each width is as low as the bound allows -- one bit less on any single
-    width breaks max_error (the search's own stopping rule, checked from outside)."""
+    """Greedy: one bit less on any single width misses max_error or grows the area
+    proxy (the search's own stopping rule, checked from outside)."""
     t = _table("1/sqrt(x)", ("1", "4"), 2, 8)
     limit = Fraction(1, 2 ** 10)
     d = design_piecewise(t, 12, 12, widths="auto", max_error=limit)
     assert Fraction(d.budget()["total"]) <= limit
     n = d.degree
+    area = shape_cost(t, (d.local_bits, n, False, d.coef_frac, d.t_keep, d.acc_frac, False,
+                          d.prod_frac), d.coefficients)
     base = {"coef_frac": list(d.coef_frac), "t_keep": list(d.t_keep),
-            "acc_frac": list(d.acc_frac[1:n])}
-    for key, lowest in (("coef_frac", -8), ("t_keep", 1), ("acc_frac", -8)):
+            "acc_frac": list(d.acc_frac[1:n]), "prod_frac": list(d.prod_frac)}
+    for key, lowest in (("coef_frac", -8), ("t_keep", 1), ("acc_frac", -8), ("prod_frac", -8)):
         for i in range(len(base[key])):
             if base[key][i] <= lowest:
                 continue
             w = {k: list(v) for k, v in base.items()}
             w[key][i] -= 1
             shape = (d.local_bits, n, False, tuple(w["coef_frac"]), tuple(w["t_keep"]),
-                     (d.acc_frac[0], *w["acc_frac"], w["coef_frac"][n]))
-            assert sized_bound(t, shape)[1][2] > limit, (key, i)
+                     (d.acc_frac[0], *w["acc_frac"], w["coef_frac"][n]), False,
+                     tuple(w["prod_frac"]))
+            rom, bound = sized_bound(t, shape)
+            assert bound[2] > limit or shape_cost(t, shape, rom) > area, (key, i)
 
 
 def test_explicit_widths_and_coefficient_rerounding_enter_the_bound():

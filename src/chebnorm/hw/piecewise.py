@@ -71,6 +71,7 @@ from .verilog import simulate, synthesize_text
 
 __all__ = [
     "MAX_PW_IN_BITS",
+    "ROM_WEIGHT",
     "PiecewiseDesign",
     "design_piecewise",
     "piecewise_cells",
@@ -127,7 +128,8 @@ class PiecewiseDesign:
     acc_frac: tuple[int, ...] = ()       # G_j, j = 0..n: fractional bits of a_j (G_0 = y's)
     coefficients: tuple[tuple[int, ...], ...] = ()   # per segment, c_j / 2^F_j
     cuts: tuple[int, ...] = ()           # pipeline registers: 0 after the ROM, i after step i
-    multipliers: str = "full"            # "truncated": partial-product columns below X dropped
+    multipliers: str = "full"            # "truncated": partial-product columns below P dropped
+    prod_frac: tuple[int, ...] = ()      # P_j, j = 0..n-1: fractional bits kept of product j
     q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
     bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
 
@@ -292,11 +294,12 @@ class _Shape(NamedTuple):
     T: tuple[int, ...]
     G: tuple[int, ...]
     truncated: bool = False   # truncated multipliers: partial-product columns dropped
+    P: tuple[int, ...] = ()   # per step j: fractional bits kept of the product (default X)
 
 
 def _shape(d: PiecewiseDesign) -> _Shape:
     return _Shape(d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac,
-                  d.multipliers == "truncated")
+                  d.multipliers == "truncated", d.prod_frac)
 
 
 def sized_steps(shape) -> list[dict]:
@@ -304,29 +307,32 @@ def sized_steps(shape) -> list[dict]:
 
         t_j = low >> tshift (- 2^(T_j - 1) when centred)   T_j fractional bits
         p_j = a_{j+1} * t_j                                 pf = G_{j+1} + T_j
-        q_j = p_j >> pshift  (<< -pshift when negative)     X = max(G_j, F_j)
-        s_j = q_j + (c_j << cshift)                          X
+        q_j = p_j >> pshift  (<< -pshift when negative)     P_j
+        s_j = (q_j << qshift) + (c_j << cshift)             X = max(P_j, F_j, G_j)
         a_j = s_j >> ashift                                  G_j
 
-    every shift a floor (drops bits, no rounding adder); the bias is paid for
-    in the coefficients (:func:`sized_bound` centres each segment's error).
+    every right shift a floor (drops bits, no rounding adder); the bias is
+    paid for in the coefficients (:func:`sized_bound` centres each segment's
+    error). ``P_j`` defaults to ``max(G_j, F_j)``.
 
     >>> st = sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]
     >>> st["pf"], st["X"], st["pshift"], st["cshift"], st["ashift"]   # pf = G_1 + T_0
     (11, 10, 1, 0, 1)
     """
     L, n, _, F, T, G = shape[:6]
+    P = shape[7] if len(shape) > 7 and shape[7] else None
     out = []
     for j in range(n - 1, -1, -1):
         pf = G[j + 1] + T[j]
-        X = max(G[j], F[j])
-        st = {"j": j, "tshift": L - T[j], "pf": pf, "X": X, "pshift": pf - X,
-              "cshift": X - F[j], "ashift": X - G[j], "rows": ()}
-        if len(shape) > 6 and shape[6] and pf > X:
+        Pj = P[j] if P else max(G[j], F[j])
+        X = max(Pj, G[j], F[j])
+        st = {"j": j, "tshift": L - T[j], "pf": pf, "P": Pj, "X": X, "pshift": pf - Pj,
+              "qshift": X - Pj, "cshift": X - F[j], "ashift": X - G[j], "rows": ()}
+        if len(shape) > 6 and shape[6] and pf > Pj:
             # row i of the multiplier: bit i of t's code times a_{j+1} * 2^i, every bit
-            # below column X dropped (a floor: a >> (pshift - i)); centred, the top row
+            # below column P dropped (a floor: a >> (pshift - i)); centred, the top row
             # is -a_{j+1} * 2^(T-1) gated by the inverted top bit (t = code - 2^(T-1))
-            st["rows"] = tuple((i, pf - X - i, bool(shape[2]) and i == T[j] - 1)
+            st["rows"] = tuple((i, pf - Pj - i, bool(shape[2]) and i == T[j] - 1)
                                for i in range(T[j]))
         out.append(st)
     return out
@@ -374,7 +380,7 @@ def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
             q = truncated_product(acc, bit, st["rows"])
         else:
             q = _shift(p, st["pshift"])
-        sm = q + (rom[s, j] << st["cshift"])
+        sm = (q << st["qshift"]) + (rom[s, j] << st["cshift"])
         acc = sm >> st["ashift"]
         w.update({f"t{j}": tj, f"p{j}": p, f"q{j}": q, f"s{j}": sm, f"a{j}": acc})
         if j == upto:
@@ -421,7 +427,8 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
     k = np.arange(nseg << L, dtype=np.int64) if codes is None else codes
     # every interval end is an integer in units of 2^-D (D above every fractional
     # width in play); products with t are rounded outward back to 2^-D (rigorous)
-    D = max([fc, L, *F, *G] + [G[j + 1] + T[j] for j in range(n)]) + 4
+    D = max([fc, L, *F, *G, *(shape[7] if len(shape) > 7 else ())]
+            + [G[j + 1] + T[j] for j in range(n)]) + 4
     Q = [np.array([seg.integers[j] for seg in table.segments], dtype=object) << (D - fc)
          for j in range(n + 1)]
     tl = -(1 << (L - 1)) if centered else 0          # t's range in units of 2^-L
@@ -451,11 +458,13 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
             at_lo, at_hi = at_lo << sh, at_hi << sh
         else:
             at_lo, at_hi = at_lo >> -sh, -(-at_hi >> -sh)
-        if st["rows"]:  # each truncated row floors: error in (-(1 - 2^-shift), 0] ulps of X
-            pi = sum((1 << (D - st["X"])) - (1 << (D - st["X"] - sh))
+        if st["rows"]:  # each truncated row floors: error in (-(1 - 2^-shift), 0] ulps of P
+            pi = sum((1 << (D - st["P"])) - (1 << (D - st["P"] - sh))
                      for _, sh, _ in st["rows"] if sh > 0)
+        elif st["pshift"] > 0:
+            pi = (1 << (D - st["P"])) - (1 << (D - st["pf"]))
         else:
-            pi = max(0, (1 << (D - st["X"])) - (1 << (D - st["pf"])))
+            pi = 0
         sigma = (1 << (D - G[j])) - (1 << (D - st["X"]))
         lo, hi = plo - at_hi - pi - sigma, phi - at_lo
         rom[:, j] = nearest(2 * Q[j] - (lo + hi), D + 1 - F[j])
@@ -483,16 +492,21 @@ def _int_rom(rom) -> np.ndarray:
 def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int,
                         truncated: bool = False) -> _Shape:
     """``widths`` (a mapping with ``coef_frac``, ``t_keep``, ``acc_frac``) as a shape."""
-    if not isinstance(widths, dict) or set(widths) != {"coef_frac", "t_keep", "acc_frac"}:
+    if not isinstance(widths, dict) or not {"coef_frac", "t_keep", "acc_frac"} <= set(widths) \
+            or not set(widths) <= {"coef_frac", "t_keep", "acc_frac", "prod_frac"}:
         raise ValueError("widths: expected None, 'auto' or a dict with keys coef_frac (n+1 "
-                         "values), t_keep (n values), acc_frac (n-1 values, for a_1..a_{n-1})")
+                         "values), t_keep (n values), acc_frac (n-1 values, for a_1..a_{n-1}) "
+                         "and optionally prod_frac (n values)")
+    P = tuple(check_width(v, "widths prod_frac", -8, 62) for v in widths.get("prod_frac", ()))
+    if P and len(P) != n:
+        raise ValueError(f"widths: degree {n} needs {n} prod_frac values; got {len(P)}")
     F = tuple(check_width(v, "widths coef_frac", -8, 62) for v in widths["coef_frac"])
     T = tuple(check_width(v, "widths t_keep", 1, L) for v in widths["t_keep"])
     A = tuple(check_width(v, "widths acc_frac", -8, 62) for v in widths["acc_frac"])
     if len(F) != n + 1 or len(T) != n or len(A) != max(n - 1, 0):
         raise ValueError(f"widths: degree {n} needs {n + 1} coef_frac, {n} t_keep and "
                          f"{max(n - 1, 0)} acc_frac values; got {len(F)}, {len(T)}, {len(A)}")
-    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()), truncated)
+    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()), truncated, P)
 
 
 def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDesign | None:
@@ -529,6 +543,8 @@ def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDe
                    coef_frac=shape.F, t_keep=shape.T, acc_frac=shape.G,
                    coefficients=tuple(rom), cuts=tuple(cuts), bound=bound,
                    multipliers="truncated" if len(shape) > 6 and shape[6] else "full",
+                   prod_frac=tuple(st["P"] for st in sorted(sized_steps(shape),
+                                                            key=lambda st: st["j"])),
                    q_bits=tuple(q_bits))
 
 
@@ -536,13 +552,15 @@ def _meets(bound, max_error: Fraction, strict: bool) -> bool:
     return bound[2] < max_error if strict else bound[2] <= max_error
 
 
-#: the greedy's area proxy: Yosys cells per ROM bit (as hw.piecewise_search's model)
-_ROM_WEIGHT = 0.15
+#: the greedy's default area proxy: Yosys cells per ROM bit against one per
+#: partial-product bit (as hw.piecewise_search's model)
+ROM_WEIGHT = 0.15
 
 
-def shape_cost(table: PiecewiseTable, shape, rom) -> float:
+def shape_cost(table: PiecewiseTable, shape, rom, rom_weight: float = ROM_WEIGHT) -> float:
     """Area proxy of a sized datapath with ROM ``rom`` (:func:`sized_bound`):
-    ROM bits x 0.15 plus ``a x b`` per ``a x b`` multiplier plus each sum's
+    ROM bits x ``rom_weight`` plus ``a x b`` per ``a x b`` multiplier (the
+    kept partial-product bits of a truncated one) plus each sum's
     width, the widths from the exact wire ranges over all codes (one model run).
 
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -551,14 +569,14 @@ def shape_cost(table: PiecewiseTable, shape, rom) -> float:
     >>> shape_cost(t, sh, sized_bound(t, sh)[0]) > 0
     True
     """
-    L, n = shape.L, shape.n
+    L, n = shape[0], shape[1]
     rom_i = _int_rom(np.array(rom, dtype=object))
     w = _run_sized(rom_i, np.arange(table.segment_count << L, dtype=np.int64), shape)
 
     def bits(v) -> int:
         return signed_bits(int(v.min()), int(v.max()))
 
-    cost = _ROM_WEIGHT * len(rom) * sum(bits(rom_i[:, j]) for j in range(n + 1))
+    cost = rom_weight * len(rom) * sum(bits(rom_i[:, j]) for j in range(n + 1))
     for st in sized_steps(shape):
         j = st["j"]
         aw = bits(w[f"a{j + 1}"])
@@ -569,62 +587,91 @@ def shape_cost(table: PiecewiseTable, shape, rom) -> float:
 
 
 def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool,
-                truncated: bool = False) -> _Shape:
+                truncated: bool = False, rom_weight: float = ROM_WEIGHT) -> _Shape:
     """Greedy widths: start from ``Fy + 6`` fractional bits for every column and
     accumulator and every bit of ``t`` (or, when that misses ``max_error``,
     generous: the table's ``Fc`` for every column, ``Fy + 8`` accumulator
-    bits); then, round after round, try
-    each width one bit lower and keep, among the changes whose certified bound
-    still meets ``max_error``, the one that saves the most area
-    (:func:`shape_cost`) per unit of error budget it spends (a change that
-    saves nothing only when no other is left; ties: the highest-order width
-    first), until none is left."""
+    bits); then, round after round, try each width one bit lower and keep,
+    among the changes whose certified bound still meets ``max_error``, the one
+    that saves the most area (:func:`shape_cost`) per unit of error budget it
+    spends (a change that saves nothing only when no other is left, one that
+    costs area never; ties: the highest-order width first), until none is
+    left. Then trade: one width one bit higher, the descent again without it;
+    kept when the area drops. The result: no width can be one bit lower
+    without missing ``max_error`` or growing the area."""
     t = proto.table
     n, L, fc = t.degree, proto.local_bits, t.coef_frac_bits
     start = {("F", j): max(fc, fy + 2) for j in range(n + 1)}
     start.update({("T", j): L for j in range(n)})
     start.update({("G", j): fy + 8 for j in range(1, n)})
-    floors = {"F": -8, "T": 1, "G": -8}
+    start.update({("P", j): fy + 8 for j in range(n)})
+    floors = {"F": -8, "T": 1, "G": -8, "P": -8}
+    ceils = {"F": 62, "T": L, "G": 62, "P": 62}
+    # highest order first: F_n .. F_0, T_{n-1} .. T_0, P_{n-1} .. P_0, G_{n-1} .. G_1
+    order = sorted(start, key=lambda key: ("FTPG".index(key[0]), -key[1]))
+    memo: dict = {}
 
     def shape(v):
         F = tuple(v["F", j] for j in range(n + 1))
         G = (fy,) + tuple(v["G", j] for j in range(1, n)) + ((F[n],) if n > 0 else ())
-        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G, truncated)
+        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G, truncated,
+                      tuple(v["P", j] for j in range(n)))
+
+    def judge(v):  # (meets, area, certified total), memoised
+        key = tuple(v[k] for k in order)
+        if key not in memo:
+            rom, b = sized_bound(t, shape(v))
+            ok = _meets(b, max_error, strict)
+            memo[key] = (ok, shape_cost(t, shape(v), rom, rom_weight) if ok else math.inf, b[2])
+        return memo[key]
+
+    def descend(cur, frozen=None):
+        _, cost, bound = judge(cur)
+        while True:
+            best = None
+            for key in order:
+                if key == frozen or cur[key] <= floors[key[0]]:
+                    continue
+                trial = dict(cur)
+                trial[key] -= 1
+                ok, c, b = judge(trial)
+                if not ok or c > cost:
+                    continue
+                # area saved per unit of the error budget spent (free moves last)
+                saved, spent = cost - c, b - bound
+                score = (True, saved / spent if spent > 0 else math.inf) if saved > 0 \
+                    else (False, -spent)
+                if best is None or score > best[0]:
+                    best = (score, trial)
+            if best is None:
+                return cur
+            cur = best[1]
+            _, cost, bound = judge(cur)
 
     # a moderate start (6 guard bits everywhere) saves most of the walk down when it meets
-    moderate = {key: (min(v, fy + 6) if key[0] in "FG" else v) for key, v in start.items()}
-    cur = moderate
-    rom, b = sized_bound(t, shape(cur))
-    if not _meets(b, max_error, strict):
+    cur = {key: (min(v, fy + 6) if key[0] in "FGP" else v) for key, v in start.items()}
+    if not judge(cur)[0]:
         cur = dict(start)
-        rom, b = sized_bound(t, shape(cur))
-    if not _meets(b, max_error, strict):
+    ok, _, total = judge(cur)
+    if not ok:
+        approx = max(Fraction(seg.abs_error_bound) for seg in t.segments)
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
-                         f"(certified {float(b[2]):.6e}; approximation {float(b[0]):.6e}); "
+                         f"(certified {float(total):.6e}; approximation {float(approx):.6e}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
-    cost, bound = shape_cost(t, shape(cur), rom), b[2]
-    # highest order first: F_n .. F_0, then T_{n-1} .. T_0, then G_{n-1} .. G_1
-    order = sorted(cur, key=lambda key: ("FTG".index(key[0]), -key[1]))
-    while True:
-        best = None
+    cur = descend(cur)
+    for _ in range(4):  # trades, while one pays
+        gained = False
         for key in order:
-            if cur[key] <= floors[key[0]]:
+            if cur[key] >= ceils[key[0]]:
                 continue
-            trial = dict(cur)
-            trial[key] -= 1
-            rom, b = sized_bound(t, shape(trial))
-            if not _meets(b, max_error, strict):
-                continue
-            c = shape_cost(t, shape(trial), rom)
-            # area saved per unit of the error budget spent (free moves last)
-            saved, spent = cost - c, b[2] - bound
-            score = (saved > 0, saved / spent if spent > 0 else math.inf) if saved > 0 \
-                else (False, -spent)
-            if best is None or score > best[0]:
-                best = (score, c, b[2], trial)
-        if best is None:
-            return shape(cur)
-        _, cost, bound, cur = best
+            up = dict(cur)
+            up[key] += 1
+            trial = descend(up, frozen=key)
+            if judge(trial)[1] < judge(cur)[1]:
+                cur, gained = trial, True
+        if not gained:
+            break
+    return shape(descend(cur))
 
 
 def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
@@ -641,7 +688,8 @@ def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
 
 def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                      guard_bits: int = 2, name: str | None = None, widths=None,
-                     max_error=None, pipeline=None, multipliers: str = "full") -> PiecewiseDesign:
+                     max_error=None, pipeline=None, multipliers: str = "full",
+                     rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
     """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
 
     ``in_bits`` must exceed the table's index bits (the rest is the local
@@ -685,6 +733,10 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         the product's bits below ``X_j``; ``"truncated"`` never forms them:
         each partial-product row is floored at column ``X_j``
         (:func:`truncated_product`), the rows' errors enter the bound.
+    rom_weight : float
+        ``widths="auto"``: the greedy's price of one ROM bit against one
+        partial-product bit (:func:`shape_cost`; default :data:`ROM_WEIGHT`,
+        generic Yosys cells; an FPGA whose LUT6 holds 64 ROM bits wants less).
 
     Examples
     --------
@@ -731,7 +783,7 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         if multipliers not in ("full", "truncated"):
             raise ValueError(f"multipliers {multipliers!r}; accepted: 'full', 'truncated'")
         return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated",
-                             span)
+                             span, _check_weight(rom_weight))
     if pipeline is not None or multipliers != "full":
         raise ValueError("pipeline, multipliers: need the sized architecture; accepted: "
                          "widths='auto' or a widths dict with them, or their defaults")
@@ -762,7 +814,8 @@ def _uniform_design(proto: PiecewiseDesign, w: dict, fa: int, fy: int,
 
 
 def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
-                  truncated: bool = False, span: Fraction = Fraction(0)) -> PiecewiseDesign:
+                  truncated: bool = False, span: Fraction = Fraction(0),
+                  rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
     """:func:`design_piecewise` with ``widths`` given: y's fractional bits
     lowered from the uniform design's ``fy`` until y's range fits (``span``:
     the exact polynomial's range of values)."""
@@ -778,7 +831,7 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
         lim = Fraction(1, 2 ** f) if limit is None else limit
         if widths == "auto":
             try:  # faithful at fewer fractional bits of y may still be reachable
-                shape = _auto_shape(proto, f, lim, strict, truncated)
+                shape = _auto_shape(proto, f, lim, strict, truncated, rom_weight)
             except ValueError as exc:
                 # only where y's range is tight at f bits is f given up for fewer bits
                 # (else max_error is out of reach and y keeps its last place)
@@ -797,6 +850,12 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
     if failed is not None:
         raise failed
     raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+
+
+def _check_weight(w) -> float:
+    if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or w < 0:
+        raise ValueError(f"rom_weight {w!r}: accepted a finite number >= 0")
+    return float(w)
 
 
 def _error_limit(max_error) -> Fraction:

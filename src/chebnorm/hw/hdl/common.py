@@ -178,9 +178,10 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
               f"Rounding: {design.rounding} after each multiply-add; accumulators with "
               f"{design.acc_frac_bits} fractional bits."
               if not design.sized else
-              f"Step j multiplies by the top T_j bits of t, T = {list(design.t_keep)}; products "
-              f"and sums truncated (floor) to G = {list(design.acc_frac)} fractional bits "
-              f"(a_0 .. a_n); the bias is centred in the ROM.",
+              f"Step j multiplies by the top T_j bits of t, T = {list(design.t_keep)}; "
+              f"{design.multipliers} multipliers, products truncated (floor) to P = "
+              f"{list(design.prod_frac)} and sums to G = {list(design.acc_frac)} fractional "
+              f"bits (a_0 .. a_n); the bias is centred in the ROM.",
               f"Error budget |y - f(x)| <= {b['total']:.6e} = approximation "
               f"{b['approximation']:.6e} + Horner rounding {b['horner_rounding']:.6e} + output "
               f"rounding {b['output_rounding']:.6e}"]

@@ -515,8 +515,9 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     for i, st in enumerate(d.sized_signals(), start=1):
         j, T = st["j"], st["T"]
         lo = cur["low"]
-        out.append(f"    // step {j}: a{j} = ((a{j + 1} * t{j}) >>> {st['pshift']} + "
-                   f"c{j} <<< {st['cshift']}) >>> {st['ashift']}, t{j} = top {T} bits of t")
+        out.append(f"    // step {j}: a{j} = (((a{j + 1} * t{j}) >>> {st['pshift']}) <<< {st['qshift']}"
+                   f" + c{j} <<< {st['cshift']}) >>> {st['ashift']}, t{j} = top {T} bits of t"
+                   + (", truncated multiplier" if st["rows"] else ""))
         if t.centered:
             bits = f"~{lo}[{L - 1}]" if T == 1 else f"{{~{lo}[{L - 1}], {lo}[{L - 2}:{L - T}]}}"
             out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = {bits};")
@@ -530,7 +531,8 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
             shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
             out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
         cs = f" <<< {st['cshift']}" if st["cshift"] else ""
-        out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = q{j} + ({cur[f'c{j}']}{cs});")
+        qs = f"(q{j} <<< {st['qshift']})" if st["qshift"] else f"q{j}"
+        out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = {qs} + ({cur[f'c{j}']}{cs});")
         ash = f" >>> {st['ashift']}" if st["ashift"] else ""
         out.append(f"    wire signed [{st['aw'] - 1}:0] a{j} = s{j}{ash};")
         del live[f"c{j}"], cur[f"c{j}"]
@@ -557,7 +559,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
 
 def _truncated_rows(st: dict, a: str, aw: int, low: str) -> list[str]:
     """The truncated multiplier ``q_j`` of a sized step: one row per bit of
-    ``t_j``'s code, ``a`` floored at column ``X`` (an arithmetic shift), gated by
+    ``t_j``'s code, ``a`` floored at column ``P`` (an arithmetic shift), gated by
     the bit (the inverted top bit, negated row, when ``t`` is centred), all
     rows added modulo ``2^qw`` (the exact sum fits ``qw`` bits)."""
     j, qw = st["j"], st["qw"]

@@ -553,8 +553,9 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     for i, st in enumerate(d.sized_signals(), start=1):
         j, T, tw = st["j"], st["T"], st["tw"]
         lo = cur["low"]
-        b.stmt.append(f"    -- step {j}: a{j} = ((a{j + 1} * t{j}) >> {st['pshift']} + "
-                      f"c{j} << {st['cshift']}) >> {st['ashift']}, t{j} = top {T} bits of t")
+        b.stmt.append(f"    -- step {j}: a{j} = (((a{j + 1} * t{j}) >> {st['pshift']}) << {st['qshift']}"
+                      f" + c{j} << {st['cshift']}) >> {st['ashift']}, t{j} = top {T} bits of t"
+                      + (", truncated multiplier" if st["rows"] else ""))
         if t.centered:
             rest = f" & {lo}({L - 2} downto {L - T})" if T > 1 else ""
             b.wire(f"t{j}", tw, f"signed(not {lo}({L - 1} downto {L - 1}){rest})")
@@ -575,7 +576,9 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
         ctx = max(qw, sw, d.rom_bits[j])
         c = f"wrap({cur[f'c{j}']}, {ctx})"
         c = f"shift_left({c}, {st['cshift']})" if st["cshift"] else c
-        b.wire(f"s{j}", sw, f"wrap(wrap(q{j}, {ctx}) + {c}, {sw})")
+        qv = f"wrap(q{j}, {ctx})"
+        qv = f"shift_left({qv}, {st['qshift']})" if st["qshift"] else qv
+        b.wire(f"s{j}", sw, f"wrap({qv} + {c}, {sw})")
         a_expr = f"shift_right(s{j}, {st['ashift']})" if st["ashift"] else f"s{j}"
         b.wire(f"a{j}", aw, f"wrap({a_expr}, {aw})")
         del live[f"c{j}"], cur[f"c{j}"]
@@ -604,7 +607,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
 
 def _truncated_rows(b: _Body, st: dict, a: str, aw: int, low: str) -> None:
     """The truncated multiplier ``q_j``, as the Verilog printer writes it: one
-    row per bit of ``t_j``'s code, floored at column ``X``, gated, summed
+    row per bit of ``t_j``'s code, floored at column ``P``, gated, summed
     modulo ``2^qw``."""
     j, qw = st["j"], st["qw"]
     if any(neg for _, _, neg in st["rows"]):
