@@ -475,10 +475,14 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
         rom[:, 0] = nearest(Q[0] + sigma // 2, D - F[0])
         d = (rom[:, 0] << (D - F[0])) - Q[0]
         lo, hi = d - sigma, d
+    # per segment approximation + datapath, in integers (floats are dyadic: exact)
     approx = [Fraction(seg.abs_error_bound) for seg in table.segments]
-    path = [Fraction(max(-int(x), int(y)), 2 ** D) for x, y in zip(lo, hi)]
-    total = max(a_ + p_ for a_, p_ in zip(approx, path))
-    return [tuple(int(v) for v in row) for row in rom], (max(approx), max(path), total)
+    M = max([D] + [a_.denominator.bit_length() - 1 for a_ in approx])
+    path = [max(-int(x), int(y)) for x, y in zip(lo, hi)]
+    total = max(a_.numerator * (1 << (M - a_.denominator.bit_length() + 1)) + (p_ << (M - D))
+                for a_, p_ in zip(approx, path))
+    return [tuple(int(v) for v in row) for row in rom], (max(approx), Fraction(max(path), 2 ** D),
+                                                         Fraction(total, 2 ** M))
 
 
 def _int_rom(rom) -> np.ndarray:
@@ -571,7 +575,10 @@ def shape_cost(table: PiecewiseTable, shape, rom, rom_weight: float = ROM_WEIGHT
     """
     L, n = shape[0], shape[1]
     rom_i = _int_rom(np.array(rom, dtype=object))
-    w = _run_sized(rom_i, np.arange(table.segment_count << L, dtype=np.int64), shape)
+    # a proxy: the wires' ranges on each segment's first, middle and last codes
+    local = np.array(sorted({0, 1, 1 << (L - 1), (1 << L) - 2, (1 << L) - 1}), dtype=np.int64)
+    seg = np.arange(table.segment_count, dtype=np.int64) << L
+    w = _run_sized(rom_i, (seg[:, None] + local[None, :]).ravel(), shape)
 
     def bits(v) -> int:
         return signed_bits(int(v.min()), int(v.max()))
@@ -659,7 +666,7 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
                          f"(certified {float(total):.6e}; approximation {float(approx):.6e}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
     cur = descend(cur)
-    for _ in range(4):  # trades, while one pays
+    for _ in range(2):  # trades, while one pays
         gained = False
         for key in order:
             if cur[key] >= ceils[key[0]]:
