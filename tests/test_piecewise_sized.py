@@ -196,3 +196,27 @@ def test_faithful_default_out_of_reach_names_it():
     assert t.abs_error_bound > 2 ** -11
     with pytest.raises(ValueError, match="faithful"):
         design_piecewise(t, 12, 12, widths="auto")
+
+
+@pytest.mark.parametrize("widths, multipliers, pipeline", [
+    # a product shorter than its kept column (shifted left), a product truncated below G_1
+    ({"coef_frac": (12, 9, 7), "t_keep": (4, 3), "acc_frac": (8,), "prod_frac": (14, 6)},
+     "full", None),
+    ({"coef_frac": (12, 9, 7), "t_keep": (6, 3), "acc_frac": (8,), "prod_frac": (9, 12)},
+     "truncated", (1,)),
+    ({"coef_frac": (8, 12, 7), "t_keep": (7, 7), "acc_frac": (14,), "prod_frac": (6, 6)},
+     "truncated", "full"),
+])
+def test_explicit_widths_edge_shifts(tmp_path, widths, multipliers, pipeline):
+    """Hand-given widths reaching every shift direction of the sized step: the bound
+    covers the exact error on every code and both HDLs match the model bit for bit."""
+    t = _table("1/sqrt(x)", ("1", "4"), 2, 8, centered=True)
+    d = design_piecewise(t, 10, 10, widths=widths, multipliers=multipliers, pipeline=pipeline)
+    steps = d.sized_signals()
+    assert any(st["pshift"] < 0 for st in steps) or any(st["qshift"] > 0 for st in steps)
+    assert max(_datapath_error(d)) <= Fraction(d.budget()["datapath"])
+    assert d.measure()["max_error"] <= d.budget()["total"]
+    for language in ("verilog", "vhdl"):
+        if _HAVE[language]:
+            sim = _simulate(d, tmp_path, language)
+            assert sim.passed and sim.mismatches == 0, sim.line
