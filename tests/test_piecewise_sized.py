@@ -170,15 +170,18 @@ def test_hdl_bit_exact_small(tmp_path, language, expr, interval, degree, segment
     assert sim.passed and sim.vectors == 1024 and sim.mismatches == 0, sim.line
 
 
-@pytest.mark.parametrize("language, degree, segments", [("verilog", 2, 128), ("vhdl", 1, 256)])
-def test_spec_16_bit_faithful_pipelined_exhaustive(tmp_path, language, degree, segments):
+@pytest.mark.parametrize("language, degree, segments, centered",
+                         [("verilog", 2, 128, True), ("vhdl", 1, 256, False)])
+def test_spec_16_bit_faithful_pipelined_exhaustive(tmp_path, language, degree, segments,
+                                                   centered):
     """The issue-28 spec, 1/sqrt(1+3x) on [0, 1) at 16 bits, faithful, truncated
     multipliers, fully pipelined (the generic winner in Verilog, the xc7 LUT winner in
     VHDL): every one of the 65,536 codes simulated one per cycle matches the model after
     the latency, and the exact |y - f| stays below the certified bound < 2^-16."""
     if not _HAVE[language]:
         pytest.skip(f"{language} simulator not installed")
-    t = piecewise_fit(*SPEC, degree, segments=segments, coef_frac_bits=26, name="rs")
+    t = piecewise_fit(*SPEC, degree, segments=segments, coef_frac_bits=26, centered=centered,
+                      name="rs")
     d = design_piecewise(t, 16, 16, widths="auto", pipeline="full", multipliers="truncated")
     assert d.y_format.frac_bits == 16 and d.latency == degree + 1
     assert any(st["rows"] for st in d.sized_signals())
