@@ -20,6 +20,22 @@ against ``f(x)`` is bounded by the table's certified bound plus
 ``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
 compares it, code by code and in 40-digit arithmetic, with ``f``.
 
+The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``,
+issue 28) gives every ROM column its own fractional bits ``F_j`` (the
+coefficients re-rounded from the table's ``Fc``), multiplies step ``j`` by
+the top ``T_j`` bits of ``t`` only, and truncates (floors) products and sums
+to ``G_j`` fractional bits -- with ``multipliers="truncated"`` the
+partial-product columns below the kept ones are never formed. No rounding
+adder anywhere: each segment's ROM coefficients are chosen to centre that
+segment's error interval (the truncations' bias is paid in the ROM).
+:func:`sized_bound` certifies it per segment in exact integer interval
+arithmetic; ``widths="auto"`` lowers the widths greedily while the certified
+total meets ``max_error`` (default: faithful). ``pipeline=`` puts registers
+after the ROM and after chosen multiply-adds (``latency`` cycles, one result
+per cycle); Verilog and VHDL of every variant are bit-identical to
+:meth:`PiecewiseDesign.evaluate`. ``widths=None`` (the default) keeps the
+one-width design and its outputs unchanged.
+
 >>> from chebnorm.approx.piecewise_fit import piecewise_fit
 >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
 >>> d = design_piecewise(t, 8, 8)
@@ -30,8 +46,9 @@ compares it, code by code and in 40-digit arithmetic, with ``f``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
+from typing import NamedTuple
 
 import mpmath
 import numpy as np
@@ -54,13 +71,18 @@ from .verilog import simulate, synthesize_text
 
 __all__ = [
     "MAX_PW_IN_BITS",
+    "ROM_WEIGHT",
     "PiecewiseDesign",
     "design_piecewise",
     "piecewise_cells",
     "piecewise_outputs",
     "piecewise_testbench",
     "piecewise_verilog",
+    "shape_cost",
     "simulate_piecewise",
+    "sized_bound",
+    "sized_steps",
+    "truncated_product",
 ]
 
 MAX_PW_IN_BITS = 20
@@ -100,6 +122,16 @@ class PiecewiseDesign:
     widths: tuple[tuple[int, int, int], ...]   # per step j=n-1..0: (product, sum, out)
     top_frac_bits: int
     rounding: str = ROUNDING
+    # the sized architecture (empty: one width for every coefficient, RNE after each step)
+    coef_frac: tuple[int, ...] = ()      # F_j, j = 0..n: fractional bits of ROM column j
+    t_keep: tuple[int, ...] = ()         # T_j, j = 0..n-1: top bits of t step j multiplies by
+    acc_frac: tuple[int, ...] = ()       # G_j, j = 0..n: fractional bits of a_j (G_0 = y's)
+    coefficients: tuple[tuple[int, ...], ...] = ()   # per segment, c_j / 2^F_j
+    cuts: tuple[int, ...] = ()           # pipeline registers: 0 after the ROM, i after step i
+    multipliers: str = "full"            # "truncated": partial-product columns below P dropped
+    prod_frac: tuple[int, ...] = ()      # P_j, j = 0..n-1: fractional bits kept of product j
+    q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
+    bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
 
     @property
     def module_name(self) -> str:
@@ -110,10 +142,36 @@ class PiecewiseDesign:
         return self.table.degree
 
     @property
+    def sized(self) -> bool:
+        """True for the sized architecture (a width per coefficient, truncated steps)."""
+        return bool(self.coef_frac)
+
+    @property
+    def latency(self) -> int:
+        """Clock cycles from ``x`` to ``y``: the number of pipeline registers (0: combinational)."""
+        return len(self.cuts)
+
+    @property
     def index_bits(self) -> int:
         return self.table.index_bits
 
+    def sized_signals(self) -> list[dict]:
+        """The sized datapath's steps ``j = n-1 .. 0`` for the HDL printers:
+        :func:`sized_steps`' shifts plus the widths of ``t_j`` (``tw``),
+        ``p_j``, ``q_j``, ``s_j`` and ``a_j`` (``pw``, ``qw``, ``sw``, ``aw``)."""
+        out = []
+        for st, (pw, sw, ow) in zip(sized_steps(_shape(self)), self.widths):
+            T = self.t_keep[st["j"]]
+            ps = st["pshift"]
+            qw = self.q_bits[len(out)] if self.q_bits else (
+                max(pw - ps, 2) if ps >= 0 else pw - ps)
+            out.append(dict(st, T=T, tw=T if self.table.centered else T + 1, pw=pw, qw=qw,
+                            sw=sw, aw=ow))
+        return out
+
     def _rom(self, dtype=np.int64) -> np.ndarray:
+        if self.sized:
+            return np.array(self.coefficients, dtype=dtype)
         return np.array([seg.integers for seg in self.table.segments], dtype=dtype)
 
     def _t(self, k: np.ndarray) -> np.ndarray:
@@ -124,7 +182,10 @@ class PiecewiseDesign:
         """Output codes for input ``codes`` (default: all ``2**in_bits``)."""
         k = np.arange(2 ** self.in_bits, dtype=np.int64) if codes is None \
             else np.asarray(codes, dtype=np.int64)
-        w = _run(self, k, self.acc_frac_bits, self.y_format.frac_bits)
+        if self.sized:
+            w = _run_sized(self._rom(k.dtype), k, _shape(self))
+        else:
+            w = _run(self, k, self.acc_frac_bits, self.y_format.frac_bits)
         raw = w["rounded"] - self.y_format.offset_code
         w["raw"] = raw
         w["y"] = np.clip(raw, 0, self.y_format.max_code)
@@ -135,7 +196,24 @@ class PiecewiseDesign:
         return [lo + (hi - lo) * Fraction(int(c), 2 ** self.in_bits) for c in codes]
 
     def budget(self) -> dict:
-        """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up)."""
+        """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up).
+
+        The sized architecture's bound is per segment (:func:`sized_bound`):
+        ``total`` is the largest over the segments of the segment's certified
+        approximation bound plus its datapath bound (coefficient re-rounding,
+        truncated ``t``, truncated products and sums, the output truncation);
+        ``datapath`` the largest datapath bound; ``output_rounding`` is
+        ``2^-(Fy+1)`` and ``horner_rounding`` the rest of ``datapath``, so
+        that the parts add up to at least ``total``.
+        """
+        if self.sized:
+            approx, path, total = self.bound
+            out = Fraction(1, 2 ** (self.y_format.frac_bits + 1))
+            return {"approximation": float_up(approx),
+                    "horner_rounding": float_up(max(path - out, Fraction(0))),
+                    "output_rounding": float_up(out), "datapath": float_up(path),
+                    "total": float_up(total),
+                    "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
         tmax = Fraction(1, 2) if self.table.centered else Fraction(1)
         fa = self.acc_frac_bits
         steps = [rounding_error_bound(fa, self.rounding) * tmax ** j
@@ -203,13 +281,469 @@ def _run(d, k, fa, fy) -> dict:
     return w
 
 
+# -- the sized architecture: a width per coefficient, truncated Horner steps ---------
+
+class _Shape(NamedTuple):
+    """The sized datapath's widths: local bits ``L``, degree ``n``, centred
+    ``t``, and ``F`` (per ROM column), ``T`` (per step), ``G`` (per accumulator)."""
+
+    L: int
+    n: int
+    centered: bool
+    F: tuple[int, ...]
+    T: tuple[int, ...]
+    G: tuple[int, ...]
+    truncated: bool = False   # truncated multipliers: partial-product columns dropped
+    P: tuple[int, ...] = ()   # per step j: fractional bits kept of the product (default X)
+
+
+def _shape(d: PiecewiseDesign) -> _Shape:
+    return _Shape(d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac,
+                  d.multipliers == "truncated", d.prod_frac)
+
+
+def sized_steps(shape) -> list[dict]:
+    """The shifts of each step ``j = n-1 .. 0`` of the sized datapath::
+
+        t_j = low >> tshift (- 2^(T_j - 1) when centred)   T_j fractional bits
+        p_j = a_{j+1} * t_j                                 pf = G_{j+1} + T_j
+        q_j = p_j >> pshift  (<< -pshift when negative)     P_j
+        s_j = (q_j << qshift) + (c_j << cshift)             X = max(P_j, F_j, G_j)
+        a_j = s_j >> ashift                                  G_j
+
+    every right shift a floor (drops bits, no rounding adder); the bias is
+    paid for in the coefficients (:func:`sized_bound` centres each segment's
+    error). ``P_j`` defaults to ``max(G_j, F_j)``.
+
+    >>> st = sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]
+    >>> st["pf"], st["X"], st["pshift"], st["cshift"], st["ashift"]   # pf = G_1 + T_0
+    (11, 10, 1, 0, 1)
+    """
+    L, n, _, F, T, G = shape[:6]
+    P = shape[7] if len(shape) > 7 and shape[7] else None
+    out = []
+    for j in range(n - 1, -1, -1):
+        pf = G[j + 1] + T[j]
+        Pj = P[j] if P else max(G[j], F[j])
+        X = max(Pj, G[j], F[j])
+        st = {"j": j, "tshift": L - T[j], "pf": pf, "P": Pj, "X": X, "pshift": pf - Pj,
+              "qshift": X - Pj, "cshift": X - F[j], "ashift": X - G[j], "rows": ()}
+        if len(shape) > 6 and shape[6] and pf > Pj:
+            # row i of the multiplier: bit i of t's code times a_{j+1} * 2^i, every bit
+            # below column P dropped (a floor: a >> (pshift - i)); centred, the top row
+            # is -a_{j+1} * 2^(T-1) gated by the inverted top bit (t = code - 2^(T-1))
+            st["rows"] = tuple((i, pf - Pj - i, bool(shape[2]) and i == T[j] - 1)
+                               for i in range(T[j]))
+        out.append(st)
+    return out
+
+
+def truncated_product(a, bits, rows):
+    """``sum_i bit_i * floor(+-a * 2^-shift_i)`` over ``rows = (i, shift, negated)``:
+    the truncated multiplier (``bits(i)`` gives row i's enabling bit, 0 or 1).
+
+    >>> truncated_product(7, lambda i: 1, ((0, 2, False), (1, 1, False)))   # 7>>2 + 7>>1
+    4
+    """
+    q = 0
+    for i, sh, neg in rows:
+        q = q + bits(i) * _shift(-a if neg else a, sh)
+    return q
+
+
+def _shift(v, sh: int):
+    return v >> sh if sh >= 0 else v << -sh
+
+
+def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
+    """Wires of the sized datapath for codes ``k`` (ROM ``rom[segment, j]``);
+    ``upto``: stop after the step computing ``a_upto``."""
+    L, n, centered, F, T, G = shape[:6]
+    s = k >> L
+    low = k & ((1 << L) - 1)
+    acc = rom[s, n]
+    w = {"s": s, f"a{n}": acc}
+    for st in sized_steps(shape):
+        j = st["j"]
+        tj = low >> st["tshift"]
+        if centered:
+            tj = tj - (1 << (T[j] - 1))
+        p = acc * tj
+        if st["rows"]:
+            code = low >> st["tshift"]
+            top = T[j] - 1
+
+            def bit(i, code=code, top=top):
+                b = (code >> i) & 1
+                return 1 - b if centered and i == top else b
+
+            q = truncated_product(acc, bit, st["rows"])
+        else:
+            q = _shift(p, st["pshift"])
+        sm = (q << st["qshift"]) + (rom[s, j] << st["cshift"])
+        acc = sm >> st["ashift"]
+        w.update({f"t{j}": tj, f"p{j}": p, f"q{j}": q, f"s{j}": sm, f"a{j}": acc})
+        if j == upto:
+            return w
+    if n == 0:
+        acc = _shift(acc, F[0] - G[0])
+        w["a0"] = acc
+    w["rounded"] = acc
+    return w
+
+
+def sized_bound(table: PiecewiseTable, shape, codes=None):
+    """Choose the ROM and certify the sized datapath, segment by segment.
+
+    Returns ``(rom, (approximation, datapath, total))``: ``rom[s][j]`` the
+    coefficient ``c_j`` of segment ``s`` with ``F_j`` fractional bits, and
+    exact (Fraction) bounds. For each segment the error ``e_j = a_j - â_j``
+    of each accumulator against the exact Horner value ``â_j`` of the table's
+    polynomial (coefficients ``q_j / 2^Fc``, local variable ``t``) is enclosed
+    in an interval, from the top::
+
+        e_n = c_n / 2^F_n - q_n / 2^Fc
+        e_j = e_{j+1} * t - a_{j+1} * tau_j - pi_j - sigma_j + delta_j
+
+    with ``t`` in its segment range, ``a_{j+1}`` in its exact range over the
+    segment's codes (the model's wires), ``tau_j`` in ``[0, 2^-T_j - 2^-L]``
+    (``t`` truncated), ``pi_j`` in ``[0, 2^-X - 2^-pf]`` (the product
+    truncated), ``sigma_j`` in ``[0, 2^-G_j - 2^-X]`` (the sum truncated)
+    and ``delta_j = c_j / 2^F_j - q_j / 2^Fc``, where ``c_j`` is chosen as
+    the ``F_j``-bit value nearest ``q_j / 2^Fc`` minus the middle of the rest
+    of ``e_j``'s interval (the truncations' bias is paid in the ROM, for
+    free). ``a_0`` is y's code: ``|y - f| <= approx_s + max |e_0|`` on
+    segment ``s``, rigorously (every term is enclosed; no floating point).
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+    >>> rom, (a, p, tot) = sized_bound(t, _Shape(6, 1, False, (10, 8), (6,), (8, 8)))
+    >>> len(rom), tot <= a + p, p < Fraction(1, 2 ** 8)
+    (4, True, True)
+    """
+    L, n, centered, F, T, G = shape[:6]
+    fc = table.coef_frac_bits
+    nseg = table.segment_count
+    k = np.arange(nseg << L, dtype=np.int64) if codes is None else codes
+    # every interval end is an integer in units of 2^-D (D above every fractional
+    # width in play); products with t are rounded outward back to 2^-D (rigorous)
+    D = max([fc, L, *F, *G, *(shape[7] if len(shape) > 7 else ())]
+            + [G[j + 1] + T[j] for j in range(n)]) + 4
+    Q = [np.array([seg.integers[j] for seg in table.segments], dtype=object) << (D - fc)
+         for j in range(n + 1)]
+    tl = -(1 << (L - 1)) if centered else 0          # t's range in units of 2^-L
+    th = (1 << L) - 1 + tl
+    rom = np.zeros((nseg, n + 1), dtype=object)
+
+    def nearest(v, sh):  # round(v / 2^sh), ties up; sh >= 1
+        return (v + (1 << (sh - 1))) >> sh
+
+    lo = hi = None
+    if n > 0:
+        rom[:, n] = nearest(Q[n], D - F[n])
+        lo = hi = (rom[:, n] << (D - F[n])) - Q[n]
+    for st in sized_steps(shape):
+        j = st["j"]
+        rom_i = _int_rom(rom)
+        w = _run_sized(rom_i, k, shape, upto=j + 1) if j + 1 < n else {f"a{n}": rom_i[k >> L, n]}
+        a = w[f"a{j + 1}"].reshape(nseg, -1)
+        amin, amax = a.min(axis=1).astype(object), a.max(axis=1).astype(object)
+        prods = (lo * tl, lo * th, hi * tl, hi * th)
+        plo = np.minimum(np.minimum(prods[0], prods[1]), np.minimum(prods[2], prods[3])) >> L
+        phi = -(-np.maximum(np.maximum(prods[0], prods[1]), np.maximum(prods[2], prods[3])) >> L)
+        taum = (1 << (L - T[j])) - 1                      # tau_j's top in units of 2^-L
+        at_lo, at_hi = np.minimum(amin * taum, 0), np.maximum(amax * taum, 0)
+        sh = D - G[j + 1] - L
+        if sh >= 0:
+            at_lo, at_hi = at_lo << sh, at_hi << sh
+        else:
+            at_lo, at_hi = at_lo >> -sh, -(-at_hi >> -sh)
+        if st["rows"]:  # each truncated row floors: error in (-(1 - 2^-shift), 0] ulps of P
+            pi = sum((1 << (D - st["P"])) - (1 << (D - st["P"] - sh))
+                     for _, sh, _ in st["rows"] if sh > 0)
+        elif st["pshift"] > 0:
+            pi = (1 << (D - st["P"])) - (1 << (D - st["pf"]))
+        else:
+            pi = 0
+        sigma = (1 << (D - G[j])) - (1 << (D - st["X"]))
+        lo, hi = plo - at_hi - pi - sigma, phi - at_lo
+        rom[:, j] = nearest(2 * Q[j] - (lo + hi), D + 1 - F[j])
+        d = (rom[:, j] << (D - F[j])) - Q[j]
+        lo, hi = lo + d, hi + d
+    if n == 0:  # y = c_0 shifted to G_0 bits: a truncation when F_0 > G_0
+        sigma = max(0, (1 << (D - G[0])) - (1 << (D - F[0])))
+        rom[:, 0] = nearest(Q[0] + sigma // 2, D - F[0])
+        d = (rom[:, 0] << (D - F[0])) - Q[0]
+        lo, hi = d - sigma, d
+    # per segment approximation + datapath, in integers (floats are dyadic: exact)
+    approx = [Fraction(seg.abs_error_bound) for seg in table.segments]
+    M = max([D] + [a_.denominator.bit_length() - 1 for a_ in approx])
+    path = [max(-int(x), int(y)) for x, y in zip(lo, hi)]
+    total = max(a_.numerator * (1 << (M - a_.denominator.bit_length() + 1)) + (p_ << (M - D))
+                for a_, p_ in zip(approx, path))
+    return [tuple(int(v) for v in row) for row in rom], (max(approx), Fraction(max(path), 2 ** D),
+                                                         Fraction(total, 2 ** M))
+
+
+def _int_rom(rom) -> np.ndarray:
+    """The ROM as int64 when every value fits (the model's fast path), else Python ints."""
+    vals = [int(v) for v in rom.ravel()]
+    if vals and max(abs(v) for v in vals) < 2 ** 40:
+        return np.array(vals, dtype=np.int64).reshape(rom.shape)
+    return np.array(vals, dtype=object).reshape(rom.shape)
+
+
+def _check_sized_widths(widths, n: int, L: int, centered: bool, fy: int,
+                        truncated: bool = False) -> _Shape:
+    """``widths`` (a mapping with ``coef_frac``, ``t_keep``, ``acc_frac``) as a shape."""
+    if not isinstance(widths, dict) or not {"coef_frac", "t_keep", "acc_frac"} <= set(widths) \
+            or not set(widths) <= {"coef_frac", "t_keep", "acc_frac", "prod_frac"}:
+        raise ValueError("widths: expected None, 'auto' or a dict with keys coef_frac (n+1 "
+                         "values), t_keep (n values), acc_frac (n-1 values, for a_1..a_{n-1}) "
+                         "and optionally prod_frac (n values)")
+    P = tuple(check_width(v, "widths prod_frac", -8, 62) for v in widths.get("prod_frac", ()))
+    if P and len(P) != n:
+        raise ValueError(f"widths: degree {n} needs {n} prod_frac values; got {len(P)}")
+    F = tuple(check_width(v, "widths coef_frac", -8, 62) for v in widths["coef_frac"])
+    T = tuple(check_width(v, "widths t_keep", 1, L) for v in widths["t_keep"])
+    A = tuple(check_width(v, "widths acc_frac", -8, 62) for v in widths["acc_frac"])
+    if len(F) != n + 1 or len(T) != n or len(A) != max(n - 1, 0):
+        raise ValueError(f"widths: degree {n} needs {n + 1} coef_frac, {n} t_keep and "
+                         f"{max(n - 1, 0)} acc_frac values; got {len(F)}, {len(T)}, {len(A)}")
+    return _Shape(L, n, centered, F, T, (fy,) + A + ((F[n],) if n > 0 else ()), truncated, P)
+
+
+def _sized_design(proto: PiecewiseDesign, shape: _Shape, cuts=()) -> PiecewiseDesign | None:
+    """The sized design of ``shape``, or None when y's range does not fit ``out_bits``."""
+    t = proto.table
+    rom, bound = sized_bound(t, shape)
+    rom_i = _int_rom(np.array(rom, dtype=object))
+    k = np.arange(2 ** proto.in_bits, dtype=np.int64)
+    w = _run_sized(rom_i, k, shape)
+    r = w["rounded"]
+    y_off = int(r.min())
+    if int(r.max()) - y_off > 2 ** proto.out_bits - 1:
+        return None
+    n, L = shape.n, shape.L
+    widths, q_bits = [], []
+    for st in sized_steps(shape):
+        j = st["j"]
+        p, sm, a = w[f"p{j}"], w[f"s{j}"], w[f"a{j}"]
+        q_bits.append(max(signed_bits(int(w[f"q{j}"].min()), int(w[f"q{j}"].max())), 2))
+        for key in ("p", "q", "s"):
+            v = w[f"{key}{j}"]
+            check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
+                        f"wire {key}{j} of the sized Horner datapath")
+        widths.append((max(signed_bits(int(p.min()), int(p.max())), 2),
+                       max(signed_bits(int(sm.min()), int(sm.max())), 2),
+                       max(signed_bits(int(a.min()), int(a.max())), 2)))
+    cols = np.array(rom, dtype=object).reshape(len(rom), n + 1)
+    rom_bits = tuple(max(signed_bits(int(min(cols[:, j])), int(max(cols[:, j]))), 2)
+                     for j in range(n + 1))
+    return replace(proto, acc_frac_bits=max(shape.G[1:n], default=shape.G[0]),
+                   y_format=QFormat(proto.out_bits, shape.G[0], offset_code=y_off),
+                   rom_bits=rom_bits, t_bits=max(shape.T, default=L) + 1,
+                   widths=tuple(widths), top_frac_bits=shape.G[0], rounding="trunc",
+                   coef_frac=shape.F, t_keep=shape.T, acc_frac=shape.G,
+                   coefficients=tuple(rom), cuts=tuple(cuts), bound=bound,
+                   multipliers="truncated" if len(shape) > 6 and shape[6] else "full",
+                   prod_frac=tuple(st["P"] for st in sorted(sized_steps(shape),
+                                                            key=lambda st: st["j"])),
+                   q_bits=tuple(q_bits))
+
+
+def _meets(bound, max_error: Fraction, strict: bool) -> bool:
+    return bound[2] < max_error if strict else bound[2] <= max_error
+
+
+#: the greedy's default area proxy: Yosys cells per ROM bit against one per
+#: partial-product bit (as hw.piecewise_search's model)
+ROM_WEIGHT = 0.15
+
+
+def shape_cost(table: PiecewiseTable, shape, rom, rom_weight: float = ROM_WEIGHT) -> float:
+    """Area proxy of a sized datapath with ROM ``rom`` (:func:`sized_bound`):
+    ROM bits x ``rom_weight`` plus ``a x b`` per ``a x b`` multiplier (the
+    kept partial-product bits of a truncated one) plus each sum's
+    width, the widths from the exact wire ranges over all codes (one model run).
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
+    >>> sh = _Shape(6, 1, False, (10, 8), (6,), (8, 8))
+    >>> shape_cost(t, sh, sized_bound(t, sh)[0]) > 0
+    True
+    """
+    L, n = shape[0], shape[1]
+    rom_i = _int_rom(np.array(rom, dtype=object))
+    # a proxy: the wires' ranges on each segment's first, middle and last codes
+    local = np.array(sorted({0, 1, 1 << (L - 1), (1 << L) - 2, (1 << L) - 1}), dtype=np.int64)
+    seg = np.arange(table.segment_count, dtype=np.int64) << L
+    w = _run_sized(rom_i, (seg[:, None] + local[None, :]).ravel(), shape)
+
+    def bits(v) -> int:
+        return signed_bits(int(v.min()), int(v.max()))
+
+    cost = rom_weight * len(rom) * sum(bits(rom_i[:, j]) for j in range(n + 1))
+    for st in sized_steps(shape):
+        j = st["j"]
+        aw = bits(w[f"a{j + 1}"])
+        mul = (sum(max(aw - sh, 1) for _, sh, _ in st["rows"]) if st["rows"]
+               else aw * bits(w[f"t{j}"]))
+        cost += mul + bits(w[f"s{j}"])
+    return float(cost)
+
+
+def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bool,
+                truncated: bool = False, rom_weight: float = ROM_WEIGHT) -> _Shape:
+    """Greedy widths: start from ``Fy + 6`` fractional bits for every column and
+    accumulator and every bit of ``t`` (or, when that misses ``max_error``,
+    generous: the table's ``Fc`` for every column, ``Fy + 8`` accumulator
+    bits); then, round after round, try each width one bit lower and keep,
+    among the changes whose certified bound still meets ``max_error``, the one
+    that saves the most area (:func:`shape_cost`) per unit of error budget it
+    spends (a change that saves nothing only when no other is left, one that
+    costs area never; ties: the highest-order width first), until none is
+    left. Then trade: one width one bit higher, the descent again without it;
+    kept when the area drops. The result: no width can be one bit lower
+    without missing ``max_error`` or growing the area."""
+    t = proto.table
+    n, L, fc = t.degree, proto.local_bits, t.coef_frac_bits
+    start = {("F", j): max(fc, fy + 2) for j in range(n + 1)}
+    start.update({("T", j): L for j in range(n)})
+    start.update({("G", j): fy + 8 for j in range(1, n)})
+    start.update({("P", j): fy + 8 for j in range(n)})
+    floors = {"F": -8, "T": 1, "G": -8, "P": -8}
+    ceils = {"F": 62, "T": L, "G": 62, "P": 62}
+    # highest order first: F_n .. F_0, T_{n-1} .. T_0, P_{n-1} .. P_0, G_{n-1} .. G_1
+    order = sorted(start, key=lambda key: ("FTPG".index(key[0]), -key[1]))
+    memo: dict = {}
+
+    def shape(v):
+        F = tuple(v["F", j] for j in range(n + 1))
+        G = (fy,) + tuple(v["G", j] for j in range(1, n)) + ((F[n],) if n > 0 else ())
+        return _Shape(L, n, t.centered, F, tuple(v["T", j] for j in range(n)), G, truncated,
+                      tuple(v["P", j] for j in range(n)))
+
+    def judge(v):  # (meets, area, certified total), memoised
+        key = tuple(v[k] for k in order)
+        if key not in memo:
+            rom, b = sized_bound(t, shape(v))
+            ok = _meets(b, max_error, strict)
+            memo[key] = (ok, shape_cost(t, shape(v), rom, rom_weight) if ok else math.inf, b[2])
+        return memo[key]
+
+    def descend(cur, frozen=None):
+        _, cost, bound = judge(cur)
+        while True:
+            best = None
+            for key in order:
+                if key == frozen or cur[key] <= floors[key[0]]:
+                    continue
+                trial = dict(cur)
+                trial[key] -= 1
+                ok, c, b = judge(trial)
+                if not ok or c > cost:
+                    continue
+                # area saved per unit of the error budget spent (free moves last)
+                saved, spent = cost - c, b - bound
+                score = (True, saved / spent if spent > 0 else math.inf) if saved > 0 \
+                    else (False, -spent)
+                if best is None or score > best[0]:
+                    best = (score, trial)
+            if best is None:
+                return cur
+            cur = best[1]
+            _, cost, bound = judge(cur)
+
+    # a moderate start (6 guard bits everywhere) saves most of the walk down when it meets
+    cur = {key: (min(v, fy + 6) if key[0] in "FGP" else v) for key, v in start.items()}
+    if not judge(cur)[0]:
+        cur = dict(start)
+    ok, _, total = judge(cur)
+    if not ok:
+        approx = max(Fraction(seg.abs_error_bound) for seg in t.segments)
+        raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
+                         f"(certified {float(total):.6e}; approximation {float(approx):.6e}); "
+                         f"accepted: a table whose approximation bound leaves room for rounding")
+    cur = descend(cur)
+    for _ in range(2):  # trades, while one pays
+        gained = False
+        for key in order:
+            if cur[key] >= ceils[key[0]]:
+                continue
+            up = dict(cur)
+            up[key] += 1
+            trial = descend(up, frozen=key)
+            if judge(trial)[1] < judge(cur)[1]:
+                cur, gained = trial, True
+        if not gained:
+            break
+    return shape(descend(cur))
+
+
+def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
+    if pipeline is None:
+        return ()
+    if pipeline == "full":
+        return tuple(range(n + 1))
+    if isinstance(pipeline, (str, bytes)) or not hasattr(pipeline, "__iter__"):
+        raise ValueError(f"pipeline: {pipeline!r}; accepted: None, 'full' or cut points in "
+                         f"0..{n} (0 after the ROM, i after the i-th multiply-add)")
+    cuts = sorted({check_width(c, "pipeline cut", 0, n) for c in pipeline})
+    return tuple(cuts)
+
+
 def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
-                     guard_bits: int = 2, name: str | None = None) -> PiecewiseDesign:
+                     guard_bits: int = 2, name: str | None = None, widths=None,
+                     max_error=None, pipeline=None, multipliers: str = "full",
+                     rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
     """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
 
     ``in_bits`` must exceed the table's index bits (the rest is the local
-    variable); the accumulators carry ``y_frac_bits + guard_bits`` fractional
-    bits. Raises ValueError naming the value and the accepted range.
+    variable). Raises ValueError naming the value and the accepted range.
+
+    Parameters
+    ----------
+    table : PiecewiseTable
+        A uniform table (its coefficients ``q_j / 2^Fc``).
+    in_bits, out_bits : int
+        Widths of the input code and of the output code.
+    guard_bits : int
+        ``widths=None`` only: the accumulators carry ``y_frac_bits +
+        guard_bits`` fractional bits, rounded to nearest after each step.
+    name : str, optional
+        Module name stem (default: the table's name).
+    widths : None, "auto" or dict
+        None (default, today's architecture): one ROM width for every
+        coefficient, an exact product and a rounding after each step.
+        Otherwise the *sized* architecture (:func:`sized_steps`): ROM column
+        ``j`` with its own ``F_j`` fractional bits, step ``j`` multiplying by
+        the top ``T_j`` bits of ``t``, products and sums truncated (floors;
+        the bias is paid in the ROM coefficients) to ``G_j`` accumulator
+        bits, the last one to y's. ``"auto"``: the greedy search of
+        :func:`_auto_shape` under ``max_error``; a dict ``{"coef_frac":
+        (F_0..F_n), "t_keep": (T_0..T_{n-1}), "acc_frac": (G_1..G_{n-1})}``
+        gives them. Every width change enters the certified bound
+        (:func:`sized_bound`).
+    max_error : float or str, optional
+        ``widths="auto"``: the certified total must be ``<= max_error``;
+        default: faithful, ``< 2^-Fy`` (one unit of y's last place), with
+        ``Fy`` the most fractional bits of y at which that is reachable and
+        y's range fits ``out_bits``.
+    pipeline : None, "full" or iterable of int
+        Sized architecture only: register cut points, ``0`` after the ROM
+        read, ``i`` after the ``i``-th multiply-add; ``"full"``: all
+        ``degree + 1``. ``latency`` is their number; the values are those of
+        the combinational datapath, ``latency`` cycles later.
+    multipliers : "full" or "truncated"
+        Sized architecture only: ``"full"`` multiplies exactly and then drops
+        the product's bits below ``X_j``; ``"truncated"`` never forms them:
+        each partial-product row is floored at column ``X_j``
+        (:func:`truncated_product`), the rows' errors enter the bound.
+    rom_weight : float
+        ``widths="auto"``: the greedy's price of one ROM bit against one
+        partial-product bit (:func:`shape_cost`; default :data:`ROM_WEIGHT`,
+        generic Yosys cells; an FPGA whose LUT6 holds 64 ROM bits wants less).
 
     Examples
     --------
@@ -252,6 +786,22 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         y_off = int(r.min())
         if int(r.max()) - y_off <= 2 ** out_bits - 1:
             break
+    if widths is not None:
+        if multipliers not in ("full", "truncated"):
+            raise ValueError(f"multipliers {multipliers!r}; accepted: 'full', 'truncated'")
+        return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated",
+                             span, _check_weight(rom_weight))
+    if pipeline is not None or multipliers != "full":
+        raise ValueError("pipeline, multipliers: need the sized architecture; accepted: "
+                         "widths='auto' or a widths dict with them, or their defaults")
+    return _uniform_design(proto, w, fa, fy, y_off)
+
+
+def _uniform_design(proto: PiecewiseDesign, w: dict, fa: int, fy: int,
+                    y_off: int) -> PiecewiseDesign:
+    """The one-width design from the wires ``w`` of its datapath at ``fa``
+    accumulator and ``fy`` output fractional bits (each wire checked for int64)."""
+    table, L = proto.table, proto.local_bits
     for key, v in w.items():
         if key[0] in "psa" and key != "s":
             check_int64(signed_bits(int(v.min()), int(v.max())) + 1,
@@ -266,9 +816,65 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                        max(signed_bits(int(s.min()), int(s.max())), 2),
                        max(signed_bits(int(out.min()), int(out.max())), 2)))
         check_int64(widths[-1][1], f"the sum of Horner step {j}")
-    return PiecewiseDesign(name, table, in_bits, out_bits, L, fa,
-                           QFormat(out_bits, fy, offset_code=y_off), rom_bits, L + 2,
-                           tuple(widths), int(w["top_frac"]))
+    return replace(proto, acc_frac_bits=fa, y_format=QFormat(proto.out_bits, fy, offset_code=y_off),
+                   widths=tuple(widths), top_frac_bits=int(w["top_frac"]))
+
+
+def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
+                  truncated: bool = False, span: Fraction = Fraction(0),
+                  rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
+    """:func:`design_piecewise` with ``widths`` given: y's fractional bits
+    lowered from the uniform design's ``fy`` until y's range fits (``span``:
+    the exact polynomial's range of values)."""
+    t = proto.table
+    n, L = t.degree, proto.local_bits
+    cuts = _check_cuts(pipeline, n)
+    if max_error is None:
+        limit, strict = None, True
+    else:
+        limit, strict = _error_limit(max_error), False
+    failed = None
+    for f in range(fy, fy - 8, -1):
+        lim = Fraction(1, 2 ** f) if limit is None else limit
+        if widths == "auto":
+            try:  # faithful at fewer fractional bits of y may still be reachable
+                shape = _auto_shape(proto, f, lim, strict, truncated, rom_weight)
+            except ValueError as exc:
+                # only where y's range is tight at f bits is f given up for fewer bits
+                # (else max_error is out of reach and y keeps its last place)
+                if span * 2 ** f + 2 <= 2 ** proto.out_bits - 1:
+                    if limit is None:
+                        raise ValueError(f"max_error None (faithful: error < 2^-{f}, y's last "
+                                         f"place): {exc}") from None
+                    raise
+                failed = failed or exc
+                continue
+        else:
+            shape = _check_sized_widths(widths, n, L, t.centered, f, truncated)
+        d = _sized_design(proto, shape, cuts)
+        if d is not None:
+            return d
+    if failed is not None:
+        raise failed
+    raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+
+
+def _check_weight(w) -> float:
+    if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or w < 0:
+        raise ValueError(f"rom_weight {w!r}: accepted a finite number >= 0")
+    return float(w)
+
+
+def _error_limit(max_error) -> Fraction:
+    if isinstance(max_error, str):
+        v = parse_number(max_error)
+        if not v.is_Rational or v <= 0:
+            raise ValueError(f"max_error {max_error!r}: accepted a positive rational (2^-16, 1e-5)")
+        return Fraction(int(v.p), int(v.q))
+    if isinstance(max_error, bool) or not isinstance(max_error, (int, float, Fraction)) or \
+            not math.isfinite(max_error) or max_error <= 0:
+        raise ValueError(f"max_error {max_error!r}: accepted a positive finite number")
+    return Fraction(max_error)
 
 
 # -- HDL (printed by chebnorm.hw.hdl) ----------------------------------------------

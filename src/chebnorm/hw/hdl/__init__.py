@@ -7,7 +7,9 @@ A *design* is a sized, bit-accurate evaluator of a table:
   or pipelined;
 * a :class:`~chebnorm.hw.piecewise.PiecewiseDesign` (``design_piecewise``:
   coefficient ROM + one Horner datapath of a uniform
-  :class:`~chebnorm.approx.PiecewiseTable`), combinational.
+  :class:`~chebnorm.approx.PiecewiseTable`), combinational, or -- the sized
+  architecture with ``pipeline=`` -- with registers at its cut points (the
+  module then has ``clk`` and ``LATENCY``; its bench is clocked).
 
 Each is printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008 (:mod:`.vhdl`),
 bit for bit the design's model, with an exhaustive self-checking bench that
@@ -32,10 +34,10 @@ from chebnorm.approx.piecewise_table import PiecewiseTable
 from ..horner import HornerDesign
 from .common import (LANGUAGES, SUFFIX, check_language, comment_lines, horner_facts,
                      module_name, piecewise_facts, pipelined_name, vector_file)
-from .verilog import (piecewise_verilog, verilog_module, verilog_pipelined_module,
-                      verilog_pipelined_testbench, verilog_testbench)
-from .vhdl import (piecewise_vhdl, piecewise_vhdl_testbench, vhdl_module, vhdl_pipelined_module,
-                   vhdl_pipelined_testbench, vhdl_testbench)
+from .verilog import (piecewise_clocked_testbench, piecewise_verilog, verilog_module,
+                      verilog_pipelined_module, verilog_pipelined_testbench, verilog_testbench)
+from .vhdl import (piecewise_vhdl, piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench,
+                   vhdl_module, vhdl_pipelined_module, vhdl_pipelined_testbench, vhdl_testbench)
 
 __all__ = ["LANGUAGES", "SUFFIX", "check_language", "is_piecewise", "module_text",
            "testbench_text", "hdl_text", "hdl_files", "banner_facts", "comment_lines",
@@ -74,7 +76,8 @@ def _printers(design, language: str, pipelined: bool):
     check_language(language)
     if pipelined and piecewise:
         raise ValueError("pipelined: not available for a piecewise design; accepted: "
-                         "pipelined=False (the combinational evaluator)")
+                         "pipelined=False (a piecewise design is pipelined by "
+                         "design_piecewise(..., pipeline=...): its module is clocked)")
     if pipelined and design.degree < 1:
         raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
                          f"degree >= 1")
@@ -135,6 +138,9 @@ def testbench_text(design, language: str = "verilog", *, pipelined: bool = False
     '-- tb_chebnorm_dichotomy_d1: exhaustive self-checking test bench of chebnorm_dichotomy_d1.'
     """
     _, bench = _printers(design, language, pipelined)
+    if is_piecewise(design) and design.latency > 0:
+        bench = {"verilog": piecewise_clocked_testbench,
+                 "vhdl": piecewise_vhdl_clocked_testbench}[language]
     return bench(design, vectors)
 
 

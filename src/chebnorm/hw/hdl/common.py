@@ -171,12 +171,24 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
               + (" - 1/2" if t.centered else ""),
               f"y: unsigned {design.out_bits}-bit code k, value = ({yf.offset_code} + k) / "
               f"2^{yf.frac_bits}",
-              f"ROM: coefficients q_j / 2^{fc}, widths {list(design.rom_bits)} bits (j ascending).",
+              f"ROM: coefficients q_j / 2^{fc}, widths {list(design.rom_bits)} bits (j ascending)."
+              if not design.sized else
+              f"ROM: coefficient c_j / 2^F_j, F = {list(design.coef_frac)}, widths "
+              f"{list(design.rom_bits)} bits (j ascending).",
               f"Rounding: {design.rounding} after each multiply-add; accumulators with "
-              f"{design.acc_frac_bits} fractional bits.",
+              f"{design.acc_frac_bits} fractional bits."
+              if not design.sized else
+              f"Step j multiplies by the top T_j bits of t, T = {list(design.t_keep)}; "
+              f"{design.multipliers} multipliers, products truncated (floor) to P = "
+              f"{list(design.prod_frac)} and sums to G = {list(design.acc_frac)} fractional "
+              f"bits (a_0 .. a_n); the bias is centred in the ROM.",
               f"Error budget |y - f(x)| <= {b['total']:.6e} = approximation "
               f"{b['approximation']:.6e} + Horner rounding {b['horner_rounding']:.6e} + output "
               f"rounding {b['output_rounding']:.6e}"]
+    if design.latency:
+        lines.append(f"Pipelined: registers at cut points {list(design.cuts)} (0 after the ROM, "
+                     f"i after the i-th multiply-add); latency {design.latency} cycles (LATENCY), "
+                     f"one result per cycle.")
     return lines
 
 

@@ -38,7 +38,8 @@ from .common import (comment_lines, horner_facts, module_name, piecewise_facts, 
                      vectors_name)
 
 __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
-           "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench"]
+           "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
+           "sized_piecewise_vhdl", "piecewise_vhdl_clocked_testbench"]
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"
@@ -152,11 +153,12 @@ def _vhdl_name(name: str) -> str:
 
 
 def _entity(name: str, design, clocked: bool) -> list[str]:
+    latency = design.latency if getattr(design, "latency", 0) else design.degree
     _vhdl_name(name)
     generics = [f"        IN_BITS  : natural := {design.in_bits};",
                 f"        OUT_BITS : natural := {design.out_bits}" + (";" if clocked else "")]
     if clocked:
-        generics.append(f"        LATENCY  : natural := {design.degree}")
+        generics.append(f"        LATENCY  : natural := {latency}")
     ports = (["        clk : in  std_logic;"] if clocked else []) + [
         "        x   : in  std_logic_vector(IN_BITS - 1 downto 0);",
         "        y   : out std_logic_vector(OUT_BITS - 1 downto 0)"]
@@ -280,10 +282,11 @@ _HEX = [
 ]
 
 
-def _bench(design, name: str, vectors: str | None, clocked: bool) -> str:
+def _bench(design, name: str, vectors: str | None, clocked: bool,
+           latency: int | None = None) -> str:
     vectors = vectors_name(name, vectors)
     count = 2 ** design.in_bits
-    n = design.degree
+    n = design.degree if latency is None else latency
     digits = (design.out_bits + 3) // 4
     latency = n if clocked else 1
     dut_generics = "IN_BITS => IN_BITS, OUT_BITS => OUT_BITS" + \
@@ -436,6 +439,8 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     >>> v.count("-- segment "), "entity chebnorm_rs is" in v   # one ROM row per segment and power
     (8, True)
     """
+    if d.sized:
+        return sized_piecewise_vhdl(d, version=version, command=command)
     t = d.table
     n, L, fc = t.degree, d.local_bits, t.coef_frac_bits
     name = module_name(d)
@@ -490,3 +495,151 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     '-- tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs.'
     """
     return _bench(d, module_name(d), vectors, clocked=False)
+
+
+def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
+    """The VHDL-2008 entity of a sized piecewise design ``d`` (``d.sized``),
+    bit for bit :func:`~chebnorm.hw.hdl.verilog.sized_piecewise_verilog`
+    (the same wire widths, the same cut registers; every width change
+    through ``wrap``).
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=16, name="rs")
+    >>> v = sized_piecewise_vhdl(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline=(0, 2)))
+    >>> v.count("rising_edge(clk)"), "LATENCY  : natural := 2" in v
+    (2, True)
+    """
+    t = d.table
+    n, L, K = t.degree, d.local_bits, t.index_bits
+    name = module_name(d)
+    out = comment_lines(piecewise_facts(d, version=version, command=command), "vhdl")
+    out += _entity(name, d, clocked=d.latency > 0)
+    b = _Body()
+    b.decl.append(f"    signal low : std_logic_vector({L - 1} downto 0);")
+    b.stmt.append(f"    low <= x({L - 1} downto 0);")
+    if K == 0:
+        for j in range(n + 1):
+            b.wire(f"c{j}", d.rom_bits[j], _bits(d.coefficients[0][j], d.rom_bits[j]))
+    else:
+        b.decl.append(f"    signal idx : unsigned({K - 1} downto 0);")
+        b.stmt.append(f"    idx <= unsigned(x({d.in_bits - 1} downto {L}));")
+        for j in range(n + 1):
+            w = d.rom_bits[j]
+            b.decl.append(f"    type rom{j}_t is array (0 to {2 ** K - 1}) of signed({w - 1} downto 0);")
+            rows = [f"        {_bits(row[j], w)}{',' if s < len(d.coefficients) - 1 else ''}"
+                    f"  -- segment {s}: {row[j]}" for s, row in enumerate(d.coefficients)]
+            b.decl += [f"    constant ROM{j} : rom{j}_t := (", *rows, "    );"]
+            b.wire(f"c{j}", w, f"ROM{j}(to_integer(idx))")
+    live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
+    cur = {k: k for k in live}
+    acc, accw = f"c{n}", d.rom_bits[n]
+
+    def cut(stage: int) -> None:
+        regs = []
+        for key, (w, sgn) in live.items():
+            r = f"{key}_r{stage}"
+            typ = f"signed({w - 1} downto 0)" if sgn else f"std_logic_vector({w - 1} downto 0)"
+            b.decl.append(f"    signal {r} : {typ};")
+            regs.append(f"            {r} <= {cur[key]};")
+            cur[key] = r
+        b.stmt.extend(["    process (clk)", "    begin", "        if rising_edge(clk) then", *regs,
+                       "        end if;", "    end process;"])
+
+    if 0 in d.cuts:
+        cut(0)
+    for i, st in enumerate(d.sized_signals(), start=1):
+        j, T, tw = st["j"], st["T"], st["tw"]
+        lo = cur["low"]
+        b.stmt.append(f"    -- step {j}: a{j} = (((a{j + 1} * t{j}) >> {st['pshift']}) << {st['qshift']}"
+                      f" + c{j} << {st['cshift']}) >> {st['ashift']}, t{j} = top {T} bits of t"
+                      + (", truncated multiplier" if st["rows"] else ""))
+        if t.centered:
+            rest = f" & {lo}({L - 2} downto {L - T})" if T > 1 else ""
+            b.wire(f"t{j}", tw, f"signed(not {lo}({L - 1} downto {L - 1}){rest})")
+        else:
+            b.wire(f"t{j}", tw, f"signed(\"0\" & {lo}({L - 1} downto {L - T}))")
+        pw, qw, sw, aw = st["pw"], st["qw"], st["sw"], st["aw"]
+        ps = st["pshift"]
+        if not st["rows"]:
+            b.wire(f"p{j}", pw, f"wrap({cur[acc]} * t{j}, {pw})")
+        if st["rows"]:
+            _truncated_rows(b, st, cur[acc], accw, lo)
+        elif ps > 0:
+            b.wire(f"q{j}", qw, f"wrap(shift_right(p{j}, {ps}), {qw})")
+        elif ps < 0:
+            b.wire(f"q{j}", qw, f"shift_left(wrap(p{j}, {qw}), {-ps})")
+        else:
+            b.wire(f"q{j}", qw, f"wrap(p{j}, {qw})")
+        ctx = max(qw, sw, d.rom_bits[j])
+        c = f"wrap({cur[f'c{j}']}, {ctx})"
+        c = f"shift_left({c}, {st['cshift']})" if st["cshift"] else c
+        qv = f"wrap(q{j}, {ctx})"
+        qv = f"shift_left({qv}, {st['qshift']})" if st["qshift"] else qv
+        b.wire(f"s{j}", sw, f"wrap({qv} + {c}, {sw})")
+        a_expr = f"shift_right(s{j}, {st['ashift']})" if st["ashift"] else f"s{j}"
+        b.wire(f"a{j}", aw, f"wrap({a_expr}, {aw})")
+        del live[f"c{j}"], cur[f"c{j}"]
+        live.pop(acc, None)
+        cur.pop(acc, None)
+        acc, accw = f"a{j}", aw
+        live[acc], cur[acc] = (aw, True), acc
+        if j == 0:
+            del live["low"]
+        if i in d.cuts:
+            cut(i)
+    top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]
+    if n == 0:
+        f0, g0 = d.coef_frac[0], d.acc_frac[0]
+        top_bits = d.rom_bits[0] + max(0, g0 - f0)
+        src = f"wrap({cur['c0']}, {top_bits})"
+        expr = (f"shift_right({src}, {f0 - g0})" if f0 > g0 else
+                f"shift_left({src}, {g0 - f0})" if g0 > f0 else src)
+        b.wire("a0", top_bits, expr)
+        cur["a0"] = acc = "a0"
+    _output(b, cur[acc], top_bits, d.y_format.frac_bits, d.y_format, d.out_bits, "trunc")
+    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
+            "end architecture rtl;", ""]
+    return "\n".join(out)
+
+
+def _truncated_rows(b: _Body, st: dict, a: str, aw: int, low: str) -> None:
+    """The truncated multiplier ``q_j``, as the Verilog printer writes it: one
+    row per bit of ``t_j``'s code, floored at column ``P``, gated, summed
+    modulo ``2^qw``."""
+    j, qw = st["j"], st["qw"]
+    if any(neg for _, _, neg in st["rows"]):
+        b.wire(f"na{j}", aw + 1, f"-wrap({a}, {aw + 1})")
+    terms = []
+    for i, sh, neg in st["rows"]:
+        src = f"na{j}" if neg else a
+        sw = max(aw + 1 if neg else aw, qw)
+        if sh > 0:
+            expr = f"wrap(shift_right(wrap({src}, {sw}), {sh}), {qw})"
+        elif sh < 0:
+            expr = f"shift_left(wrap({src}, {qw}), {-sh})"
+        else:
+            expr = f"wrap({src}, {qw})"
+        b.wire(f"r{j}_{i}", qw, expr)
+        bit = f"{low}({st['tshift'] + i})"
+        on = "'0'" if neg else "'1'"
+        b.wire(f"m{j}_{i}", qw, f"r{j}_{i} when {bit} = {on} else (others => '0')")
+        terms.append(f"m{j}_{i}")
+    b.wire(f"q{j}", qw, " + ".join(terms))
+
+
+def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
+    """Exhaustive bench of a pipelined piecewise entity (``d.latency > 0``):
+    one code per cycle, the output after edge ``i`` checked against code
+    ``i - LATENCY + 1``.
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline="full")
+    >>> [ln.strip() for ln in piecewise_vhdl_clocked_testbench(d).splitlines() if "LATENCY  :" in ln]
+    ['constant LATENCY  : natural := 2;']
+    """
+    return _bench(d, module_name(d), vectors, clocked=True, latency=d.latency)
