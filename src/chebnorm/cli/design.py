@@ -4,6 +4,7 @@ also the piecewise-table paths of ``chebnorm hw verilog`` and ``hw report``."""
 from __future__ import annotations
 
 import json
+import math
 
 from .common import command_line, print_json
 from .parallel_options import add_parallel_args, parallel_kwargs
@@ -21,7 +22,14 @@ def register(sub) -> None:
                    help="rational endpoints: the input code maps onto [LO, HI)")
     p.add_argument("--in-bits", type=int, required=True, help="input code width, 2..20")
     p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
-    p.add_argument("--max-error", type=float, required=True, help="bound on |y - f(x)|, > 0")
+    acc = p.add_mutually_exclusive_group(required=True)
+    acc.add_argument("--max-error", default=None, metavar="E",
+                     help="certified bound on |y - f(x)|, > 0 (a number or e.g. 2^-16)")
+    acc.add_argument("--faithful", action="store_true",
+                     help="certified |y - f(x)| < 1 unit of the output's last place (FloPoCo's "
+                     "contract)")
+    acc.add_argument("--correctly-rounded", action="store_true",
+                     help="every output code the proved rounding of f (a plain table)")
     p.add_argument("--degrees", type=int, nargs="+", default=[1, 2, 3], help="default 1 2 3")
     p.add_argument("--max-segments", default=None, metavar="2^k",
                    help="largest segment count tried, 2^0..2^min(12, in-bits - 1) (default "
@@ -38,13 +46,24 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _max_error(text) -> float:
+    """``--max-error`` as a float: a number or an exact expression such as ``2^-16``."""
+    from chebnorm.approx import parse_number
+
+    try:
+        value = float(parse_number(str(text).replace("^", "**")))
+    except (ValueError, TypeError, OverflowError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. 1e-5 or "
+                         f"2^-16")
+    return value
+
+
 def run(args) -> int:
     from pathlib import Path
 
-    from chebnorm.core.files import write_folder
-    from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.core.textsafe import identifier
-    from chebnorm.hw.piecewise_search import search
     from chebnorm.hw.targets import get_target
 
     name = identifier(args.name, field="name")
@@ -52,32 +71,156 @@ def run(args) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
-    res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, args.max_error,
-                 degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
-                 var=args.var, synth=not args.no_synth, name=name, target=target,
-                 **parallel_kwargs(args))
-    if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
-        best = min(res.points, key=lambda p: p.total_bound)
-        raise ValueError(f"no design meets --max-error {args.max_error:.4g}: the smallest "
-                         f"certified error reached is {best.total_bound:.4g} (degree {best.degree}, "
-                         f"{best.segments} segments, {best.coef_frac_bits} coefficient bits); "
-                         f"accepted: a larger --max-error, or more --max-segments, --degrees "
-                         f"or --out-bits")
+    accuracy = ("faithful" if args.faithful else "correctly-rounded" if args.correctly_rounded
+                else "max-error")
+    max_error = _max_error(args.max_error) if accuracy == "max-error" else None
+    if accuracy != "max-error" and args.no_synth:
+        raise ValueError(f"--{accuracy} compares architectures by synthesis; accepted: without "
+                         f"--no-synth (or --max-error E with --no-synth)")
+    others = []
+    if not args.no_synth:
+        others = _architectures(args, name, target, accuracy, max_error)
+    if accuracy == "correctly-rounded":
+        return _write_architectures(args, out, name, others, None)
+    if accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
+        ulps = [c.ulp for c in others if c.ulp is not None]
+        max_error = math.nextafter(min(ulps), 0.0)
+    res = _search(args, name, target, max_error)
     csv, png = res.csv(), res.plot_png()
     # the winner's place and route may fail (too large for the device): before writing
     figures = winner_figures(res) if res.winner.target_cost is not None else []
-    write_folder(out, {f"design_{name}.csv": csv, f"design_{name}.png": png})
-    print(out / f"design_{name}.csv")
-    print(out / f"design_{name}.png")
+    files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
+    best = _best_other(others)
+    if best is not None and best.cost.score < _score(res.winner):
+        return _write_architectures(args, out, name, others, res, files)
+    if others:
+        files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, winner=None)
+    write_folder_print(out, files)
     print("\n".join(res.explain()))
     w = res.winner
     if figures:
         print("\n".join(figures))
+    for c in others:
+        print(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None else ""))
     print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
           f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
           f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
           f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
     return 0
+
+
+def _search(args, name, target, max_error):
+    """The one-width piecewise Pareto search (:mod:`chebnorm.hw.piecewise_search`)."""
+    from chebnorm.approx.piecewise_table import parse_segments
+    from chebnorm.hw.piecewise_search import search
+
+    res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, max_error,
+                 degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
+                 var=args.var, synth=not args.no_synth, name=name, target=target,
+                 **parallel_kwargs(args))
+    if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
+        best = min(res.points, key=lambda p: p.total_bound)
+        raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
+                         f"certified error reached is {best.total_bound:.4g} (degree {best.degree}, "
+                         f"{best.segments} segments, {best.coef_frac_bits} coefficient bits); "
+                         f"accepted: a larger --max-error, or more --max-segments, --degrees "
+                         f"or --out-bits")
+    return res
+
+
+def _architectures(args, name, target, accuracy, max_error):
+    """The sized piecewise, multipartite and plain-table candidates, synthesized."""
+    from chebnorm.hw.architectures import architecture_candidates
+
+    degrees = sorted(set(args.degrees))
+    # the sized search starts where a one-width design of each degree first meets the
+    # error (a cheap model-only walk); four index bits below it when unknown
+    return architecture_candidates(args.expr, tuple(args.interval), args.in_bits, args.out_bits,
+                                   accuracy=accuracy, max_error=max_error, degrees=degrees,
+                                   k_start={d: max(0, min(args.in_bits - 2, 3 + 2 * (3 - d)))
+                                            for d in degrees},
+                                   var=args.var, name=name, target=target)
+
+
+def _score(point) -> float:
+    """A search point's figure on its target (yosys cells on generic)."""
+    if point.target_cost is not None:
+        return point.target_cost.score
+    return float(point.cost)
+
+
+def _best_other(others):
+    built = [c for c in others if c.design is not None and c.cost is not None]
+    return min(built, key=lambda c: (c.cost.score, c.architecture)) if built else None
+
+
+def _architectures_csv(others, res, winner) -> str:
+    import csv as csvmod
+    import io
+
+    from chebnorm.core.textsafe import csv_cell
+
+    buf = io.StringIO()
+    w = csvmod.writer(buf, lineterminator="\n")
+    w.writerow(["architecture", "description", "score", "cells", "luts", "dsps", "carries",
+                "brams", "error", "ulp", "winner", "note"])
+    if res is not None:
+        p = res.winner
+        c = p.target_cost
+        w.writerow(["piecewise", csv_cell(p.describe()), f"{_score(p):.1f}",
+                    "" if c is None else c.cells, "" if c is None else c.luts,
+                    "" if c is None else c.dsps, "" if c is None else c.carries,
+                    "" if c is None else c.brams, f"{p.total_bound:.6e}", "",
+                    int(winner is None), ""])
+    for o in others:
+        c = o.cost
+        w.writerow([o.architecture, csv_cell(o.description),
+                    "" if c is None else f"{c.score:.1f}", "" if c is None else c.cells,
+                    "" if c is None else c.luts, "" if c is None else c.dsps,
+                    "" if c is None else c.carries, "" if c is None else c.brams,
+                    "" if o.error is None else f"{o.error:.6e}",
+                    "" if o.ulp is None else f"{o.ulp:.6e}", int(o is winner), csv_cell(o.note)])
+    return buf.getvalue()
+
+
+def _write_architectures(args, out, name, others, res, files=None) -> int:
+    """A winner from another architecture: its Verilog and VHDL beside the CSVs."""
+    from chebnorm import __version__
+
+    best = _best_other(others)
+    if best is None:
+        raise ValueError("no architecture meets the accuracy asked (" + "; ".join(
+            c.line() for c in others) + "); accepted: more --out-bits, or --faithful / "
+            "--max-error instead of --correctly-rounded")
+    files = dict(files or {})
+    files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, best)
+    d = best.design
+    cmd = command_line(args)
+    if hasattr(d, "vhdl"):
+        files[f"{d.module_name}.v"] = d.verilog(version=__version__, command=cmd)
+        files[f"{d.module_name}.vhd"] = d.vhdl(version=__version__, command=cmd)
+    else:
+        from chebnorm.hw.hdl import module_text
+
+        files[f"{d.module_name}.v"] = module_text(d, "verilog", version=__version__, command=cmd)
+        files[f"{d.module_name}.vhd"] = module_text(d, "vhdl", version=__version__, command=cmd)
+    write_folder_print(out, files)
+    print(f"winner: {best.line()}")
+    if res is not None:
+        print(f"  piecewise (one width): {res.winner.describe()} -- score {_score(res.winner):.1f}"
+              f", costlier than the winner")
+    for c in others:
+        if c is not best:
+            print(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None else ""))
+    return 0
+
+
+def write_folder_print(out, files) -> None:
+    """Write ``files`` into the folder ``out`` (all or none) and print each path."""
+    from chebnorm.core.files import write_folder
+
+    for path in write_folder(out, dict(sorted(files.items()))):
+        print(path)
 
 
 def winner_figures(res) -> list[str]:
