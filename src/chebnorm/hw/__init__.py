@@ -33,6 +33,8 @@ from .verilog import SimResult, SynthResult, simulate, synthesize
 from .multipartite import (MultipartiteDesign, OffsetTable, design_multipartite,
                            multipartite_candidates)
 from .plain_table import PlainTableDesign, design_plain_table
+from .targets import TargetCost, fmax_ice40, synthesize_target
+from .architectures import Candidate, architecture_candidates
 from .hdl.tables import table_files, table_module
 from .table_run import simulate_table
 
@@ -54,4 +56,5 @@ __all__ = [
     "MultipartiteDesign", "OffsetTable", "design_multipartite", "multipartite_candidates",
     "PlainTableDesign",
     "design_plain_table", "table_module", "table_files", "simulate_table",
+    "TargetCost", "synthesize_target", "fmax_ice40", "Candidate", "architecture_candidates",
 ]
