@@ -98,14 +98,12 @@ class Candidate:
 
 
 def _sized(expr, interval, in_bits, out_bits, degrees, k_start, max_error, var, name, target):
-    """Per degree, the sized piecewise design with the fewest ROM bits among the
-    first segment counts (from ``k_start``) at which the width search meets the
-    error: ``[(degree, design, description)]``."""
+    """Every sized piecewise design that meets the error at the first segment
+    counts from ``k_start`` on: ``[(degree, design, description)]``."""
     mult = "full" if get_target(target).name == "xc7" else "truncated"
     found = []
     for degree in degrees:
         k0 = k_start.get(degree)
-        best = None
         for k in range(k0, min(k0 + 3, in_bits - 2) + 1) if k0 is not None else ():
             f_hi = out_bits + 10 if max_error is None else math.ceil(-math.log2(max_error)) + 10
             t = piecewise_fit(expr, interval, degree, segments=2 ** k,
@@ -116,13 +114,23 @@ def _sized(expr, interval, in_bits, out_bits, degrees, k_start, max_error, var, 
                                      multipliers=mult)
             except ValueError:  # not reachable at this segment count
                 continue
-            key = (sum(d.rom_bits) << k, k)
-            if best is None or key < best[0]:
-                best = (key, d, f"degree {degree}, {2 ** k} centred segments, ROM "
-                        f"{sum(d.rom_bits) << k} bits, {mult} multipliers")
-        if best is not None:
-            found.append((degree, best[1], best[2]))
+            found.append((degree, d, f"degree {degree}, {2 ** k} centred segments, ROM "
+                          f"{sum(d.rom_bits) << k} bits, {mult} multipliers"))
     return found
+
+
+def _cheapest_per_degree(cands: list[Candidate]) -> list[Candidate]:
+    """Per degree, the sized candidate of the lowest synthesized score (or, not
+    synthesized, of the fewest ROM bits)."""
+    best: dict[int, Candidate] = {}
+    for c in cands:
+        d = c.design
+        key = (c.cost.score if c.cost is not None else sum(d.rom_bits) << d.index_bits,
+               d.index_bits)
+        old = best.get(d.degree)
+        if old is None or key < old[0]:
+            best[d.degree] = (key, c)
+    return [best[k][1] for k in sorted(best)]
 
 
 def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,
@@ -186,4 +194,7 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
                Candidate(c.architecture, c.description, c.design, c.error, c.ulp,
                          synthesize_target(c.verilog, c.design.module_name, target))
                for c in out]
-    return out
+    sized = [c for c in out if c.architecture == "piecewise-sized" and c.design is not None]
+    keep = set(map(id, _cheapest_per_degree(sized)))
+    return [c for c in out if c.architecture != "piecewise-sized" or c.design is None
+            or id(c) in keep]
