@@ -29,8 +29,8 @@ HX8K ct256, seed 1, the module between input and output registers).
 
 Output: a Markdown table on stdout (deterministic row order), progress on
 stderr; ``--json PATH`` keeps every finished row (written after each one), and
-a rerun with the same ``--json`` reuses the rows already there (delete the
-file to measure afresh). A row that fails records the error and the run goes on.
+a rerun with the same ``--json`` reuses the rows finished there (delete the
+file to measure afresh; a failed row is tried again). A row that fails records the error and the run goes on.
 """
 
 from __future__ import annotations
@@ -167,9 +167,24 @@ def measure_row(spec, arch, cache, sim: bool) -> dict | None:
     row["targets"] = {t: synthesize_target(text, top, t).as_dict() for t in target_names()}
     for c in row["targets"].values():
         c.pop("by_type", None)
-    row["fmax_ice40_mhz"] = round(fmax_ice40(text, top, clocked=row.pop("clocked")), 2)
+    try:
+        row["fmax_ice40_mhz"] = round(fmax_ice40(text, top, clocked=row.pop("clocked")), 2)
+    except ValueError as e:   # e.g. a ROM needing more RAM blocks than the HX8K has
+        row["fmax_ice40_mhz"] = None
+        row["fmax_error"] = " ".join(str(e).split())[:400]
     row["seconds"] = round(time.perf_counter() - t0, 1)
     return row
+
+
+def _ram(cost: dict) -> str:
+    return f" + {cost['brams']} RAM" if cost.get("brams") else ""
+
+
+def _fmax(r: dict) -> str:
+    if r.get("fmax_ice40_mhz") is not None:
+        return f"{r['fmax_ice40_mhz']:.1f}"
+    err = r.get("fmax_error", "")
+    return "does not fit HX8K" if "no BELs remaining" in err else "failed (JSON)"
 
 
 def markdown(results: dict, specs) -> str:
@@ -189,8 +204,9 @@ def markdown(results: dict, specs) -> str:
             name = f"{arch} ({r['detail']})"
             lines.append(
                 f"| {spec[0]} | {name} | {t['generic']['cells']} | {t['xc7']['luts']} + "
-                f"{t['xc7']['dsps']} | {t['xc7-nodsp']['luts']} | {t['ice40']['luts']} | "
-                f"{r['fmax_ice40_mhz']:.1f} | {r['latency']} | {r['max_error_ulp']:.3f} |")
+                f"{t['xc7']['dsps']}{_ram(t['xc7'])} | {t['xc7-nodsp']['luts']}"
+                f"{_ram(t['xc7-nodsp'])} | {t['ice40']['luts']}{_ram(t['ice40'])} | "
+                f"{_fmax(r)} | {r['latency']} | {r['max_error_ulp']:.3f} |")
     return "\n".join(lines)
 
 
@@ -230,8 +246,8 @@ def main(argv=None) -> int:
     for spec, arch in bar:
         key = f"{spec[0]} | {arch}"
         bar.set_postfix_str(key)
-        if key in results:
-            continue
+        if key in results and (results[key] is None or "targets" in results[key]):
+            continue   # done (a failed row is tried again)
         sim = not args.no_sim and spec[0] not in simulated and (
             arch == "pw2 pipe" or (arch == "multipartite" and "pw2 pipe" not in
                                    {k.split(" | ")[1] for k, r in results.items()
