@@ -1,0 +1,274 @@
+"""Architectures per spec on every FPGA target (issue 28): faithful designs,
+checked exhaustively, synthesized by yosys, timed by nextpnr-ice40.
+
+    python benchmarks/bench_specs.py [--quick] [--json PATH] [--no-sim] [--spec I ...]
+
+For each spec (function, interval, input and output bits, faithful: error
+< 1 ulp of the output) and each architecture:
+
+* ``pw1``, ``pw2``: the sized piecewise polynomial (``design_piecewise(...,
+  widths="auto", multipliers="truncated")``, a width per coefficient) of
+  degree 1 and 2 on a centred uniform table; the segment count is the
+  cheapest faithful one of a small sweep (``2**k``, from the first ``k``
+  that is faithful, three counts) by the design's own area proxy
+  (:func:`chebnorm.hw.piecewise.shape_cost`, the greedy's price);
+* ``pw1 pipe``, ``pw2 pipe``: the same design fully pipelined
+  (``pipeline="full"``, latency = degree + 1 cycles);
+* ``multipartite``: ``design_multipartite`` (faithful, its own LUT model);
+* ``plain table``: ``design_plain_table`` (correctly rounded), only when
+  ``2**in_bits * out_bits <= 2**20`` ROM bits.
+
+Each design's exhaustive maximum error is measured (piecewise: ``measure()``
+against 40-digit mpmath; tables: ``measure()``, Arb enclosures) and must be
+below one output ulp; one design per spec (the pipelined degree-2 piecewise,
+else the multipartite) is simulated over every input code in Icarus Verilog
+against the bit-accurate model. Every design is synthesized on ``generic``,
+``xc7``, ``xc7-nodsp`` and ``ice40`` (:func:`chebnorm.hw.targets.synthesize_target`)
+and placed and routed by nextpnr-ice40 for Fmax (:func:`chebnorm.hw.targets.fmax_ice40`,
+HX8K ct256, seed 1, the module between input and output registers).
+
+Output: a Markdown table on stdout (deterministic row order), progress on
+stderr; ``--json PATH`` keeps every finished row (written after each one), and
+a rerun with the same ``--json`` reuses the rows finished there (delete the
+file to measure afresh; a failed row is tried again). A row that fails records the error and the run goes on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from fractions import Fraction
+from pathlib import Path
+
+from tqdm import tqdm
+
+from chebnorm.approx.piecewise_fit import piecewise_fit
+from chebnorm.core.files import write_atomic
+from chebnorm.hw.multipartite import design_multipartite
+from chebnorm.hw.piecewise import design_piecewise, shape_cost, simulate_piecewise
+from chebnorm.hw.plain_table import design_plain_table
+from chebnorm.hw.table_run import simulate_table
+from chebnorm.hw.targets import fmax_ice40, synthesize_target, target_names
+
+#: (label, expression, interval, in_bits, out_bits); the first is issue 28's
+SPECS = (
+    ("1/sqrt(1+3x) [0,1) 16b", "1/sqrt(1+3*x)", ("0", "1"), 16, 16),
+    ("2^x [0,1) 12b", "2**x", ("0", "1"), 12, 12),
+    ("exp(-x) [0,1) 14b", "exp(-x)", ("0", "1"), 14, 14),
+    ("1/sqrt(x) [1,4) 14b", "1/sqrt(x)", ("1", "4"), 14, 14),
+    ("sin(pi/2 x) [0,1) 16b", "sin(pi/2*x)", ("0", "1"), 16, 16),
+    ("log2(1+x) [0,1) 18b", "log(1+x)/log(2)", ("0", "1"), 18, 18),
+)
+ARCHS = ("pw1", "pw1 pipe", "pw2", "pw2 pipe", "multipartite", "plain table")
+#: segment counts tried per degree after the first faithful one
+SWEEP = 3
+PLAIN_LIMIT = 2 ** 20
+
+
+def _shape(d):
+    """The public shape tuple of a sized design (as :func:`sized_bound` takes it)."""
+    return (d.local_bits, d.degree, d.table.centered, d.coef_frac, d.t_keep, d.acc_frac,
+            d.multipliers == "truncated", d.prod_frac)
+
+
+def sized_piecewise(expr, interval, in_bits, out_bits, degree):
+    """The cheapest faithful sized piecewise design of ``degree`` over a sweep of
+    segment counts, by :func:`shape_cost`; (design, sweep notes)."""
+    fc = min(out_bits + 10, 40)
+    notes, found = [], []
+    for k in range(1, in_bits - degree - 1):
+        try:
+            t = piecewise_fit(expr, interval, degree, segments=2 ** k, coef_frac_bits=fc,
+                              centered=True, name=f"pw{degree}")
+            d = design_piecewise(t, in_bits, out_bits, widths="auto", multipliers="truncated")
+        except ValueError as e:
+            if found:
+                notes.append(f"2^{k}: {str(e)[:80]}")
+                break
+            continue
+        cost = shape_cost(t, _shape(d), d.coefficients)
+        found.append((cost, k, d))
+        notes.append(f"2^{k}: proxy {cost:.0f}")
+        if len(found) == SWEEP:
+            break
+    if not found:
+        raise ValueError(f"no faithful degree-{degree} design for 2 .. 2^{in_bits - degree - 2} "
+                         f"segments")
+    cost, k, d = min(found, key=lambda c: (c[0], c[1]))
+    return d, {"segments": 2 ** k, "sweep": notes, "proxy": round(cost, 1)}
+
+
+def _piecewise_row(d, info) -> dict:
+    m = d.measure()
+    lsb = Fraction(1, 2 ** d.y_format.frac_bits)
+    return {"detail": f"{info['segments']} seg, F={list(d.coef_frac)}, T={list(d.t_keep)}",
+            "sweep": info["sweep"], "bound_ulp": round(d.budget()["total"] / float(lsb), 4),
+            "max_error_ulp": round(m["max_error"] / float(lsb), 4), "latency": d.latency,
+            "verilog": d_verilog(d), "top": d.module_name, "clocked": d.latency > 0}
+
+
+def d_verilog(d) -> str:
+    from chebnorm.hw.hdl import hdl_text
+
+    return hdl_text(d, "verilog")
+
+
+def _table_row(d, detail) -> dict:
+    m = d.measure()
+    lsb = 2.0 ** -d.y_format.frac_bits
+    return {"detail": detail, "bound_ulp": round(m["upper"] / lsb, 4),
+            "max_error_ulp": round(m["upper"] / lsb, 4), "latency": 0,
+            "verilog": d.verilog(), "top": d.module_name, "clocked": False}
+
+
+def build(spec, arch, cache):
+    """The design of ``arch`` for ``spec`` and its row fields (measured error)."""
+    _, expr, interval, wi, wo = spec
+    if arch.startswith("pw"):
+        degree = int(arch[2])
+        key = (spec[0], degree)
+        if key not in cache:
+            cache[key] = sized_piecewise(expr, interval, wi, wo, degree)
+        d, info = cache[key]
+        if arch.endswith("pipe"):
+            d = design_piecewise(d.table, wi, wo, widths="auto", multipliers="truncated",
+                                 pipeline="full")
+        return d, _piecewise_row(d, info)
+    if arch == "multipartite":
+        d = design_multipartite(expr, interval, wi, wo)
+        return d, _table_row(d, f"split {d.split}, guard {d.guard_bits}, ROM {d.rom_bits} b")
+    if 2 ** wi * wo > PLAIN_LIMIT:
+        return None, None
+    d = design_plain_table(expr, interval, wi, wo)
+    return d, _table_row(d, f"ROM {d.rom_bits} b, correctly rounded {d.correctly_rounded}")
+
+
+def simulate(d, arch) -> str:
+    with tempfile.TemporaryDirectory() as tmp:
+        r = simulate_piecewise(d, tmp) if arch.startswith("pw") else simulate_table(d, tmp)
+    return r.line
+
+
+def measure_row(spec, arch, cache, sim: bool) -> dict | None:
+    t0 = time.perf_counter()
+    d, row = build(spec, arch, cache)
+    if d is None:
+        return None
+    if row["max_error_ulp"] >= 1:
+        row["error"] = f"not faithful: measured {row['max_error_ulp']} ulp"
+    if sim:
+        row["simulation"] = simulate(d, arch)
+    text, top = row.pop("verilog"), row.pop("top")
+    row["targets"] = {t: synthesize_target(text, top, t).as_dict() for t in target_names()}
+    for c in row["targets"].values():
+        c.pop("by_type", None)
+    try:
+        row["fmax_ice40_mhz"] = round(fmax_ice40(text, top, clocked=row.pop("clocked")), 2)
+    except ValueError as e:   # e.g. a ROM needing more RAM blocks than the HX8K has
+        row["fmax_ice40_mhz"] = None
+        row["fmax_error"] = " ".join(str(e).split())[:400]
+    row["seconds"] = round(time.perf_counter() - t0, 1)
+    return row
+
+
+def _ram(cost: dict) -> str:
+    return f" + {cost['brams']} RAM" if cost.get("brams") else ""
+
+
+def _fmax(r: dict) -> str:
+    if r.get("fmax_ice40_mhz") is not None:
+        return f"{r['fmax_ice40_mhz']:.1f}"
+    err = r.get("fmax_error", "")
+    return "does not fit HX8K" if "no BELs remaining" in err else "failed (JSON)"
+
+
+def markdown(results: dict, specs) -> str:
+    head = ("| spec | architecture | generic cells | xc7 LUT+DSP | xc7-nodsp LUT | ice40 LUT4 "
+            "| ice40 Fmax MHz | latency | max error / ulp |")
+    lines = [head, "|" + "---|" * 9]
+    for spec in specs:
+        for arch in ARCHS:
+            r = results.get(f"{spec[0]} | {arch}")
+            if r is None:
+                continue
+            if "targets" not in r:
+                lines.append(f"| {spec[0]} | {arch} | failed: {r.get('error', '?')[:90]} "
+                             f"| | | | | | |")
+                continue
+            t = r["targets"]
+            name = f"{arch} ({r['detail']})"
+            lines.append(
+                f"| {spec[0]} | {name} | {t['generic']['cells']} | {t['xc7']['luts']} + "
+                f"{t['xc7']['dsps']}{_ram(t['xc7'])} | {t['xc7-nodsp']['luts']}"
+                f"{_ram(t['xc7-nodsp'])} | {t['ice40']['luts']}{_ram(t['ice40'])} | "
+                f"{_fmax(r)} | {r['latency']} | {r['max_error_ulp']:.3f} |")
+    return "\n".join(lines)
+
+
+def _versions() -> dict:
+    out = {}
+    for tool, arg in (("yosys", "-V"), ("nextpnr-ice40", "--version"), ("iverilog", "-V")):
+        try:
+            p = subprocess.run([tool, arg], capture_output=True, text=True, timeout=30,
+                               stdin=subprocess.DEVNULL)
+            out[tool] = (p.stdout + p.stderr).strip().splitlines()[0]
+        except (OSError, IndexError, subprocess.SubprocessError):
+            out[tool] = "unavailable"
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="only the issue-28 spec")
+    ap.add_argument("--json", help="keep the rows here (and reuse those already there)")
+    ap.add_argument("--no-sim", action="store_true", help="skip the Icarus simulations")
+    ap.add_argument("--spec", type=int, action="append", choices=range(len(SPECS)),
+                    help="run only these specs (indexes into SPECS; repeatable)")
+    args = ap.parse_args(argv)
+    specs = SPECS[:1] if args.quick else SPECS
+    if args.spec:
+        specs = tuple(SPECS[i] for i in sorted(set(args.spec)))
+    path = Path(args.json) if args.json else None
+    doc = {"results": {}}
+    if path is not None and path.exists():
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    results = doc.setdefault("results", {})
+    doc["versions"] = _versions()
+    cache: dict = {}
+    jobs = [(s, a) for s in specs for a in ARCHS]
+    simulated: set = {k.split(" | ")[0] for k, r in results.items() if r and r.get("simulation")}
+    bar = tqdm(jobs, file=sys.stderr, desc="bench_specs")
+    for spec, arch in bar:
+        key = f"{spec[0]} | {arch}"
+        bar.set_postfix_str(key)
+        if key in results and (results[key] is None or "targets" in results[key]):
+            continue   # done (a failed row is tried again)
+        sim = not args.no_sim and spec[0] not in simulated and (
+            arch == "pw2 pipe" or (arch == "multipartite" and "pw2 pipe" not in
+                                   {k.split(" | ")[1] for k, r in results.items()
+                                    if k.startswith(spec[0]) and r and "targets" in r}))
+        t0 = time.perf_counter()
+        try:
+            row = measure_row(spec, arch, cache, sim)
+        except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
+            row = {"error": " ".join(str(e).split())[:300],
+                   "seconds": round(time.perf_counter() - t0, 1)}
+        if row is not None and row.get("simulation"):
+            simulated.add(spec[0])
+        results[key] = row
+        tqdm.write(f"{key}: {json.dumps(row, sort_keys=True)[:400]}", file=sys.stderr)
+        if path is not None:
+            doc["load"] = os.getloadavg()
+            write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+    print(markdown(results, specs))
+    print(f"\n{doc['versions']}; load {tuple(round(v, 2) for v in os.getloadavg())}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
