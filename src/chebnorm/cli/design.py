@@ -186,6 +186,7 @@ def _architectures_csv(others, res, winner) -> str:
 def _write_architectures(args, out, name, others, res, files=None) -> int:
     """A winner from another architecture: its Verilog and VHDL beside the CSVs."""
     from chebnorm import __version__
+    from chebnorm.hw.targets import get_target
 
     best = _best_other(others)
     if best is None:
@@ -204,8 +205,17 @@ def _write_architectures(args, out, name, others, res, files=None) -> int:
 
         files[f"{d.module_name}.v"] = module_text(d, "verilog", version=__version__, command=cmd)
         files[f"{d.module_name}.vhd"] = module_text(d, "vhdl", version=__version__, command=cmd)
+    figures = []
+    if get_target(args.target).name != "generic":  # before writing: place and route may fail
+        from chebnorm.hw.targets import target_figures
+
+        fig = target_figures(best.verilog, d.module_name, args.target, cost=best.cost,
+                             latency=getattr(d, "latency", 0))
+        figures = [f"winner {fig['line']}", f"timing: {fig['timing']}"]
     write_folder_print(out, files)
     print(f"winner: {best.line()}")
+    if figures:
+        print("\n".join(figures))
     if res is not None:
         print(f"  piecewise (one width): {res.winner.describe()} -- score {_score(res.winner):.1f}"
               f", costlier than the winner")
