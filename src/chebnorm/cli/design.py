@@ -39,6 +39,11 @@ def register(sub) -> None:
                    help="price by this target's mapping: generic (yosys cells; default), xc7, "
                    "xc7-nodsp (LUT equivalents: a DSP48E1 = 264.2 LUTs) or ice40 (with "
                    "nextpnr-ice40 Fmax of the winner)")
+    p.add_argument("--frequency", default=None, metavar="MHZ",
+                   help="pipeline the winner to this clock (MHz > 0): registers at its stage "
+                   "boundaries until nextpnr-ice40's Fmax (ice40) or the sta model's (xc7, "
+                   "xc7-nodsp) reaches it, or the highest reached is said; the pipelined RTL "
+                   "is simulated cycle by cycle over every input code before it is written")
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
@@ -74,6 +79,7 @@ def run(args) -> int:
     accuracy = ("faithful" if args.faithful else "correctly-rounded" if args.correctly_rounded
                 else "max-error")
     max_error = _max_error(args.max_error) if accuracy == "max-error" else None
+    frequency = _frequency(args, target)
     if accuracy != "max-error" and args.no_synth:
         raise ValueError(f"--{accuracy} compares architectures by synthesis; accepted: without "
                          f"--no-synth (or --max-error E with --no-synth)")
@@ -88,13 +94,16 @@ def run(args) -> int:
     res = _search(args, name, target, max_error)
     csv, png = res.csv(), res.plot_png()
     # the winner's place and route may fail (too large for the device): before writing
-    figures = winner_figures(res) if res.winner.target_cost is not None else []
+    figures = winner_figures(res) if res.winner.target_cost is not None and \
+        frequency is None else []
     files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
     best = _best_other(others)
     if best is not None and best.cost.score < _score(res.winner):
         return _write_architectures(args, out, name, others, res, files)
     if others:
         files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, winner=None)
+    if frequency is not None:  # the one-width winner has no cut points: timed as it is
+        figures, _ = _pipelined(args, _winner_design(res), frequency)
     write_folder_print(out, files)
     print("\n".join(res.explain()))
     w = res.winner
@@ -107,6 +116,76 @@ def run(args) -> int:
           f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
           f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
     return 0
+
+
+def _frequency(args, target):
+    """``--frequency`` in MHz (None without it), checked with the target and synthesis."""
+    if getattr(args, "frequency", None) is None:
+        return None
+    from chebnorm.hw.pipeline import check_frequency
+
+    freq = check_frequency(args.frequency, "--frequency")
+    if target == "generic" or args.no_synth:
+        raise ValueError(f"--frequency {args.frequency} needs a device's timing; accepted: "
+                         f"--target ice40, xc7 or xc7-nodsp, without --no-synth")
+    return freq
+
+
+def _pipelined(args, design, frequency):
+    """Pipeline ``design`` to ``frequency`` (:mod:`chebnorm.hw.pipeline`) and
+    simulate the pipelined RTL over every code (Icarus Verilog; GHDL too for
+    its VHDL): (figure lines, the pipelined design). The shortfall, if any, is
+    one warning line on stderr."""
+    import sys
+    import warnings
+
+    from chebnorm.hw.pipeline import FrequencyWarning, pipeline_to_frequency, verify_pipelined
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FrequencyWarning)  # printed below, once
+        res = pipeline_to_frequency(design, args.target, frequency)
+    d = res.design
+    lines = [f"winner {res.cost.line()}", f"timing: {res.line()}"]
+    if res.latency > 0:
+        sim = verify_pipelined(d)
+        if not sim.passed:
+            raise ValueError(f"internal: the pipelined RTL of {d.module_name} disagrees with the "
+                             f"bit-accurate model ({sim.line}); nothing written")
+        lines.append(f"cycle-accurate simulation (Icarus Verilog, every code): {sim.line}")
+        vhdl = _verify_vhdl(d)
+        if vhdl is not None:
+            lines.append(f"cycle-accurate simulation (GHDL, every code): {vhdl}")
+    if not res.met:
+        print(f"chebnorm: warning: {res.shortfall()}", file=sys.stderr)
+    return lines, d
+
+
+def _verify_vhdl(d):
+    """GHDL's verdict on the pipelined VHDL over every code (None without GHDL)."""
+    import shutil
+    import tempfile
+
+    if shutil.which("ghdl") is None:
+        return None
+    from pathlib import Path
+
+    from chebnorm.hw.pipeline import design_files
+    from chebnorm.hw.vhdl import simulate_vhdl
+
+    with tempfile.TemporaryDirectory() as tmp:
+        for fname, text in design_files(d, "vhdl").items():
+            (Path(tmp) / fname).write_text(text, encoding="utf-8")
+        res = simulate_vhdl(tmp, d)
+    if not res.passed:
+        raise ValueError(f"internal: the pipelined VHDL of {d.module_name} disagrees with the "
+                         f"bit-accurate model ({res.line}); nothing written")
+    return res.line
+
+
+def _winner_design(res):
+    """The one-width search's winning design."""
+    return next(res.designs[k] for k, p in zip(sorted(res.designs), res.points)
+                if p is res.winner)
 
 
 def _search(args, name, target, max_error):
@@ -197,6 +276,11 @@ def _write_architectures(args, out, name, others, res, files=None) -> int:
     files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, best)
     d = best.design
     cmd = command_line(args)
+    figures = []
+    if getattr(args, "frequency", None) is not None:  # checked by _frequency
+        from chebnorm.hw.pipeline import check_frequency
+
+        figures, d = _pipelined(args, d, check_frequency(args.frequency))
     if hasattr(d, "vhdl"):
         files[f"{d.module_name}.v"] = d.verilog(version=__version__, command=cmd)
         files[f"{d.module_name}.vhd"] = d.vhdl(version=__version__, command=cmd)
@@ -205,8 +289,7 @@ def _write_architectures(args, out, name, others, res, files=None) -> int:
 
         files[f"{d.module_name}.v"] = module_text(d, "verilog", version=__version__, command=cmd)
         files[f"{d.module_name}.vhd"] = module_text(d, "vhdl", version=__version__, command=cmd)
-    figures = []
-    if get_target(args.target).name != "generic":  # before writing: place and route may fail
+    if not figures and get_target(args.target).name != "generic":  # may fail: before writing
         from chebnorm.hw.targets import target_figures
 
         fig = target_figures(best.verilog, d.module_name, args.target, cost=best.cost,

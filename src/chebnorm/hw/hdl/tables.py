@@ -22,10 +22,11 @@ from __future__ import annotations
 from chebnorm.core.textsafe import comment_text
 
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
-from .verilog import verilog_testbench
-from .vhdl import vhdl_testbench
+from .verilog import piecewise_clocked_testbench, verilog_testbench
+from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
-__all__ = ["table_facts", "table_module", "table_testbench", "table_files"]
+__all__ = ["TABLE_CUTS", "table_cuts", "table_facts", "table_module", "table_testbench",
+           "table_files"]
 
 
 def _kind(design) -> str:
@@ -88,8 +89,28 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
                      + (" (faithful)" if design.faithful else "") + ".")
     lines.append(f"Proved over all {c.codes} codes (Arb enclosures of f): |y - f(x)| <= "
                  f"{c.upper:.6e} = {c.upper * 2.0 ** yf.frac_bits:.4f} LSB of y.")
-    lines.append("Combinational.")
+    cuts = table_cuts(design)
+    lines.append(f"Pipelined: registers at {', '.join(TABLE_CUTS[c] for c in cuts)}; latency "
+                 f"{len(cuts)} cycles (LATENCY), one result per cycle." if cuts else
+                 "Combinational.")
     return lines
+
+
+#: a multipartite design's cut points: 0 after the table reads, 1 after the offsets' sum
+TABLE_CUTS = {0: "the table reads", 1: "the offsets' sum"}
+
+
+def table_cuts(design) -> tuple[int, ...]:
+    """The pipeline cut points of a table design (``design.cuts``; none for a
+    plain table, whose one ROM read has no inner boundary here): ``0`` after
+    the table reads, ``1`` after the sum of the offset tables."""
+    cuts = tuple(getattr(design, "cuts", ()) or ())
+    if cuts and (_kind(design) != "multipartite" or not set(cuts) <= set(TABLE_CUTS)
+                 or list(cuts) != sorted(set(cuts))):
+        raise ValueError(f"cuts {list(cuts)[:8]}: accepted: a multipartite design's sorted "
+                         f"cut points among 0 (after the table reads) and 1 (after the "
+                         f"offsets' sum)")
+    return cuts
 
 
 def _hex(value: int, bits: int) -> str:
@@ -104,12 +125,26 @@ def _verilog_rom(out: list[str], reg: str, addr: str, abits: int, width: int, va
     out += [f"            default: {reg} = {_hex(0, width)};", "        endcase", "    end"]
 
 
+def _verilog_regs(out: list[str], cur: dict, widths: dict, stage: int) -> None:
+    """Register every signal of ``cur`` (name -> current wire) at ``stage``."""
+    regs = []
+    for key in cur:
+        r = f"{key}_r{stage}"
+        out.append(f"    reg [{widths[key] - 1}:0] {r};")
+        regs.append(f"        {r} <= {cur[key]};")
+        cur[key] = r
+    out.extend(["    always @(posedge clk) begin", *regs, "    end"])
+
+
 def _verilog(design, facts: list[str]) -> str:
     name = module_name(design)
     w = design.in_bits
+    cuts = table_cuts(design)
     out = comment_lines(facts, "verilog")
     out += [f"module {name} #(", f"    parameter IN_BITS = {w},",
-            f"    parameter OUT_BITS = {design.out_bits}", ") (",
+            f"    parameter OUT_BITS = {design.out_bits}" + ("," if cuts else ""),
+            *([f"    parameter LATENCY = {len(cuts)}"] if cuts else []), ") (",
+            *(["    input  wire                clk,"] if cuts else []),
             "    input  wire [IN_BITS-1:0]  x,", "    output wire [OUT_BITS-1:0] y", ");"]
     if design.architecture == "plain_table":
         _verilog_rom(out, "rom", "x", w, design.out_bits, design.values)
@@ -136,8 +171,15 @@ def _verilog(design, facts: list[str]) -> str:
             out.append(f"    wire [{t.width - 1}:0] o{i} = t{i};")
         terms.append(f"o{i}")
     ob = _offset_sum_bits(design)
-    out.append(f"    wire [{ob - 1}:0] osum = {' + '.join(terms)};")
-    out += [f"    wire [{s - 1}:0] acc = tiv + osum;",
+    cur = {"tiv": "tiv", **{o: o for o in terms}}
+    widths = {"tiv": s, "osum": ob, **{f"o{i}": t.width for i, t in enumerate(design.offsets)}}
+    if 0 in cuts:
+        _verilog_regs(out, cur, widths, 0)
+    out.append(f"    wire [{ob - 1}:0] osum = {' + '.join(cur.pop(o) for o in terms)};")
+    cur["osum"] = "osum"
+    if 1 in cuts:
+        _verilog_regs(out, cur, widths, 1)
+    out += [f"    wire [{s - 1}:0] acc = {cur['tiv']} + {cur['osum']};",
             f"    assign y = acc[{s - 1}:{g}];" if s - g == design.out_bits else
             f"    assign y = {{{{{design.out_bits - (s - g)}{{1'b0}}}}, acc[{s - 1}:{g}]}};",
             "endmodule", ""]
@@ -162,16 +204,32 @@ def _vhdl_rom(decl: list[str], stmt: list[str], sig: str, addr: str, width: int,
     stmt.append(f"    {sig} <= {sig.upper()}_ROM(to_integer(unsigned({addr})));")
 
 
+def _vhdl_regs(decl: list[str], stmt: list[str], cur: dict, widths: dict, stage: int) -> None:
+    """Register every signal of ``cur`` (name -> current signal) at ``stage``."""
+    regs = []
+    for key in cur:
+        r = f"{key}_r{stage}"
+        decl.append(f"    signal {r} : unsigned({widths[key] - 1} downto 0);")
+        regs.append(f"            {r} <= {cur[key]};")
+        cur[key] = r
+    stmt.extend([f"    regs{stage} : process (clk)", "    begin",
+                 "        if rising_edge(clk) then", *regs, "        end if;",
+                 f"    end process regs{stage};"])
+
+
 def _vhdl(design, facts: list[str]) -> str:
     name = module_name(design)
     if "__" in name or name.endswith("_"):
         raise ValueError(f"name {design.name!r} is not a VHDL identifier (two underscores in a "
                          f"row, or a trailing one); accepted: a name without them")
     w = design.in_bits
+    cuts = table_cuts(design)
     out = comment_lines(facts, "vhdl")
     out += ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
             f"entity {name} is", "    generic (", f"        IN_BITS  : natural := {w};",
-            f"        OUT_BITS : natural := {design.out_bits}", "    );", "    port (",
+            f"        OUT_BITS : natural := {design.out_bits}" + (";" if cuts else ""),
+            *([f"        LATENCY  : natural := {len(cuts)}"] if cuts else []), "    );",
+            "    port (", *(["        clk : in  std_logic;"] if cuts else []),
             "        x : in  std_logic_vector(IN_BITS - 1 downto 0);",
             "        y : out std_logic_vector(OUT_BITS - 1 downto 0)", "    );",
             f"end entity {name};", ""]
@@ -205,11 +263,19 @@ def _vhdl(design, facts: list[str]) -> str:
                             f"x({t.position + lb}));")
             else:
                 stmt.append(f"    o{i} <= t{i};")
-            terms.append(f"resize(o{i}, {ob})")
+            terms.append(f"o{i}")
+        cur = {"tiv": "tiv", **{o: o for o in terms}}
+        widths = {"tiv": s, "osum": ob,
+                  **{f"o{i}": t.width for i, t in enumerate(design.offsets)}}
+        if 0 in cuts:
+            _vhdl_regs(decl, stmt, cur, widths, 0)
         decl += [f"    signal osum : unsigned({ob - 1} downto 0);",
                  f"    signal acc : unsigned({s - 1} downto 0);"]
-        stmt += [f"    osum <= {' + '.join(terms)};",
-                 f"    acc <= tiv + resize(osum, {s});",
+        stmt.append(f"    osum <= {' + '.join(f'resize({cur.pop(o)}, {ob})' for o in terms)};")
+        cur["osum"] = "osum"
+        if 1 in cuts:
+            _vhdl_regs(decl, stmt, cur, widths, 1)
+        stmt += [f"    acc <= {cur['tiv']} + resize({cur['osum']}, {s});",
                  f"    y <= std_logic_vector(resize(acc({s - 1} downto {g}), OUT_BITS));"]
     out += [f"architecture rtl of {name} is", *decl, "begin", *stmt, "end architecture rtl;", ""]
     return "\n".join(out)
@@ -241,6 +307,10 @@ def table_testbench(design, language: str = "verilog") -> str:
     >>> table_testbench(d).splitlines()[0]
     '// tb_chebnorm_table: exhaustive self-checking test bench of chebnorm_table.'
     """
+    if table_cuts(design):  # clocked: one code per cycle, checked LATENCY cycles later
+        if check_language(language) == "verilog":
+            return piecewise_clocked_testbench(design)
+        return piecewise_vhdl_clocked_testbench(design)
     _kind(design)
     if check_language(language) == "verilog":
         return verilog_testbench(design)

@@ -1,0 +1,362 @@
+"""Pipelining a design to a clock frequency, FloPoCo-style (``design --frequency``).
+
+:func:`pipeline_to_frequency` starts from the combinational module, measures
+its Fmax on the target and adds pipeline registers at the most useful stage
+boundaries (:func:`cut_plans`) until the asked frequency is met or no cut is
+left; the result is the first plan (fewest registers) that meets it, or the
+fastest one measured when none does (with a :class:`FrequencyWarning`).
+
+Timing, per target (:mod:`chebnorm.hw.targets`):
+
+* ``ice40``: nextpnr-ice40's Fmax after place and route on the HX8K
+  (``ct256``, placer seed fixed), the module between input and output
+  registers -- a real figure;
+* ``xc7`` / ``xc7-nodsp``: the model -- yosys ``sta`` over the 7-series cell
+  delays, no routing (optimistic: it ranks, it does not sign off);
+* ``generic`` has no device and no time: refused.
+
+Cut points of a sized piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`
+with ``sized``): ``0`` after the ROM read, ``i`` after the ``i``-th
+multiply-add (the values are unchanged; ``latency`` cycles later). The plans
+balance the stages by a weight per stage (:data:`STAGE_WEIGHTS`: a
+multiply-add weighs two ROM reads). A multipartite design (:class:`PipelinedTable`)
+has two: after the table reads, after the offsets' sum. A plain table and the
+one-width piecewise design have none here (their plan list is empty: only the
+combinational module is measured).
+
+:func:`verify_pipelined` simulates the pipelined module cycle by cycle over
+every input code in Icarus Verilog (one code per clock; output ``i`` checked
+against the bit-accurate model's value of code ``i - latency``).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import warnings
+from dataclasses import dataclass, replace
+from itertools import combinations
+from pathlib import Path
+
+from .hdl import hdl_files, module_text
+from .hdl.tables import table_cuts, table_files, table_module
+from .targets import fmax_ice40, get_target, synthesize_target
+
+__all__ = ["FrequencyWarning", "PipelineStep", "PipelineResult", "PipelinedTable",
+           "STAGE_WEIGHTS", "check_frequency", "cut_plans", "design_files",
+           "pipeline_to_frequency", "verify_pipelined", "with_cuts"]
+
+#: relative delay of a stage: the ROM read, one multiply-add, the output saturation
+STAGE_WEIGHTS = {"rom": 1.0, "step": 2.0, "output": 0.5}
+#: nextpnr's timing-driven placement aims at most at this frequency (its range)
+MAX_PNR_MHZ = 1000.0
+
+
+class FrequencyWarning(UserWarning):
+    """The asked clock frequency was not reached (the highest reached is named)."""
+
+
+def check_frequency(value, name: str = "frequency") -> float:
+    """``value`` as a frequency in MHz: a finite number > 0 (text such as ``"250"``
+    is read as a number).
+
+    Raises
+    ------
+    ValueError
+        naming ``name`` and the accepted range.
+
+    >>> check_frequency("125.5")
+    125.5
+    >>> check_frequency(0)
+    Traceback (most recent call last):
+    ...
+    ValueError: frequency 0: accepted: a finite number of MHz > 0, e.g. 100
+    """
+    v = math.nan
+    if not isinstance(value, bool):
+        try:
+            v = float(value)
+        except (TypeError, ValueError, OverflowError):
+            v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{name} {str(value)[:40]}: accepted: a finite number of MHz > 0, "
+                         f"e.g. 100")
+    return v
+
+
+def _pipelinable(design) -> bool:
+    if getattr(design, "architecture", None) == "multipartite":
+        return True
+    return bool(getattr(design, "sized", False)) and hasattr(design, "cuts")
+
+
+def _base(design):
+    """``design`` without pipeline registers."""
+    if isinstance(design, PipelinedTable):
+        return design.base
+    return replace(design, cuts=()) if getattr(design, "sized", False) else design
+
+
+class PipelinedTable:
+    """A multipartite design with pipeline registers at ``cuts``
+    (:data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table reads,
+    ``1`` after the offsets' sum); every other attribute is the design's
+    (same values, ``latency`` cycles later).
+
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> p = PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
+    >>> p.latency, p.module_name, "parameter LATENCY = 2" in p.verilog()
+    (2, 'chebnorm_multipartite', True)
+    """
+
+    def __init__(self, base, cuts):
+        if getattr(base, "architecture", None) != "multipartite":
+            raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign")
+        self.base = base
+        self.cuts = tuple(cuts)
+        table_cuts(self)  # checked
+
+    def __getattr__(self, name):
+        if name == "base":  # not yet set (copy, pickle): no recursion
+            raise AttributeError(name)
+        return getattr(self.base, name)
+
+    @property
+    def latency(self) -> int:
+        """Clock cycles from ``x`` to ``y``."""
+        return len(self.cuts)
+
+    def verilog(self, *, version: str = "", command: str | None = None) -> str:
+        """The pipelined Verilog-2005 module (:func:`chebnorm.hw.hdl.tables.table_module`)."""
+        return table_module(self, "verilog", version=version, command=command)
+
+    def vhdl(self, *, version: str = "", command: str | None = None) -> str:
+        """The pipelined VHDL-2008 entity (:func:`chebnorm.hw.hdl.tables.table_module`)."""
+        return table_module(self, "vhdl", version=version, command=command)
+
+
+def _verilog(design) -> str:
+    return design.verilog() if hasattr(design, "verilog") else module_text(design, "verilog")
+
+
+def design_files(design, language: str = "verilog") -> dict:
+    """File name -> text of ``design``'s module, its exhaustive bench (clocked
+    when pipelined) and its vector file in ``language``."""
+    if getattr(design, "architecture", None) in ("multipartite", "plain_table"):
+        return table_files(design, language)
+    return hdl_files(design, language)
+
+
+def cut_plans(design) -> list[tuple[int, ...]]:
+    """The cut sets tried, one per latency ``1, 2, ...``: for each count of
+    registers the set whose heaviest stage (by :data:`STAGE_WEIGHTS`) is the
+    lightest, ties to the earliest cuts. Empty for a design without cut
+    points.
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=16, name="rs")
+    >>> cut_plans(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5))
+    [(1,), (0, 1), (0, 1, 2)]
+    >>> cut_plans(design_piecewise(t, 8, 8))
+    []
+    """
+    if not _pipelinable(design):
+        return []
+    if getattr(design, "architecture", None) == "multipartite":
+        return [(0,), (0, 1)]
+    n = design.degree
+    # stage k (k = 0 .. n+1) sits between cut point k-1 and k: the ROM, the steps, the output
+    weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["step"]] * n + [STAGE_WEIGHTS["output"]])
+
+    def worst(cuts) -> float:
+        edges = [0, *[c + 1 for c in cuts], len(weights)]
+        return max(sum(weights[a:b]) for a, b in zip(edges, edges[1:]))
+
+    return [min(combinations(range(n + 1), m), key=lambda c: (worst(c), c))
+            for m in range(1, n + 2)]
+
+
+def with_cuts(design, cuts):
+    """``design`` with pipeline registers at ``cuts`` (same values, ``len(cuts)``
+    cycles later); ValueError for a design without cut points."""
+    if not _pipelinable(design):
+        raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
+                         f"accepted: a sized piecewise design (design_piecewise(..., "
+                         f"widths=...))")
+    cuts = tuple(sorted(set(cuts)))
+    if getattr(design, "architecture", None) == "multipartite":
+        return PipelinedTable(_base(design), cuts)
+    if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= design.degree
+           for c in cuts):
+        raise ValueError(f"cuts {list(cuts)}: accepted: integers 0..{design.degree}")
+    return replace(design, cuts=cuts)
+
+
+@dataclass(frozen=True)
+class PipelineStep:
+    """One measured plan: its cut points, latency and Fmax in MHz."""
+
+    cuts: tuple[int, ...]
+    latency: int
+    fmax_mhz: float
+
+
+@dataclass(frozen=True)
+class PipelineResult:
+    """The outcome of :func:`pipeline_to_frequency`.
+
+    Attributes
+    ----------
+    design : object
+        The design chosen (with its cuts): the first plan meeting the
+        frequency, else the fastest measured (fewest registers on a tie).
+    target : str
+        The target timed.
+    frequency_mhz : float
+        The frequency asked.
+    met : bool
+        Whether ``fmax_mhz >= frequency_mhz``.
+    latency : int
+        Clock cycles from input to output (0: combinational).
+    fmax_mhz : float
+        The chosen design's Fmax.
+    source : str
+        Where the figure comes from (nextpnr-ice40 or the sta model).
+    cost : TargetCost
+        The chosen module's mapping on the target (its FFs are the extra
+        flip-flops: the combinational module has none).
+    steps : tuple of PipelineStep
+        Every plan measured, in order.
+    """
+
+    design: object
+    target: str
+    frequency_mhz: float
+    met: bool
+    latency: int
+    fmax_mhz: float
+    source: str
+    cost: object
+    steps: tuple
+
+    @property
+    def extra_ffs(self) -> int:
+        """Flip-flops the pipeline adds (the mapped module's FFs)."""
+        return int(self.cost.ffs)
+
+    def line(self) -> str:
+        """One line: latency, Fmax, the asked frequency and the extra FFs."""
+        verdict = "met" if self.met else "NOT met"
+        return (f"pipelined for {self.frequency_mhz:g} MHz ({verdict}): latency {self.latency} "
+                f"cycles, Fmax {self.fmax_mhz:.2f} MHz ({self.source}), {self.extra_ffs} extra "
+                f"FFs; {self.cost.line()}")
+
+    def shortfall(self) -> str:
+        """The one-line message when the frequency is not met (empty when met)."""
+        if self.met:
+            return ""
+        tried = ", ".join(f"{s.latency}: {s.fmax_mhz:.2f}" for s in self.steps)
+        why = ("no more cut points" if len(self.steps) > 1 else
+               "this architecture has no pipeline cut points")
+        return (f"{self.frequency_mhz:g} MHz not reached: the highest is {self.fmax_mhz:.2f} MHz "
+                f"at latency {self.latency} ({why}; MHz per latency {tried}; {self.source})")
+
+
+def _timing(design, target: str, frequency: float, seed: int):
+    """(Fmax MHz, source, TargetCost or None) of ``design``'s module on ``target``."""
+    text = _verilog(design)
+    top = design.module_name
+    clocked = getattr(design, "latency", 0) > 0
+    if target == "ice40":
+        f = fmax_ice40(text, top, clocked=clocked, freq_mhz=min(frequency, MAX_PNR_MHZ),
+                       seed=seed)
+        return f, f"nextpnr-ice40, HX8K ct256, placed and routed, seed {seed}", None
+    cost = synthesize_target(text, top, target, timing=True)
+    if not cost.delay_ns:
+        raise ValueError(f"yosys sta gave no delay for {top}")
+    return (1000.0 / cost.delay_ns,
+            "model: yosys sta, Artix-7 cell delays without routing (optimistic)", cost)
+
+
+def pipeline_to_frequency(design, target: str, frequency_mhz, *, seed: int = 1,
+                          warn: bool = True) -> PipelineResult:
+    """Pipeline ``design`` until its Fmax on ``target`` reaches ``frequency_mhz``.
+
+    Parameters
+    ----------
+    design : object
+        A design of :mod:`chebnorm.hw` (combinational). Only a sized
+        piecewise design has cut points (:func:`cut_plans`); any other is
+        measured as it is.
+    target : str
+        ``ice40`` (nextpnr-ice40 Fmax), ``xc7`` or ``xc7-nodsp`` (the sta
+        model); ``generic`` has no time and is refused.
+    frequency_mhz : float
+        The clock asked, MHz (:func:`check_frequency`).
+    seed : int
+        nextpnr-ice40's placer seed (same seed, same figure).
+    warn : bool
+        Issue a :class:`FrequencyWarning` when the frequency is not reached.
+
+    Returns
+    -------
+    PipelineResult
+
+    Raises
+    ------
+    ValueError
+        for a bad frequency, the ``generic`` target, or a tool failure.
+    """
+    freq = check_frequency(frequency_mhz, "frequency_mhz")
+    t = get_target(target)
+    if t.timing not in ("nextpnr", "sta"):
+        raise ValueError(f"target {t.name!r} has no device and no clock (gate depth only); "
+                         f"accepted for a frequency: ice40 (nextpnr-ice40), xc7 or xc7-nodsp "
+                         f"(the sta delay model)")
+    base = _base(design)
+    plans = [()] + cut_plans(base)
+    steps, measured = [], []
+    for cuts in plans:
+        d = with_cuts(base, cuts) if cuts else base
+        fmax, source, cost = _timing(d, t.name, freq, seed)
+        steps.append(PipelineStep(tuple(cuts), len(cuts), round(fmax, 2)))
+        measured.append((d, fmax, cost))
+        if fmax >= freq:
+            break
+    # the first plan meeting the frequency (the loop stopped there), else the fastest
+    i = len(measured) - 1 if measured[-1][1] >= freq else \
+        max(range(len(measured)), key=lambda k: (measured[k][1], -k))
+    d, fmax, cost = measured[i]
+    if cost is None:
+        cost = synthesize_target(_verilog(d), d.module_name, t.name)
+    res = PipelineResult(d, t.name, freq, fmax >= freq, len(steps[i].cuts), round(fmax, 2),
+                         source, cost, tuple(steps))
+    if warn and not res.met:
+        warnings.warn(res.shortfall(), FrequencyWarning, stacklevel=2)
+    return res
+
+
+def verify_pipelined(design, *, bench_design=None):
+    """Simulate ``design``'s module in Icarus Verilog over every input code, one
+    code per clock cycle, each output checked against the bit-accurate model
+    ``latency`` cycles later (combinational: every code at once).
+
+    ``bench_design``: print the bench of this design instead (same module
+    name and model, another latency) -- a deliberately wrong bench, which
+    must fail (the mutation test of the check itself).
+
+    Returns
+    -------
+    chebnorm.hw.verilog.SimResult
+    """
+    from .verilog import simulate
+
+    files = design_files(design, "verilog")
+    if bench_design is not None:
+        bench = design_files(bench_design, "verilog")
+        files = {k: (bench[k] if k.startswith("tb_") else v) for k, v in files.items()}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in files.items():
+            (Path(tmp) / name).write_text(text, encoding="utf-8")
+        return simulate(tmp, design)
