@@ -139,13 +139,16 @@ def _pipelined(args, design, frequency):
     import sys
     import warnings
 
-    from chebnorm.hw.pipeline import FrequencyWarning, pipeline_to_frequency, verify_pipelined
+    from chebnorm.hw.pipeline import (FrequencyWarning, cut_names, pipeline_to_frequency,
+                                      verify_pipelined)
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FrequencyWarning)  # printed below, once
         res = pipeline_to_frequency(design, args.target, frequency)
     d = res.design
-    lines = [f"winner {res.cost.line()}", f"timing: {res.line()}"]
+    lines = [f"timing: {res.line()}", "measured (latency: Fmax MHz): " + ", ".join(
+        f"{st.latency}: {st.fmax_mhz:.2f}" + (f" (after {', '.join(cut_names(design, st.cuts))})" if st.cuts else "")
+        for st in res.steps)]
     if res.latency > 0:
         sim = verify_pipelined(d)
         if not sim.passed:

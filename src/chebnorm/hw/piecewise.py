@@ -128,6 +128,7 @@ class PiecewiseDesign:
     acc_frac: tuple[int, ...] = ()       # G_j, j = 0..n: fractional bits of a_j (G_0 = y's)
     coefficients: tuple[tuple[int, ...], ...] = ()   # per segment, c_j / 2^F_j
     cuts: tuple[int, ...] = ()           # pipeline registers: 0 after the ROM, i after step i
+    mult_cuts: tuple[int, ...] = ()      # registers between the multiply and the add of step i
     multipliers: str = "full"            # "truncated": partial-product columns below P dropped
     prod_frac: tuple[int, ...] = ()      # P_j, j = 0..n-1: fractional bits kept of product j
     q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
@@ -149,7 +150,7 @@ class PiecewiseDesign:
     @property
     def latency(self) -> int:
         """Clock cycles from ``x`` to ``y``: the number of pipeline registers (0: combinational)."""
-        return len(self.cuts)
+        return len(self.cuts) + len(self.mult_cuts)
 
     @property
     def index_bits(self) -> int:

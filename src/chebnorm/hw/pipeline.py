@@ -16,10 +16,10 @@ Timing, per target (:mod:`chebnorm.hw.targets`):
 * ``generic`` has no device and no time: refused.
 
 Cut points of a sized piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`
-with ``sized``): ``0`` after the ROM read, ``i`` after the ``i``-th
-multiply-add (the values are unchanged; ``latency`` cycles later). The plans
-balance the stages by a weight per stage (:data:`STAGE_WEIGHTS`: a
-multiply-add weighs two ROM reads). A multipartite design (:class:`PipelinedTable`)
+with ``sized``): after the ROM read, after each multiply, after each add (the
+values are unchanged; ``latency`` cycles later). The plans balance the stages
+by a weight per stage (:data:`STAGE_WEIGHTS`: a multiply weighs two ROM reads
+or two adds). A multipartite design (:class:`PipelinedTable`)
 has two: after the table reads, after the offsets' sum. A plain table and the
 one-width piecewise design have none here (their plan list is empty: only the
 combinational module is measured).
@@ -43,11 +43,11 @@ from .hdl.tables import table_cuts, table_files, table_module
 from .targets import fmax_ice40, get_target, synthesize_target
 
 __all__ = ["FrequencyWarning", "PipelineStep", "PipelineResult", "PipelinedTable",
-           "STAGE_WEIGHTS", "check_frequency", "cut_plans", "design_files",
+           "STAGE_WEIGHTS", "check_frequency", "cut_names", "cut_plans", "design_files",
            "pipeline_to_frequency", "verify_pipelined", "with_cuts"]
 
-#: relative delay of a stage: the ROM read, one multiply-add, the output saturation
-STAGE_WEIGHTS = {"rom": 1.0, "step": 2.0, "output": 0.5}
+#: relative delay of a stage: the ROM read, a multiply, an add, the output saturation
+STAGE_WEIGHTS = {"rom": 1.0, "mul": 2.0, "add": 1.0, "output": 0.5}
 #: nextpnr's timing-driven placement aims at most at this frequency (its range)
 MAX_PNR_MHZ = 1000.0
 
@@ -94,7 +94,9 @@ def _base(design):
     """``design`` without pipeline registers."""
     if isinstance(design, PipelinedTable):
         return design.base
-    return replace(design, cuts=()) if getattr(design, "sized", False) else design
+    if getattr(design, "sized", False):
+        return replace(design, cuts=(), mult_cuts=())
+    return design
 
 
 class PipelinedTable:
@@ -148,16 +150,20 @@ def design_files(design, language: str = "verilog") -> dict:
 
 
 def cut_plans(design) -> list[tuple[int, ...]]:
-    """The cut sets tried, one per latency ``1, 2, ...``: for each count of
-    registers the set whose heaviest stage (by :data:`STAGE_WEIGHTS`) is the
-    lightest, ties to the earliest cuts. Empty for a design without cut
-    points.
+    """The cut sets tried, one per latency ``1, 2, ...``, as *positions*: for
+    a sized piecewise design of degree ``n``, ``0`` after the ROM read,
+    ``2i - 1`` after the ``i``-th multiply, ``2i`` after the ``i``-th add
+    (:func:`cut_names`); for each count of registers the set whose heaviest
+    stage (by :data:`STAGE_WEIGHTS`) is the lightest, ties to the earliest
+    cuts. A multipartite design: ``[(0,), (0, 1)]`` (after the table reads,
+    after the offsets' sum). Empty for a design without cut points.
 
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=16, name="rs")
-    >>> cut_plans(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5))
-    [(1,), (0, 1), (0, 1, 2)]
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5)
+    >>> [cut_names(d, p) for p in cut_plans(d)]
+    [['mul1'], ['rom', 'mul1'], ['rom', 'mul1', 'add1']]
     >>> cut_plans(design_piecewise(t, 8, 8))
     []
     """
@@ -166,31 +172,45 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     if getattr(design, "architecture", None) == "multipartite":
         return [(0,), (0, 1)]
     n = design.degree
-    # stage k (k = 0 .. n+1) sits between cut point k-1 and k: the ROM, the steps, the output
-    weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["step"]] * n + [STAGE_WEIGHTS["output"]])
+    # stage k sits before position k: the ROM, then a multiply and an add per step, the output
+    weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["mul"], STAGE_WEIGHTS["add"]] * n
+               + [STAGE_WEIGHTS["output"]])
 
     def worst(cuts) -> float:
         edges = [0, *[c + 1 for c in cuts], len(weights)]
         return max(sum(weights[a:b]) for a, b in zip(edges, edges[1:]))
 
-    return [min(combinations(range(n + 1), m), key=lambda c: (worst(c), c))
-            for m in range(1, n + 2)]
+    return [min(combinations(range(2 * n + 1), m), key=lambda c: (worst(c), c))
+            for m in range(1, 2 * n + 2)]
+
+
+def cut_names(design, cuts) -> list[str]:
+    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise) or
+    ``tables``, ``offsets`` (multipartite)."""
+    if getattr(design, "architecture", None) == "multipartite":
+        return [("tables", "offsets")[c] for c in cuts]
+    return ["rom" if c == 0 else f"{'mul' if c % 2 else 'add'}{(c + 1) // 2}" for c in cuts]
 
 
 def with_cuts(design, cuts):
-    """``design`` with pipeline registers at ``cuts`` (same values, ``len(cuts)``
-    cycles later); ValueError for a design without cut points."""
+    """``design`` with pipeline registers at the positions ``cuts``
+    (:func:`cut_plans`; the same values, ``len(cuts)`` cycles later);
+    ValueError for a design without cut points or a position out of range."""
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
                          f"accepted: a sized piecewise design (design_piecewise(..., "
-                         f"widths=...))")
+                         f"widths=...)) or a multipartite design")
+    if isinstance(cuts, (str, bytes)) or not hasattr(cuts, "__iter__"):
+        raise ValueError(f"cuts {cuts!r}: accepted: an iterable of cut positions")
     cuts = tuple(sorted(set(cuts)))
     if getattr(design, "architecture", None) == "multipartite":
         return PipelinedTable(_base(design), cuts)
-    if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= design.degree
-           for c in cuts):
-        raise ValueError(f"cuts {list(cuts)}: accepted: integers 0..{design.degree}")
-    return replace(design, cuts=cuts)
+    top = 2 * design.degree
+    if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= top for c in cuts):
+        raise ValueError(f"cuts {list(cuts)[:8]}: accepted: integers 0..{top} (0 after the ROM, "
+                         f"2i-1 after the i-th multiply, 2i after the i-th add)")
+    return replace(design, cuts=tuple(c // 2 for c in cuts if c % 2 == 0),
+                   mult_cuts=tuple((c + 1) // 2 for c in cuts if c % 2 == 1))
 
 
 @dataclass(frozen=True)
@@ -249,7 +269,7 @@ class PipelineResult:
         """One line: latency, Fmax, the asked frequency and the extra FFs."""
         verdict = "met" if self.met else "NOT met"
         return (f"pipelined for {self.frequency_mhz:g} MHz ({verdict}): latency {self.latency} "
-                f"cycles, Fmax {self.fmax_mhz:.2f} MHz ({self.source}), {self.extra_ffs} extra "
+                f"cycle{'' if self.latency == 1 else 's'}, Fmax {self.fmax_mhz:.2f} MHz ({self.source}), {self.extra_ffs} extra "
                 f"FFs; {self.cost.line()}")
 
     def shortfall(self) -> str:

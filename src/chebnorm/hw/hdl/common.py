@@ -186,9 +186,12 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
               f"{b['approximation']:.6e} + Horner rounding {b['horner_rounding']:.6e} + output "
               f"rounding {b['output_rounding']:.6e}"]
     if design.latency:
+        mult = getattr(design, "mult_cuts", ())
         lines.append(f"Pipelined: registers at cut points {list(design.cuts)} (0 after the ROM, "
-                     f"i after the i-th multiply-add); latency {design.latency} cycles (LATENCY), "
-                     f"one result per cycle.")
+                     f"i after the i-th multiply-add)"
+                     + (f" and between the multiply and the add of steps {list(mult)}"
+                        if mult else "")
+                     + f"; latency {design.latency} cycles (LATENCY), one result per cycle.")
     return lines
 
 

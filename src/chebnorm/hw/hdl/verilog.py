@@ -501,7 +501,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     cur = {k: k for k in live}
     acc, accw = f"c{n}", d.rom_bits[n]
 
-    def cut(stage: int) -> None:
+    def cut(stage) -> None:
         regs = []
         for key, (w, sgn) in live.items():
             r = f"{key}_r{stage}"
@@ -530,8 +530,18 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
             ps = st["pshift"]
             shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
             out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
+        q = f"q{j}"
+        if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
+            live.pop(acc, None)
+            cur.pop(acc, None)
+            if j == 0:
+                live.pop("low", None)
+            live[q], cur[q] = (st["qw"], True), q
+            cut(f"m{i}")
+            q = cur.pop(q)
+            del live[f"q{j}"]
         cs = f" <<< {st['cshift']}" if st["cshift"] else ""
-        qs = f"(q{j} <<< {st['qshift']})" if st["qshift"] else f"q{j}"
+        qs = f"({q} <<< {st['qshift']})" if st["qshift"] else q
         out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = {qs} + ({cur[f'c{j}']}{cs});")
         ash = f" >>> {st['ashift']}" if st["ashift"] else ""
         out.append(f"    wire signed [{st['aw'] - 1}:0] a{j} = s{j}{ash};")
@@ -541,7 +551,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
         acc, accw = f"a{j}", st["aw"]
         live[acc], cur[acc] = (st["aw"], True), acc
         if j == 0:
-            del live["low"]
+            live.pop("low", None)
         if i in d.cuts:
             cut(i)
     top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]

@@ -537,7 +537,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     cur = {k: k for k in live}
     acc, accw = f"c{n}", d.rom_bits[n]
 
-    def cut(stage: int) -> None:
+    def cut(stage) -> None:
         regs = []
         for key, (w, sgn) in live.items():
             r = f"{key}_r{stage}"
@@ -573,10 +573,20 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
             b.wire(f"q{j}", qw, f"shift_left(wrap(p{j}, {qw}), {-ps})")
         else:
             b.wire(f"q{j}", qw, f"wrap(p{j}, {qw})")
+        q = f"q{j}"
+        if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
+            live.pop(acc, None)
+            cur.pop(acc, None)
+            if j == 0:
+                live.pop("low", None)
+            live[q], cur[q] = (qw, True), q
+            cut(f"m{i}")
+            q = cur.pop(q)
+            del live[f"q{j}"]
         ctx = max(qw, sw, d.rom_bits[j])
         c = f"wrap({cur[f'c{j}']}, {ctx})"
         c = f"shift_left({c}, {st['cshift']})" if st["cshift"] else c
-        qv = f"wrap(q{j}, {ctx})"
+        qv = f"wrap({q}, {ctx})"
         qv = f"shift_left({qv}, {st['qshift']})" if st["qshift"] else qv
         b.wire(f"s{j}", sw, f"wrap({qv} + {c}, {sw})")
         a_expr = f"shift_right(s{j}, {st['ashift']})" if st["ashift"] else f"s{j}"
@@ -587,7 +597,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
         acc, accw = f"a{j}", aw
         live[acc], cur[acc] = (aw, True), acc
         if j == 0:
-            del live["low"]
+            live.pop("low", None)
         if i in d.cuts:
             cut(i)
     top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]
