@@ -146,9 +146,10 @@ def _pipelined(args, design, frequency):
         warnings.simplefilter("ignore", FrequencyWarning)  # printed below, once
         res = pipeline_to_frequency(design, args.target, frequency)
     d = res.design
-    lines = [f"timing: {res.line()}", "measured (latency: Fmax MHz): " + ", ".join(
-        f"{st.latency}: {st.fmax_mhz:.2f}" + (f" (after {', '.join(cut_names(design, st.cuts))})" if st.cuts else "")
-        for st in res.steps)]
+    tried = [f"{st.latency}: {st.fmax_mhz:.2f}"
+             + (f" (after {', '.join(cut_names(design, st.cuts))})" if st.cuts else "")
+             for st in res.steps]
+    lines = [f"timing: {res.line()}", f"measured (latency: Fmax MHz): {', '.join(tried)}"]
     if res.latency > 0:
         sim = verify_pipelined(d)
         if not sim.passed:
