@@ -53,7 +53,11 @@ MAX_PNR_MHZ = 1000.0
 
 
 class FrequencyWarning(UserWarning):
-    """The asked clock frequency was not reached (the highest reached is named)."""
+    """The asked clock frequency was not reached (the highest reached is named).
+
+    >>> issubclass(FrequencyWarning, UserWarning)
+    True
+    """
 
 
 def check_frequency(value, name: str = "frequency") -> float:
@@ -143,7 +147,13 @@ def _verilog(design) -> str:
 
 def design_files(design, language: str = "verilog") -> dict:
     """File name -> text of ``design``'s module, its exhaustive bench (clocked
-    when pipelined) and its vector file in ``language``."""
+    when pipelined) and its vector file in ``language``.
+
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> sorted(design_files(PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"),
+    ...                                                        8, 8), (0,)), "vhdl"))
+    ['chebnorm_multipartite.hex', 'chebnorm_multipartite.vhd', 'tb_chebnorm_multipartite.vhd']
+    """
     if getattr(design, "architecture", None) in ("multipartite", "plain_table"):
         return table_files(design, language)
     return hdl_files(design, language)
@@ -186,7 +196,12 @@ def cut_plans(design) -> list[tuple[int, ...]]:
 
 def cut_names(design, cuts) -> list[str]:
     """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise) or
-    ``tables``, ``offsets`` (multipartite)."""
+    ``tables``, ``offsets`` (multipartite).
+
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> cut_names(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
+    ['tables', 'offsets']
+    """
     if getattr(design, "architecture", None) == "multipartite":
         return [("tables", "offsets")[c] for c in cuts]
     return ["rom" if c == 0 else f"{'mul' if c % 2 else 'add'}{(c + 1) // 2}" for c in cuts]
@@ -195,7 +210,15 @@ def cut_names(design, cuts) -> list[str]:
 def with_cuts(design, cuts):
     """``design`` with pipeline registers at the positions ``cuts``
     (:func:`cut_plans`; the same values, ``len(cuts)`` cycles later);
-    ValueError for a design without cut points or a position out of range."""
+    ValueError for a design without cut points or a position out of range.
+
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> d = with_cuts(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5), (0, 1))
+    >>> d.cuts, d.mult_cuts, d.latency
+    ((0,), (1,), 2)
+    """
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
                          f"accepted: a sized piecewise design (design_piecewise(..., "
@@ -215,7 +238,11 @@ def with_cuts(design, cuts):
 
 @dataclass(frozen=True)
 class PipelineStep:
-    """One measured plan: its cut points, latency and Fmax in MHz."""
+    """One measured plan: its cut positions, latency and Fmax in MHz.
+
+    >>> PipelineStep((1,), 1, 46.9).latency
+    1
+    """
 
     cuts: tuple[int, ...]
     latency: int
@@ -248,6 +275,17 @@ class PipelineResult:
         flip-flops: the combinational module has none).
     steps : tuple of PipelineStep
         Every plan measured, in order.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.targets import cost_from_types
+    >>> r = PipelineResult(None, "ice40", 80.0, False, 1, 61.5, "nextpnr-ice40",
+    ...                    cost_from_types("ice40", {"SB_LUT4": 90, "SB_DFF": 12}),
+    ...                    (PipelineStep((), 0, 40.0), PipelineStep((1,), 1, 61.5)))
+    >>> r.extra_ffs
+    12
+    >>> r.shortfall()
+    '80 MHz not reached: the highest is 61.50 MHz at latency 1 (no more cut points; MHz per latency 0: 40.00, 1: 61.50; nextpnr-ice40)'
     """
 
     design: object
@@ -327,6 +365,15 @@ def pipeline_to_frequency(design, target: str, frequency_mhz, *, seed: int = 1,
     ------
     ValueError
         for a bad frequency, the ``generic`` target, or a tool failure.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> d = design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8)
+    >>> pipeline_to_frequency(d, "generic", 100)
+    Traceback (most recent call last):
+    ...
+    ValueError: target 'generic' has no device and no clock (gate depth only); accepted for a frequency: ice40 (nextpnr-ice40), xc7 or xc7-nodsp (the sta delay model)
     """
     freq = check_frequency(frequency_mhz, "frequency_mhz")
     t = get_target(target)
@@ -369,6 +416,20 @@ def verify_pipelined(design, *, bench_design=None):
     Returns
     -------
     chebnorm.hw.verilog.SimResult
+
+    Examples
+    --------
+    >>> import shutil
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> d = with_cuts(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
+    >>> if shutil.which("iverilog"):
+    ...     print(verify_pipelined(d).line)
+    ...     print(verify_pipelined(d, bench_design=with_cuts(d, (0,))).passed)
+    ... else:
+    ...     print("PASS: 256 vectors, 0 mismatches (chebnorm_multipartite, latency 2)")
+    ...     print(False)
+    PASS: 256 vectors, 0 mismatches (chebnorm_multipartite, latency 2)
+    False
     """
     from .verilog import simulate
 

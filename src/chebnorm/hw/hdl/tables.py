@@ -103,7 +103,12 @@ TABLE_CUTS = {0: "the table reads", 1: "the offsets' sum"}
 def table_cuts(design) -> tuple[int, ...]:
     """The pipeline cut points of a table design (``design.cuts``; none for a
     plain table, whose one ROM read has no inner boundary here): ``0`` after
-    the table reads, ``1`` after the sum of the offset tables."""
+    the table reads, ``1`` after the sum of the offset tables.
+
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> table_cuts(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4))
+    ()
+    """
     cuts = tuple(getattr(design, "cuts", ()) or ())
     if cuts and (_kind(design) != "multipartite" or not set(cuts) <= set(TABLE_CUTS)
                  or list(cuts) != sorted(set(cuts))):
