@@ -198,6 +198,7 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     from 0 at high degree prefer ``basis="shifted"``.
     """
     name = _table_name(name)
+    expr, var = as_expression(expr, var)
     if segments is not None or segment_by is not None or centered:
         return _fit_segments(expr, interval, degree, kind, error, var=var, name=name,
                              frac_bits=frac_bits, command=command, basis=basis,
@@ -248,6 +249,54 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     return table
 
 
+def as_expression(expr, var="x"):
+    """``(expression, variable name)`` as :func:`fit` reads its ``expr`` and ``var``.
+
+    Parameters
+    ----------
+    expr : str, sympy.Expr, Function1D or callable
+        Text such as ``"exp(x)"`` and sympy expressions are returned as they
+        are (:func:`~chebnorm.approx.parse_function` reads them); a callable
+        (``np.exp``, ``lambda x: 1 / np.sqrt(x)``, a function using
+        :mod:`math`) is traced into a sympy expression
+        (:func:`chebnorm.approx.trace.trace_callable`).
+    var : str or sympy.Symbol
+        The variable (a Symbol stands for its name).
+
+    Returns
+    -------
+    tuple
+        ``(expr, name)``: ``expr`` text, a sympy expression or a Function1D;
+        ``name`` the variable's name (str).
+
+    Raises
+    ------
+    ValueError
+        When ``var`` is neither a string nor a Symbol, or a callable cannot
+        be traced (the message says to pass a string or a sympy expression).
+
+    Examples
+    --------
+    >>> import numpy as np, sympy as sp
+    >>> as_expression(np.exp, sp.Symbol("t"))
+    (exp(t), 't')
+    >>> as_expression("exp(x)", "x")
+    ('exp(x)', 'x')
+    """
+    if isinstance(var, sp.Symbol):
+        var = var.name
+    if not isinstance(var, str):
+        raise ValueError(f"var of type {type(var).__name__} is not accepted; accepted: a "
+                         f"string naming the variable, such as 'x', or a sympy Symbol")
+    if callable(expr) and not isinstance(expr, (str, sp.Basic, Function1D)):
+        from chebnorm.core.textsafe import identifier
+
+        from .trace import trace_callable
+
+        expr = trace_callable(expr, sp.Symbol(identifier(var, field="var")))
+    return expr, var
+
+
 def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant):
     """The real coefficients of :func:`fit` (constrained to ``monomials`` /
     ``fix_constant`` when given), their notes, provenance entries and
@@ -283,8 +332,8 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
     if basis not in BASES:
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
     if basis != "monomial" and (quantized or constrained):
-        raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
-                         "fix-constant) with basis shifted are not supported; accepted: "
+        raise ValueError("quantized coefficients (frac_bits, coef_format, monomials, "
+                         "fix_constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
     if constrained and not quantized and kind != "minimax":
         raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
@@ -300,14 +349,14 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
 
     if basis != "monomial":
         raise ValueError(f"basis {basis} applies to one polynomial; accepted with segments, "
-                         f"segment-by or centered: basis monomial (centered evaluates each "
+                         f"segment_by or centered: basis monomial (centered evaluates each "
                          f"segment about its middle)")
     if coef_format not in (None, "fixed") or monomials is not None or fix_constant:
-        raise ValueError("coef-format, monomials and fix-constant apply to one polynomial; "
-                         "accepted with segments, segment-by or centered: fixed-point "
-                         "coefficients (frac-bits F, one integer)")
+        raise ValueError("coef_format, monomials and fix_constant apply to one polynomial; "
+                         "accepted with segments, segment_by or centered: fixed-point "
+                         "coefficients (frac_bits F, one integer)")
     if isinstance(frac_bits, (list, tuple)):
-        raise ValueError(f"frac-bits {','.join(map(str, frac_bits))}: piecewise tables share "
+        raise ValueError(f"frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
                          f"one format; accepted: one integer")
     return piecewise_fit(expr, tuple(interval), degree, segments=segments or 1,
                          segment_by=segment_by or "uniform",
@@ -489,28 +538,28 @@ def _check_table(table, argument: str) -> None:
 
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
-        raise ValueError(f"frac-bits {frac_bits!r} is not a non-negative integer")
+        raise ValueError(f"frac_bits {frac_bits!r} is not a non-negative integer")
     limit = 2 ** (word_bits - 1) - 1
     biggest = max(abs(c) for c in coeffs)
     if biggest == 0:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
     if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
-        raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: the largest "
+        raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: the largest "
                          f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
-                         f"accepted: frac-bits <= {max_f}")
+                         f"accepted: frac_bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
-            raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: coefficient of "
+            raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
                              f"x^{k} = {c:.6g} becomes {round(math.ldexp(c, frac_bits))}; "
-                             f"accepted: frac-bits <= {max_f}")
+                             f"accepted: frac_bits <= {max_f}")
 
 
 def _frac_list(frac_bits, degree: int, coeffs, word_bits: int) -> list[int]:
     """``frac_bits`` (an integer or one per power 0..degree) as a list, checked."""
     if isinstance(frac_bits, (list, tuple)):
         if len(frac_bits) != degree + 1:
-            raise ValueError(f"frac-bits list {list(frac_bits)} has {len(frac_bits)} entries; "
+            raise ValueError(f"frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
                              f"accepted: one integer, or degree + 1 = {degree + 1} integers "
                              f"(one per power 0..{degree})")
         for k, f in enumerate(frac_bits):
@@ -593,11 +642,11 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
-            raise ValueError("coefficient format fixed needs frac-bits (an integer, or one per "
+            raise ValueError("coefficient format fixed needs frac_bits (an integer, or one per "
                              "power); accepted: e.g. 14 or 14,16,18")
         fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
     elif frac_bits is not None:
-        raise ValueError(f"frac-bits applies to coefficient format fixed, not {coef_format}")
+        raise ValueError(f"frac_bits applies to coefficient format fixed, not {coef_format}")
     else:
         fracs = None
     fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \

@@ -167,14 +167,14 @@ class CoefficientTable(Table):
         >>> fit("exp(x)", ("0", "1"), 2, basis="shifted").require_monomial("hw")
         Traceback (most recent call last):
         ...
-        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with --basis monomial
+        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
         """
         if self.shift is not None:
             c, s = self.shift
             raise ValueError(f"table {self.name!r} is stored in the shifted variable "
                              f"t = ({self.variable} - {c!r})/{s!r}; {consumer}: plain "
                              f"powers of {self.variable} only; accepted: a table fitted with "
-                             f"--basis monomial")
+                             f"basis='monomial'")
 
     # -- evaluation -------------------------------------------------------
     def __call__(self, x, dtype=np.float64):
