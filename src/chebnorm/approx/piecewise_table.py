@@ -207,6 +207,56 @@ class PiecewiseTable(Table):
             acc = acc * t + coeffs[s, j]
         return acc
 
+    # -- conversions (numpy, sympy) ---------------------------------------------
+    def to_sympy(self):
+        """The table as a sympy ``Piecewise`` in its variable, exactly.
+
+        Segment ``s`` holds for ``a_s <= x < b_s`` (the last one up to and
+        including ``hi``), as :meth:`__call__` locates it; its polynomial is
+        in the local variable ``t = (x - a_s)/(b_s - a_s)`` (``t - 1/2``
+        when ``centered``), with the exact coefficients
+        ``integers[j] / 2**coef_frac_bits`` and the exact segment endpoints.
+        Outside ``[lo, hi]`` the Piecewise is undefined (sympy's ``nan``).
+
+        Returns
+        -------
+        sympy.Piecewise
+
+        Examples
+        --------
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=8)
+        >>> e = t.to_sympy()
+        >>> len(e.args), float(e.subs("x", 3)) == float(t(3.0))
+        (2, True)
+        """
+        x = sp.Symbol(self.variable)
+        scale = sp.Integer(2) ** -self.coef_frac_bits
+        pieces = []
+        for s in range(self.segment_count):
+            a, b = self.segment_bounds(s)
+            t = (x - a) / (b - a) - (sp.Rational(1, 2) if self.centered else 0)
+            poly = sp.Add(*(q * scale * t ** j for j, q in enumerate(self.segments[s].integers)))
+            last = s == self.segment_count - 1
+            cond = sp.And(x >= a, x <= b) if last else sp.And(x >= a, x < b)
+            pieces.append((poly, cond))
+        return sp.Piecewise(*pieces)
+
+    def __array__(self, dtype=None, copy=None):
+        """``np.asarray(table)``: the coefficients, shape ``(segments, degree + 1)``,
+        float64: row ``s`` is :meth:`coefficients` ``(s)`` (each segment's, in its
+        local variable, exactly ``integers / 2**coef_frac_bits``).
+
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> np.asarray(piecewise_fit("x**2", ("0", "1"), 1, segments=4)).shape
+        (4, 2)
+        """
+        if copy is False:
+            raise ValueError("a table's coefficients are copied into a new array; accepted: "
+                             "copy=None or copy=True")
+        return np.array([self.coefficients(s) for s in range(self.segment_count)],
+                        dtype=np.float64 if dtype is None else dtype)
+
     def _locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(s, t)``: the segment of each ``x`` and its local variable in ``[0, 1]``, in float64."""
         lo_f, hi_f = float(self.lo), float(self.hi)
