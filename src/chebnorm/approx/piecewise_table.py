@@ -51,6 +51,7 @@ import sympy as sp
 
 from flint import arb
 
+from chebnorm.core.display import summary_repr
 from chebnorm.core.numeric import arb_precision, signed_bits
 
 from .certify import arb_enclose, certify
@@ -154,6 +155,14 @@ class PiecewiseTable(Table):
     WHAT = "piecewise table"
     MAX_BYTES = MAX_PIECEWISE_BYTES
     JSON_INDENT = 1
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("segments", self.segment_count),
+                ("segment_by", self.segment_by), ("degree", self.degree),
+                ("coef_frac_bits", self.coef_frac_bits), ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
 
     # -- geometry ------------------------------------------------------------
     @property

@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 
+from chebnorm.core.display import summary_html, summary_repr
+
 from .contract import Table
 from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
                      MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
@@ -69,6 +71,14 @@ class FixedPoint:
         """The quantized coefficients as floats (exact)."""
         return tuple(math.ldexp(q, -self.frac_bits) for q in self.integers)
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("frac_bits", self.frac_bits), ("integers", self.integers),
+                ("word_bits", self.word_bits), ("method", self.method),
+                ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
 
 @dataclass(frozen=True)
 class Quantized:
@@ -103,6 +113,14 @@ class Quantized:
     def coefficients(self) -> tuple[float, ...]:
         """The stored coefficients as floats (exact)."""
         return tuple(math.ldexp(m, e) for m, e in zip(self.mantissas, self.exponents))
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("format", self.format), ("monomials", self.monomials),
+                ("coefficients", self.coefficients), ("method", self.method),
+                ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
 
 @dataclass(frozen=True)
@@ -153,6 +171,16 @@ class CoefficientTable(Table):
     MAX_BYTES = MAX_TABLE_BYTES
     TOO_LARGE_HINT = "; accepted: a table written by chebnorm (a few kB)"
     JSON_INDENT = 2
+
+    def _summary(self) -> list[tuple[str, object]]:
+        out = [("name", self.name), ("expression", self.expression),
+               ("interval", self.interval), ("degree", self.degree), ("kind", self.kind),
+               ("abs_error_bound", self.abs_error_bound)]
+        if self.quantized is not None:
+            out.append(("quantized_error_bound", self.quantized.abs_error_bound))
+        return out
+
+    __repr__ = summary_repr
 
     @property
     def basis(self) -> str:

@@ -143,6 +143,16 @@ class RenderResult(ImageFrame):
     def image8(self) -> np.ndarray:
         return to_8bit(self.image)
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("mesh", self.mesh), ("shading", self.shading), ("method", self.method),
+                ("size", tuple(self.image.shape[::-1])), ("triangles", self.triangles),
+                ("seconds", self.seconds)]
+
+    def __repr__(self) -> str:
+        from chebnorm.core.display import summary_repr
+
+        return summary_repr(self)
+
     @property
     def pixels(self) -> int:
         return int(self.mask.sum())
