@@ -56,7 +56,8 @@ def test_math_and_numpy_functions_trace_to_sympy():
 @pytest.mark.parametrize("fn", [
     lambda t: t if t > 0 else -t,               # a branch
     lambda t: np.where(t > 0, t, 0),            # not a ufunc
-    lambda t: np.add.reduce([t, t]),            # a ufunc method
+    lambda t: math.floor(t) + 1,                # a math function without a rule
+    lambda t: np.floor(t),                      # a ufunc without a rule
     np.add,                                     # two arguments
     lambda t: "text",                           # not an expression
 ])
@@ -239,16 +240,32 @@ def test_piecewise_to_sympy_evaluates_as_the_table(segment_by, centered):
 
 
 # ------------------------------------------------------------------ displays
-def _check_display(obj, limit=250):
+def _check_display(obj, limit=250, named=True):
     text = repr(obj)
     assert len(text) <= limit, f"{type(obj).__name__} repr is {len(text)} characters: {text}"
+    assert text.startswith(type(obj).__name__ + "(")
     html = obj._repr_html_()
-    assert html.startswith("<") and type(obj).__name__ in html
+    assert html.startswith("<") and (type(obj).__name__ in html or not named)
 
 
-def test_tables_display():
-    _check_display(cn.fit("exp(x)", (0, 1), 3))
-    _check_display(cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4))
+def test_result_objects_display_briefly():
+    from chebnorm.methods.analysis import analyze, error_sweep
+
+    t = cn.fit("exp(x)", (0, 1), 3)
+    q = cn.quantize(t, 12)
+    objects = [t, q, q.fixed_point, cn.quantize(t, coef_format="binary32").quantized,
+               cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4), cn.target("dichotomy"),
+               cn.hw.report.analyze(cn.fit_target("dichotomy", 1), 8, 8, coef_bits=12,
+                                    synth=False, gappa=False),
+               analyze("newton", 0.5, 8),
+               error_sweep(("none", "exact"), [0.2, 0.4], (8,), (np.float64,)),
+               cn.span_normals("exact", [[1.0, 0, 0]], [[0.0, 1, 0]], [4])]
+    for obj in objects:
+        _check_display(obj)
+    assert "quantized_error_bound=" in repr(q)
+    # user text is escaped in the HTML
+    assert "<script>" not in cn.fit("exp(x)", (0, 1), 1,
+                                    command="<script>")._repr_html_()
 
 
 def test_compare_without_flip_reports_not_computed():
@@ -256,6 +273,44 @@ def test_compare_without_flip_reports_not_computed():
         warnings.simplefilter("ignore")
         a = cn.render(shading="phong", size=(24, 24), engine="numpy")
         b = cn.render(shading="gouraud", size=(24, 24), engine="numpy")
-    c = cn.compare(b, a, flip=False)
-    assert c.flip is None
-    assert "not computed" in repr(c) or "flip" not in repr(c)
+    m, _ = cn.compare(b, a, flip=False)
+    assert m.flip is None and m.max_abs_8bit > 0   # not computed, not a FLIP of 0.0
+    assert "<td style='text-align:left'>not computed</td>" in m._repr_html_()
+    view = cn.RenderComparison(b, a, flip=False)
+    assert "flip=not computed" in repr(view) and "not computed" in view._repr_html_()
+    _check_display(view, named=False)   # images, heat map and metrics
+    _check_display(a, named=False)
+    assert cn.compare(b, a)[0].flip > 0   # computed when asked
+
+
+# ------------------------------------------------------------------ numba's first compile
+def test_numba_compile_is_announced_once_and_not_timed(monkeypatch):
+    pytest.importorskip("numba")
+    import time
+
+    import importlib
+
+    render_module = importlib.import_module("chebnorm.raster.render")
+    from chebnorm.raster.engines.numba import jit
+
+    monkeypatch.setattr(render_module, "_WARMED", set())
+    monkeypatch.setattr(jit, "_ANNOUNCED", __import__("threading").Event())
+    monkeypatch.setattr(jit, "ANNOUNCE_AFTER", 0.0)
+    slow = 1.0  # a compile that takes this long (the warm-up made slow on purpose)
+    real = render_module._warm_up
+
+    def slow_warm_up(*args, **kw):
+        time.sleep(slow)
+        return real(*args, **kw) + slow
+
+    monkeypatch.setattr(render_module, "_warm_up", slow_warm_up)
+    with pytest.warns(jit.NumbaCompileWarning, match="numba is compiling the raster engine "
+                                                     "for gouraud"):
+        first = cn.render("sphere", "gouraud", size=(16, 16), tess=4, engine="numba")
+    assert first.compile_seconds >= slow > first.seconds  # a 16x16 frame takes milliseconds
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        second = cn.render("sphere", "gouraud", size=(16, 16), tess=4, engine="numba")
+        cn.render("sphere", "phong", size=(16, 16), tess=4, engine="numba")  # once per process
+    assert second.compile_seconds == 0.0
+    assert not [w for w in caught if issubclass(w.category, jit.NumbaCompileWarning)]

@@ -138,6 +138,9 @@ class RenderResult(ImageFrame):
     triangle: np.ndarray | None = None
     #: (H, W) ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background
     normal_length: np.ndarray | None = None
+    #: seconds spent compiling (numba, the first render of a kind in this process),
+    #: before the clock of ``seconds`` started
+    compile_seconds: float = 0.0
 
     @property
     def image8(self) -> np.ndarray:
@@ -208,6 +211,7 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     ((32, 32), True)
     """
     t_start = time.perf_counter()
+    compile_seconds = 0.0
     if shading not in SHADING_MODES:
         raise ValueError(f"unknown shading mode {shading!r}; accepted: {', '.join(SHADING_MODES)}")
     w, h = _validate_size(size)
@@ -223,6 +227,13 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         method = None
     check_options(shading, bump, eta_threshold, q)
     mesh = get_mesh(mesh, tess)
+    if eng.name == "numba" and span_normals is None:
+        key = (shading, method, np.dtype(dtype).name, bump, tables is None)
+        if key not in _WARMED:   # compile on a small frame, before the clock
+            _WARMED.add(key)
+            compile_seconds = _warm_up(shading, method, dtype=dtype, tables=tables, bump=bump,
+                                       eta_threshold=eta_threshold, q=q, k=k)
+            t_start += compile_seconds
     if shading == "bump" and not mesh.has_parametrization:
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
@@ -246,7 +257,25 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
                                  **kw)
     return RenderResult(out.image, out.mask, mesh.name, shading, method,
                         time.perf_counter() - t_start, int(len(mesh.faces)), int(out.fragments),
-                        out.stats, out.triangle, out.normal_length)
+                        out.stats, out.triangle, out.normal_length, compile_seconds)
+
+
+#: (shading, method, dtype, bump, default tables) rendered once by the numba engine in
+#: this process (its kernels compiled)
+_WARMED: set = set()
+
+
+def _warm_up(shading, method, **kw) -> float:
+    """Render a small sphere with the numba engine (compiling the kernels the mode
+    calls), announced if slow (:func:`~chebnorm.raster.engines.numba.jit.announce_slow`);
+    the seconds it took."""
+    from .engines.numba.jit import announce_slow
+
+    t0 = time.perf_counter()
+    announce_slow(lambda: render("sphere", shading, method, size=(16, 16), tess=4,
+                                 engine="numba", **kw),
+                  f"the raster engine for {shading}" + (f":{method}" if method else ""))
+    return time.perf_counter() - t0
 
 
 def check_options(shading, bump, eta_threshold, q):
