@@ -111,7 +111,7 @@ def _api_calls(table):
 
 
 def test_api_wrong_types_raise_value_error_naming_the_argument(table):
-    names = {"fit expr": "expression", "fit var": "var", "fit frac": "frac-bits",
+    names = {"fit expr": "expression", "fit var": "var", "fit frac": "frac_bits",
              "quantize word": "word_bits", "quantize table": "table", "target": "target",
              "fit_target": "target", "export": "table", "hw.report": "table",
              "certify fn": "fn", "certify coef": "coefficients", "certify lo": "lo",

@@ -156,34 +156,91 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         centered: bool = False):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
-    ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
-    ``kind="minimax"``: the Remez exchange, minimizing the absolute
-    (``error="abs"``) or relative (``error="rel"``) error. Every table carries
-    rigorous bounds of both errors (see :mod:`chebnorm.approx.certify`).
-    With ``frac_bits`` (one integer or one per power), ``coef_format``
-    (``"fixed"``, ``"binary16"``, ``"bfloat16"``, ``"binary32"``,
-    ``"binary64"``), ``monomials`` or ``fix_constant`` the table also gets
-    re-certified quantized coefficients: see :func:`quantize`.
-    ``basis="shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c``
-    the midpoint, ``s`` a power of two at least the half-width; recorded in
-    ``table.shift``), well conditioned on narrow or offset intervals where
-    plain powers of ``x`` (``basis="monomial"``, the default) lose accuracy:
+    Every table carries rigorous bounds of both its absolute and its relative
+    error (see :mod:`chebnorm.approx.certify`).
 
-    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
-    >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
-    >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
-    ((100.5, 0.5), True, True)
+    Parameters
+    ----------
+    expr : str, sympy.Expr or callable
+        The function ``f``: text such as ``"1/sqrt(2+z)"`` (decimals exact,
+        see :func:`~chebnorm.approx.read_expression`), a sympy expression
+        (its Floats at their exact binary values), or a Python callable of
+        one argument built from arithmetic, numpy ufuncs (``np.exp`` itself),
+        :mod:`math` and sympy functions, traced into a sympy expression
+        (:func:`chebnorm.approx.trace.trace_callable`; floats in it are the
+        doubles it computes with: ``np.pi`` is not ``pi``).
+    interval : pair
+        ``(lo, hi)``: exact constants as text (``"sqrt(2)"``, ``"0.1"`` is
+        1/10), sympy numbers, ints, or floats (at their exact binary value).
+    degree : int
+        ``0 <= degree <= MAX_DEGREE``.
+    kind : {"chebyshev", "minimax"}, optional
+        Interpolation at the Chebyshev nodes (mpmath), or the Remez exchange.
+    error : {"abs", "rel"}, optional
+        The error the minimax fit minimizes: ``|p - f|`` or ``|p/f - 1|``.
+    var : str or sympy.Symbol, optional
+        The variable of ``expr`` (default ``"x"``).
+    name : str, optional
+        The table's name, an identifier (it names generated code); default
+        ``"table"``.
+    frac_bits : int or sequence of int, optional
+        Also quantize the coefficients to fixed point with this many
+        fractional bits (one, or one per power): see :func:`quantize`. For a
+        piecewise table, the one fixed-point format (default 24).
+    command : str, optional
+        The command recorded in ``provenance["command"]``.
+    basis : {"monomial", "shifted"}, optional
+        ``"shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c`` the
+        midpoint, ``s`` a power of two at least the half-width; recorded in
+        ``table.shift``), well conditioned on narrow or offset intervals where
+        plain powers of ``x`` lose accuracy.
+    coef_format : {"fixed", "binary16", "bfloat16", "binary32", "binary64"}, optional
+        Also quantize the coefficients to this format (:func:`quantize`).
+    monomials : sequence of int, optional
+        Keep only these powers (e.g. ``(1, 3, 5)``).
+    fix_constant : bool, optional
+        Hold the constant coefficient at ``f(0)`` rounded to its format.
+    segments : int or str, optional
+        ``2**k`` segments: a piecewise table instead
+        (:func:`~chebnorm.approx.piecewise_fit.piecewise_fit`).
+    segment_by : {"uniform", "exponent"}, optional
+        How a piecewise table's segments are indexed.
+    centered : bool, optional
+        Piecewise: each segment's polynomial in ``t - 1/2``.
 
-    ``segments`` (``2**k``), ``segment_by`` (``"uniform"`` or ``"exponent"``)
-    or ``centered`` make a piecewise table instead (a
-    :class:`~chebnorm.approx.PiecewiseTable`, coefficients in one
-    fixed-point format of ``frac_bits``, default 24, see
-    :func:`~chebnorm.approx.piecewise_fit.piecewise_fit`):
+    Returns
+    -------
+    CoefficientTable or PiecewiseTable
+        The certified table (a :class:`~chebnorm.approx.PiecewiseTable` with
+        ``segments``, ``segment_by`` or ``centered``).
 
-    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
-    >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
-    (16, True)
+    Raises
+    ------
+    ValueError
+        For an argument out of its accepted range (the message names the
+        argument and the accepted values), an expression that cannot be
+        read or traced, or a function that is not finite and real on the
+        interval.
 
+    Warns
+    -----
+    FitWarning
+        The Remez exchange did not converge, a minimax fit lost to a simpler
+        polynomial, or a bound missed its tightness (the bounds still hold).
+
+    See Also
+    --------
+    quantize : round the coefficients and re-certify.
+    chebnorm.approx.certify : the certificate of given coefficients.
+
+    Notes
+    -----
+    Choice of degree: each extra degree buys roughly a factor
+    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
+    from 0 at high degree prefer ``basis="shifted"``.
+
+    Examples
+    --------
     Seed 000, method 4 (claim C5): the degree-2 Chebyshev fit of
     ``1/sqrt(2+z)`` on ``[sqrt(2), 2]``:
 
@@ -193,9 +250,28 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     >>> round(t.max_abs_error, 7), t.abs_error_bound >= t.max_abs_error
     (2.16e-05, True)
 
-    Choice of degree: each extra degree buys roughly a factor
-    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
-    from 0 at high degree prefer ``basis="shifted"``.
+    A callable is traced, a sympy expression taken as it is; both give the
+    table of the text:
+
+    >>> import numpy as np, sympy as sp
+    >>> fit(np.exp, (0, 1), 5).coefficients == fit("exp(x)", (0, 1), 5).coefficients
+    True
+    >>> z = sp.Symbol("z")
+    >>> fit(1 / sp.sqrt(2 + z), ("sqrt(2)", 2), 2, var=z) == t
+    True
+
+    The shifted basis where monomials lose accuracy:
+
+    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
+    >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
+    >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
+    ((100.5, 0.5), True, True)
+
+    A piecewise table:
+
+    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
+    >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
+    (16, True)
     """
     name = _table_name(name)
     expr, var = as_expression(expr, var)
@@ -591,36 +667,64 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
              fix_constant: bool = False) -> CoefficientTable:
     """Round the coefficients to a fixed or floating format and re-certify.
 
-    ``coef_format="fixed"`` (the default) stores coefficient ``k`` with
-    ``frac_bits`` fractional bits (one integer, or one per power
-    ``0..degree``) as a ``word_bits``-bit integer; ``"binary16"``,
-    ``"bfloat16"``, ``"binary32"``, ``"binary64"`` store each coefficient as a
-    number of that floating format. ``monomials`` (e.g. ``(1, 3, 5)``) keeps
-    only those powers; ``fix_constant`` holds the constant coefficient at
-    ``f(0)`` rounded to its format (so ``p(0) = f(0)`` when that is
-    representable). The error minimized is the table's ``error_kind``.
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in the monomial basis (from :func:`fit` or ``load``).
+    frac_bits : int or sequence of int, optional
+        Fixed point (``coef_format="fixed"``, required there): coefficient
+        ``k`` stored with ``frac_bits`` fractional bits (one integer, or one
+        per power ``0..degree``) as a ``word_bits``-bit integer.
+    word_bits : int, optional
+        ``2 <= word_bits <= 53``: the signed integer width of fixed point.
+    reoptimize : bool, optional
+        Choose the coefficients as Sollya's ``fpminimax`` does (default), or
+        (False) only round each to nearest.
+    coef_format : {"fixed", "binary16", "bfloat16", "binary32", "binary64"}, optional
+        The format of every stored coefficient.
+    monomials : sequence of int, optional
+        Keep only these powers (e.g. ``(1, 3, 5)``).
+    fix_constant : bool, optional
+        Hold the constant coefficient at ``f(0)`` rounded to its format (so
+        ``p(0) = f(0)`` when that is representable).
 
-    With ``reoptimize=False`` each coefficient is only rounded to nearest.
-    Otherwise the coefficients are chosen as Sollya's ``fpminimax`` chooses them
-    (lattice reduction and a closest vector at Chebyshev points, see
-    :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
-    the lower ones refitted at Chebyshev nodes) compete: they are ranked by their
-    sampled error and certified in that order while they can still win; the one
-    with the smallest certified bound wins (``method`` names it; floating
-    formats: within a factor 1 + 2^-20 of the smallest). Fixed formats
-    are monotone in the bits: more fractional bits never certify a worse error.
-    A table fitted with the same ``monomials`` / ``fix_constant`` (same held
-    constant) is quantized from its own coefficients, otherwise the constrained
-    real fit is computed first.
+    Returns
+    -------
+    CoefficientTable
+        ``table`` with ``quantized`` set (and ``fixed_point``: fixed format
+        with one ``frac_bits``, all powers, free constant). Its own bound is
+        :attr:`CoefficientTable.error_bound` (``quantized.abs_error_bound``);
+        ``abs_error_bound`` stays the float coefficients'.
 
-    The result is the table with ``quantized`` (always) and ``fixed_point``
-    (fixed format with one ``frac_bits``, all powers, free constant) set.
+    Raises
+    ------
+    ValueError
+        For a table that is not a CoefficientTable or is in the shifted basis,
+        a format or ``frac_bits`` out of range (naming the largest accepted
+        ``frac_bits``), or when no rounding could be certified.
 
+    Notes
+    -----
+    The error minimized is the table's ``error_kind``. With ``reoptimize``
+    the coefficients are chosen by lattice reduction and a closest vector at
+    Chebyshev points (see :mod:`chebnorm.approx.rounding`); plain rounding
+    and the greedy refit (rounded from the highest power down, the lower ones
+    refitted at Chebyshev nodes) compete: they are ranked by their sampled
+    error and certified in that order while they can still win; the one with
+    the smallest certified bound wins (``method`` names it; floating formats:
+    within a factor 1 + 2^-20 of the smallest). Fixed formats are monotone in
+    the bits: more fractional bits never certify a worse error. A table
+    fitted with the same ``monomials`` / ``fix_constant`` (same held
+    constant) is quantized from its own coefficients, otherwise the
+    constrained real fit is computed first.
+
+    Examples
+    --------
     >>> t = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 14)
-    >>> t.fixed_point.integers, f"{t.fixed_point.abs_error_bound:.3e}"
+    >>> t.fixed_point.integers, f"{t.error_bound:.3e}"
     ((11152, -1944, 232), '2.781e-05')
     >>> s = quantize(fit("sin(x)", ("0", "1"), 5), coef_format="binary32", monomials=(1, 3, 5))
-    >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
+    >>> s.quantized.mantissas[0::2], s.error_bound < 4e-6
     ((0, 0, 0), True)
     """
     _check_table(table, "table")
