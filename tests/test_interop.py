@@ -293,7 +293,9 @@ def test_numba_compile_is_announced_once_and_not_timed(monkeypatch):
     render_module = importlib.import_module("chebnorm.raster.render")
     from chebnorm.raster.engines.numba import jit
 
-    monkeypatch.setattr(render_module, "_WARMED", set())
+    from chebnorm.raster.engines import get_engine
+
+    monkeypatch.setattr(get_engine("numba"), "warmed", set())
     monkeypatch.setattr(jit, "_ANNOUNCED", __import__("threading").Event())
     monkeypatch.setattr(jit, "ANNOUNCE_AFTER", 0.0)
     slow = 1.0  # a compile that takes this long (the warm-up made slow on purpose)
@@ -301,7 +303,7 @@ def test_numba_compile_is_announced_once_and_not_timed(monkeypatch):
 
     def slow_warm_up(*args, **kw):
         time.sleep(slow)
-        return real(*args, **kw) + slow
+        real(*args, **kw)
 
     monkeypatch.setattr(render_module, "_warm_up", slow_warm_up)
     with pytest.warns(jit.NumbaCompileWarning, match="numba is compiling the raster engine "

@@ -227,13 +227,13 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         method = None
     check_options(shading, bump, eta_threshold, q)
     mesh = get_mesh(mesh, tess)
-    if eng.name == "numba" and span_normals is None:
-        key = (shading, method, np.dtype(dtype).name, bump, tables is None)
-        if key not in _WARMED:   # compile on a small frame, before the clock
-            _WARMED.add(key)
-            compile_seconds = _warm_up(shading, method, dtype=dtype, tables=tables, bump=bump,
-                                       eta_threshold=eta_threshold, q=q, k=k)
-            t_start += compile_seconds
+    if span_normals is None:   # a compiling engine compiles on a small frame, before the clock
+        compile_seconds = eng.warm_up(
+            (shading, method, np.dtype(dtype).name, bump, tables is None),
+            lambda: _warm_up(shading, method, engine=eng.name, dtype=dtype, tables=tables,
+                             bump=bump, eta_threshold=eta_threshold, q=q, k=k),
+            f"the raster engine for {shading}" + (f":{method}" if method else ""))
+        t_start += compile_seconds
     if shading == "bump" and not mesh.has_parametrization:
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
@@ -260,22 +260,9 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
                         out.stats, out.triangle, out.normal_length, compile_seconds)
 
 
-#: (shading, method, dtype, bump, default tables) rendered once by the numba engine in
-#: this process (its kernels compiled)
-_WARMED: set = set()
-
-
-def _warm_up(shading, method, **kw) -> float:
-    """Render a small sphere with the numba engine (compiling the kernels the mode
-    calls), announced if slow (:func:`~chebnorm.raster.engines.numba.jit.announce_slow`);
-    the seconds it took."""
-    from .engines.numba.jit import announce_slow
-
-    t0 = time.perf_counter()
-    announce_slow(lambda: render("sphere", shading, method, size=(16, 16), tess=4,
-                                 engine="numba", **kw),
-                  f"the raster engine for {shading}" + (f":{method}" if method else ""))
-    return time.perf_counter() - t0
+def _warm_up(shading, method, **kw) -> None:
+    """Render a small sphere in the mode (compiling the kernels it calls)."""
+    render("sphere", shading, method, size=(16, 16), tess=4, **kw)
 
 
 def check_options(shading, bump, eta_threshold, q):

@@ -152,6 +152,13 @@ class Engine:
     #: the name ``render(engine=...)`` selects this engine by
     name = ""
 
+    def warm_up(self, key, work, what: str) -> float:
+        """Prepare the engine for a kind of frame (``key``) before ``render``'s clock
+        starts: a compiling engine runs ``work()`` (a small frame of that kind) the
+        first time it sees ``key`` and returns the seconds it took; this one
+        compiles nothing and returns 0.0. ``what`` names the kind, for a message."""
+        return 0.0
+
     def setup(self, mesh, camera, size, cull) -> Setup:
         """Camera (``camera`` or the default fitted one), projection and the front-facing
         (``cull``) or all non-degenerate triangles of ``mesh`` at ``size = (w, h)``."""
