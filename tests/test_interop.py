@@ -316,3 +316,13 @@ def test_numba_compile_is_announced_once_and_not_timed(monkeypatch):
         cn.render("sphere", "phong", size=(16, 16), tess=4, engine="numba")  # once per process
     assert second.compile_seconds == 0.0
     assert not [w for w in caught if issubclass(w.category, jit.NumbaCompileWarning)]
+
+
+def test_error_curve_of_a_shifted_table_is_within_its_bound():
+    # the curve (and so plot()) evaluated the shifted coefficients in x, not t
+    t = cn.fit("exp(x)", ("0", "1"), 4, basis="shifted")
+    x, g = t.error_curve(201)
+    assert abs(g).max() <= t.abs_error_bound   # was 0.65: the powers of x, not of t
+    # at the located maximum (an endpoint here, on the grid) the curve is the table's error
+    assert t.max_abs_at in (x[0], x[-1])
+    assert abs(g[0 if t.max_abs_at == x[0] else -1]) == pytest.approx(t.max_abs_error, rel=1e-12)

@@ -544,8 +544,9 @@ class CoefficientTable(Table):
             for i, xi in enumerate(x):
                 xm = mpmath.mpf(float(xi))
                 p = mpmath.mpf(0)
+                tm = _local_mp(self, xm)   # the shifted variable of a shifted table
                 for c in reversed(coeffs):
-                    p = p * xm + mpmath.mpf(c)
+                    p = p * tm + mpmath.mpf(c)
                 f = f_mp(xm)
                 g[i] = float(p - f) if error == "abs" else float(p / f - 1)
         return x, g
@@ -965,10 +966,20 @@ def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float,
     with mpmath.workdps(40):
         xm = mpmath.mpf(float(at))
         p = mpmath.mpf(0)
+        tm = _local_mp(table, xm)
         for c in reversed(table.coefficients):
-            p = p * xm + mpmath.mpf(c)
+            p = p * tm + mpmath.mpf(c)
         f = f_mp(xm)
         return at, float(p - f) if error == "abs" else float(p / f - 1)
+
+
+def _local_mp(table: CoefficientTable, xm):
+    """``x`` (an mpmath number) in the table's variable: ``(x - c)/s`` when shifted."""
+    import mpmath
+
+    if table.shift is None:
+        return xm
+    return (xm - mpmath.mpf(table.shift[0])) / mpmath.mpf(table.shift[1])
 
 
 def _power_to_chebyshev(coeffs: list[Fraction]) -> list[Fraction]:
