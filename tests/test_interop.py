@@ -326,3 +326,14 @@ def test_error_curve_of_a_shifted_table_is_within_its_bound():
     # at the located maximum (an endpoint here, on the grid) the curve is the table's error
     assert t.max_abs_at in (x[0], x[-1])
     assert abs(g[0 if t.max_abs_at == x[0] else -1]) == pytest.approx(t.max_abs_error, rel=1e-12)
+
+
+def test_piecewise_c_in_bits_named_as_argument_and_as_flag(tmp_path, capsys):
+    pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16)
+    with pytest.raises(ValueError, match=r"^in_bits = 1 is out of range; accepted: 2 <= in_bits"):
+        cn.export(pw, "c", in_bits=1)
+    pw.save(tmp_path / "pw.json")
+    assert main(["export", str(tmp_path / "pw.json"), "--format", "c", "--in-bits", "1",
+                 "-o", str(tmp_path / "pw.h")]) == 2
+    assert "error: in-bits = 1 is out of range; accepted: 2 <= in-bits" in capsys.readouterr().err
+    assert not (tmp_path / "pw.h").exists()

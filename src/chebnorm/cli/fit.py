@@ -81,7 +81,7 @@ def _int_list(text: str):
 #: the library's argument names as this command's words (its messages name the
 #: Python argument; the command line names the flag, as it always did)
 _CLI_WORDS = re.compile(r"(?<![\w.])(coef_frac_bits|frac_bits|coef_format|segment_by|"
-                        r"fix_constant)(?![\w\[])")
+                        r"fix_constant|in_bits|out_bits)(?![\w\[])")
 _CLI_PHRASES = (("set it with var=", "set it with --var"),
                 ("interval=('1/4', '4')", "--interval 1/4 4"),
                 ("basis='monomial'", "--basis monomial"))
