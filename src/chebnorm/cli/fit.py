@@ -92,6 +92,19 @@ def cli_words(message: str) -> str:
     ``chebnorm fit`` spells them (``frac_bits`` -> ``frac-bits``, ``var=`` ->
     ``--var``).
 
+    Parameters
+    ----------
+    message : str
+        A library's ValueError text (Python argument names).
+
+    Returns
+    -------
+    str
+        The text with the command line's words (a field of a table file, such as
+        ``quantized.frac_bits``, is left as it is).
+
+    Examples
+    --------
     >>> cli_words("frac_bits 40 overflows int32; accepted: frac_bits <= 30")
     'frac-bits 40 overflows int32; accepted: frac-bits <= 30'
     """
@@ -102,6 +115,18 @@ def cli_phrases(message: str) -> str:
     """The phrases of library messages that name an argument by its Python
     spelling (``basis='monomial'``, ``var=``) as the flag (any command).
 
+    Parameters
+    ----------
+    message : str
+        A library's ValueError text.
+
+    Returns
+    -------
+    str
+        The text with those phrases as flags.
+
+    Examples
+    --------
     >>> cli_phrases("accepted: a table fitted with basis='monomial'")
     'accepted: a table fitted with --basis monomial'
     """

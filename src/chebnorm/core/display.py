@@ -75,13 +75,49 @@ def short(value, limit: int = MAX_VALUE) -> str:
 
 
 def summary_repr(self) -> str:
-    """``Name(label=value, ...)`` from ``self._summary()`` (each value :func:`short`)."""
+    """``Name(label=value, ...)`` from ``self._summary()`` (each value :func:`short`).
+
+    Parameters
+    ----------
+    self : object
+        A result with ``_summary()`` (``(label, value)`` pairs).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> class R:
+    ...     def _summary(self):
+    ...         return [("n", 3), ("bound", 1.23456789e-5)]
+    >>> summary_repr(R())
+    'R(n=3, bound=1.23457e-05)'
+    """
     items = ", ".join(f"{k}={short(v)}" for k, v in self._summary())
     return f"{type(self).__name__}({items})"
 
 
 def summary_html(self) -> str:
-    """An HTML table of ``self._display_rows()`` (or ``self._summary()``), escaped."""
+    """An HTML table of ``self._display_rows()`` (or ``self._summary()``), escaped.
+
+    Parameters
+    ----------
+    self : object
+        A result with ``_summary()`` and, optionally, ``_display_rows()``.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> class R:
+    ...     def _summary(self):
+    ...         return [("expression", "<b>")]
+    >>> "&lt;b&gt;" in summary_html(R()) and "<b>R</b>" in summary_html(R())
+    True
+    """
     rows = self._display_rows() if hasattr(self, "_display_rows") else self._summary()
     body = "".join(f"<tr><th style='text-align:left'>{escape(str(k))}</th>"
                    f"<td style='text-align:left'>{escape(short(v, 400) if not isinstance(v, str) else v)}"

@@ -153,10 +153,23 @@ class Engine:
     name = ""
 
     def warm_up(self, key, work, what: str) -> float:
-        """Prepare the engine for a kind of frame (``key``) before ``render``'s clock
-        starts: a compiling engine runs ``work()`` (a small frame of that kind) the
-        first time it sees ``key`` and returns the seconds it took; this one
-        compiles nothing and returns 0.0. ``what`` names the kind, for a message."""
+        """Prepare the engine for a kind of frame before ``render``'s clock starts.
+
+        Parameters
+        ----------
+        key : hashable
+            The kind of frame (mode, method, dtype, ...).
+        work : callable
+            Renders a small frame of that kind (a compiling engine runs it the
+            first time it sees ``key``).
+        what : str
+            The kind, for a message.
+
+        Returns
+        -------
+        float
+            The seconds the preparation took: 0.0 here (nothing is compiled).
+        """
         return 0.0
 
     def setup(self, mesh, camera, size, cull) -> Setup:

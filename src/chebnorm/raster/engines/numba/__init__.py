@@ -39,10 +39,26 @@ class NumbaEngine(NumpyEngine):
         self.warmed: set = set()
 
     def warm_up(self, key, work, what: str) -> float:
-        """Run ``work()`` the first time ``key`` is seen in this process (numba
-        compiles, or loads from its disk cache, the kernels it calls), announced by
-        one :class:`~.jit.NumbaCompileWarning` when slow (:func:`~.jit.announce_slow`);
-        the seconds it took (0.0 after the first time)."""
+        """Run ``work()`` the first time ``key`` is seen in this process.
+
+        numba compiles (or loads from its disk cache) the kernels ``work`` calls;
+        when that is slow, one :class:`~.jit.NumbaCompileWarning` per process
+        says so (:func:`~.jit.announce_slow`).
+
+        Parameters
+        ----------
+        key : hashable
+            The kind of frame.
+        work : callable
+            Renders a small frame of that kind.
+        what : str
+            The kind, for the warning.
+
+        Returns
+        -------
+        float
+            The seconds ``work()`` took; 0.0 after the first time.
+        """
         if key in self.warmed:
             return 0.0
         self.warmed.add(key)   # before the work: it renders with this key itself
