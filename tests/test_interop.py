@@ -48,6 +48,7 @@ def test_math_and_numpy_functions_trace_to_sympy():
     assert trace_callable(lambda t: math.exp(t) * np.sin(t) + np.log1p(t), x) == \
         sp.exp(x) * sp.sin(x) + sp.log(1 + x)
     assert trace_callable(np.cbrt, x) == sp.root(x, 3)
+    assert trace_callable(math.sqrt, x) == sp.sqrt(x) and trace_callable(sp.exp, x) == sp.exp(x)
     # a float is the double the callable computes with: np.pi is not pi
     traced = trace_callable(lambda t: np.sin(np.pi * t), x)
     assert not traced.has(sp.pi) and traced == sp.sin(sp.Rational(*math.pi.as_integer_ratio()) * x)

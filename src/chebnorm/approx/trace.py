@@ -172,11 +172,11 @@ def _substitute(value, shims: dict):
 def _rebound(fn):
     """``fn`` (a Python function) with the ``math`` names of its globals and
     closure replaced by shims; other callables unchanged."""
-    if not isinstance(fn, types.FunctionType):
-        return fn
     module = _math_module()
     shims = {name: getattr(module, name) for name in dir(module) if not name.startswith("_")}
     shims["__module__"] = module
+    if not isinstance(fn, types.FunctionType):
+        return _substitute(fn, shims)   # math.exp itself, or another callable unchanged
     glob = {k: _substitute(v, shims) for k, v in fn.__globals__.items()}
     if all(glob[k] is v for k, v in fn.__globals__.items()) and not fn.__closure__:
         return fn
@@ -229,8 +229,8 @@ def trace_callable(fn, var: sp.Symbol) -> sp.Expr:
     >>> import numpy as np
     >>> import sympy as sp
     >>> x = sp.Symbol("x")
-    >>> trace_callable(np.exp, x)
-    exp(x)
+    >>> trace_callable(np.exp, x), trace_callable(math.sqrt, x), trace_callable(sp.cos, x)
+    (exp(x), sqrt(x), cos(x))
     >>> trace_callable(lambda t: 1 / np.sqrt(2 + t) + math.sin(t) ** 2, x)
     sin(x)**2 + 1/sqrt(x + 2)
     >>> trace_callable(lambda t: t if t > 0 else -t, x)
