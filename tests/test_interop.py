@@ -49,6 +49,10 @@ def test_math_and_numpy_functions_trace_to_sympy():
         sp.exp(x) * sp.sin(x) + sp.log(1 + x)
     assert trace_callable(np.cbrt, x) == sp.root(x, 3)
     assert trace_callable(math.sqrt, x) == sp.sqrt(x) and trace_callable(sp.exp, x) == sp.exp(x)
+    # numpy scalars and 0-d arrays are numbers at their exact values
+    assert trace_callable(lambda t: t * np.array(2.0) + np.float32(0.1) * t ** 2 + np.int64(3),
+                          x) == 2 * x + sp.Rational(*float(np.float32(0.1)).as_integer_ratio()) \
+        * x ** 2 + 3
     # a float is the double the callable computes with: np.pi is not pi
     traced = trace_callable(lambda t: np.sin(np.pi * t), x)
     assert not traced.has(sp.pi) and traced == sp.sin(sp.Rational(*math.pi.as_integer_ratio()) * x)

@@ -83,8 +83,8 @@ def _sym(value):
         return sp.Rational(*f.as_integer_ratio())
     if isinstance(value, sp.Basic):
         return value
-    if isinstance(value, np.ndarray) and value.shape == () and value.dtype == object:
-        return _sym(value.item())
+    if isinstance(value, np.ndarray) and value.shape == ():
+        return _sym(value.item() if value.dtype == object else value[()])
     raise _Untraceable(f"a value of type {type(value).__name__}")
 
 
