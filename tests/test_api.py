@@ -52,8 +52,11 @@ def test_facade_names_are_the_stage_objects():
 
 def test_export_dispatches_over_every_format():
     t = cn.fit_target("dichotomy", 1)
-    for fmt, (printer, _) in cn.export.FORMATS.items():
+    for fmt, (printer, _) in cn.export.TABLE_FORMATS.items():
         assert cn.export(t, fmt) == printer(t, "")
+    # FORMATS lists every format the command line exports (issue 31: it listed five)
+    assert list(cn.export.FORMATS) == ["c", "glsl", "hlsl", "json", "verilog", "vhdl", "wgsl"]
+    assert cn.export.FORMATS["verilog"] == ".v" and cn.export.FORMATS["c"] == ".h"
     with pytest.raises(ValueError, match="accepted: .*c.*json"):
         cn.export(t, "nope")
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from chebnorm.approx import fit, fit_target
-from chebnorm.export import EXPORT_FORMATS, FORMATS, c_header, export_table
+from chebnorm.export import EXPORT_FORMATS, FORMATS, TABLE_FORMATS, c_header, export_table
 
 GCC = shutil.which("gcc")
 needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc is not installed (apt-get install gcc)")
@@ -105,7 +105,8 @@ class TestText:
 
     def test_formats_and_atomic_write(self, tmp_path):
         t = fit_target("eta_term", 1)
-        assert sorted(FORMATS) == ["c", "glsl", "hlsl", "json", "wgsl"]  # need only the table
+        assert sorted(TABLE_FORMATS) == ["c", "glsl", "hlsl", "json", "wgsl"]  # need only the table
+        assert tuple(FORMATS) == EXPORT_FORMATS
         assert EXPORT_FORMATS == ("c", "glsl", "hlsl", "json", "verilog", "vhdl", "wgsl")
         out = tmp_path / "t.json"
         export_table(t, "json", out)

@@ -91,7 +91,7 @@ def test_load_reproves_and_names_fields(tmp_path):
     ({"segments": "2^13"}, r"k = 13 is out of range; accepted: 0 <= k <= 12"),
     ({"segments": 3}, "not a power of two"),
     ({"degree": -1}, r"degree = -1 is out of range; accepted: 0 <= degree <= 8"),
-    ({"coef_frac_bits": 60}, r"coef-frac-bits = 60 is out of range"),
+    ({"coef_frac_bits": 60}, r"coef_frac_bits = 60 is out of range"),
     ({"interval": ("-1", "4")}, r"not finite and real on segment 0"),
     ({"segment_by": "exponent", "interval": ("1", "3")}, "powers of two"),
 ])

@@ -73,7 +73,7 @@ def test_frac_bits_2000(capsys, table):
                            "--coef-frac-bits", "2000"], capsys)
     assert status == 2 and "accepted: frac-bits <= 30" in _one_line(err)
     for bits in (2000, 2 ** 70):
-        with pytest.raises(ValueError, match="accepted: frac-bits <= 30"):
+        with pytest.raises(ValueError, match="accepted: frac_bits <= 30"):
             cn.quantize(table, bits)
 
 
@@ -111,7 +111,7 @@ def _api_calls(table):
 
 
 def test_api_wrong_types_raise_value_error_naming_the_argument(table):
-    names = {"fit expr": "expression", "fit var": "var", "fit frac": "frac-bits",
+    names = {"fit expr": "expression", "fit var": "var", "fit frac": "frac_bits",
              "quantize word": "word_bits", "quantize table": "table", "target": "target",
              "fit_target": "target", "export": "table", "hw.report": "table",
              "certify fn": "fn", "certify coef": "coefficients", "certify lo": "lo",

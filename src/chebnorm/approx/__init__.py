@@ -5,7 +5,8 @@ Where things are: ``schema`` (kinds, limits, versions, the JSON field readers),
 (:class:`CoefficientTable`), ``piecewise_table`` (:class:`PiecewiseTable`),
 ``load`` (:func:`load_table`: a file of either kind); the fitters ``api``
 (:func:`fit`, :func:`quantize`) and ``piecewise_fit`` (:func:`piecewise_fit`), on
-``fitting``, ``rounding``, ``certify`` and ``certify_batch``.
+``fitting``, ``rounding``, ``certify`` and ``certify_batch``; ``trace`` turns a Python
+callable given to :func:`fit` into a sympy expression.
 
 >>> from chebnorm.approx import fit
 >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, kind="minimax", var="z")

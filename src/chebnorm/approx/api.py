@@ -156,34 +156,91 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         centered: bool = False):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
-    ``kind="chebyshev"``: interpolation at the Chebyshev nodes (mpmath).
-    ``kind="minimax"``: the Remez exchange, minimizing the absolute
-    (``error="abs"``) or relative (``error="rel"``) error. Every table carries
-    rigorous bounds of both errors (see :mod:`chebnorm.approx.certify`).
-    With ``frac_bits`` (one integer or one per power), ``coef_format``
-    (``"fixed"``, ``"binary16"``, ``"bfloat16"``, ``"binary32"``,
-    ``"binary64"``), ``monomials`` or ``fix_constant`` the table also gets
-    re-certified quantized coefficients: see :func:`quantize`.
-    ``basis="shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c``
-    the midpoint, ``s`` a power of two at least the half-width; recorded in
-    ``table.shift``), well conditioned on narrow or offset intervals where
-    plain powers of ``x`` (``basis="monomial"``, the default) lose accuracy:
+    Every table carries rigorous bounds of both its absolute and its relative
+    error (see :mod:`chebnorm.approx.certify`).
 
-    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
-    >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
-    >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
-    ((100.5, 0.5), True, True)
+    Parameters
+    ----------
+    expr : str, sympy.Expr or callable
+        The function ``f``: text such as ``"1/sqrt(2+z)"`` (decimals exact,
+        see :func:`~chebnorm.approx.read_expression`), a sympy expression
+        (its Floats at their exact binary values), or a Python callable of
+        one argument built from arithmetic, numpy ufuncs (``np.exp`` itself),
+        :mod:`math` and sympy functions, traced into a sympy expression
+        (:func:`chebnorm.approx.trace.trace_callable`; floats in it are the
+        doubles it computes with: ``np.pi`` is not ``pi``).
+    interval : pair
+        ``(lo, hi)``: exact constants as text (``"sqrt(2)"``, ``"0.1"`` is
+        1/10), sympy numbers, ints, or floats (at their exact binary value).
+    degree : int
+        ``0 <= degree <= MAX_DEGREE``.
+    kind : {"chebyshev", "minimax"}, optional
+        Interpolation at the Chebyshev nodes (mpmath), or the Remez exchange.
+    error : {"abs", "rel"}, optional
+        The error the minimax fit minimizes: ``|p - f|`` or ``|p/f - 1|``.
+    var : str or sympy.Symbol, optional
+        The variable of ``expr`` (default ``"x"``).
+    name : str, optional
+        The table's name, an identifier (it names generated code); default
+        ``"table"``.
+    frac_bits : int or sequence of int, optional
+        Also quantize the coefficients to fixed point with this many
+        fractional bits (one, or one per power): see :func:`quantize`. For a
+        piecewise table, the one fixed-point format (default 24).
+    command : str, optional
+        The command recorded in ``provenance["command"]``.
+    basis : {"monomial", "shifted"}, optional
+        ``"shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c`` the
+        midpoint, ``s`` a power of two at least the half-width; recorded in
+        ``table.shift``), well conditioned on narrow or offset intervals where
+        plain powers of ``x`` lose accuracy.
+    coef_format : {"fixed", "binary16", "bfloat16", "binary32", "binary64"}, optional
+        Also quantize the coefficients to this format (:func:`quantize`).
+    monomials : sequence of int, optional
+        Keep only these powers (e.g. ``(1, 3, 5)``).
+    fix_constant : bool, optional
+        Hold the constant coefficient at ``f(0)`` rounded to its format.
+    segments : int or str, optional
+        ``2**k`` segments: a piecewise table instead
+        (:func:`~chebnorm.approx.piecewise_fit.piecewise_fit`).
+    segment_by : {"uniform", "exponent"}, optional
+        How a piecewise table's segments are indexed.
+    centered : bool, optional
+        Piecewise: each segment's polynomial in ``t - 1/2``.
 
-    ``segments`` (``2**k``), ``segment_by`` (``"uniform"`` or ``"exponent"``)
-    or ``centered`` make a piecewise table instead (a
-    :class:`~chebnorm.approx.PiecewiseTable`, coefficients in one
-    fixed-point format of ``frac_bits``, default 24, see
-    :func:`~chebnorm.approx.piecewise_fit.piecewise_fit`):
+    Returns
+    -------
+    CoefficientTable or PiecewiseTable
+        The certified table (a :class:`~chebnorm.approx.PiecewiseTable` with
+        ``segments``, ``segment_by`` or ``centered``).
 
-    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
-    >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
-    (16, True)
+    Raises
+    ------
+    ValueError
+        For an argument out of its accepted range (the message names the
+        argument and the accepted values), an expression that cannot be
+        read or traced, or a function that is not finite and real on the
+        interval.
 
+    Warns
+    -----
+    FitWarning
+        The Remez exchange did not converge, a minimax fit lost to a simpler
+        polynomial, or a bound missed its tightness (the bounds still hold).
+
+    See Also
+    --------
+    quantize : round the coefficients and re-certify.
+    chebnorm.approx.certify : the certificate of given coefficients.
+
+    Notes
+    -----
+    Choice of degree: each extra degree buys roughly a factor
+    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
+    from 0 at high degree prefer ``basis="shifted"``.
+
+    Examples
+    --------
     Seed 000, method 4 (claim C5): the degree-2 Chebyshev fit of
     ``1/sqrt(2+z)`` on ``[sqrt(2), 2]``:
 
@@ -193,11 +250,31 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     >>> round(t.max_abs_error, 7), t.abs_error_bound >= t.max_abs_error
     (2.16e-05, True)
 
-    Choice of degree: each extra degree buys roughly a factor
-    ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
-    from 0 at high degree prefer ``basis="shifted"``.
+    A callable is traced, a sympy expression taken as it is; both give the
+    table of the text:
+
+    >>> import numpy as np, sympy as sp
+    >>> fit(np.exp, (0, 1), 5).coefficients == fit("exp(x)", (0, 1), 5).coefficients
+    True
+    >>> z = sp.Symbol("z")
+    >>> fit(1 / sp.sqrt(2 + z), ("sqrt(2)", 2), 2, var=z) == t
+    True
+
+    The shifted basis where monomials lose accuracy:
+
+    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
+    >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
+    >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
+    ((100.5, 0.5), True, True)
+
+    A piecewise table:
+
+    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
+    >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
+    (16, True)
     """
     name = _table_name(name)
+    expr, var = as_expression(expr, var)
     if segments is not None or segment_by is not None or centered:
         return _fit_segments(expr, interval, degree, kind, error, var=var, name=name,
                              frac_bits=frac_bits, command=command, basis=basis,
@@ -248,6 +325,54 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     return table
 
 
+def as_expression(expr, var="x"):
+    """``(expression, variable name)`` as :func:`fit` reads its ``expr`` and ``var``.
+
+    Parameters
+    ----------
+    expr : str, sympy.Expr, Function1D or callable
+        Text such as ``"exp(x)"`` and sympy expressions are returned as they
+        are (:func:`~chebnorm.approx.parse_function` reads them); a callable
+        (``np.exp``, ``lambda x: 1 / np.sqrt(x)``, a function using
+        :mod:`math`) is traced into a sympy expression
+        (:func:`chebnorm.approx.trace.trace_callable`).
+    var : str or sympy.Symbol
+        The variable (a Symbol stands for its name).
+
+    Returns
+    -------
+    tuple
+        ``(expr, name)``: ``expr`` text, a sympy expression or a Function1D;
+        ``name`` the variable's name (str).
+
+    Raises
+    ------
+    ValueError
+        When ``var`` is neither a string nor a Symbol, or a callable cannot
+        be traced (the message says to pass a string or a sympy expression).
+
+    Examples
+    --------
+    >>> import numpy as np, sympy as sp
+    >>> as_expression(np.exp, sp.Symbol("t"))
+    (exp(t), 't')
+    >>> as_expression("exp(x)", "x")
+    ('exp(x)', 'x')
+    """
+    if isinstance(var, sp.Symbol):
+        var = var.name
+    if not isinstance(var, str):
+        raise ValueError(f"var of type {type(var).__name__} is not accepted; accepted: a "
+                         f"string naming the variable, such as 'x', or a sympy Symbol")
+    if callable(expr) and not isinstance(expr, (str, sp.Basic, Function1D)):
+        from chebnorm.core.textsafe import identifier
+
+        from .trace import trace_callable
+
+        expr = trace_callable(expr, sp.Symbol(identifier(var, field="var")))
+    return expr, var
+
+
 def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant):
     """The real coefficients of :func:`fit` (constrained to ``monomials`` /
     ``fix_constant`` when given), their notes, provenance entries and
@@ -283,8 +408,8 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
     if basis not in BASES:
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
     if basis != "monomial" and (quantized or constrained):
-        raise ValueError("quantized coefficients (frac-bits, coef-format, monomials, "
-                         "fix-constant) with basis shifted are not supported; accepted: "
+        raise ValueError("quantized coefficients (frac_bits, coef_format, monomials, "
+                         "fix_constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
     if constrained and not quantized and kind != "minimax":
         raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
@@ -300,14 +425,14 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
 
     if basis != "monomial":
         raise ValueError(f"basis {basis} applies to one polynomial; accepted with segments, "
-                         f"segment-by or centered: basis monomial (centered evaluates each "
+                         f"segment_by or centered: basis monomial (centered evaluates each "
                          f"segment about its middle)")
     if coef_format not in (None, "fixed") or monomials is not None or fix_constant:
-        raise ValueError("coef-format, monomials and fix-constant apply to one polynomial; "
-                         "accepted with segments, segment-by or centered: fixed-point "
-                         "coefficients (frac-bits F, one integer)")
+        raise ValueError("coef_format, monomials and fix_constant apply to one polynomial; "
+                         "accepted with segments, segment_by or centered: fixed-point "
+                         "coefficients (frac_bits F, one integer)")
     if isinstance(frac_bits, (list, tuple)):
-        raise ValueError(f"frac-bits {','.join(map(str, frac_bits))}: piecewise tables share "
+        raise ValueError(f"frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
                          f"one format; accepted: one integer")
     return piecewise_fit(expr, tuple(interval), degree, segments=segments or 1,
                          segment_by=segment_by or "uniform",
@@ -489,28 +614,28 @@ def _check_table(table, argument: str) -> None:
 
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
-        raise ValueError(f"frac-bits {frac_bits!r} is not a non-negative integer")
+        raise ValueError(f"frac_bits {frac_bits!r} is not a non-negative integer")
     limit = 2 ** (word_bits - 1) - 1
     biggest = max(abs(c) for c in coeffs)
     if biggest == 0:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
     if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
-        raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: the largest "
+        raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: the largest "
                          f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
-                         f"accepted: frac-bits <= {max_f}")
+                         f"accepted: frac_bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
-            raise ValueError(f"frac-bits {frac_bits} overflows int{word_bits}: coefficient of "
+            raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
                              f"x^{k} = {c:.6g} becomes {round(math.ldexp(c, frac_bits))}; "
-                             f"accepted: frac-bits <= {max_f}")
+                             f"accepted: frac_bits <= {max_f}")
 
 
 def _frac_list(frac_bits, degree: int, coeffs, word_bits: int) -> list[int]:
     """``frac_bits`` (an integer or one per power 0..degree) as a list, checked."""
     if isinstance(frac_bits, (list, tuple)):
         if len(frac_bits) != degree + 1:
-            raise ValueError(f"frac-bits list {list(frac_bits)} has {len(frac_bits)} entries; "
+            raise ValueError(f"frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
                              f"accepted: one integer, or degree + 1 = {degree + 1} integers "
                              f"(one per power 0..{degree})")
         for k, f in enumerate(frac_bits):
@@ -542,36 +667,64 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
              fix_constant: bool = False) -> CoefficientTable:
     """Round the coefficients to a fixed or floating format and re-certify.
 
-    ``coef_format="fixed"`` (the default) stores coefficient ``k`` with
-    ``frac_bits`` fractional bits (one integer, or one per power
-    ``0..degree``) as a ``word_bits``-bit integer; ``"binary16"``,
-    ``"bfloat16"``, ``"binary32"``, ``"binary64"`` store each coefficient as a
-    number of that floating format. ``monomials`` (e.g. ``(1, 3, 5)``) keeps
-    only those powers; ``fix_constant`` holds the constant coefficient at
-    ``f(0)`` rounded to its format (so ``p(0) = f(0)`` when that is
-    representable). The error minimized is the table's ``error_kind``.
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in the monomial basis (from :func:`fit` or ``load``).
+    frac_bits : int or sequence of int, optional
+        Fixed point (``coef_format="fixed"``, required there): coefficient
+        ``k`` stored with ``frac_bits`` fractional bits (one integer, or one
+        per power ``0..degree``) as a ``word_bits``-bit integer.
+    word_bits : int, optional
+        ``2 <= word_bits <= 53``: the signed integer width of fixed point.
+    reoptimize : bool, optional
+        Choose the coefficients as Sollya's ``fpminimax`` does (default), or
+        (False) only round each to nearest.
+    coef_format : {"fixed", "binary16", "bfloat16", "binary32", "binary64"}, optional
+        The format of every stored coefficient.
+    monomials : sequence of int, optional
+        Keep only these powers (e.g. ``(1, 3, 5)``).
+    fix_constant : bool, optional
+        Hold the constant coefficient at ``f(0)`` rounded to its format (so
+        ``p(0) = f(0)`` when that is representable).
 
-    With ``reoptimize=False`` each coefficient is only rounded to nearest.
-    Otherwise the coefficients are chosen as Sollya's ``fpminimax`` chooses them
-    (lattice reduction and a closest vector at Chebyshev points, see
-    :mod:`chebnorm.approx.rounding`); plain rounding and the greedy refit (rounded from the highest power down,
-    the lower ones refitted at Chebyshev nodes) compete: they are ranked by their
-    sampled error and certified in that order while they can still win; the one
-    with the smallest certified bound wins (``method`` names it; floating
-    formats: within a factor 1 + 2^-20 of the smallest). Fixed formats
-    are monotone in the bits: more fractional bits never certify a worse error.
-    A table fitted with the same ``monomials`` / ``fix_constant`` (same held
-    constant) is quantized from its own coefficients, otherwise the constrained
-    real fit is computed first.
+    Returns
+    -------
+    CoefficientTable
+        ``table`` with ``quantized`` set (and ``fixed_point``: fixed format
+        with one ``frac_bits``, all powers, free constant). Its own bound is
+        :attr:`CoefficientTable.error_bound` (``quantized.abs_error_bound``);
+        ``abs_error_bound`` stays the float coefficients'.
 
-    The result is the table with ``quantized`` (always) and ``fixed_point``
-    (fixed format with one ``frac_bits``, all powers, free constant) set.
+    Raises
+    ------
+    ValueError
+        For a table that is not a CoefficientTable or is in the shifted basis,
+        a format or ``frac_bits`` out of range (naming the largest accepted
+        ``frac_bits``), or when no rounding could be certified.
 
+    Notes
+    -----
+    The error minimized is the table's ``error_kind``. With ``reoptimize``
+    the coefficients are chosen by lattice reduction and a closest vector at
+    Chebyshev points (see :mod:`chebnorm.approx.rounding`); plain rounding
+    and the greedy refit (rounded from the highest power down, the lower ones
+    refitted at Chebyshev nodes) compete: they are ranked by their sampled
+    error and certified in that order while they can still win; the one with
+    the smallest certified bound wins (``method`` names it; floating formats:
+    within a factor 1 + 2^-20 of the smallest). Fixed formats are monotone in
+    the bits: more fractional bits never certify a worse error. A table
+    fitted with the same ``monomials`` / ``fix_constant`` (same held
+    constant) is quantized from its own coefficients, otherwise the
+    constrained real fit is computed first.
+
+    Examples
+    --------
     >>> t = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 14)
-    >>> t.fixed_point.integers, f"{t.fixed_point.abs_error_bound:.3e}"
+    >>> t.fixed_point.integers, f"{t.error_bound:.3e}"
     ((11152, -1944, 232), '2.781e-05')
     >>> s = quantize(fit("sin(x)", ("0", "1"), 5), coef_format="binary32", monomials=(1, 3, 5))
-    >>> s.quantized.mantissas[0::2], s.quantized.abs_error_bound < 4e-6
+    >>> s.quantized.mantissas[0::2], s.error_bound < 4e-6
     ((0, 0, 0), True)
     """
     _check_table(table, "table")
@@ -593,11 +746,11 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
-            raise ValueError("coefficient format fixed needs frac-bits (an integer, or one per "
+            raise ValueError("coefficient format fixed needs frac_bits (an integer, or one per "
                              "power); accepted: e.g. 14 or 14,16,18")
         fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
     elif frac_bits is not None:
-        raise ValueError(f"frac-bits applies to coefficient format fixed, not {coef_format}")
+        raise ValueError(f"frac_bits applies to coefficient format fixed, not {coef_format}")
     else:
         fracs = None
     fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \

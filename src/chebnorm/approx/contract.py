@@ -152,6 +152,13 @@ class Table(abc.ABC):
         """The certified bounds of the whole table: ``(abs, rel)`` (``rel`` may be None)."""
         return ErrorBounds(self.abs_error_bound, self.rel_error_bound)
 
+    @property
+    def error_bound(self) -> float:
+        """The certified bound of ``sup |p - f|`` for the coefficients the table
+        delivers (a quantized :class:`~chebnorm.approx.CoefficientTable`: its
+        quantized coefficients'; otherwise ``abs_error_bound``)."""
+        return self.abs_error_bound
+
     # -- files ----------------------------------------------------------------------
     def to_json(self) -> str:
         """The JSON text: keys sorted, strict JSON (no ``NaN``/``Infinity``)."""

@@ -753,7 +753,7 @@ def _parse_function(text, var: str) -> Function1D:
         except _Refusal as exc:
             message = f"cannot parse expression {_show(text) if isinstance(text, str) else ''}: {exc}"
             if str(exc).startswith("unknown variable"):
-                message += f" (the variable is {var!r}: set it with --var)"
+                message += f" (the variable is {var!r}: set it with var=)"
             raise ValueError(f"{message}; {_accepted(symbols)}") from None
     if expr.has(sp.zoo, sp.nan, sp.oo, -sp.oo, sp.I):
         raise ValueError(f"expression {_show(str(text))} = {expr} is not a finite real function")

@@ -146,13 +146,13 @@ def _check_binades(lo, hi, index_bits: int) -> None:
     """Refuse an exponent-indexed interval that is not [2^e0, 2^e1] of a few binades."""
     e0, e1 = exact_log2(lo), exact_log2(hi)
     if e0 is None or e1 is None:
-        raise ValueError(f"segment-by exponent needs an interval [2^e0, 2^e1] of powers of "
-                         f"two, got [{lo}, {hi}]; accepted: e.g. --interval 1/4 4")
+        raise ValueError(f"segment_by exponent needs an interval [2^e0, 2^e1] of powers of "
+                         f"two, got [{lo}, {hi}]; accepted: e.g. interval=('1/4', '4')")
     if not 1 <= e1 - e0 <= MAX_EXPONENT_SPAN:
-        raise ValueError(f"segment-by exponent: {e1 - e0} binades; accepted: 1 to "
+        raise ValueError(f"segment_by exponent: {e1 - e0} binades; accepted: 1 to "
                          f"{MAX_EXPONENT_SPAN}")
     if (e1 - e0) * 2 ** index_bits > 2 ** MAX_INDEX_BITS:
-        raise ValueError(f"segment-by exponent: {e1 - e0} binades x 2^{index_bits} = "
+        raise ValueError(f"segment_by exponent: {e1 - e0} binades x 2^{index_bits} = "
                          f"{(e1 - e0) * 2 ** index_bits} segments; accepted: at most "
                          f"2^{MAX_INDEX_BITS}")
 
@@ -165,9 +165,9 @@ def _checked(name, segments, degree, coef_frac_bits, segment_by, fit, error, cen
     name = identifier(name, field="name")
     index_bits = parse_segments(segments)
     degree = check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
-    frac_bits = check_int(coef_frac_bits, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS)
+    frac_bits = check_int(coef_frac_bits, "coef_frac_bits", 0, MAX_COEF_FRAC_BITS)
     if segment_by not in SEGMENT_BY:
-        raise ValueError(f"segment-by {segment_by!r} is unknown; accepted: {', '.join(SEGMENT_BY)}")
+        raise ValueError(f"segment_by {segment_by!r} is unknown; accepted: {', '.join(SEGMENT_BY)}")
     if fit not in FITS:
         raise ValueError(f"fit kind {fit!r} is unknown; accepted: {', '.join(FITS)}")
     if error not in ERRORS:
@@ -200,9 +200,9 @@ def _fit_all(fn, lo, hi, segment_by, index_bits, degree, frac_bits, centered, fi
         big = max(abs(c) for c in coeffs)
         if big * 2.0 ** frac_bits >= limit:
             max_f = max(0, math.floor(math.log2(limit / big)) - 1)
-            raise ValueError(f"coef-frac-bits {frac_bits} overflows the {MAX_COEF_INT_BITS}-bit "
+            raise ValueError(f"coef_frac_bits {frac_bits} overflows the {MAX_COEF_INT_BITS}-bit "
                              f"coefficient integers (segment {s}: |c| = {big:.6g}); accepted: "
-                             f"coef-frac-bits <= {max_f}")
+                             f"coef_frac_bits <= {max_f}")
         with np.errstate(all="ignore"):
             ints_all.append(_quantize_segment(g, coeffs, frac_bits, *loc, error))
         if progress is not None:

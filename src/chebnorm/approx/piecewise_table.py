@@ -51,6 +51,7 @@ import sympy as sp
 
 from flint import arb
 
+from chebnorm.core.display import summary_repr
 from chebnorm.core.numeric import arb_precision, signed_bits
 
 from .certify import arb_enclose, certify
@@ -155,6 +156,14 @@ class PiecewiseTable(Table):
     MAX_BYTES = MAX_PIECEWISE_BYTES
     JSON_INDENT = 1
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("segments", self.segment_count),
+                ("segment_by", self.segment_by), ("degree", self.degree),
+                ("coef_frac_bits", self.coef_frac_bits), ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
+
     # -- geometry ------------------------------------------------------------
     @property
     def segment_count(self) -> int:
@@ -206,6 +215,56 @@ class PiecewiseTable(Table):
         for j in range(self.degree - 1, -1, -1):
             acc = acc * t + coeffs[s, j]
         return acc
+
+    # -- conversions (numpy, sympy) ---------------------------------------------
+    def to_sympy(self):
+        """The table as a sympy ``Piecewise`` in its variable, exactly.
+
+        Segment ``s`` holds for ``a_s <= x < b_s`` (the last one up to and
+        including ``hi``), as :meth:`__call__` locates it; its polynomial is
+        in the local variable ``t = (x - a_s)/(b_s - a_s)`` (``t - 1/2``
+        when ``centered``), with the exact coefficients
+        ``integers[j] / 2**coef_frac_bits`` and the exact segment endpoints.
+        Outside ``[lo, hi]`` the Piecewise is undefined (sympy's ``nan``).
+
+        Returns
+        -------
+        sympy.Piecewise
+
+        Examples
+        --------
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=8)
+        >>> e = t.to_sympy()
+        >>> len(e.args), float(e.subs("x", 3)) == float(t(3.0))
+        (2, True)
+        """
+        x = sp.Symbol(self.variable)
+        scale = sp.Integer(2) ** -self.coef_frac_bits
+        pieces = []
+        for s in range(self.segment_count):
+            a, b = self.segment_bounds(s)
+            t = (x - a) / (b - a) - (sp.Rational(1, 2) if self.centered else 0)
+            poly = sp.Add(*(q * scale * t ** j for j, q in enumerate(self.segments[s].integers)))
+            last = s == self.segment_count - 1
+            cond = sp.And(x >= a, x <= b) if last else sp.And(x >= a, x < b)
+            pieces.append((poly, cond))
+        return sp.Piecewise(*pieces)
+
+    def __array__(self, dtype=None, copy=None):
+        """``np.asarray(table)``: the coefficients, shape ``(segments, degree + 1)``,
+        float64: row ``s`` is :meth:`coefficients` ``(s)`` (each segment's, in its
+        local variable, exactly ``integers / 2**coef_frac_bits``).
+
+        >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+        >>> np.asarray(piecewise_fit("x**2", ("0", "1"), 1, segments=4)).shape
+        (4, 2)
+        """
+        if copy is False:
+            raise ValueError("a table's coefficients are copied into a new array; accepted: "
+                             "copy=None or copy=True")
+        return np.array([self.coefficients(s) for s in range(self.segment_count)],
+                        dtype=np.float64 if dtype is None else dtype)
 
     def _locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(s, t)``: the segment of each ``x`` and its local variable in ``[0, 1]``, in float64."""

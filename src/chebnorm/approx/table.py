@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 
+from chebnorm.core.display import summary_html, summary_repr
+
 from .contract import Table
 from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
                      MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
@@ -69,6 +71,14 @@ class FixedPoint:
         """The quantized coefficients as floats (exact)."""
         return tuple(math.ldexp(q, -self.frac_bits) for q in self.integers)
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("frac_bits", self.frac_bits), ("integers", self.integers),
+                ("word_bits", self.word_bits), ("method", self.method),
+                ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
 
 @dataclass(frozen=True)
 class Quantized:
@@ -103,6 +113,14 @@ class Quantized:
     def coefficients(self) -> tuple[float, ...]:
         """The stored coefficients as floats (exact)."""
         return tuple(math.ldexp(m, e) for m, e in zip(self.mantissas, self.exponents))
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("format", self.format), ("monomials", self.monomials),
+                ("coefficients", self.coefficients), ("method", self.method),
+                ("abs_error_bound", self.abs_error_bound)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
 
 @dataclass(frozen=True)
@@ -154,6 +172,16 @@ class CoefficientTable(Table):
     TOO_LARGE_HINT = "; accepted: a table written by chebnorm (a few kB)"
     JSON_INDENT = 2
 
+    def _summary(self) -> list[tuple[str, object]]:
+        out = [("name", self.name), ("expression", self.expression),
+               ("interval", self.interval), ("degree", self.degree), ("kind", self.kind),
+               ("abs_error_bound", self.abs_error_bound)]
+        if self.quantized is not None:
+            out.append(("quantized_error_bound", self.quantized.abs_error_bound))
+        return out
+
+    __repr__ = summary_repr
+
     @property
     def basis(self) -> str:
         """``"monomial"`` (powers of ``x``) or ``"shifted"`` (powers of ``(x - c)/s``)."""
@@ -167,14 +195,14 @@ class CoefficientTable(Table):
         >>> fit("exp(x)", ("0", "1"), 2, basis="shifted").require_monomial("hw")
         Traceback (most recent call last):
         ...
-        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with --basis monomial
+        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
         """
         if self.shift is not None:
             c, s = self.shift
             raise ValueError(f"table {self.name!r} is stored in the shifted variable "
                              f"t = ({self.variable} - {c!r})/{s!r}; {consumer}: plain "
                              f"powers of {self.variable} only; accepted: a table fitted with "
-                             f"--basis monomial")
+                             f"basis='monomial'")
 
     # -- evaluation -------------------------------------------------------
     def __call__(self, x, dtype=np.float64):
@@ -191,6 +219,201 @@ class CoefficientTable(Table):
     def covers(self, lo: float, hi: float) -> bool:
         """True when ``[lo, hi]`` lies inside the table's interval."""
         return self.interval_float[0] <= lo and hi <= self.interval_float[1]
+
+    # -- the quantized part's bound ------------------------------------------
+    @property
+    def quantized_error_bound(self) -> float | None:
+        """The certified bound of ``sup |p_q - f|`` for the quantized coefficients
+        (``quantized.abs_error_bound``), or None for a table that is not quantized.
+
+        ``abs_error_bound`` stays the bound of the float ``coefficients`` (the
+        JSON field, verified against them, and printed by the exporters next
+        to the quantized one), so a quantized table names its own bound here
+        and in :attr:`error_bound`.
+
+        Examples
+        --------
+        >>> from chebnorm.approx import fit, quantize
+        >>> q = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 14)
+        >>> q.quantized_error_bound == q.quantized.abs_error_bound > q.abs_error_bound
+        True
+        """
+        return None if self.quantized is None else self.quantized.abs_error_bound
+
+    @property
+    def error_bound(self) -> float:
+        """The certified bound of ``sup |p - f|`` for the coefficients the table
+        delivers: the quantized ones' (:attr:`quantized_error_bound`) when the
+        table is quantized, else the float ones' (``abs_error_bound``).
+
+        Examples
+        --------
+        >>> from chebnorm.approx import fit, quantize
+        >>> t = fit("exp(x)", ("0", "1"), 3)
+        >>> t.error_bound == t.abs_error_bound
+        True
+        >>> q = quantize(t, 12)
+        >>> q.error_bound == q.quantized.abs_error_bound
+        True
+        """
+        q = self.quantized_error_bound
+        return self.abs_error_bound if q is None else q
+
+    # -- conversions (numpy, sympy) ---------------------------------------------
+    def _coefficients_of(self, quantized: bool) -> tuple[float, ...]:
+        if not quantized:
+            return self.coefficients
+        if self.quantized is None:
+            raise ValueError(f"quantized=True: table {self.name!r} has no quantized part; "
+                             f"accepted: quantized=False, or a table from chebnorm.quantize")
+        return self.quantized.coefficients
+
+    def to_polynomial(self, quantized: bool = False):
+        """The polynomial as a :class:`numpy.polynomial.Polynomial` of ``x``.
+
+        Parameters
+        ----------
+        quantized : bool, optional
+            Use the quantized coefficients (``quantized.coefficients``)
+            instead of the float ones (default).
+
+        Returns
+        -------
+        numpy.polynomial.Polynomial
+            The coefficients in ascending powers; for a shifted table (powers
+            of ``t = (x - c)/s``) ``domain = [c - s, c + s]`` and ``window =
+            [-1, 1]``, so that calling it with ``x`` maps ``x`` to ``t`` as
+            the table does. ``symbol`` is the table's variable.
+
+        Raises
+        ------
+        ValueError
+            ``quantized=True`` on a table without a quantized part.
+
+        Examples
+        --------
+        >>> from chebnorm.approx import fit
+        >>> t = fit("exp(x)", ("0", "1"), 3)
+        >>> p = t.to_polynomial()
+        >>> bool(p(0.3) == t(0.3)), p.degree()
+        (True, 3)
+        >>> t = fit("sin(x)", ("100", "101"), 8, basis="shifted")
+        >>> s = t.to_polynomial()
+        >>> s.domain.tolist(), s.window.tolist(), bool(s(100.25) == t(100.25))
+        ([100.0, 101.0], [-1.0, 1.0], True)
+        """
+        from numpy.polynomial import Polynomial
+
+        coeffs = np.array(self._coefficients_of(quantized), dtype=np.float64)
+        if self.shift is None:
+            return Polynomial(coeffs, symbol=self.variable)
+        c, s = self.shift
+        return Polynomial(coeffs, domain=[c - s, c + s], window=[-1.0, 1.0],
+                          symbol=self.variable)
+
+    def to_chebyshev(self, quantized: bool = False):
+        """The polynomial as a :class:`numpy.polynomial.Chebyshev` series on the interval.
+
+        The change of basis is exact (rational arithmetic): each Chebyshev
+        coefficient is the exact one rounded once to float64.
+
+        Parameters
+        ----------
+        quantized : bool, optional
+            Use the quantized coefficients instead of the float ones (default).
+
+        Returns
+        -------
+        numpy.polynomial.Chebyshev
+            ``domain = interval_float`` (``window = [-1, 1]``): calling it with
+            ``x`` in the interval gives ``p(x)``.
+
+        Raises
+        ------
+        ValueError
+            ``quantized=True`` on a table without a quantized part.
+
+        Examples
+        --------
+        >>> from chebnorm.approx import fit
+        >>> t = fit("exp(x)", ("0", "1"), 3)
+        >>> ch = t.to_chebyshev()
+        >>> ch.domain.tolist(), bool(abs(ch(0.7) - t(0.7)) < 1e-15)
+        ([0.0, 1.0], True)
+        """
+        from numpy.polynomial import Chebyshev
+
+        lo, hi = self.interval_float
+        series = _power_to_chebyshev(self._rational_power(quantized, Fraction(lo), Fraction(hi)))
+        return Chebyshev([float(a) for a in series], domain=[lo, hi], symbol=self.variable)
+
+    def _rational_power(self, quantized: bool, lo: Fraction, hi: Fraction) -> list[Fraction]:
+        """Exact coefficients of ``p(m + h*u)`` in powers of ``u`` (``[lo, hi]`` -> ``[-1, 1]``)."""
+        from flint import fmpq, fmpq_poly
+
+        coeffs = [Fraction(c) for c in self._coefficients_of(quantized)]
+        m, h = (lo + hi) / 2, (hi - lo) / 2
+        x_of_u = fmpq_poly([fmpq(m.numerator, m.denominator), fmpq(h.numerator, h.denominator)])
+        if self.shift is not None:  # t = (x - c)/s
+            c, s = (Fraction(v) for v in self.shift)
+            x_of_u = (x_of_u - fmpq(c.numerator, c.denominator)) / fmpq(s.numerator,
+                                                                        s.denominator)
+        poly = fmpq_poly([fmpq(c.numerator, c.denominator) for c in coeffs])(x_of_u)
+        out = [Fraction(int(q.p), int(q.q)) for q in poly.coeffs()]
+        return out + [Fraction(0)] * (len(coeffs) - len(out))
+
+    def to_sympy(self, quantized: bool = False):
+        """The polynomial as a sympy expression in the table's variable, exactly.
+
+        Every coefficient is a double (or, quantized, ``m * 2**e``): it becomes
+        the sympy Rational of exactly that value. A shifted table gives the
+        sum of ``c_k * ((x - c)/s)**k`` (unexpanded; ``sympy.expand`` it for
+        powers of ``x``, exactly).
+
+        Parameters
+        ----------
+        quantized : bool, optional
+            Use the quantized coefficients instead of the float ones (default).
+
+        Returns
+        -------
+        sympy.Expr
+
+        Raises
+        ------
+        ValueError
+            ``quantized=True`` on a table without a quantized part.
+
+        Examples
+        --------
+        >>> from chebnorm.approx import fit, quantize
+        >>> q = quantize(fit("1/sqrt(2+z)", ("sqrt(2)", 2), 2, var="z"), 14)
+        >>> q.to_sympy(quantized=True)
+        29*z**2/2048 - 243*z/2048 + 697/1024
+        """
+        import sympy as sp
+
+        x = sp.Symbol(self.variable)
+        if self.shift is not None:
+            c, s = (sp.Rational(*float(v).as_integer_ratio()) for v in self.shift)
+            x = (x - c) / s
+        return sp.Add(*(sp.Rational(*float(a).as_integer_ratio()) * x ** k
+                        for k, a in enumerate(self._coefficients_of(quantized))))
+
+    def __array__(self, dtype=None, copy=None):
+        """``np.asarray(table)``: the float ``coefficients`` (ascending powers, in
+        the table's basis: of ``x``, or of ``t = (x - c)/s`` for a shifted table)
+        as a float64 array; :meth:`to_polynomial` and :meth:`to_chebyshev`
+        give the polynomial itself.
+
+        >>> from chebnorm.approx import fit
+        >>> np.asarray(fit("exp(x)", ("0", "1"), 2)).shape
+        (3,)
+        """
+        if copy is False:
+            raise ValueError("a table's coefficients are copied into a new array; accepted: "
+                             "copy=None or copy=True")
+        return np.array(self.coefficients, dtype=np.float64 if dtype is None else dtype)
 
     # -- JSON ---------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -278,6 +501,13 @@ class CoefficientTable(Table):
             if fp.max_rel_error is not None and fp.rel_error_bound is not None:
                 rows.append(("fixed max |p/f - 1|", f"{fp.max_rel_error:.6e}; certified bound "
                                                     f"{fp.rel_error_bound:.6e}"))
+        q = self.quantized
+        if q is not None and fp is None:
+            rows.append(("quantized", f"{q.format} ({q.method}), powers "
+                                      f"{','.join(map(str, q.monomials))}: "
+                                      + ", ".join(repr(c) for c in q.coefficients)))
+            rows.append(("quantized max |p - f|", f"{q.max_abs_error:.6e}; certified bound "
+                                                  f"{q.abs_error_bound:.6e}"))
         if self.provenance:
             rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
         return rows
@@ -314,8 +544,9 @@ class CoefficientTable(Table):
             for i, xi in enumerate(x):
                 xm = mpmath.mpf(float(xi))
                 p = mpmath.mpf(0)
+                tm = _local_mp(self, xm)   # the shifted variable of a shifted table
                 for c in reversed(coeffs):
-                    p = p * xm + mpmath.mpf(c)
+                    p = p * tm + mpmath.mpf(c)
                 f = f_mp(xm)
                 g[i] = float(p - f) if error == "abs" else float(p / f - 1)
         return x, g
@@ -735,7 +966,36 @@ def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float,
     with mpmath.workdps(40):
         xm = mpmath.mpf(float(at))
         p = mpmath.mpf(0)
+        tm = _local_mp(table, xm)
         for c in reversed(table.coefficients):
-            p = p * xm + mpmath.mpf(c)
+            p = p * tm + mpmath.mpf(c)
         f = f_mp(xm)
         return at, float(p - f) if error == "abs" else float(p / f - 1)
+
+
+def _local_mp(table: CoefficientTable, xm):
+    """``x`` (an mpmath number) in the table's variable: ``(x - c)/s`` when shifted."""
+    import mpmath
+
+    if table.shift is None:
+        return xm
+    return (xm - mpmath.mpf(table.shift[0])) / mpmath.mpf(table.shift[1])
+
+
+def _power_to_chebyshev(coeffs: list[Fraction]) -> list[Fraction]:
+    """Exact Chebyshev coefficients ``a`` with ``sum a_k T_k(u) = sum c_k u**k``."""
+    n = len(coeffs) - 1
+    cheb = [[Fraction(1)], [Fraction(0), Fraction(1)]]  # T_k in powers of u
+    while len(cheb) <= n:
+        a, b = cheb[-1], cheb[-2]
+        nxt = [Fraction(0)] + [2 * v for v in a]
+        for i, v in enumerate(b):
+            nxt[i] -= v
+        cheb.append(nxt)
+    rest = list(coeffs)
+    out = [Fraction(0)] * (n + 1)
+    for k in range(n, -1, -1):
+        out[k] = rest[k] / cheb[k][k]
+        for i, v in enumerate(cheb[k]):
+            rest[i] -= out[k] * v
+    return out

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from chebnorm.core.display import summary_html, summary_repr
+
 from .expr import compare, read_expression, parse_number
 
 __all__ = ["Target", "TARGETS", "get_target", "target_names"]
@@ -35,6 +37,17 @@ class Target:
     degrees: tuple[int, ...]
     kind: str
     meaning: str
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("variable", self.variable), ("interval_text", self.interval_text),
+                ("degrees", self.degrees), ("kind", self.kind)]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return self._summary() + [("meaning", self.meaning)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def interval(self, psi_max: float | str = "pi/4") -> tuple[str, str]:
         """Exact endpoint strings with psi_max substituted (sympy syntax).

@@ -76,6 +76,9 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, OSError) and exc.strerror and exc.filename and "Errno" in text:
             text = f"{exc.filename}: {exc.strerror}"  # no "[Errno 13]" noise
         message = " ".join(text.split()) or type(exc).__name__
+        from .fit import cli_phrases  # the library's ``basis='monomial'`` as a flag
+
+        message = cli_phrases(message)
         print(f"chebnorm: error: {message}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

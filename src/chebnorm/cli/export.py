@@ -15,6 +15,7 @@ from chebnorm.approx import PiecewiseTable, load_table
 from chebnorm.export import EXPORT_FORMATS, HDL_FORMATS, export_table, options_for
 
 from .common import command_line, deprecated_alias
+from .fit import cli_words
 
 #: export option -> (argparse dest, flag)
 _FLAGS = {"in_bits": ("in_bits", "--in-bits"), "out_bits": ("out_bits", "--out-bits"),
@@ -73,5 +74,8 @@ def run(args) -> int:
         accepted = "" if isinstance(table, PiecewiseTable) else "; accepted: 1..20 and 1..32"
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
                          f"output code widths){accepted}")
-    export_table(table, args.format, args.output, command_line(args), **given)
+    try:
+        export_table(table, args.format, args.output, command_line(args), **given)
+    except ValueError as exc:   # the library names its arguments (in_bits): the flags' words
+        raise ValueError(cli_words(str(exc))) from None
     return 0

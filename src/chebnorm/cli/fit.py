@@ -78,13 +78,77 @@ def _int_list(text: str):
     return parts[0] if len(parts) == 1 and "," not in text else parts
 
 
+#: the library's argument names as this command's words (its messages name the
+#: Python argument; the command line names the flag, as it always did)
+_CLI_WORDS = re.compile(r"(?<![\w.])(coef_frac_bits|frac_bits|coef_format|segment_by|"
+                        r"fix_constant|in_bits|out_bits)(?![\w\[])")
+_CLI_PHRASES = (("set it with var=", "set it with --var"),
+                ("interval=('1/4', '4')", "--interval 1/4 4"),
+                ("basis='monomial'", "--basis monomial"))
+
+
+def cli_words(message: str) -> str:
+    """A library message with the argument names of :func:`chebnorm.fit` as
+    ``chebnorm fit`` spells them (``frac_bits`` -> ``frac-bits``, ``var=`` ->
+    ``--var``).
+
+    Parameters
+    ----------
+    message : str
+        A library's ValueError text (Python argument names).
+
+    Returns
+    -------
+    str
+        The text with the command line's words (a field of a table file, such as
+        ``quantized.frac_bits``, is left as it is).
+
+    Examples
+    --------
+    >>> cli_words("frac_bits 40 overflows int32; accepted: frac_bits <= 30")
+    'frac-bits 40 overflows int32; accepted: frac-bits <= 30'
+    """
+    return _CLI_WORDS.sub(lambda m: m.group(1).replace("_", "-"), cli_phrases(message))
+
+
+def cli_phrases(message: str) -> str:
+    """The phrases of library messages that name an argument by its Python
+    spelling (``basis='monomial'``, ``var=``) as the flag (any command).
+
+    Parameters
+    ----------
+    message : str
+        A library's ValueError text.
+
+    Returns
+    -------
+    str
+        The text with those phrases as flags.
+
+    Examples
+    --------
+    >>> cli_phrases("accepted: a table fitted with basis='monomial'")
+    'accepted: a table fitted with --basis monomial'
+    """
+    for python, flag in _CLI_PHRASES:
+        message = message.replace(python, flag)
+    return message
+
+
+def _fit_cli(args, **kw):
+    """:func:`chebnorm.fit` with the command's arguments; its refusals in the CLI's words."""
+    try:
+        return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
+                   error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
+                   command=command_line(args), basis=args.basis,
+                   coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
+    except ValueError as exc:
+        raise ValueError(cli_words(str(exc))) from None
+
+
 def _run_piecewise(args) -> int:
-    table = fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
-                var=args.var, name=args.name, frac_bits=args.frac_bits,
-                command=command_line(args), basis=args.basis, coef_format=args.coef_format,
-                monomials=args.monomials, fix_constant=args.fix_constant,
-                segments=args.segments or 1, segment_by=args.segment_by or "uniform",
-                centered=args.centered)
+    table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
+                     segment_by=args.segment_by or "uniform", centered=args.centered)
     if args.output:
         table.save(args.output)
     if args.json:
@@ -116,11 +180,7 @@ def run(args) -> int:
 
 
 def _fit(args, mon):
-    return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind, error=args.error,
-                var=args.var, name=args.name, frac_bits=args.frac_bits,
-                command=command_line(args), basis=args.basis,
-                coef_format=args.coef_format, monomials=mon,
-                fix_constant=args.fix_constant)
+    return _fit_cli(args, monomials=mon)
 
 
 def _report(args, table) -> int:

@@ -4,7 +4,7 @@ Every format ``chebnorm export`` offers is printed here, for both kinds of
 table (:data:`EXPORT_FORMATS`, :func:`formats_for`):
 
 * a :class:`~chebnorm.approx.CoefficientTable`: ``c``, ``json``, ``glsl``,
-  ``wgsl``, ``hlsl`` (:data:`FORMATS`: printers that need only the table) and
+  ``wgsl``, ``hlsl`` (:data:`TABLE_FORMATS`: printers that need only the table) and
   ``verilog``, ``vhdl`` (:data:`HDL_FORMATS`: a fixed-point evaluator, sized
   by ``in_bits`` and ``out_bits``, printed by :mod:`chebnorm.hw.hdl`);
 * a :class:`~chebnorm.approx.PiecewiseTable`: ``c``, ``json``,
@@ -43,18 +43,22 @@ def json_text(table, command: str = "") -> str:
 
 
 #: the printers that need only the table: format -> (printer(table, command), file suffix)
-FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json"), "glsl": (glsl_source, ".glsl"),
+TABLE_FORMATS = {"c": (c_header, ".h"), "json": (json_text, ".json"), "glsl": (glsl_source, ".glsl"),
            "wgsl": (wgsl_source, ".wgsl"), "hlsl": (hlsl_source, ".hlsl")}
 #: the fixed-point hardware formats (``in_bits`` and ``out_bits`` needed): format -> suffix
 HDL_FORMATS = {"verilog": ".v", "vhdl": ".vhd"}
-#: every format ``chebnorm export`` offers (for some kind of table)
-EXPORT_FORMATS = tuple(sorted({*FORMATS, *HDL_FORMATS}))
+#: every format ``chebnorm export`` offers (for some kind of table): format -> file
+#: suffix, sorted by format (``list(chebnorm.export.FORMATS)`` lists the seven)
+FORMATS = {fmt: suffix for fmt, suffix in sorted(
+    [(f, suffix) for f, (_, suffix) in TABLE_FORMATS.items()] + list(HDL_FORMATS.items()))}
+#: the names of :data:`FORMATS`, a sorted tuple
+EXPORT_FORMATS = tuple(FORMATS)
 #: the formats of a piecewise table
 PIECEWISE_FORMATS = ("c", "json", "verilog", "vhdl")
 #: the keyword options of a Horner evaluator in an HDL
 HDL_OPTIONS = ("in_bits", "out_bits", "coef_frac_bits", "acc_bits", "rounding")
 
-__all__ = ["FORMATS", "HDL_FORMATS", "EXPORT_FORMATS", "PIECEWISE_FORMATS", "HDL_OPTIONS",
+__all__ = ["FORMATS", "TABLE_FORMATS", "HDL_FORMATS", "EXPORT_FORMATS", "PIECEWISE_FORMATS", "HDL_OPTIONS",
            "formats_for", "options_for", "c_header", "json_text", "export_text", "export_table",
            "hdl_export", "horner_rounding_bound", "glsl_source", "wgsl_source", "hlsl_source",
            "shader_source", "float32_eval_bound", "piecewise_c_header", "DEFAULT_C_IN_BITS"]
@@ -177,22 +181,52 @@ def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bit
                     budget=report.budget)
 
 
-def export_text(table, fmt: str, command: str = "", **options) -> str:
-    """The text of ``table`` in format ``fmt`` (one of :func:`formats_for`).
+def export_text(table, fmt: str, command: str = "", *, name: str | None = None,
+                **options) -> str:
+    """The text of ``table`` in format ``fmt``.
 
-    ``options`` are the format's keyword options (:func:`options_for`; a
-    ``None`` value is not given): ``in_bits`` and ``out_bits`` (required)
-    and ``coef_frac_bits``, ``acc_bits``, ``rounding`` for ``verilog`` and
-    ``vhdl`` (:func:`hdl_export`); ``in_bits`` for a piecewise table's ``c``
-    (default :data:`DEFAULT_C_IN_BITS`). The package itself is callable with
-    the same arguments: ``chebnorm.export(table, "c")`` is
-    ``export_text(table, "c")``.
+    The package itself is callable with the same arguments:
+    ``chebnorm.export(table, "c")`` is ``export_text(table, "c")``.
+
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table (verified again if it changed since it was made).
+    fmt : str
+        One of :func:`formats_for` ``(table)``: ``"c"``, ``"json"``,
+        ``"glsl"``, ``"wgsl"``, ``"hlsl"``, ``"verilog"``, ``"vhdl"``
+        (:data:`FORMATS`).
+    command : str, optional
+        The command line stated in the generated file's banner.
+    name : str, optional
+        The identifier of the generated function, macro or module (default:
+        the table's own ``name``); ``[A-Za-z_][A-Za-z0-9_]*``.
+    **options
+        The format's keyword options (:func:`options_for`; a ``None`` value
+        is not given): ``in_bits`` and ``out_bits`` (required) and
+        ``coef_frac_bits``, ``acc_bits``, ``rounding`` for ``verilog`` and
+        ``vhdl`` (:func:`hdl_export`); ``in_bits`` for a piecewise table's
+        ``c`` (default :data:`DEFAULT_C_IN_BITS`).
+
+    Returns
+    -------
+    str
+        The text of the file.
+
+    Raises
+    ------
+    ValueError
+        For an unknown format, a format the kind of table lacks, an option
+        the format does not take (naming the accepted ones), a missing
+        ``in_bits``/``out_bits``, a ``name`` that is not an identifier.
 
     Examples
     --------
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="dich")
     >>> "static inline double chebnorm_dich(double" in export_text(t, "c")
+    True
+    >>> "chebnorm_rs(" in export_text(t, "glsl", name="rs")
     True
     >>> export_text(t, "json") == t.to_json()
     True
@@ -220,6 +254,8 @@ def export_text(table, fmt: str, command: str = "", **options) -> str:
     if unknown:
         raise ValueError(f"{', '.join(unknown)} does nothing with format {fmt!r} of a {kind}; "
                          f"accepted there: {', '.join(accepted) or 'no option'}")
+    if name is not None and name != table.name:
+        table = _renamed(table, name)
     if fmt in HDL_FORMATS:
         if "in_bits" not in given or "out_bits" not in given:
             raise ValueError(f"format {fmt!r} needs in_bits and out_bits (input and output code "
@@ -231,8 +267,21 @@ def export_text(table, fmt: str, command: str = "", **options) -> str:
             return piecewise_c_header(table, command, in_bits=given.get("in_bits",
                                                                          DEFAULT_C_IN_BITS))
         return json_text(table, command)
-    printer, _ = FORMATS[fmt]
+    printer, _ = TABLE_FORMATS[fmt]
     return printer(table, command)
+
+
+def _renamed(table, name):
+    """``table`` under another ``name`` (checked; the bounds, verified first, are kept)."""
+    from dataclasses import replace
+
+    from chebnorm.approx.contract import construction
+    from chebnorm.core.textsafe import identifier
+
+    identifier(name, field="name")
+    table.verify()
+    with construction("fitted"):  # only the name changes: every field checked, no re-proof
+        return replace(table, name=name)
 
 
 def export_table(table, fmt: str, path, command: str = "", **options) -> str:
@@ -256,8 +305,49 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
 class _CallableModule(types.ModuleType):
     """``chebnorm.export`` is callable: ``chebnorm.export(table, "c")``."""
 
-    def __call__(self, table, fmt: str, command: str = "", **options) -> str:
-        return export_text(table, fmt, command, **options)
+    def __call__(self, table, fmt: str | None = None, command: str = "", *,
+                 name: str | None = None, **options) -> str:
+        """The text of ``table`` in format ``fmt``: :func:`export_text`.
+
+        Parameters
+        ----------
+        table : CoefficientTable or PiecewiseTable
+            The table.
+        fmt : str
+            The format, one of :data:`FORMATS` (``format=`` is accepted too,
+            as the command line's ``--format``).
+        command : str, optional
+            The command line stated in the banner.
+        name : str, optional
+            The identifier of the generated function or module.
+        **options
+            The format's options (:func:`options_for`).
+
+        Returns
+        -------
+        str
+            The text of the file.
+
+        Raises
+        ------
+        ValueError
+            As :func:`export_text`; also when no format is given.
+
+        Examples
+        --------
+        >>> import chebnorm as cn
+        >>> t = cn.fit("exp(x)", (0, 1), 3)
+        >>> "float chebnorm_e3(float" in cn.export(t, "glsl", name="e3")
+        True
+        >>> cn.export(t, format="c") == cn.export(t, "c")
+        True
+        """
+        if fmt is None and isinstance(options.get("format"), str):
+            fmt = options.pop("format")
+        if fmt is None:
+            raise ValueError(f"no export format given; accepted: fmt (or format=) one of "
+                             f"{', '.join(EXPORT_FORMATS)}")
+        return export_text(table, fmt, command, name=name, **options)
 
 
 sys.modules[__name__].__class__ = _CallableModule

@@ -93,8 +93,8 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
     if uniform:
         if isinstance(in_bits, bool) or not isinstance(in_bits, int) or \
                 not max(K, 1) <= in_bits <= MAX_C_IN_BITS:
-            raise ValueError(f"in-bits = {in_bits!r} is out of range; accepted: {max(K, 1)} <= "
-                             f"in-bits <= {MAX_C_IN_BITS} (the table has 2^{K} segments)")
+            raise ValueError(f"in_bits = {in_bits!r} is out of range; accepted: {max(K, 1)} <= "
+                             f"in_bits <= {MAX_C_IN_BITS} (the table has 2^{K} segments)")
     var, expr = comment_text(table.variable), comment_text(table.expression)
     lo_s, hi_s = (comment_text(v) for v in table.interval)
     out = banner_head(fn, table, command)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
+from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.files import write_folder
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
@@ -83,6 +84,19 @@ class HardwareReport:
                                            or m.rounding <= b.gappa_rounding)),
             "no_overflow": m.overflows == 0,
         }
+
+    def _summary(self) -> list[tuple[str, object]]:
+        d = self.design
+        return [("module", d.module_name), ("degree", d.degree), ("in_bits", d.in_bits),
+                ("out_bits", d.out_bits), ("total_error_bound", self.budget.total),
+                ("measured_max_error", self.measurement.total),
+                ("checks_pass", all(self.checks.values()))]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return [(f"line {i + 1}", line) for i, line in enumerate(self.lines())]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def as_dict(self) -> dict:
         d, b = self.design, self.budget

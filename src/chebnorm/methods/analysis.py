@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
 
 from . import detmath
@@ -139,6 +140,23 @@ class MethodReport:
     specular_errors: tuple[float, ...]  # n = 1 .. N_SPECULAR
     ops: OpCounts
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("method", self.method), ("psi", self.psi), ("m", self.m), ("dtype", self.dtype),
+                ("max_length_error", self.max_length_error),
+                ("max_angle_error", self.max_angle_error)]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return self._summary() + [
+            ("max_angle_error_slerp", self.max_angle_error_slerp),
+            ("max_vector_error", self.max_vector_error), ("diffuse_error", self.diffuse_error),
+            ("specular_error(n = 1, 8, 128)", tuple(self.specular_errors[n - 1]
+                                                     for n in (1, 8, 128))),
+            ("ops per pixel", str(dict(self.ops.per_pixel))),
+            ("ops per span", str(dict(self.ops.per_span)))]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
     def specular_error(self, n: int) -> float:
         """Largest ``|(N.R)^n - 1|`` over the span, ``1 <= n <= 128``."""
         if not 1 <= n <= N_SPECULAR:
@@ -214,6 +232,19 @@ class ErrorSweep:
     vector_error: np.ndarray
     diffuse_error: np.ndarray
     specular_error: np.ndarray
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("methods", self.methods), ("dtypes", self.dtypes), ("psis", self.psis),
+                ("ms", self.ms)]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        rows = self._summary()
+        for i, name in enumerate(self.methods):
+            rows.append((f"{name}: max length error", float(self.length_error[i].max())))
+        return rows
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def get(self, quantity: str, method: str, dtype="float64", m=None) -> np.ndarray:
         """One curve over psi (or, with ``m=None``, the ``(len(psis), len(ms))`` block)."""

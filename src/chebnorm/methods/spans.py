@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from chebnorm.approx import CoefficientTable, get_target
+from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.approx.method_registry import MethodSpec, get_method
 
 from . import detmath
@@ -51,6 +52,13 @@ class SpanNormals:
     normals: np.ndarray   # (P, 3), dtype of the computation
     offsets: np.ndarray   # (S + 1,) int64
     t: np.ndarray         # (P,) float64
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("spans", len(self.offsets) - 1), ("pixels", len(self.normals)),
+                ("dtype", str(self.normals.dtype))]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def span(self, i: int) -> np.ndarray:
         """The normals of span ``i``."""

@@ -113,10 +113,22 @@ class RenderComparison:
     def __post_init__(self):
         self.metrics, self.diff = compare(self.test, self.reference, flip=self.flip)
 
+    def __repr__(self) -> str:
+        def frame(r):
+            return f"{getattr(r, 'mesh', '?')} {getattr(r, 'shading', '?')}" + (
+                f":{r.method}" if getattr(r, "method", None) else "")
+
+        m = self.metrics
+        return (f"RenderComparison(test={frame(self.test)!r}, reference="
+                f"{frame(self.reference)!r}, max_abs_8bit={m.max_abs_8bit}, "
+                f"psnr={m.psnr if m.psnr is None else round(m.psnr, 3)}, "
+                f"flip={'not computed' if m.flip is None else round(m.flip, 6)})")
+
     def _repr_html_(self) -> str:
         worst = int(np.abs(self.diff).max()) if self.diff.size else 0
         parts = [_figure(_describe(self.test), self.test.image8, "test"),
                  _figure(_describe(self.reference), self.reference.image8, "reference"),
                  _figure("|test - reference|", error_map_rgb(self.diff), f"white = {max(worst, 1)} levels")]
-        rows = [(k, "n/a (identical)" if v is None else v) for k, v in self.metrics.to_dict().items()]
+        rows = [(k, ("not computed" if k == "flip" else "n/a (identical)") if v is None else v)
+                for k, v in self.metrics.to_dict().items()]
         return "<div>" + "".join(parts) + f"<table>{_rows(rows)}</table></div>"

@@ -18,6 +18,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from chebnorm.core.display import summary_html
+
 __all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_image", "write_png", "image_bytes",
            "image_format", "IMAGE_FORMATS", "ImageFrame", "to_8bit"]
 
@@ -27,15 +29,22 @@ class ImageMetrics:
     """Errors of a frame against a reference, on 8-bit images, over the
     covered pixels (see the module docstring): largest and mean absolute
     difference in levels, pixels off by one level or more, PSNR (``None``
-    when identical), SSIM, mean FLIP, and the number of covered pixels."""
+    when identical), SSIM, mean FLIP (``None`` when not computed:
+    ``compare(..., flip=False)``), and the number of covered pixels."""
 
     max_abs_8bit: int
     pixels_off_1: int
     mean_abs_8bit: float
     psnr: float | None
     ssim: float
-    flip: float
+    flip: float | None
     pixels: int
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return [(k, ("n/a (identical)" if k == "psnr" else "not computed") if v is None else v)
+                for k, v in asdict(self).items()]
+
+    _repr_html_ = summary_html
 
     def to_dict(self) -> dict:
         """The fields as a plain dict (for JSON)."""
@@ -81,8 +90,8 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
 
     >>> import numpy as np
     >>> m, d = compare(np.zeros((8, 8)), np.zeros((8, 8)), flip=False)
-    >>> m.max_abs_8bit, m.psnr
-    (0, None)
+    >>> m.max_abs_8bit, m.psnr, m.flip
+    (0, None, None)
     """
     from skimage.metrics import structural_similarity
 
@@ -100,7 +109,7 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
     win -= 1 - win % 2
     ssim = float(structural_similarity(a, b, data_range=255, win_size=max(win, 1))) if win >= 3 else \
         float(a.tobytes() == b.tobytes())
-    flip_mean = 0.0
+    flip_mean = 0.0 if flip else None   # not computed: None, never a FLIP of 0
     if flip and n and ad.max() > 0:
         import flip_evaluator
 

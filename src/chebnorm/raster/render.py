@@ -138,10 +138,23 @@ class RenderResult(ImageFrame):
     triangle: np.ndarray | None = None
     #: (H, W) ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background
     normal_length: np.ndarray | None = None
+    #: seconds spent compiling (numba, the first render of a kind in this process),
+    #: before the clock of ``seconds`` started
+    compile_seconds: float = 0.0
 
     @property
     def image8(self) -> np.ndarray:
         return to_8bit(self.image)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("mesh", self.mesh), ("shading", self.shading), ("method", self.method),
+                ("size", tuple(self.image.shape[::-1])), ("triangles", self.triangles),
+                ("seconds", self.seconds)]
+
+    def __repr__(self) -> str:
+        from chebnorm.core.display import summary_repr
+
+        return summary_repr(self)
 
     @property
     def pixels(self) -> int:
@@ -198,6 +211,7 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     ((32, 32), True)
     """
     t_start = time.perf_counter()
+    compile_seconds = 0.0
     if shading not in SHADING_MODES:
         raise ValueError(f"unknown shading mode {shading!r}; accepted: {', '.join(SHADING_MODES)}")
     w, h = _validate_size(size)
@@ -213,6 +227,13 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         method = None
     check_options(shading, bump, eta_threshold, q)
     mesh = get_mesh(mesh, tess)
+    if span_normals is None:   # a compiling engine compiles on a small frame, before the clock
+        compile_seconds = eng.warm_up(
+            (shading, method, np.dtype(dtype).name, bump, tables is None),
+            lambda: _warm_up(shading, method, engine=eng.name, dtype=dtype, tables=tables,
+                             bump=bump, eta_threshold=eta_threshold, q=q, k=k),
+            f"the raster engine for {shading}" + (f":{method}" if method else ""))
+        t_start += compile_seconds
     if shading == "bump" and not mesh.has_parametrization:
         raise ValueError(f"bump mapping needs a parametrized mesh (uv, P_u, P_v); mesh {mesh.name!r} "
                          "has none; use teapot, sphere, torus or square")
@@ -236,7 +257,12 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
                                  **kw)
     return RenderResult(out.image, out.mask, mesh.name, shading, method,
                         time.perf_counter() - t_start, int(len(mesh.faces)), int(out.fragments),
-                        out.stats, out.triangle, out.normal_length)
+                        out.stats, out.triangle, out.normal_length, compile_seconds)
+
+
+def _warm_up(shading, method, **kw) -> None:
+    """Render a small sphere in the mode (compiling the kernels it calls)."""
+    render("sphere", shading, method, size=(16, 16), tess=4, **kw)
 
 
 def check_options(shading, bump, eta_threshold, q):

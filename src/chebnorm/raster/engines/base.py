@@ -152,6 +152,26 @@ class Engine:
     #: the name ``render(engine=...)`` selects this engine by
     name = ""
 
+    def warm_up(self, key, work, what: str) -> float:
+        """Prepare the engine for a kind of frame before ``render``'s clock starts.
+
+        Parameters
+        ----------
+        key : hashable
+            The kind of frame (mode, method, dtype, ...).
+        work : callable
+            Renders a small frame of that kind (a compiling engine runs it the
+            first time it sees ``key``).
+        what : str
+            The kind, for a message.
+
+        Returns
+        -------
+        float
+            The seconds the preparation took: 0.0 here (nothing is compiled).
+        """
+        return 0.0
+
     def setup(self, mesh, camera, size, cull) -> Setup:
         """Camera (``camera`` or the default fitted one), projection and the front-facing
         (``cull``) or all non-degenerate triangles of ``mesh`` at ``size = (w, h)``."""

@@ -11,12 +11,14 @@ fused, threaded ``phong`` frame).  :class:`NumbaEngine` is what ``render`` uses.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from ..base import Setup, dot
 from ..numpy import NumpyEngine
 from . import frame
-from .jit import HAVE_NUMBA
+from .jit import HAVE_NUMBA, announce_slow
 from .kernels import fast_half_vectors, fast_shade, fast_span_normals
 from .kernels import supports as kernels_support
 from .rasterize import (default_camera_of, fast_lerp, fast_setup_spans, fast_zbuffer,
@@ -31,6 +33,38 @@ class NumbaEngine(NumpyEngine):
     :mod:`.frame`."""
 
     name = "numba"
+
+    def __init__(self):
+        #: the kinds of frame compiled in this process (see :meth:`warm_up`)
+        self.warmed: set = set()
+
+    def warm_up(self, key, work, what: str) -> float:
+        """Run ``work()`` the first time ``key`` is seen in this process.
+
+        numba compiles (or loads from its disk cache) the kernels ``work`` calls;
+        when that is slow, one :class:`~.jit.NumbaCompileWarning` per process
+        says so (:func:`~.jit.announce_slow`).
+
+        Parameters
+        ----------
+        key : hashable
+            The kind of frame.
+        work : callable
+            Renders a small frame of that kind.
+        what : str
+            The kind, for the warning.
+
+        Returns
+        -------
+        float
+            The seconds ``work()`` took; 0.0 after the first time.
+        """
+        if key in self.warmed:
+            return 0.0
+        self.warmed.add(key)   # before the work: it renders with this key itself
+        t0 = time.perf_counter()
+        announce_slow(work, what)
+        return time.perf_counter() - t0
 
     def setup(self, mesh, camera, size, cull) -> Setup:
         w, h = size

@@ -11,6 +11,8 @@ Python function and the engine is not offered (:func:`chebnorm.raster.engines.ge
 from __future__ import annotations
 
 import os
+import threading
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 
 try:  # pragma: no cover - exercised by whichever environment runs the tests
@@ -24,7 +26,57 @@ except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
 
 __all__ = ["HAVE_NUMBA", "njit", "fma", "f2i", "i2f", "threads", "pool", "run",
-           "run_with_caller"]
+           "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
+
+
+class NumbaCompileWarning(UserWarning):
+    """numba is compiling the raster engine's kernels (the first render of a kind
+    on this machine; numba caches them on disk for later processes). Issued once
+    per process, and only when the compile takes a while (:data:`ANNOUNCE_AFTER`);
+    ``render`` compiles before starting its clock, so its ``seconds`` do not
+    count it (``RenderResult.compile_seconds`` does)."""
+
+
+#: seconds a warm-up (compile or cache load) may take before it is announced
+ANNOUNCE_AFTER = 3.0
+#: the announcement is made once per process
+_ANNOUNCED = threading.Event()
+
+
+def announce_slow(work, what: str = "the raster engine"):
+    """Run ``work()``; if it takes longer than :data:`ANNOUNCE_AFTER` seconds,
+    issue one :class:`NumbaCompileWarning` while it runs (once per process).
+
+    Parameters
+    ----------
+    work : callable
+        The warm-up (compiles the kernels it calls).
+    what : str
+        What is being compiled, for the message.
+
+    Returns
+    -------
+    object
+        What ``work()`` returns.
+    """
+    done = threading.Event()
+
+    def note():
+        if not done.wait(ANNOUNCE_AFTER) and not _ANNOUNCED.is_set():
+            _ANNOUNCED.set()
+            warnings.warn_explicit(
+                f"numba is compiling {what}: the first render of this kind on this machine "
+                f"takes seconds (numba caches the code on disk for later processes); the "
+                f"render's seconds do not count it", NumbaCompileWarning, "chebnorm", 0,
+                module="chebnorm.raster")
+
+    watcher = threading.Thread(target=note, name="chebnorm-compile-note", daemon=True)
+    watcher.start()
+    try:
+        return work()
+    finally:
+        done.set()
+        watcher.join()
 
 
 def njit(fn=None, *, inline=False):
