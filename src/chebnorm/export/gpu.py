@@ -225,11 +225,7 @@ def glsl_runner(source: str, batch: int = MAX_SAMPLES):
     """A function ``run(xs) -> ys`` that evaluates the GLSL compute shader
     ``source`` (as :func:`compute_shader_around` prints it) on float32 inputs,
     compiled once and dispatched in batches of ``batch`` inputs (buffers
-    reused), and a ``close()`` that releases the program and buffers.
-
-    >>> callable(glsl_runner)
-    True
-    """
+    reused), and a ``close()`` that releases the program and buffers."""
     ctx = gl_context()
     batch = int(batch)
     with ctx:
