@@ -219,6 +219,22 @@ def test_piecewise_uniform_codes(tmp_path):
 
 
 @needs_gcc
+def test_quantized_float_evaluator():
+    q = fit("1/sqrt(x)", ("1", "1 + 2**-10"), 2, name="qv", coef_format="binary16")
+    header = export_text(q, "c")
+    xs = _every_float32(*_interval(header, q))
+    cs = [np.float32(c) for c in q.quantized.coefficients]
+    acc = np.full(xs.size, cs[-1], dtype=np.float32)
+    for c in reversed(cs[:-1]):
+        acc = (acc * xs).astype(np.float32) + c
+    got = c_evaluate(header, "chebnorm_qv_quant_f", xs)
+    assert np.array_equal(got.view(np.uint32), acc.view(np.uint32))
+    (r,) = verify(q, "c", variant="quant-f").variants
+    assert r.bound_name == "CHEBNORM_QV_QUANT_F_EVAL_ERROR_BOUND" and r.count == xs.size
+    assert r.measured_max == pytest.approx(_true_errors(xs, acc).max(), rel=1e-12)
+
+
+@needs_gcc
 def test_spread_inputs(table):
     (r,) = verify(table, "c", variant="float", inputs=1000).variants
     assert r.count == 1000 and "evenly spread" in r.inputs

@@ -252,6 +252,11 @@ def _ordered(f: float) -> int:
     return bits if bits >= 0 else -(bits & 0x7FFFFFFF)
 
 
+def _ordered_array(values: np.ndarray) -> np.ndarray:
+    bits = np.asarray(values, dtype=np.float32).view(np.int32).astype(np.int64)
+    return np.where(bits >= 0, bits, -(bits & 0x7FFFFFFF))
+
+
 def _from_ordered(keys: np.ndarray) -> np.ndarray:
     keys = np.asarray(keys, dtype=np.int64)
     bits = np.where(keys >= 0, keys, (-keys) | 0x80000000).astype(np.uint32)
@@ -311,12 +316,20 @@ def _make_inputs(kind: str, a: int, b: int, spread: int | None, what: str) -> _I
                          f"holds at least one")
     n = b - a + 1
     if spread is None and n > MAX_INPUTS:
-        raise ValueError(f"the interval holds {n} {what}s, more than {MAX_INPUTS}; accepted: "
-                         f"inputs = a count (evenly spread)")
+        raise ValueError(f"the interval holds {n} inputs ({what}), more than {MAX_INPUTS}; "
+                         f"accepted: inputs = a count (evenly spread)")
     if spread is not None and spread < n:
         keys = np.unique(np.round(np.linspace(a, b, spread)).astype(np.int64))
-        return _Inputs(kind, a, b, keys, f"{keys.size} {what}s evenly spread (of {n})")
-    return _Inputs(kind, a, b, None, f"every {what} ({n})")
+        if kind == "f32":  # half evenly in value too (float32 order crowds near zero)
+            lo, hi = _from_ordered(np.array([a, b]))
+            by_value = np.clip(np.linspace(float(lo), float(hi), spread).astype(np.float32),
+                               lo, hi)
+            keys = np.unique(np.concatenate([keys, _ordered_array(by_value)]))
+            keys = keys[np.unique(np.round(np.linspace(0, keys.size - 1, spread)).astype(
+                np.int64))]
+        return _Inputs(kind, a, b, keys, f"{keys.size} of the {n} inputs ({what}), evenly "
+                       f"spread in order and in value")
+    return _Inputs(kind, a, b, None, f"every input: {what} ({n})")
 
 
 def _float32_set(lo: float, hi: float, spread, what="float32 in [LO, HI]") -> _Inputs:
@@ -776,7 +789,8 @@ def verify(table, fmt: str = "c", *, variant=None, inputs="all", source: str | N
     inputs : "all" or int
         ``"all"``: every input (every float32 of the interval; every code of a
         fixed-point or piecewise evaluator), at most :data:`MAX_INPUTS`; a count:
-        that many, evenly spread in float32 order.
+        that many, evenly spread (float32 inputs: half evenly in float32 order,
+        half evenly in value, which reaches tiny magnitudes near a zero).
     source : str, optional
         The exported text to check (a file as shipped); default: printed now by
         :func:`chebnorm.export.export_text`.
