@@ -180,6 +180,18 @@ def test_glsl_on_llvmpipe(table):
         "CHEBNORM_RSV_EVAL_ERROR_BOUND"] and r.passed
 
 
+def test_wgsl_on_lavapipe(table):
+    from chebnorm.export import gpu
+
+    (r,) = verify(table, "wgsl").variants
+    if r.skipped is not None:
+        pytest.skip(f"no WebGPU here: {r.skipped}")
+    xs = _every_float32(*gpu.interval32(table))
+    err = _true_errors(xs, gpu.wgsl_evaluate(table, xs))  # one dispatch, independent
+    assert r.count == xs.size and r.variant == "lavapipe"
+    assert r.measured_max == pytest.approx(err.max(), rel=1e-12) and r.passed
+
+
 def test_glsl_without_a_driver_is_skipped_with_the_reason(table, monkeypatch):
     from chebnorm.export import gpu
 
@@ -259,6 +271,16 @@ def test_bad_files_exit_2(table_file, tmp_path, capsys):
     other.write_text("/* not a chebnorm header */\n", encoding="utf-8")
     status, _, err = _cli(capsys, table_file, "--source", other)
     assert status == 2 and err.count("\n") == 1 and "CHEBNORM_RSV_LO" in err
+
+
+@needs_gcc
+def test_source_that_does_not_compile_exits_2(table, table_file, tmp_path, capsys):
+    broken = tmp_path / "broken.h"
+    broken.write_text(export_text(table, "c").replace("return acc;", "return acc +;", 1),
+                      encoding="utf-8")
+    status, out, err = _cli(capsys, table_file, "--source", broken)
+    assert status == 2 and out == "" and err.count("\n") == 1
+    assert "does not compile" in err
 
 
 def test_python_errors_name_the_argument(table):

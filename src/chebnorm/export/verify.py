@@ -469,8 +469,8 @@ class _CLibrary:
         proc = subprocess.run([gcc, *flags, "-std=c99", "-fPIC", "-shared", "-o", str(lib),
                                str(src), "-lm"], capture_output=True, text=True, timeout=300)
         if proc.returncode != 0:
-            raise _Skip(f"gcc {' '.join(flags)} failed: "
-                        f"{' '.join(proc.stderr.split())[:300]}")
+            raise _CompileError(f"gcc {' '.join(flags)} failed: "
+                                f"{' '.join(proc.stderr.split())[:300]}")
         self.lib = ctypes.CDLL(str(lib))
 
     def evaluator(self, ret: str, name: str, arg: str):
@@ -488,6 +488,11 @@ class _CLibrary:
 
 class _Skip(Exception):
     """A variant that cannot run here (the reason in the message)."""
+
+
+class _CompileError(_Skip):
+    """The C text does not compile (bad input for the unfused build; the
+    fused one's ``-march=native`` may be what the compiler refuses)."""
 
 
 def c_evaluate(text: str, name: str, xs, *, fused: bool = False) -> np.ndarray:
@@ -608,6 +613,10 @@ def _run_c(plan, text, fn, bounds, inputs_of) -> list[VariantResult]:
             try:
                 libs[fused] = _CLibrary(text, evaluators, _FUSED if fused else _UNFUSED,
                                         Path(tmp), "fused" if fused else "unfused")
+            except _CompileError as exc:
+                if not fused:
+                    raise ValueError(f"source: the C text does not compile: {exc}") from None
+                libs[fused] = exc
             except _Skip as exc:
                 libs[fused] = exc
         fma = _fused_note() if any(p[5] for p in plan) else ""
@@ -707,11 +716,21 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
         run, close = _glsl(source) if fmt == "glsl" else (_wgsl(source), lambda: None)
     except ToolMissing as exc:
         return skipped(str(exc))
+    except Exception as exc:  # the driver's own compile errors
+        raise ValueError(f"source: the {fmt} text does not compile on the driver: "
+                         f"{' '.join(str(exc).split())[:300]}") from None
     fn = parse_function(table.expression, table.variable)
     inputs = _float32_set(lo, hi, spread)
     try:
         m, at, up, ref, sec = _run(fn, run, inputs, lambda v: v.astype(np.float64),
                                    lambda y: y.astype(np.float64), _f32_exact)
+    except ToolMissing as exc:
+        return skipped(str(exc))
+    except (ValueError, RuntimeError):
+        raise
+    except Exception as exc:  # the driver's own errors (WGSL compiles at the first dispatch)
+        raise ValueError(f"source: the {fmt} text does not run on the driver: "
+                         f"{' '.join(str(exc).split())[:300]}") from None
     finally:
         close()
     note = "OpenGL 4.3 compute shader, dispatches of 2^20" if fmt == "glsl" else \
