@@ -180,6 +180,23 @@ def test_glsl_on_llvmpipe(table):
         "CHEBNORM_RSV_EVAL_ERROR_BOUND"] and r.passed
 
 
+def test_shader_inputs_are_the_c_float_inputs():
+    # sqrt(2) rounds to a float32 whose shortest decimal lies above it: read as
+    # a double and rounded inward, the interval would lose its first float32
+    from chebnorm.export import gpu
+
+    t = fit("1/sqrt(x)", ("sqrt(2)", "sqrt(2) + 2**-12"), 1, name="s2")
+    lo, hi = gpu.interval32(t)
+    xs = _every_float32(lo, hi)
+    for fmt in ("glsl", "wgsl"):
+        (r,) = verify(t, fmt).variants
+        if r.skipped is not None:
+            continue
+        assert r.count == xs.size, fmt
+    (r,) = verify(t, "c", variant="float").variants
+    assert r.count == xs.size
+
+
 def test_wgsl_on_lavapipe(table):
     from chebnorm.export import gpu
 

@@ -72,7 +72,7 @@ VARIANTS = {"c": ("double", "double-fused", "float", "float-fused", "fixed", "qu
                   "quant-fused", "quant-f", "quant-f-fused"),
             "glsl": ("llvmpipe",), "wgsl": ("lavapipe",), "hlsl": ("glslang",)}
 #: the most inputs ``inputs="all"`` runs per variant (larger sets: give a count)
-MAX_INPUTS = 2 ** 28
+MAX_INPUTS = 2 ** 31
 _CHUNK = 2 ** 22
 _TOP = 64
 _SPREAD = 256
@@ -692,8 +692,11 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
     cname, macro = f"chebnorm_{name}", f"CHEBNORM_{name.upper()}"
     bounds = stated_bounds(text)
     bound_name = macro + "_EVAL_ERROR_BOUND"
-    stated = bounds.get(bound_name)
-    lo, hi = bounds.get(macro + "_LO"), bounds.get(macro + "_HI")
+    # the shader constants are float32: their literals convert exactly to one
+    # (directly and through a double), which is the value the shader uses
+    stated, lo, hi = (None if v is None else float(np.float32(v)) for v in
+                      (bounds.get(bound_name), bounds.get(macro + "_LO"),
+                       bounds.get(macro + "_HI")))
     variant = VARIANTS[fmt][0]
     if lo is None or hi is None:
         raise ValueError(f"the {fmt} text defines no {macro}_LO and {macro}_HI; accepted: a "
