@@ -319,17 +319,24 @@ def _make_inputs(kind: str, a: int, b: int, spread: int | None, what: str) -> _I
         raise ValueError(f"the interval holds {n} inputs ({what}), more than {MAX_INPUTS}; "
                          f"accepted: inputs = a count (evenly spread)")
     if spread is not None and spread < n:
-        keys = np.unique(np.round(np.linspace(a, b, spread)).astype(np.int64))
+        keys = _sorted_unique(np.round(np.linspace(a, b, spread)).astype(np.int64))
         if kind == "f32":  # half evenly in value too (float32 order crowds near zero)
             lo, hi = _from_ordered(np.array([a, b]))
             by_value = np.clip(np.linspace(float(lo), float(hi), spread).astype(np.float32),
                                lo, hi)
-            keys = np.unique(np.concatenate([keys, _ordered_array(by_value)]))
-            keys = keys[np.unique(np.round(np.linspace(0, keys.size - 1, spread)).astype(
+            keys = _sorted_unique(np.sort(np.concatenate([keys, _ordered_array(by_value)])))
+            keys = keys[_sorted_unique(np.round(np.linspace(0, keys.size - 1, spread)).astype(
                 np.int64))]
         return _Inputs(kind, a, b, keys, f"{keys.size} of the {n} inputs ({what}), evenly "
                        f"spread in order and in value")
     return _Inputs(kind, a, b, None, f"every input: {what} ({n})")
+
+
+def _sorted_unique(keys: np.ndarray) -> np.ndarray:
+    """The distinct values of a sorted array (``np.unique`` without its hash or sort)."""
+    if keys.size == 0:
+        return keys
+    return keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
 
 
 def _float32_set(lo: float, hi: float, spread, what="float32 in [LO, HI]") -> _Inputs:
@@ -630,9 +637,11 @@ def _run_c(plan, text, fn, bounds, inputs_of) -> list[VariantResult]:
                     raise lib
                 if stated is None:
                     raise _Skip(f"the header states no {bound_name}")
+                t0 = time.perf_counter()
                 inputs, to_x, to_y, exact, note = inputs_of(p)
-                m, at, up, ref, sec = _run(fn, lib.evaluator(ret, name, arg), inputs, to_x,
-                                           to_y, exact)
+                m, at, up, ref, _ = _run(fn, lib.evaluator(ret, name, arg), inputs, to_x,
+                                         to_y, exact)
+                sec = time.perf_counter() - t0  # inputs, evaluation and reference
             except _Skip as exc:
                 results.append(VariantResult("c", variant, name, bound_name, stated, None, None,
                                              None, None, 0, "", 0.0, skipped=str(exc)))
@@ -723,10 +732,12 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
         raise ValueError(f"source: the {fmt} text does not compile on the driver: "
                          f"{' '.join(str(exc).split())[:300]}") from None
     fn = parse_function(table.expression, table.variable)
+    t0 = time.perf_counter()
     inputs = _float32_set(lo, hi, spread)
     try:
-        m, at, up, ref, sec = _run(fn, run, inputs, lambda v: v.astype(np.float64),
-                                   lambda y: y.astype(np.float64), _f32_exact)
+        m, at, up, ref, _ = _run(fn, run, inputs, lambda v: v.astype(np.float64),
+                                 lambda y: y.astype(np.float64), _f32_exact)
+        sec = time.perf_counter() - t0
     except ToolMissing as exc:
         return skipped(str(exc))
     except (ValueError, RuntimeError):
