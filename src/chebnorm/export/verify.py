@@ -324,7 +324,8 @@ def _make_inputs(kind: str, a: int, b: int, spread: int | None, what: str) -> _I
             lo, hi = _from_ordered(np.array([a, b]))
             by_value = np.clip(np.linspace(float(lo), float(hi), spread).astype(np.float32),
                                lo, hi)
-            keys = _sorted_unique(np.sort(np.concatenate([keys, _ordered_array(by_value)])))
+            keys = _sorted_unique(np.sort(np.concatenate([keys, _ordered_array(by_value)]),
+                                          kind="stable"))  # two sorted runs: a merge
             keys = keys[_sorted_unique(np.round(np.linspace(0, keys.size - 1, spread)).astype(
                 np.int64))]
         return _Inputs(kind, a, b, keys, f"{keys.size} of the {n} inputs ({what}), evenly "
