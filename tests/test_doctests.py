@@ -39,6 +39,7 @@ EXAMPLE_EXEMPT = {
     "chebnorm.export.gpu.gl_context": _GPU,
     "chebnorm.export.gpu.glsl_evaluate": _GPU,
     "chebnorm.export.gpu.wgsl_evaluate": _GPU,
+    "chebnorm.export.gpu.glsl_runner": _GPU,
     "chebnorm.export.gpu.glslang_validate": _TOOL,
     "chebnorm.hw.verilog.simulate": _TOOL,
     "chebnorm.hw.verilog.synthesize": _TOOL,

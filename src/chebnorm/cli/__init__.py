@@ -19,7 +19,7 @@ __all__ = ["main", "build_parser", "UsageError"]
 
 #: subcommand modules, in the order ``chebnorm --help`` lists them
 SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "render_sweep", "hw", "design",
-               "repro")
+               "repro", "verify")
 
 
 class UsageError(ValueError):

@@ -33,7 +33,8 @@ from chebnorm.core.textsafe import identifier
 from .shader import interval32, shader_source
 
 __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
-           "wgsl_evaluate", "gl_context", "compute_shader_source", "MAX_SAMPLES"]
+           "wgsl_evaluate", "gl_context", "compute_shader_source", "compute_shader_around",
+           "glsl_runner", "MAX_SAMPLES"]
 
 MAX_SAMPLES = 2 ** 20
 _GROUP = 64
@@ -125,7 +126,17 @@ def compute_shader_source(table: CoefficientTable, language: str, *, es: bool = 
     '#version 310 es'
     """
     fn = f"chebnorm_{identifier(table.name, field='table.name')}"
-    body = shader_source(table, language)
+    return compute_shader_around(shader_source(table, language), fn, language, es=es)
+
+
+def compute_shader_around(body: str, fn: str, language: str, *, es: bool = False) -> str:
+    """The compute shader of :func:`compute_shader_source` around a given
+    function text ``body`` defining ``fn`` (e.g. an exported file as shipped).
+
+    >>> src = compute_shader_around("float f(float x) { return x; }", "f", "glsl")
+    >>> src.splitlines()[0], "ys[i] = f(xs[i]);" in src
+    ('#version 430', True)
+    """
     if language not in _KERNELS:
         raise ValueError(f"unknown shader language {language!r}; accepted: glsl, wgsl, hlsl")
     head = (["#version 310 es", "precision highp float;"] if es else ["#version 430"]) \
@@ -208,6 +219,44 @@ def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
             bx.release()
             by.release()
             prog.release()
+
+
+def glsl_runner(source: str, batch: int = MAX_SAMPLES):
+    """A function ``run(xs) -> ys`` that evaluates the GLSL compute shader
+    ``source`` (as :func:`compute_shader_around` prints it) on float32 inputs,
+    compiled once and dispatched in batches of ``batch`` inputs (buffers
+    reused), and a ``close()`` that releases the program and buffers."""
+    ctx = gl_context()
+    batch = int(batch)
+    with ctx:
+        prog = ctx.compute_shader(source)
+        bx = ctx.buffer(reserve=batch * 4)
+        by = ctx.buffer(reserve=batch * 4)
+
+    def run(xs) -> np.ndarray:
+        x = np.ascontiguousarray(xs, dtype=np.float32)
+        out = np.empty_like(x)
+        with ctx:
+            bx.bind_to_storage_buffer(0)
+            by.bind_to_storage_buffer(1)
+            for start in range(0, x.size, batch):
+                part = x[start:start + batch]
+                if part.size < batch:  # xs.length() must be the part's size
+                    part = np.concatenate([part, np.full(batch - part.size, part[-1],
+                                                         dtype=np.float32)])
+                bx.write(part.tobytes())
+                prog.run(group_x=-(-batch // _GROUP))
+                ctx.finish()
+                n = min(batch, x.size - start)
+                out[start:start + n] = np.frombuffer(by.read(), dtype=np.float32)[:n]
+        return out
+
+    def close() -> None:
+        with ctx:
+            for obj in (bx, by, prog):
+                obj.release()
+
+    return run, close
 
 
 def wgsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:

@@ -1,0 +1,71 @@
+"""``chebnorm verify TABLE.json --format c|glsl|wgsl|hlsl [--variant V] [--json OUT]``.
+
+Runs the exported evaluators over every input of the table's interval
+(:func:`chebnorm.export.verify.verify`) and prints, per variant, the
+measured maximum error, the bound the exported text states, their ratio, the
+input count and the seconds. Exit status 0 when every stated bound holds, 1
+when one is exceeded (one line on stderr naming it), 2 on bad input.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+from chebnorm.approx import load_table
+from chebnorm.core.files import write_atomic
+from chebnorm.export.verify import MAX_INPUTS, VARIANTS, VERIFY_FORMATS, verify
+
+
+def register(sub) -> None:
+    p = sub.add_parser("verify", help="run an exported evaluator over every float32 of its "
+                       "interval and compare with its stated bound")
+    p.add_argument("table", metavar="TABLE.json")
+    p.add_argument("--format", default="c", help=f"one of {', '.join(VERIFY_FORMATS)} "
+                   f"(default c)")
+    p.add_argument("--variant", action="append", default=None,
+                   help="a variant to run (repeatable; default all): "
+                   + "; ".join(f"{f}: {', '.join(v)}" for f, v in VARIANTS.items()))
+    p.add_argument("--inputs", default="all",
+                   help=f"'all' (default: every input of the interval) or a count 2..{MAX_INPUTS} "
+                   f"evenly spread")
+    p.add_argument("--source", metavar="FILE", default=None,
+                   help="check this exported file (as shipped) instead of exporting now")
+    p.add_argument("--json", metavar="OUT", default=None, help="write the results as JSON")
+    p.add_argument("--markdown", action="store_true", help="print a Markdown table instead")
+    p.set_defaults(func=run)
+
+
+def _inputs(text: str):
+    if text == "all":
+        return "all"
+    try:
+        return int(text)
+    except ValueError:
+        raise ValueError(f"--inputs {text[:40]!r} is not accepted; accepted: all, or a count "
+                         f"2..{MAX_INPUTS}") from None
+
+
+def run(args) -> int:
+    if args.format not in VERIFY_FORMATS:
+        raise ValueError(f"unknown format {args.format[:40]!r} for verify; accepted: "
+                         f"{', '.join(VERIFY_FORMATS)}")
+    inputs = _inputs(args.inputs)
+    table = load_table(args.table)
+    source = None
+    if args.source is not None:
+        with open(args.source, encoding="utf-8") as fh:
+            source = fh.read()
+    result = verify(table, args.format, variant=args.variant, inputs=inputs, source=source)
+    if args.json is not None:
+        write_atomic(args.json, json.dumps(result.to_dict(), sort_keys=True, indent=2,
+                                           allow_nan=False) + "\n")
+    print(result.markdown() if args.markdown else str(result), end="\n" if not args.markdown
+          else "")
+    bad = result.exceeded
+    if bad:
+        print("chebnorm: verify: stated bound exceeded: " + "; ".join(
+            f"{v.evaluator} ({v.format} {v.variant}) measured {v.measured_max:.4e} > "
+            f"{v.bound_name} {v.stated_bound:.4e}" for v in bad), file=sys.stderr)
+        return 1
+    return 0
