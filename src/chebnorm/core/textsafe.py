@@ -30,6 +30,7 @@ import re
 
 __all__ = ["identifier", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
 
+#: the identifiers accepted in generated sources (a regular expression; at most 63 characters)
 IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
 _IDENT = re.compile(IDENTIFIER_PATTERN + r"\Z")
 _MAX_IDENT = 63  # C99 guarantees 63 significant characters in an internal identifier

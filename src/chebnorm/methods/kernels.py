@@ -237,10 +237,15 @@ class _Slerp:
         return vadd(vmul(st["a"], wa), vmul(st["b"], wb))
 
 
+#: kernel of ``exact``: linear interpolation, then :func:`normalize_classic`
 EXACT = _Linear(normalize_classic)
+#: kernel of ``none``: linear interpolation, not normalized
 NONE = _Linear(None)
+#: kernel of ``newton``: linear interpolation, then :func:`normalize_newton`
 NEWTON = _Linear(normalize_newton)
+#: kernel of ``lyon``: linear interpolation, then :func:`normalize_lyon`
 LYON = _Linear(normalize_lyon)
+#: kernel of ``slerp``: the spherical interpolation, evaluated directly per pixel
 SLERP = _Slerp()
 
 
@@ -412,7 +417,9 @@ class _Steps:
         return self.generator(ops, nl, nr, t0, dt, n, start_at_left=start_at_left, **kw)
 
 
+#: kernel of ``quadratic``: :func:`quadratic_steps`
 QUADRATIC = _Steps(quadratic_steps, ("coefficients",))
+#: kernel of ``angular``: :func:`angular_steps`
 ANGULAR = _Steps(angular_steps, ("reanchor",))
 
 
@@ -548,4 +555,5 @@ class _Tree:
     pick = staticmethod(dichotomy_pick)
 
 
+#: kernel of ``dichotomy``: :func:`dichotomy_tree`, :func:`dichotomy_fraction`, :func:`dichotomy_pick`
 DICHOTOMY = _Tree()

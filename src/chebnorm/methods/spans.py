@@ -28,6 +28,7 @@ UNIT_TOL = 1e-5
 ANTIPARALLEL_TOL = 1e-6
 #: deepest dichotomy (steps down to 2**-MAX_LEVELS)
 MAX_LEVELS = 20
+#: the dtypes a method computes in
 DTYPES = (np.float32, np.float64)
 #: slack on a table's interval when checking that it covers the spans' range
 #: (rounding of N_l.N_r; the polynomial is smooth just outside its interval)
