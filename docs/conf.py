@@ -428,6 +428,15 @@ def _resolve_in_defining_module(app, env, node, contnode):
     py = env.get_domain("py")
     for ctx in contexts:
         obj = _lookup(f"{ctx}.{target}" if ctx else target)
+        if obj is None and "." in target:
+            # a dataclass field without a default is no class attribute: link the
+            # field's entry under the documented name of its class
+            owner, attr = target.rsplit(".", 1)
+            cls = _lookup(f"{ctx}.{owner}" if ctx else owner)
+            hit = documented.get(id(cls)) if inspect.isclass(cls) else None
+            if hit is not None and f"{hit[1]}.{attr}" in py.objects:
+                return py.resolve_xref(env, node["refdoc"], app.builder, "attr", f"{hit[1]}.{attr}",
+                                       node, contnode)
         if obj is None:
             continue
         if inspect.ismodule(obj):
@@ -461,8 +470,23 @@ def _forget_documented(app, env):
         del env._chebnorm_documented
 
 
+def _widget_fallback(app, doctree):
+    """An executed notebook's slider cell shows ipywidgets' text form,
+    ``interactive(children=(IntSlider(...` (the live widget needs a kernel): say so
+    instead (the static figure drawn before it stays)."""
+    from docutils import nodes
+
+    for block in list(doctree.findall(nodes.literal_block)):
+        if block.astext().startswith("interactive(children="):
+            note = nodes.paragraph(text="Sliders here in Jupyter (with ipywidgets installed); "
+                                        "the static figure above shows the same.")
+            note["classes"].append("widget-fallback")
+            block.replace_self(note)
+
+
 def setup(app):
     """Register the reference resolver."""
+    app.connect("doctree-read", _widget_fallback)
     app.connect("env-updated", _forget_documented)
     app.connect("missing-reference", _resolve_in_defining_module, priority=900)
     app.connect("autodoc-process-docstring", _escape_bars)

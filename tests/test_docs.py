@@ -93,6 +93,7 @@ def test_notebook_pages_show_their_figures(built):
         for src in images:
             assert (built / "gallery" / "notebooks" / src).resolve().is_file(), src
         assert "cell_output" in page
+        assert "interactive(children=" not in page   # a slider's text form is replaced by a note
 
 
 @pytest.mark.slow
