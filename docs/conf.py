@@ -414,8 +414,6 @@ def _resolve_in_defining_module(app, env, node, contnode):
     if node.get("refdomain") != "py":
         return None
     target = node["reftarget"].lstrip("~.")
-    if os.environ.get("CHEBNORM_DOCS_DEBUG") and target.endswith(os.environ["CHEBNORM_DOCS_DEBUG"]):
-        print("resolve", target, node.source, node.get("py:module"), file=sys.stderr)
     contexts = [""]
     source = _DOC_SOURCE.search(str(node.source or ""))
     if source:
