@@ -1,19 +1,32 @@
 """Sphinx configuration of the chebnorm documentation.
 
-Build (offline, warnings are errors)::
+Build (offline, nitpicky, warnings are errors)::
 
-    python -m sphinx -W -b html docs docs/_build/html
+    python -m sphinx -W -n -b html docs docs/_build/html
 
-The API reference is generated from the code (autosummary + autodoc, numpy
-docstrings); the notebooks are copied into the gallery at build time and
-rendered as stored (never executed); the paper figures are the committed
-files under ``figures/``.
+The API reference is generated from the code (autosummary + autodoc, numpydoc
+docstrings): a page per stage (its ``__all__``) and a page per module (the
+public names it defines that its stage does not re-export). The notebooks are
+copied into the gallery and executed by the build, their outputs cached by
+jupyter-cache under ``docs/_build/.jupyter_cache`` (a notebook runs again only
+when its code changes). Math is typeset by a MathJax shipped with the
+``sphinx-mathjax-offline`` package and copied into the site, so pages need no
+network. Intersphinx links to Python, numpy, sympy and mpmath are made only
+when their inventories can be fetched (or were fetched before, into
+``docs/_build/_inventories``); offline, such names render as plain code.
 """
 
 from __future__ import annotations
 
+import importlib
+import inspect
+import os
+import pkgutil
+import re
 import shutil
+import socket
 import sys
+import urllib.request
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
@@ -32,15 +45,32 @@ version = release
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
+    "sphinx.ext.intersphinx",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
     "numpydoc",
     "myst_nb",
+    # MathJax 3 shipped inside the package, copied to _static/mathjax: math without a CDN
+    "sphinx-mathjax-offline",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints"]
+# _layer_rule.rst is a fragment, included by contributing.md
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst"]
 templates_path = ["_templates"]
+
+# every cross-reference must resolve (python -m sphinx -n); see _resolve_in_defining_module
+nitpicky = True
+nitpick_ignore_regex = [
+    # Names of other projects. They link through intersphinx when the inventories are
+    # reachable; offline they have no target in this site and render as code.
+    ("py:.*", r"(math|abc|typing|collections|enum|dataclasses|pathlib|concurrent|io|os)(\..*)?"),
+    ("py:.*", r"(numpy|np|sympy|sp|mpmath|scipy|flint|matplotlib|PIL|numba|trimesh)(\..*)?"),
+    ("py:.*", r"(ABC|Enum|IntEnum|NamedTuple|Path|Axes|Figure|ndarray|Symbol|Expr|Rational|Basic)"),
+    ("py:.*", r"(mpf|mpc|arb|arb_poly|fmpq|fmpz|Future|Executor|Callable|Iterable|Iterator|Sequence|Mapping)"),
+    ("py:.*", r"(int|float|str|bytes|bool|dict|list|tuple|set|frozenset|object|type|callable|None|complex)"),
+    ("py:.*", r"(ValueError|TypeError|OSError|RuntimeError|KeyError|UserWarning|Warning|Exception)"),
+]
 
 # -- API reference --------------------------------------------------------
 autosummary_generate = True
@@ -51,21 +81,62 @@ autodoc_typehints = "none"
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_validation_checks: set[str] = set()
+numpydoc_xref_param_type = False
 add_module_names = False
 
-# -- Markdown / notebooks: render what is stored, never run, never fetch ----
-nb_execution_mode = "off"
+# -- Markdown / notebooks ----------------------------------------------------
+# Executed at build time; outputs cached per notebook (keyed on its code), in one place
+# for every build directory, so a rebuild (and the docs test) reuses them.
+nb_execution_mode = "cache"
+nb_execution_cache_path = str(DOCS / "_build" / ".jupyter_cache")
+nb_execution_timeout = 600
+nb_execution_raise_on_error = True
+nb_execution_show_tb = True
+# ipywidgets' views need the widget manager's JavaScript from a CDN: show their static
+# fallback instead (each notebook draws its static figure before it adds sliders)
+nb_mime_priority_overrides = [("html", "application/vnd.jupyter.widget-view+json", None),
+                              ("html", "application/vnd.jupyter.widget-state+json", None)]
+nb_ipywidgets_js: dict = {}  # and never load require.js or the widget manager from a CDN
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
-intersphinx_mapping: dict = {}
-# the CLI page includes a part of README.md, whose in-page links (#targets, ...)
-# point at README sections outside that part: they work on the README itself
-suppress_warnings = ["myst.xref_missing"]
+
+# -- Intersphinx: only inventories that can be had; never a warning offline ----------
+INVENTORIES = {
+    "python": "https://docs.python.org/3/",
+    "numpy": "https://numpy.org/doc/stable/",
+    "sympy": "https://docs.sympy.org/latest/",
+    "mpmath": "https://mpmath.org/doc/current/",
+}
+INVENTORY_CACHE = DOCS / "_build" / "_inventories"
+
+
+def _inventory(name: str, url: str) -> str | None:
+    """The local path of ``name``'s ``objects.inv``: fetched now when the host answers
+    within two seconds, else an earlier fetch; None when neither (offline, first build).
+    ``CHEBNORM_DOCS_OFFLINE=1`` skips the network."""
+    path = INVENTORY_CACHE / f"{name}.inv"
+    if os.environ.get("CHEBNORM_DOCS_OFFLINE") != "1":
+        host = re.match(r"https://([^/]+)/", url).group(1)
+        try:
+            socket.create_connection((host, 443), timeout=2).close()
+            with urllib.request.urlopen(url + "objects.inv", timeout=10) as resp:
+                data = resp.read()
+            INVENTORY_CACHE.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        except OSError:
+            pass
+    return str(path) if path.is_file() else None
+
+
+intersphinx_mapping = {name: (url, inv) for name, url in INVENTORIES.items()
+                       if (inv := _inventory(name, url)) is not None}
+intersphinx_timeout = 5
 
 # -- HTML -------------------------------------------------------------------
-html_theme = "alabaster"
+html_theme = "furo"
 html_title = f"chebnorm {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["wide.css"]
 
 
 def _copy_notebooks() -> None:
@@ -93,6 +164,13 @@ def _markdown_text(text: str) -> str:
     return "".join("\\" + ch if ch in "\\`*_[]<>|{}$" else ch for ch in " ".join(text.split()))
 
 
+def _write_if_changed(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` unless it holds it already (keeps Sphinx's cache)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists() or path.read_text(encoding="utf-8") != text:
+        path.write_text(text, encoding="utf-8")
+
+
 def _write_figure_gallery() -> None:
     """gallery/figures.md: every committed figure with its caption file (a
     build product, git-ignored; regenerated on each build so it follows
@@ -111,14 +189,303 @@ def _write_figure_gallery() -> None:
             lines += [f"```{{figure}} ../../figures/{topic}/{png.name}", f":alt: {png.stem}",
                       ":width: 100%", "", f"`figures/{topic}/{png.name}`: {_markdown_text(caption)}",
                       "```", ""]
-    text = "\n".join(lines)
-    out = DOCS / "gallery" / "figures.md"
-    if not out.exists() or out.read_text(encoding="utf-8") != text:
-        out.write_text(text, encoding="utf-8")
+    _write_if_changed(DOCS / "gallery" / "figures.md", "\n".join(lines))
+
+
+STAGES = ("core", "symbolic", "approx", "export", "methods", "hw", "raster")
+
+
+def _stage_modules() -> dict[str, list[str]]:
+    """Every public module below each stage (no ``_name`` part), in name order,
+    without the modules a stage's ``__all__`` exports (autosummary pages those)."""
+    out = {}
+    for stage in STAGES:
+        pkg = importlib.import_module(f"chebnorm.{stage}")
+        exported = {getattr(pkg, n).__name__ for n in pkg.__all__ if inspect.ismodule(getattr(pkg, n))}
+        names = [m.name for m in pkgutil.walk_packages(pkg.__path__, f"chebnorm.{stage}.")
+                 if not any(part.startswith("_") for part in m.name.split("."))]
+        out[stage] = sorted(n for n in names if n not in exported)
+    return out
+
+
+def _module_page(modname: str) -> str:
+    """The page of one module: the public names it defines, except those its stage
+    re-exports (documented once, on the stage's page, and linked from here)."""
+    stage = ".".join(modname.split(".")[:2])
+    pkg = importlib.import_module(stage)
+    mod = importlib.import_module(modname)
+    own = getattr(mod, "__all__", None) or [n for n in vars(mod) if not n.startswith("_")]
+    # the names this module shares with its stage (the same object): documented there
+    shown = [n for n in own if n in pkg.__all__ and getattr(mod, n, None) is getattr(pkg, n)
+             and (inspect.isfunction(getattr(pkg, n)) or inspect.isclass(getattr(pkg, n)))]
+    lines = [modname, "=" * len(modname), ""]
+    if hasattr(pkg, modname.split(".")[2]) and not inspect.ismodule(getattr(pkg, modname.split(".")[2])) \
+            and len(modname.split(".")) == 3:
+        # the stage exports a function of the module's name (chebnorm.approx.certify):
+        # one full name, two objects; the stage's function keeps the name, and this
+        # page shows the module's text and documents its other names one by one
+        from sphinx.pycode import ModuleAnalyzer
+        attrs = {name for (cls, name) in ModuleAnalyzer.for_module(modname).find_attr_docs() if cls == ""}
+        members = sorted(n for n, v in vars(mod).items() if not n.startswith("_") and n not in shown
+                         and (getattr(v, "__module__", None) == modname and not inspect.ismodule(v)
+                              or n in attrs))
+        lines += [f".. automodule:: {modname}", "   :no-index:", "", f".. currentmodule:: {modname}", ""]
+        for n in members:
+            v = getattr(mod, n)
+            kind = "class" if inspect.isclass(v) else "function" if callable(v) else "data"
+            lines += [f".. auto{kind}:: {modname}.{n}", ""]
+    else:
+        lines += [f".. automodule:: {modname}", "   :members:", "   :undoc-members:", "   :ignore-module-all:"]
+        if shown:
+            lines.append(f"   :exclude-members: {', '.join(shown)}")
+        lines.append("")
+    if shown:
+        lines += [f"Defined here and documented with :mod:`{stage}`:", ""]
+        lines += [f"* :obj:`{stage}.{n}`" for n in shown]
+        lines.append("")
+    del mod
+    return "\n".join(lines)
+
+
+def _write_module_pages() -> None:
+    """modules/*.rst and modules/index.rst (build products, git-ignored)."""
+    out = DOCS / "modules"
+    by_stage = _stage_modules()
+    wanted = {f"{m}.rst" for mods in by_stage.values() for m in mods} | {"index.rst"}
+    if out.is_dir():
+        for old in out.glob("*.rst"):
+            if old.name not in wanted:
+                old.unlink()
+    index = ["Modules", "=======", "",
+             "Every public module of every stage, with the names it defines that its stage",
+             "does not export (those are on the stage's page). Import the stage's names from",
+             "the stage; a module's own names are stable too, but closer to the implementation.", ""]
+    for stage, mods in by_stage.items():
+        if not mods:
+            continue
+        title = f"chebnorm.{stage}"
+        index += [title, "-" * len(title), "", ".. toctree::", "   :maxdepth: 1", ""]
+        index += [f"   {m}" for m in mods]
+        index.append("")
+        for m in mods:
+            _write_if_changed(out / f"{m}.rst", _module_page(m))
+    _write_if_changed(out / "index.rst", "\n".join(index))
+
+
+def _write_layer_rule() -> None:
+    """_layer_rule.rst: the layer rule section of the package docstring (the one place
+    it is written), for the contributor page (a build product, git-ignored)."""
+    doc = inspect.cleandoc(chebnorm.__doc__)
+    start = doc.index("Architecture: the layer rule")
+    end = doc.index("The everyday names, one import away")
+    body = doc[start:end].split("\n", 2)[2]  # without the title and its underline
+    body = body.replace(":data:`LAYERS`", ":data:`~chebnorm.LAYERS`")
+    _write_if_changed(DOCS / "_layer_rule.rst", body.strip() + "\n")
 
 
 _copy_notebooks()
 _write_figure_gallery()
+_write_layer_rule()
 # autosummary's pages are a build product: a module that moved or was removed must not
 # leave its page behind (a stale page imports a name that no longer exists)
 shutil.rmtree(DOCS / "generated", ignore_errors=True)
+_write_module_pages()
+
+
+# -- cross-references resolved where the docstring's module would resolve them ------
+
+_DOC_SOURCE = re.compile(r"docstring of ([\w.]+)")
+
+
+def _documented_names(env) -> dict[int, tuple[str, str]]:
+    """id(object) -> (objtype, documented full name), for every documented Python object."""
+    cache = getattr(env, "_chebnorm_documented", None)
+    if cache is not None:
+        return cache
+    cache = {}
+    py = env.get_domain("py")
+    for name, _dispname, objtype, _doc, _anchor, _prio in py.get_objects():
+        obj = sys.modules.get(name) if objtype == "module" else _lookup(name)
+        if obj is None:
+            continue
+        if isinstance(obj, (int, float, str, bytes, bool, tuple, frozenset)):
+            # values that may be shared by identity: keyed by (last name, id)
+            cache.setdefault((name.rsplit(".", 1)[-1], id(obj)), (objtype, name))
+        else:
+            cache.setdefault(id(obj), (objtype, name))
+    env._chebnorm_documented = cache
+    return cache
+
+
+def _lookup(dotted: str):
+    """The object a dotted name denotes, as Python resolves it: attributes from the
+    top-level module down (``chebnorm.approx.piecewise_fit`` is the function the
+    stage exports, not the module of that name), else an imported module and
+    attributes below it; None when neither. A method is its function."""
+    obj = _walk(dotted)
+    if obj is None:
+        obj = _import_walk(dotted)
+    return getattr(obj, "__func__", obj)
+
+
+def _walk(dotted: str):
+    parts = dotted.split(".")
+    try:
+        obj = importlib.import_module(parts[0])
+        for part in parts[1:]:
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        return None
+    return obj
+
+
+def _import_walk(dotted: str):
+    parts = dotted.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except Exception:  # noqa: BLE001 - any import failure: not a module name
+            continue
+        try:
+            for attr in parts[i:]:
+                obj = getattr(obj, attr)
+        except AttributeError:
+            return None
+        return obj
+    return None
+
+
+#: the role that finds a documented object of each type (one name may be a module and a function)
+_ROLE = {"function": "func", "class": "class", "exception": "exc", "data": "data", "attribute": "attr",
+         "method": "meth", "property": "attr", "module": "mod"}
+
+_CODE_OR_ROLE = re.compile(r"(``.*?``|:[\w:]+:`[^`]*`|`[^`]*`_?)")
+_BARS = re.compile(r"(?<![\\\w])\|([^|\n]*?[^|\s\\])\|(?!\w)")
+
+
+def _escape_bars(app, what, name, obj, options, lines):
+    """Docstrings write ``|p - f|`` for an absolute value: in reStructuredText that
+    is a substitution reference. Escape such bars outside code, roles and tables."""
+    for i, line in enumerate(lines):
+        if "|" not in line or line.lstrip().startswith(("|", "+")):
+            continue
+        parts = _CODE_OR_ROLE.split(line)
+        lines[i] = "".join(p if k % 2 else _BARS.sub(r"\\|\1\\|", p) for k, p in enumerate(parts))
+
+
+_ATTR_DOCS: dict[str, dict] = {}
+
+
+def _attr_docs(modname: str) -> dict:
+    """The ``#:`` descriptions of a module's assignments, by name (cached)."""
+    if modname not in _ATTR_DOCS:
+        from sphinx.pycode import ModuleAnalyzer
+        try:
+            found = ModuleAnalyzer.for_module(modname).find_attr_docs()
+        except Exception:  # noqa: BLE001 - no source
+            found = {}
+        _ATTR_DOCS[modname] = {n: list(v) for (cls, n), v in found.items() if cls == ""}
+    return _ATTR_DOCS[modname]
+
+
+def _constant_doc(app, what, name, obj, options, lines):
+    """A constant a stage re-exports (``chebnorm.approx.COEF_FORMATS``) has its ``#:``
+    description where it is assigned, not in the stage: autodoc then falls back to the
+    docstring of the value's type (tuple's, int's). Use the description of the module
+    that assigns it, or nothing."""
+    if what not in ("data", "attribute") or "." not in name:
+        return
+    typedoc = inspect.getdoc(type(obj)) or ""
+    if not lines or not typedoc or lines[0].strip() != typedoc.splitlines()[0].strip():
+        return
+    modname, short = name.rsplit(".", 1)
+    for cand in sorted(m for m in sys.modules if m == modname or m.startswith(modname + ".")):
+        mod = sys.modules[cand]
+        if getattr(mod, short, None) is obj and short in _attr_docs(cand):
+            lines[:] = [line for line in _attr_docs(cand)[short] if line.strip()]
+            return
+    lines[:] = []
+
+
+def _resolve_in_defining_module(app, env, node, contnode):
+    """A reference in a docstring means the name in the module that defines the
+    docstring (``dot_to_code`` in ``chebnorm.hw.datapaths``), wherever the
+    docstring is shown; link it to the page where that object is documented."""
+    if node.get("refdomain") != "py":
+        return None
+    target = node["reftarget"].lstrip("~.")
+    contexts = [""]
+    source = _DOC_SOURCE.search(str(node.source or ""))
+    if source:
+        parts = source.group(1).split(".")
+        contexts += [".".join(parts[:i]) for i in range(len(parts), 0, -1)]
+    for key in ("py:class", "py:module"):
+        if node.get(key):
+            contexts.append(node[key])
+    documented = _documented_names(env)
+    py = env.get_domain("py")
+    for ctx in contexts:
+        obj = _lookup(f"{ctx}.{target}" if ctx else target)
+        if obj is None and "." in target:
+            # a dataclass field without a default is no class attribute: link the
+            # field's entry under the documented name of its class
+            owner, attr = target.rsplit(".", 1)
+            cls = _lookup(f"{ctx}.{owner}" if ctx else owner)
+            hit = documented.get(id(cls)) if inspect.isclass(cls) else None
+            if hit is not None and f"{hit[1]}.{attr}" in py.objects:
+                return py.resolve_xref(env, node["refdoc"], app.builder, "attr", f"{hit[1]}.{attr}",
+                                       node, contnode)
+        if obj is None:
+            continue
+        if inspect.ismodule(obj):
+            if obj.__name__ in env.get_domain("py").modules:
+                return env.get_domain("py").resolve_xref(env, node["refdoc"], app.builder, "mod",
+                                                         obj.__name__, node, contnode)
+            continue
+        hit = documented.get(id(obj)) or documented.get((target.rsplit(".", 1)[-1], id(obj)))
+        if hit is not None:
+            return py.resolve_xref(env, node["refdoc"], app.builder, _ROLE.get(hit[0], "obj"), hit[1],
+                                   node, contnode)
+        if target.rsplit(".", 1)[-1].startswith("_"):
+            # a private helper of the defining module: never documented by design, so
+            # the name is shown as code (it exists: _lookup found it)
+            return contnode
+    # a bare name documented exactly once in the site (an autosummary line of the facade)
+    if "." not in target:
+        names = {name for _t, name in documented.values() if name.rsplit(".", 1)[-1] == target}
+        if len(names) == 1:
+            name = names.pop()
+            objtype = next(t for t, n in documented.values() if n == name)
+            return py.resolve_xref(env, node["refdoc"], app.builder, _ROLE.get(objtype, "obj"), name,
+                                   node, contnode)
+    return None
+
+
+def _forget_documented(app, env):
+    """The map of documented objects is rebuilt for each build (the environment is
+    pickled between builds)."""
+    if hasattr(env, "_chebnorm_documented"):
+        del env._chebnorm_documented
+
+
+def _widget_fallback(app, doctree):
+    """An executed notebook's slider cell shows ipywidgets' text form,
+    ``interactive(children=(IntSlider(...` (the live widget needs a kernel): say so
+    instead (the static figure drawn before it stays)."""
+    from docutils import nodes
+
+    for block in list(doctree.findall(nodes.literal_block)):
+        if block.astext().startswith("interactive(children="):
+            note = nodes.paragraph(text="Sliders here in Jupyter (with ipywidgets installed); "
+                                        "the static figure above shows the same.")
+            note["classes"].append("widget-fallback")
+            block.replace_self(note)
+
+
+def setup(app):
+    """Register the reference resolver."""
+    app.connect("doctree-read", _widget_fallback)
+    app.connect("env-updated", _forget_documented)
+    app.connect("missing-reference", _resolve_in_defining_module, priority=900)
+    app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("autodoc-process-docstring", _constant_doc)

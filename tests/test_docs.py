@@ -1,5 +1,7 @@
-"""The documentation site builds offline with warnings as errors, and its API
-reference lists every public name of the facade and of every stage.
+"""The documentation site builds offline with warnings as errors and every
+cross-reference resolved (nitpicky), its API reference lists every public name
+of the facade and of every stage, math and notebooks render without a network,
+and the notebook pages show their figures.
 
 Skipped, with the reason, when the docs extra is not installed
 (``pip install -e ".[docs]"``)."""
@@ -7,6 +9,7 @@ Skipped, with the reason, when the docs extra is not installed
 from __future__ import annotations
 
 import importlib
+import os
 import re
 import subprocess
 import sys
@@ -17,6 +20,8 @@ import pytest
 pytest.importorskip("sphinx", reason="sphinx not installed (pip install -e '.[docs]')")
 pytest.importorskip("numpydoc", reason="numpydoc not installed (pip install -e '.[docs]')")
 pytest.importorskip("myst_nb", reason="myst-nb not installed (pip install -e '.[docs]')")
+pytest.importorskip("furo", reason="furo not installed (pip install -e '.[docs]')")
+pytest.importorskip("sphinx-mathjax-offline", reason="sphinx-mathjax-offline not installed (pip install -e '.[docs]')")
 
 REPO = Path(__file__).resolve().parent.parent
 STAGES = ["chebnorm.core", "chebnorm.symbolic", "chebnorm.approx", "chebnorm.export", "chebnorm.methods",
@@ -26,9 +31,11 @@ STAGES = ["chebnorm.core", "chebnorm.symbolic", "chebnorm.approx", "chebnorm.exp
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("docs")
-    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
+    # offline: no intersphinx fetch (CHEBNORM_DOCS_OFFLINE), as on a machine without network
+    env = {**os.environ, "CHEBNORM_DOCS_OFFLINE": "1"}
+    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-n", "--keep-going", "-q", "-b", "html",
                            "-d", str(out / "doctrees"), str(REPO / "docs"), str(out / "html")],
-                          capture_output=True, text=True, cwd=REPO)
+                          capture_output=True, text=True, cwd=REPO, env=env)
     assert proc.returncode == 0, f"sphinx -W failed:\n{proc.stderr[-4000:]}"
     return out / "html"
 
@@ -61,3 +68,43 @@ def test_site_has_the_papers_the_cli_and_the_gallery(built):
     assert figures and all((built / "_images" / name).exists() for name in figures)
     for nb in (REPO / "notebooks").glob("*.ipynb"):
         assert (built / "gallery" / "notebooks" / f"{nb.stem}.html").exists()
+
+
+@pytest.mark.slow
+def test_math_renders_from_the_site_itself(built):
+    """MathJax is a file of the site, referenced by the pages that have math; no page
+    loads a script from another host."""
+    papers = (built / "papers.html").read_text(encoding="utf-8")
+    assert re.search(r'<script[^>]+src="_static/mathjax/tex-chtml\.js', papers)
+    assert (built / "_static" / "mathjax" / "tex-chtml.js").stat().st_size > 100_000
+    assert 'class="math' in papers and r"\delta_d(\varphi)" in papers   # typeset in the browser
+    for page in built.rglob("*.html"):
+        scripts = re.findall(r'<script[^>]+src="([^"]+)"', page.read_text(encoding="utf-8"))
+        assert [s for s in scripts if re.match(r"(https?:)?//", s)] == [], page
+
+
+@pytest.mark.slow
+def test_notebook_pages_show_their_figures(built):
+    """Executed at build time: each notebook page holds its outputs, figures included."""
+    for nb in (REPO / "notebooks").glob("*.ipynb"):
+        page = (built / "gallery" / "notebooks" / f"{nb.stem}.html").read_text(encoding="utf-8")
+        images = re.findall(r'<img[^>]+src="([^"]+\.png)"', page)
+        assert images, f"{nb.name}: no figure on its page"
+        for src in images:
+            assert (built / "gallery" / "notebooks" / src).resolve().is_file(), src
+        assert "cell_output" in page
+        assert "interactive(children=" not in page   # a slider's text form is replaced by a note
+
+
+@pytest.mark.slow
+def test_site_pages(built):
+    """Installation, contributor and changelog pages; the layer rule on the contributor
+    page, not on the API page; the guide shows committed figures."""
+    for name in ("installation", "contributing", "changelog"):
+        assert (built / f"{name}.html").exists()
+    text = lambda name: re.sub(r"<[^>]+>", "", (built / f"{name}.html").read_text(encoding="utf-8"))  # noqa: E731
+    assert "layer rule" in text("contributing") and "tests/test_architecture.py" in text("contributing")
+    assert "Where a change goes" in text("contributing")
+    assert "Architecture: the layer rule" not in text("api") and "0. chebnorm.core" not in text("api")
+    guide = (built / "guide.html").read_text(encoding="utf-8")
+    assert re.findall(r'<img[^>]+src="_images/[^"]+\.png"', guide)

@@ -36,7 +36,38 @@ __all__ = [
 
 def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = None,
                error: str = "abs", frac_bits: int | None = None) -> CoefficientTable:
-    """Fit a registered target: ``fit_target("dichotomy", 2)``."""
+    """Fit a registered target: ``fit_target("dichotomy", 2)``.
+
+    Parameters
+    ----------
+    name : str
+        A registered target (:func:`target_names`).
+    degree : int
+        The polynomial degree.
+    psi_max : str or float, optional
+        The largest angle the table must cover (sympy text or radians).
+    kind : str, optional
+        ``"chebyshev"`` or ``"minimax"`` (default: the target's).
+    error : str, optional
+        ``"abs"`` or ``"rel"``.
+    frac_bits : int, optional
+        Also quantize to this many fractional bits.
+
+    Returns
+    -------
+    CoefficientTable
+        The certified table, named ``<name>_d<degree>``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown target or arguments out of range (as :func:`fit`).
+
+    Examples
+    --------
+    >>> fit_target("dichotomy", 2).name
+    'dichotomy_d2'
+    """
     t = get_target(name)
     return fit(t.expression, t.interval(psi_max), degree, kind=kind or t.kind, error=error,
                var=t.variable, name=f"{name}_d{degree}", frac_bits=frac_bits,

@@ -346,6 +346,48 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     candidates against a known bound); otherwise the certificate is the one
     computed without it.
 
+    Parameters
+    ----------
+    fn : Function1D
+        The function ``f`` (from :func:`chebnorm.approx.expr.parse_function`).
+    coefficients : sequence of float
+        The polynomial's coefficients, ascending powers.
+    lo, hi : sympy.Expr
+        Exact endpoints, ``lo < hi``.
+    kind : str, optional
+        ``"abs"`` (``g = p - f``) or ``"rel"`` (``g = p/f - 1``).
+    tol : float, optional
+        The relative tightness aimed at: ``bound <= (1 + tol) sup |g|``.
+    max_subintervals : int, optional
+        A cap on the subdivision (the bound stays rigorous, ``tight`` False).
+    prec : int, optional
+        Working precision in bits (default 128).
+    shift : tuple of (float, float), optional
+        ``(c, s)``: coefficients in ``(x - c)/s``.
+    abort_at : float, optional
+        Stop (return None) once the bound is proven ``>= abort_at``.
+
+    Returns
+    -------
+    Certificate or None
+        The certified bound, the located maximum and where; None only with ``abort_at``.
+
+    Raises
+    ------
+    ValueError
+        When ``g`` is not finite somewhere on the interval, or the interval holds no float64.
+
+    References
+    ----------
+    Sollya's ``supnorm`` (Chevillard, Harrison, Joldes, Lauter: "Efficient and accurate
+    computation of upper bounds of approximation errors", Theoretical Computer Science
+    412(16), 2011) solves the same problem; ``tests/test_sollya.py`` compares the two.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> from chebnorm.approx.expr import parse_function
     >>> import sympy as sp
     >>> c = certify(parse_function("x**2"), [0.0, 0.0, 1.0], sp.Integer(0), sp.Integer(1))

@@ -194,6 +194,11 @@ def get_method(name) -> MethodSpec:
 def method_names() -> tuple[str, ...]:
     """The registered methods, in the order the papers and the CLI list them.
 
+    Returns
+    -------
+    tuple of str
+        The names.
+
     Examples
     --------
     >>> method_names()

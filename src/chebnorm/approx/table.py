@@ -55,6 +55,25 @@ class FixedPoint:
     nearest), ``"reoptimized"`` (coefficients rounded from the highest power
     down, the lower ones refitted after each rounding) or ``"lattice"``
     (lattice reduction and a closest vector, as Sollya's ``fpminimax``).
+
+    Attributes
+    ----------
+    frac_bits : int
+        Fractional bits ``F``.
+    integers : tuple of int
+        ``round(c_k 2**F)`` (re-optimized), ascending powers.
+    word_bits : int
+        The signed width every integer fits.
+    method : str
+        ``"rounded"``, ``"reoptimized"`` or ``"lattice"``.
+    abs_error_bound : float
+        Certified ``sup |p_q - f|`` of the quantized polynomial.
+    rel_error_bound : float or None
+        Certified ``sup |p_q/f - 1|`` (None when ``f`` vanishes).
+    max_abs_error : float
+        A located maximum of ``|p_q - f|``.
+    max_rel_error : float or None
+        A located maximum of ``|p_q/f - 1|``.
     """
 
     frac_bits: int
@@ -133,6 +152,51 @@ class CoefficientTable(Table):
     ``|p - f|`` at ``max_abs_at``, a located maximum (so a lower bound of the
     supremum). ``rel_*`` fields are None when ``f`` vanishes on the interval.
 
+    Attributes
+    ----------
+    name : str
+        An identifier (C, Verilog, VHDL, shaders): the generated names' prefix.
+    expression : str
+        The fitted function ``f``, sympy text.
+    variable : str
+        Its variable's name.
+    interval : tuple of (str, str)
+        The exact endpoints ``[lo, hi]``, sympy text.
+    interval_float : tuple of (float, float)
+        The nearest float64 endpoints.
+    degree : int
+        The polynomial's degree.
+    kind : str
+        How it was fitted: ``"chebyshev"`` (interpolation) or ``"minimax"`` (Remez).
+    error_kind : str
+        ``"abs"`` or ``"rel"``: the error the fit minimizes.
+    coefficients : tuple of float
+        Ascending powers of ``variable`` (of ``(x - c)/s`` when ``shift`` is set).
+    abs_error_bound : float
+        Certified ``sup |p - f|`` on the interval (rounded up).
+    rel_error_bound : float or None
+        Certified ``sup |p/f - 1|``; None when ``f`` vanishes on the interval.
+    max_abs_error : float
+        ``|p - f|`` at ``max_abs_at``: a located maximum, a lower bound of the supremum.
+    max_abs_at : float
+        Where it is attained.
+    max_rel_error : float or None
+        ``|p/f - 1|`` at ``max_rel_at`` (None with ``rel_error_bound``).
+    max_rel_at : float or None
+        Where it is attained.
+    fixed_point : FixedPoint or None
+        The coefficients in fixed point, re-certified (:func:`~chebnorm.approx.quantize`).
+    provenance : dict of str to str
+        The command and versions that made the table.
+    schema_version : int
+        The JSON contract's version.
+    shift : tuple of (float, float) or None
+        ``(c, s)`` of the shifted basis, or None for monomials in ``x``.
+    quantized : Quantized or None
+        Coefficients in a chosen format (fixed point per power or floating), re-certified.
+
+    Examples
+    --------
     >>> t = CoefficientTable(name="sq", expression="x**2", variable="x",
     ...     interval=("0", "1"), interval_float=(0.0, 1.0), degree=2,
     ...     kind="chebyshev", error_kind="abs", coefficients=(0.0, 0.0, 1.0),

@@ -94,6 +94,16 @@ TARGETS: dict[str, Target] = {t.name: t for t in (
 def target_names() -> list[str]:
     """The names of the registered targets, sorted.
 
+    Returns
+    -------
+    list of str
+        The registered names, sorted.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> target_names()
     ['dichotomy', 'eta_term', 'midpoint', 'rsqrt']
     """
@@ -101,11 +111,31 @@ def target_names() -> list[str]:
 
 
 def get_target(name: str) -> Target:
-    """The registered :class:`Target` called ``name`` (``chebnorm.target``).
+    """The registered :class:`~chebnorm.approx.targets.Target` called ``name`` (``chebnorm.target``).
 
     Seed 000, method 4: the dichotomy denominator ``1/sqrt(2 + z)``,
     ``z = 2 cos(theta)``, on ``[2 cos(psi_max), 2]``:
 
+    Parameters
+    ----------
+    name : str
+        A registered target's name.
+
+    Returns
+    -------
+    Target
+        Its expression, variable, interval rule and fit kind.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, naming the registered ones.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> t = get_target("dichotomy")
     >>> t.expression, t.interval("pi/4")
     ('1/sqrt(2+z)', ('sqrt(2)', '2'))

@@ -39,6 +39,25 @@ def elementwise(fn, x, *args: float, numpy_fn=None) -> np.ndarray:
     ``x`` as float64, in x's shape. Where ``fn`` raises, the element is
     ``numpy_fn(v, *args)``, or NaN without ``numpy_fn``.
 
+    Parameters
+    ----------
+    fn : callable
+        A float64 function of one float and the ``args`` (``math.atan2``, ``math.pow``).
+    x : array_like
+        The values, converted to float64.
+    *args : float
+        Further scalar arguments, the same for every element.
+    numpy_fn : callable, optional
+        The fallback where ``fn`` raises ``ValueError`` or ``OverflowError``
+        (a numpy ufunc giving NaN or an infinity); NaN when omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 values in ``x``'s shape.
+
+    Examples
+    --------
     >>> elementwise(math.atan2, np.array([[1.0, -1.0]]), 1.0).shape
     (1, 2)
     """
@@ -81,6 +100,20 @@ def power(x, y) -> np.ndarray:
     ``pow`` element by element (``x`` and ``y`` broadcast). NaN where ``x < 0`` and ``y``
     is not an integer, infinities where the power overflows, as numpy.
 
+    Parameters
+    ----------
+    x : array_like
+        Bases (float64).
+    y : array_like
+        Exponents, broadcast against ``x``.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 ``x ** y`` in the broadcast shape, the same bits on every CPU.
+
+    Examples
+    --------
     >>> power(np.array([0.5, 2.0]), 3).tolist(), power(2.0, np.array([0.5, 10.0])).tolist()
     ([0.125, 8.0], [1.4142135623730951, 1024.0])
     >>> x = np.linspace(0.0, 1.0, 101)

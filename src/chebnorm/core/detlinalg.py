@@ -29,7 +29,25 @@ __all__ = ["matvec", "solve"]
 
 def matvec(a: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``a @ x`` over the last axis of ``a``, summed from the first column to the
-    last (``(..., m) x (m,) -> (...)``)."""
+    last (``(..., m) x (m,) -> (...)``).
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        float64 array of shape ``(..., m)``.
+    x : numpy.ndarray
+        float64 vector of length ``m``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``sum_j a[..., j] * x[j]`` of shape ``a.shape[:-1]``, added in the order
+        ``j = 0, 1, ..., m - 1`` (no BLAS: the same bits on every CPU).
+
+    Examples
+    --------
+    >>> matvec(np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([1.0, 1.0])).tolist()
+    [3.0, 7.0]"""
     a = np.asarray(a, dtype=float)
     x = np.asarray(x, dtype=float)
     out = a[..., 0] * x[0]
@@ -41,7 +59,27 @@ def matvec(a: np.ndarray, x: np.ndarray) -> np.ndarray:
 def solve(a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
     """The solution of ``a y = b`` (``a`` square, ``b`` a vector) by Gaussian
     elimination with partial pivoting (the first largest pivot wins a tie), or
-    None when a pivot is zero or the result is not finite (singular)."""
+    None when a pivot is zero or the result is not finite (singular).
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        float64 matrix of shape ``(n, n)``.
+    b : numpy.ndarray
+        float64 right-hand side of length ``n``.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The solution ``y`` (length ``n``), computed in a fixed order without
+        LAPACK (the same bits on every CPU); None when ``a`` is singular.
+
+    Examples
+    --------
+    >>> solve(np.array([[2.0, 0.0], [0.0, 4.0]]), np.array([1.0, 1.0])).tolist()
+    [0.5, 0.25]
+    >>> solve(np.zeros((2, 2)), np.ones(2)) is None
+    True"""
     m = np.array(a, dtype=float)
     y = np.array(b, dtype=float)
     n = m.shape[0]

@@ -187,6 +187,11 @@ def write_all(items) -> None:
     ``(path, data)`` (``data`` text, written as UTF-8 with ``\\n`` line ends,
     or bytes). Each destination follows the rules of the module docstring.
 
+    Parameters
+    ----------
+    items : iterable of (path, str or bytes)
+        The destinations and their contents.
+
     Every destination is checked and every temporary file written before any
     is renamed into place; when one fails, the temporaries are removed and
     :class:`WriteError` names the destination, so no regular file has
@@ -244,6 +249,13 @@ def write_atomic(path, data: str | bytes) -> None:
 
     Text is written as UTF-8 with ``\\n`` line ends, bytes unchanged.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination.
+    data : str or bytes
+        The contents.
+
     Raises
     ------
     WriteError
@@ -266,8 +278,27 @@ def write_atomic(path, data: str | bytes) -> None:
 def write_folder(directory, files) -> list[Path]:
     """Write ``files`` (name -> text or bytes) into ``directory``, all or
     none (:func:`write_all`); the folder is created if missing, and removed
-    again when the write fails. Returns the paths written, in order.
+    again when the write fails.
 
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The folder (created with its parents if missing).
+    files : dict of str to (str or bytes)
+        File name -> contents, written in this order.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The paths written, in the order of ``files``.
+
+    Raises
+    ------
+    WriteError
+        When a file cannot be written (nothing is left behind).
+
+    Examples
+    --------
     >>> import pathlib, tempfile
     >>> d = pathlib.Path(tempfile.mkdtemp()) / "out"
     >>> [p.name for p in write_folder(d, {"b.txt": "b", "a.txt": "a"})]
@@ -294,10 +325,25 @@ def write_folder(directory, files) -> list[Path]:
 
 
 def make_folder(path) -> Path:
-    """Create folder ``path`` (and its parents) if missing and return it;
-    raises :class:`WriteError` naming ``path`` when it exists as a file or
-    cannot be created.
+    """Create folder ``path`` (and its parents) if missing and return it.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path`` as a Path, an existing folder.
+
+    Raises
+    ------
+    WriteError
+        Naming ``path`` when it exists as a file or cannot be created.
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> make_folder(pathlib.Path(tempfile.mkdtemp()) / "a" / "b").is_dir()
     True

@@ -28,6 +28,18 @@ __all__ = ["float_up", "float_down", "ball_float_up", "ball_float_down", "signed
 def float_up(x: Fraction) -> float:
     """The smallest float64 ``>= x`` (``x`` a rational, or an int or float).
 
+    Parameters
+    ----------
+    x : fractions.Fraction or int or float
+        An exact rational.
+
+    Returns
+    -------
+    float
+        ``x`` rounded toward plus infinity.
+
+    Examples
+    --------
     >>> float_up(Fraction(1, 10)) == math.nextafter(0.1, 1.0) or float_up(Fraction(1, 10)) == 0.1
     True
     >>> Fraction(float_up(Fraction(1, 10))) >= Fraction(1, 10)
@@ -43,6 +55,18 @@ def float_up(x: Fraction) -> float:
 def float_down(x: Fraction) -> float:
     """The largest float64 ``<= x``.
 
+    Parameters
+    ----------
+    x : fractions.Fraction or int or float
+        An exact rational.
+
+    Returns
+    -------
+    float
+        ``x`` rounded toward minus infinity.
+
+    Examples
+    --------
     >>> Fraction(float_down(Fraction(1, 10))) <= Fraction(1, 10)
     True
     """
@@ -56,6 +80,19 @@ def float_down(x: Fraction) -> float:
 def ball_float_up(x) -> float:
     """The smallest float64 ``>=`` every point of the Arb ball ``x``.
 
+    Parameters
+    ----------
+    x : flint.arb
+        A finite ball.
+
+    Returns
+    -------
+    float
+        The bound, rounded up to float64 (directed rounding
+        of the ball's upper end).
+
+    Examples
+    --------
     >>> from flint import arb
     >>> ball_float_up(arb(1) / 3) >= 1 / 3
     True
@@ -72,6 +109,19 @@ def ball_float_up(x) -> float:
 def ball_float_down(x) -> float:
     """The largest float64 ``<=`` every point of the Arb ball ``x``.
 
+    Parameters
+    ----------
+    x : flint.arb
+        A finite ball.
+
+    Returns
+    -------
+    float
+        The bound, rounded down to float64 (directed rounding
+        of the ball's lower end).
+
+    Examples
+    --------
     >>> from flint import arb
     >>> ball_float_down(arb(1) / 3) <= 1 / 3
     True
@@ -88,6 +138,18 @@ def ball_float_down(x) -> float:
 def signed_bits(lo: int, hi: int) -> int:
     """Smallest two's-complement width holding every integer of ``[lo, hi]``.
 
+    Parameters
+    ----------
+    lo, hi : int
+        The range, ``lo <= hi``.
+
+    Returns
+    -------
+    int
+        The width in bits (sign bit included).
+
+    Examples
+    --------
     >>> signed_bits(-4, 3), signed_bits(0, 4), signed_bits(-5, 0)
     (3, 4, 4)
     """
@@ -100,6 +162,18 @@ def signed_bits(lo: int, hi: int) -> int:
 def unsigned_bits(hi: int) -> int:
     """Smallest unsigned width holding ``0..hi`` (at least 1).
 
+    Parameters
+    ----------
+    hi : int
+        The largest value, ``hi >= 0``.
+
+    Returns
+    -------
+    int
+        The width in bits.
+
+    Examples
+    --------
     >>> unsigned_bits(0), unsigned_bits(255), unsigned_bits(256)
     (1, 8, 9)
     """
@@ -110,6 +184,27 @@ def check_int(value, name: str, lo: int, hi: int) -> int:
     """``value`` as an int when it is an integer (not a bool) in ``[lo, hi]``;
     otherwise a ValueError naming ``name`` and the accepted range.
 
+    Parameters
+    ----------
+    value : object
+        The value to check (numpy integers are accepted, bools and floats are not).
+    name : str
+        The argument's name, used in the message.
+    lo, hi : int
+        The accepted range, both ends included.
+
+    Returns
+    -------
+    int
+        ``value`` as a Python int.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not an integer or lies outside ``[lo, hi]``.
+
+    Examples
+    --------
     >>> check_int(12, "in_bits", 1, 31)
     12
     >>> check_int(40, "in_bits", 1, 31)
@@ -133,6 +228,18 @@ def arb_precision(prec: int):
     """Run a block at Arb working precision ``prec`` bits, restoring the
     previous ``flint.ctx.prec`` on every exit (return, exception).
 
+    Parameters
+    ----------
+    prec : int
+        Working precision in bits.
+
+    Yields
+    ------
+    None
+        Inside the ``with`` block the precision is ``prec``.
+
+    Examples
+    --------
     >>> from flint import ctx
     >>> before = ctx.prec
     >>> with arb_precision(200):

@@ -27,6 +27,13 @@ __all__ = ["map_ordered", "default_workers", "check_workers", "check_scheduler"]
 def default_workers() -> int:
     """The number of cores this process may run on.
 
+    Returns
+    -------
+    int
+        ``len(os.sched_getaffinity(0))`` where available, else ``os.cpu_count()`` (at least 1).
+
+    Examples
+    --------
     >>> default_workers() >= 1
     True
     """
@@ -39,6 +46,23 @@ def default_workers() -> int:
 def check_workers(workers) -> int:
     """``workers`` as an int >= 1 (None: :func:`default_workers`).
 
+    Parameters
+    ----------
+    workers : int or None
+        Local worker processes.
+
+    Returns
+    -------
+    int
+        The count to use.
+
+    Raises
+    ------
+    ValueError
+        Naming ``workers`` when it is not an integer >= 1.
+
+    Examples
+    --------
     >>> check_workers(2), check_workers(None) >= 1
     (2, True)
     """
@@ -53,6 +77,18 @@ def check_scheduler(scheduler) -> None:
     """Raise ``ValueError`` unless ``scheduler`` is None, a non-empty address string or a
     ``distributed.Client``; and unless dask.distributed is importable when one is given.
 
+    Parameters
+    ----------
+    scheduler : str or distributed.Client or None
+        The scheduler to check.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scheduler`` and what is accepted.
+
+    Examples
+    --------
     >>> check_scheduler(None)
     """
     if scheduler is None:
@@ -88,6 +124,8 @@ def map_ordered(fn: Callable, items: Iterable, *, workers: int | None = None, sc
         A Dask distributed scheduler address (``tcp://host:8786``) or a client.
     progress : bool
         Show a tqdm progress bar (on stderr) labelled ``desc``.
+    desc : str, optional
+        The progress bar's label.
     on_result : callable, optional
         ``on_result(index, result)``, called here as each item finishes.
 

@@ -30,6 +30,7 @@ import re
 
 __all__ = ["identifier", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
 
+#: the identifiers accepted in generated sources (a regular expression; at most 63 characters)
 IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
 _IDENT = re.compile(IDENTIFIER_PATTERN + r"\Z")
 _MAX_IDENT = 63  # C99 guarantees 63 significant characters in an internal identifier
@@ -39,8 +40,27 @@ def identifier(name, *, field: str = "name") -> str:
     """Return ``name`` if it is a safe identifier in every target, else raise.
 
     Accepted: ``[A-Za-z_][A-Za-z0-9_]*``, at most 63 characters (C99's
-    significant length). Raises :class:`ValueError` naming ``field``.
+    significant length).
 
+    Parameters
+    ----------
+    name : str
+        The identifier.
+    field : str, optional
+        What ``name`` is, for the message (``"table.name"``).
+
+    Returns
+    -------
+    str
+        ``name`` unchanged.
+
+    Raises
+    ------
+    ValueError
+        Naming ``field`` when ``name`` is not a safe identifier.
+
+    Examples
+    --------
     >>> identifier("rsqrt d2", field="table.name")
     Traceback (most recent call last):
     ...
@@ -60,6 +80,18 @@ def comment_text(text, *, max_length: int = 400) -> str:
     backslashes become ``_`` (line continuation); ``*/`` and ``/*`` get a space
     between their characters, ``??`` too (trigraphs), repeatedly until none is
     left. Longer texts are cut to ``max_length`` characters and end in ``...``.
+
+    Parameters
+    ----------
+    text : object
+        The text (anything else is converted with ``str``).
+    max_length : int, optional
+        The longest result, ``...`` included.
+
+    Returns
+    -------
+    str
+        Printable ASCII that cannot end the comment or continue its line.
 
     Examples
     --------
@@ -86,6 +118,16 @@ def csv_cell(text) -> str:
     is not a plain number gets a leading apostrophe (the OWASP advice for CSV
     injection); a cell holding a comma, quote or line break is quoted with
     doubled quotes.
+
+    Parameters
+    ----------
+    text : object
+        The cell's value (converted with ``str``).
+
+    Returns
+    -------
+    str
+        The cell as it appears between commas.
 
     Examples
     --------

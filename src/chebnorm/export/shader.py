@@ -110,6 +110,7 @@ class ShaderLanguage:
     postlude: tuple[str, ...] = ()
 
 
+#: the shader languages the printer writes, by name (``glsl``, ``wgsl``, ``hlsl``)
 SHADER_LANGUAGES = {
     "glsl": ShaderLanguage(
         name="glsl", title="GLSL 4.30 / GLSL ES 3.10", float_type="float", suffix="",

@@ -42,7 +42,9 @@ from chebnorm.core.numeric import signed_bits, unsigned_bits
 __all__ = ["QFormat", "ROUNDINGS", "OVERFLOWS", "shift_round", "fit_bits", "signed_bits",
            "unsigned_bits", "rounding_error_bound", "check_int64", "check_width"]
 
+#: rounding modes: toward minus infinity (drop bits), to nearest with ties to even
 ROUNDINGS = ("trunc", "rne")
+#: overflow modes: clamp to the range, or keep the low bits (two's complement)
 OVERFLOWS = ("saturate", "wrap")
 
 #: widest integer the vectorized model keeps in int64 (sign bit and a margin)

@@ -107,6 +107,7 @@ class HornerDesign:
     stages: tuple[Stage, ...]
     top_bits: int
     raw_bits: int
+    #: ``(lo, hi)``: the input codes whose values lie in the table's interval (the error budget holds on them)
     valid_codes: tuple[int, int]
     notes: tuple[str, ...] = field(default_factory=tuple)
 

@@ -897,7 +897,7 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
 
 
 def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
-    """The exhaustive self-checking bench (expected codes from :meth:`evaluate`).
+    """The exhaustive self-checking bench (expected codes from ``d.evaluate``).
 
     Examples
     --------

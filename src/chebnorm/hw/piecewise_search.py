@@ -49,6 +49,7 @@ from .targets import TargetCost, get_target
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
            "TARGET_COLUMNS"]
 
+#: the columns of the search's CSV (``design_NAME.csv``), in order
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
            "rom_bits", "approx_bound", "total_bound", "meets", "model_cost", "yosys_cells",
            "pareto", "winner")

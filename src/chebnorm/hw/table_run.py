@@ -21,7 +21,7 @@ __all__ = ["simulate_table"]
 def simulate_table(design, directory, language: str = "verilog") -> SimResult:
     """Write the module, its exhaustive bench and the model's vectors into
     ``directory`` and run the bench (Icarus Verilog or GHDL): every input
-    code's output compared with :meth:`evaluate`'s.
+    code's output compared with ``design.evaluate``'s.
 
     Examples
     --------

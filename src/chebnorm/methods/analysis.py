@@ -73,6 +73,20 @@ def _check_m(m) -> int:
 def reference_normals(nl, nr, t) -> np.ndarray:
     """``R(t)``: linear interpolation then exact normalization, float64, (P, 3).
 
+    Parameters
+    ----------
+    nl, nr : numpy.ndarray
+        End normals per pixel, shape ``(P, 3)``.
+    t : numpy.ndarray
+        Positions, shape ``(P,)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``R(t) = (N_l + t (N_r - N_l)) / |N_l + t (N_r - N_l)|`` in float64, shape ``(P, 3)``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> reference_normals(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.array([0.5])).round(12).tolist()
     [[0.707106781187, 0.707106781187, 0.0]]
@@ -87,6 +101,22 @@ def slerp_normals(nl, nr, psi, t) -> np.ndarray:
     Seed 000, method 3: ``[sin((1-t) psi) N_l + sin(t psi) N_r] / sin psi``.
     A third of the way along a right angle is 30 degrees from ``N_l``:
 
+    Parameters
+    ----------
+    nl, nr : numpy.ndarray
+        Unit end normals per pixel, shape ``(P, 3)``.
+    psi : float or numpy.ndarray
+        The angle between them (radians), a scalar or per pixel; ``psi > 0``.
+    t : numpy.ndarray
+        Angle fractions, shape ``(P,)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The slerp points in float64, shape ``(P, 3)``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> s = slerp_normals(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.pi / 2, np.array([1 / 3]))
     >>> bool(np.allclose(s, [[np.cos(np.pi / 6), np.sin(np.pi / 6), 0.0]]))
@@ -118,6 +148,31 @@ def _pixel_errors(n, nl, nr, psi, t):
 @dataclass(frozen=True)
 class MethodReport:
     """Errors and operation counts of one method on one span (see the module docstring).
+
+    Attributes
+    ----------
+    method : str
+        The method's registry name.
+    psi : float
+        The span angle (radians).
+    m : int
+        The span length (pixels ``0..m``).
+    dtype : str
+        The dtype the method computed in (``"float32"``, ``"float64"``).
+    max_length_error : float
+        Largest ``| |N| - 1 |``.
+    max_angle_error : float
+        Largest angle (radians) between ``N`` and the normalized linear interpolant ``R``.
+    max_angle_error_slerp : float
+        Largest angle between ``N`` and the slerp point ``S(t)``.
+    max_vector_error : float
+        Largest ``|N - R|``.
+    diffuse_error : float
+        Largest ``|N.R - 1|``.
+    specular_errors : tuple of float
+        Largest ``|(N.R)^n - 1|`` for ``n = 1 .. N_SPECULAR``.
+    ops : OpCounts
+        The method's operation counts on this span.
 
     Examples
     --------
@@ -186,6 +241,34 @@ def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
     pi/4, the degree-2 tables fitted for ``psi_max = psi`` are used
     (:func:`~.spans.default_tables`).
 
+    Parameters
+    ----------
+    method : str
+        A registered method (:func:`~chebnorm.methods.method_names`).
+    psi : float
+        The angle between the end normals, ``0 <= psi < pi`` (radians).
+    m : int
+        The span length: pixels at ``t = j/m``, ``j = 0..m``.
+    dtype : numpy dtype, optional
+        float32 or float64, the arithmetic of the method.
+    tables : dict, optional
+        Coefficient tables by method name, as in :func:`~chebnorm.methods.span_normals`.
+    angular_reanchor : int, optional
+        Restart the angular recurrence every this many pixels.
+
+    Returns
+    -------
+    MethodReport
+        The errors (maxima over the span, measured in float64) and the operation counts.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method or dtype, ``psi`` outside ``[0, pi)``, ``m < 1``, or
+        tables that do not cover the span.
+
+    Examples
+    --------
     >>> r = analyze("newton", 0.7853981633974483, 64)
     >>> round(r.max_length_error, 6), r.ops.per_pixel["sqrt"]
     (0.008471, 0)
@@ -212,6 +295,20 @@ def analyze(method: str, psi: float, m: int, dtype=np.float64, *, tables=None,
 @dataclass(frozen=True)
 class ErrorSweep:
     """Errors over a grid: arrays indexed ``[method, dtype, psi, m]`` (specular: ``[..., n-1]``).
+
+    Attributes
+    ----------
+    methods, dtypes : tuple of str
+        The methods and dtype names along the first two axes.
+    psis : numpy.ndarray
+        The span angles (radians) along the third axis.
+    ms : tuple of int
+        The span lengths along the fourth axis.
+    length_error, angle_error, angle_error_slerp, vector_error, diffuse_error : numpy.ndarray
+        The per-span maxima of the errors of :class:`MethodReport`, shape
+        ``(methods, dtypes, psis, ms)``.
+    specular_error : numpy.ndarray
+        The specular errors, shape ``(methods, dtypes, psis, ms, N_SPECULAR)``.
 
     Examples
     --------
@@ -277,6 +374,35 @@ def error_sweep(methods=None, psis=None, ms=(8, 64, 512), dtypes=(np.float64, np
     a Dask scheduler (:func:`chebnorm.core.parallel.map_ordered`; default: here);
     the result is the same.
 
+    Parameters
+    ----------
+    methods : sequence of str, optional
+        Registered methods (default: all).
+    psis : array_like, optional
+        Span angles in ``[0, pi)`` radians (default: 33 points on ``[0, pi/2]``).
+    ms : sequence of int, optional
+        Span lengths.
+    dtypes : sequence of numpy dtypes, optional
+        float32 and/or float64.
+    tables : dict, optional
+        Coefficient tables by method name.
+    workers : int, optional
+        Local processes (1: in this process).
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler instead of local processes.
+
+    Returns
+    -------
+    ErrorSweep
+        The per-span maxima of every error over the grid.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method or dtype, angles or lengths out of range.
+
+    Examples
+    --------
     >>> s = error_sweep(("none",), [0.2], (4,), (np.float64,))
     >>> round(float(s.get("diffuse_error", "none", m=4)[0]), 7)   # delta_d(0.2), claim C1
     0.0049958
@@ -341,6 +467,32 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
 
     Tables as in :func:`~.spans.span_normals` (missing keys: the defaults).
 
+    Parameters
+    ----------
+    method : str
+        A registered method.
+    psi : float
+        The span angle, ``0 <= psi < pi`` (radians).
+    m : int
+        The span length.
+    tables : dict, optional
+        Coefficient tables by method name (their certified relative bounds enter
+        the ``dichotomy`` and ``quadratic`` bounds).
+    dtype : numpy dtype, optional
+        The arithmetic whose rounding allowance (``eps``) is added.
+
+    Returns
+    -------
+    float
+        The bound (an estimate for ``angular``, see above).
+
+    Raises
+    ------
+    ValueError
+        For an unknown method or dtype, or arguments out of range.
+
+    Examples
+    --------
     >>> round(length_error_bound("none", math.pi / 4, 64), 7)
     0.0761205
     """
@@ -383,6 +535,29 @@ def length_error_bound(method: str, psi: float, m: int, *, tables=None, dtype=np
 class DriftReport:
     """Per-pixel errors of the ``angular`` recurrence against its ideal, slerp (float64).
 
+    Attributes
+    ----------
+    psi : float
+        The span angle (radians).
+    m : int
+        The span length.
+    dtype : str
+        The arithmetic: ``"float32"``, ``"float64"`` or ``"Q.F"`` (fixed point).
+    reanchor : int or None
+        The re-anchoring period in pixels (None: never).
+    t : numpy.ndarray
+        The pixel positions, ``m + 1`` values in ``[0, 1]``.
+    length_error : numpy.ndarray
+        ``| |N| - 1 |`` per pixel.
+    angle_error : numpy.ndarray
+        The angle between ``N`` and the slerp point ``S(t)`` per pixel (radians).
+    max_length_error, max_angle_error : float
+        The maxima over the span.
+    final_length_error, final_angle_error : float
+        The errors at the last pixel (``t = 1``).
+    ops : OpCounts
+        The operation counts (with re-anchoring, ``per_pixel`` is an average).
+
     Examples
     --------
     >>> d = angular_drift(math.pi / 4, 64, np.float64)
@@ -416,6 +591,31 @@ def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,
     the subtraction exact -- what an integer datapath does; ``dtype`` of the
     report is then ``"Q.F"``.
 
+    Parameters
+    ----------
+    psi : float, optional
+        The span angle (radians), default ``pi/4``.
+    m : int, optional
+        The span length, default 512.
+    dtype : numpy dtype, optional
+        float32 (default) or float64.
+    reanchor : int, optional
+        Restart from the closed form every this many pixels.
+    frac_bits : int, optional
+        Run in fixed point with this many fractional bits instead of ``dtype``.
+
+    Returns
+    -------
+    DriftReport
+        Per-pixel length and angle errors against slerp, and the operation counts.
+
+    Raises
+    ------
+    ValueError
+        For ``psi`` outside ``[0, pi)``, ``m < 1``, or an invalid ``reanchor`` or ``frac_bits``.
+
+    Examples
+    --------
     >>> d = angular_drift(math.pi / 4, 512, np.float64)
     >>> d.max_angle_error < 1e-11
     True

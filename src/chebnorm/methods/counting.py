@@ -73,6 +73,27 @@ def _clean(v):
 class OpCounts:
     """Counts of one method on one span (see the module docstring).
 
+    Attributes
+    ----------
+    method : str
+        The method counted.
+    m : int
+        The span length.
+    per_pixel : dict of str to int or float
+        Operations per pixel of the loop, by kind.
+    per_span : dict of str to int
+        Operations of the span's set-up, by kind.
+    pixels_in_setup : int
+        Pixels the set-up computes itself.
+    pixels_in_loop : int
+        Pixels the loop computes.
+    pow2_per_pixel : float
+        Multiplications by a power of two per pixel (among ``per_pixel["mul"]``).
+    pow2_per_span : int
+        Multiplications by a power of two in the set-up.
+    total : dict of str to int
+        The whole span's counts, by kind.
+
     Examples
     --------
     >>> c = count_ops("none", 8)   # N_l + t (N_r - N_l): 3 mul, 3 add per pixel
@@ -103,6 +124,15 @@ class NormalizationCounts:
     operation kind to its count, ``pow2`` counts the multiplications by a
     power of two among them (see :func:`normalization_ops`).
 
+    Attributes
+    ----------
+    method : str
+        The method counted.
+    ops : dict of str to int
+        Count per operation kind (``add``, ``mul``, ``div``, ``sqrt``, ``trig``, ``cmp``).
+    pow2 : int
+        How many of the multiplications are by a power of two.
+
     Examples
     --------
     >>> c = normalization_ops("lyon")
@@ -124,6 +154,23 @@ def normalization_ops(method: str) -> NormalizationCounts:
     (1 add), the product with ``N`` (3 mul) and the halving (1 mul by a
     power of two, ``pow2``), no division:
 
+    Parameters
+    ----------
+    method : str
+        A method whose kernel has a normalizer: ``exact``, ``newton`` or ``lyon``.
+
+    Returns
+    -------
+    NormalizationCounts
+        The counts of one normalization.
+
+    Raises
+    ------
+    ValueError
+        For a method without a normalization step.
+
+    Examples
+    --------
     >>> normalization_ops("exact").ops
     {'add': 2, 'mul': 3, 'div': 3, 'sqrt': 1, 'trig': 0, 'cmp': 0}
     >>> c = normalization_ops("newton")
@@ -144,6 +191,18 @@ def generic_pair(psi: float):
     """Unit normals at angle ``psi`` in a generic plane (no component zero or equal):
     the end normals the counting and analysis functions run one span on.
 
+    Parameters
+    ----------
+    psi : float
+        The angle between the two normals (radians).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(nl, nr)``, two float64 unit vectors of shape ``(3,)`` with ``nl . nr = cos(psi)``.
+
+    Examples
+    --------
     >>> nl, nr = generic_pair(0.5)
     >>> round(float(nl @ nr), 12) == round(math.cos(0.5), 12)
     True
@@ -200,6 +259,35 @@ def count_ops(method: str, m: int, *, t0: float = 0.0, dt: float | None = None,
     being the float64 normals the counting run computed (equal to
     ``span_normals`` in float64 up to the libm's last bit).
 
+    Parameters
+    ----------
+    method : str
+        A registered method.
+    m : int
+        The span length.
+    t0, dt, count : optional
+        The first position, step and pixel count, as in :func:`~chebnorm.methods.span_normals`.
+    tables : dict, optional
+        Coefficient tables by method name (their degrees set the Horner counts).
+    angular_reanchor : int, optional
+        Re-anchoring period of the angular recurrence.
+    psi : float, optional
+        The angle of the end normals the counting run uses.
+    return_values : bool, optional
+        Also return the normals computed.
+
+    Returns
+    -------
+    OpCounts or tuple of (OpCounts, numpy.ndarray)
+        The counts; with ``return_values``, also the float64 normals, shape ``(P, 3)``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method or arguments out of range (as :func:`~chebnorm.methods.span_normals`).
+
+    Examples
+    --------
     >>> c = count_ops("exact", 8)
     >>> c.per_pixel["sqrt"], c.per_pixel["div"], c.per_span["add"]
     (1, 3, 3)

@@ -108,6 +108,16 @@ def _apply(name: str, x):
 def sin(x):
     """``sin(x)``: float32 correctly rounded, float64 by the C library (see the module docstring).
 
+    Parameters
+    ----------
+    x : numpy.ndarray or numpy scalar
+        Angles (radians), float32 or float64.
+
+    Returns
+    -------
+    numpy.ndarray or numpy scalar
+        ``sin(x)`` in the dtype of ``x`` and its shape.
+
     Examples
     --------
     >>> import mpmath
@@ -121,6 +131,16 @@ def sin(x):
 def cos(x):
     """``cos(x)``: float32 correctly rounded, float64 by the C library.
 
+    Parameters
+    ----------
+    x : numpy.ndarray or numpy scalar
+        Angles (radians), float32 or float64.
+
+    Returns
+    -------
+    numpy.ndarray or numpy scalar
+        ``cos(x)`` in the dtype of ``x`` and its shape.
+
     Examples
     --------
     >>> cos(np.array([0.0, np.pi])).tolist(), cos(np.float32(0.0)).dtype
@@ -132,6 +152,16 @@ def cos(x):
 def arccos(x):
     """``arccos(x)``: float32 correctly rounded, float64 by the C library; NaN outside [-1, 1].
 
+    Parameters
+    ----------
+    x : numpy.ndarray or numpy scalar
+        Cosines, float32 or float64.
+
+    Returns
+    -------
+    numpy.ndarray or numpy scalar
+        ``arccos(x)`` in the dtype of ``x`` and its shape.
+
     Examples
     --------
     >>> arccos(np.array([1.0, -1.0, 2.0])).tolist()
@@ -142,6 +172,16 @@ def arccos(x):
 
 def arctan2(y, x) -> np.ndarray:
     """``arctan2(y, x)`` in float64 by the C library's ``atan2``, element by element.
+
+    Parameters
+    ----------
+    y, x : array_like
+        float64 coordinates; they broadcast.
+
+    Returns
+    -------
+    numpy.ndarray
+        The angles in ``[-pi, pi]`` (radians).
 
     Examples
     --------
@@ -160,6 +200,18 @@ def power(x, y: float) -> np.ndarray:
     0.5, -1, 1, 0 by ``square``, ``sqrt``, ``reciprocal``, a copy and ones (correctly
     rounded), any other ``y`` by ``pow`` element by element (:func:`chebnorm.core.clib.power`).
 
+    Parameters
+    ----------
+    x : array_like
+        float64 bases.
+    y : float
+        The exponent.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``x ** y``, the same bits on every x86-64 CPU.
+
     Examples
     --------
     >>> power(np.array([0.5, 2.0]), 3.0).tolist(), power(np.array([3.0]), 2.0).tolist()
@@ -175,6 +227,16 @@ def log2(x) -> np.ndarray:
     """``log2(x)`` in float64 by the C library, element by element: ``-inf`` at 0,
     NaN below 0, as numpy.
 
+    Parameters
+    ----------
+    x : array_like
+        float64 values.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``log2(x)`` element by element.
+
     Examples
     --------
     >>> log2(np.array([8.0, 0.0, -1.0, np.inf])).tolist()
@@ -188,6 +250,18 @@ def powers(x, n: int) -> np.ndarray:
     fixed order, of the squarings ``x^(2^i)`` for the bits of ``k`` (at most ``2 log2 n``
     correctly rounded multiplications; a rounding of ``x^j`` moves ``x^k`` by ``k/j`` of it,
     so the result is within ``(k - 1)/2`` ulp of the exact ``x^k``).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        float64 values.
+    n : int
+        The highest power, ``n >= 1``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``x.shape + (n,)``: ``[..., k-1]`` is ``x^k``.
 
     Examples
     --------

@@ -58,6 +58,18 @@ def vmul(a, s):
 def dot(a, b):
     """``a.b``: 3 mul, 2 add.
 
+    Parameters
+    ----------
+    a, b : tuple of 3 scalars or arrays
+        Two vectors, component by component.
+
+    Returns
+    -------
+    scalar or array
+        ``a[0] b[0] + a[1] b[1] + a[2] b[2]``, added in that order.
+
+    Examples
+    --------
     >>> dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0))
     32.0
     """
@@ -72,6 +84,22 @@ def lerp(a, d, t):
 def horner(ops, coefficients, x):
     """``p(x)`` from ascending coefficients (degree d: d mul, d add).
 
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    coefficients : sequence of float
+        Ascending coefficients (constants of the backend).
+    x : scalar or array
+        The argument.
+
+    Returns
+    -------
+    scalar or array
+        ``p(x)`` by Horner's rule from the highest coefficient.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.methods.ops import NumpyOps
     >>> float(horner(NumpyOps(), [1.0, 2.0, 3.0], np.array(2.0)))   # 1 + 2*2 + 3*4
@@ -87,6 +115,20 @@ def horner(ops, coefficients, x):
 def normalize_classic(ops, n):
     """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div.
 
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    n : tuple of 3 scalars or arrays
+        The vector to normalize.
+
+    Returns
+    -------
+    tuple of 3 scalars or arrays
+        ``N / sqrt(N.N)``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.methods.ops import NumpyOps
     >>> [float(c) for c in normalize_classic(NumpyOps(), (np.array(3.0), np.array(4.0), np.array(0.0)))]
@@ -104,6 +146,20 @@ def normalize_newton(ops, n):
     For a normal of length ``l`` the result has length ``l (3 - l^2)/2``,
     short of 1 by ``(1 - l)^2 (2 + l)/2``; ``l = 0.95`` gives ``0.9963125``:
 
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    n : tuple of 3 scalars or arrays
+        The vector to normalize.
+
+    Returns
+    -------
+    tuple of 3 scalars or arrays
+        ``N (3 - N.N) / 2``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.methods.ops import NumpyOps
     >>> float(normalize_newton(NumpyOps(), (np.array(0.95), np.array(0.0), np.array(0.0)))[0])
@@ -119,6 +175,20 @@ def normalize_lyon(ops, n):
 
     ``l = 0.95``: ``0.95 (15 - 10 * 0.9025 + 3 * 0.81450625)/8``:
 
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    n : tuple of 3 scalars or arrays
+        The vector to normalize.
+
+    Returns
+    -------
+    tuple of 3 scalars or arrays
+        ``N (15 - 10 x + 3 x^2) / 8``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.methods.ops import NumpyOps
     >>> round(float(normalize_lyon(NumpyOps(), (np.array(0.95), np.array(0.0), np.array(0.0)))[0]), 10)
@@ -167,10 +237,15 @@ class _Slerp:
         return vadd(vmul(st["a"], wa), vmul(st["b"], wb))
 
 
+#: kernel of ``exact``: linear interpolation, then :func:`normalize_classic`
 EXACT = _Linear(normalize_classic)
+#: kernel of ``none``: linear interpolation, not normalized
 NONE = _Linear(None)
+#: kernel of ``newton``: linear interpolation, then :func:`normalize_newton`
 NEWTON = _Linear(normalize_newton)
+#: kernel of ``lyon``: linear interpolation, then :func:`normalize_lyon`
 LYON = _Linear(normalize_lyon)
+#: kernel of ``slerp``: the spherical interpolation, evaluated directly per pixel
 SLERP = _Slerp()
 
 
@@ -189,6 +264,28 @@ def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None)
     ``reanchor=K`` recomputes ``N_{j-1}, N_j`` from the closed form every K
     pixels (4 trig, 16 mul, 8 add per anchor instead of 3 mul, 3 add),
     bounding the float32 drift.
+
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    nl, nr : tuple of 3 scalars or arrays
+        The span's unit end normals, component by component.
+    t0 : float or array
+        The first pixel's position.
+    dt : float or array
+        The step between pixels.
+    n : int
+        The number of pixels.
+    start_at_left : bool, optional
+        The first pixel is ``N_l`` itself (``t0 = 0``), not computed.
+    reanchor : int, optional
+        Recompute from the closed form every this many pixels.
+
+    Yields
+    ------
+    tuple of 3 scalars or arrays
+        The pixel normals in order, not normalized by anything but the recurrence.
 
     Examples
     --------
@@ -242,6 +339,28 @@ def quadratic_steps(ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=
     differences (6 add per pixel) and not normalized.
 
     ``Q = N_l``, ``G = 2 N_l + 2 N_r - 4 N_c``, ``P = 4 N_c - 3 N_l - N_r``.
+
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    nl, nr : tuple of 3 scalars or arrays
+        The span's unit end normals.
+    t0 : float or array
+        The first pixel's position.
+    dt : float or array
+        The step between pixels.
+    n : int
+        The number of pixels.
+    coefficients : sequence of float, optional
+        Ascending coefficients of ``p(x) ~ 1/sqrt(2(1 + x))``; None: exact ``1/sqrt``.
+    start_at_left : bool, optional
+        The first pixel is ``N_l`` itself (``t0 = 0``).
+
+    Yields
+    ------
+    tuple of 3 scalars or arrays
+        The pixel normals ``G t^2 + P t + Q`` in order (not normalized).
 
     Examples
     --------
@@ -298,7 +417,9 @@ class _Steps:
         return self.generator(ops, nl, nr, t0, dt, n, start_at_left=start_at_left, **kw)
 
 
+#: kernel of ``quadratic``: :func:`quadratic_steps`
 QUADRATIC = _Steps(quadratic_steps, ("coefficients",))
+#: kernel of ``angular``: :func:`angular_steps`
 ANGULAR = _Steps(angular_steps, ("reanchor",))
 
 
@@ -312,6 +433,23 @@ def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
     one denominator ``r = p(z)`` (the ``dichotomy`` table; ``None``: exact
     ``1/sqrt``) and the next level's ``z' = sqrt(2 + z) = (2 + z) r`` (one mul,
     no sqrt); per midpoint 3 add, 3 mul.
+
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    nl, nr : tuple of 3 scalars or arrays
+        The span's unit end normals.
+    levels : int
+        The number of halving rounds.
+    coefficients : sequence of float, optional
+        Ascending coefficients of the denominator polynomial ``p(z) ~ 1/sqrt(2 + z)``;
+        None: exact ``1/sqrt``.
+
+    Returns
+    -------
+    list of tuple of 3 scalars or arrays
+        The ``2**levels + 1`` nodes, from ``N_l`` to ``N_r``.
 
     Examples
     --------
@@ -348,6 +486,20 @@ def dichotomy_fraction(ops, t, levels):
     """Position ``t`` on the dyadic grid: node index ``k = floor(t 2**levels)`` (a scalar)
     and fraction ``f`` (1 pow2 mul, 1 cmp, 1 add).
 
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    t : array
+        Pixel positions in ``[0, 1]``.
+    levels : int
+        The depth of the dyadic grid.
+
+    Returns
+    -------
+    tuple of (array, array)
+        The node index ``k`` (as floats) and the fraction ``f`` in ``[0, 1)``.
+
     Examples
     --------
     >>> import math
@@ -364,6 +516,20 @@ def dichotomy_fraction(ops, t, levels):
 
 def dichotomy_pick(ops, a, b, f):
     """Linear pick between the nodes around an off-grid pixel: ``A + f (B - A)``.
+
+    Parameters
+    ----------
+    ops : NumpyOps or CountingOps
+        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    a, b : tuple of 3 scalars or arrays
+        The nodes left and right of the pixel.
+    f : array
+        The pixel's fraction between them.
+
+    Returns
+    -------
+    tuple of 3 arrays
+        ``A + f (B - A)``, not normalized.
 
     Examples
     --------
@@ -389,4 +555,5 @@ class _Tree:
     pick = staticmethod(dichotomy_pick)
 
 
+#: kernel of ``dichotomy``: :func:`dichotomy_tree`, :func:`dichotomy_fraction`, :func:`dichotomy_pick`
 DICHOTOMY = _Tree()

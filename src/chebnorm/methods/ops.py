@@ -60,6 +60,11 @@ def _is_pow2(c) -> bool:
 class NumpyOps:
     """numpy backend: every scalar is an array of ``dtype``.
 
+    Parameters
+    ----------
+    dtype : numpy dtype, optional
+        float32 or float64: every constant and result has this dtype.
+
     Examples
     --------
     >>> ops = NumpyOps(np.float32)
@@ -129,6 +134,13 @@ class Counter:
 class Counted:
     """A float64 value that records the operations applied to it in a :class:`Counter`.
 
+    Parameters
+    ----------
+    v : float
+        The value.
+    counter : Counter
+        Where the operations on it are recorded.
+
     Examples
     --------
     >>> c = Counter()
@@ -187,6 +199,11 @@ class Counted:
 
 class CountingOps:
     """Counting backend: scalars are :class:`Counted`, constants stay plain floats.
+
+    Parameters
+    ----------
+    counter : Counter
+        Where the operations are recorded (set-up and per-pixel phases).
 
     Examples
     --------

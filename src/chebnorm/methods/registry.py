@@ -60,6 +60,22 @@ def _kernel_of(spec: MethodSpec):
 def method_kernel(method: str | MethodSpec):
     """The span kernel object of ``method`` (a name or a registry entry).
 
+    Parameters
+    ----------
+    method : str or MethodSpec
+        A registered method's name or its registry entry.
+
+    Returns
+    -------
+    object
+        The kernel: an object with a ``shape`` (``"direct"``, ``"steps"``, ``"tree"``)
+        and the functions that compute the span.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, naming the registered ones.
+
     Examples
     --------
     >>> k = method_kernel("dichotomy")
@@ -75,6 +91,11 @@ def method_kernel(method: str | MethodSpec):
 def method_kernels() -> dict:
     """Every registered method's span kernel: ``{name: kernel}``.
 
+    Returns
+    -------
+    dict of str to object
+        Every registered method's name and kernel.
+
     Examples
     --------
     >>> sorted({k.shape for k in method_kernels().values()})
@@ -85,6 +106,11 @@ def method_kernels() -> dict:
 
 def table_methods() -> dict[str, TableSpec]:
     """The methods that read a coefficient table, and the table each reads.
+
+    Returns
+    -------
+    dict of str to TableSpec
+        Method name -> the table it reads (target, degree, ``psi_max``).
 
     Examples
     --------
@@ -108,6 +134,28 @@ def default_tables(psi_max: float | str | None = None,
     None meaning the registered degree (2) and ``psi_max`` (``"pi/4"``).
     Each table is fitted once per process and argument.
 
+    Parameters
+    ----------
+    psi_max : float or str, optional
+        The largest span angle the tables must cover (radians, or sympy text such as ``"pi/4"``).
+    degree : int, optional
+        The polynomial degree (default: each method's registered degree).
+
+    Returns
+    -------
+    dict of str to CoefficientTable
+        The table of each method that reads one (``dichotomy``, ``quadratic``).
+
+    Raises
+    ------
+    ValueError
+        For an invalid ``psi_max`` or ``degree`` (as :func:`chebnorm.approx.fit_target`).
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> t = default_tables()
     >>> [round(c, 5) for c in t["dichotomy"].coefficients]
     [0.68076, -0.11881, 0.01422]

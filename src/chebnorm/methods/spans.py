@@ -29,6 +29,7 @@ UNIT_TOL = 1e-5
 ANTIPARALLEL_TOL = 1e-6
 #: deepest dichotomy (steps down to 2**-MAX_LEVELS)
 MAX_LEVELS = 20
+#: the dtypes a method computes in
 DTYPES = (np.float32, np.float64)
 #: slack on a table's interval when checking that it covers the spans' range
 #: (rounding of N_l.N_r; the polynomial is smooth just outside its interval)
@@ -39,6 +40,15 @@ COVER_SLACK = 1e-9
 class SpanNormals:
     """Pixel normals of S spans: span i's pixels are ``normals[offsets[i]:offsets[i+1]]``,
     at positions ``t[offsets[i]:offsets[i+1]]`` (0 at ``N_l``, 1 at ``N_r``).
+
+    Attributes
+    ----------
+    normals : numpy.ndarray
+        Every pixel normal, shape ``(P, 3)``, in the dtype of the computation.
+    offsets : numpy.ndarray
+        ``S + 1`` increasing indices into ``normals``.
+    t : numpy.ndarray
+        Each pixel's position along its span, shape ``(P,)``.
 
     Examples
     --------
@@ -111,6 +121,26 @@ def check_method(method) -> MethodSpec:
     """The registry entry of ``method`` (a name, or an entry already looked up); an
     unknown name is the registry's ValueError naming the accepted methods.
 
+    Parameters
+    ----------
+    method : str or MethodSpec
+        A method name or registry entry.
+
+    Returns
+    -------
+    MethodSpec
+        The registry entry.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, naming the registered methods.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> check_method("exact").name
     'exact'
     """
@@ -121,6 +151,26 @@ def check_dtype(dtype):
     """The numpy scalar type of ``dtype`` if it is one of :data:`DTYPES` (float32,
     float64); ValueError naming the accepted ones otherwise.
 
+    Parameters
+    ----------
+    dtype : object
+        A numpy dtype, scalar type or name.
+
+    Returns
+    -------
+    type
+        ``numpy.float32`` or ``numpy.float64``.
+
+    Raises
+    ------
+    ValueError
+        For any other dtype, naming the accepted ones.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> check_dtype("float32")
     <class 'numpy.float32'>
     """
@@ -159,6 +209,32 @@ def resolve_table(spec, tables, cosines, levels):
     ``tables[spec.name]`` if given, else the registry's default; ValueError when it does
     not cover the end normals' cosines ``cosines``.
 
+    Parameters
+    ----------
+    spec : MethodSpec
+        The method's registry entry.
+    tables : dict or None
+        The caller's tables by method name.
+    cosines : numpy.ndarray
+        ``N_l.N_r`` per span.
+    levels : numpy.ndarray or None
+        The dichotomy depth per span.
+
+    Returns
+    -------
+    CoefficientTable or None
+        The table to use; None for exact denominators or a method without a table.
+
+    Raises
+    ------
+    ValueError
+        When the table does not cover the spans, naming the interval needed.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> import numpy as np
     >>> spec = check_method("dichotomy")
     >>> type(resolve_table(spec, None, np.array([0.9]), np.array([2]))).__name__
@@ -214,6 +290,25 @@ def span_levels(dt, t0=None, count=None, cos=None) -> np.ndarray:
     (a one-pixel span between normals 34 degrees apart would otherwise be short by
     ``1 - cos(17 deg) = 4.4 %``, as bad as no normalization).
 
+    Parameters
+    ----------
+    dt : numpy.ndarray
+        The step per span.
+    t0, count : numpy.ndarray, optional
+        The first position and number of pixels per span.
+    cos : numpy.ndarray, optional
+        ``N_l.N_r`` per span.
+
+    Returns
+    -------
+    numpy.ndarray
+        The depth ``L`` per span (int).
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> span_levels([0.25, 0.1]).tolist()      # ceil(log2(1/dt))
     [2, 4]
     """
@@ -276,6 +371,42 @@ def span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=None, ta
     antiparallel end normals (``1 + cos psi <= 1e-6``); ``m < 1``; ``count < 1``;
     ``dt <= 0``; pixels outside ``[0, 1]``; tables not covering the angles.
 
+    Parameters
+    ----------
+    method : str
+        A registered method (:func:`~chebnorm.methods.method_names`).
+    n_left, n_right : array_like
+        Unit end normals, shape ``(S, 3)``.
+    m : array_like
+        Span lengths, shape ``(S,)`` (``m >= 1``).
+    t0 : array_like, optional
+        First pixel position per span (default 0).
+    dt : array_like, optional
+        Step per span (default ``1/m``).
+    count : array_like, optional
+        Pixels per span (default ``m + 1``, both ends included).
+    tables : dict, optional
+        Coefficient tables by method name (see Tables above).
+    dtype : numpy dtype, optional
+        float32 or float64.
+    angular_reanchor : int, optional
+        Restart the angular recurrence every this many pixels.
+
+    Returns
+    -------
+    SpanNormals
+        The pixel normals, their offsets per span and positions.
+
+    Raises
+    ------
+    ValueError
+        See above.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> import numpy as np
     >>> nl = np.array([[1.0, 0.0, 0.0]]); nr = np.array([[0.0, 1.0, 0.0]])
     >>> out = span_normals("none", nl, nr, [2])
@@ -328,6 +459,25 @@ class SpanInput:
     their ``cosines``, per-span ``m``, ``dt``, ``t0``, ``count``, the dichotomy depth
     ``levels`` (None for the other kernels) and the table's ``coefficients`` (None: exact).
 
+    Attributes
+    ----------
+    spec : MethodSpec
+        The method's registry entry.
+    kernel : object
+        Its span kernel.
+    dtype : type
+        ``numpy.float32`` or ``numpy.float64``.
+    n_left, n_right : numpy.ndarray
+        The unit end normals, float64, shape ``(S, 3)``.
+    cosines : numpy.ndarray
+        ``N_l.N_r`` per span, shape ``(S,)``.
+    m, dt, t0, count : numpy.ndarray
+        Per span: length, step, first position, number of pixels.
+    levels : numpy.ndarray or None
+        The dichotomy depth per span (None for the other kernels).
+    coefficients : tuple or None
+        The table's coefficients (None: exact denominators).
+
     Examples
     --------
     >>> inp = check_span_input("quadratic", [[1.0, 0, 0]], [[0.8, 0.6, 0]], [4])
@@ -354,6 +504,26 @@ def check_span_input(method, n_left, n_right, m, *, t0=None, dt=None, count=None
     """Every check :func:`span_normals` makes, and the values it derives before computing
     (same arguments, same errors).
 
+    Parameters
+    ----------
+    method, n_left, n_right, m, t0, dt, count, tables, dtype
+        As in :func:`span_normals`.
+
+    Returns
+    -------
+    SpanInput
+        The checked and derived values.
+
+    Raises
+    ------
+    ValueError
+        As :func:`span_normals`.
+
+    Examples
+    --------
+
+    Examples
+    --------
     >>> inp = check_span_input("dichotomy", [[1.0, 0, 0]], [[0.8, 0.6, 0]], [4])
     >>> inp.levels.tolist(), inp.count.tolist()
     ([2], [5])

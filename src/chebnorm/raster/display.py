@@ -35,6 +35,18 @@ def png_data_uri(array) -> str:
     """A ``data:image/png;base64,...`` URI of a uint8 ``(H, W)`` or
     ``(H, W, 3)`` image.
 
+    Parameters
+    ----------
+    array : numpy.ndarray
+        uint8 image, ``(H, W)`` or ``(H, W, 3)``.
+
+    Returns
+    -------
+    str
+        The PNG encoded as a data URI, for an ``<img src=...>``.
+
+    Examples
+    --------
     >>> png_data_uri(np.zeros((2, 2), dtype=np.uint8)).startswith("data:image/png;base64,")
     True
     """
@@ -76,6 +88,18 @@ def render_html(result: ImageFrame) -> str:
     """The HTML shown for a :class:`RenderResult`: image, length-error map
     (when the mode has pixel normals) and the render's numbers.
 
+    Parameters
+    ----------
+    result : RenderResult
+        The frame.
+
+    Returns
+    -------
+    str
+        HTML with the images inlined as data URIs (no file, no network).
+
+    Examples
+    --------
     >>> from chebnorm.raster import render
     >>> "length error" in render_html(render("sphere", "phong", "newton", size=(16, 16), tess=6))
     True
@@ -102,6 +126,15 @@ class RenderComparison:
     largest error) and the :class:`ImageMetrics` of :func:`compare`.
 
     ``flip``: compute the FLIP metric too (slower). See the module example.
+
+    Parameters
+    ----------
+    test : RenderResult or ImageFrame
+        The frame judged.
+    reference : RenderResult or ImageFrame
+        The frame it is compared with (same size).
+    flip : bool, optional
+        Compute the FLIP metric too (slower).
     """
 
     test: ImageFrame

@@ -34,6 +34,7 @@ __all__ = [
     "teapot", "load_mesh", "crease_normals", "unit",
 ]
 
+#: the generated meshes :func:`get_mesh` knows by name
 MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")
 
 #: a triangle whose area is below AREA_RTOL * (bounding-box diagonal)^2 is degenerate
@@ -50,6 +51,28 @@ class Mesh:
     Construction validates everything and raises ``ValueError`` naming the
     first bad value.
 
+    Parameters
+    ----------
+    name : str
+        The mesh's name (a generator's or the file's).
+    positions : numpy.ndarray
+        Vertex positions, float64 ``(V, 3)``.
+    normals : numpy.ndarray
+        Unit vertex normals, float64 ``(V, 3)``.
+    faces : numpy.ndarray
+        Vertex indices of the triangles, int64 ``(F, 3)``.
+    uv : numpy.ndarray, optional
+        Surface parameters ``(V, 2)`` (bump mapping needs them).
+    P_u, P_v : numpy.ndarray, optional
+        Surface partial derivatives ``(V, 3)``.
+
+    Raises
+    ------
+    ValueError
+        Naming the first bad value (shape, dtype, non-finite, non-unit normal, index out of range).
+
+    Examples
+    --------
     >>> import numpy as np
     >>> m = Mesh("tri", np.eye(3), np.tile([0.0, 0.0, 1.0], (3, 1)), np.array([[0, 1, 2]]))
     >>> m.faces.shape, m.has_parametrization
@@ -147,6 +170,18 @@ def unit(v):
     """``v / |v|`` along the last axis (``np.linalg.norm``: its summation order is part
     of the renderer's reference bytes).
 
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Vectors ``(..., 3)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The unit vectors (``v`` divided by its norm: NaN where ``v`` is zero).
+
+    Examples
+    --------
     >>> unit(np.array([3.0, 4.0])).tolist()
     [0.6, 0.8]
     """
@@ -199,6 +234,23 @@ def uv_sphere(tess: int = 16) -> Mesh:
     ``2 (2 tess) tess`` grid triangles less the ``2 (2 tess)`` of zero area at
     the poles:
 
+    Parameters
+    ----------
+    tess : int, optional
+        Tessellation: rings (``2 tess`` segments) (default 16).
+
+    Returns
+    -------
+    Mesh
+        The mesh with its ``uv``, ``P_u`` and ``P_v``.
+
+    Raises
+    ------
+    ValueError
+        For ``tess`` out of range.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> s = uv_sphere(4)
     >>> len(s.positions), len(s.faces)
@@ -232,6 +284,23 @@ def icosphere(tess: int = 3) -> Mesh:
     ``20 * 4**tess`` faces and, by Euler's formula, ``10 * 4**tess + 2``
     vertices:
 
+    Parameters
+    ----------
+    tess : int, optional
+        Tessellation: subdivisions, 0..7 (default 3).
+
+    Returns
+    -------
+    Mesh
+        The mesh.
+
+    Raises
+    ------
+    ValueError
+        For ``tess`` out of range.
+
+    Examples
+    --------
     >>> m = icosphere(2)
     >>> len(m.faces), len(m.positions)
     (320, 162)
@@ -251,6 +320,27 @@ def torus(tess: int = 16, R: float = 1.0, r: float = 0.4) -> Mesh:
 
     The normal is ``P_u x P_v`` normalized (seed 001):
 
+    Parameters
+    ----------
+    tess : int, optional
+        Segments around the tube (``2 tess`` around the axis).
+    R : float, optional
+        Distance from the axis to the tube's centre.
+    r : float, optional
+        The tube's radius, ``0 < r < R``.
+
+    Returns
+    -------
+    Mesh
+        The torus with ``uv``, ``P_u`` and ``P_v``.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> t = torus(4)
     >>> len(t.faces)
@@ -278,6 +368,23 @@ def square(tess: int = 8) -> Mesh:
     """Flat square ``[-1, 1]^2`` in the plane z = 0, normal +z, ``tess x tess``
     cells; ``P_u = (2, 0, 0)``, ``P_v = (0, 2, 0)``: a square patch, k = 2.
 
+    Parameters
+    ----------
+    tess : int, optional
+        Tessellation: cells per side (default 8).
+
+    Returns
+    -------
+    Mesh
+        The mesh with its ``uv``, ``P_u`` and ``P_v``.
+
+    Raises
+    ------
+    ValueError
+        For ``tess`` out of range.
+
+    Examples
+    --------
     >>> s = square(2)
     >>> len(s.positions), len(s.faces), s.P_u[0].tolist()
     (9, 8, [2.0, 0.0, 0.0])
@@ -329,6 +436,23 @@ def teapot(tess: int = 20) -> Mesh:
     are not welded; ``uv`` is the patch parameter (each patch spans [0,1]^2),
     with ``u`` and ``v`` of the data swapped so that ``P_u x P_v`` is outward.
 
+    Parameters
+    ----------
+    tess : int, optional
+        Tessellation: grid size per patch (default 20).
+
+    Returns
+    -------
+    Mesh
+        The mesh with its ``uv``, ``P_u`` and ``P_v``.
+
+    Raises
+    ------
+    ValueError
+        For ``tess`` out of range.
+
+    Examples
+    --------
     >>> t = teapot(4)
     >>> t.has_parametrization, round(float(t.positions[:, 2].max() - t.positions[:, 2].min()), 2)
     (True, 3.15)
@@ -383,6 +507,22 @@ def crease_normals(positions, faces, crease_angle: float = np.radians(30.0)):
     vertices, one per face, each with its face's normal; with a crease angle
     above 90 degrees nothing splits:
 
+    Parameters
+    ----------
+    positions : numpy.ndarray
+        Vertex positions ``(V, 3)``.
+    faces : numpy.ndarray
+        Triangles ``(F, 3)``.
+    crease_angle : float, optional
+        Faces meeting at a larger angle (radians) keep separate normals; default 30 degrees.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(positions, normals, faces)`` with split vertices.
+
+    Examples
+    --------
     >>> import numpy as np, trimesh
     >>> box = trimesh.creation.box()
     >>> pos, nrm, faces = crease_normals(box.vertices, box.faces)
@@ -521,6 +661,25 @@ def load_mesh(path, crease_angle: float | None = None) -> Mesh:
     that is not finite (naming it: trimesh would silently drop its
     triangles), a zero normal, and degenerate triangles.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An ``.obj``, ``.ply`` or ``.stl`` file.
+    crease_angle : float, optional
+        Crease angle in radians (see above).
+
+    Returns
+    -------
+    Mesh
+        The mesh, without ``uv``, ``P_u``, ``P_v``.
+
+    Raises
+    ------
+    ValueError
+        See above.
+
+    Examples
+    --------
     >>> import tempfile, os
     >>> p = os.path.join(tempfile.mkdtemp(), "tri.obj")
     >>> _ = open(p, "w").write("v 0 0 0\\nv 1 0 0\\nv 0 1 0\\nvn 0 0 2\\nf 1//1 2//1 3//1\\n")
@@ -566,6 +725,27 @@ def get_mesh(name_or_path, tess: int | None = None, crease_angle: float | None =
     radians). Generated meshes have exact normals: a ``crease_angle`` for one
     is refused.
 
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike or Mesh
+        A generator's name, a mesh file, or a Mesh (returned as is).
+    tess : int, optional
+        Tessellation level of a generated mesh.
+    crease_angle : float, optional
+        Crease angle (radians) for a file's normals.
+
+    Returns
+    -------
+    Mesh
+        The mesh.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, an unreadable file, or an option that does not apply.
+
+    Examples
+    --------
     >>> get_mesh("sphere", 6).name, len(get_mesh("icosphere", 1).faces)
     ('sphere', 80)
     """

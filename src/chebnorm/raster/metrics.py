@@ -30,7 +30,25 @@ class ImageMetrics:
     covered pixels (see the module docstring): largest and mean absolute
     difference in levels, pixels off by one level or more, PSNR (``None``
     when identical), SSIM, mean FLIP (``None`` when not computed:
-    ``compare(..., flip=False)``), and the number of covered pixels."""
+    ``compare(..., flip=False)``), and the number of covered pixels.
+
+    Attributes
+    ----------
+    max_abs_8bit : int
+        Largest absolute difference in 8-bit levels.
+    pixels_off_1 : int
+        Covered pixels that differ by one level or more.
+    mean_abs_8bit : float
+        Mean absolute difference in levels.
+    psnr : float or None
+        Peak signal-to-noise ratio in dB (None when the images are identical).
+    ssim : float
+        Structural similarity (1 for identical images).
+    flip : float or None
+        Mean FLIP error (None when not computed).
+    pixels : int
+        Covered pixels (either frame's mask).
+    """
 
     max_abs_8bit: int
     pixels_off_1: int
@@ -64,6 +82,18 @@ def to_8bit(image) -> np.ndarray:
     """Intensities in ``[0, 1]`` to 8-bit levels, ``round(255 I)`` after
     clipping.
 
+    Parameters
+    ----------
+    image : numpy.ndarray
+        Intensities (float; clipped to ``[0, 1]``).
+
+    Returns
+    -------
+    numpy.ndarray
+        uint8 levels.
+
+    Examples
+    --------
     >>> to_8bit([-0.5, 0.0, 0.5, 1.0, 2.0]).tolist()
     [0, 0, 128, 255, 255]
     """
@@ -88,6 +118,29 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
     ``[0, 1]`` / uint8) and the signed difference ``test - reference`` in
     8-bit levels, shape ``(H, W)``.
 
+    Parameters
+    ----------
+    test : RenderResult or numpy.ndarray
+        The frame judged: a render, or an image in ``[0, 1]`` or uint8.
+    reference : RenderResult or numpy.ndarray
+        The frame compared with, of the same size.
+    flip : bool, optional
+        Compute the FLIP metric (slower).
+
+    Returns
+    -------
+    metrics : ImageMetrics
+        The error figures.
+    diff : numpy.ndarray
+        ``test - reference`` in 8-bit levels, int, shape ``(H, W)``.
+
+    Raises
+    ------
+    ValueError
+        For images of different sizes or values out of range.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> m, d = compare(np.zeros((8, 8)), np.zeros((8, 8)), flip=False)
     >>> m.max_abs_8bit, m.psnr, m.flip
@@ -129,6 +182,20 @@ def error_map_rgb(diff, scale: float | None = None) -> np.ndarray:
     red and yellow to white at ``scale`` levels (default: the largest error,
     at least 1).
 
+    Parameters
+    ----------
+    diff : numpy.ndarray
+        Differences in 8-bit levels, ``(H, W)``.
+    scale : float, optional
+        The level shown white.
+
+    Returns
+    -------
+    numpy.ndarray
+        uint8 RGB image ``(H, W, 3)``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> error_map_rgb(np.array([[0, -1, 2, 3, 9]]), scale=3).tolist()
     [[[0, 0, 0], [255, 0, 0], [255, 255, 0], [255, 255, 255], [255, 255, 255]]]
@@ -154,6 +221,25 @@ def image_bytes(array, fmt: str = "PNG") -> bytes:
     """Encode a uint8 image ``(H, W)`` or ``(H, W, 3)`` in ``fmt`` (a value of
     :data:`IMAGE_FORMATS`); JPEG at quality :data:`JPEG_QUALITY`.
 
+    Parameters
+    ----------
+    array : numpy.ndarray
+        uint8 image ``(H, W)`` or ``(H, W, 3)``.
+    fmt : str, optional
+        The format name.
+
+    Returns
+    -------
+    bytes
+        The encoded file.
+
+    Raises
+    ------
+    ValueError
+        For an unknown format or an image that is not uint8 of those shapes.
+
+    Examples
+    --------
     >>> image_bytes(np.zeros((2, 2), np.uint8))[:4]
     b'\\x89PNG'
     """
@@ -177,6 +263,23 @@ def image_format(path) -> str:
     """The image format a file name asks for, from its extension; refuses an
     extension outside :data:`IMAGE_FORMATS` (naming the accepted set).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file name.
+
+    Returns
+    -------
+    str
+        The format name (``"PNG"``, ``"JPEG"``, ...).
+
+    Raises
+    ------
+    ValueError
+        For an extension outside :data:`IMAGE_FORMATS`.
+
+    Examples
+    --------
     >>> image_format("out.JPG")
     'JPEG'
     """
@@ -190,7 +293,22 @@ def image_format(path) -> str:
 def write_image(path, array) -> None:
     """Write a uint8 image ``(H, W)`` or ``(H, W, 3)`` in the format its
     extension names (:data:`IMAGE_FORMATS`), atomically and with mode 0644
-    (:func:`chebnorm.core.files.write_atomic`)."""
+    (:func:`chebnorm.core.files.write_atomic`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination; its extension names the format.
+    array : numpy.ndarray
+        uint8 image ``(H, W)`` or ``(H, W, 3)``.
+
+    Raises
+    ------
+    ValueError
+        For an extension that is not accepted, or a bad image.
+    chebnorm.core.files.WriteError
+        When the file cannot be written.
+    """
     from chebnorm.core.files import write_atomic
 
     data = image_bytes(array, image_format(path))
@@ -199,7 +317,22 @@ def write_image(path, array) -> None:
 
 def write_png(path, array) -> None:
     """:func:`write_image` for a ``.png`` path (refuses any other extension,
-    so a PNG never hides behind another name)."""
+    so a PNG never hides behind another name).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination; its extension names the format.
+    array : numpy.ndarray
+        uint8 image ``(H, W)`` or ``(H, W, 3)``.
+
+    Raises
+    ------
+    ValueError
+        For an extension that is not accepted, or a bad image.
+    chebnorm.core.files.WriteError
+        When the file cannot be written.
+    """
     if image_format(path) != "PNG":
         raise ValueError(f"write_png writes PNG; {os.fspath(path)!r} names another format "
                          "(use write_image)")

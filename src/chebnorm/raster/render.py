@@ -42,19 +42,34 @@ __all__ = [
     "available_methods", "get_span_normals", "to_8bit", "check_options",
 ]
 
+#: the shading modes of :func:`render`
 SHADING_MODES = ("gouraud", "phong", "adaptive", "split-gouraud", "bump")
+#: the bump-mapping variants of ``render(..., shading="bump", bump=...)``
 BUMP_VARIANTS = ("full", "square", "object")
 
 
 # ------------------------------------------------------------------ methods
 def get_span_normals():
-    """The default span interpolator, :func:`chebnorm.methods.span_normals`."""
+    """The default span interpolator, :func:`chebnorm.methods.span_normals`.
+
+    Returns
+    -------
+    callable
+        :func:`chebnorm.methods.span_normals` (imported on first use).
+    """
     return _span_normals
 
 
 def available_methods() -> tuple[str, ...]:
     """The normalization methods ``render`` accepts: every registered method.
 
+    Returns
+    -------
+    tuple of str
+        The registered methods' names.
+
+    Examples
+    --------
     >>> {"exact", "none", "dichotomy"} <= set(available_methods())
     True
     """
@@ -67,7 +82,21 @@ class Lighting:
     """Blinn-Phong parameters (docs/papers.md): ``I0, k_a, k_d, k_s``, shininess
     ``n``, unit direction ``light`` *toward* the light (world; default: up and
     to the right of the camera), and where ``H`` is computed: ``"pixel"`` or
-    ``"triangle"`` (one ``H`` per triangle, at its centroid, as in seed 002)."""
+    ``"triangle"`` (one ``H`` per triangle, at its centroid, as in seed 002).
+
+    Attributes
+    ----------
+    I0 : float
+        Light intensity.
+    ka, kd, ks : float
+        Ambient, diffuse and specular coefficients.
+    shininess : float
+        The specular exponent ``n``.
+    light : tuple of 3 float, optional
+        Unit direction toward the light (world); None: up and to the right of the camera.
+    half_vector : str
+        ``"pixel"`` or ``"triangle"``.
+    """
 
     I0: float = 1.0
     ka: float = 0.1
@@ -106,7 +135,15 @@ class Lighting:
 @dataclass(frozen=True)
 class HeightMap:
     """Procedural height map ``F(u, v) = A sin(2 pi f_u u) sin(2 pi f_v v)``
-    with exact ``F_u, F_v`` (seed 001: the height map gives F_u, F_v)."""
+    with exact ``F_u, F_v`` (seed 001: the height map gives F_u, F_v).
+
+    Attributes
+    ----------
+    amplitude : float
+        ``A``, the height's amplitude.
+    frequency : tuple of (int, int)
+        ``(f_u, f_v)``, periods over the parameter square.
+    """
 
     amplitude: float = 0.01
     frequency: tuple = (8, 8)
@@ -123,7 +160,33 @@ class HeightMap:
 class RenderResult(ImageFrame):
     """A rendered frame: ``image (H, W)`` intensities in ``[0, 1]``
     (background 0), ``mask`` of covered pixels, and what the mode reports in
-    ``stats`` (a flat dict of numbers)."""
+    ``stats`` (a flat dict of numbers).
+
+    Attributes
+    ----------
+    image : numpy.ndarray
+        Intensities ``(H, W)`` in ``[0, 1]``.
+    mask : numpy.ndarray
+        Covered pixels, bool ``(H, W)``.
+    mesh : str
+        The mesh's name.
+    shading : str
+        The shading mode.
+    method : str or None
+        The normalization method (None where the mode has none).
+    seconds : float
+        Wall time of the render.
+    triangles : int
+        Triangles rendered.
+    fragments : int
+        Fragments shaded.
+    stats : dict
+        What the mode reports (a flat dict of numbers).
+    triangle : numpy.ndarray, optional
+        Index of the visible triangle per pixel, -1 on background.
+    normal_length : numpy.ndarray, optional
+        ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background.
+    """
 
     image: np.ndarray
     mask: np.ndarray
@@ -206,6 +269,56 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     :mod:`chebnorm.raster.engines.numba`; the same image bytes) or ``"auto"`` (numba
     when installed).
 
+    Parameters
+    ----------
+    mesh : Mesh or str or os.PathLike, optional
+        The mesh: a Mesh, a generator's name or a mesh file.
+    shading : str, optional
+        One of :data:`SHADING_MODES`.
+    method : str or None, optional
+        The normalization method (see above).
+    size : tuple of (int, int), optional
+        ``(width, height)`` in pixels.
+    tess : int, optional
+        Tessellation of a generated mesh.
+    lighting : Lighting, optional
+        Blinn-Phong parameters.
+    camera : Camera, optional
+        The view (default: fitted to the mesh).
+    tables : dict, optional
+        Coefficient tables by method name.
+    dtype : numpy dtype, optional
+        float32 or float64, the arithmetic of the span interpolator.
+    eta_threshold : float, optional
+        ``adaptive``'s threshold on ``eta``.
+    q : float, optional
+        ``split-gouraud``'s threshold.
+    bump : str, optional
+        The bump variant.
+    height_map : HeightMap, optional
+        The height map of ``bump``.
+    k : float, optional
+        The common length of ``P_u``, ``P_v`` for ``bump="square"`` (default: the median of ``sqrt|P_u x P_v|`` over the vertices).
+    cull : bool, optional
+        Drop back-facing triangles.
+    span_normals : callable, optional
+        A replacement span interpolator.
+    engine : str, optional
+        ``"numpy"``, ``"numba"`` or ``"auto"``.
+
+    Returns
+    -------
+    RenderResult
+        The frame, its mask, counts, timing and the mode's statistics.
+
+    Raises
+    ------
+    ValueError
+        For an unknown mesh, mode, method, engine or option, a size out of range,
+        or tables that do not cover the spans.
+
+    Examples
+    --------
     >>> r = render("sphere", "phong", "exact", size=(32, 32), tess=8)
     >>> r.image.shape, r.pixels > 300
     ((32, 32), True)
@@ -274,6 +387,19 @@ def check_options(shading, bump, eta_threshold, q):
     ValueError
         Naming the option and the accepted values.
 
+    Parameters
+    ----------
+    shading : str
+        The shading mode.
+    bump : str
+        The bump variant: ``full``, ``square`` or ``object``.
+    eta_threshold : float
+        ``adaptive``'s threshold.
+    q : float
+        ``split-gouraud``'s threshold.
+
+    Examples
+    --------
     >>> check_options("phong", "full", 0.005, 1 / 255)
     """
     if shading == "bump" and bump not in BUMP_VARIANTS:

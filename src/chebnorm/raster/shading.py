@@ -68,7 +68,32 @@ def interpolated_normals(engine, sp, cols, method, interp, tables, dtype, sel=No
     """Pixel normals of the spans ``sel`` (all if None), in fragment order: the normal
     columns ``cols`` interpolated by ``method`` (``none``: the engine's plain linear
     interpolation), ``interp`` the span interpolator (signature of
-    :func:`chebnorm.methods.span_normals`)."""
+    :func:`chebnorm.methods.span_normals`).
+
+    Parameters
+    ----------
+    engine : module
+        The engine (numpy or numba) whose interpolation is used.
+    sp : Spans
+        The frame's spans.
+    cols : slice or sequence of int
+        The attribute columns holding the normal.
+    method : str
+        The normalization method (``none``: linear interpolation).
+    interp : callable
+        The span interpolator.
+    tables : dict or None
+        Coefficient tables by method name.
+    dtype : numpy dtype
+        The interpolator's arithmetic.
+    sel : numpy.ndarray, optional
+        The spans to interpolate (default: all).
+
+    Returns
+    -------
+    numpy.ndarray
+        The pixel normals ``(P, 3)`` in fragment order.
+    """
     idx = np.arange(len(sp.count)) if sel is None else np.flatnonzero(sel)
     if len(idx) == 0:
         return np.zeros((0, 3))

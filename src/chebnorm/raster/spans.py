@@ -37,7 +37,19 @@ __all__ = ["Camera", "default_camera", "fit_camera", "project", "Spans", "setup_
 @dataclass(frozen=True)
 class Camera:
     """A pinhole camera: ``eye``, ``target``, ``up`` (world), vertical field
-    of view ``fov_y`` (radians)."""
+    of view ``fov_y`` (radians).
+
+    Attributes
+    ----------
+    eye : tuple of 3 float
+        The camera's position (world).
+    target : tuple of 3 float
+        The point looked at.
+    up : tuple of 3 float
+        The up direction.
+    fov_y : float
+        Vertical field of view (radians).
+    """
 
     eye: tuple
     target: tuple
@@ -61,6 +73,24 @@ def default_camera(center, radius, direction=(2.0, -3.0, 1.8), fov_y=np.radians(
     """A camera looking at ``center`` from ``direction``, far enough for the
     bounding sphere ``radius`` to fill about 90 % of the view height.
 
+    Parameters
+    ----------
+    center : array_like
+        The point looked at.
+    radius : float
+        The bounding sphere's radius.
+    direction : array_like, optional
+        From the centre toward the eye.
+    fov_y : float, optional
+        Vertical field of view (radians).
+
+    Returns
+    -------
+    Camera
+        The camera.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
     >>> bool(np.isclose(np.linalg.norm(cam.eye), 1 / np.sin(np.radians(15)) / 0.9))
@@ -78,6 +108,26 @@ def fit_camera(points, width: int, height: int, direction=(2.0, -3.0, 1.8),
     """:func:`default_camera` re-aimed and zoomed so that the projected
     ``points`` are centred and fill ``fill`` of the tighter image dimension.
 
+    Parameters
+    ----------
+    points : numpy.ndarray
+        World points ``(N, 3)`` to frame.
+    width, height : int
+        The image size in pixels.
+    direction : array_like, optional
+        From the points toward the eye.
+    fov_y : float, optional
+        Vertical field of view (radians).
+    fill : float, optional
+        The fraction of the tighter image dimension the points fill.
+
+    Returns
+    -------
+    Camera
+        The camera.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> pts = np.array([[-1.0, -1, -1], [1, 1, 1]])
     >>> xy, _ = project(fit_camera(pts, 64, 48), pts, 64, 48)
@@ -107,6 +157,29 @@ def project(camera: Camera, points, width: int, height: int):
 
     The target lands on the image centre, at ``1/w = 1/|eye - target|``:
 
+    Parameters
+    ----------
+    camera : Camera
+        The view.
+    points : numpy.ndarray
+        World points ``(..., 3)``.
+    width, height : int
+        The image size in pixels.
+
+    Returns
+    -------
+    xy : numpy.ndarray
+        Screen coordinates ``(..., 2)`` in pixels.
+    inv_w : numpy.ndarray
+        ``1/w`` per point.
+
+    Raises
+    ------
+    ValueError
+        If a point is not in front of the camera.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
     >>> xy, inv_w = project(cam, [[0.0, 0.0, 0.0]], 100, 100)
@@ -139,6 +212,19 @@ class Spans:
 
     Fragment arrays (one entry per covered pixel of each span, in span order):
     ``frag_span``, ``frag_pixel`` (``row * width + col``), ``frag_t``.
+
+    Attributes
+    ----------
+    tri, row, x0, count, m : numpy.ndarray
+        Per span: triangle index, pixel row, first pixel column, pixel count, span length.
+    t0, dt : numpy.ndarray
+        Per span: the first pixel's position and the step along the span.
+    left, right : numpy.ndarray
+        The attributes at the span ends ``(S, K)``.
+    offsets : numpy.ndarray
+        ``(S + 1,)`` indices into the fragment arrays.
+    frag_span, frag_pixel, frag_t : numpy.ndarray
+        Per fragment: its span, its pixel index ``row * width + col`` and its position.
     """
 
     tri: np.ndarray
@@ -178,6 +264,22 @@ def setup_spans(xy, attrs, width: int, height: int) -> Spans:
     rows 0..7, row ``r`` covering the ``8 - r`` centres left of the
     hypotenuse ``x + y = 9`` (half-open ranges), 36 pixels in all:
 
+    Parameters
+    ----------
+    xy : numpy.ndarray
+        Screen corners ``(T, 3, 2)``.
+    attrs : numpy.ndarray
+        Corner attributes ``(T, 3, K)``.
+    width, height : int
+        The image size in pixels.
+
+    Returns
+    -------
+    Spans
+        The spans and their fragments (pixel centres inside, half-open ranges).
+
+    Examples
+    --------
     >>> import numpy as np
     >>> sp = setup_spans(np.array([[[0.5, 0.5], [8.5, 0.5], [0.5, 8.5]]]), np.zeros((1, 3, 1)), 16, 16)
     >>> sp.count.tolist(), sp.n_fragments
@@ -244,6 +346,22 @@ def zbuffer(pixel, inv_w, n_pixels: int):
     """Indices of the visible fragments (largest ``1/w`` per pixel, ties to
     the earliest fragment), sorted by pixel.
 
+    Parameters
+    ----------
+    pixel : numpy.ndarray
+        Pixel index per fragment.
+    inv_w : numpy.ndarray
+        ``1/w`` per fragment (larger is nearer).
+    n_pixels : int
+        The number of pixels of the image.
+
+    Returns
+    -------
+    numpy.ndarray
+        Indices of the visible fragments, sorted by pixel.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> zbuffer(np.array([3, 1, 3]), np.array([0.5, 0.2, 0.9]), 4).tolist()
     [1, 2]

@@ -40,7 +40,21 @@ __all__ = ["EtaLevel", "eta_study", "split_gouraud_study", "SplitGouraudStudy", 
 class EtaLevel:
     """One tessellation level of :func:`eta_study`: the metrics of
     ``phong:none`` against ``phong:exact``, and per visible triangle its eta
-    and its worst relative diffuse error (eta bounds it: ``bound_holds``)."""
+    and its worst relative diffuse error (eta bounds it: ``bound_holds``).
+
+    Attributes
+    ----------
+    tess : int
+        The tessellation level.
+    triangles : int
+        Triangles rendered.
+    metrics : dict
+        :class:`~chebnorm.raster.ImageMetrics` (as a dict) of ``phong:none`` against ``phong:exact``.
+    eta : numpy.ndarray
+        ``eta`` per visible triangle.
+    worst_rel_diffuse : numpy.ndarray
+        The worst relative diffuse error ``1 - |N|`` per visible triangle.
+    """
 
     tess: int
     triangles: int
@@ -77,6 +91,24 @@ def eta_study(tess_levels=(4, 6, 8, 12, 16, 24), size=(128, 128), mesh="sphere",
     worst value over the triangle's pixels is compared with the triangle's
     ``eta`` (docs/papers.md: eta sums the three edge bounds).
 
+    Parameters
+    ----------
+    tess_levels : sequence of int, optional
+        Tessellation levels.
+    size : tuple of (int, int), optional
+        The image size.
+    mesh : str, optional
+        A generated mesh.
+    lighting : Lighting, optional
+        Blinn-Phong parameters.
+
+    Returns
+    -------
+    list of EtaLevel
+        One entry per level, in order.
+
+    Examples
+    --------
     >>> level = eta_study((4,), size=(48, 48))[0]
     >>> level.tess, level.bound_holds, level.tightness <= 1.0
     (4, True, True)
@@ -105,7 +137,23 @@ class SplitGouraudStudy:
     """Seed 002 (claim C11): plain and split Gouraud against a Phong
     reference on one mesh; ``gouraud`` and ``split_gouraud`` hold each one's
     :class:`ImageMetrics` as a dict, ``split_stats`` the extra vertices
-    shaded."""
+    shaded.
+
+    Attributes
+    ----------
+    mesh : str
+        The mesh's name.
+    tess : int
+        Its tessellation.
+    shininess : float
+        The specular exponent.
+    gouraud, split_gouraud : dict
+        Each mode's metrics against Phong ``exact``.
+    split_stats : dict
+        The vertices added by splitting (counts and fraction).
+    images : dict
+        The renders and their error maps.
+    """
 
     mesh: str
     tess: int
@@ -133,6 +181,28 @@ def split_gouraud_study(tess: int = 6, shininess: float = 64.0, size=(256, 256),
     """Seed 002 (C11): plain and split Gouraud against Phong ``exact`` on a
     coarse sphere whose highlight falls inside triangles.
 
+    Parameters
+    ----------
+    tess : int, optional
+        Tessellation of the mesh.
+    shininess : float, optional
+        The specular exponent.
+    size : tuple of (int, int), optional
+        The image size.
+    q : float, optional
+        The split threshold on ``I0 k_s (max H.N)^n``.
+    mesh : str, optional
+        A generated mesh.
+    half_vector : str, optional
+        ``"pixel"`` or ``"triangle"``.
+
+    Returns
+    -------
+    SplitGouraudStudy
+        The metrics of both modes and the split statistics.
+
+    Examples
+    --------
     >>> s = split_gouraud_study(tess=6, size=(64, 64))
     >>> s.closer_to_phong, s.split_stats["extra_vertices"] > 0
     (True, True)
@@ -154,7 +224,21 @@ def split_gouraud_study(tess: int = 6, shininess: float = 64.0, size=(256, 256),
 class BumpCase:
     """Square-patch (and object-space) against full coefficients on one mesh
     (:func:`bump_comparison`): ``k`` is the patch size used, the two dicts
-    hold :class:`ImageMetrics` against the full-coefficient render."""
+    hold :class:`ImageMetrics` against the full-coefficient render.
+
+    Attributes
+    ----------
+    mesh : str
+        The mesh's name.
+    k : float
+        The square-patch length used.
+    square_vs_full, object_vs_full : dict
+        :class:`~chebnorm.raster.ImageMetrics` (as dicts) of the square-patch and the
+        object-space renders against the full-coefficient render.
+    images : dict
+        The renders (``full``, ``square``, ``object``, uint8) and the signed 8-bit
+        differences (``square_error``, ``object_error``).
+    """
 
     mesh: str
     k: float
@@ -178,6 +262,26 @@ def bump_comparison(meshes=("square", "sphere", "torus"), size=(256, 256), tess=
 
     On the flat square (``k = 2``) the simplification is exact (claim C12):
 
+    Parameters
+    ----------
+    meshes : sequence of str, optional
+        Generated meshes with a parametrization.
+    size : tuple of (int, int), optional
+        The image size.
+    tess : int, optional
+        Tessellation level (default: each generator's).
+    height_map : HeightMap, optional
+        The height map (default :class:`~chebnorm.raster.render.HeightMap` ``()``).
+    lighting : Lighting, optional
+        Blinn-Phong parameters.
+
+    Returns
+    -------
+    list of BumpCase
+        One case per mesh, in order.
+
+    Examples
+    --------
     >>> case = bump_comparison(("square",), size=(32, 32))[0]
     >>> case.k, case.square_vs_full["max_abs_8bit"]
     (2.0, 0)
@@ -202,6 +306,20 @@ def write_bump_figures(cases, directory) -> list[str]:
     error maps ``bump_<mesh>_square_error.png``, ``..._object_error.png``
     (heat maps on a common scale); returns the paths.
 
+    Parameters
+    ----------
+    cases : sequence of BumpCase
+        From :func:`bump_comparison`.
+    directory : str or os.PathLike
+        The folder (created if missing).
+
+    Returns
+    -------
+    list of str
+        The paths written, in order.
+
+    Examples
+    --------
     >>> import os, tempfile
     >>> cases = bump_comparison(("square",), size=(16, 16))
     >>> with tempfile.TemporaryDirectory() as d:
@@ -244,7 +362,27 @@ class RenderCase:
     its tessellation (None: the generator's default; always None for a file),
     the image size, the shininess, the shading mode, the normalization method
     (None for ``gouraud`` and ``split-gouraud``, which have none), the bump
-    variant (None unless ``bump``) and the reference ``(mode, method, variant)``."""
+    variant (None unless ``bump``) and the reference ``(mode, method, variant)``.
+
+    Attributes
+    ----------
+    mesh : str
+        A generator's name or a file path.
+    tess : int or None
+        The tessellation (None: the default; always None for a file).
+    width, height : int
+        The image size.
+    shininess : float
+        The specular exponent.
+    shading : str
+        The shading mode.
+    method : str or None
+        The normalization method (None for a mode without one).
+    bump : str or None
+        The bump variant (None unless ``shading == "bump"``).
+    reference : tuple of (str, str or None, str or None)
+        ``(mode, method, variant)`` of the reference render.
+    """
 
     mesh: str
     tess: int | None
@@ -282,7 +420,19 @@ class RenderCase:
 class RenderSweepRow:
     """A rendered case: its triangle and fragment counts, its
     :class:`~chebnorm.raster.ImageMetrics` against the reference (as a dict),
-    and, when asked for, the image and its error map as PNG bytes."""
+    and, when asked for, the image and its error map as PNG bytes.
+
+    Attributes
+    ----------
+    case : RenderCase
+        The case rendered.
+    triangles, fragments : int
+        The render's counts.
+    metrics : dict
+        Its metrics against the reference.
+    image_png, error_png : bytes, optional
+        The image and its error map as PNG bytes (when asked for).
+    """
 
     case: RenderCase
     triangles: int
@@ -305,7 +455,13 @@ class RenderSweepRow:
 
 @dataclass(frozen=True)
 class RenderSweep:
-    """The rows of :func:`render_sweep`, in the order of the cases' ``sort_key``."""
+    """The rows of :func:`render_sweep`, in the order of the cases' ``sort_key``.
+
+    Attributes
+    ----------
+    rows : tuple of RenderSweepRow
+        One row per case.
+    """
 
     rows: tuple
 
@@ -377,6 +533,37 @@ def render_sweep_cases(meshes=("teapot",), shadings=("phong",), methods=None,
     ``phong:exact`` (``bump:full`` for bump cases). A bad name or size raises
     ``ValueError`` naming it and the accepted set.
 
+    Parameters
+    ----------
+    meshes : sequence of str, optional
+        Generator names or mesh files.
+    shadings : sequence of str, optional
+        Shading modes.
+    methods : sequence of str, optional
+        Normalization methods.
+    sizes : sequence of (int, int), optional
+        Image sizes.
+    tess : sequence of int or None, optional
+        Tessellation levels.
+    shininess : sequence of float, optional
+        Specular exponents.
+    bumps : sequence of str, optional
+        Bump variants.
+    reference : tuple, optional
+        ``(mode, method, variant)`` of the reference.
+
+    Returns
+    -------
+    list of RenderCase
+        The cases, sorted.
+
+    Raises
+    ------
+    ValueError
+        See above.
+
+    Examples
+    --------
     >>> [(c.shading, c.method) for c in render_sweep_cases(
     ...     ("sphere",), ("gouraud", "phong"), ("none", "exact"), sizes=[(32, 32)])]
     [('gouraud', None), ('phong', 'exact'), ('phong', 'none')]
@@ -450,6 +637,34 @@ def render_sweep(cases, *, half_vector: str = "pixel", eta_threshold: float = 0.
     interrupted. ``half_vector``, ``eta_threshold``, ``q``, ``engine``: as
     :func:`render`, for every case.
 
+    Parameters
+    ----------
+    cases : sequence of RenderCase
+        The cases (:func:`render_sweep_cases`).
+    half_vector : str, optional
+        ``"pixel"`` or ``"triangle"``.
+    eta_threshold, q : float, optional
+        ``adaptive``'s and ``split-gouraud``'s thresholds.
+    engine : str, optional
+        ``"numpy"``, ``"numba"`` or ``"auto"``.
+    images : bool, optional
+        Keep each image and error map as PNG bytes.
+    workers : int, optional
+        Local processes.
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler instead.
+    progress : bool, optional
+        Show a progress bar.
+    on_row : callable, optional
+        ``on_row(index, row)`` for each finished row.
+
+    Returns
+    -------
+    RenderSweep
+        The rows, in the order of the cases.
+
+    Examples
+    --------
     >>> cases = render_sweep_cases(("sphere",), ("phong",), ("exact", "none"),
     ...                            sizes=[(48, 48)], tess=[8])
     >>> sweep = render_sweep(cases, workers=1)

@@ -23,6 +23,18 @@ __all__ = ["vector", "reduce_modulo"]
 def vector(name: str) -> sp.Matrix:
     """A generic real 3-vector ``[name_x, name_y, name_z]`` as a column.
 
+    Parameters
+    ----------
+    name : str
+        The prefix of the component symbols.
+
+    Returns
+    -------
+    sympy.Matrix
+        A 3 x 1 matrix of real symbols.
+
+    Examples
+    --------
     >>> vector("N").T
     Matrix([[N_x, N_y, N_z]])
     """
@@ -51,8 +63,27 @@ def reduce_modulo(
     first), so the result equals ``expr`` wherever the relations hold and the
     denominator does not vanish.
 
-    Raises ``ArithmeticError`` if the denominator reduces to zero.
+    Parameters
+    ----------
+    expr : sympy.Expr
+        A rational expression.
+    relations : sequence of sympy.Expr
+        Polynomials that vanish (``|a|^2 - 1`` for a unit vector ``a``).
+    eliminate : iterable of sympy.Symbol
+        The symbols to remove, eliminated first.
 
+    Returns
+    -------
+    sympy.Expr
+        The reduced expression, equal to ``expr`` where the relations hold.
+
+    Raises
+    ------
+    ArithmeticError
+        If the denominator reduces to zero.
+
+    Examples
+    --------
     >>> a = vector("a")
     >>> c = sp.Symbol("c", real=True)
     >>> unit = (a.T * a)[0] - 1          # |a|^2 = 1

@@ -143,12 +143,27 @@ def bump_coefficients(P_u, P_v, F_u, F_v) -> np.ndarray:
     """Tangent-space perturbed normal ``[a, b, c] = [N'.T, N'.B, N'.N^]``
     (seed 001), not normalized.
 
-    ``P_u``, ``P_v``: surface partial derivatives, ``(..., 3)``; ``F_u``,
-    ``F_v``: height-map derivatives, arrays broadcasting against the leading
-    shape.  Returns an array of shape ``(..., 3)``.  Raises ``ValueError`` for
-    non-finite input, zero vectors and parallel tangents
-    (``|P_u x P_v| <= eps |P_u| |P_v|``, no surface normal).
+    Parameters
+    ----------
+    P_u, P_v : array_like
+        The surface's partial derivatives, shape ``(..., 3)``.
+    F_u, F_v : array_like
+        The height map's partial derivatives, broadcasting against the
+        leading shape of ``P_u``.
 
+    Returns
+    -------
+    numpy.ndarray
+        ``[a, b, c]`` of shape ``(..., 3)``.
+
+    Raises
+    ------
+    ValueError
+        For non-finite input, zero vectors and parallel tangents
+        (``|P_u x P_v| <= eps |P_u| |P_v|``, no surface normal).
+
+    Examples
+    --------
     >>> bump_coefficients([2.0, 0.0, 0.0], [0.0, 2.0, 0.0], 0.5, 0.25)
     array([-1. , -0.5,  4. ])
     """
@@ -178,9 +193,25 @@ def bump_coefficients_square(F_u, F_v, k) -> np.ndarray:
     """Square-patch coefficients ``[-F_u/k, -F_v/k, 1]`` (seed 001, claim C12):
     ``bump_coefficients(k e_1, k e_2, F_u, F_v)`` divided by its ``c = k^2``.
 
-    ``k > 0`` is the common length of ``P_u`` and ``P_v``; arguments broadcast;
-    the result has shape ``(..., 3)``.
+    Parameters
+    ----------
+    F_u, F_v : array_like
+        The height map's partial derivatives.
+    k : array_like
+        The common length of ``P_u`` and ``P_v``, ``k > 0``; all three broadcast.
 
+    Returns
+    -------
+    numpy.ndarray
+        ``[-F_u/k, -F_v/k, 1]`` of shape ``(..., 3)``.
+
+    Raises
+    ------
+    ValueError
+        For non-finite input or ``k <= 0``.
+
+    Examples
+    --------
     >>> bump_coefficients_square(0.5, 0.25, 2.0)
     array([-0.25 , -0.125,  1.   ])
     """

@@ -25,7 +25,10 @@ import numpy as np
 
 __all__ = ["UNIT_RTOL", "DOT_ATOL"]
 
+#: accepted relative deviation ``| |N| - 1 |`` of a vector called unit
 UNIT_RTOL = 1e-6
+#: accepted absolute slack of a dot product of unit vectors outside ``[-1, 1]``, and the
+#: distance from -1 or 1 under which two normals count as antiparallel or parallel
 DOT_ATOL = 3 * UNIT_RTOL
 
 

@@ -57,6 +57,15 @@ class EdgeHighlight:
     Holds sympy expressions (:func:`edge_highlight_expr`) or numpy arrays
     (:func:`edge_highlight`, :func:`edge_highlight_unclipped`).
 
+    Attributes
+    ----------
+    t : sympy.Expr or numpy.ndarray
+        The position on the edge, ``N(t) = (1 - t) N_A + t N_B``.
+    value : sympy.Expr or numpy.ndarray
+        The cosine ``H.N(t)/|N(t)|`` at ``t``.
+
+    Examples
+    --------
     Seed 002: the maximum is at ``t* = (b - a c)/((a + b)(1 - c))``, where it
     is ``sqrt((a^2 - 2abc + b^2)/(1 - c^2))``. With ``N_A``, ``N_B`` at 45
     degrees either side of ``H`` (``a = b = cos 45``, ``c = 0``) it is the
@@ -147,18 +156,37 @@ def edge_highlight(a, b, c) -> EdgeHighlight:
     """The maximum of ``h(t) = H.N(t)/|N(t)|`` on the edge ``t in [0, 1]``
     (seed 002, steps 1-2 of the algorithm).
 
-    ``a = H.N_A``, ``b = H.N_B``, ``c = N_A.N_B`` (arrays that broadcast, each
-    in ``[-1, 1]``; ``c > -1 + DOT_ATOL``; they must be the dot products of
-    three unit vectors, up to ``GRAM_ATOL``).  Returns ``EdgeHighlight(t,
-    value)``: if ``a + b > 0`` and ``t*`` lies in ``[0, 1]``, ``t = t*`` and
-    ``value = sqrt((a^2 - 2abc + b^2)/(1 - c^2))``; otherwise ``t`` is the
-    endpoint (``clip(t*, 0, 1)`` when ``a + b > 0``, the better endpoint when
-    ``a + b <= 0``) and ``value = h(t)``, i.e. ``a`` or ``b``.
+    Parameters
+    ----------
+    a : array_like
+        ``H.N_A``, in ``[-1, 1]``.
+    b : array_like
+        ``H.N_B``, in ``[-1, 1]``.
+    c : array_like
+        ``N_A.N_B``, in ``(-1 + DOT_ATOL, 1]``. The three broadcast and must be
+        the dot products of three unit vectors, up to ``GRAM_ATOL``.
 
+    Returns
+    -------
+    EdgeHighlight
+        If ``a + b > 0`` and ``t*`` lies in ``[0, 1]``, ``t = t*`` and
+        ``value = sqrt((a^2 - 2abc + b^2)/(1 - c^2))``; otherwise ``t`` is the
+        endpoint (``clip(t*, 0, 1)`` when ``a + b > 0``, the better endpoint
+        when ``a + b <= 0``) and ``value = h(t)``, i.e. ``a`` or ``b``.
+
+    Raises
+    ------
+    ValueError
+        For arguments outside their ranges or not the dot products of unit vectors.
+
+    Notes
+    -----
     Parallel normals (``1 - c <= DOT_ATOL``): ``t*`` is undefined (0/0); the
     endpoint maximum ``max(a, b)`` is returned (``t = 0`` on ties).  The
     maximum over such an edge exceeds it by at most ``(1 - c)/4``.
 
+    Examples
+    --------
     >>> peak = edge_highlight(0.8, 0.8, 0.6)
     >>> print(f"{peak.t:.2f} {peak.value:.6f}")
     0.50 0.894427
@@ -191,6 +219,23 @@ def edge_highlight_unclipped(a, b, c) -> EdgeHighlight:
     parallel normals (``1 - c <= DOT_ATOL``, then ``value`` is NaN too, the
     plane being undefined) and ``a + b = 0`` (``h`` monotone).
 
+    Parameters
+    ----------
+    a, b, c : array_like
+        ``H.N_A``, ``H.N_B``, ``N_A.N_B``, as for :func:`edge_highlight`.
+
+    Returns
+    -------
+    EdgeHighlight
+        ``t*`` (possibly outside ``[0, 1]``) and the value there.
+
+    Raises
+    ------
+    ValueError
+        As :func:`edge_highlight`.
+
+    Examples
+    --------
     >>> peak = edge_highlight_unclipped(0.9, 0.3, 0.6)
     >>> print(f"{peak.t:.3f} {peak.value:.6f}")
     -0.500 0.948683

@@ -28,7 +28,7 @@ Derivations
    and ``1 - |N|^n`` are largest at ``min |N|``: ``delta_d``, ``delta_s``.
 5. ``eta`` is the sum over the three edges of the edge bound
    ``1 - min |N| = 1 - sqrt(2(1 + c_ij))/2``.
-7. ``N(t) = G t^2 + P t + Q`` through ``N_l, N_c, N_r`` at ``t = 0, 1/2, 1``:
+6. ``N(t) = G t^2 + P t + Q`` through ``N_l, N_c, N_r`` at ``t = 0, 1/2, 1``:
    the three interpolation conditions are solved with ``sympy.linsolve``.
 """
 
@@ -91,6 +91,25 @@ def norm2_linear_np(t, c):
     be any finite real (the identity holds on the whole line); ``c`` must lie
     in ``[-1, 1]`` (up to ``DOT_ATOL``, then clipped).  Arguments broadcast.
 
+    Parameters
+    ----------
+    t : array_like
+        Positions along the edge (any finite reals).
+    c : array_like
+        ``N_A.N_B``, in ``[-1, 1]``.
+
+    Returns
+    -------
+    numpy.ndarray or numpy.float64
+        The squared lengths.
+
+    Raises
+    ------
+    ValueError
+        For non-finite input or ``c`` outside ``[-1, 1]`` beyond ``DOT_ATOL``.
+
+    Examples
+    --------
     >>> print(f"{norm2_linear_np(0.5, 0.0):.3f}")
     0.500
     """
@@ -135,14 +154,29 @@ def _midpoint_scale_kernel():
 def midpoint_normal(na, nb) -> np.ndarray:
     """Normalized midpoint ``(N_A + N_B) / sqrt(2(1 + N_A.N_B))`` (seed 003).
 
-    ``na``, ``nb``: unit normals, arrays of shape ``(..., 3)`` that broadcast.
-    Raises ``ValueError`` for zero, non-finite or non-unit vectors and for
-    antiparallel pairs (``1 + N_A.N_B <= DOT_ATOL``), where the formula
-    divides by zero.
+    Parameters
+    ----------
+    na, nb : array_like
+        Unit normals, shape ``(..., 3)``; they broadcast.
 
+    Returns
+    -------
+    numpy.ndarray
+        The unit midpoint normals, shape ``(..., 3)``.
+
+    Raises
+    ------
+    ValueError
+        For zero, non-finite or non-unit vectors and for antiparallel pairs
+        (``1 + N_A.N_B <= DOT_ATOL``), where the formula divides by zero.
+
+    Notes
+    -----
     Possible issues: the result has unit length only as far as the inputs do;
     its length error is about ``(| |N_A| - 1 | + | |N_B| - 1 |) / (2(1 + c))``.
 
+    Examples
+    --------
     >>> m = midpoint_normal([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     >>> print(np.round(m, 6))
     [0.707107 0.707107 0.      ]
@@ -237,11 +271,29 @@ def _check_phi(x, func: str) -> np.ndarray:
 def delta_d(phi):
     """``delta_d(phi) = 1 - cos(phi/2)`` (seed 003, claim C1), ``phi`` in radians.
 
-    ``phi`` must lie in ``[0, pi]``.
+    Parameters
+    ----------
+    phi : array_like
+        The angle between two unit normals, in ``[0, pi]`` radians.
 
+    Returns
+    -------
+    numpy.ndarray or numpy.float64
+        The largest relative diffuse error of not normalizing (a scalar for
+        scalar input).
+
+    Raises
+    ------
+    ValueError
+        For ``phi`` outside ``[0, pi]`` or not finite.
+
+    Notes
+    -----
     Possible issues: evaluated as written, so for tiny ``phi`` the relative
     error is about ``8 eps / phi^2`` (the absolute error stays ``~eps``).
 
+    Examples
+    --------
     >>> print(f"{delta_d(0.2):.7f}")
     0.0049958
     """
@@ -269,8 +321,25 @@ def _delta_s_kernel():
 def delta_s(phi, n):
     """``delta_s(phi, n) = 1 - cos(phi/2)^n`` (seed 003, Fig. 5, claim C2).
 
-    ``phi`` in ``[0, pi]`` radians, exponent ``n >= 0``; they broadcast.
+    Parameters
+    ----------
+    phi : array_like
+        The angle between two unit normals, in ``[0, pi]`` radians.
+    n : array_like
+        The specular exponent, ``n >= 0``; broadcasts against ``phi``.
 
+    Returns
+    -------
+    numpy.ndarray or numpy.float64
+        The largest relative specular error of not normalizing.
+
+    Raises
+    ------
+    ValueError
+        For arguments outside their ranges or not finite.
+
+    Examples
+    --------
     >>> print(f"{delta_s(0.2, 1.0):.7f}")
     0.0049958
     >>> print(f"{delta_s(0.2, 64):.4f}")
@@ -324,8 +393,29 @@ def eta(na, nb, nc):
     ``na, nb, nc`` (arrays of shape ``(..., 3)``, broadcast) (seed 003).
 
     ``eta >= 0``; triangles with ``eta`` under a threshold skip normalization.
-    Raises ``ValueError`` for zero, non-finite or non-unit normals.
 
+    .. math::
+
+        \\eta = 3 - \\tfrac12\\left[\\sqrt{2(1 + N_A\\cdot N_B)} + \\sqrt{2(1 + N_B\\cdot N_C)}
+          + \\sqrt{2(1 + N_A\\cdot N_C)}\\right]
+
+    Parameters
+    ----------
+    na, nb, nc : array_like
+        Unit vertex normals, shape ``(..., 3)``; they broadcast.
+
+    Returns
+    -------
+    numpy.ndarray or numpy.float64
+        ``eta`` per triangle (a scalar for single vectors).
+
+    Raises
+    ------
+    ValueError
+        For zero, non-finite or non-unit normals.
+
+    Examples
+    --------
     >>> e = eta([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0])
     >>> print(f"{e:.3f}")
     0.000
@@ -347,6 +437,17 @@ class QuadraticCoefficients:
     Holds sympy expressions (from :func:`quadratic_coefficients_expr`) or
     ``(..., 3)`` arrays (from :func:`quadratic_coefficients`).
 
+    Attributes
+    ----------
+    G : sympy.Expr or numpy.ndarray
+        The coefficient of ``t^2``, ``2 N_l - 4 N_c + 2 N_r``.
+    P : sympy.Expr or numpy.ndarray
+        The coefficient of ``t``, ``-3 N_l + 4 N_c - N_r``.
+    Q : sympy.Expr or numpy.ndarray
+        The constant, ``N_l``.
+
+    Examples
+    --------
     The quadratic passes through ``N_l`` (t = 0), the normalized midpoint
     (t = 1/2) and ``N_r`` (t = 1):
 
@@ -420,6 +521,26 @@ def quadratic_coefficients(nl, nr, nc=None) -> QuadraticCoefficients:
     ``nc`` is only checked for shape and finiteness, so an approximate
     midpoint (e.g. from a Chebyshev fit of ``1/sqrt(2(1+x))``) can be used.
 
+    Parameters
+    ----------
+    nl, nr : array_like
+        Unit end normals of the span, shape ``(..., 3)``.
+    nc : array_like, optional
+        The normal at ``t = 1/2``; the exact normalized midpoint when omitted.
+
+    Returns
+    -------
+    QuadraticCoefficients
+        ``G``, ``P``, ``Q`` as arrays of shape ``(..., 3)``.
+
+    Raises
+    ------
+    ValueError
+        For invalid end normals (as :func:`midpoint_normal`), or an ``nc`` of
+        the wrong shape or not finite.
+
+    Examples
+    --------
     >>> q = quadratic_coefficients([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     >>> print(np.round(q.evaluate(0.5), 6))
     [0.707107 0.707107 0.      ]

@@ -143,7 +143,7 @@ def put(out: dict, name: str, arr: np.ndarray) -> None:
 
 class UnitKind(ABC):
     """One kind of normalization unit; subclasses fill in the methods and are
-    registered once with :func:`register`. The methods take valid designs
+    registered once with :func:`~chebnorm.hw.units.base.register`. The methods take valid designs
     (made by their own :meth:`design`) and do not check them again.
 
     Examples

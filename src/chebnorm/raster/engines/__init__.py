@@ -22,6 +22,23 @@ def resolve_engine(engine) -> str:
     """``"numpy"`` or ``"numba"``: what ``engine`` (``"auto"``, None, ``"numpy"``,
     ``"numba"``) means here; ``"numba"`` without numba installed is an error.
 
+    Parameters
+    ----------
+    engine : str or None
+        ``"auto"``, None, ``"numpy"`` or ``"numba"``.
+
+    Returns
+    -------
+    str
+        ``"numpy"`` or ``"numba"``.
+
+    Raises
+    ------
+    ValueError
+        For another name, or ``"numba"`` without numba installed.
+
+    Examples
+    --------
     >>> resolve_engine("numpy")
     'numpy'
     """

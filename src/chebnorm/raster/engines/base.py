@@ -42,7 +42,29 @@ class Setup:
     (set by ``render``), the front-facing triangles ``tri`` (ids into ``mesh.faces``)
     and their corners: screen ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals
     ``(T,3,3)``; ``attrs``: ``[1/w, normal, position] (T,3,7)`` if the engine gathered
-    them (the numba engine's ``phong`` frame), else None."""
+    them (the numba engine's ``phong`` frame), else None.
+
+    Attributes
+    ----------
+    mesh : Mesh
+        The mesh.
+    camera : Camera
+        The view.
+    width, height : int
+        The image size.
+    L : numpy.ndarray or None
+        Unit direction toward the light.
+    tri : numpy.ndarray
+        The front triangles' indices into ``mesh.faces``.
+    xy : numpy.ndarray
+        Screen corners ``(T, 3, 2)``.
+    inv_w : numpy.ndarray
+        ``1/w`` at the corners ``(T, 3)``.
+    pos, nrm : numpy.ndarray
+        Corner positions and normals ``(T, 3, 3)``.
+    attrs : numpy.ndarray, optional
+        ``[1/w, normal, position]`` per corner ``(T, 3, 7)``, or None.
+    """
 
     mesh: Mesh
     camera: Camera
@@ -61,7 +83,23 @@ class Setup:
 class ModeResult:
     """What a shading mode hands back to ``render``: the image (H, W), coverage mask,
     fragment count, the mode's ``stats``, and (phong, adaptive) the triangle and
-    ``|N|`` maps."""
+    ``|N|`` maps.
+
+    Attributes
+    ----------
+    image : numpy.ndarray
+        Intensities ``(H, W)`` in ``[0, 1]``.
+    mask : numpy.ndarray
+        Covered pixels, bool ``(H, W)``.
+    fragments : int
+        Fragments shaded.
+    stats : dict
+        The mode's statistics.
+    triangle : numpy.ndarray, optional
+        Visible triangle per pixel (-1 off the mesh).
+    normal_length : numpy.ndarray, optional
+        ``|N|`` per pixel before shading (NaN off the mesh).
+    """
 
     image: np.ndarray
     mask: np.ndarray
@@ -73,18 +111,55 @@ class ModeResult:
 
 def dot(a, b):
     """Row-wise dot products ``a . b`` over the last axis (numpy's ``einsum``: its
-    summation order is part of the reference's bytes)."""
+    summation order is part of the reference's bytes).
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Vectors ``(..., 3)``; they broadcast.
+
+    Returns
+    -------
+    numpy.ndarray
+        The dot products ``(...)``.
+    """
     return np.einsum("...k,...k->...", a, b)
 
 
 def half_vectors(L, eye, points):
-    """Blinn half vectors ``unit(L + unit(eye - P))`` at ``points (..., 3)``."""
+    """Blinn half vectors ``unit(L + unit(eye - P))`` at ``points (..., 3)``.
+
+    Parameters
+    ----------
+    L : numpy.ndarray
+        Unit direction toward the light ``(3,)``.
+    eye : numpy.ndarray
+        The camera position ``(3,)``.
+    points : numpy.ndarray
+        Surface points ``(..., 3)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit half vectors ``(..., 3)``.
+    """
     V = unit(np.asarray(eye, float) - points)
     return unit(L + V)
 
 
 def triangle_half_vectors(st: Setup) -> np.ndarray:
-    """One half vector per front triangle of ``st``, at its centroid (seed 002), (T, 3)."""
+    """One half vector per front triangle of ``st``, at its centroid (seed 002), (T, 3).
+
+    Parameters
+    ----------
+    st : Setup
+        The frame's set-up (with ``L``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit half vectors ``(T, 3)``.
+    """
     return half_vectors(st.L, st.camera.eye, st.pos.mean(axis=1))
 
 

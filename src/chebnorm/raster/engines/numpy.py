@@ -60,7 +60,26 @@ class NumpyEngine(Engine):
 
 def to_image(st, sp, vis, values):
     """``(image, mask)`` (H, W) of ``st``'s frame: ``values`` at the visible fragments
-    ``vis`` clipped to [0, 1], 0 elsewhere, and the covered pixels."""
+    ``vis`` clipped to [0, 1], 0 elsewhere, and the covered pixels.
+
+    Parameters
+    ----------
+    st : Setup
+        The frame's set-up.
+    sp : Spans
+        The frame's spans.
+    vis : numpy.ndarray
+        Indices of the visible fragments.
+    values : numpy.ndarray
+        Intensity per visible fragment.
+
+    Returns
+    -------
+    image : numpy.ndarray
+        Intensities ``(H, W)`` in ``[0, 1]``.
+    mask : numpy.ndarray
+        Covered pixels, bool ``(H, W)``.
+    """
     img = np.zeros(st.width * st.height)
     mask = np.zeros(st.width * st.height, dtype=bool)
     img[sp.frag_pixel[vis]] = values
@@ -69,7 +88,26 @@ def to_image(st, sp, vis, values):
 
 
 def pixel_map(st, sp, vis, values, fill):
-    """An (H, W) map of ``values`` at the visible fragments ``vis``, ``fill`` elsewhere."""
+    """An (H, W) map of ``values`` at the visible fragments ``vis``, ``fill`` elsewhere.
+
+    Parameters
+    ----------
+    st : Setup
+        The frame's set-up (its size).
+    sp : Spans
+        The frame's spans.
+    vis : numpy.ndarray
+        Indices of the visible fragments.
+    values : numpy.ndarray
+        One value per visible fragment.
+    fill : float
+        The value elsewhere.
+
+    Returns
+    -------
+    numpy.ndarray
+        The map ``(H, W)``.
+    """
     out = np.full(st.width * st.height, fill, dtype=np.asarray(values).dtype)
     out[sp.frag_pixel[vis]] = values
     return out.reshape(st.height, st.width)

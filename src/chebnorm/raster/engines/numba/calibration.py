@@ -83,6 +83,22 @@ def first_orders(kinds, cases, probe):
     ``probe(kind, order, case)`` holds on every one of ``cases`` (tried in order, the
     next order at the first miss); None if some kind has none.
 
+    Parameters
+    ----------
+    kinds : sequence
+        The reductions to calibrate.
+    cases : sequence
+        The inputs each order must reproduce.
+    probe : callable
+        ``probe(kind, order, case) -> bool``: the order gives the reference's bits on the case.
+
+    Returns
+    -------
+    dict or None
+        ``{kind: order}``, or None when a kind has no such order.
+
+    Examples
+    --------
     >>> first_orders(("a", "b"), (1, 2), lambda kind, order, case: order == len(kind))
     (1, 1)
     """
@@ -142,6 +158,20 @@ def det(name: str, x):
     float64 by the C library (what :mod:`math` calls), float32 correctly rounded from
     it, the few arguments whose rounding is in doubt handed to :mod:`detmath`.
 
+    Parameters
+    ----------
+    name : str
+        ``"sin"``, ``"cos"`` or ``"arccos"``.
+    x : numpy.ndarray
+        The arguments (float32 or float64).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``detmath.<name>(x)``, the same bits.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> x = np.linspace(-3, 3, 101, dtype=np.float32)
     >>> bool((det("sin", x) == detmath.sin(x)).all())
@@ -163,7 +193,13 @@ def det(name: str, x):
 
 
 class DetOps(NumpyOps):
-    """:class:`NumpyOps` with :func:`det` for the transcendental functions."""
+    """:class:`NumpyOps` with :func:`det` for the transcendental functions.
+
+    Parameters
+    ----------
+    dtype : numpy dtype, optional
+        float32 or float64.
+    """
 
     def sin(self, x):
         return det("sin", x)

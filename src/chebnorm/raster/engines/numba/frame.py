@@ -2,7 +2,7 @@
 then deferred shading.
 
 The numpy engine (:mod:`chebnorm.raster.engines.numpy`) is the reference and the
-compiled engine's step-by-step path (:mod:`.rasterize`, :mod:`.kernels`) its twin
+compiled engine's step-by-step path (:mod:`~chebnorm.raster.engines.numba.rasterize`, :mod:`~chebnorm.raster.engines.numba.kernels`) its twin
 operation by operation; this module computes the same ``phong`` frame, byte for byte,
 without the full-frame intermediate arrays of those two paths (fragment lists, a
 frame-sized z-buffer, per-fragment normals, half vectors and dot products):
@@ -592,6 +592,18 @@ def supports(spec) -> bool:
     """Whether :func:`phong` renders method ``spec`` (its kernel has a fused twin, numba is
     installed and :func:`calibrated` found the reductions' orders).
 
+    Parameters
+    ----------
+    spec : MethodSpec
+        A method's registry entry.
+
+    Returns
+    -------
+    bool
+        True when the fused frame renders it.
+
+    Examples
+    --------
     >>> from chebnorm.methods import get_method
     >>> supports(get_method("dichotomy")) == (HAVE_NUMBA and calibrated() is not None)
     True
@@ -649,6 +661,24 @@ def phong(st, spec, lighting, tables, dtype):
     chebnorm.raster.engines.base.FrameUnsupported
         Where this path cannot promise the reference's bytes (the caller then draws the
         frame step by step).
+
+    Parameters
+    ----------
+    st : Setup
+        The frame's set-up, with ``L``.
+    spec : MethodSpec
+        The normalization method's registry entry.
+    lighting : Lighting
+        Blinn-Phong parameters.
+    tables : dict or None
+        Coefficient tables by method name.
+    dtype : numpy dtype
+        The span interpolator's arithmetic.
+
+    Returns
+    -------
+    ModeResult
+        The frame, the same bytes as the numpy engine's.
     """
     orders = calibrated()
     if orders is None or id(method_kernel(spec)) not in MODES:

@@ -1,5 +1,5 @@
 """The compiled engine's floor: the numba import guard, :func:`njit`, three LLVM
-intrinsics (:func:`fma`, :func:`f2i`, :func:`i2f`) and the one thread pool of the process.
+intrinsics (``fma``, ``f2i``, ``i2f``: LLVM intrinsics, callable from compiled code only) and the one thread pool of the process.
 
 Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
 cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
@@ -20,6 +20,7 @@ try:  # pragma: no cover - exercised by whichever environment runs the tests
     from llvmlite import ir as _ir
     from numba.core import types as _types
     from numba.core.extending import intrinsic as _intrinsic
+    #: whether numba is installed (else every function here runs as plain Python)
     HAVE_NUMBA = True
 except ImportError:  # pragma: no cover
     numba = None
@@ -91,6 +92,11 @@ def njit(fn=None, *, inline=False):
         The function to compile (``@njit``); None for ``@njit(...)``.
     inline : bool
         Inline into callers (``inline="always"``) instead of calling.
+
+    Returns
+    -------
+    callable
+        The compiled function (or, for ``@njit(...)``, the decorator).
     """
     def deco(f):
         if not HAVE_NUMBA:
@@ -143,7 +149,13 @@ else:  # pragma: no cover
 
 
 def threads() -> int:
-    """Threads to split a frame over: the CPUs this process may run on (at most 8)."""
+    """Threads to split a frame over: the CPUs this process may run on (at most 8).
+
+    Returns
+    -------
+    int
+        Between 1 and 8.
+    """
     try:
         n = len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
@@ -156,7 +168,13 @@ _POOL: dict = {}
 
 
 def pool():
-    """This process's thread pool (a forked child makes its own)."""
+    """This process's thread pool (a forked child makes its own).
+
+    Returns
+    -------
+    concurrent.futures.ThreadPoolExecutor
+        The pool, :func:`threads` workers.
+    """
     ex = _POOL.get(os.getpid())
     if ex is None:
         _POOL.clear()
@@ -167,7 +185,18 @@ def pool():
 
 def run(jobs):
     """Run ``[(kernel, args), ...]`` (compiled with ``nogil``) at once on :func:`pool`;
-    their results in order."""
+    their results in order.
+
+    Parameters
+    ----------
+    jobs : sequence of (callable, tuple)
+        Compiled ``nogil`` kernels and their arguments.
+
+    Returns
+    -------
+    list
+        Each kernel's result, in the order of ``jobs``.
+    """
     if len(jobs) == 1:
         return [jobs[0][0](*jobs[0][1])]
     futures = [pool().submit(fn, *args) for fn, args in jobs]
@@ -177,7 +206,18 @@ def run(jobs):
 def run_with_caller(jobs):
     """Run ``[(kernel, args), ...]`` (compiled with ``nogil``): the first on this thread,
     the others on :func:`pool` (whose threads may be busy with the frame's
-    background); their results in order."""
+    background); their results in order.
+
+    Parameters
+    ----------
+    jobs : sequence of (callable, tuple)
+        Compiled ``nogil`` kernels and their arguments.
+
+    Returns
+    -------
+    list
+        Each kernel's result, in the order of ``jobs``.
+    """
     if len(jobs) == 1:
         return [jobs[0][0](*jobs[0][1])]
     futures = [pool().submit(fn, *args) for fn, args in jobs[1:]]

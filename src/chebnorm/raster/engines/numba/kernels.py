@@ -257,7 +257,18 @@ _LINEAR_MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3}
 
 
 def supports(method) -> bool:
-    """Whether the method's kernel (from the registry) has a compiled twin here."""
+    """Whether the method's kernel (from the registry) has a compiled twin here.
+
+    Parameters
+    ----------
+    method : str or MethodSpec
+        A registered method.
+
+    Returns
+    -------
+    bool
+        True when a compiled twin exists.
+    """
     kern = method_kernel(method)
     return HAVE_NUMBA and (id(kern) in _LINEAR_MODES or kern is K.SLERP or kern is K.QUADRATIC
                            or kern is K.ANGULAR or kern is K.DICHOTOMY)
@@ -268,6 +279,23 @@ def fast_span_normals(method, n_left, n_right, m, *, t0=None, dt=None, count=Non
     """:func:`chebnorm.methods.span_normals` (same arguments but ``angular_reanchor``,
     same checks and errors), compiled: the same bytes.
 
+    Parameters
+    ----------
+    method, n_left, n_right, m, t0, dt, count, tables, dtype
+        As in :func:`chebnorm.methods.span_normals`.
+
+    Returns
+    -------
+    SpanNormals
+        The same arrays as :func:`chebnorm.methods.span_normals`.
+
+    Raises
+    ------
+    ValueError
+        As :func:`chebnorm.methods.span_normals`.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.methods import span_normals
     >>> nl = np.array([[1.0, 0.0, 0.0]]); nr = np.array([[0.8, 0.0, 0.6]])
@@ -322,7 +350,26 @@ def _stack(v):
 
 
 def quadratic_setup(ops, nl, nr, t0, dt, coeffs, start_at_left):
-    """The set-up of :func:`chebnorm.methods.kernels.quadratic_steps`, in its operation order."""
+    """The set-up of :func:`chebnorm.methods.kernels.quadratic_steps`, in its operation order.
+
+    Parameters
+    ----------
+    ops : NumpyOps or DetOps
+        The arithmetic backend.
+    nl, nr : tuple of 3 arrays
+        The spans' unit end normals.
+    t0, dt : array
+        First position and step per span.
+    coeffs : sequence of float or None
+        The midpoint table's coefficients (None: exact).
+    start_at_left : bool
+        The first pixel is ``N_l`` itself.
+
+    Returns
+    -------
+    tuple
+        The forward-difference state ``(v, d1, d2)`` per span.
+    """
     x = K.dot(nl, nr)
     s = K.vadd(nl, nr)
     r = K.horner(ops, coeffs, x) if coeffs is not None else 1.0 / ops.sqrt((x + 1.0) * 2.0)
@@ -342,7 +389,26 @@ def quadratic_setup(ops, nl, nr, t0, dt, coeffs, start_at_left):
 
 def angular_setup(ops, nl, nr, t0, dt, n, start_at_left):
     """The first two pixels of :func:`chebnorm.methods.kernels.angular_steps` (run by the
-    kernel itself) and its recurrence factor ``2 cos(phi)``, in its operation order."""
+    kernel itself) and its recurrence factor ``2 cos(phi)``, in its operation order.
+
+    Parameters
+    ----------
+    ops : NumpyOps or DetOps
+        The arithmetic backend.
+    nl, nr : tuple of 3 arrays
+        The spans' unit end normals.
+    t0, dt : array
+        First position and step per span.
+    n : array
+        Pixels per span.
+    start_at_left : bool
+        The first pixel is ``N_l`` itself.
+
+    Returns
+    -------
+    tuple
+        The first two pixels and ``2 cos(phi)``, per span.
+    """
     gen = K.angular_steps(ops, nl, nr, t0, dt, n, start_at_left=start_at_left)
     p0 = next(gen)
     p1 = next(gen) if n >= 2 else p0
@@ -379,7 +445,26 @@ def _half_vectors_kernel(frag_span, frag_t, left, right, c0, sel, L, eye):
 
 def fast_half_vectors(sp: Spans, col: int, vis, L, eye) -> np.ndarray:
     """Per-pixel Blinn half vectors at the visible fragments (positions in attribute
-    columns ``col .. col+2``), as the numpy engine computes them."""
+    columns ``col .. col+2``), as the numpy engine computes them.
+
+    Parameters
+    ----------
+    sp : Spans
+        The frame's spans.
+    col : int
+        The first attribute column of the positions.
+    vis : numpy.ndarray
+        Indices of the visible fragments.
+    L : numpy.ndarray
+        Unit direction toward the light.
+    eye : numpy.ndarray
+        The camera position.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit half vectors ``(P, 3)``.
+    """
     return _half_vectors_kernel(sp.frag_span, sp.frag_t, np.ascontiguousarray(sp.left),
                                 np.ascontiguousarray(sp.right), int(col),
                                 np.asarray(vis, np.int64), np.asarray(L, np.float64),
@@ -414,7 +499,28 @@ def _shade_kernel(ndotl, ndoth, N, pixel, tri_of, light, n_pixels):
 
 def fast_shade(ndotl, ndoth, N, pixel, tri_of, lighting, n_pixels):
     """Blinn-Phong intensities clipped to [0, 1] scattered into the image, with the
-    coverage mask, the triangle map (-1 off the mesh) and ``|N|`` (NaN off the mesh)."""
+    coverage mask, the triangle map (-1 off the mesh) and ``|N|`` (NaN off the mesh).
+
+    Parameters
+    ----------
+    ndotl, ndoth : numpy.ndarray
+        ``N.L`` and ``N.H`` per visible fragment.
+    N : numpy.ndarray
+        The pixel normals ``(P, 3)``.
+    pixel : numpy.ndarray
+        Pixel index per visible fragment.
+    tri_of : numpy.ndarray
+        Triangle index per visible fragment.
+    lighting : Lighting
+        Blinn-Phong parameters.
+    n_pixels : int
+        Pixels of the image.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Flat ``(image, mask, triangle, |N|)`` maps of ``n_pixels``.
+    """
     light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess],
                      np.float64)
     return _shade_kernel(np.ascontiguousarray(ndotl, np.float64),

@@ -133,6 +133,22 @@ def _fragments(row, c0, count, t0, dt, width):
 def fast_setup_spans(xy, attrs, width: int, height: int) -> Spans:
     """:func:`chebnorm.raster.setup_spans`, compiled; the same arrays.
 
+    Parameters
+    ----------
+    xy : numpy.ndarray
+        Screen corners ``(T, 3, 2)``.
+    attrs : numpy.ndarray
+        Corner attributes ``(T, 3, K)``.
+    width, height : int
+        The image size.
+
+    Returns
+    -------
+    Spans
+        The same arrays as :func:`chebnorm.raster.setup_spans`.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> from chebnorm.raster import setup_spans
     >>> xy = np.array([[[1.0, 1.0], [9.0, 2.0], [3.0, 8.0]]]); at = np.ones((1, 3, 1))
@@ -179,7 +195,20 @@ def _zbuffer_kernel(frag_span, frag_pixel, frag_t, left, right, n_pixels):
 
 def fast_zbuffer(sp: Spans, n_pixels: int) -> np.ndarray:
     """``zbuffer(sp.frag_pixel, sp.lerp([0])[:, 0], n_pixels)``, compiled (depth in
-    attribute column 0; finite depths)."""
+    attribute column 0; finite depths).
+
+    Parameters
+    ----------
+    sp : Spans
+        The frame's spans (depth ``1/w`` in attribute column 0).
+    n_pixels : int
+        Pixels of the image.
+
+    Returns
+    -------
+    numpy.ndarray
+        Indices of the visible fragments, sorted by pixel.
+    """
     return _zbuffer_kernel(sp.frag_span, sp.frag_pixel, sp.frag_t,
                            np.ascontiguousarray(sp.left), np.ascontiguousarray(sp.right),
                            int(n_pixels))
@@ -201,7 +230,22 @@ def _lerp_kernel(frag_span, frag_t, left, right, cols, sel):
 
 
 def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
-    """``sp.lerp(cols)[sel]``, compiled, without interpolating the other fragments."""
+    """``sp.lerp(cols)[sel]``, compiled, without interpolating the other fragments.
+
+    Parameters
+    ----------
+    sp : Spans
+        The frame's spans.
+    cols : sequence of int
+        Attribute columns.
+    sel : numpy.ndarray
+        The fragments wanted.
+
+    Returns
+    -------
+    numpy.ndarray
+        The interpolated attributes ``(len(sel), len(cols))``.
+    """
     return _lerp_kernel(sp.frag_span, sp.frag_t, np.ascontiguousarray(sp.left),
                         np.ascontiguousarray(sp.right), np.asarray(cols, np.int64),
                         np.asarray(sel, np.int64))
@@ -251,7 +295,24 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
 def gather_setup(mesh, xy, inv_w, cull):
     """The per-triangle arrays of ``NumpyEngine.setup``, gathered in compiled code: front
     triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``, and
-    the corner attributes of :func:`phong`'s spans, ``[1/w, normal, position] (T,3,7)``."""
+    the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh.
+    xy : numpy.ndarray
+        Projected vertices ``(V, 2)``.
+    inv_w : numpy.ndarray
+        ``1/w`` per vertex.
+    cull : bool
+        Drop back-facing triangles.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(tri, xy, inv_w, pos, nrm, attrs)`` as described above.
+    """
     tri, txy, attrs, iw, pos, nrm = _gather_setup(
         np.ascontiguousarray(mesh.positions, np.float64),
         np.ascontiguousarray(mesh.normals, np.float64), np.ascontiguousarray(xy, np.float64),
@@ -385,6 +446,24 @@ def row_spans(xy, attrs, width, height, work=None):
     are views of this thread's :func:`.workspace.span_buffers`, valid until its next
     such call.  ``tests/raster_oracles.py`` holds the pair-by-pair oracle.
 
+    Parameters
+    ----------
+    xy : numpy.ndarray
+        Screen corners ``(T, 3, 2)``.
+    attrs : numpy.ndarray
+        Corner attributes ``(T, 3, K)``.
+    width, height : int
+        The image size.
+    work : Workspace, optional
+        Scratch arrays for the geometry.
+
+    Returns
+    -------
+    types.SimpleNamespace
+        The span arrays listed above.
+
+    Examples
+    --------
     >>> from chebnorm.raster.spans import setup_spans
     >>> xy = np.array([[[0.0, 0.0], [8.0, 0.0], [0.0, 6.0]], [[1.0, 0.5], [7.0, 1.5], [2.0, 5.0]]])
     >>> a, b = row_spans(xy, np.ones((2, 3, 1)), 8, 6), setup_spans(xy, np.ones((2, 3, 1)), 8, 6)
@@ -478,6 +557,29 @@ def project(camera, points, width, height):
     """:func:`chebnorm.raster.spans.project` (the same bits and errors), compiled where
     :func:`_gemm_fma` holds.
 
+    Parameters
+    ----------
+    camera : Camera
+        The view.
+    points : numpy.ndarray
+        World points ``(..., 3)``.
+    width, height : int
+        The image size.
+
+    Returns
+    -------
+    xy : numpy.ndarray
+        Screen coordinates ``(..., 2)``.
+    inv_w : numpy.ndarray
+        ``1/w`` per point.
+
+    Raises
+    ------
+    ValueError
+        If a point is not in front of the camera.
+
+    Examples
+    --------
     >>> from chebnorm.raster.spans import default_camera, project as ref
     >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
     >>> p = np.random.default_rng(1).standard_normal((50, 3)) * 0.3
@@ -517,7 +619,20 @@ def _same_bits(a, b):
 
 def default_camera_of(positions, width, height):
     """``fit_camera(positions, width, height)``, remembered for the last few position
-    arrays by value (a copy of the positions is kept and compared bit for bit)."""
+    arrays by value (a copy of the positions is kept and compared bit for bit).
+
+    Parameters
+    ----------
+    positions : numpy.ndarray
+        Vertex positions ``(V, 3)``.
+    width, height : int
+        The image size.
+
+    Returns
+    -------
+    Camera
+        The fitted camera.
+    """
     pos = np.ascontiguousarray(positions, np.float64)
     key = (int(width), int(height))
     hit = _CAMERAS.get(key)

@@ -218,7 +218,26 @@ def widest_dot(sp, spec, dtype, diff, work=None):
     ``auto_tables``) for method ``spec``, the normals in ``dtype`` (if float32
     or float64; ``diff``: see :func:`_ends_part`); ``(ends, None)`` when a check of
     ``check_span_input`` fails on them, ``(None, None)`` without :func:`ends_orders`
-    (then the reference runs); arrays from ``work`` (a :class:`Workspace`) if given."""
+    (then the reference runs); arrays from ``work`` (a :class:`Workspace`) if given.
+
+    Parameters
+    ----------
+    sp : Spans
+        The frame's spans.
+    spec : MethodSpec
+        The method's registry entry.
+    dtype : numpy dtype
+        The arithmetic.
+    diff : object
+        The end-normal summation orders.
+    work : Workspace, optional
+        Scratch arrays.
+
+    Returns
+    -------
+    tuple
+        ``(ends, smallest N_l.N_r)`` as described above.
+    """
     orders = ends_orders()
     if orders is None:
         return None, None
@@ -254,12 +273,38 @@ def _table(spec, tables, ends, tree):
 
 
 def span_input(spec, sp, tables, dtype, ends, diff):
-    """What :func:`phong` takes from ``check_span_input(spec, unit(sp.left[:, [1,
+    """What :func:`~chebnorm.raster.engines.numba.frame.phong` takes from ``check_span_input(spec, unit(sp.left[:, [1,
     2, 3]]), unit(sp.right[:, [1, 2, 3]]), sp.m, t0=sp.t0, dt=sp.dt, count=sp.count,
     tables=tables, dtype=dtype)``, from the compiled pass ``ends`` (:func:`widest_dot`),
     the same values and the same errors: ``(dtype, coefficients, levels, A, B, t0 all
     zero, largest count)``, ``A``, ``B`` the end normals (3, S) in the dtype
-    (``diff``: ``B - A`` for ``B``)."""
+    (``diff``: ``B - A`` for ``B``).
+
+    Parameters
+    ----------
+    spec : MethodSpec
+        The method's registry entry.
+    sp : Spans
+        The frame's spans.
+    tables : dict or None
+        Coefficient tables by method name.
+    dtype : numpy dtype
+        float32 or float64.
+    ends : object
+        The compiled pass's end normals (:func:`widest_dot`).
+    diff : object
+        The end-normal summation orders.
+
+    Returns
+    -------
+    tuple
+        The values listed above.
+
+    Raises
+    ------
+    ValueError
+        As :func:`chebnorm.methods.spans.check_span_input`.
+    """
     if ends is None or ends.bad:
         # the reference, on the spans in its order (triangle, row): its errors name spans
         # by that order
@@ -300,8 +345,23 @@ def _linear_setup(nl, nr, A, B, diff):
 
 
 def end_arrays(inp, dtype, diff):
-    """``(A, B)`` of :func:`phong`: the end normals in ``dtype``, (3, S), and
-    (``diff``) ``B - A`` instead of ``B``."""
+    """``(A, B)`` of :func:`~chebnorm.raster.engines.numba.frame.phong`: the end normals in ``dtype``, (3, S), and
+    (``diff``) ``B - A`` instead of ``B``.
+
+    Parameters
+    ----------
+    inp : tuple
+        What :func:`span_input` derived.
+    dtype : numpy dtype
+        float32 or float64.
+    diff : object
+        The end-normal summation orders (see :func:`widest_dot`).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(A, B)``, each ``(3, S)``.
+    """
     S = inp.n_left.shape[0]
     A, B = np.empty((3, S), dtype), np.empty((3, S), dtype)
     parts = _parts(S)
@@ -484,11 +544,36 @@ def _consts(dtype):
 
 
 def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=None):
-    """The per-span arrays of :func:`phong`'s ``mode`` 4 (slerp: ``(psi, 1/sin
+    """The per-span arrays of :func:`~chebnorm.raster.engines.numba.frame.phong`'s ``mode`` 4 (slerp: ``(psi, 1/sin
     psi)``), 5 (quadratic: ``(v, d1, d2)``) or 6 (angular: ``(p0, p1, 2 cos phi)``) from
     the end normals ``A``, ``B`` (3, S) in the dtype, ``t0``, ``dt`` in the dtype: the
     bits of ``K.SLERP.setup``, :func:`quadratic_setup`, :func:`angular_setup`
-    with ``ops`` (``DetOps``); arrays from ``work`` if given."""
+    with ``ops`` (``DetOps``); arrays from ``work`` if given.
+
+    Parameters
+    ----------
+    mode : int
+        4 (slerp), 5 (quadratic) or 6 (angular).
+    A, B : numpy.ndarray
+        End normals ``(3, S)`` in the dtype.
+    t0, dt : numpy.ndarray
+        First position and step per span.
+    coeffs : sequence of float or None
+        The table's coefficients (None: exact).
+    start_left : bool
+        The first pixel is ``N_l`` itself.
+    count_max : int
+        The largest pixel count of a span.
+    ops : DetOps
+        The arithmetic backend.
+    work : Workspace, optional
+        Scratch arrays.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The per-span set-up arrays of the mode.
+    """
     dtype = A.dtype.type
     S = A.shape[1]
     k = _consts(dtype)

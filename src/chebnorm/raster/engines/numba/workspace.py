@@ -48,7 +48,13 @@ _FREE: list = []
 
 
 def take() -> Workspace:
-    """A workspace for one frame (a new one when every kept one is in use)."""
+    """A workspace for one frame (a new one when every kept one is in use).
+
+    Returns
+    -------
+    Workspace
+        A workspace for this frame (hand it back with :func:`give`).
+    """
     try:
         return _FREE.pop()
     except IndexError:
@@ -56,7 +62,13 @@ def take() -> Workspace:
 
 
 def give(work: Workspace) -> None:
-    """Return a frame's workspace (at most two are kept)."""
+    """Return a frame's workspace (at most two are kept).
+
+    Parameters
+    ----------
+    work : Workspace
+        The workspace :func:`take` gave.
+    """
     if len(_FREE) < 2:
         _FREE.append(work)
 
@@ -83,6 +95,18 @@ def output_maps(npx):
     view of it), else new arrays.  Hand the set back with :func:`keep_maps` once the
     frame is drawn.
 
+    Parameters
+    ----------
+    npx : int
+        Pixels of the frame.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(image, mask, triangle, normal_length)``, flat, uninitialised.
+
+    Examples
+    --------
     >>> a = output_maps(10); keep_maps(a); a0 = a[2].ctypes.data; del a
     >>> output_maps(10)[2].ctypes.data == a0   # dropped by the caller: the same memory
     True
@@ -97,7 +121,13 @@ def output_maps(npx):
 
 
 def keep_maps(maps):
-    """Remember a frame's map set for reuse once its user drops it."""
+    """Remember a frame's map set for reuse once its user drops it.
+
+    Parameters
+    ----------
+    maps : tuple of numpy.ndarray
+        The set :func:`output_maps` gave.
+    """
     with _MAPS_LOCK:
         _MAPS.append(tuple(maps))
         del _MAPS[:-_KEEP_MAPS]
@@ -105,13 +135,43 @@ def keep_maps(maps):
 
 def scratch(work, name, shape, dtype=np.float64):
     """An uninitialised array ``name`` of ``work`` (a :class:`Workspace`), or a new one
-    when ``work`` is None."""
+    when ``work`` is None.
+
+    Parameters
+    ----------
+    work : Workspace or None
+        The frame's workspace.
+    name : str
+        The array's name in it.
+    shape : tuple of int
+        The shape.
+    dtype : numpy dtype, optional
+        The dtype.
+
+    Returns
+    -------
+    numpy.ndarray
+        An uninitialised array.
+    """
     return np.empty(shape, dtype) if work is None else work.empty(name, shape, dtype)
 
 
 def span_arrays(S, Kc):
     """Arrays for ``S`` spans of ``Kc`` attributes: ``tri, row, x0, count, m, t0, dt, left,
-    right``."""
+    right``.
+
+    Parameters
+    ----------
+    S : int
+        The number of spans.
+    Kc : int
+        Attributes per span end.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(tri, row, x0, count, m, t0, dt, left, right)``, uninitialised.
+    """
     return (np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S, np.int64),
             np.empty(S, np.int64), np.empty(S, np.int64), np.empty(S), np.empty(S),
             np.empty((S, Kc)), np.empty((S, Kc)))
@@ -127,7 +187,20 @@ _SCRATCH_MAX = 1 << 21     # spans (about 350 MB); larger frames get fresh array
 def span_buffers(S, Kc):
     """:func:`span_arrays` as views of buffers this thread keeps between frames: fresh
     pages cost as much as the span set-up itself (a page fault per 4 KiB in this VM,
-    13 MB of spans at 1024x1024), reused ones nothing. Grown by a quarter when short."""
+    13 MB of spans at 1024x1024), reused ones nothing. Grown by a quarter when short.
+
+    Parameters
+    ----------
+    S : int
+        The number of spans.
+    Kc : int
+        Attributes per span end.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(tri, row, x0, count, m, t0, dt, left, right)``, uninitialised.
+    """
     cache = getattr(_SCRATCH, "spans", None)
     if cache is None:
         cache = _SCRATCH.spans = {}

@@ -1,0 +1,266 @@
+"""Every public callable of chebnorm has a numpydoc docstring with the sections
+its signature calls for: ``Parameters`` when it takes arguments (for a class:
+its constructor's, in ``Parameters`` or ``Attributes``), ``Returns`` (or
+``Yields``) when it returns a value, and every argument named there.
+
+Public means: the facade's ``chebnorm.__all__``, and every name of a public
+module (no ``_`` in its dotted path) of a stage, that is its ``__all__`` or,
+without one, the functions and classes it defines whose names do not start
+with ``_``. Each object is checked once, under the module that defines it.
+Skipped without numpydoc (``pip install -e ".[docs]"``).
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import pkgutil
+import textwrap
+
+import pytest
+
+docscrape = pytest.importorskip("numpydoc.docscrape", reason="numpydoc not installed (pip install -e '.[docs]')")
+
+import chebnorm  # noqa: E402
+
+STAGES = ("core", "symbolic", "approx", "methods", "hw", "export", "raster", "cli")
+
+#: Stages whose docstrings are still being rewritten on other branches: their items
+#: run and report (xfail, not strict: a passing one shows as XPASS), and the set is
+#: emptied once the sweep of each is merged.
+PENDING = {"approx", "hw", "export", "cli"}
+#: Modules of the other stages whose sweep is pending too (the compiled engine's internals).
+PENDING_MODULES: tuple[str, ...] = ()
+
+
+def _public_modules() -> list[str]:
+    """Every public module of every stage, the stage packages included."""
+    names = []
+    for stage in STAGES:
+        pkg = importlib.import_module(f"chebnorm.{stage}")
+        names.append(pkg.__name__)
+        names += [m.name for m in pkgutil.walk_packages(pkg.__path__, f"{pkg.__name__}.")
+                  if not any(part.startswith("_") for part in m.name.split("."))]
+    return sorted(set(names))
+
+
+def _public_names(mod) -> list[str]:
+    """The module's ``__all__``, or the functions and classes it defines."""
+    if hasattr(mod, "__all__"):
+        return list(mod.__all__)
+    return [n for n, v in vars(mod).items() if not n.startswith("_")
+            and (inspect.isfunction(v) or inspect.isclass(v)) and v.__module__ == mod.__name__]
+
+
+def _callables() -> dict[str, object]:
+    """Qualified name (where defined) -> every public function and class, once each."""
+    found: dict[int, tuple[str, object]] = {}
+    sources = [(chebnorm, list(chebnorm.__all__))]
+    sources += [(m, _public_names(m)) for m in map(importlib.import_module, _public_modules())]
+    for mod, names in sources:
+        for name in names:
+            obj = getattr(mod, name)
+            if not (inspect.isfunction(obj) or inspect.isclass(obj)):
+                continue
+            obj = inspect.unwrap(obj)
+            qual = f"{obj.__module__}.{obj.__qualname__}"
+            if qual.startswith("chebnorm."):
+                found.setdefault(id(obj), (qual, obj))
+    return dict(sorted(found.values()))
+
+
+CALLABLES = _callables()
+
+
+def _stage(qual: str) -> str:
+    return qual.split(".")[1]
+
+
+def _pending(qual: str) -> bool:
+    return _stage(qual) in PENDING or qual.startswith(PENDING_MODULES)
+
+
+def _params(obj) -> list[str]:
+    """The arguments a caller passes (no self/cls, no ``*args``/``**kwargs`` names)."""
+    target = obj.__init__ if inspect.isclass(obj) else obj
+    if inspect.isclass(obj) and not inspect.isfunction(target):
+        return []  # the constructor of a builtin base (an exception's message arguments)
+    try:
+        sig = inspect.signature(target)
+    except (TypeError, ValueError):
+        return []
+    out = []
+    for i, p in enumerate(sig.parameters.values()):
+        if i == 0 and p.name in ("self", "cls") and inspect.isclass(obj):
+            continue
+        if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
+            out.append(("*" if p.kind == p.VAR_POSITIONAL else "**") + p.name)
+        else:
+            out.append(p.name)
+    return out
+
+
+def _returns_value(func) -> bool:
+    """True when the function's own body has ``return <expr>`` (not None) or ``yield``."""
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(func)))
+    except (OSError, TypeError, SyntaxError):
+        return False
+    fn = tree.body[0]
+    stack = list(fn.body)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue  # a nested function's returns are its own
+        if isinstance(node, (ast.Yield, ast.YieldFrom)):
+            return True
+        if isinstance(node, ast.Return) and node.value is not None and not (
+                isinstance(node.value, ast.Constant) and node.value.value is None):
+            return True
+        stack.extend(ast.iter_child_nodes(node))
+    return False
+
+
+def _documented(section) -> set[str]:
+    """Names a Parameters/Attributes section documents (``a, b : int`` counts both)."""
+    names = set()
+    for p in section:
+        for n in p.name.split(","):
+            names.add(n.strip())
+    return names
+
+
+def problems(obj) -> list[str]:
+    """What the docstring of ``obj`` lacks, as short phrases (empty when complete)."""
+    doc = inspect.getdoc(obj) if inspect.isclass(obj) else obj.__doc__
+    if inspect.isclass(obj) and doc == inspect.getdoc(object):
+        doc = None
+    if not doc or not doc.strip():
+        return ["no docstring"]
+    parsed = docscrape.ClassDoc(obj, doc=doc) if inspect.isclass(obj) else docscrape.FunctionDoc(obj, doc=doc)
+    out = []
+    if not parsed["Summary"]:
+        out.append("no summary line")
+    params = _params(obj)
+    given = _documented(parsed["Parameters"]) | _documented(parsed["Other Parameters"])
+    if inspect.isclass(obj):
+        given |= _documented(parsed["Attributes"])
+    if params and not given:
+        out.append("no Parameters section" + (" (nor Attributes)" if inspect.isclass(obj) else ""))
+    elif params:
+        missing = [p for p in params if p.lstrip("*") not in {g.lstrip("*") for g in given}]
+        if missing:
+            out.append(f"Parameters does not name {', '.join(missing)}")
+    if inspect.isfunction(obj) and _returns_value(obj) and not (parsed["Returns"] or parsed["Yields"]):
+        out.append("no Returns section")
+    return out
+
+
+@pytest.mark.parametrize("qual", [pytest.param(
+    q, marks=pytest.mark.xfail(reason="docstring sweep pending", strict=False) if _pending(q) else ())
+    for q in CALLABLES])
+def test_numpydoc_sections(qual):
+    assert problems(CALLABLES[qual]) == []
+
+
+def test_the_sweep_covers_the_facade_and_every_stage():
+    """The parametrization is not empty by accident: every facade callable and every
+    stage contributes, and PENDING names only stages."""
+    assert PENDING <= set(STAGES)
+    stages = {_stage(q) for q in CALLABLES}
+    assert stages == set(STAGES)
+    for name in chebnorm.__all__:
+        obj = getattr(chebnorm, name)
+        if inspect.isfunction(obj) or inspect.isclass(obj):
+            assert f"{obj.__module__}.{obj.__qualname__}" in CALLABLES
+
+
+def test_the_checker_finds_what_is_missing():
+    """problems() reports each kind of gap (so a pass above means something)."""
+    def bare(a, b):
+        """Add."""
+        return a + b
+
+    def half(a, b):
+        """Add.
+
+        Parameters
+        ----------
+        a : int
+            One.
+
+        Returns
+        -------
+        int
+            The sum.
+        """
+        return a + b
+
+    def full(a, *rest):
+        """Add.
+
+        Parameters
+        ----------
+        a : int
+            One.
+        *rest : int
+            More.
+
+        Returns
+        -------
+        int
+            The sum.
+        """
+        return a + sum(rest)
+
+    assert problems(bare) == ["no Parameters section", "no Returns section"]
+    assert problems(half) == ["Parameters does not name b"]
+    assert problems(full) == []
+
+
+def _constants() -> dict[str, bool]:
+    """Qualified name (where assigned) -> whether it has a ``#:`` description there, for
+    every public constant: the non-callable, non-module names of the facade's and
+    each public module's ``__all__`` (a stage's re-exports are found where assigned)."""
+    from sphinx.pycode import ModuleAnalyzer
+
+    docs: dict[str, set[str]] = {}
+    where: dict[int, str] = {}
+    for modname in _public_modules():
+        mod = importlib.import_module(modname)
+        try:
+            attrs = {n for (cls, n) in ModuleAnalyzer.for_module(modname).find_attr_docs() if cls == ""}
+        except Exception:  # noqa: BLE001 - no source: nothing documented
+            attrs = set()
+        docs[modname] = attrs
+        for n in getattr(mod, "__all__", ()):
+            if n not in vars(mod) and n not in docs.get(modname, ()):
+                if hasattr(mod, "__getattr__") and not any(n in vars(importlib.import_module(m))
+                                                           for m in docs if m.startswith(modname + ".")):
+                    continue  # computed on access (PEP 562): described in the module docstring
+            v = getattr(mod, n)
+            if inspect.ismodule(v) or callable(v) or n.startswith("__"):
+                continue
+            # the module that assigns it: the one whose analyzer knows the name, else the
+            # deepest module exporting the same object
+            where.setdefault(id(v), f"{modname}.{n}")
+            if n in attrs:
+                where[id(v)] = f"{modname}.{n}"
+    out = {}
+    for qual in where.values():
+        modname, n = qual.rsplit(".", 1)
+        out[qual] = n in docs[modname]
+    return dict(sorted(out.items()))
+
+
+CONSTANTS = _constants()
+
+
+@pytest.mark.parametrize("qual", [pytest.param(
+    q, marks=pytest.mark.xfail(reason="docstring sweep pending", strict=False) if _pending(q) else ())
+    for q in CONSTANTS])
+def test_constant_has_a_description(qual):
+    """A ``#:`` comment above the assignment (else the API reference shows the docstring
+    of the value's type, ``tuple``'s or ``int``'s)."""
+    assert CONSTANTS[qual], f"{qual}: add a #: comment above its assignment"
