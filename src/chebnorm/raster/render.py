@@ -175,7 +175,8 @@ class RenderResult(ImageFrame):
     method : str or None
         The normalization method (None where the mode has none).
     seconds : float
-        Wall time of the render.
+        Wall time of the render (numba's first compile excluded: see
+        ``compile_seconds``).
     triangles : int
         Triangles rendered.
     fragments : int
@@ -186,6 +187,9 @@ class RenderResult(ImageFrame):
         Index of the visible triangle per pixel, -1 on background.
     normal_length : numpy.ndarray, optional
         ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background.
+    compile_seconds : float
+        Seconds spent compiling (numba, the first render of a kind in this
+        process), before the clock of ``seconds`` started.
     """
 
     image: np.ndarray
