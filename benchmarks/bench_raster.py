@@ -4,6 +4,12 @@ frame relative to a bare numpy normalization of the same number of vectors
 
     .venv/bin/python benchmarks/bench_raster.py [--size 512 512] [--repeat 5] [--json]
                                                 [--engine numba numpy] [--peer llvmpipe]
+                                                [--stages]
+
+``--stages``: process CPU time of each stage of the numba engine's ``phong`` frame
+(set-up, row spans, end normals and checks, method set-up, then the frame's passes:
+visibility and background, the method's normals, half vectors, shading with ``pow``
+and the output maps), every method.
 
 ``--peer llvmpipe`` (issue 30): the ``phong`` frame of every method against Mesa's
 llvmpipe drawing the same frame (the shader demo's fragment shader with
@@ -219,6 +225,48 @@ def print_peer(res, mesh, size):
           "(load average above the core count) neither is a fair measurement")
 
 
+def stages(mesh, size, methods, repeat):
+    """Per-stage process CPU time of the numba engine's ``phong`` frame, per method (best
+    of ``repeat`` after a warm-up; the median per stage, since the frame's passes are
+    differences of runs): the engine's set-up (projection, triangle gather), then
+    :func:`chebnorm.raster.engines.numba.frame.stage_times`' stages."""
+    from chebnorm.methods import get_method
+    from chebnorm.raster.engines import get_engine
+    from chebnorm.raster.engines.numba.frame import stage_times
+    from chebnorm.raster.render import Lighting
+
+    eng = get_engine("numba")
+    lighting = Lighting()
+    out = {}
+    for m in methods:
+        spec = get_method(m)
+        seen = {}
+        for rnd in range(repeat + 1):
+            c, w = time.process_time(), time.perf_counter()
+            st = eng.setup(mesh, None, size, True)
+            st.L = lighting.direction(st.camera)
+            got = {"setup": (time.process_time() - c, time.perf_counter() - w)}
+            got.update(stage_times(st, spec, lighting))
+            if rnd:
+                for k, v in got.items():
+                    seen.setdefault(k, []).append(v)
+        out[m] = {k: tuple(float(x) for x in np.median(np.array(v), axis=0))
+                  for k, v in seen.items()}
+    return out
+
+
+def print_stages(res, mesh, size, load_before):
+    la = os.getloadavg()
+    print(f"{mesh.name} {size[0]}x{size[1]}: numba phong frame per stage, process CPU ms "
+          f"(all threads; median of the rounds, per stage); load average {load_before[0]:.2f} "
+          f"before, {la[0]:.2f} after")
+    names = list(next(iter(res.values())))
+    print(f"  {'method':12s}" + "".join(f" {n:>12s}" for n in names) + f" {'total':>8s}")
+    for m, st in res.items():
+        print(f"  {m:12s}" + "".join(f" {st[n][0] * 1e3:12.2f}" for n in names)
+              + f" {sum(v[0] for v in st.values()) * 1e3:8.2f}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--mesh", default="teapot")
@@ -233,11 +281,21 @@ def main(argv=None):
     ap.add_argument("--peer", choices=["llvmpipe"], default=None,
                     help="time the phong frame of every method against Mesa llvmpipe drawing "
                          "the same frame (moderngl, EGL), interleaved; prints the rate ratios")
+    ap.add_argument("--stages", action="store_true",
+                    help="per-stage CPU time of the numba engine's phong frame, every method")
     args = ap.parse_args(argv)
     args.repeat_set = args.repeat is not None
     args.repeat = args.repeat if args.repeat_set else 5
     mesh = get_mesh(args.mesh)
     size = tuple(args.size)
+    if args.stages:
+        load_before = os.getloadavg()
+        res = stages(mesh, size, list(available_methods()), args.repeat)
+        if args.json:
+            print(json.dumps(res, indent=2))
+        else:
+            print_stages(res, mesh, size, load_before)
+        return
     if args.peer:
         methods = list(available_methods())
         res = peer_llvmpipe(mesh, size, methods, args.repeat if args.repeat_set else 7,
