@@ -42,7 +42,7 @@ import time
 import numpy as np
 from machine import cpu_description
 
-from chebnorm.raster import available_methods, get_mesh, render
+from chebnorm.raster import available_methods, get_mesh, render, to_8bit
 
 
 def best_of(fn, repeat):
@@ -189,8 +189,13 @@ def peer_llvmpipe(mesh, size, methods, repeat, engine="numba"):
             if rnd and sec < best[name]:
                 best[name], cpu[name] = sec, cs
     load_after = os.getloadavg()
-    _, gl_mask = peer.frame_read()
+    gl_img, gl_mask = peer.frame_read()
     peer.release()
+    # the same frame: coverage and the 8-bit intensity where both cover (exact)
+    ref = render(mesh, "phong", "exact", size=size, engine=engine)
+    both = gl_mask & ref.mask
+    diff = np.abs(to_8bit(gl_img.astype(np.float64)).astype(np.int64)
+                  - to_8bit(ref.image).astype(np.int64))[both]
     gl = best["llvmpipe"]
     rows = [{"case": name, "seconds": best[name], "cpu_s": cpu[name],
              "fragments": frags.get(name),
@@ -199,7 +204,11 @@ def peer_llvmpipe(mesh, size, methods, repeat, engine="numba"):
              if name in methods else None,
              "cpu_ratio_vs_llvmpipe": cpu["llvmpipe"] / cpu[name]
              if name in methods and cpu[name] else None} for name, _ in cases]
-    return {"rows": rows, "gl_pixels": int(gl_mask.sum()), "load_average_before": load_before,
+    return {"rows": rows, "gl_pixels": int(gl_mask.sum()), "chebnorm_pixels": int(ref.mask.sum()),
+            "common_pixels": int(both.sum()),
+            "max_abs_8bit": int(diff.max()) if diff.size else None,
+            "pixels_over_1_level": int((diff > 1).sum()),
+            "load_average_before": load_before,
             "load_average_after": load_after, "rounds": repeat, "engine": engine}
 
 
@@ -220,6 +229,10 @@ def print_peer(res, mesh, size):
         print(f"  {r['case']:16s} {r['seconds'] * 1e3:8.2f} {r['cpu_s'] * 1e3:8.2f}  "
               f"{r['ratio_vs_llvmpipe']:15.2f}x  {r['ratio_vs_llvmpipe_read']:14.2f}x "
               f"{r['cpu_ratio_vs_llvmpipe'] or float('nan'):9.2f}x  >= {goal:.1f}: {verdict}")
+    print(f"  same frame: {res['gl_pixels']} pixels covered by llvmpipe, "
+          f"{res['chebnorm_pixels']} by chebnorm, {res['common_pixels']} by both; there the 8-bit "
+          f"intensities (exact) differ by more than 1 level at {res['pixels_over_1_level']} "
+          f"pixels (at most {res['max_abs_8bit']}: visibility ties)")
     print("  rate ratio = llvmpipe ms / chebnorm ms (wall, best round); cpu time: the same "
           "with process CPU time (all threads), less sensitive to other jobs; under load "
           "(load average above the core count) neither is a fair measurement")
