@@ -232,7 +232,7 @@ def print_peer(res, mesh, size):
     print(f"  same frame: {res['gl_pixels']} pixels covered by llvmpipe, "
           f"{res['chebnorm_pixels']} by chebnorm, {res['common_pixels']} by both; there the 8-bit "
           f"intensities (exact) differ by more than 1 level at {res['pixels_over_1_level']} "
-          f"pixels (at most {res['max_abs_8bit']}: visibility ties)")
+          f"pixels (at most {res['max_abs_8bit']})")
     print("  rate ratio = llvmpipe ms / chebnorm ms (wall, best round); cpu time: the same "
           "with process CPU time (all threads), less sensitive to other jobs; under load "
           "(load average above the core count) neither is a fair measurement")
