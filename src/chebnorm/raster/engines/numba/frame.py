@@ -43,8 +43,8 @@ from chebnorm.methods.registry import method_kernel
 from chebnorm.methods.spans import MAX_LEVELS
 
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
-from .calibration import (DetOps, calibrated, dot3, f32_round, pow_calibrated, powers, trig64,
-                          trig_calibrated)
+from .calibration import (DetOps, calibrated, dot3, dot3_select, f32_round, pow_calibrated,
+                          powers, trig64, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, threads
 from .kernels import dichotomy_denominators
 from .rasterize import row_spans
@@ -167,35 +167,6 @@ def _step(mode, j, v0, v1, v2, e0, e1, e2, f0, f1, f2, k2):
 def _clamp0(a):
     """``np.maximum(a, 0.0)`` (NaN kept)."""
     return a if (a >= 0.0 or a != a) else 0.0
-
-
-@njit()
-def _dots_row(x0, x1, x2, y0, y1, y2, out, nw, order):
-    """``out[k] = x[k] . y[k]`` in summation order ``order`` (one loop per order, so
-    each vectorizes)."""
-    if order == 0:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 0)
-    elif order == 1:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 1)
-    else:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 2)
-
-
-@njit()
-def _dotc_row(x0, x1, x2, c0, c1, c2, out, nw, order):
-    """``out[k] = x[k] . c`` (``c`` one vector), in summation order ``order``."""
-    if order == 0:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 0)
-    elif order == 1:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 1)
-    else:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 2)
 
 
 @njit()
@@ -365,13 +336,11 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
     I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
     fastpow = light[5] != 0.0
     o0, o1, o2 = orders[0], orders[1], orders[2]
-    _dotc_row(n0, n1, n2, l0, l1, l2, av, nw, o0)
-    _dots_row(n0, n1, n2, h0, h1, h2, bv, nw, o1)
-    _dots_row(n0, n1, n2, n0, n1, n2, nl, nw, o2)
-    for k in range(nw):
-        av[k] = _clamp0(av[k])
-        bv[k] = _clamp0(bv[k])
-        nl[k] = np.sqrt(nl[k])
+    for k in range(nw):     # one vectorized loop: the orders selected, not branched on
+        N0, N1, N2 = n0[k], n1[k], n2[k]
+        av[k] = _clamp0(dot3_select(N0, N1, N2, l0, l1, l2, o0))
+        bv[k] = _clamp0(dot3_select(N0, N1, N2, h0[k], h1[k], h2[k], o1))
+        nl[k] = np.sqrt(dot3_select(N0, N1, N2, N0, N1, N2, o2))
     powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
     for k in range(nw):
         v = I0 * (ka + kdif * av[k] + ks * pw[k])
