@@ -371,3 +371,28 @@ def test_fused_span_buffers_per_thread():
     with ThreadPoolExecutor(2) as pool:
         for _ in range(3):
             assert list(pool.map(draw, cases + cases[::-1])) == alone + alone[::-1]
+
+
+@pytest.mark.parametrize("order", [0, 1, 2])
+def test_dot3_select_is_dot3(order):
+    """The branch-free dot product of the fused shading loop sums in the order it is
+    given, to the bit: against exact rational arithmetic rounded per operation."""
+    from fractions import Fraction as Q
+
+    def rnd(q):          # one rounding to the nearest float64
+        return Q(float(q))
+
+    rng = np.random.default_rng(30 + order)
+    vals = rng.standard_normal((300, 6)) * np.exp2(rng.integers(-30, 30, (300, 6)))
+    for a0, a1, a2, b0, b1, b2 in vals:
+        A, B = [Q(float(v)) for v in (a0, a1, a2)], [Q(float(v)) for v in (b0, b1, b2)]
+        p = [rnd(A[i] * B[i]) for i in range(3)]
+        if order == 0:
+            want = rnd(rnd(p[0] + p[1]) + p[2])
+        elif order == 1:
+            want = rnd(rnd(p[0] + p[2]) + p[1])
+        else:
+            want = rnd(A[2] * B[2] + rnd(A[0] * B[0] + p[1]))
+        got = calibration.dot3_select(a0, a1, a2, b0, b1, b2, order)
+        assert got == float(want)
+        assert got == calibration.dot3(a0, a1, a2, b0, b1, b2, order)

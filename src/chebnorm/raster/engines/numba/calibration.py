@@ -23,7 +23,7 @@ from chebnorm.methods.ops import NumpyOps
 
 from .jit import HAVE_NUMBA, f2i, fma, i2f, njit
 
-__all__ = ["dot3", "dots", "calibrated", "first_orders", "f32_round", "det", "DetOps",
+__all__ = ["dot3", "dot3_select", "dots", "calibrated", "first_orders", "f32_round", "det", "DetOps",
            "powers", "pow_calibrated", "trig64", "trig_calibrated", "ends_orders"]
 
 
@@ -37,6 +37,22 @@ def dot3(a0, a1, a2, b0, b1, b2, order):
     if order == 1:
         return (a0 * b0 + a2 * b2) + a1 * b1
     return fma(a2, b2, fma(a0, b0, a1 * b1))
+
+
+@njit(inline=True)
+def dot3_select(a0, a1, a2, b0, b1, b2, order):
+    """:func:`dot3` without a branch: every order's sum computed, the one of ``order``
+    selected (the same operations, so the same bits), so that a loop over pixels with
+    ``order`` a run-time value still vectorizes."""
+    p0 = a0 * b0
+    p1 = a1 * b1
+    p2 = a2 * b2
+    one = order == 1
+    x = p2 if one else p1
+    y = p1 if one else p2
+    r01 = (p0 + x) + y
+    r2 = fma(a2, b2, fma(a0, b0, p1))
+    return r2 if order == 2 else r01
 
 
 @njit()

@@ -33,6 +33,8 @@ promise the reference's bytes for a method, and :func:`phong` raises
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from chebnorm.methods import detmath
@@ -41,15 +43,15 @@ from chebnorm.methods.registry import method_kernel
 from chebnorm.methods.spans import MAX_LEVELS
 
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
-from .calibration import (DetOps, calibrated, dot3, f32_round, pow_calibrated, powers, trig64,
-                          trig_calibrated)
+from .calibration import (DetOps, calibrated, dot3, dot3_select, f32_round, pow_calibrated,
+                          powers, trig64, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, threads
 from .kernels import dichotomy_denominators
 from .rasterize import row_spans
 from .setup import method_setup, span_input, widest_dot
 from .workspace import give, keep_maps, output_maps, take
 
-__all__ = ["MODES", "supports", "phong"]
+__all__ = ["MODES", "supports", "phong", "stage_times"]
 
 
 #: kernel -> mode number of the fused kernel
@@ -168,35 +170,6 @@ def _clamp0(a):
 
 
 @njit()
-def _dots_row(x0, x1, x2, y0, y1, y2, out, nw, order):
-    """``out[k] = x[k] . y[k]`` in summation order ``order`` (one loop per order, so
-    each vectorizes)."""
-    if order == 0:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 0)
-    elif order == 1:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 1)
-    else:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], y0[k], y1[k], y2[k], 2)
-
-
-@njit()
-def _dotc_row(x0, x1, x2, c0, c1, c2, out, nw, order):
-    """``out[k] = x[k] . c`` (``c`` one vector), in summation order ``order``."""
-    if order == 0:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 0)
-    elif order == 1:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 1)
-    else:
-        for k in range(nw):
-            out[k] = dot3(x0[k], x1[k], x2[k], c0, c1, c2, 2)
-
-
-@njit()
 def _half_row(h0, h1, h2, e0, e1, e2, l0, l1, l2, nw, order):
     """``h[k] = _half(P[k])`` in place (``h`` holds the positions ``P`` on entry)."""
     if order == 0:
@@ -235,7 +208,7 @@ def _linear_row(mode, n0, n1, n2, a0, a1, a2, d0, d1, d2, tc, kc, out0, out1, ou
 @njit()
 def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
            A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
-           light, orders, part, parts, img, mask, tri_map, nlen):
+           light, orders, part, parts, img, mask, tri_map, nlen, stop=0):
     """The visibility and shading passes, one scan line at a time, on the rows
     ``part, part + parts, ...`` (threads run the parts at once: each writes every pixel
     of its own rows of the four output maps, the background where no fragment lands:
@@ -245,7 +218,10 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
     then each quantity of the shading for all of them in one loop (gathers first, then
     loops of arithmetic alone, which LLVM vectorizes: ``sqrt`` and division are
-    correctly rounded in every lane, so the bits are the scalar ones)."""
+    correctly rounded in every lane, so the bits are the scalar ones).
+
+    ``stop`` (profiling only, :func:`stage_times`): 0 draws the frame; 1, 2, 3 stop each
+    row after its visibility and background, its normals, its half vectors."""
     hard = 0
     l0, l1, l2 = L[0], L[1], L[2]
     ey0, ey1, ey2 = eye[0], eye[1], eye[2]
@@ -289,6 +265,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             tu = t0[s] + (wx[k] - c0[s]) * dt[s]
             tc[k] = tu                       # the reference's t.astype(dtype)
             wt[k] = min(max(tu, 0.0), 1.0)
+        if stop == 1:
+            continue
         # the method's normals, widened to float64
         if mode == 0:
             for k in range(nw):
@@ -314,6 +292,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
                                sab, skip, n0, n1, n2, nw)
         else:
             _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw)
+        if stop == 2:
+            continue
         # half vectors
         if per_pixel_h:
             for k in range(nw):
@@ -326,6 +306,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
             _half_row(h0, h1, h2, ey0, ey1, ey2, l0, l1, l2, nw, o2)
         else:
             _tri_half_row(ws, stri, Htri, h0, h1, h2, nw)
+        if stop == 3:
+            continue
         _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
                    bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
     return hard
@@ -354,13 +336,11 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
     I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
     fastpow = light[5] != 0.0
     o0, o1, o2 = orders[0], orders[1], orders[2]
-    _dotc_row(n0, n1, n2, l0, l1, l2, av, nw, o0)
-    _dots_row(n0, n1, n2, h0, h1, h2, bv, nw, o1)
-    _dots_row(n0, n1, n2, n0, n1, n2, nl, nw, o2)
-    for k in range(nw):
-        av[k] = _clamp0(av[k])
-        bv[k] = _clamp0(bv[k])
-        nl[k] = np.sqrt(nl[k])
+    for k in range(nw):     # one vectorized loop: the orders selected, not branched on
+        N0, N1, N2 = n0[k], n1[k], n2[k]
+        av[k] = _clamp0(dot3_select(N0, N1, N2, l0, l1, l2, o0))
+        bv[k] = _clamp0(dot3_select(N0, N1, N2, h0[k], h1[k], h2[k], o1))
+        nl[k] = np.sqrt(dot3_select(N0, N1, N2, N0, N1, N2, o2))
     powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
     for k in range(nw):
         v = I0 * (ka + kdif * av[k] + ks * pw[k])
@@ -588,6 +568,10 @@ def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, p
 
 
 # ------------------------------------------------------------------ driver
+def _no_clock(name):
+    """The stage recorder of an unprofiled frame."""
+
+
 def supports(spec) -> bool:
     """Whether :func:`phong` renders method ``spec`` (its kernel has a fused twin, numba is
     installed and :func:`calibrated` found the reductions' orders).
@@ -680,6 +664,13 @@ def phong(st, spec, lighting, tables, dtype):
     ModeResult
         The frame, the same bytes as the numpy engine's.
     """
+    return _phong(st, spec, lighting, tables, dtype, None)
+
+
+def _phong(st, spec, lighting, tables, dtype, clock):
+    """:func:`phong`; ``clock`` (None, or :func:`stage_times`' stage recorder) is called
+    with each stage's name once the stage is done."""
+    tick = clock or _no_clock
     orders = calibrated()
     if orders is None or id(method_kernel(spec)) not in MODES:
         raise FrameUnsupported("no calibrated reduction orders or no fused kernel")
@@ -691,6 +682,7 @@ def phong(st, spec, lighting, tables, dtype):
         attrs = attrs[..., :4]
     work = take()    # scratch arrays of an earlier frame (pages mapped)
     sp = row_spans(st.xy, attrs, st.width, st.height, work)
+    tick("spans")
     # the output maps: the memory of an earlier frame's once the user dropped it (else
     # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows
     maps = output_maps(st.width * st.height)
@@ -702,6 +694,7 @@ def phong(st, spec, lighting, tables, dtype):
     ends, dot_min = (widest_dot(sp, spec, dtype, mode <= 3, work)
                      if S and (mode or spec.table is not None) else (None, None))
     tables = auto_tables(spec, sp, [[1, 2, 3]], tables, stats, dot_min=dot_min)
+    tick("ends")
     dt_, A, B, C, sc, sc2, levels, R, off, kd = _mode_arrays(mode, spec, sp, tables, dtype,
                                                              ends, work)
     kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
@@ -721,6 +714,11 @@ def phong(st, spec, lighting, tables, dtype):
               *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
               per_pixel_h, Htri, L, eye, light, ords)
     k = min(threads(), st.height)
+    tick("method set-up")
+    if clock is not None:     # the frame's passes, cumulatively, for stage_times
+        for stop, name in ((1, "visibility"), (2, "normals"), (3, "half vectors")):
+            run([(_frame, (*common, q, k, *maps, stop)) for q in range(k)])
+            tick(name)
     nh = sum(run([(_frame, (*common, q, k, *maps)) for q in range(k)]))
     if nh:
         pix = np.flatnonzero(tri_map < -1)
@@ -733,9 +731,46 @@ def phong(st, spec, lighting, tables, dtype):
                      L, eye, light, ords, img, mask, tri_map, nlen, face_id)
     give(work)
     keep_maps(maps)
+    tick("shading")
     if np.count_nonzero(mask) < 2:
         # numpy computes N @ L for one row by another route than BLAS
         raise FrameUnsupported("fewer than two pixels covered")
     shape = (st.height, st.width)
     return ModeResult(img.reshape(shape), mask.reshape(shape), int(sp.count.sum()), stats,
                       triangle=tri_map.reshape(shape), normal_length=nlen.reshape(shape))
+
+
+def stage_times(st, spec, lighting, tables=None, dtype=np.float64):
+    """Process CPU time (all threads) and wall time of each stage of :func:`phong`'s
+    frame, for the benchmark's ``--stages``: ``{stage: (cpu_s, wall_s)}`` in order:
+    ``spans`` (row spans), ``ends`` (unit end normals, the method's checks, tables),
+    ``method set-up``, then the frame's passes over the rows, each timed alone
+    (the frame run up to it minus the frame run up to the one before):
+    ``visibility`` (z-test, background, winners), ``normals`` (the method's),
+    ``half vectors``, ``shading`` (dot products, ``pow``, the output maps).
+
+    Parameters
+    ----------
+    st, spec, lighting, tables, dtype
+        As :func:`phong` takes them.
+
+    Returns
+    -------
+    dict
+        Stage name -> ``(cpu_s, wall_s)``.
+    """
+    marks = [("start", time.process_time(), time.perf_counter())]
+
+    def clock(name):
+        marks.append((name, time.process_time(), time.perf_counter()))
+
+    _phong(st, spec, lighting, tables, dtype, clock)
+    out = {}
+    for (_, c0, w0), (name, c1, w1) in zip(marks, marks[1:]):
+        out[name] = (c1 - c0, w1 - w0)
+    # the frame's passes ran cumulatively: each stage is its run minus the one before
+    cum = ["visibility", "normals", "half vectors", "shading"]
+    runs = {n: out[n] for n in cum}
+    for a, b in zip(cum, cum[1:]):
+        out[b] = (runs[b][0] - runs[a][0], runs[b][1] - runs[a][1])
+    return out
