@@ -12,7 +12,8 @@ the benches too).
 from __future__ import annotations
 
 from chebnorm.approx import PiecewiseTable, load_table
-from chebnorm.export import EXPORT_FORMATS, HDL_FORMATS, export_table, options_for
+from chebnorm.export import (EXPORT_FORMATS, HDL_FORMATS, export_table, export_with_proofs,
+                             options_for)
 
 from .common import command_line, deprecated_alias
 
@@ -32,6 +33,9 @@ def register(sub) -> None:
     p.add_argument("table", metavar="TABLE.json")
     p.add_argument("--format", default="c", help=f"one of {_all_formats()} (default c)")
     p.add_argument("-o", "--output", metavar="FILE", required=True)
+    p.add_argument("--proof", action="store_true",
+                   help="also write a Gappa script per stated evaluation bound beside FILE "
+                   "(FILE's stem.CONSTANT.gappa; formats c, glsl, wgsl, hlsl)")
     hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
     hw.add_argument("--in-bits", type=int, default=None,
                     help="input code width, 1..20 (a piecewise table's C export: 1..32, "
@@ -73,5 +77,8 @@ def run(args) -> int:
         accepted = "" if isinstance(table, PiecewiseTable) else "; accepted: 1..20 and 1..32"
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
                          f"output code widths){accepted}")
+    if args.proof:
+        export_with_proofs(table, args.format, args.output, command_line(args), **given)
+        return 0
     export_table(table, args.format, args.output, command_line(args), **given)
     return 0

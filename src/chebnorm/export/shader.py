@@ -73,12 +73,12 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from chebnorm.core.numeric import float_up
 
-from .c import (horner_rounding_bound, inner_interval, interval_max_abs, range_problem,
-                round_inward)
+from .c import inner_interval, interval_max_abs, range_problem, round_inward
+from .evalbound import BINARY32_FTZ, Evaluator, Piece
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
            "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source",
-           "interval32"]
+           "interval32", "shader_evaluator"]
 
 U32 = Fraction(1, 2 ** 24)
 _FLUSH = Fraction(1, 2 ** 126)  # largest magnitude a flushed subnormal float32 loses
@@ -255,21 +255,45 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
                          f"within the float32 range (|values| < 3.4e38)")
-    c32 = [float(np.float32(c)) for c in coeffs]
-    coef = sum((abs(Fraction(a) - Fraction(b)) * m ** k
-                for k, (a, b) in enumerate(zip(coeffs, c32))), Fraction(0))
-    rounding = horner_rounding_bound(c32, m, float(U32))
-    n = len(coeffs) - 1
-    flush = 4 * _FLUSH * (sum((m ** j for j in range(n)), Fraction(0))
-                          + sum((k * abs(Fraction(c)) * m ** (k - 1)
-                                 for k, c in enumerate(c32) if k), Fraction(0)))
-    total = certified + coef + rounding + flush
+    ev = shader_evaluator(table)
+    eb = ev.bound()
+    c32 = ev.pieces[0].coeffs
+    lo32, hi32 = interval32(table)
+    flush = Fraction(0)
+    if lo32 < 2.0 ** -126 and hi32 > -2.0 ** -126:
+        # a subnormal input may be flushed to 0: p moves by 2^-126 max |p'|,
+        # and the evaluation at 0 adds a local bound of its own
+        flush = _FLUSH * sum((k * abs(Fraction(c)) * m ** (k - 1)
+                              for k, c in enumerate(c32) if k), Fraction(0)) + eb.local
+    total = Fraction(eb.stated) + flush
     up = float_up(total)
     up32 = float(np.float32(up))
     if up32 < up:
         up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
-    return ShaderBound(certified=certified, coefficients=coef,
-                       rounding=rounding, flush=flush, total=up, total32=up32)
+    return ShaderBound(certified=certified, coefficients=Fraction(0),
+                       rounding=Fraction(eb.stated) - certified, flush=flush, total=up,
+                       total32=up32)
+
+
+def shader_evaluator(table: CoefficientTable, constant: str = ""):
+    """The :class:`~chebnorm.export.evalbound.Evaluator` of the shader
+    function: float32 Horner's rule (fused or not, subnormals possibly
+    flushed) on the float32 coefficients, over the float32 interval.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> shader_evaluator(fit("1/x", ("1", "2"), 1, name="inv")).arith.flush
+    True
+    """
+    coeffs, certified, _ = _coefficients(table)
+    c32 = tuple(float(np.float32(c)) for c in coeffs)
+    lo32, hi32 = interval32(table)
+    piece = Piece(c32, tuple(coeffs), certified, min(lo32, 0.0) if lo32 < 2.0 ** -126 < hi32
+                  and lo32 > 0 else lo32, hi32)
+    name = identifier(table.name, field="table.name")
+    return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
+                     f"chebnorm_{name}", BINARY32_FTZ, (piece,))
 
 
 def interval32(table: CoefficientTable) -> tuple[float, float]:
@@ -286,8 +310,11 @@ def interval32(table: CoefficientTable) -> tuple[float, float]:
     return round_inward(*inner_interval(table), "f")
 
 
-def shader_source(table: CoefficientTable, language: str, command: str = "") -> str:
-    """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl).
+def shader_source(table: CoefficientTable, language: str, command: str = "", *,
+                  proof: str = "") -> str:
+    """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl);
+    ``proof``: the stem of the Gappa proof file named in the banner (empty:
+    none).
 
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="d1")
@@ -329,10 +356,12 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
       f" in ascending powers of {var}, rounded to float32 (exact literals).")
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
-    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients "
-      f"{float(bound.coefficients):.6e}")
-    w(f"//   + Horner rounding gamma_2n (fused or not) {float(bound.rounding):.6e} + subnormal"
-      f" flushes {float(bound.flush):.3e}.")
+    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
+      f" {float(bound.rounding):.6e}")
+    w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half an"
+      " ulp of its")
+    w(f"//   largest result there, fused or not) + subnormal input flush {float(bound.flush):.3e}."
+      + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
     w("// Assumes float32 (highp) with correctly rounded + and *, and a multiply-add that is fused"
       " or two roundings.")
     w("")
