@@ -191,9 +191,9 @@ def _step(arith, acc, e, var, et, c):
         h = _half_ulp(arith, big, small)
         if grid is not None:  # both addends on the grid and the sum fits: exact
             exact = big <= np.ldexp(grid, arith.precision)
-            if arith.flush:  # an exact but subnormal sum may still be flushed
-                exact &= small >= 2.0 ** arith.emin
-            h = np.where(exact, 0.0, h)
+            # an exact but subnormal sum may still be flushed (error < 2^emin)
+            flushed = (small < 2.0 ** arith.emin) if arith.flush else np.zeros_like(exact)
+            h = np.where(exact, np.where(flushed, 2.0 ** arith.emin, 0.0), h)
         return _up(err + h)
 
     return (nl, nh), np.maximum(rounded_sum(e_prod, _sum_grid(arith, psmall, c)),

@@ -257,14 +257,14 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
                          f"within the float32 range (|values| < 3.4e38)")
     ev = shader_evaluator(table)
     eb = ev.bound()
-    c32 = ev.pieces[0].coeffs
     lo32, hi32 = interval32(table)
     flush = Fraction(0)
     if lo32 < 2.0 ** -126 and hi32 > -2.0 ** -126:
-        # a subnormal input may be flushed to 0: p moves by 2^-126 max |p'|,
-        # and the evaluation at 0 adds a local bound of its own
+        # a subnormal input x may be flushed to x' = 0, which lies in the
+        # analysed interval (shader_evaluator): |shader(x') - p(x')| is within
+        # the local bound, and |p(x') - p(x)| <= 2^-126 max |p'|
         flush = _FLUSH * sum((k * abs(Fraction(c)) * m ** (k - 1)
-                              for k, c in enumerate(c32) if k), Fraction(0)) + eb.local
+                              for k, c in enumerate(coeffs) if k), Fraction(0))
     total = Fraction(eb.stated) + flush
     up = float_up(total)
     up32 = float(np.float32(up))
@@ -288,9 +288,14 @@ def shader_evaluator(table: CoefficientTable, constant: str = ""):
     """
     coeffs, certified, _ = _coefficients(table)
     c32 = tuple(float(np.float32(c)) for c in coeffs)
-    lo32, hi32 = interval32(table)
-    piece = Piece(c32, tuple(coeffs), certified, min(lo32, 0.0) if lo32 < 2.0 ** -126 < hi32
-                  and lo32 > 0 else lo32, hi32)
+    # the C header's interval (its float32 inputs are the shader's), reaching 0
+    # when a subnormal input may be flushed to it
+    lo, hi = inner_interval(table)
+    if 0 < lo < 2.0 ** -126:
+        lo = 0.0
+    elif -2.0 ** -126 < hi < 0:
+        hi = 0.0
+    piece = Piece(c32, tuple(coeffs), certified, lo, hi)
     name = identifier(table.name, field="table.name")
     return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
                      f"chebnorm_{name}", BINARY32_FTZ, (piece,))
