@@ -16,7 +16,9 @@ rounded to nearest, ties up, by ``(acc * x_q + 2^(F-1)) >> F``; one
 sequence); the input ``x`` is a number of the evaluator's type. A
 piecewise evaluator gets one such pair per segment, all in one script over
 the segment's local variable. Hints: ``$ x in N`` bisects the interval into
-as many pieces as :func:`chebnorm.export.evalbound.horner_bound` uses, and
+the fewest pieces (a power of two, at most the 64 of
+:func:`chebnorm.export.evalbound.horner_bound`) on which our own computation
+already proves the bound with half the headroom to spare, and
 ``~`` / ``->`` tell Gappa which exact value each computed one approximates.
 
 Not modelled: the shaders' flush of subnormal results to zero (the script
@@ -125,7 +127,7 @@ def gappa_script(ev: Evaluator, bound: float | None = None) -> str:
     --------
     >>> from chebnorm.approx import fit
     >>> from chebnorm.export.shader import shader_evaluator
-    >>> "$ x in 64;" in gappa_script(shader_evaluator(fit("1/x", ("1", "2"), 1, name="inv")))
+    >>> "$ x in " in gappa_script(shader_evaluator(fit("1/x", ("1", "2"), 1, name="inv")))
     True
     """
     if bound is None:
@@ -165,9 +167,27 @@ def gappa_script(ev: Evaluator, bound: float | None = None) -> str:
         goals += g
         hints += hi_
     out.append("{ " + " /\\ ".join(hyps) + "\n  -> " + " /\\ ".join(goals) + " }")
-    out.append(f"$ x in {ev.subintervals};")
+    out.append(f"$ x in {_pieces(ev, bound)};")
     out += hints
     return "\n".join(out) + "\n"
+
+
+def _pieces(ev: Evaluator, bound: float) -> int:
+    """The fewest pieces (a power of two, at most ``ev.subintervals``) on
+    which our own computation proves ``bound`` with half the headroom to
+    spare: Gappa's time grows with the pieces, and its enclosures match ours
+    to well within that headroom."""
+    from dataclasses import replace
+
+    from .evalbound import PROOF_HEADROOM
+
+    n = 1
+    while n < ev.subintervals:
+        b = replace(ev, subintervals=n).bound()
+        if b.approximation + b.local * (1 + PROOF_HEADROOM / 2) <= Fraction(bound):
+            return n
+        n *= 2
+    return ev.subintervals
 
 
 def gappa_proofs(evaluators, stem: str) -> dict[str, str]:

@@ -24,26 +24,21 @@ shader analogue of the C header's ``_F_EVAL_ERROR_BOUND``
 
 * the certified bound of ``|p - f|`` for the coefficients evaluated: the
   table's double coefficients, or its ``quantized`` ones when their format is
-  binary16, bfloat16 or binary32 (each a float32 exactly, so the next term is 0);
-* ``sum_k |c_k - fl32(c_k)| M^k``: rounding the coefficients to float32
-  (``M`` = max |x| on the interval);
-* ``gamma_2n sum_k |fl32(c_k)| M^k`` with ``gamma_k = k u / (1 - k u)``,
-  ``u = 2^-24``: Horner's rounding error (Higham, *Accuracy and Stability of
-  Numerical Algorithms*, 2nd ed., eq. 5.3). The proof writes the computed
-  value as ``sum_k c_k x^k (1 + theta_(k))`` where ``1 + theta_(k)`` is a
-  product of at most ``2n`` factors ``(1 + delta)``, ``|delta| <= u``, one per
-  rounding the term goes through, and ``|theta_j| <= gamma_j``. A fused step
-  ``fl(a x + c)`` rounds once where the unfused ``fl(fl(a x) + c)`` rounds
-  twice, so every term of a fused, unfused or mixed evaluation carries
-  ``j <= 2n`` factors and ``|theta_j| <= gamma_j <= gamma_2n``: the one
-  bound covers the compiler fusing any subset of the steps (GLSL and WGSL
-  allow it; HLSL's ``mad`` may be either);
-* ``2^-124 (sum_{j<n} M^j + sum_k k |c_k| M^(k-1))``: subnormal flushes,
-  which all three languages allow. Each of the ``2n`` operations may flush a
-  subnormal result to zero, an absolute error below ``2^-126`` that later
-  steps multiply by ``|x| <= M`` at most ``n - 1`` times (two per step, and a
-  factor 2 for the roundings the error goes through later); a subnormal input
-  ``x`` flushed to zero moves ``p`` by at most ``2^-126 max |p'|``.
+  binary16, bfloat16 or binary32 (each a float32 exactly);
+* the float32 evaluation error, computed for the shader's operation sequence
+  by :func:`chebnorm.export.evalbound.horner_bound` (the C header's
+  ``_F_EVAL_ERROR_BOUND`` computation): on each of 64 pieces of the interval,
+  the coefficients' rounding to float32 and every operation's rounding (half
+  an ulp of its largest result there, or the ``2^-126`` a flushed subnormal
+  result loses), each step bounded fused and unfused, so the bound covers the
+  compiler fusing any subset of the steps (GLSL and WGSL allow it; HLSL's
+  ``mad`` may be either);
+* ``2^-126 max |p'|`` when a subnormal input may be flushed to 0 (the
+  analysed interval then reaches 0, so the evaluation at 0 is covered).
+
+:func:`shader_evaluator` gives the evaluator that
+:func:`chebnorm.export.gappa.gappa_script` proves (``chebnorm export
+--proof``); the script models IEEE binary32 without the flushes.
 
 What the bound assumes of the driver, from the specifications: float32
 ``+``, ``-``, ``*`` correctly rounded (round to nearest) and ``fma``'s
@@ -198,8 +193,11 @@ def float32_literal(value: float, suffix: str = "") -> str:
 class ShaderBound:
     """Parts of the float32 bound of ``|shader(x) - f(x)|`` (module docstring).
 
-    ``total`` is rounded up to a double; ``total32`` up to a float32 (the
-    value printed as a shader constant).
+    ``rounding`` is the evaluation part (float32 coefficients and Horner
+    rounding together, with the proof headroom; ``coefficients`` is 0, kept
+    for callers), ``flush`` the subnormal-input term; ``total`` is their sum
+    with ``certified`` rounded up to a double, ``total32`` up to a float32
+    (the value printed as a shader constant).
 
     Examples
     --------
