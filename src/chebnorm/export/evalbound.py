@@ -34,7 +34,7 @@ Examples
 --------
 >>> from fractions import Fraction
 >>> b = horner_bound([1.0, 0.5], [1.0, 0.5], Fraction(0), 1.0, 2.0, BINARY32)
->>> b.rounding <= Fraction(3, 2 ** 24)    # product in [0.5, 1], sum in [1.5, 2]
+>>> 3 * 2.0 ** -24 <= b.local < 3.0001 * 2.0 ** -24  # half an ulp of 1 and of 2 (largest results)
 True
 """
 
@@ -116,8 +116,8 @@ class EvalBound:
     Examples
     --------
     >>> b = horner_bound([2.0], [2.0], Fraction(1, 8), 0.0, 1.0, BINARY64)
-    >>> b.total, b.local
-    (0.125, Fraction(0, 1))
+    >>> b.total >= 0.125 and b.local < 1e-300   # a constant: nothing rounded
+    True
     """
 
     approximation: Fraction
