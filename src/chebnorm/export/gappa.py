@@ -59,7 +59,7 @@ def _lit(v) -> str:
 def _horner(coeffs, var: str) -> str:
     expr = _lit(coeffs[-1])
     for c in reversed(coeffs[:-1]):
-        expr = f"({expr}) * {var} + {_lit(c)}"
+        expr = f"({expr}) * {var}" + (f" + {_lit(c)}" if c != 0 else "")
     return expr
 
 
@@ -73,7 +73,11 @@ def _piece_lines(ev: Evaluator, k: int, piece, var: str, bound: float) -> tuple[
     defs, hyps, goals, hints = [], [], [], []
     p = f"_{k}"
     pvar = "T" if ev.shift is not None else "x"
-    defs.append(f"P{p} = {_horner(piece.ref_coeffs, pvar)};")
+    same = tuple(piece.coeffs) == tuple(piece.ref_coeffs)
+    if ev.parity is not None and same:  # the certified polynomial, in the evaluator's form
+        p_def = f"P{p} = {'Yy' + p if ev.parity == 1 else f'Y{p}_0'};"
+    else:
+        p_def = f"P{p} = {_horner(piece.ref_coeffs, pvar)};"
     seqs = ["u"] if fixed else ["u", "f"]
     for s in seqs:
         defs.append(f"{s}{p}_{len(cs) - 1} = {_lit(cs[-1])};")
@@ -82,26 +86,34 @@ def _piece_lines(ev: Evaluator, k: int, piece, var: str, bound: float) -> tuple[
         c = _lit(cs[j])
         if fixed:
             defs.append(f"u{p}_{j} = rnd(u{p}_{j + 1} * {var}) + {c};")
+        elif cs[j] == 0:  # fl(fl(a x) + 0) = fma(a, x, 0) = fl(a x)
+            defs.append(f"u{p}_{j} = rnd(u{p}_{j + 1} * {var});")
+            defs.append(f"f{p}_{j} = rnd(f{p}_{j + 1} * {var});")
         else:
             defs.append(f"u{p}_{j} = rnd(rnd(u{p}_{j + 1} * {var}) + {c});")
             defs.append(f"f{p}_{j} = rnd(f{p}_{j + 1} * {var} + {c});")
-        defs.append(f"Y{p}_{j} = Y{p}_{j + 1} * {'T' if var == 't' else var} + {c};")
+        defs.append(f"Y{p}_{j} = Y{p}_{j + 1} * {'T' if var == 't' else var}"
+                    + (f" + {c};" if cs[j] != 0 else ";"))
         for s in seqs:
             hints.append(f"{s}{p}_{j} ~ Y{p}_{j};")
+    if ev.parity == 1:
+        defs.append(f"Yy{p} = Y{p}_0 * x;")
     for s in seqs:
         y = f"{s}{p}_0"
         if ev.parity == 1:
             defs.append(f"{s}{p}_y = rnd({y} * x);")
             y = f"{s}{p}_y"
+            hints.append(f"{y} ~ Yy{p};")
         goals.append(f"|{y} - F{p}| <= {_lit(bound)}")
-        yex = f"Y{p}_0" + (" * x" if ev.parity == 1 else "")
+        yex = f"Yy{p}" if ev.parity == 1 else f"Y{p}_0"
         hints.append(f"{y} - F{p} -> ({y} - P{p}) + (P{p} - F{p});")
         hints.append(f"{y} - P{p} -> ({y} - {yex}) + ({yex} - P{p});")
     if tuple(piece.coeffs) != tuple(piece.ref_coeffs):
         d = [Fraction(c) - Fraction(r) for c, r in zip(piece.coeffs, piece.ref_coeffs)]
         if all(float(v) == v for v in d):  # the differences, exact doubles
-            yex = f"Y{p}_0" + (" * x" if ev.parity == 1 else "")
+            yex = f"Yy{p}" if ev.parity == 1 else f"Y{p}_0"
             hints.append(f"{yex} - P{p} -> {_horner(d, pvar)};")
+    defs.append(p_def)  # after the Y its evaluator form uses
     hyps.append(f"|P{p} - F{p}| <= {_lit(piece.approx_bound)}")
     return defs, hyps, goals, hints
 
