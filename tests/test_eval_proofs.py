@@ -71,12 +71,15 @@ def _own(key):
                    name="own_cos_even")
     if key == "log_d5":
         return fit("log(x)", ("1", "2"), 5, kind="minimax", name="own_log_d5")
+    if key == "shifted":  # t = (x - 3/4) * 4 computed in the evaluator's type
+        return fit("1/sqrt(x)", ("1/2", "1"), 4, kind="minimax", basis="shifted",
+                   name="own_shifted")
     if key == "piecewise":
         return piecewise_fit("1/sqrt(x)", ("1", "4"), 2, segments=8, name="own_pw")
     raise KeyError(key)
 
 
-OWN = ("rsqrt_d8", "exp_d6", "rsqrt_d3_fixed", "sin_odd", "cos_even", "log_d5")
+OWN = ("rsqrt_d8", "exp_d6", "rsqrt_d3_fixed", "sin_odd", "cos_even", "log_d5", "shifted")
 _CACHE: dict = {}
 
 

@@ -168,7 +168,9 @@ def gappa_script(ev: Evaluator, bound: float | None = None) -> str:
         d = f"rnd(x - {_lit(c_t)})"
         out.append(f"t = rnd({d} * {_lit(1 / s)});" if exact else
                    f"t = rnd({d} / {_lit(s_t)});")
-        out.append(f"T = (x - {_lit(c)}) / {_lit(s)};")
+        out.append(f"T = (x - {_lit(c)}) * {_lit(1 / s)};" if exact else
+                   f"T = (x - {_lit(c)}) / {_lit(s)};")
+        hints.append(f"rnd(x - {_lit(c_t)}) ~ x - {_lit(c)};")
         hints.append("t ~ T;")
         var = "t"
     hyps, goals = [f"x in [{_lit(lo)}, {_lit(hi)}]"], []
