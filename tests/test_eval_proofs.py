@@ -168,7 +168,8 @@ def _bounds(header_text: str) -> dict:
     out = {}
     for line in header_text.splitlines():
         if line.startswith("#define") and "EVAL_ERROR_BOUND" in line:
-            out[line.split()[1]] = float.fromhex(line.split()[2])
+            v = line.split()[2]  # a hex literal (c.py) or a repr (c_piecewise.py)
+            out[line.split()[1]] = float.fromhex(v) if "0x" in v else float(v)
     return out
 
 
