@@ -12,7 +12,8 @@ the benches too).
 from __future__ import annotations
 
 from chebnorm.approx import PiecewiseTable, load_table
-from chebnorm.export import EXPORT_FORMATS, HDL_FORMATS, export_table, options_for
+from chebnorm.export import (EXPORT_FORMATS, HDL_FORMATS, export_table, export_with_proofs,
+                             options_for)
 
 from .common import command_line, deprecated_alias
 from .fit import cli_words
@@ -33,6 +34,9 @@ def register(sub) -> None:
     p.add_argument("table", metavar="TABLE.json")
     p.add_argument("--format", default="c", help=f"one of {_all_formats()} (default c)")
     p.add_argument("-o", "--output", metavar="FILE", required=True)
+    p.add_argument("--proof", action="store_true",
+                   help="also write a Gappa script per stated evaluation bound beside FILE "
+                   "(FILE's stem.CONSTANT.gappa; formats c, glsl, wgsl, hlsl)")
     hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
     hw.add_argument("--in-bits", type=int, default=None,
                     help="input code width, 1..20 (a piecewise table's C export: 1..32, "
@@ -75,7 +79,10 @@ def run(args) -> int:
         raise ValueError(f"--format {args.format} needs --in-bits and --out-bits (input and "
                          f"output code widths){accepted}")
     try:
-        export_table(table, args.format, args.output, command_line(args), **given)
+        if args.proof:
+            export_with_proofs(table, args.format, args.output, command_line(args), **given)
+        else:
+            export_table(table, args.format, args.output, command_line(args), **given)
     except ValueError as exc:   # the library names its arguments (in_bits): the flags' words
         raise ValueError(cli_words(str(exc))) from None
     return 0

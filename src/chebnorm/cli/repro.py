@@ -31,7 +31,7 @@ from pathlib import Path
 
 from chebnorm.approx import TARGETS, fit_target, target_names
 from chebnorm.core.files import write_atomic
-from chebnorm.export import c_header, json_text
+from chebnorm.export import export_with_proofs, json_text
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 
 from .parallel_options import add_parallel_args, parallel_kwargs
@@ -53,10 +53,11 @@ def export_coefficients(out: Path, **_options) -> list[Path]:
         for degree in TARGETS[name].degrees:
             table = fit_target(name, degree, frac_bits=EXPORT_FRAC_BITS)
             cmd = "chebnorm repro coefficients"
-            for text, path in ((json_text(table, cmd), folder / f"{table.name}.json"),
-                               (c_header(table, cmd), folder / f"chebnorm_{table.name}.h")):
-                write_atomic(path, text)
-                written.append(path)
+            write_atomic(folder / f"{table.name}.json", json_text(table, cmd))
+            written.append(folder / f"{table.name}.json")
+            # the header and a Gappa proof of each of its evaluation bounds
+            files = export_with_proofs(table, "c", folder / f"chebnorm_{table.name}.h", cmd)
+            written += [folder / name for name in files]
     return written
 
 

@@ -61,7 +61,8 @@ HDL_OPTIONS = ("in_bits", "out_bits", "coef_frac_bits", "acc_bits", "rounding")
 __all__ = ["FORMATS", "TABLE_FORMATS", "HDL_FORMATS", "EXPORT_FORMATS", "PIECEWISE_FORMATS", "HDL_OPTIONS",
            "formats_for", "options_for", "c_header", "json_text", "export_text", "export_table",
            "hdl_export", "horner_rounding_bound", "glsl_source", "wgsl_source", "hlsl_source",
-           "shader_source", "float32_eval_bound", "piecewise_c_header", "DEFAULT_C_IN_BITS"]
+           "shader_source", "float32_eval_bound", "piecewise_c_header", "DEFAULT_C_IN_BITS",
+           "export_with_proofs"]
 
 
 def _kind(table) -> str:
@@ -300,6 +301,60 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     text = export_text(table, fmt, command, **options)
     write_atomic(path, text)
     return text
+
+
+def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> dict[str, str]:
+    """Print ``table`` in ``fmt`` naming a Gappa proof beside each stated
+    evaluation bound, and write the output and the proofs
+    (:mod:`chebnorm.export.gappa`: ``STEM.CONSTANT.gappa`` next to ``path``,
+    ``STEM`` its name without the suffix). ``fmt``: one of
+    :data:`~chebnorm.export.gappa.PROOF_FORMATS` (``c`` of either kind of
+    table, ``glsl``, ``wgsl``, ``hlsl``). Returns file name -> text of
+    everything written (the output first).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from chebnorm.approx import fit
+    >>> t = fit("1/x", ("1", "2"), 1, name="inv")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     sorted(export_with_proofs(t, "glsl", os.path.join(d, "inv.glsl")))
+    ['inv.CHEBNORM_INV_EVAL_ERROR_BOUND.gappa', 'inv.glsl']
+    """
+    from pathlib import Path
+
+    from .c import c_header_evaluators
+    from .c_piecewise import piecewise_evaluator
+    from .gappa import PROOF_FORMATS, gappa_proofs
+    from .shader import shader_evaluator
+
+    if fmt not in PROOF_FORMATS:
+        raise ValueError(f"format {str(fmt)[:40]!r} has no proof; accepted with proofs: "
+                         f"{', '.join(PROOF_FORMATS)}")
+    export_text(table, fmt, command, **options)  # every check of the plain export
+    path = Path(path)
+    stem = path.name.split(".")[0] or "out"
+    if _kind(table) == "piecewise table":
+        text = piecewise_c_header(table, command, proof=stem,
+                                  in_bits=options.get("in_bits") or DEFAULT_C_IN_BITS)
+        evaluators = [piecewise_evaluator(table)]
+    elif fmt == "c":
+        text, evaluators = c_header_evaluators(table, command, proof=stem)
+    else:
+        text = shader_source(table, fmt, command, proof=stem)
+        ev = shader_evaluator(table)
+        evaluators = [ev]
+    files = {path.name: text}
+    scripts = gappa_proofs(evaluators, stem)
+    if fmt in ("glsl", "wgsl", "hlsl"):  # the constant printed is the float32 rounded up
+        from .gappa import gappa_script
+        scripts = {name: gappa_script(ev, float32_eval_bound(table).total32)
+                   for name in scripts}
+    files.update(scripts)
+    write_atomic(path, text)
+    for name, script in scripts.items():
+        write_atomic(path.parent / name, script)
+    return files
 
 
 class _CallableModule(types.ModuleType):

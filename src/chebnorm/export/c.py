@@ -11,15 +11,17 @@ decimal value in a comment, Horner evaluators, and the bounds:
 ``<P>_ABS_ERROR_BOUND`` / ``<P>_REL_ERROR_BOUND``
     certified bounds of ``|p - f|`` and ``|p/f - 1|`` for the double
     coefficients evaluated exactly;
-``<P>_EVAL_ERROR_BOUND`` / ``<P>_F_EVAL_ERROR_BOUND``
-    bounds of ``|evaluator(x) - f(x)|`` for the double and float evaluators
-    on inputs in the interval: the certified bound plus the rounding error of
-    Horner's rule (Higham, Accuracy and Stability, eq. 5.3:
-    ``|fl(p(x)) - p(x)| <= gamma_2n * sum |c_k| |x|^k``) and, for float, the
-    rounding of the coefficients to float;
-``<P>_Q_EVAL_ERROR_BOUND``
-    for a quantized table, the bound of the integer evaluator: the fixed-point
-    certified bound plus half an LSB per Horner step, amplified by ``|x|``.
+``<P>_EVAL_ERROR_BOUND`` / ``<P>_F_EVAL_ERROR_BOUND`` / ``<P>_Q_EVAL_ERROR_BOUND``
+    bounds of ``|evaluator(x) - f(x)|`` for the double, float and (for a
+    quantized table) integer evaluators on inputs in the interval, computed
+    for the evaluator's own operation sequence by
+    :func:`chebnorm.export.evalbound.horner_bound` (interval arithmetic on
+    64 pieces of the interval, each rounding bounded by half an ulp of its
+    largest possible result there, fused and unfused steps both covered):
+    the certified bound plus the largest local coefficient-rounding and
+    evaluation error. ``chebnorm export --proof`` writes one Gappa script per
+    constant (:mod:`chebnorm.export.gappa`) proving it, and the header names
+    it beside the constant.
 ``<P>_QUANT_ABS_ERROR_BOUND``, ``<P>_QUANT_EVAL_ERROR_BOUND`` (and ``_F_``)
     for a table whose ``quantized`` part is not a plain ``fixed_point`` (a
     floating format, one fractional width per power, chosen monomials or a
@@ -51,8 +53,9 @@ from fractions import Fraction
 import numpy as np
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import comment_text, identifier
+
+from .evalbound import BINARY32, BINARY64, Evaluator, Piece, fixed_arithmetic
 
 __all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
            "range_problem", "underflow_bound", "round_inward", "interval_max_abs"]
@@ -292,13 +295,6 @@ def horner_rounding_bound(coefficients, max_abs_x: Fraction, unit_roundoff: floa
     return gamma * total
 
 
-def _fixed_rounding_bound(degree: int, frac_bits: int, max_abs_x: Fraction) -> Fraction:
-    """Each Horner step ``(acc * x_q + 2^(F-1)) >> F`` adds at most half an
-    LSB, later multiplied by ``|x|`` once per remaining step."""
-    half = Fraction(1, 2 ** (frac_bits + 1))
-    return half * sum(max_abs_x ** j for j in range(degree))
-
-
 def _is_power_of_two(s: float) -> bool:
     return s > 0 and math.frexp(s)[0] == 0.5
 
@@ -374,28 +370,34 @@ def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
     return out
 
 
-def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: Fraction
-                ) -> tuple[Fraction | None, str | None]:
-    """``(bound, None)``: a bound of ``|evaluator(x) - f(x)|`` in the type of
-    ``suffix`` (module docstring, plus :func:`underflow_bound`); or
-    ``(None, reason)`` when the evaluator can meet a non-finite intermediate
-    on the interval (:func:`range_problem`)."""
+def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: Fraction,
+                name: str = "", constant: str = ""):
+    """``(evaluator, None)``: the :class:`~chebnorm.export.evalbound.Evaluator`
+    of the evaluator in the type of ``suffix`` (its tight bound:
+    ``evaluator.bound()``); or ``(None, reason)`` when the evaluator can meet a
+    non-finite intermediate on the interval (:func:`range_problem`)."""
     problem = range_problem(coeffs, Fraction(0), suffix, u)  # a coefficient out of range
     if problem is not None and problem.startswith("coefficient"):
         return None, problem
     cs = [float(np.float32(c)) for c in coeffs] if suffix == "f" else list(coeffs)
     if table.shift is not None:
-        max_t, t_err = _shift_error(table, cs, suffix, u)
+        max_t, _ = _shift_error(table, cs, suffix, u)
     else:
-        max_t, t_err = max_x, Fraction(0)
+        max_t = max_x
     problem = range_problem(cs, max_t, suffix, u, where=(*inner_interval(table), table.shift, None))
     if problem is not None:
         return None, problem
-    coef_err = sum(abs(Fraction(a) - Fraction(b)) * max_t ** k
-                   for k, (a, b) in enumerate(zip(coeffs, cs)))
-    return (Fraction(table.abs_error_bound) + coef_err + t_err
-            + horner_rounding_bound(cs, max_t, u)
-            + underflow_bound(len(cs) - 1, max_t, suffix, u)), None
+    shift = None
+    if table.shift is not None:
+        scale = float(table.shift[1])
+        shift = (Fraction(table.shift[0]), Fraction(scale),
+                 Fraction(_to_type(table.shift[0], suffix)), Fraction(_to_type(scale, suffix)),
+                 _is_power_of_two(scale))
+    lo, hi = inner_interval(table)
+    piece = Piece(tuple(cs), tuple(float(c) for c in coeffs), Fraction(table.abs_error_bound),
+                  lo, hi)
+    return Evaluator(constant, name, BINARY32 if suffix == "f" else BINARY64, (piece,),
+                     shift=shift), None
 
 
 def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, name: str,
@@ -431,37 +433,6 @@ def _parity(q, degree: int) -> int | None:
     return None
 
 
-def _parity_rounding_bound(coeffs, parity: int, max_abs_x: Fraction, u: float) -> Fraction:
-    """Bound of the rounding error of ``x^parity * q(x*x)`` by Horner's rule in
-    ``t = fl(x*x)``: each term ``b_j t^j`` carries at most ``2m`` roundings of
-    Horner's rule, ``j`` from ``t``'s own rounding and one from the final
-    multiply by ``x`` (odd), so ``gamma_(3m + parity) * sum |b_j| M^(2j + parity)``."""
-    b = coeffs[parity::2]
-    m = len(b) - 1
-    n = 3 * m + parity
-    if n == 0:
-        return Fraction(0)
-    uf = Fraction(u)
-    gamma = n * uf / (1 - n * uf)
-    return gamma * sum(abs(Fraction(c)) * max_abs_x ** (2 * j + parity) for j, c in enumerate(b))
-
-
-def _parity_underflow_bound(coeffs, parity: int, max_abs_x: Fraction, suffix: str,
-                            u: float) -> Fraction:
-    """What gradual underflow adds to :func:`_parity_evaluator`: ``t = x*x``
-    off by ``eta`` moves ``q(t)`` by ``eta max |q'|``, Horner's rule in ``t``
-    adds :func:`underflow_bound`, and the final product by ``x`` one ``eta``;
-    all within the ``(1 + gamma)`` factors of the steps after them."""
-    eta = _RANGE[suffix][2]
-    b = coeffs[parity::2]
-    t_max = max_abs_x ** 2 * (1 + Fraction(u)) + eta
-    g = 1 + _gamma(3 * len(b) + 1, u)
-    slope = sum((j * abs(Fraction(c)) * t_max ** (j - 1) for j, c in enumerate(b) if j),
-                Fraction(0))
-    inner = underflow_bound(len(b) - 1, t_max, suffix, u) + g * eta * slope
-    return g * inner * (max_abs_x if parity else 1) + (eta if parity else 0)
-
-
 def _quantized_range(table, coeffs, parity, suffix: str, u: float, max_x: Fraction):
     """:func:`range_problem` of the quantized evaluator (in ``x*x`` and times
     ``x`` at the end for a parity evaluator)."""
@@ -492,7 +463,8 @@ def _parity_evaluator(coeffs, parity: int, ctype: str, suffix: str, name: str,
     return out + [f"    return acc{' * x' if parity else ''};", "}"]
 
 
-def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fraction) -> list[str]:
+def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fraction,
+                    evaluators: list, proof: str) -> list[str]:
     """Bounds, exact coefficient array and Horner evaluators of ``table.quantized``
     (in ``x*x`` when only odd or only even powers are used)."""
     q = table.quantized
@@ -527,12 +499,13 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
             w(f"/* No {ctype} evaluator of the quantized coefficients: {comment_text(problem)}. */")
             continue
         emitted.append(row)
-        rounding = (horner_rounding_bound(coeffs, max_x, u) + underflow_bound(
-            table.degree, max_x, suffix, u) if parity is None
-            else _parity_rounding_bound(coeffs, parity, max_x, u)
-            + _parity_underflow_bound(coeffs, parity, max_x, suffix, u))
-        bound = Fraction(q.abs_error_bound) + rounding
-        w(f"#define {macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(float_up(bound), '')}")
+        constant = f"{macro}_QUANT{fsuffix.upper()}_EVAL_ERROR_BOUND"
+        piece = Piece(tuple(coeffs), tuple(coeffs), Fraction(q.abs_error_bound),
+                      *inner_interval(table))
+        ev = Evaluator(constant, f"{fn}_quant{fsuffix}", BINARY32 if suffix == "f" else BINARY64,
+                       (piece,), parity=parity)
+        evaluators.append(ev)
+        w(f"#define {constant} {_literal(ev.bound().stated, '')}{_backed(ev, proof)}")
     w(f"static const double {fn}_quant_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
         w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* x^{k} */")
@@ -571,6 +544,35 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     >>> "static inline double chebnorm_d1(double x)" in h
     True
     """
+    return c_header_evaluators(table, command)[0]
+
+
+def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str = ""
+                        ) -> tuple[str, list]:
+    """The C99 header text and its :class:`~chebnorm.export.evalbound.Evaluator`
+    list (one per stated evaluation bound).
+
+    Parameters
+    ----------
+    table : CoefficientTable
+    command : str
+        The generating command stated in the banner.
+    proof : str
+        The stem of the Gappa proof files, named beside each bound (empty:
+        none named).
+
+    Returns
+    -------
+    tuple of (str, list of Evaluator)
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> text, evs = c_header_evaluators(fit("1/x", ("1", "2"), 2, name="inv"))
+    >>> [e.constant for e in evs]
+    ['CHEBNORM_INV_EVAL_ERROR_BOUND', 'CHEBNORM_INV_F_EVAL_ERROR_BOUND']
+    """
+    evaluators: list = []
     name = identifier(table.name, field="name")
     macro = f"CHEBNORM_{name.upper()}"
     fn = f"chebnorm_{name}"
@@ -617,7 +619,8 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
         w(f"#define {macro}_SCALE {_literal(float(table.shift[1]), '')}")
     emitted = []
     for ctype, suffix, fsuffix, u in FLOAT_TYPES:
-        bound, problem = _eval_bound(table, coeffs, suffix, u, max_x)
+        bound, problem = _eval_bound(table, coeffs, suffix, u, max_x, f"{fn}{fsuffix}",
+                                     f"{macro}{fsuffix.upper()}_EVAL_ERROR_BOUND")
         if problem is not None and suffix == "":
             raise ValueError(f"table {table.name!r} has no double evaluator on its interval: "
                              f"{problem}; accepted: a table whose Horner evaluation stays "
@@ -626,14 +629,18 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
             w(f"/* No {ctype} evaluator: {comment_text(problem)}. */")
             continue
         emitted.append((ctype, suffix, fsuffix))
-        w(f"#define {macro}{fsuffix.upper()}_EVAL_ERROR_BOUND {_literal(float_up(bound), '')}")
+        evaluators.append(bound)
+        w(f"#define {bound.constant} {_literal(bound.bound().stated, '')}{_backed(bound, proof)}")
     if table.fixed_point is not None:
         fp = _checked_fixed(table)
         _check_fixed_ranges(table, max_x)
         w(f"#define {macro}_FRAC_BITS {fp.frac_bits}")
         w(f"#define {macro}_Q_ABS_ERROR_BOUND {_literal(fp.abs_error_bound, '')}")
-        qb = Fraction(fp.abs_error_bound) + _fixed_rounding_bound(table.degree, fp.frac_bits, max_x)
-        w(f"#define {macro}_Q_EVAL_ERROR_BOUND {_literal(float_up(qb), '')}")
+        qs = tuple(float(Fraction(q) / 2 ** fp.frac_bits) for q in fp.integers)
+        ev = Evaluator(f"{macro}_Q_EVAL_ERROR_BOUND", f"{fn}_q_eval", fixed_arithmetic(fp.frac_bits),
+                       (Piece(qs, qs, Fraction(fp.abs_error_bound), *inner_interval(table)),))
+        evaluators.append(ev)
+        w(f"#define {ev.constant} {_literal(ev.bound().stated, '')}{_backed(ev, proof)}")
     w("")
     w(f"static const double {fn}_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
@@ -644,7 +651,12 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     if table.fixed_point is not None:
         out += _fixed_evaluator(table.fixed_point, fn, macro)
     elif table.quantized is not None:
-        out += _quantized_part(table, fn, macro, max_x)
+        out += _quantized_part(table, fn, macro, max_x, evaluators, proof)
     w("")
     w(f"#endif /* {macro}_H */")
-    return "\n".join(out) + "\n"
+    return "\n".join(out) + "\n", evaluators
+
+
+def _backed(ev, proof: str) -> str:
+    """The comment naming the proof file of ``ev``'s constant (when proofs are written)."""
+    return f"  /* proof: {proof}.{ev.constant}.gappa */" if proof else ""

@@ -15,8 +15,8 @@ computation and Horner's rule in the segment's local variable:
 The local variable is computed exactly in both, so the bounds are
 ``<P>_ABS_ERROR_BOUND`` (the table's certified ``max_s sup |p_s - f|``) and
 ``<P>_EVAL_ERROR_BOUND``: ``max_s`` of the segment's certified bound plus
-the double Horner rounding bound ``gamma_2n sum |c_j| |t|^j`` (Higham eq. 5.3)
--- the same bounds as :func:`chebnorm.export.c_header`. Names pass through
+its local double Horner rounding bound (:mod:`chebnorm.export.evalbound`,
+fused or not) -- as :func:`chebnorm.export.c_header`. Names pass through
 :func:`chebnorm.core.textsafe.identifier`, other text through
 ``comment_text``; numbers are printed from floats and ints.
 
@@ -33,11 +33,10 @@ from fractions import Fraction
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.textsafe import comment_text, identifier
 
-from chebnorm.core.numeric import float_up
+from .c import banner_head, range_problem
+from .evalbound import BINARY64, Evaluator, Piece
 
-from .c import banner_head, horner_rounding_bound, range_problem, underflow_bound
-
-__all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound"]
+__all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound", "piecewise_evaluator"]
 
 DEFAULT_C_IN_BITS = 24
 MAX_C_IN_BITS = 32
@@ -48,8 +47,38 @@ def _lit(x: float) -> str:
     return "0.0" if x == 0 else f"{float(x).hex()} /* {x!r} */"
 
 
+def piecewise_evaluator(table: PiecewiseTable, constant: str = ""):
+    """The :class:`~chebnorm.export.evalbound.Evaluator` of the double
+    evaluator: one piece per segment (its coefficients, certified bound and
+    the range of its exact local variable ``t``), 64 subintervals each.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> ev = piecewise_evaluator(piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, name="r"))
+    >>> len(ev.pieces), ev.pieces[0].lo, ev.pieces[0].hi
+    (4, 0.0, 1.0)
+    """
+    tlo, thi = (-0.5, 0.5) if table.centered else (0.0, 1.0)
+    tmax = Fraction(1, 2) if table.centered else Fraction(1)
+    pieces = []
+    for s, seg in enumerate(table.segments):
+        cs = tuple(float(c) for c in table.coefficients(s))
+        problem = range_problem(cs, tmax, "", _U)
+        if problem is not None:
+            raise ValueError(f"table {table.name!r}, segment {s}: no double evaluator: {problem}; "
+                             f"accepted: coefficients whose Horner evaluation stays within the "
+                             f"double range")
+        pieces.append(Piece(cs, cs, Fraction(seg.abs_error_bound), tlo, thi))
+    name = identifier(table.name, field="name")
+    return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND", f"chebnorm_{name}",
+                     BINARY64, tuple(pieces), subintervals=64)
+
+
 def piecewise_eval_bound(table: PiecewiseTable) -> float:
-    """Bound of ``|evaluator(x) - f(x)|`` for the double evaluator (module docstring).
+    """Bound of ``|evaluator(x) - f(x)|`` for the double evaluator (module
+    docstring): the largest over the segments of the certified bound plus the
+    local rounding bound of :func:`chebnorm.export.evalbound.horner_bound`.
 
     Examples
     --------
@@ -60,23 +89,11 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
     >>> worst < b < worst + 1e-15
     True
     """
-    tmax = Fraction(1, 2) if table.centered else Fraction(1)
-    worst = Fraction(0)
-    for s, seg in enumerate(table.segments):
-        cs = table.coefficients(s)
-        problem = range_problem(cs, tmax, "", _U)
-        if problem is not None:
-            raise ValueError(f"table {table.name!r}, segment {s}: no double evaluator: {problem}; "
-                             f"accepted: coefficients whose Horner evaluation stays within the "
-                             f"double range")
-        b = (Fraction(seg.abs_error_bound) + horner_rounding_bound(cs, tmax, _U)
-             + underflow_bound(len(cs) - 1, tmax, "", _U))
-        worst = max(worst, b)
-    return float_up(worst)
+    return piecewise_evaluator(table).bound().stated
 
 
 def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
-                       in_bits: int = DEFAULT_C_IN_BITS) -> str:
+                       in_bits: int = DEFAULT_C_IN_BITS, proof: str = "") -> str:
     """The C99 header text for a piecewise table (see the module docstring).
 
     Examples
@@ -120,7 +137,8 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
     w(f"#define {macro}_ABS_ERROR_BOUND {table.abs_error_bound!r}")
     if table.rel_error_bound is not None:
         w(f"#define {macro}_REL_ERROR_BOUND {table.rel_error_bound!r}")
-    w(f"#define {macro}_EVAL_ERROR_BOUND {piecewise_eval_bound(table)!r}")
+    w(f"#define {macro}_EVAL_ERROR_BOUND {piecewise_eval_bound(table)!r}"
+      + (f"  /* proof: {proof}.{macro}_EVAL_ERROR_BOUND.gappa */" if proof else ""))
     if uniform:
         w(f"#define {macro}_IN_BITS {in_bits}")
     w("")

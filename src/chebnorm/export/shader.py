@@ -24,26 +24,21 @@ shader analogue of the C header's ``_F_EVAL_ERROR_BOUND``
 
 * the certified bound of ``|p - f|`` for the coefficients evaluated: the
   table's double coefficients, or its ``quantized`` ones when their format is
-  binary16, bfloat16 or binary32 (each a float32 exactly, so the next term is 0);
-* ``sum_k |c_k - fl32(c_k)| M^k``: rounding the coefficients to float32
-  (``M`` = max |x| on the interval);
-* ``gamma_2n sum_k |fl32(c_k)| M^k`` with ``gamma_k = k u / (1 - k u)``,
-  ``u = 2^-24``: Horner's rounding error (Higham, *Accuracy and Stability of
-  Numerical Algorithms*, 2nd ed., eq. 5.3). The proof writes the computed
-  value as ``sum_k c_k x^k (1 + theta_(k))`` where ``1 + theta_(k)`` is a
-  product of at most ``2n`` factors ``(1 + delta)``, ``|delta| <= u``, one per
-  rounding the term goes through, and ``|theta_j| <= gamma_j``. A fused step
-  ``fl(a x + c)`` rounds once where the unfused ``fl(fl(a x) + c)`` rounds
-  twice, so every term of a fused, unfused or mixed evaluation carries
-  ``j <= 2n`` factors and ``|theta_j| <= gamma_j <= gamma_2n``: the one
-  bound covers the compiler fusing any subset of the steps (GLSL and WGSL
-  allow it; HLSL's ``mad`` may be either);
-* ``2^-124 (sum_{j<n} M^j + sum_k k |c_k| M^(k-1))``: subnormal flushes,
-  which all three languages allow. Each of the ``2n`` operations may flush a
-  subnormal result to zero, an absolute error below ``2^-126`` that later
-  steps multiply by ``|x| <= M`` at most ``n - 1`` times (two per step, and a
-  factor 2 for the roundings the error goes through later); a subnormal input
-  ``x`` flushed to zero moves ``p`` by at most ``2^-126 max |p'|``.
+  binary16, bfloat16 or binary32 (each a float32 exactly);
+* the float32 evaluation error, computed for the shader's operation sequence
+  by :func:`chebnorm.export.evalbound.horner_bound` (the C header's
+  ``_F_EVAL_ERROR_BOUND`` computation): on each of 64 pieces of the interval,
+  the coefficients' rounding to float32 and every operation's rounding (half
+  an ulp of its largest result there, or the ``2^-126`` a flushed subnormal
+  result loses), each step bounded fused and unfused, so the bound covers the
+  compiler fusing any subset of the steps (GLSL and WGSL allow it; HLSL's
+  ``mad`` may be either);
+* ``2^-126 max |p'|`` when a subnormal input may be flushed to 0 (the
+  analysed interval then reaches 0, so the evaluation at 0 is covered).
+
+:func:`shader_evaluator` gives the evaluator that
+:func:`chebnorm.export.gappa.gappa_script` proves (``chebnorm export
+--proof``); the script models IEEE binary32 without the flushes.
 
 What the bound assumes of the driver, from the specifications: float32
 ``+``, ``-``, ``*`` correctly rounded (round to nearest) and ``fma``'s
@@ -73,12 +68,12 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from chebnorm.core.numeric import float_up
 
-from .c import (horner_rounding_bound, inner_interval, interval_max_abs, range_problem,
-                round_inward)
+from .c import inner_interval, interval_max_abs, range_problem, round_inward
+from .evalbound import BINARY32_FTZ, Evaluator, Piece
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
            "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source",
-           "interval32"]
+           "interval32", "shader_evaluator"]
 
 U32 = Fraction(1, 2 ** 24)
 _FLUSH = Fraction(1, 2 ** 126)  # largest magnitude a flushed subnormal float32 loses
@@ -199,8 +194,11 @@ def float32_literal(value: float, suffix: str = "") -> str:
 class ShaderBound:
     """Parts of the float32 bound of ``|shader(x) - f(x)|`` (module docstring).
 
-    ``total`` is rounded up to a double; ``total32`` up to a float32 (the
-    value printed as a shader constant).
+    ``rounding`` is the evaluation part (float32 coefficients and Horner
+    rounding together, with the proof headroom; ``coefficients`` is 0, kept
+    for callers), ``flush`` the subnormal-input term; ``total`` is their sum
+    with ``certified`` rounded up to a double, ``total32`` up to a float32
+    (the value printed as a shader constant).
 
     Examples
     --------
@@ -256,21 +254,50 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
                          f"within the float32 range (|values| < 3.4e38)")
-    c32 = [float(np.float32(c)) for c in coeffs]
-    coef = sum((abs(Fraction(a) - Fraction(b)) * m ** k
-                for k, (a, b) in enumerate(zip(coeffs, c32))), Fraction(0))
-    rounding = horner_rounding_bound(c32, m, float(U32))
-    n = len(coeffs) - 1
-    flush = 4 * _FLUSH * (sum((m ** j for j in range(n)), Fraction(0))
-                          + sum((k * abs(Fraction(c)) * m ** (k - 1)
-                                 for k, c in enumerate(c32) if k), Fraction(0)))
-    total = certified + coef + rounding + flush
+    ev = shader_evaluator(table)
+    eb = ev.bound()
+    lo32, hi32 = interval32(table)
+    flush = Fraction(0)
+    if lo32 < 2.0 ** -126 and hi32 > -2.0 ** -126:
+        # a subnormal input x may be flushed to x' = 0, which lies in the
+        # analysed interval (shader_evaluator): |shader(x') - p(x')| is within
+        # the local bound, and |p(x') - p(x)| <= 2^-126 max |p'|
+        flush = _FLUSH * sum((k * abs(Fraction(c)) * m ** (k - 1)
+                              for k, c in enumerate(coeffs) if k), Fraction(0))
+    total = Fraction(eb.stated) + flush
     up = float_up(total)
     up32 = float(np.float32(up))
     if up32 < up:
         up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
-    return ShaderBound(certified=certified, coefficients=coef,
-                       rounding=rounding, flush=flush, total=up, total32=up32)
+    return ShaderBound(certified=certified, coefficients=Fraction(0),
+                       rounding=Fraction(eb.stated) - certified, flush=flush, total=up,
+                       total32=up32)
+
+
+def shader_evaluator(table: CoefficientTable, constant: str = ""):
+    """The :class:`~chebnorm.export.evalbound.Evaluator` of the shader
+    function: float32 Horner's rule (fused or not, subnormals possibly
+    flushed) on the float32 coefficients, over the float32 interval.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> shader_evaluator(fit("1/x", ("1", "2"), 1, name="inv")).arith.flush
+    True
+    """
+    coeffs, certified, _ = _coefficients(table)
+    c32 = tuple(float(np.float32(c)) for c in coeffs)
+    # the C header's interval (its float32 inputs are the shader's), reaching 0
+    # when a subnormal input may be flushed to it
+    lo, hi = inner_interval(table)
+    if 0 < lo < 2.0 ** -126:
+        lo = 0.0
+    elif -2.0 ** -126 < hi < 0:
+        hi = 0.0
+    piece = Piece(c32, tuple(coeffs), certified, lo, hi)
+    name = identifier(table.name, field="table.name")
+    return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
+                     f"chebnorm_{name}", BINARY32_FTZ, (piece,))
 
 
 def interval32(table: CoefficientTable) -> tuple[float, float]:
@@ -287,8 +314,11 @@ def interval32(table: CoefficientTable) -> tuple[float, float]:
     return round_inward(*inner_interval(table), "f")
 
 
-def shader_source(table: CoefficientTable, language: str, command: str = "") -> str:
-    """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl).
+def shader_source(table: CoefficientTable, language: str, command: str = "", *,
+                  proof: str = "") -> str:
+    """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl);
+    ``proof``: the stem of the Gappa proof file named in the banner (empty:
+    none).
 
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="d1")
@@ -330,10 +360,12 @@ def shader_source(table: CoefficientTable, language: str, command: str = "") -> 
       f" in ascending powers of {var}, rounded to float32 (exact literals).")
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
-    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients "
-      f"{float(bound.coefficients):.6e}")
-    w(f"//   + Horner rounding gamma_2n (fused or not) {float(bound.rounding):.6e} + subnormal"
-      f" flushes {float(bound.flush):.3e}.")
+    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
+      f" {float(bound.rounding):.6e}")
+    w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half an"
+      " ulp of its")
+    w(f"//   largest result there, fused or not) + subnormal input flush {float(bound.flush):.3e}."
+      + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
     w("// Assumes float32 (highp) with correctly rounded + and *, and a multiply-add that is fused"
       " or two roundings.")
     w("")
