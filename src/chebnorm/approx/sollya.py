@@ -28,7 +28,7 @@ def available() -> bool:
     Returns
     -------
     bool
-        Whether :func:`shutil.which` finds ``sollya``.
+        Whether ``shutil.which`` finds ``sollya``.
     """
     return shutil.which("sollya") is not None
 

@@ -20,7 +20,7 @@ def command_line(args) -> str:
     Returns
     -------
     str
-        The words of ``args.argv`` shell-quoted (:func:`shlex.quote`) and joined
+        The words of ``args.argv`` shell-quoted (``shlex.quote``) and joined
         by spaces, e.g. ``"chebnorm fit 'x^2' --degree 3"``.
     """
     return " ".join(shlex.quote(a) for a in getattr(args, "argv", ["chebnorm"]))
@@ -74,7 +74,7 @@ def deprecated_alias(parser, old: str, new: str, dest: str, **kwargs) -> None:
     dest : str
         The attribute of the parsed namespace both flags store into.
     **kwargs
-        Further :meth:`argparse.ArgumentParser.add_argument` arguments (``type``,
+        Further ``argparse.ArgumentParser.add_argument`` arguments (``type``,
         ``metavar``, ...), as given to ``new``.
     """
     parser.add_argument(old, dest=dest, action=_DeprecatedFlag, new_flag=new,

@@ -34,7 +34,7 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        :meth:`argparse.ArgumentParser.add_subparsers`); the new parser's ``func``
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
     p = sub.add_parser("export", help="print a coefficient table as C, JSON, GLSL, WGSL, HLSL, "

@@ -18,7 +18,7 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        :meth:`argparse.ArgumentParser.add_subparsers`); the new parser's ``func``
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
     p = sub.add_parser("methods", help="errors and operation counts of the normalization methods",

@@ -20,7 +20,7 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        :meth:`argparse.ArgumentParser.add_subparsers`); the new parser's ``func``
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
     from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES

@@ -160,7 +160,7 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        :meth:`argparse.ArgumentParser.add_subparsers`); the new parser's ``func``
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
     p = sub.add_parser("repro", help="regenerate every figure, table, ledger and coefficient header",

@@ -24,7 +24,7 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        :meth:`argparse.ArgumentParser.add_subparsers`); the new parser's ``func``
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
     p = sub.add_parser("verify", help="run an exported evaluator over every float32 of its "
