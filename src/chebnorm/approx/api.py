@@ -656,7 +656,6 @@ def warnings_of(table: CoefficientTable) -> list[str]:
 
     Examples
     --------
-
     >>> warnings_of(fit("exp(x)", ("0", "1"), 2))
     []
     """

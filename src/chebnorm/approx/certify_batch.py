@@ -185,7 +185,6 @@ def certify_batch(fn: Function1D, origins: Sequence, widths: Sequence,
 
     Examples
     --------
-
     >>> from chebnorm.approx.expr import parse_function
     >>> c, = certify_batch(parse_function("exp(x)"), [0], [1], [[1.0, 1.0, 0.5]], (-0.5, 0.5))
     >>> c.maximum <= c.bound <= (1 + 2**-8) * c.maximum, 0.02 < c.bound < 0.03

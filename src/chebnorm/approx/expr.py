@@ -339,7 +339,6 @@ def read_expression(text: str, variables: Iterable[str] = ("x",)) -> sp.Expr:
 
     Examples
     --------
-
     >>> read_expression("x^2 + 0.1")
     x**2 + 1/10
     >>> read_expression("2*cos(psi_max)", ["psi_max"])
@@ -420,7 +419,6 @@ def parse_number(text: str | float | int) -> sp.Expr:
 
     Examples
     --------
-
     >>> parse_number("0.1"), parse_number(0.5), parse_number("2*cos(pi/4)")
     (1/10, 1/2, sqrt(2))
     """

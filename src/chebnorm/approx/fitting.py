@@ -49,7 +49,6 @@ def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) ->
 
     Examples
     --------
-
     >>> [round(c, 12) + 0.0 for c in chebyshev_interpolant(lambda x: 3 * x**2 - x, 0, 1, 2)]
     [0.0, -1.0, 3.0]
     """
@@ -97,7 +96,6 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
 
     Examples
     --------
-
     >>> cheb_to_monomial([0.0, 0.0, 1.0], -1.0, 1.0), cheb_to_monomial([0.0, 0.0, 1.0], 0.0, 2.0)
     ([-1.0, 0.0, 2.0], [1.0, -4.0, 2.0])
     >>> cheb_to_monomial([0.0, 0.0, 1.0], 0.0, 2.0, center=1.0, scale=1.0)
@@ -157,7 +155,6 @@ def shift_for(lo: float, hi: float) -> tuple[float, float]:
 
     Examples
     --------
-
     >>> shift_for(1e6, 1e6 + 1)
     (1000000.5, 0.5)
     """
@@ -387,7 +384,6 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
 
     Examples
     --------
-
     >>> import numpy as np
     >>> r = remez(lambda x: x**2, np.ones_like, 0.0, 1.0, 1)
     >>> [round(float(c), 9) for c in r.cheb], round(float(r.levelled), 9), r.converged
@@ -495,7 +491,6 @@ def polish(f_mp: Callable, lo: float, hi: float, ref: np.ndarray, degree: int,
 
     Examples
     --------
-
     >>> [float(c) for c in polish(lambda x: x**2, 0.0, 1.0, [-1.0, 0.0, 1.0], 1)]
     [0.375, 0.5]
     """
@@ -756,7 +751,6 @@ def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | 
 
     Examples
     --------
-
     >>> from chebnorm.approx import parse_function
     >>> r = minimax_powers(parse_function("x**3"), -1.0, 1.0, 3, (1,))
     >>> r.converged, round(r.level, 7), [round(c, 7) for c in r.coefficients]

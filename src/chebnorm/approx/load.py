@@ -49,7 +49,6 @@ def table_kind(value) -> type[Table] | None:
 
     Examples
     --------
-
     >>> table_kind({"kind": "chebnorm.piecewise_table"}).__name__
     'PiecewiseTable'
     >>> table_kind({"schema_version": 1, "kind": "minimax"}).__name__

@@ -196,7 +196,6 @@ def register(spec: MethodSpec, *, replace: bool = False) -> MethodSpec:
 
     Examples
     --------
-
     >>> s = register(MethodSpec("toy_doc", "copy N_l", "none", "mymodule:KERNEL"))
     >>> "toy_doc" in method_names()
     True
@@ -261,7 +260,6 @@ def get_method(name) -> MethodSpec:
 
     Examples
     --------
-
     >>> get_method("nope")
     Traceback (most recent call last):
     ...

@@ -536,7 +536,6 @@ def exact_log2(value: sp.Expr) -> int | None:
 
     Examples
     --------
-
     >>> exact_log2(sp.Rational(1, 4)), exact_log2(sp.Integer(3))
     (-2, None)
     """
@@ -574,7 +573,6 @@ def segment_bounds(segment_by, lo, hi, index_bits, s):
 
     Examples
     --------
-
     >>> segment_bounds("exponent", sp.Integer(1), sp.Integer(4), 1, 3)
     (3, 4)
     """
@@ -608,7 +606,6 @@ def segment_count(segment_by, lo, hi, index_bits) -> int:
 
     Examples
     --------
-
     >>> segment_count("exponent", sp.Rational(1, 4), sp.Integer(4), 2)
     16
     """
@@ -637,7 +634,6 @@ def parse_segments(text) -> int:
 
     Examples
     --------
-
     >>> parse_segments("2^8"), parse_segments("16"), parse_segments(1)
     (8, 4, 0)
     """
@@ -692,7 +688,6 @@ def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None
 
     Examples
     --------
-
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
     >>> [c.bound <= s.abs_error_bound for c, s in zip(certify_segments(t), t.segments)]
@@ -758,7 +753,6 @@ def segment_balls(segment_by, lo, hi, index_bits, centered, segments):
 
     Examples
     --------
-
     >>> o, w = segment_balls("uniform", sp.Integer(1), sp.Integer(2), 1, False, [1])
     >>> float(o[0].mid()), float(w[0].mid())
     (1.5, 0.5)

@@ -125,7 +125,6 @@ def show(value) -> str:
 
     Examples
     --------
-
     >>> show(None), show(True), show([1, 2]), show({}), show("x" * 70)[-5:]
     ('null', 'true', 'an array of 2', 'an object', 'xx...')
     """

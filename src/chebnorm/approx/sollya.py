@@ -93,7 +93,6 @@ def function_text(expr: str, var: str = "x") -> str:
 
     Examples
     --------
-
     >>> function_text("1/sqrt(2+z)", "z")
     '1/sqrt(x + 2)'
     """
@@ -121,7 +120,6 @@ def interval_text(lo: str, hi: str) -> str:
 
     Examples
     --------
-
     >>> interval_text("sqrt(2)", "2")
     '[sqrt(2);2]'
     """
@@ -177,7 +175,6 @@ def script_supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: st
 
     Examples
     --------
-
     >>> print(script_supnorm("x**2", "x", [0.0, 0.0, 1.0], "0", "1"))
     prec=200!;
     display=decimal!;
