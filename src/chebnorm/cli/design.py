@@ -96,11 +96,11 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        When the output exists and is not a folder, ``--max-error`` is not a
-        finite number > 0, ``--frequency`` is given without a device's timing,
-        ``--faithful``/``--correctly-rounded`` is combined with ``--no-synth``, or
-        no design meets the accuracy asked (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        When the output exists and is not a folder, ``--max-error`` is not a finite
+        number > 0, ``--frequency`` is given without a device's timing,
+        ``--faithful``/``--correctly-rounded`` is combined with ``--no-synth``, or no
+        design meets the accuracy asked (:func:`chebnorm.cli.main` prints it as one line
+        on stderr and exits with status 2).
     """
     from pathlib import Path
 

@@ -63,8 +63,8 @@ def _given(args) -> dict:
 
 
 def run(args) -> int:
-    """Run ``chebnorm export``: print or write a coefficient table in one
-    of the export formats (C, JSON, GLSL, WGSL, HLSL, Verilog, VHDL).
+    """Run ``chebnorm export``: write a coefficient table in one of the export
+    formats (C, JSON, GLSL, WGSL, HLSL, Verilog, VHDL) into ``-o FILE``.
 
     Parameters
     ----------
@@ -81,10 +81,10 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On an unknown ``--format``, an option given that does nothing with that
-        format, a hardware format without ``--in-bits``/``--out-bits``, or a table
-        the exporter refuses (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On an unknown ``--format``, an option given that does nothing with that format,
+        a hardware format without ``--in-bits``/``--out-bits``, or a table the exporter
+        refuses (:func:`chebnorm.cli.main` prints it as one line on stderr and exits
+        with status 2).
     """
     if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")

@@ -192,9 +192,9 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On an argument :func:`chebnorm.fit` refuses, reworded with the command's
-        flags (:func:`cli_words`) (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On an argument :func:`chebnorm.fit` refuses, reworded with the command's flags
+        (:func:`cli_words`) (:func:`chebnorm.cli.main` prints it as one line on stderr
+        and exits with status 2).
     """
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
     if args.segments is not None or args.segment_by is not None or args.centered:

@@ -185,8 +185,8 @@ def run_verilog(args) -> int:
     Raises
     ------
     ValueError
-        When the output exists and is not a folder, or ``--pipelined`` is asked
-        of a degree-0 table (:func:`chebnorm.cli.main` prints it as one line on stderr and
+        When the output exists and is not a folder, or ``--pipelined`` is asked of a
+        degree-0 table (:func:`chebnorm.cli.main` prints it as one line on stderr and
         exits with status 2).
     """
     from chebnorm import __version__
@@ -263,9 +263,9 @@ def run_report(args) -> int:
     Raises
     ------
     ValueError
-        On an unknown ``--target``, a ``--target`` with ``--no-synth``, or an
-        option that does nothing for the table given (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On an unknown ``--target``, a ``--target`` with ``--no-synth``, or an option
+        that does nothing for the table given (:func:`chebnorm.cli.main` prints it as
+        one line on stderr and exits with status 2).
     """
     from chebnorm.hw.units import analyze_unit, get_unit, table_matches
 
@@ -379,9 +379,9 @@ def run_unit(args) -> int:
     Raises
     ------
     ValueError
-        When the output exists and is not a folder, ``--table`` is a piecewise
-        table, or an option does not apply to the unit's kind (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        When the output exists and is not a folder, ``--table`` is a piecewise table, or
+        an option does not apply to the unit's kind (:func:`chebnorm.cli.main` prints it
+        as one line on stderr and exits with status 2).
     """
     from chebnorm import __version__
     from chebnorm.hw.report import write_outputs
@@ -429,9 +429,9 @@ def run_sweep(args) -> int:
     Raises
     ------
     ValueError
-        When the output exists and is not a folder, an option of the other sweep
-        is given, or ``--psi-max`` is out of the target's range (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        When the output exists and is not a folder, an option of the other sweep is
+        given, or ``--psi-max`` is out of the target's range (:func:`chebnorm.cli.main`
+        prints it as one line on stderr and exits with status 2).
     """
     from pathlib import Path
 

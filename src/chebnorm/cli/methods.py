@@ -61,8 +61,8 @@ def run(args) -> int:
     ------
     ValueError
         When ``--dtype`` is not float32 or float64, or ``--angle`` is not finite
-        (accepted: 0 <= PSI < pi radians) (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        (accepted: 0 <= PSI < pi radians) (:func:`chebnorm.cli.main` prints it as one
+        line on stderr and exits with status 2).
     """
     from chebnorm.methods import analyze, angular_drift, method_names
 

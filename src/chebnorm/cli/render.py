@@ -127,7 +127,7 @@ def _refuse_unused(args) -> None:
 def run(args) -> int:
     """Run ``chebnorm render``: render a mesh with the chosen shading and
     normalization, measure its error against the reference, and write the
-    images with ``-o``.
+    image (``--out``) and the error heat map (``--error-map``) when asked.
 
     Parameters
     ----------
@@ -144,9 +144,10 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On a bad option (an unknown ``--reference`` mode, a ``--crease-angle``
-        out of range, an option that does nothing with this ``--shading``) (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On a bad option (an unknown ``--reference`` mode, a ``--crease-angle`` out of
+        range, an option that does nothing with this ``--shading``)
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
     """
     import numpy as np
 

@@ -110,9 +110,10 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        When the output exists and is not a folder, a size is malformed, two
-        cases would write the same image name, or an option is out of range (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        When the output exists and is not a folder, a size is malformed, two cases would
+        write the same image name, or an option is out of range
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
     """
     from pathlib import Path
 

@@ -205,9 +205,9 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On an unknown job name, a ``--bench-results`` that is not a file, or a
-        bad ``--workers``/``--scheduler`` (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On an unknown job name, a ``--bench-results`` that is not a file, or a bad
+        ``--workers``/``--scheduler`` (:func:`chebnorm.cli.main` prints it as one line
+        on stderr and exits with status 2).
     """
     available = jobs()
     if args.list:

@@ -43,8 +43,9 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        When ``--psi-max`` is not a readable angle in the target's range (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        When ``--psi-max`` is not a readable angle in the target's range
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
     """
     rows = []
     for name in target_names():

@@ -76,9 +76,9 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On an unknown ``--format`` or a bad ``--inputs`` (accepted: all, or a
-        count) (:func:`chebnorm.cli.main` prints it as one line on stderr and
-        exits with status 2).
+        On an unknown ``--format`` or a bad ``--inputs`` (accepted: all, or a count)
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
     """
     if args.format not in VERIFY_FORMATS:
         raise ValueError(f"unknown format {args.format[:40]!r} for verify; accepted: "
