@@ -44,9 +44,9 @@ def register(sub) -> None:
     ----------
     sub : argparse._SubParsersAction
         The subparsers of the ``chebnorm`` parser (from
-        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
-        default is :func:`run_verilog`, :func:`run_report`,
-        :func:`run_unit` or :func:`run_sweep`.
+        ``argparse.ArgumentParser.add_subparsers``); each of the four
+        parsers of ``hw`` sets ``func``, its runner: :func:`run_verilog`,
+        :func:`run_report`, :func:`run_unit` or :func:`run_sweep`.
     """
     from chebnorm.hw.units import UNIT_TARGETS, unit_names
 
