@@ -49,6 +49,30 @@ class Interval:
     *inside* the interval (where it is sampled and its maximum located).
     ``binary`` names the endpoints given as Python floats, whose exact binary
     value is used (``0.1`` as a float is 3602879701896397/36028797018963968).
+
+    Parameters
+    ----------
+    lo, hi : str, int, float, fractions.Fraction or sympy.Expr
+        The endpoints, read by :func:`chebnorm.approx.expr.parse_number`: text
+        such as ``"sqrt(2)"`` or ``"0.1"`` exactly, a float at its exact binary
+        value. ``lo < hi``, both finite and below 2^1023 in magnitude.
+
+    Attributes
+    ----------
+    lo, hi : sympy.Expr
+        The exact endpoints.
+    lo_f, hi_f : float
+        The float64 nearest each endpoint.
+    lo_in, hi_in : float
+        The float64 nearest each endpoint inside the interval.
+    binary : dict of str to float
+        ``"LO"``/``"HI"`` -> the endpoint given as a Python float, if any.
+
+    Raises
+    ------
+    ValueError
+        When an endpoint cannot be read, is outside the float64 range, the
+        interval is empty or reversed, or holds no float64 number.
     """
 
     def __init__(self, lo, hi):
@@ -103,8 +127,29 @@ def _nearest_float(ball: arb) -> float:
 def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndarray:
     """Sample ``f`` on the interval and reject it where it is not finite and real.
 
-    Returns the samples. The certification later proves finiteness on the
-    whole interval; this check only gives an early, precise message.
+    The certification later proves finiteness on the whole interval; this check
+    only gives an early, precise message.
+
+    Parameters
+    ----------
+    fn : Function1D
+        The function, evaluated in complex arithmetic (so that a square root of a
+        negative number shows as non-real rather than NaN).
+    iv : Interval
+        The interval, sampled from ``iv.lo_in`` to ``iv.hi_in`` (both included).
+    samples : int, optional
+        The number of equally spaced samples, at least 2; default 2001.
+
+    Returns
+    -------
+    numpy.ndarray
+        The real parts of ``f`` at the samples, float64 of shape ``(samples,)``.
+
+    Raises
+    ------
+    ValueError
+        When ``f`` is infinite, NaN or non-real (imaginary part above ``1e-12``
+        relative) at a sample, naming the first such point.
     """
     x = np.linspace(iv.lo_in, iv.hi_in, samples)
     x[0], x[-1] = iv.lo_in, iv.hi_in
@@ -598,6 +643,19 @@ def warnings_of(table: CoefficientTable) -> list[str]:
     """The warnings a table's provenance carries (Remez not converged, a
     certificate that missed its tightness), one string each.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table from :func:`fit`, :func:`quantize` or a file.
+
+    Returns
+    -------
+    list of str
+        The warnings of ``table.provenance["warnings"]`` (split at ``" | "``),
+        empty when there are none.
+
+    Examples
+    --------
     >>> warnings_of(fit("exp(x)", ("0", "1"), 2))
     []
     """

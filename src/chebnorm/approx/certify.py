@@ -77,6 +77,21 @@ class Certificate:
     evaluated. ``tight`` is True when ``bound <= (1 + tol) * sup`` was
     reached; when a cap stopped the subdivision first it is False and
     ``reason`` says which (the bound is rigorous either way).
+
+    Attributes
+    ----------
+    bound : float
+        The certified upper bound of ``sup |g|`` (rounded upward).
+    maximum : float
+        ``|g(at)|``, a lower bound of the supremum.
+    at : float
+        The point of the interval where ``maximum`` was located.
+    subintervals : int
+        The number of pieces the interval was cut into.
+    tight : bool, default True
+        Whether ``bound <= (1 + tol) * sup |g|`` was reached.
+    reason : str, default ""
+        When not ``tight``: the cap that stopped the subdivision.
     """
 
     bound: float
@@ -89,7 +104,24 @@ class Certificate:
 
 def arb_enclose(value: sp.Expr) -> arb:
     """A ball enclosing a real sympy constant (``sqrt(2)``, ``2*cos(pi/4)``) at
-    the current ``flint.ctx.prec``."""
+    the current ``flint.ctx.prec``.
+
+    Parameters
+    ----------
+    value : sympy.Expr
+        A real constant expression (no free symbols) of the functions the
+        certification engine supports.
+
+    Returns
+    -------
+    flint.arb
+        A ball containing ``value`` (cached per precision).
+
+    Raises
+    ------
+    ValueError
+        When ``value`` uses a function the engine does not support.
+    """
     return _enclose(value, ctx.prec)
 
 

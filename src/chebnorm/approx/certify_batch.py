@@ -153,6 +153,38 @@ def certify_batch(fn: Function1D, origins: Sequence, widths: Sequence,
     unless a cap was reached (then ``tight`` is False and ``reason`` says
     why). Raises ValueError as ``certify`` does when ``g_s`` is not finite.
 
+    Parameters
+    ----------
+    fn : Function1D
+        The function ``f``.
+    origins, widths : sequence of exact numbers or flint.arb
+        Per segment, the origin and the width of the map ``t -> x``; one of each
+        per entry of ``coefficients``.
+    coefficients : sequence of sequence of float
+        Per segment, the finite float coefficients of ``p_s`` in powers of ``t``
+        (an empty list stands for ``[0.0]``).
+    local : tuple of float, optional
+        The interval of ``t``, default ``(0, 1)``; its midpoint must be exact.
+    kind : {"abs", "rel"}, optional
+        The error certified, default ``"abs"``.
+    tol : float, optional
+        The relative tightness aimed at, a finite number > 0; default
+        :data:`chebnorm.approx.certify.TOL` (2^-8).
+
+    Returns
+    -------
+    list of Certificate
+        One certificate per segment, in order.
+
+    Raises
+    ------
+    ValueError
+        When ``kind`` or ``tol`` is out of range, the three sequences differ in
+        length, a coefficient is not finite, or ``g_s`` is not finite on a
+        segment.
+
+    Examples
+    --------
     >>> from chebnorm.approx.expr import parse_function
     >>> c, = certify_batch(parse_function("exp(x)"), [0], [1], [[1.0, 1.0, 0.5]], (-0.5, 0.5))
     >>> c.maximum <= c.bound <= (1 + 2**-8) * c.maximum, 0.02 < c.bound < 0.03

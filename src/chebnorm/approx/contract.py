@@ -311,6 +311,17 @@ def construction(mode: str):
         defenses only (such a table is not sealed, so :meth:`Table.verify`
         re-proves it).
 
+    Yields
+    ------
+    None
+        The block runs with table construction in ``mode``; the previous mode
+        is restored on exit, also on an exception.
+
+    Raises
+    ------
+    ValueError
+        When ``mode`` is not one of the three.
+
     Examples
     --------
     >>> from chebnorm.approx import CoefficientTable
@@ -351,7 +362,21 @@ def _seal(t) -> None:
 
 def sealed(t) -> bool:
     """True when the table ``t`` was verified and none of its fields (nested ones
-    included) changed since."""
+    included) changed since.
+
+    Parameters
+    ----------
+    t : Table
+        A table (a :class:`~chebnorm.approx.CoefficientTable` or
+        :class:`~chebnorm.approx.PiecewiseTable`), or any object.
+
+    Returns
+    -------
+    bool
+        True only when ``t`` was verified (constructed in ``"prove"`` or
+        ``"fitted"`` mode) and its JSON text is unchanged since; False for
+        anything else, including an object whose JSON cannot be written.
+    """
     entry = _SEALS.get(id(t))
     if entry is None or entry[0]() is not t:
         return False

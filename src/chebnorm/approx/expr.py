@@ -317,6 +317,28 @@ def read_expression(text: str, variables: Iterable[str] = ("x",)) -> sp.Expr:
     Decimals are exact, ``^`` is a power, and nothing in ``text`` is ever run.
     Raises ValueError naming the offending token and the accepted set.
 
+    Parameters
+    ----------
+    text : str
+        The expression, at most :data:`MAX_LENGTH` characters of ASCII letters,
+        digits, spaces and ``+ - * / ^ ( ) . , _``, using the functions of
+        :data:`FUNCTIONS` and the constants ``pi`` and ``E``.
+    variables : iterable of str, optional
+        The names of the variables it may use, default ``("x",)``.
+
+    Returns
+    -------
+    sympy.Expr
+        The expression, its variables real sympy Symbols.
+
+    Raises
+    ------
+    ValueError
+        When ``text`` is not a string, too long, has a character or construct
+        outside the accepted set, an unknown name, or is not a scalar expression.
+
+    Examples
+    --------
     >>> read_expression("x^2 + 0.1")
     x**2 + 1/10
     >>> read_expression("2*cos(psi_max)", ["psi_max"])
@@ -378,6 +400,25 @@ def parse_number(text: str | float | int) -> sp.Expr:
     ``fractions.Fraction`` exactly. Raises ValueError for anything that is not
     a finite real constant.
 
+    Parameters
+    ----------
+    text : str, int, float, fractions.Fraction or sympy.Expr
+        The constant; a bool is refused.
+
+    Returns
+    -------
+    sympy.Expr
+        The exact constant (an Integer, a Rational, or an expression such as
+        ``sqrt(2)``).
+
+    Raises
+    ------
+    ValueError
+        When ``text`` is not finite, not a constant (it names a variable), cannot
+        be parsed, or not a real number.
+
+    Examples
+    --------
     >>> parse_number("0.1"), parse_number(0.5), parse_number("2*cos(pi/4)")
     (1/10, 1/2, sqrt(2))
     """
@@ -671,6 +712,13 @@ class Function1D:
     ``expr`` is the sympy expression, ``var`` its variable. The evaluators are
     compiled on first use. Internal: no input checking.
 
+    Parameters
+    ----------
+    expr : sympy.Expr
+        The expression, in the single variable ``var``.
+    var : sympy.Symbol
+        Its variable (a real Symbol).
+
     Examples
     --------
     >>> f = parse_function("1/sqrt(x)")
@@ -720,13 +768,31 @@ def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:
     A sympy expression is taken as it is, its Floats at their exact binary
     values.
 
+    Parameters
+    ----------
+    text : str or sympy.Expr
+        The function, e.g. ``"1/sqrt(x)"``.
+    var : str, optional
+        The name of its variable, default ``"x"``.
+
+    Returns
+    -------
+    Function1D
+        The function and its evaluators.
+
+    Raises
+    ------
+    ValueError
+        For text that is not accepted, for variables other than ``var`` and for
+        functions the certification engine does not support (or that are not
+        finite and real, such as ``1/0``).
+
+    Examples
+    --------
     >>> parse_function("1/sqrt(2+z)", "z").expr
     1/sqrt(z + 2)
     >>> parse_function("x + 0.1").expr
     x + 1/10
-
-    Raises ValueError for text that is not accepted, for variables other than
-    ``var`` and for functions the certification engine does not support.
     """
     if not isinstance(text, (str, sp.Expr)):
         raise ValueError(f"expression of type {type(text).__name__} is not accepted; accepted: "

@@ -30,6 +30,25 @@ def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) ->
 
     A polynomial of degree at most ``degree`` is its own interpolant:
 
+    Parameters
+    ----------
+    f_mp : callable
+        ``f``, taking and returning mpmath numbers.
+    lo, hi : float, int or mpmath number
+        The interval, ``lo < hi``.
+    degree : int
+        The degree, >= 0; the interpolant uses ``degree + 1`` nodes.
+    dps : int, optional
+        The decimal digits of the mpmath working precision, default 40.
+
+    Returns
+    -------
+    list of float
+        The ``degree + 1`` monomial coefficients in ``x``, ascending, each
+        rounded once to float64.
+
+    Examples
+    --------
     >>> [round(c, 12) + 0.0 for c in chebyshev_interpolant(lambda x: 3 * x**2 - x, 0, 1, 2)]
     [0.0, -1.0, 3.0]
     """
@@ -52,6 +71,31 @@ def cheb_to_monomial(cheb: np.ndarray, lo: float, hi: float, center: float = 0.0
     ``T_2(u) = 2 u^2 - 1``; on ``[0, 2]``, ``u = x - 1`` and
     ``T_2 = 2 x^2 - 4 x + 1``; in ``t = x - 1`` it stays ``2 t^2 - 1``:
 
+    Parameters
+    ----------
+    cheb : array_like of float or mpmath numbers
+        The Chebyshev coefficients ``c_k`` of ``sum c_k T_k(u)``, ascending; each
+        finite and taken exactly.
+    lo, hi : float
+        The interval that maps to ``u in [-1, 1]``, ``lo < hi``.
+    center : float, optional
+        The ``c`` of ``t = (x - c)/s``, default 0.
+    scale : float, optional
+        The ``s`` of ``t = (x - c)/s``, nonzero; default 1.
+
+    Returns
+    -------
+    list of float
+        ``len(cheb)`` coefficients in powers of ``t``, ascending, each the exact
+        rational coefficient rounded once to the nearest float64.
+
+    Raises
+    ------
+    ValueError
+        When a coefficient is not finite.
+
+    Examples
+    --------
     >>> cheb_to_monomial([0.0, 0.0, 1.0], -1.0, 1.0), cheb_to_monomial([0.0, 0.0, 1.0], 0.0, 2.0)
     ([-1.0, 0.0, 2.0], [1.0, -4.0, 2.0])
     >>> cheb_to_monomial([0.0, 0.0, 1.0], 0.0, 2.0, center=1.0, scale=1.0)
@@ -98,6 +142,19 @@ def shift_for(lo: float, hi: float) -> tuple[float, float]:
     ``c`` the float midpoint, ``s`` the smallest power of two at least the
     half-width, so ``|t| <= 1`` and dividing by ``s`` is exact.
 
+    Parameters
+    ----------
+    lo, hi : float
+        The interval, finite floats with ``lo < hi``.
+
+    Returns
+    -------
+    tuple of float
+        ``(c, s)``: the midpoint ``(lo + hi)/2`` rounded to float64, and the
+        power of two ``s >= max(hi - c, c - lo)``.
+
+    Examples
+    --------
     >>> shift_for(1e6, 1e6 + 1)
     (1000000.5, 0.5)
     """
@@ -113,7 +170,26 @@ class RemezResult:
     """Result of :func:`remez`: ``cheb``, the Chebyshev-basis coefficients in
     the mapped variable ``t in [-1, 1]``; ``levelled``, the equioscillation
     level; ``max_error``, the largest error on the grid; ``iterations``,
-    ``converged``, the final reference ``ref`` and ``noise_limited``."""
+    ``converged``, the final reference ``ref`` and ``noise_limited``.
+
+    Parameters
+    ----------
+    cheb : numpy.ndarray
+        The Chebyshev-basis coefficients in ``t``, ascending.
+    levelled : float
+        The equioscillation level ``|h|`` of the last solve.
+    max_error : float
+        The largest weighted error found on the grid.
+    iterations : int
+        The number of exchanges done.
+    converged : bool
+        Whether ``levelled`` and ``max_error`` agree to ``rtol`` (or to the
+        float64 noise floor).
+    ref : numpy.ndarray, optional
+        The final reference (``degree + 2`` points of ``t``); default None.
+    noise_limited : bool, optional
+        Whether float64's resolution of ``w f`` limited the solve; default False.
+    """
 
     def __init__(self, cheb: np.ndarray, levelled: float, max_error: float, iterations: int,
                  converged: bool, ref: np.ndarray | None = None, noise_limited: bool = False):
@@ -283,6 +359,31 @@ def remez(f: Callable[[np.ndarray], np.ndarray], weight: Callable[[np.ndarray], 
     equioscillating at 0, 1/2, 1); with ``x = (t + 1)/2`` it is
     ``3/8 + t/2``:
 
+    Parameters
+    ----------
+    f : callable
+        ``f`` on a float64 array of ``x``, returning a float64 array.
+    weight : callable or None
+        The weight ``w`` on a float64 array of ``x`` (e.g. ``1/|f|`` for the
+        relative error), or None for ``w = 1``.
+    lo, hi : float
+        The interval, finite, ``lo < hi``.
+    degree : int
+        The degree of ``p``, >= 0.
+    max_iter : int, optional
+        The most exchanges, default 60 (``converged`` is False when reached).
+    rtol : float, optional
+        The relative agreement of the level and the largest error that stops
+        the iteration, > 0; default 1e-8.
+
+    Returns
+    -------
+    RemezResult
+        The coefficients in the Chebyshev basis of ``t``, the levelled and
+        largest errors, and whether it converged.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> r = remez(lambda x: x**2, np.ones_like, 0.0, 1.0, 1)
     >>> [round(float(c), 9) for c in r.cheb], round(float(r.levelled), 9), r.converged
@@ -368,6 +469,28 @@ def polish(f_mp: Callable, lo: float, hi: float, ref: np.ndarray, degree: int,
     The best line to ``x^2`` on ``[0, 1]`` solved at its reference 0, 1/2, 1
     (``t = -1, 0, 1``) is ``3/8 + t/2`` exactly:
 
+    Parameters
+    ----------
+    f_mp : callable
+        ``f``, taking and returning mpmath numbers.
+    lo, hi : float
+        The interval, ``lo < hi``.
+    ref : array_like of float
+        The ``degree + 2`` reference points of ``t`` in ``[-1, 1]``.
+    degree : int
+        The degree, >= 0.
+    relative : bool, optional
+        Level the relative error ``p/f - 1`` instead of ``p - f``; default False.
+    dps : int, optional
+        The decimal digits of the mpmath working precision, default 50.
+
+    Returns
+    -------
+    list of mpmath.mpf
+        The ``degree + 1`` Chebyshev coefficients, ascending.
+
+    Examples
+    --------
     >>> [float(c) for c in polish(lambda x: x**2, 0.0, 1.0, [-1.0, 0.0, 1.0], 1)]
     [0.375, 0.5]
     """
@@ -480,7 +603,22 @@ class PowersFit:
     powers ``0..degree`` of ``x``, the fixed ones included), ``level`` (the
     discrete minimax error on the final point set, a lower estimate),
     ``max_error`` (the largest error found on the dense grid and at the
-    located extrema), ``converged`` (the two agree to ``rtol``)."""
+    located extrema), ``converged`` (the two agree to ``rtol``).
+
+    Parameters
+    ----------
+    coefficients : list of float
+        The float64 coefficients of ``x^0 .. x^degree``, the fixed ones included
+        (zero for the powers not used).
+    level : float
+        The discrete minimax error on the final point set.
+    max_error : float
+        The largest error found.
+    converged : bool
+        Whether ``max_error`` is within ``1 + 10^-4`` of ``level``.
+    rounds : int
+        The number of exchange rounds of all stages.
+    """
 
     def __init__(self, coefficients, level, max_error, converged, rounds):
         self.coefficients = coefficients
@@ -588,6 +726,31 @@ def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | 
     best ``1 + c x^2`` to ``1 + x^4`` has ``c = 2 sqrt(2) - 2`` (error
     ``c^2/4``, at ``x^2 = c/2`` and at 1):
 
+    Parameters
+    ----------
+    fn : Function1D
+        The function ``f``.
+    lo, hi : float
+        The interval, finite, ``lo < hi``.
+    degree : int
+        The highest power of the result's coefficient list, >= every power used.
+    powers : iterable of int
+        The powers whose coefficients are free, each in ``0..degree``.
+    fixed : dict of int to float, optional
+        Power -> coefficient held fixed; default None (none).
+    relative : bool, optional
+        Minimize the relative error (``w = 1/|f|``); default False.
+    rtol : float, optional
+        The agreement of level and largest error that ends a stage, > 0;
+        default 1e-6.
+
+    Returns
+    -------
+    PowersFit
+        The coefficients, the level, the largest error and whether it converged.
+
+    Examples
+    --------
     >>> from chebnorm.approx import parse_function
     >>> r = minimax_powers(parse_function("x**3"), -1.0, 1.0, 3, (1,))
     >>> r.converged, round(r.level, 7), [round(c, 7) for c in r.coefficients]

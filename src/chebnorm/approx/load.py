@@ -36,6 +36,19 @@ def table_kind(value) -> type[Table] | None:
     (whatever the version and its own ``kind``, the fit's: the reader refuses
     what it does not support, naming the field).
 
+    Parameters
+    ----------
+    value : object
+        A parsed JSON value (any type; only a dict can name a kind).
+
+    Returns
+    -------
+    type or None
+        :class:`~chebnorm.approx.PiecewiseTable`,
+        :class:`~chebnorm.approx.CoefficientTable`, or None.
+
+    Examples
+    --------
     >>> table_kind({"kind": "chebnorm.piecewise_table"}).__name__
     'PiecewiseTable'
     >>> table_kind({"schema_version": 1, "kind": "minimax"}).__name__

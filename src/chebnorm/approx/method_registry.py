@@ -50,6 +50,16 @@ _DOTTED = re.compile(r"[A-Za-z_][\w.]*:[A-Za-z_]\w*\Z")
 class TableSpec:
     """The coefficient table a kernel reads: ``fit_target(target, degree, psi_max=psi_max)``.
 
+    Parameters
+    ----------
+    target : str
+        A registered target name (:func:`chebnorm.approx.get_target`).
+    degree : int, optional
+        The degree of the fit, default 2.
+    psi_max : str, optional
+        The largest span angle, an exact expression in radians, default
+        ``"pi/4"``.
+
     Examples
     --------
     >>> TableSpec("rsqrt", 3)
@@ -73,6 +83,26 @@ class MethodSpec:
     unit names implementing it, the first one evaluating ``table``;
     ``c_kernel``: its kernel in ``benchmarks/c/kernels.h`` (None: none);
     ``ideal``: ``"linear"`` or ``"slerp"`` (see :data:`IDEALS`).
+
+    Parameters
+    ----------
+    name : str
+        Lower-case letters, digits and ``_``, starting with a letter.
+    summary : str
+        One line saying what the method computes.
+    seed : str
+        Where the papers define it.
+    kernel : object
+        The span kernel, or its ``"module:attribute"`` reference (resolved on
+        use).
+    table : TableSpec or None, optional
+        The table the kernel reads; default None (no table).
+    units : tuple of str, optional
+        The hardware unit names, default ``()``.
+    c_kernel : str or None, optional
+        The C benchmark kernel, default None.
+    ideal : {"linear", "slerp"}, optional
+        What the method's error is measured against, default ``"linear"``.
 
     Examples
     --------
@@ -144,6 +174,28 @@ def _check_spec(spec) -> MethodSpec:
 def register(spec: MethodSpec, *, replace: bool = False) -> MethodSpec:
     """Add ``spec`` to the registry (``replace=True`` to redefine a name).
 
+    Parameters
+    ----------
+    spec : MethodSpec
+        The method; its name, kernel reference, table, ideal and units are
+        checked.
+    replace : bool, optional
+        Allow redefining a registered name (keyword only); default False.
+
+    Returns
+    -------
+    MethodSpec
+        ``spec``, as registered.
+
+    Raises
+    ------
+    ValueError
+        When ``spec`` is not a :class:`MethodSpec`, a field is not accepted (the
+        error names it), its table names an unknown target, or the name is taken
+        and ``replace`` is False.
+
+    Examples
+    --------
     >>> s = register(MethodSpec("toy_doc", "copy N_l", "none", "mymodule:KERNEL"))
     >>> "toy_doc" in method_names()
     True
@@ -159,6 +211,16 @@ def register(spec: MethodSpec, *, replace: bool = False) -> MethodSpec:
 
 def unregister(name: str) -> None:
     """Remove a method registered at run time (the built-in eight stay).
+
+    Parameters
+    ----------
+    name : str
+        A method registered with :func:`register`.
+
+    Raises
+    ------
+    ValueError
+        When ``name`` is built in or not registered.
 
     Examples
     --------
@@ -180,6 +242,24 @@ def unregister(name: str) -> None:
 def get_method(name) -> MethodSpec:
     """The entry of method ``name``; the one check of a method name in chebnorm.
 
+    Parameters
+    ----------
+    name : str
+        A registered method name (:func:`method_names`).
+
+    Returns
+    -------
+    MethodSpec
+        Its registry entry.
+
+    Raises
+    ------
+    ValueError
+        When ``name`` is not registered (or not a string), listing the
+        registered names.
+
+    Examples
+    --------
     >>> get_method("nope")
     Traceback (most recent call last):
     ...
@@ -210,6 +290,11 @@ def method_names() -> tuple[str, ...]:
 def registered_methods() -> tuple[MethodSpec, ...]:
     """Every registry entry, in :func:`method_names` order.
 
+    Returns
+    -------
+    tuple of MethodSpec
+        The entries.
+
     Examples
     --------
     >>> [s.name for s in registered_methods() if s.table is not None]
@@ -222,6 +307,11 @@ def unit_tables() -> dict[str, TableSpec]:
     """Hardware unit name -> the table its polynomial evaluator approximates (units
     without an evaluator are absent): the first unit of every method with a table,
     and the units that belong to no method (``eta``).
+
+    Returns
+    -------
+    dict of str to TableSpec
+        Unit name -> its table.
 
     Examples
     --------

@@ -88,7 +88,24 @@ ERRORS = ERROR_KINDS
 
 @dataclass(frozen=True)
 class PiecewiseSegment:
-    """One segment: integer coefficients and the certified claims about them."""
+    """One segment: integer coefficients and the certified claims about them.
+
+    Parameters
+    ----------
+    integers : tuple of int
+        The ``degree + 1`` coefficients, ascending, as integers:
+        coefficient ``j`` is ``integers[j] / 2**coef_frac_bits`` (the table's).
+    abs_error_bound : float
+        A rigorous bound of ``sup |p_s - f|`` on the segment (rounded upward).
+    max_abs_error : float
+        The largest ``|p_s - f|`` located on the segment (a lower bound of the
+        supremum).
+    rel_error_bound : float or None, optional
+        A rigorous bound of ``sup |p_s/f - 1|``; default None (for an ``"abs"``
+        table).
+    max_rel_error : float or None, optional
+        The largest ``|p_s/f - 1|`` located; default None.
+    """
 
     integers: tuple[int, ...]
     abs_error_bound: float
@@ -507,6 +524,18 @@ def _segment_certificates(table: PiecewiseTable, kind: str, stated, todo) -> dic
 def exact_log2(value: sp.Expr) -> int | None:
     """``e`` when ``value == 2**e`` exactly, else None.
 
+    Parameters
+    ----------
+    value : sympy.Expr
+        A real constant.
+
+    Returns
+    -------
+    int or None
+        The exponent ``e``, or None when ``value`` is not a power of two.
+
+    Examples
+    --------
     >>> exact_log2(sp.Rational(1, 4)), exact_log2(sp.Integer(3))
     (-2, None)
     """
@@ -524,6 +553,26 @@ def exact_log2(value: sp.Expr) -> int | None:
 def segment_bounds(segment_by, lo, hi, index_bits, s):
     """Exact endpoints ``(a_s, b_s)`` of segment ``s`` of ``[lo, hi]`` (sympy numbers).
 
+    Parameters
+    ----------
+    segment_by : {"uniform", "exponent"}
+        ``"uniform"``: ``2**index_bits`` equal segments of ``[lo, hi]``;
+        ``"exponent"``: ``2**index_bits`` equal segments per binade, ``lo`` and
+        ``hi`` powers of two.
+    lo, hi : sympy.Expr
+        The exact interval, ``lo < hi``.
+    index_bits : int
+        The bits that select a segment (per binade for ``"exponent"``), >= 0.
+    s : int
+        The segment index, ``0 <= s <`` :func:`segment_count`.
+
+    Returns
+    -------
+    tuple of sympy.Expr
+        ``(a_s, b_s)``, exact.
+
+    Examples
+    --------
     >>> segment_bounds("exponent", sp.Integer(1), sp.Integer(4), 1, 3)
     (3, 4)
     """
@@ -541,6 +590,22 @@ def segment_bounds(segment_by, lo, hi, index_bits, s):
 def segment_count(segment_by, lo, hi, index_bits) -> int:
     """How many segments ``index_bits`` make of ``[lo, hi]`` (per binade for ``"exponent"``).
 
+    Parameters
+    ----------
+    segment_by : {"uniform", "exponent"}
+        How the interval is cut (see :func:`segment_bounds`).
+    lo, hi : sympy.Expr
+        The exact interval; powers of two for ``"exponent"``.
+    index_bits : int
+        The bits that select a segment, >= 0.
+
+    Returns
+    -------
+    int
+        ``2**index_bits``, times the number of binades for ``"exponent"``.
+
+    Examples
+    --------
     >>> segment_count("exponent", sp.Rational(1, 4), sp.Integer(4), 2)
     16
     """
@@ -552,6 +617,23 @@ def segment_count(segment_by, lo, hi, index_bits) -> int:
 def parse_segments(text) -> int:
     """``"2^k"``, ``"2**k"`` or a power of two ``N`` -> ``k`` (index bits).
 
+    Parameters
+    ----------
+    text : str or int
+        ``"2^k"``, ``"2**k"`` or a power of two ``N >= 1`` (text or int).
+
+    Returns
+    -------
+    int
+        ``k``, in ``0 .. MAX_INDEX_BITS``.
+
+    Raises
+    ------
+    ValueError
+        When ``text`` is not of that form or ``k`` is out of range.
+
+    Examples
+    --------
     >>> parse_segments("2^8"), parse_segments("16"), parse_segments(1)
     (8, 4, 0)
     """
@@ -580,6 +662,32 @@ def certify_segments(table: PiecewiseTable, kind: str = "abs", tol: float | None
     tightness ``tol`` (default the certifier's), all segments in one batch
     (:func:`chebnorm.approx.certify_batch.certify_batch`).
 
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The table.
+    kind : {"abs", "rel"}, optional
+        The error certified, default ``"abs"``.
+    tol : float or None, optional
+        The relative tightness, a finite number > 0; default None (the
+        certifier's :data:`~chebnorm.approx.certify.TOL`, 2^-8).
+    segments : iterable of int, optional
+        The segment indices; default None (every segment, in order).
+
+    Returns
+    -------
+    list of Certificate
+        One per segment certified, in the order of ``segments``; ``at`` is a
+        point of the local variable.
+
+    Raises
+    ------
+    ValueError
+        When ``kind`` or ``tol`` is out of range, or the error is not finite on
+        a segment.
+
+    Examples
+    --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("x**3", ("0", "1"), 1, segments=2, coef_frac_bits=12)
     >>> [c.bound <= s.abs_error_bound for c, s in zip(certify_segments(t), t.segments)]
@@ -624,6 +732,27 @@ def segment_balls(segment_by, lo, hi, index_bits, centered, segments):
     the local range (128 bits; exact for binary ends), without sympy per segment,
     for the segments ``segments`` (indices).
 
+    Parameters
+    ----------
+    segment_by : {"uniform", "exponent"}
+        How the interval is cut (see :func:`segment_bounds`).
+    lo, hi : sympy.Expr
+        The exact interval; powers of two for ``"exponent"``.
+    index_bits : int
+        The bits that select a segment, >= 0.
+    centered : bool
+        The local variable is ``u`` in ``[-1/2, 1/2]`` (the origin is the
+        segment's midpoint) instead of ``t`` in ``[0, 1]``.
+    segments : iterable of int
+        The segment indices.
+
+    Returns
+    -------
+    tuple of list of flint.arb
+        ``(origins, widths)``, one ball of each per segment.
+
+    Examples
+    --------
     >>> o, w = segment_balls("uniform", sp.Integer(1), sp.Integer(2), 1, False, [1])
     >>> float(o[0].mid()), float(w[0].mid())
     (1.5, 0.5)

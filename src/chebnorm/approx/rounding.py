@@ -54,6 +54,9 @@ FLOAT_FORMATS = {
     "binary32": (24, -126, 127),
     "binary64": (53, -1022, 1023),
 }
+#: every coefficient format of :func:`chebnorm.approx.quantize` (``coef_format``):
+#: ``"fixed"`` (two's complement integers over a power of two), then the floating
+#: formats of :data:`FLOAT_FORMATS`; the facade exports it as ``COEF_FORMATS``
 FORMATS = ("fixed",) + tuple(FLOAT_FORMATS)
 #: most lattice rounds (sets of binades) tried for a floating format
 FLOAT_ROUNDS = 10
@@ -61,7 +64,24 @@ FLOAT_ROUNDS = 10
 
 @dataclass(frozen=True)
 class Candidate:
-    """One rounded polynomial: coefficient of ``x**k`` is ``mantissas[k] * 2**exponents[k]``."""
+    """One rounded polynomial: coefficient of ``x**k`` is ``mantissas[k] * 2**exponents[k]``.
+
+    Parameters
+    ----------
+    mantissas : tuple of int
+        The integer mantissa of each power ``0..degree``.
+    exponents : tuple of int
+        The power-of-two exponent of each (``-frac_bits`` in fixed point).
+    method : str
+        How the candidate was found (e.g. rounded to nearest, greedy refit,
+        lattice search).
+    bound : float
+        Its certified error bound (of the table's ``error_kind``).
+    abs_cert : Certificate
+        The certificate of ``sup |p - f|``.
+    rel_cert : Certificate or None
+        The certificate of ``sup |p/f - 1|``, None when not computed.
+    """
 
     mantissas: tuple[int, ...]
     exponents: tuple[int, ...]
@@ -869,7 +889,32 @@ def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=Non
     Candidates are ranked by their sampled error (float64, a dense grid) and
     certified in that order only while they can still beat the best bound
     certified (:func:`_certify_ranked`): the answer's bound is always
-    rigorous, the ranking only decides which candidates are certified."""
+    rigorous, the ranking only decides which candidates are certified.
+
+    Parameters
+    ----------
+    prob : Problem
+        The function, interval, error kind, free and fixed powers and word limit.
+    real : sequence of float
+        The real (unrounded) coefficients of every power ``0..degree``.
+    fmt : str
+        One of :data:`FORMATS`: ``"fixed"`` or a float format of
+        :data:`FLOAT_FORMATS`.
+    frac_bits : sequence of int, optional
+        For ``"fixed"``: the fraction bits of each power (required then);
+        default None.
+    greedy : callable, optional
+        ``quanta -> list of int or None``: the greedy refit's integers for the
+        exponents ``quanta`` of each power, one more candidate; default None.
+    plain : bool, optional
+        Round each coefficient to nearest and nothing else; default False.
+
+    Returns
+    -------
+    Candidate or None
+        The candidate of least certified bound, or None when none can be
+        certified (e.g. every one overflows the word).
+    """
     sampler = _Sampler(prob)
     if plain:
         quanta = ([-f for f in frac_bits] if fmt == "fixed" else

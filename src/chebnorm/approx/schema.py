@@ -112,6 +112,19 @@ def versions() -> dict[str, str]:
 def show(value) -> str:
     """``value`` as the user wrote it in JSON, cut to a readable length.
 
+    Parameters
+    ----------
+    value : object
+        A parsed JSON value (or any Python object).
+
+    Returns
+    -------
+    str
+        ``null``/``true``/``false``, ``an object``, ``an array of N``, or the
+        ``repr`` cut to 60 characters.
+
+    Examples
+    --------
     >>> show(None), show(True), show([1, 2]), show({}), show("x" * 70)[-5:]
     ('null', 'true', 'an array of 2', 'an object', 'xx...')
     """
@@ -128,12 +141,50 @@ def show(value) -> str:
 
 
 def bad(field: str, expected: str, value) -> ValueError:
-    """The refusal ``field: expected EXPECTED, got VALUE`` (to raise)."""
+    """The refusal ``field: expected EXPECTED, got VALUE`` (to raise).
+
+    Parameters
+    ----------
+    field : str
+        The field's name (dotted for a nested one).
+    expected : str
+        What the field accepts, e.g. ``"a finite number >= 0"``.
+    value : object
+        The value refused, shown by :func:`show`.
+
+    Returns
+    -------
+    ValueError
+        The error, for the caller to raise.
+    """
     return ValueError(f"{field}: expected {expected}, got {show(value)}")
 
 
 def number(value, field: str, *, optional: bool = False, nonneg: bool = False) -> float | None:
-    """A finite JSON number as a float (``>= 0`` with ``nonneg``; null with ``optional``)."""
+    """A finite JSON number as a float (``>= 0`` with ``nonneg``; null with ``optional``).
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value; an int or float (not a bool).
+    field : str
+        The field's name, for the refusal.
+    optional : bool, optional
+        Accept null (returned as None); default False.
+    nonneg : bool, optional
+        Accept only values ``>= 0``; default False.
+
+    Returns
+    -------
+    float or None
+        The value as a float; None for null with ``optional``.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not a finite number (or is negative with ``nonneg``),
+        naming ``field``.
+    """
     if value is None and optional:
         return None
     what = "a finite number" + (" >= 0" if nonneg else "") + (" or null" if optional else "")
@@ -153,6 +204,27 @@ def integer(value, field: str, lo: int | None = None, hi: int | None = None, *,
     """A JSON integer (not a boolean, not ``2.0``), in ``lo..hi`` when given.
 
     ``expected`` replaces the default wording ``an integer in lo..hi``.
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value; an int (not a bool, not a float).
+    field : str
+        The field's name, for the refusal.
+    lo, hi : int, optional
+        The accepted range, both ends included; default None (any integer).
+    expected : str, optional
+        The wording of the refusal (keyword only); default None.
+
+    Returns
+    -------
+    int
+        The value.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not an integer in ``lo..hi``, naming ``field``.
     """
     what = expected or ("an integer" if lo is None else f"an integer in {lo}..{hi}")
     if isinstance(value, bool) or not isinstance(value, int):
@@ -163,7 +235,30 @@ def integer(value, field: str, lo: int | None = None, hi: int | None = None, *,
 
 
 def text(value, field: str, max_length: int = MAX_TEXT, *, empty: bool = False) -> str:
-    """A JSON string of at most ``max_length`` characters (non-empty unless ``empty``)."""
+    """A JSON string of at most ``max_length`` characters (non-empty unless ``empty``).
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value; a str.
+    field : str
+        The field's name, for the refusal.
+    max_length : int, optional
+        The most characters, default :data:`MAX_TEXT`.
+    empty : bool, optional
+        Accept the empty string (keyword only); default False.
+
+    Returns
+    -------
+    str
+        The value.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not a string, is empty (without ``empty``) or longer
+        than ``max_length``, naming ``field``.
+    """
     if not isinstance(value, str):
         raise bad(field, "a string", value)
     if not value and not empty:
@@ -174,21 +269,83 @@ def text(value, field: str, max_length: int = MAX_TEXT, *, empty: bool = False) 
 
 
 def choice(value, field: str, choices, *, expected: str | None = None) -> str:
-    """One of the strings ``choices`` (``expected`` replaces the wording ``one of 'a', 'b'``)."""
+    """One of the strings ``choices`` (``expected`` replaces the wording ``one of 'a', 'b'``).
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value.
+    field : str
+        The field's name, for the refusal.
+    choices : collection of str
+        The accepted strings.
+    expected : str, optional
+        The wording of the refusal (keyword only); default None.
+
+    Returns
+    -------
+    str
+        The value.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not one of ``choices``, naming ``field``.
+    """
     if not isinstance(value, str) or value not in choices:
         raise bad(field, expected or "one of " + ", ".join(repr(c) for c in choices), value)
     return value
 
 
 def boolean(value, field: str) -> bool:
-    """A JSON ``true`` or ``false``."""
+    """A JSON ``true`` or ``false``.
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value.
+    field : str
+        The field's name, for the refusal.
+
+    Returns
+    -------
+    bool
+        The value.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not a bool, naming ``field``.
+    """
     if not isinstance(value, bool):
         raise bad(field, "true or false", value)
     return value
 
 
 def array(value, field: str, what: str, length: int | None = None) -> list:
-    """A JSON array (of ``what``), of exactly ``length`` items when given."""
+    """A JSON array (of ``what``), of exactly ``length`` items when given.
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value.
+    field : str
+        The field's name, for the refusal.
+    what : str
+        What the items are, for the refusal (e.g. ``"numbers"``).
+    length : int, optional
+        The exact number of items; default None (any).
+
+    Returns
+    -------
+    list
+        The value (items unchecked).
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not a list (of ``length`` items), naming ``field``.
+    """
     if not isinstance(value, list) or (length is not None and len(value) != length):
         raise bad(field, f"an array of {what}", value)
     return value
@@ -199,6 +356,26 @@ def check_object(d, field: str, allowed, optional=(), *, what: str = "coefficien
 
     ``field`` prefixes the keys (``fixed_point.method``); the top level has
     ``field == ""`` and is called ``what`` when it is not an object.
+
+    Parameters
+    ----------
+    d : object
+        The parsed JSON value.
+    field : str
+        The dotted name of the object (``""`` at the top level).
+    allowed : collection of str
+        Every key accepted.
+    optional : collection of str, optional
+        The keys of ``allowed`` that may be missing; default ``()``.
+    what : str, optional
+        The name of the top-level object (keyword only); default
+        ``"coefficient table"``.
+
+    Raises
+    ------
+    ValueError
+        When ``d`` is not a dict, has a key not in ``allowed`` (the first one,
+        sorted) or lacks a required key.
     """
     if not isinstance(d, dict):
         raise bad(field or what, "a JSON object", d)
@@ -214,7 +391,27 @@ def check_object(d, field: str, allowed, optional=(), *, what: str = "coefficien
 
 def provenance(value, field: str = "provenance") -> dict[str, str]:
     """The ``provenance`` object: at most :data:`MAX_PROVENANCE` entries, non-empty
-    keys of at most :data:`MAX_KEY` characters, values of at most :data:`MAX_TEXT`."""
+    keys of at most :data:`MAX_KEY` characters, values of at most :data:`MAX_TEXT`.
+
+    Parameters
+    ----------
+    value : object
+        The parsed JSON value.
+    field : str, optional
+        The field's name, default ``"provenance"``.
+
+    Returns
+    -------
+    dict of str to str
+        A copy of the object.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not an object of strings, has more than
+        :data:`MAX_PROVENANCE` entries, an empty or too long key, or a value
+        longer than :data:`MAX_TEXT`.
+    """
     if not isinstance(value, dict):
         raise bad(field, "an object of strings", value)
     if len(value) > MAX_PROVENANCE:
@@ -235,6 +432,27 @@ def parse_json(source, what: str):
     """``json.loads`` of a table's text; refuses what is not JSON, and an object
     that gives a key twice (naming the key). ``what`` names the table in a refusal.
 
+    Parameters
+    ----------
+    source : str or bytes
+        The JSON text.
+    what : str
+        The table's description, e.g. ``"coefficient table"``.
+
+    Returns
+    -------
+    object
+        The parsed value (NaN and Infinity are read, for the field readers to
+        refuse).
+
+    Raises
+    ------
+    ValueError
+        When ``source`` is not valid JSON (also too deeply nested) or an object
+        gives a key twice.
+
+    Examples
+    --------
     >>> parse_json('{"a": 1, "a": 2}', "coefficient table")
     Traceback (most recent call last):
     ...

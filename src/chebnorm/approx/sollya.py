@@ -23,13 +23,27 @@ __all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "
 
 
 def available() -> bool:
-    """True when the ``sollya`` executable is on PATH."""
+    """True when the ``sollya`` executable is on PATH.
+
+    Returns
+    -------
+    bool
+        Whether ``shutil.which`` finds ``sollya``.
+    """
     return shutil.which("sollya") is not None
 
 
 @dataclass(frozen=True)
 class SollyaSupnorm:
-    """Sollya's certified enclosure ``[lower, upper]`` of ``sup |p - f|``."""
+    """Sollya's certified enclosure ``[lower, upper]`` of ``sup |p - f|``.
+
+    Parameters
+    ----------
+    lower : float
+        A lower bound of the supremum (Sollya's ``inf`` of the enclosure).
+    upper : float
+        A rigorous upper bound of the supremum (Sollya's ``sup``).
+    """
 
     lower: float
     upper: float
@@ -60,6 +74,25 @@ def function_text(expr: str, var: str = "x") -> str:
     """``expr`` (a function of ``var``, parsed by chebnorm's own reader) as a
     Sollya expression in ``x``, for scripts of one's own.
 
+    Parameters
+    ----------
+    expr : str
+        The function, in chebnorm's expression syntax.
+    var : str, optional
+        Its variable, default ``"x"``.
+
+    Returns
+    -------
+    str
+        The Sollya expression (``^`` for powers, ``exp(1)`` for ``E``).
+
+    Raises
+    ------
+    ValueError
+        When :func:`chebnorm.approx.expr.parse_function` refuses ``expr``.
+
+    Examples
+    --------
     >>> function_text("1/sqrt(2+z)", "z")
     '1/sqrt(x + 2)'
     """
@@ -69,6 +102,24 @@ def function_text(expr: str, var: str = "x") -> str:
 def interval_text(lo: str, hi: str) -> str:
     """The interval ``[lo, hi]`` as a Sollya range with exact endpoints.
 
+    Parameters
+    ----------
+    lo, hi : str
+        The endpoints, exact expressions read by
+        :func:`chebnorm.approx.expr.parse_number`.
+
+    Returns
+    -------
+    str
+        ``"[lo;hi]"`` in Sollya syntax.
+
+    Raises
+    ------
+    ValueError
+        When an endpoint is not a finite real constant.
+
+    Examples
+    --------
     >>> interval_text("sqrt(2)", "2")
     '[sqrt(2);2]'
     """
@@ -102,6 +153,28 @@ def script_supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: st
     Every coefficient is written exactly, as an integer times a power of two
     (here ``1 = 2^52 * 2^-52``):
 
+    Parameters
+    ----------
+    expr : str
+        The function ``f``.
+    var : str
+        Its variable.
+    coefficients : sequence of float
+        The coefficients of ``p`` in powers of ``x``, ascending (finite).
+    lo, hi : str
+        The interval's exact endpoints.
+    kind : {"abs", "rel"}, optional
+        The error bounded, default ``"abs"``.
+    accuracy : float, optional
+        Sollya's relative accuracy of the enclosure, default 2^-8.
+
+    Returns
+    -------
+    str
+        The script (without ``quit;``).
+
+    Examples
+    --------
     >>> print(script_supnorm("x**2", "x", [0.0, 0.0, 1.0], "0", "1"))
     prec=200!;
     display=decimal!;
@@ -119,7 +192,34 @@ def script_supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: st
 
 def supnorm(expr: str, var: str, coefficients, lo: str, hi: str, kind: str = "abs",
             accuracy: float = 2.0 ** -8) -> SollyaSupnorm:
-    """Sollya's certified supnorm of ``p - f`` (or ``p/f - 1``)."""
+    """Sollya's certified supnorm of ``p - f`` (or ``p/f - 1``).
+
+    Parameters
+    ----------
+    expr : str
+        The function ``f``.
+    var : str
+        Its variable.
+    coefficients : sequence of float
+        The coefficients of ``p`` in powers of ``x``, ascending (finite).
+    lo, hi : str
+        The interval's exact endpoints.
+    kind : {"abs", "rel"}, optional
+        The error bounded, default ``"abs"``.
+    accuracy : float, optional
+        Sollya's relative accuracy of the enclosure, default 2^-8.
+
+    Returns
+    -------
+    SollyaSupnorm
+        The enclosure of the supremum.
+
+    Raises
+    ------
+    RuntimeError
+        When Sollya fails or prints something unexpected (run it only when
+        :func:`available`).
+    """
     out = _run(script_supnorm(expr, var, coefficients, lo, hi, kind, accuracy))
     m = re.search(rf"SUP\s+({_NUM})\s+({_NUM})", out)
     if not m:
@@ -134,6 +234,34 @@ def remez(expr: str, var: str, lo: str, hi: str, degree: int, kind: str = "abs",
     Sollya's ``remez(g, n, d, w)`` minimises ``sup |p*w - g|``: the absolute
     fit is ``remez(f, n, d)``, the relative one (``sup |p/f - 1|``)
     ``remez(1, n, d, 1/f)``.
+
+    Parameters
+    ----------
+    expr : str
+        The function ``f``.
+    var : str
+        Its variable.
+    lo, hi : str
+        The interval's exact endpoints.
+    degree : int
+        The degree of the fit, >= 0.
+    kind : {"abs", "rel"}, optional
+        The error minimized and bounded, default ``"abs"``.
+    accuracy : float, optional
+        Sollya's relative accuracy of the supnorm, default 2^-8.
+
+    Returns
+    -------
+    coefficients : list of float
+        The ``degree + 1`` coefficients in powers of ``x``, ascending (0.0 where
+        Sollya printed none).
+    sup : SollyaSupnorm
+        The enclosure of the fit's error.
+
+    Raises
+    ------
+    RuntimeError
+        When Sollya fails or prints something unexpected.
     """
     f = _sollya_expr(expr, var)
     target, weight = ("f", "1") if kind == "abs" else ("1", "1/f")
@@ -165,7 +293,32 @@ class FpminimaxCase:
     powers ``monomials``, ``coef_format`` (``"fixed"`` with ``frac_bits`` per
     power, or a floating format), ``kind`` abs or rel, ``constant`` (a float
     held as the constant coefficient) or None; ``check`` optional coefficients
-    (all powers) whose supnorm Sollya also computes."""
+    (all powers) whose supnorm Sollya also computes.
+
+    Parameters
+    ----------
+    expr : str
+        The function ``f``.
+    var : str
+        Its variable.
+    lo, hi : str
+        The interval's exact endpoints.
+    monomials : tuple of int
+        The powers of ``x`` whose coefficients are free.
+    coef_format : str
+        ``"fixed"`` or a floating format (``"binary16"``, ``"bfloat16"``,
+        ``"binary32"``, ``"binary64"``).
+    frac_bits : tuple of int or None, optional
+        For ``"fixed"``: the fraction bits of every power up to the largest
+        monomial; default None.
+    kind : {"abs", "rel"}, optional
+        The error minimized, default ``"abs"``.
+    constant : float or None, optional
+        A constant coefficient held fixed; default None.
+    check : tuple of float or None, optional
+        Coefficients (all powers) whose supnorm Sollya also computes; default
+        None.
+    """
 
     expr: str
     var: str
@@ -197,6 +350,27 @@ def fpminimax(cases, accuracy: float = 2.0 ** -20, timeout: float = 1200):
     absolute or relative as the case's ``kind``) and ``check_sup`` (the
     supnorm of the case's ``check`` coefficients, or None); a case Sollya
     fails on gives ``None``.
+
+    Parameters
+    ----------
+    cases : sequence of FpminimaxCase
+        The problems.
+    accuracy : float, optional
+        Sollya's relative accuracy of the supnorms, default 2^-20.
+    timeout : float, optional
+        Seconds before the Sollya process is stopped, default 1200.
+
+    Returns
+    -------
+    list of dict or None
+        One entry per case, in order (None when Sollya failed on it).
+
+    Raises
+    ------
+    RuntimeError
+        When the Sollya process fails.
+    subprocess.TimeoutExpired
+        When it runs longer than ``timeout``.
     """
     parts = ["prec=300!;", "display=dyadic!;", "verbosity=0!;"]
     for i, c in enumerate(cases):

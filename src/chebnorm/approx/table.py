@@ -113,6 +113,39 @@ class Quantized:
     format, not chosen by the fit. Bounds are re-certified for exactly these
     numbers. ``method`` names the candidate that won: ``"lattice"`` (LLL and
     nearest plane), ``"rounded"`` or ``"reoptimized"`` (greedy refit).
+
+    Parameters
+    ----------
+    format : str
+        ``"fixed"`` or one of ``"binary16"``, ``"bfloat16"``, ``"binary32"``,
+        ``"binary64"``.
+    monomials : tuple of int
+        The powers of ``x`` whose coefficients are stored (the others are 0).
+    mantissas : tuple of int
+        The integer mantissa of each power ``0..degree``.
+    exponents : tuple of int
+        The power-of-two exponent of each power (``-frac_bits[k]`` in fixed
+        point).
+    frac_bits : tuple of int or None
+        Fixed point: the fractional bits of each power; None for a floating
+        format.
+    word_bits : int or None
+        Fixed point: the width of the two's complement words; None for a
+        floating format.
+    fixed_constant : bool
+        Whether the constant coefficient is ``f(0)`` rounded, not fitted.
+    method : str
+        The candidate that won: ``"lattice"``, ``"rounded"`` or
+        ``"reoptimized"``.
+    abs_error_bound : float
+        A rigorous bound of ``sup |p - f|`` for exactly these coefficients.
+    rel_error_bound : float or None
+        A rigorous bound of ``sup |p/f - 1|``; None where ``f`` vanishes on the
+        interval.
+    max_abs_error : float
+        The largest ``|p - f|`` located (a lower bound of the supremum).
+    max_rel_error : float or None
+        The largest ``|p/f - 1|`` located; None with ``rel_error_bound``.
     """
 
     format: str

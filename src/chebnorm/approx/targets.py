@@ -23,6 +23,24 @@ class Target:
     """A named function, its variable, its interval as a function of psi_max,
     the degrees and kind the main job exports, and what it is for.
 
+    Parameters
+    ----------
+    name : str
+        The target's name (``chebnorm fit --target NAME``).
+    expression : str
+        The function, in chebnorm's expression syntax.
+    variable : str
+        Its variable.
+    interval_text : tuple of str
+        The endpoints as exact expressions in ``psi_max`` (see
+        :meth:`interval`).
+    degrees : tuple of int
+        The degrees the repro job exports.
+    kind : str
+        The fit, ``"chebyshev"`` or ``"minimax"``.
+    meaning : str
+        What the function is for, one line.
+
     Examples
     --------
     >>> t = get_target("dichotomy")
@@ -76,6 +94,8 @@ class Target:
         return (out[0], out[1])
 
 
+#: the registered approximation targets by name (``chebnorm targets`` lists them;
+#: :func:`get_target` reads one, refusing an unknown name)
 TARGETS: dict[str, Target] = {t.name: t for t in (
     Target("dichotomy", "1/sqrt(2+z)", "z", ("2*cos(psi_max)", "2"), (1, 2), "chebyshev",
            "seed 000, method 4: denominator of the dichotomy midpoint (N1 + N2)/sqrt(2 + z), "

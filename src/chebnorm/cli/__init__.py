@@ -35,6 +35,13 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``chebnorm`` argument parser, one subcommand per task (see the
     README's CLI reference).
 
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser, with one subparser per module of :data:`SUBCOMMANDS` (each
+        sets ``func``, the function that runs it); its ``error`` raises
+        :class:`UsageError` instead of exiting.
+
     >>> build_parser().prog
     'chebnorm'
     """
@@ -55,6 +62,21 @@ def main(argv: list[str] | None = None) -> int:
     the exit status: 0 on success, 2 with one line on stderr on bad input, 141
     and nothing on stderr when the reader of the output went away (``| head``),
     as a program that SIGPIPE ends.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program name, e.g. ``["fit", "1/sqrt(x)",
+        "--interval", "0.5", "1", "--degree", "3"]``; default (None):
+        ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success; what the subcommand returns (1 when a
+        check it runs fails, e.g. ``verify`` or ``hw verilog --simulate``); 2 on
+        bad input (a ``ValueError`` or ``OSError``, reported as one line on stderr,
+        never a traceback); 141 when stdout was closed early.
 
     >>> main(["no-such-command"])
     2

@@ -11,6 +11,15 @@ from .parallel_options import add_parallel_args, parallel_kwargs
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm design`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("design", help="cheapest certified piecewise evaluator meeting --max-error",
                        description="Search segments x degree x coefficient bits for the "
                        "cheapest piecewise ROM + Horner evaluator (yosys cells, or the model "
@@ -66,6 +75,33 @@ def _max_error(text) -> float:
 
 
 def run(args) -> int:
+    """Run ``chebnorm design``: the cheapest certified piecewise evaluator
+    (or, by synthesis, another architecture) meeting ``--max-error`` (or
+    ``--faithful``/``--correctly-rounded``) on the target device, its CSV and
+    Pareto plot written into the folder ``-o``, and the command that reproduces
+    the winner.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm design`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        When the output exists and is not a folder, ``--max-error`` is not a finite
+        number > 0, ``--frequency`` is given without a device's timing,
+        ``--faithful``/``--correctly-rounded`` is combined with ``--no-synth``, or no
+        design meets the accuracy asked (:func:`chebnorm.cli.main` prints it as one line
+        on stderr and exits with status 2).
+    """
     from pathlib import Path
 
     from chebnorm.core.textsafe import identifier
@@ -313,7 +349,16 @@ def _write_architectures(args, out, name, others, res, files=None) -> int:
 
 
 def write_folder_print(out, files) -> None:
-    """Write ``files`` into the folder ``out`` (all or none) and print each path."""
+    """Write ``files`` into the folder ``out`` (all or none) and print each path.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder (created if missing; see
+        :func:`chebnorm.core.files.write_folder`).
+    files : dict of str to (str or bytes)
+        File name -> content, written in one step.
+    """
     from chebnorm.core.files import write_folder
 
     for path in write_folder(out, dict(sorted(files.items()))):
@@ -322,7 +367,18 @@ def write_folder_print(out, files) -> None:
 
 def winner_figures(res) -> list[str]:
     """The winner's figures on the search's target: its mapping and its timing
-    (nextpnr-ice40 Fmax on ice40, the yosys sta model on xc7)."""
+    (nextpnr-ice40 Fmax on ice40, the yosys sta model on xc7).
+
+    Parameters
+    ----------
+    res : chebnorm.hw.piecewise_search.SearchResult
+        A finished one-width search whose winner has a target cost.
+
+    Returns
+    -------
+    list of str
+        Two lines: ``"winner ..."`` (the mapping) and ``"timing: ..."``.
+    """
     from chebnorm.hw.targets import target_figures
 
     key = next(k for k, p in zip(sorted(res.designs), res.points) if p is res.winner)
@@ -368,7 +424,26 @@ def _piecewise_design(args, table):
 
 
 def hw_verilog(args, table) -> int:
-    """``chebnorm hw verilog`` of a piecewise table (called by :mod:`chebnorm.cli.hw`)."""
+    """``chebnorm hw verilog`` of a piecewise table (called by :mod:`chebnorm.cli.hw`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw verilog`` command line.
+    table : chebnorm.approx.PiecewiseTable
+        The table read from ``args.table``.
+
+    Returns
+    -------
+    int
+        The exit status: 0, or 1 when ``--simulate`` finds a mismatch.
+
+    Raises
+    ------
+    ValueError
+        When an option does not apply to a piecewise table (``--pipelined``,
+        ``--coef-bits``-style widths, a rounding other than to nearest).
+    """
     from pathlib import Path
 
     from chebnorm import __version__
@@ -397,7 +472,26 @@ def hw_verilog(args, table) -> int:
 
 
 def hw_report(args, table) -> int:
-    """``chebnorm hw report`` of a piecewise table: error budget by part, measured error, cells."""
+    """``chebnorm hw report`` of a piecewise table: error budget by part, measured error, cells.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw report`` command line.
+    table : chebnorm.approx.PiecewiseTable
+        The table read from ``args.table``.
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    ValueError
+        When an option does not apply to a piecewise table (the coefficient
+    and datapath widths, a ``--rounding`` other than rne).
+    """
     from chebnorm.hw.piecewise import piecewise_cells
     from chebnorm.hw.piecewise_search import model_cost
 
@@ -435,7 +529,25 @@ def hw_report(args, table) -> int:
 
 
 def hw_sweep_piecewise(args) -> int:
-    """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot."""
+    """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw sweep`` command line (with ``--segments``).
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    ValueError
+        When a ``--segments`` value is not a power of two in range, or the grid's
+    expression (``--expr``, default ``1/sqrt(x)``), interval (default 1 to 4)
+    or widths are refused by :func:`chebnorm.hw.piecewise_search.grid`.
+    """
     from pathlib import Path
 
     from chebnorm.core.files import write_folder

@@ -29,6 +29,15 @@ def _all_formats() -> str:
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm export`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("export", help="print a coefficient table as C, JSON, GLSL, WGSL, HLSL, "
                        "VHDL or Verilog")
     p.add_argument("table", metavar="TABLE.json")
@@ -58,6 +67,29 @@ def _given(args) -> dict:
 
 
 def run(args) -> int:
+    """Run ``chebnorm export``: write a coefficient table in one of the export
+    formats (C, JSON, GLSL, WGSL, HLSL, Verilog, VHDL) into ``-o FILE``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm export`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        On an unknown ``--format``, an option given that does nothing with that format,
+        a hardware format without ``--in-bits``/``--out-bits``, or a table the exporter
+        refuses (:func:`chebnorm.cli.main` prints it as one line on stderr and exits
+        with status 2).
+    """
     if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
     given = _given(args)

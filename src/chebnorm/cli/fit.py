@@ -15,6 +15,15 @@ from .common import command_line, deprecated_alias, print_json
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm fit`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("fit", help="fit and certify a polynomial",
                        description="Fit a polynomial to EXPR on [LO, HI] and certify its "
                        "absolute and relative error bounds.")
@@ -164,6 +173,29 @@ def _run_piecewise(args) -> int:
 
 
 def run(args) -> int:
+    """Run ``chebnorm fit``: fit and certify a polynomial (or, with
+    ``--segments``, a piecewise table), print its report and write the table
+    with ``-o``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm fit`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        On an argument :func:`chebnorm.fit` refuses, reworded with the command's flags
+        (:func:`cli_words`) (:func:`chebnorm.cli.main` prints it as one line on stderr
+        and exits with status 2).
+    """
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)

@@ -37,6 +37,17 @@ def _unit_width_args(p) -> None:
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm hw`` subcommand with its own subcommands ``verilog``, ``report``,
+    ``unit`` and ``sweep``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); each of the four
+        parsers of ``hw`` sets ``func``, its runner: :func:`run_verilog`,
+        :func:`run_report`, :func:`run_unit` or :func:`run_sweep`.
+    """
     from chebnorm.hw.units import UNIT_TARGETS, unit_names
 
     hw = sub.add_parser("hw", help="bit-accurate hardware: Verilog, error budget, sweep",
@@ -154,6 +165,30 @@ def _simulator(language: str):
 
 
 def run_verilog(args) -> int:
+    """Run ``chebnorm hw verilog``: write the Verilog (or with
+    ``--lang vhdl`` VHDL) module of a table, its test bench, vectors and report
+    into the folder ``-o``; a piecewise table goes to
+    :func:`chebnorm.cli.design.hw_verilog`.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm hw verilog`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success, 1 when ``--simulate`` finds a mismatch.
+
+    Raises
+    ------
+    ValueError
+        When the output exists and is not a folder, or ``--pipelined`` is asked of a
+        degree-0 table (:func:`chebnorm.cli.main` prints it as one line on stderr and
+        exits with status 2).
+    """
     from chebnorm import __version__
     from chebnorm.hw.hdl import pipelined_name
     from chebnorm.hw.report import hdl_outputs, write_outputs
@@ -209,6 +244,29 @@ def _refuse_unit_options(args, kinds) -> None:
 
 
 def run_report(args) -> int:
+    """Run ``chebnorm hw report``: the error budget by part, the measured
+    error, the cost and the Q formats of a table's hardware evaluator (a
+    piecewise table goes to :func:`chebnorm.cli.design.hw_report`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm hw report`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        On an unknown ``--target``, a ``--target`` with ``--no-synth``, or an option
+        that does nothing for the table given (:func:`chebnorm.cli.main` prints it as
+        one line on stderr and exits with status 2).
+    """
     from chebnorm.hw.units import analyze_unit, get_unit, table_matches
 
     for kind in args.unit:
@@ -257,7 +315,20 @@ def run_report(args) -> int:
 
 
 def check_report_target(args) -> None:
-    """``hw report --target T``: a registered target, and synthesis allowed."""
+    """``hw report --target T``: a registered target, and synthesis allowed.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw report`` command line; nothing is checked when it has no
+        ``target`` or it is None.
+
+    Raises
+    ------
+    ValueError
+        When ``args.target`` is not a registered device target, or is given with
+        ``--no-synth`` (the target's mapping needs yosys).
+    """
     if getattr(args, "target", None) is None:
         return
     from chebnorm.hw.targets import get_target
@@ -269,13 +340,49 @@ def check_report_target(args) -> None:
 
 
 def argparse_ns(args, **changes):
-    """A copy of ``args`` with some attributes changed."""
+    """A copy of ``args`` with some attributes changed.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The namespace to copy (left unchanged).
+    **changes
+        Attribute name -> new value.
+
+    Returns
+    -------
+    argparse.Namespace
+        A new namespace with the attributes of ``args`` updated by ``changes``.
+    """
     import argparse
 
     return argparse.Namespace(**{**vars(args), **changes})
 
 
 def run_unit(args) -> int:
+    """Run ``chebnorm hw unit``: the Verilog of a normalization unit
+    (``--kind``), its test bench, vectors and report written into the folder
+    ``-o``, simulated with ``--simulate``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm hw unit`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success, 1 when ``--simulate`` finds a mismatch.
+
+    Raises
+    ------
+    ValueError
+        When the output exists and is not a folder, ``--table`` is a piecewise table, or
+        an option does not apply to the unit's kind (:func:`chebnorm.cli.main` prints it
+        as one line on stderr and exits with status 2).
+    """
     from chebnorm import __version__
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs
@@ -302,6 +409,30 @@ def run_unit(args) -> int:
 
 
 def run_sweep(args) -> int:
+    """Run ``chebnorm hw sweep``: the grid of degree x coefficient bits x
+    datapath bits of a target against area (or, with ``--segments``, the
+    piecewise grid of :func:`chebnorm.cli.design.hw_sweep_piecewise`), its CSV
+    and Pareto plot written into the folder ``-o``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm hw sweep`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        When the output exists and is not a folder, an option of the other sweep is
+        given, or ``--psi-max`` is out of the target's range (:func:`chebnorm.cli.main`
+        prints it as one line on stderr and exits with status 2).
+    """
     from pathlib import Path
 
     from chebnorm.approx import get_target

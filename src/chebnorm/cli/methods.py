@@ -12,6 +12,15 @@ _KEYS = ("add", "mul", "div", "sqrt", "trig", "cmp")
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm methods`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("methods", help="errors and operation counts of the normalization methods",
                        description="Run every normalization method of seed 000 on one span of "
                        "angle PSI and length M; print its largest length and angle errors and "
@@ -31,6 +40,30 @@ def _ops(d: dict) -> dict:
 
 
 def run(args) -> int:
+    """Run ``chebnorm methods``: the length and angle errors and the
+    operation counts of every normalization method over one span
+    (:func:`chebnorm.methods.analyze`), and with ``--drift`` the angular
+    recurrence's drift in float32 and float64.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm methods`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: always 0.
+
+    Raises
+    ------
+    ValueError
+        When ``--dtype`` is not float32 or float64, or ``--angle`` is not finite
+        (accepted: 0 <= PSI < pi radians) (:func:`chebnorm.cli.main` prints it as one
+        line on stderr and exits with status 2).
+    """
     from chebnorm.methods import analyze, angular_drift, method_names
 
     if args.dtype not in ("float32", "float64"):

@@ -9,6 +9,15 @@ from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm render`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES, available_methods
 
     p = sub.add_parser("render", help="render a mesh and measure the shading error",
@@ -62,7 +71,28 @@ def _crease_radians(deg):
 def parse_reference(text, shading):
     """The ``--reference`` option of ``render`` and ``render-sweep``: None, or a
     ``MODE[:METHOD]`` text checked against the shading modes (ValueError naming
-    the option and the accepted values otherwise)."""
+    the option and the accepted values otherwise).
+
+    Parameters
+    ----------
+    text : str or None
+        The option's value, ``MODE`` or ``MODE:METHOD``; None for the default
+        reference (exact Phong, or exact bump mapping when ``shading`` is bump).
+    shading : str
+        The ``--shading`` of the render being measured.
+
+    Returns
+    -------
+    tuple of str
+        ``(mode, method, bump_method)``: the reference shading mode, its
+        normalization method (default ``"exact"``) and, for ``bump``, the bump
+        method (default ``"full"``).
+
+    Raises
+    ------
+    ValueError
+        When ``MODE`` is not one of :data:`chebnorm.raster.SHADING_MODES`.
+    """
     from chebnorm.raster import SHADING_MODES
 
     if text is None:
@@ -95,6 +125,30 @@ def _refuse_unused(args) -> None:
 
 
 def run(args) -> int:
+    """Run ``chebnorm render``: render a mesh with the chosen shading and
+    normalization, measure its error against the reference, and write the
+    image (``--out``) and the error heat map (``--error-map``) when asked.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm render`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        On a bad option (an unknown ``--reference`` mode, a ``--crease-angle`` out of
+        range, an option that does nothing with this ``--shading``)
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
+    """
     import numpy as np
 
     from chebnorm.core.files import write_all

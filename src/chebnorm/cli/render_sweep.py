@@ -14,6 +14,15 @@ IMAGE_FOLDER = "render_sweep_images"
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm render-sweep`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
 
     p = sub.add_parser("render-sweep", help="render a grid of cases and measure their errors",
@@ -54,6 +63,22 @@ def register(sub) -> None:
 def parse_size(text: str) -> tuple[int, int]:
     """``"W"`` (a square) or ``"WxH"`` as ``(W, H)``; the range is checked by the sweep.
 
+    Parameters
+    ----------
+    text : str
+        One or two decimal integers of at most 6 digits, ``"W"`` or ``"WxH"``
+        (``x`` or ``X``, surrounding spaces allowed).
+
+    Returns
+    -------
+    tuple of int
+        ``(W, H)``.
+
+    Raises
+    ------
+    ValueError
+        When ``text`` is not of that form, naming the accepted range.
+
     >>> parse_size("128"), parse_size("320x200")
     ((128, 128), (320, 200))
     """
@@ -67,6 +92,29 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 def run(args) -> int:
+    """Run ``chebnorm render-sweep``: render a grid of cases (meshes x
+    methods x sizes) into the folder ``-o``, with a CSV of the measured errors.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm render-sweep`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        When the output exists and is not a folder, a size is malformed, two cases would
+        write the same image name, or an option is out of range
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
+    """
     from pathlib import Path
 
     from chebnorm.core.files import make_folder, write_atomic

@@ -45,7 +45,22 @@ PROVENANCE = "provenance.json"
 
 
 def export_coefficients(out: Path, **_options) -> list[Path]:
-    """Every registered target at each of its degrees: JSON table and C header."""
+    """Every registered target at each of its degrees: JSON table and C header.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The repro output folder; the files go into ``out / "coefficients"``
+        (created if missing).
+    **_options
+        The job options every repro job receives (``bench_results``,
+        ``ledger_dir``), unused here.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, two per target and degree.
+    """
     folder = out / "coefficients"
     folder.mkdir(parents=True, exist_ok=True)
     written = []
@@ -62,7 +77,20 @@ def export_coefficients(out: Path, **_options) -> list[Path]:
 
 
 def jobs() -> dict:
-    """All jobs by name: the library's own, then the registered ones."""
+    """All jobs by name: the library's own, then the registered ones.
+
+    Returns
+    -------
+    dict of str to callable
+        Job name -> function ``(out, **options) -> list of paths``: the built-in
+        ``coefficients`` job, then those of the ``chebnorm.repro`` entry points,
+        sorted by entry point and by name.
+
+    Raises
+    ------
+    ValueError
+        When two entry points register the same job name.
+    """
     found = {"coefficients": export_coefficients}
     for ep in sorted(entry_points(group="chebnorm.repro"), key=lambda e: e.name):
         registry = ep.load()
@@ -75,6 +103,11 @@ def jobs() -> dict:
 
 def installed_versions() -> dict[str, str]:
     """Installed version of each of :data:`NUMERIC_DEPENDENCIES` ("not installed" when missing).
+
+    Returns
+    -------
+    dict of str to str
+        Distribution name -> installed version string.
 
     >>> v = installed_versions(); v["numpy"] == __import__("numpy").__version__
     True
@@ -90,6 +123,19 @@ def installed_versions() -> dict[str, str]:
 
 def version_differences(recorded: dict, installed: dict) -> list[str]:
     """``name installed (recorded X)`` for each name whose versions differ, sorted by name.
+
+    Parameters
+    ----------
+    recorded : dict of str to str
+        The versions recorded by an earlier run (name -> version).
+    installed : dict of str to str
+        The versions installed now (:func:`installed_versions`).
+
+    Returns
+    -------
+    list of str
+        One phrase per name whose versions differ ("not installed" or
+        "nothing" standing for a missing side), sorted case-insensitively.
 
     >>> version_differences({"numpy": "2.4.6", "scipy": "1.16.0"}, {"numpy": "2.3.0", "scipy": "1.16.0"})
     ['numpy 2.3.0 (recorded 2.4.6)']
@@ -109,6 +155,15 @@ def _recorded_versions(out: Path) -> dict | None:
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm repro`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("repro", help="regenerate every figure, table, ledger and coefficient header",
                        description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", metavar="NAME", help="jobs to run (default: all); see --list")
@@ -132,6 +187,29 @@ def _run_job(item) -> int:
 
 
 def run(args) -> int:
+    """Run ``chebnorm repro``: run the selected repro jobs (all by default;
+    ``--list`` only prints their names) into the folder ``-o``, and record the
+    installed numeric versions beside them.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm repro`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 on success.
+
+    Raises
+    ------
+    ValueError
+        On an unknown job name, a ``--bench-results`` that is not a file, or a bad
+        ``--workers``/``--scheduler`` (:func:`chebnorm.cli.main` prints it as one line
+        on stderr and exits with status 2).
+    """
     available = jobs()
     if args.list:
         for name in available:

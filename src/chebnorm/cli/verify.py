@@ -18,6 +18,15 @@ from chebnorm.export.verify import MAX_INPUTS, VARIANTS, VERIFY_FORMATS, verify
 
 
 def register(sub) -> None:
+    """Add the ``chebnorm verify`` subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``chebnorm`` parser (from
+        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
+        default is :func:`run`.
+    """
     p = sub.add_parser("verify", help="run an exported evaluator over every float32 of its "
                        "interval and compare with its stated bound")
     p.add_argument("table", metavar="TABLE.json")
@@ -47,6 +56,30 @@ def _inputs(text: str):
 
 
 def run(args) -> int:
+    """Run ``chebnorm verify``: compile and run an exported evaluator over
+    every float32 of its interval (or ``--inputs N`` of them) and compare the
+    measured error with the table's stated bound.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``chebnorm verify`` (the options its
+        :func:`register` declares; ``args.argv``, set by :func:`chebnorm.cli.main`,
+        is the command quoted in provenance banners).
+
+    Returns
+    -------
+    int
+        The exit status: 0 when every evaluator stays within its stated bound, 1 (with one
+        line on stderr) when one exceeds it.
+
+    Raises
+    ------
+    ValueError
+        On an unknown ``--format`` or a bad ``--inputs`` (accepted: all, or a count)
+        (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
+        2).
+    """
     if args.format not in VERIFY_FORMATS:
         raise ValueError(f"unknown format {args.format[:40]!r} for verify; accepted: "
                          f"{', '.join(VERIFY_FORMATS)}")
