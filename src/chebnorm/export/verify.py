@@ -10,7 +10,7 @@ defines on every input and reports the measured ``max |evaluator(x) - f(x)|``
 beside the stated bound (:class:`VerifyResult`). What runs, per format:
 
 * ``c`` of a coefficient table: the header compiled by ``gcc`` into a
-  shared library (called through :mod:`ctypes`, results straight into numpy
+  shared library (called through ``ctypes``, results straight into numpy
   arrays), twice: ``-O2 -ffp-contract=off`` (``unfused``: every ``a * x + c``
   two roundings) and ``-O2 -march=native -ffp-contract=fast`` (``fused``:
   the compiler may contract to FMA). Variants: ``double``, ``double-fused``,
