@@ -428,7 +428,7 @@ def _backfit(p: _Problem, alpha: int, bits, gammas, syms):
     The residual ``z - TIV - sum TO_i`` is kept on the grid of every code
     and updated by each table's change (one pass over the codes per table
     update, not one per table)."""
-    w, m = p.w, len(bits)
+    m = len(bits)
     shape_b = tuple(2 ** b for b in reversed(bits))      # B_{m-1} .. B_0 axes
     tiv = np.zeros(2 ** alpha)
     offs = [np.zeros((2 ** g, 2 ** b)) for g, b in zip(gammas, bits)]

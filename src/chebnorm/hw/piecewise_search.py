@@ -17,10 +17,13 @@ With ``target`` other than ``"generic"`` (:mod:`chebnorm.hw.targets`) every
 point is priced by that target's calibrated model
 (:func:`chebnorm.hw.target_model.model_score`), the Pareto front is taken over
 (model score, bound), and its meeting points are synthesized on the target
-(``synth_xilinx``, ``synth_ice40``) -- except those whose model score exceeds
-``MODEL_SPREAD**2`` times the best one's (the model is within
-:data:`~chebnorm.hw.target_model.MODEL_SPREAD` of yosys, so they cannot win):
-the winner is the lowest target score.
+(``synth_xilinx``, ``synth_ice40``), cheapest model first, two at a time --
+except those whose model score over
+:data:`~chebnorm.hw.target_model.MODEL_SPREAD` (a lower bound of their yosys
+score: the model is within that ratio of yosys) is not below the best score
+synthesized so far, or a ``bound`` the caller got elsewhere: they cannot
+win. The winner is the lowest target score. (On ``generic`` the same pruning
+reads the target model's yosys-cell prediction.)
 
 >>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
 ...            progress=False, workers=1)
@@ -58,6 +61,9 @@ TARGET_COLUMNS = ("target", "target_model", "target_score", "luts", "dsps", "car
 #: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
 ROM_CELLS_PER_BIT = 0.15
 MAX_SYNTH = 6
+#: points synthesized per round of the pruned synthesis (fixed, so the points
+#: synthesized, and the CSV, do not depend on the worker count)
+SYNTH_ROUND = 2
 #: a worker thread fits one table at a time: the certifier sets python-flint's global
 #: precision, which threads of one process (a threaded Dask worker) would share
 _FIT_LOCK = threading.Lock()
@@ -262,10 +268,19 @@ def _check_max_error(max_error) -> float:
 def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
            degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
            progress: bool = True, name: str = "design", workers: int | None = None,
-           scheduler=None, target: str = "generic") -> SearchResult:
+           scheduler=None, target: str = "generic", bound: float | None = None) -> SearchResult:
     """Cheapest certified piecewise design meeting ``max_error`` (module docstring);
     ``target`` (:func:`chebnorm.hw.targets.target_names`) prices the points by that
     target's model and synthesizes the front's meeting points on it.
+
+    The front's meeting points are synthesized cheapest model first,
+    :data:`SYNTH_ROUND` at a time; a point whose model lower bound (its
+    :func:`~chebnorm.hw.target_model.model_score` over
+    :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
+    score synthesized so far, or ``bound`` (a score synthesized elsewhere,
+    e.g. another architecture's), is not synthesized: it cannot win. When
+    ``bound`` rules out every point, none is synthesized and the winner is
+    the cheapest by the model (``cost_source`` "model estimate").
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
@@ -328,33 +343,54 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
 
         if shutil.which("yosys") is not None:
             chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
-            if target == "generic":
-                cost_source = "yosys cells"
-                cells = map_ordered(_cells, [designs[k] for k in chosen], desc="yosys", **par)
-                for key, n in zip(chosen, cells):
-                    points[key] = replace(points[key], yosys_cells=n)
-            else:
-                # the model is within MODEL_SPREAD s of yosys: a point whose model score
-                # exceeds s^2 times the best one's cannot beat it, and is not synthesized
-                from .target_model import MODEL_SPREAD
-
-                bound = mc(points[chosen[0]]) * MODEL_SPREAD[target] ** 2
-                chosen = [k for k in chosen if mc(points[k]) <= bound]
-                cost_source = f"yosys {get_target(target).synth.split(' -top')[0]}"
-                costs = map_ordered(_target_cost, [(designs[k], target) for k in chosen],
-                                    desc=f"yosys {target}", **par)
-                for key, c in zip(chosen, costs):
-                    points[key] = replace(points[key], target_cost=c)
+            cost_source = ("yosys cells" if target == "generic" else
+                           f"yosys {get_target(target).synth.split(' -top')[0]}")
+            done = _synth_pruned(points, designs, chosen, target, bound, par)
+            if not done:
+                cost_source = "model estimate"
     ordered = tuple(points[k] for k in keys)
     winner = None
     if meeting:
         pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
                                                    or p.target_cost is not None
                                                    or cost_source == "model estimate")]
+        pool = pool or [p for p in ordered if p.meets]
         winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
                         max_error, ordered, winner, cost_source,
                         {k: designs[k] for k in keys}, target)
+
+
+def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
+    """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
+    target model first, skipping those whose model lower bound cannot beat
+    the best score so far (or ``bound``); update ``points``. Returns the
+    number synthesized."""
+    from .target_model import MODEL_SPREAD, model_score, piecewise_features
+
+    spread = MODEL_SPREAD[target]
+    model = {k: model_score(piecewise_features(designs[k]), target) for k in chosen}
+    todo = sorted(chosen, key=lambda k: (model[k], k))
+    best = math.inf if bound is None else float(bound)
+    n = 0
+    while todo:
+        run = [k for k in todo if model[k] / spread < best][:SYNTH_ROUND]
+        if not run:
+            break
+        if target == "generic":
+            got = map_ordered(_cells, [designs[k] for k in run], desc="yosys", **par)
+            for key, c in zip(run, got):
+                points[key] = replace(points[key], yosys_cells=c)
+                best = min(best, float(c))
+        else:
+            got = map_ordered(_target_cost, [(designs[k], target) for k in run],
+                              desc=f"yosys {target}", **par)
+            for key, c in zip(run, got):
+                points[key] = replace(points[key], target_cost=c)
+                best = min(best, c.score)
+        n += len(run)
+        todo = [k for k in todo if k not in run]
+    return n
 
 
 def _target_cost(item) -> TargetCost:
