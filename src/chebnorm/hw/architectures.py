@@ -37,6 +37,7 @@ from chebnorm.core.parallel import map_ordered
 from .hdl import module_text
 from .multipartite import design_multipartite
 from .piecewise import design_piecewise
+from .piecewise_search import SYNTH_ROUND
 from .plain_table import design_plain_table
 from .targets import get_target, synthesize_target
 
@@ -52,7 +53,18 @@ MAX_TABLE_ROM_BITS = 1 << 18
 #: per (architecture, target): the largest ``model / yosys`` measured on the
 #: architectures' candidates (benchmarks/bench_design_targets.py --calibrate);
 #: pruning divides a candidate's model score by it (or by MODEL_SPREAD, if larger)
-PRUNE_SPREAD: dict = {}
+PRUNE_SPREAD = {
+    # the issue-28 spec (16-bit 1/sqrt(1+3x), faithful), every candidate the sized walk and
+    # the multipartite search built, synthesized: the largest model/yosys times 1.1
+    ("piecewise-sized", "generic"): 1.40, ("multipartite", "generic"): 1.52,
+    ("piecewise-sized", "xc7"): 1.56, ("multipartite", "xc7"): 1.10,
+    ("piecewise-sized", "xc7-nodsp"): 1.81, ("multipartite", "xc7-nodsp"): 1.33,
+    ("piecewise-sized", "ice40"): 1.81, ("multipartite", "ice40"): 1.52,
+    # a plain table's ROM compresses by up to 7x in yosys (2^16 x 16 bits: model 115,867
+    # cells, yosys 15,986): never pruned
+    ("table", "generic"): math.inf, ("table", "xc7"): math.inf,
+    ("table", "xc7-nodsp"): math.inf, ("table", "ice40"): math.inf,
+}
 
 
 @dataclass(frozen=True)
@@ -113,10 +125,13 @@ class Candidate:
 
 def _sized_chain(item) -> list:
     """One degree of the sized search (run by ``map_ordered`` on a worker): the
-    sized designs at ``2**k`` segments for ``k = k0 .. k0 + 3``, walking up from
-    the first ``k`` that meets the error while the target's model score keeps
-    falling (``[(k, design, model)]``; the first ``k`` whose score rises ends
-    the walk: a larger ROM does not pay for itself any more)."""
+    sized designs at ``2**k`` segments for ``k = k0 .. k0 + 3`` that meet the
+    error, with their target model scores (``[(k, design, model)]``). The walk
+    ends early at a ``k`` whose model score, divided by the model's spread on
+    sized designs (:func:`prune_spread`), still exceeds the best one so far: a
+    larger ROM no longer pays for itself (the model alone is too rough to stop
+    at the first rise: on ``xc7-nodsp`` the cheapest degree-2 design has 256
+    segments, after a rise at 128)."""
     from .target_model import model_score, piecewise_features
 
     expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target = item
@@ -133,8 +148,9 @@ def _sized_chain(item) -> list:
         except ValueError:  # not reachable at this segment count
             continue
         model = model_score(piecewise_features(d), target)
-        if found and model > found[-1][2]:
-            break
+        if found and model / prune_spread("piecewise-sized", target) > min(
+                m for _, _, m in found):
+            break   # even at the model's spread, costlier than a smaller k
         found.append((k, d, model))
     return found
 
@@ -207,8 +223,9 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         In the order given; a candidate whose model lower bound
         ``model / prune_spread`` is not below the best synthesized score
         (``bound`` or a candidate's) keeps ``cost`` None and says so in
-        ``note``. Candidates are synthesized cheapest model first, ``workers``
-        at a time, so the best score found prunes the rest: a pruned candidate
+        ``note``. Candidates are synthesized cheapest model first,
+        :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND` at a time (whatever
+        ``workers``: the same ones are synthesized), so the best score found prunes the rest: a pruned candidate
         would have scored at least its lower bound, never less than the best.
 
     Examples
@@ -228,7 +245,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         return -math.inf if c.model is None else c.model / prune_spread(c.architecture, target)
 
     while todo:
-        run = [i for i in todo if not prune or lower(out[i]) < best][:max(1, workers)]
+        run = [i for i in todo if not prune or lower(out[i]) < best][:SYNTH_ROUND]
         if not run:
             break
         costs = map_ordered(_synth_item, [(out[i].verilog, out[i].design.module_name, target)
