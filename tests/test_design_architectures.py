@@ -154,3 +154,16 @@ def test_pruned_synthesis_keeps_the_winner_of_synthesizing_everything(target):
             assert f.cost.score >= best
             assert f.model / f.cost.score <= prune_spread(f.architecture, target)
 
+
+
+@needs_yosys
+def test_search_bound_skips_points_that_cannot_win():
+    """A bound below every point's model lower bound: nothing is synthesized and
+    the winner is the cheapest meeting point by the model."""
+    from chebnorm.hw.piecewise_search import search
+
+    kw = dict(degrees=(1, 2), max_index_bits=4, progress=False, workers=1, target="ice40")
+    r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, bound=1.0, **kw)
+    assert all(p.target_cost is None for p in r.points)
+    assert r.cost_source == "model estimate"
+    assert r.winner.target_model == min(p.target_model for p in r.points if p.meets)

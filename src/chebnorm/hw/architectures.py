@@ -37,7 +37,7 @@ from chebnorm.core.parallel import map_ordered
 from .hdl import module_text
 from .multipartite import design_multipartite
 from .piecewise import design_piecewise
-from .piecewise_search import SYNTH_ROUND
+from .piecewise_search import SYNTH_ROUND, map_synth
 from .plain_table import design_plain_table
 from .targets import get_target, synthesize_target
 
@@ -51,16 +51,18 @@ ACCURACIES = ("max-error", "faithful", "correctly-rounded")
 #: 1.2 Mbit: 16k yosys cells, 7k LUT on xc7 -- it cannot win against a multipartite)
 MAX_TABLE_ROM_BITS = 1 << 18
 #: per (architecture, target): the largest ``model / yosys`` measured on the
-#: architectures' candidates (benchmarks/bench_design_targets.py --calibrate);
+#: architectures' candidates (``python benchmarks/bench_design_targets.py --calibrate``);
 #: pruning divides a candidate's model score by it (or by MODEL_SPREAD, if larger)
 PRUNE_SPREAD = {
-    # the issue-28 spec (16-bit 1/sqrt(1+3x), faithful), every candidate the sized walk and
-    # the multipartite search built, synthesized: the largest model/yosys times 1.1
-    ("piecewise-sized", "generic"): 1.40, ("multipartite", "generic"): 1.52,
-    ("piecewise-sized", "xc7"): 1.56, ("multipartite", "xc7"): 1.10,
-    ("piecewise-sized", "xc7-nodsp"): 1.81, ("multipartite", "xc7-nodsp"): 1.33,
-    ("piecewise-sized", "ice40"): 1.81, ("multipartite", "ice40"): 1.52,
-    # a plain table's ROM compresses by up to 7x in yosys (2^16 x 16 bits: model 115,867
+    # two specs (1/sqrt(1+3x) on [0, 1), 12 and 16 bits, faithful), every candidate the
+    # sized walk and the multipartite search built, synthesized: the largest model/yosys
+    # times 1.1. On xc7 the model puts every product in DSP48E1s; yosys maps small ones to
+    # LUTs (a 12-bit degree-1 design: model 426, yosys 162), hence the wide spread there
+    ("piecewise-sized", "generic"): 1.70, ("multipartite", "generic"): 1.52,
+    ("piecewise-sized", "xc7"): 2.90, ("multipartite", "xc7"): 1.10,
+    ("piecewise-sized", "xc7-nodsp"): 2.54, ("multipartite", "xc7-nodsp"): 1.33,
+    ("piecewise-sized", "ice40"): 1.67, ("multipartite", "ice40"): 1.90,
+    # a plain table's ROM compresses up to 7x in yosys (2^16 x 16 bits: model 115,867
     # cells, yosys 15,986): never pruned
     ("table", "generic"): math.inf, ("table", "xc7"): math.inf,
     ("table", "xc7-nodsp"): math.inf, ("table", "ice40"): math.inf,
@@ -215,7 +217,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
     prune : bool
         False: synthesize every built candidate.
     workers, scheduler
-        Parallel yosys runs (:func:`chebnorm.core.parallel.map_ordered`).
+        Parallel yosys runs (:func:`chebnorm.hw.piecewise_search.map_synth`).
 
     Returns
     -------
@@ -233,7 +235,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
     >>> synthesize_candidates([Candidate("table", "none", note="not built")], "generic")[0].note
     'not built'
     """
-    from chebnorm.core.parallel import check_workers, map_ordered
+    from chebnorm.core.parallel import check_workers
 
     workers = check_workers(workers)
     out = list(cands)
@@ -248,8 +250,8 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         run = [i for i in todo if not prune or lower(out[i]) < best][:SYNTH_ROUND]
         if not run:
             break
-        costs = map_ordered(_synth_item, [(out[i].verilog, out[i].design.module_name, target)
-                                          for i in run], workers=workers, scheduler=scheduler)
+        costs = map_synth(_synth_item, [(out[i].verilog, out[i].design.module_name, target)
+                                        for i in run], workers=workers, scheduler=scheduler)
         for i, cost in zip(run, costs):
             c = out[i]
             out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, cost,

@@ -50,7 +50,7 @@ from .sweep import pareto_png
 from .targets import TargetCost, get_target
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
-           "TARGET_COLUMNS"]
+           "TARGET_COLUMNS", "SYNTH_ROUND", "map_synth"]
 
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
            "rom_bits", "approx_bound", "total_bound", "meets", "model_cost", "yosys_cells",
@@ -361,6 +361,46 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
                         {k: designs[k] for k in keys}, target)
 
 
+def map_synth(fn, items, *, workers: int | None = None, scheduler=None, progress=False,
+              desc: str | None = None) -> list:
+    """``[fn(x) for x in items]`` for yosys runs: on a Dask ``scheduler`` through
+    :func:`chebnorm.core.parallel.map_ordered`, else on ``workers`` threads of
+    this process (a yosys run is a child process: threads run them side by
+    side without starting a Python worker per batch).
+
+    Parameters
+    ----------
+    fn : callable
+        A function of one item (thread-safe: it writes only its own files).
+    items : iterable
+    workers : int, optional
+        Threads (default: the core count).
+    scheduler, progress, desc
+        As :func:`~chebnorm.core.parallel.map_ordered` (``progress`` and
+        ``desc`` only with a scheduler).
+
+    Returns
+    -------
+    list
+        The results in the order of ``items``.
+
+    Examples
+    --------
+    >>> map_synth(abs, [-1, 2, -3], workers=2)
+    [1, 2, 3]
+    """
+    items = list(items)
+    if scheduler is not None:
+        return map_ordered(fn, items, scheduler=scheduler, progress=progress, desc=desc)
+    workers = check_workers(workers)
+    if workers == 1 or len(items) <= 1:
+        return [fn(x) for x in items]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
+        return list(pool.map(fn, items))
+
+
 def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
     """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
     target model first, skipping those whose model lower bound cannot beat
@@ -378,13 +418,13 @@ def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
         if not run:
             break
         if target == "generic":
-            got = map_ordered(_cells, [designs[k] for k in run], desc="yosys", **par)
+            got = map_synth(_cells, [designs[k] for k in run], desc="yosys", **par)
             for key, c in zip(run, got):
                 points[key] = replace(points[key], yosys_cells=c)
                 best = min(best, float(c))
         else:
-            got = map_ordered(_target_cost, [(designs[k], target) for k in run],
-                              desc=f"yosys {target}", **par)
+            got = map_synth(_target_cost, [(designs[k], target) for k in run],
+                            desc=f"yosys {target}", **par)
             for key, c in zip(run, got):
                 points[key] = replace(points[key], target_cost=c)
                 best = min(best, c.score)
