@@ -11,6 +11,13 @@ of that run and the 1-minute load average before and after it (other work on
 the machine moves the wall figures: the CPU time is the steadier one). Prints
 one JSON line per target (its winner and timing lines too) and writes them
 all to the JSON file (sorted keys).
+
+    python benchmarks/bench_design_targets.py --calibrate [--bits 16 12] [--targets ...]
+
+measures instead what the pruning of ``design`` relies on
+(``chebnorm.hw.architectures.PRUNE_SPREAD``): every candidate the
+architectures' search builds for the spec at each width, synthesized without
+pruning, one JSON line each with its model score, yosys score and their ratio.
 """
 
 from __future__ import annotations
@@ -60,13 +67,40 @@ def run(target: str, repeat: int) -> dict:
     return best
 
 
+def calibrate(bits: int, target: str) -> list[dict]:
+    """Model against yosys for every built candidate of the spec at ``bits`` bits."""
+    from chebnorm.hw.architectures import build_candidates, synthesize_candidates
+
+    ks = {d: max(0, min(bits - 2, 3 + 2 * (3 - d))) for d in (1, 2, 3)}  # as design does
+    cands = build_candidates("1/sqrt(1+3*x)", ("0", "1"), bits, bits, accuracy="faithful",
+                             k_start=ks, target=target, workers=None)
+    rows = []
+    for c in synthesize_candidates(cands, target, prune=False, workers=None):
+        if c.cost is not None:
+            rows.append({"bits": bits, "target": target, "architecture": c.architecture,
+                         "description": c.description, "model": round(c.model, 1),
+                         "yosys": round(c.cost.score, 1),
+                         "ratio": round(c.model / c.cost.score, 3)})
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--targets", nargs="+", default=["generic", "xc7", "xc7-nodsp", "ice40"])
     ap.add_argument("--repeat", type=int, default=3, help="runs per target (best kept)")
     ap.add_argument("--json", default=os.path.join(HERE, "design_targets_results.json"),
                     help="where to write the results ('' for nowhere)")
+    ap.add_argument("--calibrate", action="store_true",
+                    help="model against yosys for every candidate (no timing)")
+    ap.add_argument("--bits", nargs="+", type=int, default=[16, 12],
+                    help="--calibrate: the spec's input and output widths")
     args = ap.parse_args(argv)
+    if args.calibrate:
+        for b in args.bits:
+            for t in args.targets:
+                for row in calibrate(b, t):
+                    print(json.dumps(row, sort_keys=True), flush=True)
+        return 0
     if args.repeat < 1:
         ap.error(f"--repeat {args.repeat}: accepted: 1 or more")
     results = []
