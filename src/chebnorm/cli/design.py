@@ -89,12 +89,12 @@ def run(args) -> int:
     best = _best_other(others)
     res = _search(args, name, target, max_error, None if best is None else best.cost.score)
     csv, png = res.csv(), res.plot_png()
-    # the winner's place and route may fail (too large for the device): before writing
-    figures = winner_figures(res) if res.winner.target_cost is not None else []
     files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
     if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
         return _write_architectures(args, out, name, others, res, files)
+    # the winner's place and route may fail (too large for the device): before writing
+    figures = winner_figures(res) if res.winner.target_cost is not None else []
     if others:
         files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, winner=None)
     write_folder_print(out, files)

@@ -168,9 +168,10 @@ def _build_item(item):
 
 
 def _synth_item(item):
-    """Yosys on one candidate (run by ``map_ordered`` on a worker)."""
+    """Yosys on one candidate, with the target's delay model (the winner's
+    timing line reads it: no second synthesis)."""
     verilog, top, target = item
-    return synthesize_target(verilog, top, target)
+    return synthesize_target(verilog, top, target, timing=True)
 
 
 def _cheapest_per_degree(cands: list[Candidate]) -> list[Candidate]:
