@@ -278,9 +278,9 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     :func:`~chebnorm.hw.target_model.model_score` over
     :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
     score synthesized so far, or ``bound`` (a score synthesized elsewhere,
-    e.g. another architecture's), is not synthesized: it cannot win. When
-    ``bound`` rules out every point, none is synthesized and the winner is
-    the cheapest by the model (``cost_source`` "model estimate").
+    e.g. another architecture's), is not synthesized: it cannot win. The
+    cheapest point by the model is always synthesized (when ``bound`` rules
+    out every point, it alone: the winner then is it).
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
@@ -345,16 +345,13 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
             chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
             cost_source = ("yosys cells" if target == "generic" else
                            f"yosys {get_target(target).synth.split(' -top')[0]}")
-            done = _synth_pruned(points, designs, chosen, target, bound, par)
-            if not done:
-                cost_source = "model estimate"
+            _synth_pruned(points, designs, chosen, target, bound, par)
     ordered = tuple(points[k] for k in keys)
     winner = None
     if meeting:
         pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
                                                    or p.target_cost is not None
                                                    or cost_source == "model estimate")]
-        pool = pool or [p for p in ordered if p.meets]
         winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
                         max_error, ordered, winner, cost_source,
@@ -404,8 +401,8 @@ def map_synth(fn, items, *, workers: int | None = None, scheduler=None, progress
 def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
     """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
     target model first, skipping those whose model lower bound cannot beat
-    the best score so far (or ``bound``); update ``points``. Returns the
-    number synthesized."""
+    the best score so far (or ``bound``; the first key always runs); update
+    ``points``. Returns the number synthesized."""
     from .target_model import MODEL_SPREAD, model_score, piecewise_features
 
     spread = MODEL_SPREAD[target]
@@ -415,6 +412,8 @@ def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
     n = 0
     while todo:
         run = [k for k in todo if model[k] / spread < best][:SYNTH_ROUND]
+        if n == 0 and not run:   # the cheapest by the model always (the CSV's winner row)
+            run = todo[:1]
         if not run:
             break
         if target == "generic":
