@@ -85,3 +85,89 @@ def test_max_error_takes_an_exact_power_of_two(tmp_path, capsys):
     assert main(["design", *SPEC, "--max-error", "0.015625", "--no-synth", "--workers", "1",
                  "-o", str(b)]) == 0
     assert (a / "design_design.csv").read_bytes() == (b / "design_design.csv").read_bytes()
+
+
+def _fake_candidates(models):
+    from chebnorm.hw.architectures import Candidate
+
+    class D:  # the least a candidate's design needs here: a module name and Verilog
+        def __init__(self, i):
+            self.module_name = f"m{i}"
+
+        def verilog(self):
+            return self.module_name
+
+    return [Candidate("piecewise-sized", f"c{i}", D(i), 0.0, 1.0, model=m)
+            for i, m in enumerate(models)]
+
+
+def test_pruning_synthesizes_cheapest_model_first_and_skips_what_cannot_win(monkeypatch):
+    """With yosys replaced by fixed scores (each within the spread of its model),
+    the pruned run finds the same best score as synthesizing everything, and a
+    skipped candidate's lower bound is never below that best."""
+    from chebnorm.hw import architectures as A
+    from chebnorm.hw.target_model import MODEL_SPREAD
+
+    s = A.prune_spread("piecewise-sized", "generic")
+    assert s >= MODEL_SPREAD["generic"]
+    # two per round: m4 and m0 (best 990), then m1 alone: m2 and m3 cannot beat 990
+    models = [1000.0, 1010.0, 1.07 * 990.0 * s, 2000.0 * s, 990.0]
+    # true scores: the model ratio stays within s; candidate 1 scores lowest
+    true = {"m0": 1000.0, "m1": 1010.0 / s, "m2": 1.07 * 990.0, "m3": 2000.0, "m4": 990.0}
+    calls = []
+
+    def fake(item):
+        calls.append(item[1])
+        return type("C", (), {"score": true[item[1]], "line": lambda self: "x"})()
+
+    monkeypatch.setattr(A, "_synth_item", fake)
+    cands = _fake_candidates(models)
+    full = A.synthesize_candidates(cands, "generic", prune=False, workers=1)
+    pruned = A.synthesize_candidates(cands, "generic", workers=1)
+    best = min(c.cost.score for c in full)
+    assert min(c.cost.score for c in pruned if c.cost is not None) == best
+    assert calls[len(models):][:2] == ["m4", "m0"]   # cheapest model first
+    skipped = [c for c in pruned if c.cost is None]
+    assert {c.design.module_name for c in skipped} == {"m2", "m3"}
+    for c in skipped:
+        assert c.model / s >= best and "cannot win" in c.note
+    # a bound from elsewhere (the one-width winner) prunes before any run
+    calls.clear()
+    none = A.synthesize_candidates(cands, "generic", bound=100.0, workers=1)
+    assert calls == [] and all(c.cost is None for c in none)
+
+
+@needs_yosys
+@pytest.mark.parametrize("target", ["generic", "ice40"])
+def test_pruned_synthesis_keeps_the_winner_of_synthesizing_everything(target):
+    """On a small spec, every built candidate synthesized against the pruned run:
+    the same best score, and no skipped candidate would have beaten it."""
+    from chebnorm.hw.architectures import build_candidates, prune_spread, synthesize_candidates
+
+    cands = build_candidates("1/sqrt(1+3*x)", ("0", "1"), 10, 10, accuracy="faithful",
+                             degrees=(1, 2, 3), k_start={1: 4, 2: 2, 3: 1}, target=target)
+    full = synthesize_candidates(cands, target, prune=False, workers=1)
+    pruned = synthesize_candidates(cands, target, workers=1)
+    best = min(c.cost.score for c in full if c.cost is not None)
+    assert min(c.cost.score for c in pruned if c.cost is not None) == best
+    for f, p in zip(full, pruned):
+        if f.design is not None and p.cost is None:
+            assert f.cost.score >= best
+            assert f.model / f.cost.score <= prune_spread(f.architecture, target)
+
+
+
+@needs_yosys
+def test_search_bound_skips_points_that_cannot_win():
+    """A bound below every point's model lower bound: only the model-cheapest
+    meeting point is synthesized (the CSV's winner row has its figures), and it
+    wins."""
+    from chebnorm.hw.piecewise_search import search
+
+    kw = dict(degrees=(1, 2), max_index_bits=4, progress=False, workers=1, target="ice40")
+    r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, bound=1.0, **kw)
+    done = [p for p in r.points if p.target_cost is not None]
+    assert len(done) == 1 and r.winner is done[0]
+    assert r.winner.target_model == min(p.target_model for p in r.points if p.meets)
+    full = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, **kw)
+    assert sum(p.target_cost is not None for p in full.points) >= 1

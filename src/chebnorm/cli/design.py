@@ -121,21 +121,23 @@ def run(args) -> int:
                          f"--no-synth (or --max-error E with --no-synth)")
     others = []
     if not args.no_synth:
-        others = _architectures(args, name, target, accuracy, max_error)
+        others = _synth_others(args, _architectures(args, name, target, accuracy, max_error),
+                               target)
     if accuracy == "correctly-rounded":
         return _write_architectures(args, out, name, others, None)
     if accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
         ulps = [c.ulp for c in others if c.ulp is not None]
         max_error = math.nextafter(min(ulps), 0.0)
-    res = _search(args, name, target, max_error)
+    best = _best_other(others)
+    res = _search(args, name, target, max_error, None if best is None else best.cost.score)
     csv, png = res.csv(), res.plot_png()
+    files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
+    synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
+    if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
+        return _write_architectures(args, out, name, others, res, files)
     # the winner's place and route may fail (too large for the device): before writing
     figures = winner_figures(res) if res.winner.target_cost is not None and \
         frequency is None else []
-    files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
-    best = _best_other(others)
-    if best is not None and best.cost.score < _score(res.winner):
-        return _write_architectures(args, out, name, others, res, files)
     if others:
         files[f"design_{name}_architectures.csv"] = _architectures_csv(others, res, winner=None)
     if frequency is not None:  # the one-width winner has no cut points: timed as it is
@@ -228,15 +230,17 @@ def _winner_design(res):
                 if p is res.winner)
 
 
-def _search(args, name, target, max_error):
-    """The one-width piecewise Pareto search (:mod:`chebnorm.hw.piecewise_search`)."""
+def _search(args, name, target, max_error, bound=None):
+    """The one-width piecewise Pareto search (:mod:`chebnorm.hw.piecewise_search`);
+    ``bound``: the other architectures' best synthesized score (a point that
+    cannot beat it is not synthesized)."""
     from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.hw.piecewise_search import search
 
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, max_error,
                  degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
                  var=args.var, synth=not args.no_synth, name=name, target=target,
-                 **parallel_kwargs(args))
+                 bound=bound, **parallel_kwargs(args))
     if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
@@ -248,17 +252,26 @@ def _search(args, name, target, max_error):
 
 
 def _architectures(args, name, target, accuracy, max_error):
-    """The sized piecewise, multipartite and plain-table candidates, synthesized."""
-    from chebnorm.hw.architectures import architecture_candidates
+    """The sized piecewise, multipartite and plain-table candidates, built and
+    priced by the target's model (synthesized by :func:`_synth_others`)."""
+    from chebnorm.hw.architectures import build_candidates
 
     degrees = sorted(set(args.degrees))
     # the sized search starts where a one-width design of each degree first meets the
     # error (a cheap model-only walk); four index bits below it when unknown
-    return architecture_candidates(args.expr, tuple(args.interval), args.in_bits, args.out_bits,
-                                   accuracy=accuracy, max_error=max_error, degrees=degrees,
-                                   k_start={d: max(0, min(args.in_bits - 2, 3 + 2 * (3 - d)))
-                                            for d in degrees},
-                                   var=args.var, name=name, target=target)
+    return build_candidates(args.expr, tuple(args.interval), args.in_bits, args.out_bits,
+                            accuracy=accuracy, max_error=max_error, degrees=degrees,
+                            k_start={d: max(0, min(args.in_bits - 2, 3 + 2 * (3 - d)))
+                                     for d in degrees},
+                            var=args.var, name=name, target=target, **parallel_kwargs(args))
+
+
+def _synth_others(args, others, target):
+    """Synthesize the candidates the model cannot rule out (the cheapest model
+    first), and keep the cheapest per degree."""
+    from chebnorm.hw.architectures import cheapest_candidates, synthesize_candidates
+
+    return cheapest_candidates(synthesize_candidates(others, target, **parallel_kwargs(args)))
 
 
 def _score(point) -> float:
@@ -340,8 +353,11 @@ def _write_architectures(args, out, name, others, res, files=None) -> int:
     if figures:
         print("\n".join(figures))
     if res is not None:
-        print(f"  piecewise (one width): {res.winner.describe()} -- score {_score(res.winner):.1f}"
-              f", costlier than the winner")
+        w = res.winner
+        why = (f"score {_score(w):.1f}, costlier than the winner" if w.target_cost is not None
+               or w.yosys_cells is not None else "not synthesized: its model cannot beat the "
+               "winner")
+        print(f"  piecewise (one width): {w.describe()} -- {why}")
     for c in others:
         if c is not best:
             print(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None else ""))

@@ -32,19 +32,41 @@ from dataclasses import dataclass
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS
 
+from chebnorm.core.parallel import map_ordered
+
 from .hdl import module_text
 from .multipartite import design_multipartite
 from .piecewise import design_piecewise
+from .piecewise_search import SYNTH_ROUND, map_synth
 from .plain_table import design_plain_table
 from .targets import get_target, synthesize_target
 
-__all__ = ["Candidate", "ACCURACIES", "MAX_TABLE_ROM_BITS", "architecture_candidates"]
+__all__ = ["Candidate", "ACCURACIES", "MAX_TABLE_ROM_BITS", "PRUNE_SPREAD",
+           "architecture_candidates", "build_candidates", "synthesize_candidates",
+           "cheapest_candidates", "prune_spread"]
 
 #: the accuracy specs ``design`` takes
 ACCURACIES = ("max-error", "faithful", "correctly-rounded")
 #: a plain table larger than this many ROM bits is not built (2^16 codes x 18 bits is
 #: 1.2 Mbit: 16k yosys cells, 7k LUT on xc7 -- it cannot win against a multipartite)
 MAX_TABLE_ROM_BITS = 1 << 18
+#: per (architecture, target): the largest ``model / yosys`` measured on the
+#: architectures' candidates (``python benchmarks/bench_design_targets.py --calibrate``);
+#: pruning divides a candidate's model score by it (or by MODEL_SPREAD, if larger)
+PRUNE_SPREAD = {
+    # two specs (1/sqrt(1+3x) on [0, 1), 12 and 16 bits, faithful), every candidate the
+    # sized walk and the multipartite search built, synthesized: the largest model/yosys
+    # times 1.1. On xc7 the model puts every product in DSP48E1s; yosys maps small ones to
+    # LUTs (a 12-bit degree-1 design: model 426, yosys 162), hence the wide spread there
+    ("piecewise-sized", "generic"): 1.70, ("multipartite", "generic"): 1.52,
+    ("piecewise-sized", "xc7"): 2.90, ("multipartite", "xc7"): 1.10,
+    ("piecewise-sized", "xc7-nodsp"): 2.54, ("multipartite", "xc7-nodsp"): 1.33,
+    ("piecewise-sized", "ice40"): 1.67, ("multipartite", "ice40"): 1.90,
+    # a plain table's ROM compresses up to 7x in yosys (2^16 x 16 bits: model 115,867
+    # cells, yosys 15,986): never pruned
+    ("table", "generic"): math.inf, ("table", "xc7"): math.inf,
+    ("table", "xc7-nodsp"): math.inf, ("table", "ice40"): math.inf,
+}
 
 
 @dataclass(frozen=True)
@@ -66,7 +88,11 @@ class Candidate:
     cost : TargetCost or None
         Its synthesis on the target.
     note : str
-        Why it was not built or cannot meet the spec (empty otherwise).
+        Why it was not built, cannot meet the spec or was not synthesized
+        (empty otherwise).
+    model : float or None
+        Its score by the target's calibrated model
+        (:func:`chebnorm.hw.target_model.model_score`).
 
     Examples
     --------
@@ -81,6 +107,7 @@ class Candidate:
     ulp: float | None = None
     cost: object = None
     note: str = ""
+    model: float | None = None
 
     @property
     def verilog(self) -> str:
@@ -92,56 +119,170 @@ class Candidate:
         """One line: the architecture, its parameters, cost and error."""
         if self.design is None:
             return f"{self.architecture}: {self.description} -- {self.note}"
-        cost = "not synthesized" if self.cost is None else self.cost.line()
+        cost = (self.cost.line() if self.cost is not None else
+                f"not synthesized ({self.note})" if self.note else "not synthesized")
         return (f"{self.architecture}: {self.description}: {cost}; certified error "
                 f"{self.error:.4e} ({self.error / self.ulp:.3f} ulp)")
 
 
-def _sized(expr, interval, in_bits, out_bits, degrees, k_start, max_error, var, name, target):
-    """Every sized piecewise design that meets the error at the first segment
-    counts from ``k_start`` on: ``[(degree, design, description)]``."""
+def _sized_chain(item) -> list:
+    """One degree of the sized search (run by ``map_ordered`` on a worker): the
+    sized designs at ``2**k`` segments for ``k = k0 .. k0 + 3`` that meet the
+    error, with their target model scores (``[(k, design, model)]``). The walk
+    ends early at a ``k`` whose model score, divided by the model's spread on
+    sized designs (:func:`prune_spread`), still exceeds the best one so far: a
+    larger ROM no longer pays for itself (the model alone is too rough to stop
+    at the first rise: on ``xc7-nodsp`` the cheapest degree-2 design has 256
+    segments, after a rise at 128)."""
+    from .target_model import model_score, piecewise_features
+
+    expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target = item
     mult = "full" if get_target(target).name == "xc7" else "truncated"
-    found = []
-    for degree in degrees:
-        k0 = k_start.get(degree)
-        for k in range(k0, min(k0 + 3, in_bits - 2) + 1) if k0 is not None else ():
-            f_hi = out_bits + 10 if max_error is None else math.ceil(-math.log2(max_error)) + 10
-            t = piecewise_fit(expr, interval, degree, segments=2 ** k,
-                              coef_frac_bits=min(f_hi, MAX_COEF_FRAC_BITS), centered=degree > 0,
-                              var=var, name=f"{name}_d{degree}")
-            try:
-                d = design_piecewise(t, in_bits, out_bits, widths="auto", max_error=max_error,
-                                     multipliers=mult)
-            except ValueError:  # not reachable at this segment count
-                continue
-            found.append((degree, d, f"degree {degree}, {2 ** k} centred segments, ROM "
-                          f"{sum(d.rom_bits) << k} bits, {mult} multipliers"))
+    f_hi = out_bits + 10 if max_error is None else math.ceil(-math.log2(max_error)) + 10
+    found: list = []
+    for k in range(k0, min(k0 + 3, in_bits - 2) + 1):
+        t = piecewise_fit(expr, interval, degree, segments=2 ** k,
+                          coef_frac_bits=min(f_hi, MAX_COEF_FRAC_BITS), centered=degree > 0,
+                          var=var, name=name)
+        try:
+            d = design_piecewise(t, in_bits, out_bits, widths="auto", max_error=max_error,
+                                 multipliers=mult)
+        except ValueError:  # not reachable at this segment count
+            continue
+        model = model_score(piecewise_features(d), target)
+        if found and model / prune_spread("piecewise-sized", target) > min(
+                m for _, _, m in found):
+            break   # even at the model's spread, costlier than a smaller k
+        found.append((k, d, model))
     return found
 
 
+def _build_item(item):
+    """One parallel item of :func:`architecture_candidates`: a degree's sized
+    chain, or the multipartite design."""
+    if item[0] == "sized":
+        return _sized_chain(item[1:])
+    expr, interval, in_bits, out_bits, e, var, name = item[1:]
+    return design_multipartite(expr, interval, in_bits, out_bits, max_error=e,
+                               faithful=e is None, var=var, name=name)
+
+
+def _synth_item(item):
+    """Yosys on one candidate, with the target's delay model (the winner's
+    timing line reads it: no second synthesis)."""
+    verilog, top, target = item
+    return synthesize_target(verilog, top, target, timing=True)
+
+
 def _cheapest_per_degree(cands: list[Candidate]) -> list[Candidate]:
-    """Per degree, the sized candidate of the lowest synthesized score (or, not
-    synthesized, of the fewest ROM bits)."""
-    best: dict[int, Candidate] = {}
+    """Per degree, the sized candidate of the lowest synthesized score (or, none
+    synthesized, of the lowest model score)."""
+    best: dict[int, tuple] = {}
     for c in cands:
         d = c.design
-        key = (c.cost.score if c.cost is not None else sum(d.rom_bits) << d.index_bits,
-               d.index_bits)
+        key = (c.cost is None, c.cost.score if c.cost is not None else c.model, d.index_bits)
         old = best.get(d.degree)
         if old is None or key < old[0]:
             best[d.degree] = (key, c)
     return [best[k][1] for k in sorted(best)]
 
 
+def prune_spread(architecture: str, target: str) -> float:
+    """The ratio by which a candidate's synthesized score may fall below its
+    model score (:data:`PRUNE_SPREAD`; :data:`chebnorm.hw.target_model.MODEL_SPREAD`
+    for an architecture without its own measurement).
+
+    >>> prune_spread("multipartite", "xc7") >= 1
+    True
+    """
+    from .target_model import MODEL_SPREAD
+
+    t = get_target(target).name
+    return max(PRUNE_SPREAD.get((architecture, t), 1.0), MODEL_SPREAD[t])
+
+
+def synthesize_candidates(cands, target: str, *, bound: float | None = None,
+                          prune: bool = True, workers: int | None = 1,
+                          scheduler=None) -> list[Candidate]:
+    """Synthesize the built candidates on ``target``, pruned by the model.
+
+    Parameters
+    ----------
+    cands : list of Candidate
+        As :func:`architecture_candidates` builds them (``model`` set).
+    target : str
+        A target name (:func:`chebnorm.hw.targets.target_names`).
+    bound : float, optional
+        A score already synthesized elsewhere (the one-width search's winner):
+        a candidate that cannot beat it is not synthesized.
+    prune : bool
+        False: synthesize every built candidate.
+    workers, scheduler
+        Parallel yosys runs (:func:`chebnorm.hw.piecewise_search.map_synth`).
+
+    Returns
+    -------
+    list of Candidate
+        In the order given; a candidate whose model lower bound
+        ``model / prune_spread`` is not below the best synthesized score
+        (``bound`` or a candidate's) keeps ``cost`` None and says so in
+        ``note``. Candidates are synthesized cheapest model first,
+        :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND` at a time (whatever
+        ``workers``: the same ones are synthesized), so the best score found prunes the rest: a pruned candidate
+        would have scored at least its lower bound, never less than the best.
+
+    Examples
+    --------
+    >>> synthesize_candidates([Candidate("table", "none", note="not built")], "generic")[0].note
+    'not built'
+    """
+    from chebnorm.core.parallel import check_workers
+
+    workers = check_workers(workers)
+    out = list(cands)
+    todo = sorted((i for i, c in enumerate(out) if c.design is not None),
+                  key=lambda i: (out[i].model is None, out[i].model or 0.0, i))
+    best = math.inf if bound is None else float(bound)
+
+    def lower(c):
+        return -math.inf if c.model is None else c.model / prune_spread(c.architecture, target)
+
+    while todo:
+        run = [i for i in todo if not prune or lower(out[i]) < best][:SYNTH_ROUND]
+        if not run:
+            break
+        costs = map_synth(_synth_item, [(out[i].verilog, out[i].design.module_name, target)
+                                        for i in run], workers=workers, scheduler=scheduler)
+        for i, cost in zip(run, costs):
+            c = out[i]
+            out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, cost,
+                               c.note, c.model)
+            best = min(best, cost.score)
+        todo = [i for i in todo if i not in run]
+    for i in todo:
+        c = out[i]
+        out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
+                           f"model {c.model:.1f} / {prune_spread(c.architecture, target):.3f} = "
+                           f"{lower(c):.1f} >= best synthesized {best:.1f}: cannot win",
+                           c.model)
+    return out
+
+
 def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,
                             max_error=None, degrees=(1, 2, 3), k_start=None, var: str = "x",
                             name: str = "design", target: str = "generic",
-                            synth: bool = True) -> list[Candidate]:
+                            synth: bool = True, bound: float | None = None, prune: bool = True,
+                            workers: int | None = 1, scheduler=None) -> list[Candidate]:
     """The other architectures' best designs for the spec (module docstring).
 
-    ``k_start`` maps a degree to the index bits at which the one-width search
-    first met the error (the sized search starts there). ``accuracy``: one of
-    :data:`ACCURACIES`; ``max_error`` its bound for ``"max-error"``.
+    ``k_start`` maps a degree to the index bits at which the sized search
+    starts (it walks up at most three more, :func:`_sized_chain`).
+    ``accuracy``: one of :data:`ACCURACIES`; ``max_error`` its bound for
+    ``"max-error"``. With ``synth``, the built candidates go through
+    :func:`synthesize_candidates` (``bound``, ``prune``, ``workers``,
+    ``scheduler``: as there); the sized search's degrees and the multipartite
+    design are built in parallel on ``workers`` too. Every candidate carries
+    its model score on ``target``.
 
     Examples
     --------
@@ -152,8 +293,54 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
     >>> cs[-1].error <= cs[-1].ulp / 2
     True
     """
+    out = build_candidates(expr, interval, in_bits, out_bits, accuracy=accuracy,
+                           max_error=max_error, degrees=degrees, k_start=k_start, var=var,
+                           name=name, target=target, workers=workers, scheduler=scheduler)
+    if synth:
+        out = synthesize_candidates(out, target, bound=bound, prune=prune, workers=workers,
+                                    scheduler=scheduler)
+    return cheapest_candidates(out)
+
+
+def cheapest_candidates(cands) -> list[Candidate]:
+    """``cands`` with, of the sized piecewise ones, only the cheapest per degree
+    (lowest synthesized score, else lowest model score).
+
+    >>> cheapest_candidates([Candidate("table", "none", note="not built")])[0].architecture
+    'table'
+    """
+    sized = [c for c in cands if c.architecture == "piecewise-sized" and c.design is not None]
+    keep = set(map(id, _cheapest_per_degree(sized)))
+    return [c for c in cands if c.architecture != "piecewise-sized" or c.design is None
+            or id(c) in keep]
+
+
+def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,
+                     max_error=None, degrees=(1, 2, 3), k_start=None, var: str = "x",
+                     name: str = "design", target: str = "generic", workers: int | None = 1,
+                     scheduler=None) -> list[Candidate]:
+    """Every candidate of :func:`architecture_candidates` (all the sized ones the
+    walk built, not only the cheapest per degree), built and priced by the
+    model, not synthesized: :func:`synthesize_candidates` and
+    :func:`cheapest_candidates` finish them.
+
+    >>> cs = build_candidates("1/sqrt(1+3*x)", ("0", "1"), 6, 6, accuracy="faithful",
+    ...                       k_start={1: 2})
+    >>> sorted({c.architecture for c in cs}), all(c.model > 0 for c in cs if c.design)
+    (['multipartite', 'piecewise-sized', 'table'], True)
+    """
     if accuracy not in ACCURACIES:
         raise ValueError(f"accuracy {accuracy!r}; accepted: {', '.join(ACCURACIES)}")
+    return _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees,
+                             dict(k_start or {}), var, name, get_target(target).name, workers,
+                             scheduler)
+
+
+def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees, k_start,
+                      var, name, target, workers, scheduler) -> list[Candidate]:
+    """Every candidate of :func:`architecture_candidates`, built, not synthesized."""
+    from .target_model import design_features, model_score
+
     e = max_error if accuracy == "max-error" else None
     out: list[Candidate] = []
     rom = (2 ** in_bits) * out_bits
@@ -163,21 +350,29 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
                                  "output's last place; a correctly rounded output needs the "
                                  "proved rounding of every code (a plain table)"))
     else:
-        sized = _sized(expr, interval, in_bits, out_bits, degrees, k_start or {}, e, var,
-                       f"{name}_sized", target)
+        items = [("sized", expr, interval, in_bits, out_bits, degree, k_start[degree], e, var,
+                  f"{name}_sized_d{degree}", target) for degree in degrees if degree in k_start]
+        if in_bits <= 20:
+            items.append(("multipartite", expr, interval, in_bits, out_bits, e, var,
+                          f"{name}_mp"))
+        built = map_ordered(_build_item, items, workers=workers, scheduler=scheduler)
+        mult = "full" if get_target(target).name == "xc7" else "truncated"
+        sized = [(k, d, m) for item, res in zip(items, built) if item[0] == "sized"
+                 for k, d, m in res]
         if not sized:
             out.append(Candidate("piecewise-sized", "no design", note="the sized search met "
                                  "the error at no degree and segment count tried"))
-        for _degree, d, text in sized:
+        for k, d, model in sized:
             b = d.budget()
-            out.append(Candidate("piecewise-sized", text, d, float(b["total"]),
-                                 float(b["y_lsb"])))
-        if in_bits <= 20:
-            m = design_multipartite(expr, interval, in_bits, out_bits, max_error=e,
-                                    faithful=e is None, var=var, name=f"{name}_mp")
+            out.append(Candidate("piecewise-sized", f"degree {d.degree}, {2 ** k} centred "
+                                 f"segments, ROM {sum(d.rom_bits) << k} bits, {mult} multipliers",
+                                 d, float(b["total"]), float(b["y_lsb"]), model=model))
+        if items and items[-1][0] == "multipartite":
+            m = built[-1]
             out.append(Candidate("multipartite", f"{len(m.offsets)} offset tables, ROM "
                                  f"{m.rom_bits} bits", m, float(m.certificate.upper),
-                                 2.0 ** -m.y_format.frac_bits))
+                                 2.0 ** -m.y_format.frac_bits,
+                                 model=model_score(design_features(m), target)))
     if rom <= MAX_TABLE_ROM_BITS:
         p = design_plain_table(expr, interval, in_bits, out_bits, var=var, name=f"{name}_table")
         ok = accuracy != "correctly-rounded" or p.correctly_rounded
@@ -185,16 +380,9 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
                              + (", correctly rounded (proved)" if p.correctly_rounded else ""),
                              p if ok else None, float(p.certificate.upper),
                              2.0 ** -p.y_format.frac_bits,
-                             note="" if ok else f"{p.unproved} codes' rounding not proved"))
+                             note="" if ok else f"{p.unproved} codes' rounding not proved",
+                             model=model_score(design_features(p), target)))
     else:
         out.append(Candidate("table", f"{2 ** in_bits} entries", note=f"ROM of {rom} bits, over "
                              f"{MAX_TABLE_ROM_BITS}: not built (it cannot win)"))
-    if synth:
-        out = [c if c.design is None else
-               Candidate(c.architecture, c.description, c.design, c.error, c.ulp,
-                         synthesize_target(c.verilog, c.design.module_name, target))
-               for c in out]
-    sized = [c for c in out if c.architecture == "piecewise-sized" and c.design is not None]
-    keep = set(map(id, _cheapest_per_degree(sized)))
-    return [c for c in out if c.architecture != "piecewise-sized" or c.design is None
-            or id(c) in keep]
+    return out

@@ -423,36 +423,39 @@ def _structures(p: _Problem, symmetric, max_tables: int):
 
 
 def _backfit(p: _Problem, alpha: int, bits, gammas, syms):
-    """Real-valued tables (output LSB units) by midrange backfitting."""
-    w, m = p.w, len(bits)
-    beta = w - alpha
-    z = p.z
+    """Real-valued tables (output LSB units) by midrange backfitting.
+
+    The residual ``z - TIV - sum TO_i`` is kept on the grid of every code
+    and updated by each table's change (one pass over the codes per table
+    update, not one per table)."""
+    m = len(bits)
     shape_b = tuple(2 ** b for b in reversed(bits))      # B_{m-1} .. B_0 axes
     tiv = np.zeros(2 ** alpha)
     offs = [np.zeros((2 ** g, 2 ** b)) for g, b in zip(gammas, bits)]
+    # the residual, shaped (2**g, 2**(alpha - g)) + shape_b for every g at no cost
+    res = np.array(p.z, dtype=np.float64).reshape((2 ** alpha,) + shape_b)
 
-    def contribution(i):
+    def grid(i, values):
+        """Table ``i``'s ``(2**g, 2**b)`` values broadcast onto the residual's axes."""
         g, b = gammas[i], bits[i]
-        full = np.broadcast_to(offs[i].reshape((2 ** g, 1) + tuple(
-            2 ** b if j == i else 1 for j in reversed(range(m)))),
-            (2 ** g, 2 ** (alpha - g)) + shape_b)
-        return full.reshape(-1)
+        return values.reshape((2 ** g, 1) + tuple(
+            2 ** b if j == i else 1 for j in reversed(range(m))))
 
-    def residual():
-        r = z - np.repeat(tiv, 2 ** beta)
-        for i in range(m):
-            r = r - contribution(i)
-        return r
+    def fit_tiv():
+        r = res.reshape(2 ** alpha, -1)
+        delta = (r.max(axis=1) + r.min(axis=1)) / 2
+        tiv[:] += delta
+        r -= delta[:, None]
 
     best = None
     for _ in range(_FIT_ROUNDS):
-        r = residual().reshape(2 ** alpha, -1)
-        tiv += (r.max(axis=1) + r.min(axis=1)) / 2
+        fit_tiv()
         for i in range(m):
             g, b = gammas[i], bits[i]
-            r = residual().reshape((2 ** g, 2 ** (alpha - g)) + shape_b)
+            r = res.reshape((2 ** g, 2 ** (alpha - g)) + shape_b)
             axes = (1,) + tuple(2 + j for j in range(m) if m - 1 - j != i)
             mr = (r.max(axis=axes) + r.min(axis=axes)) / 2        # (2**g, 2**b)
+            old = offs[i].copy()
             if syms[i]:
                 h = 2 ** (b - 1)
                 delta = (mr[:, h:] - mr[:, h - 1::-1]) / 2
@@ -460,9 +463,9 @@ def _backfit(p: _Problem, alpha: int, bits, gammas, syms):
                 offs[i][:, :h] = -offs[i][:, h:][:, ::-1]
             else:
                 offs[i] += mr
-        r = residual().reshape(2 ** alpha, -1)
-        tiv += (r.max(axis=1) + r.min(axis=1)) / 2
-        e = float(np.abs(residual()).max())
+            r -= grid(i, offs[i] - old)
+        fit_tiv()
+        e = float(np.abs(res).max())
         if best is None or e < best[0] - 1e-12:
             best = (e, tiv.copy(), [o.copy() for o in offs])
         elif e >= best[0]:
@@ -546,23 +549,28 @@ class _Table:
 
 def _tune(p: _Problem, alpha: int, guard: int, tiv, ints, widths, looks):
     """Move each integer entry by the step minimizing the largest error of the
-    codes that read it; TIV first, then each offset table, a few rounds."""
+    codes that read it; TIV first, then each offset table, a few rounds.
+    (Exact integer sums: the offsets' sum is updated table by table.)"""
     w = p.w
     a_idx = np.arange(2 ** w, dtype=np.int64) >> (w - alpha)
     z = p.z
     # every entry is read by equally many codes: group them by sorting once
     orders = [np.argsort(a, kind="stable") for a, _ in looks]
+    zs_all = [z[o] for o in orders]
+    signs = [np.where(s, 1, -1)[o] for (_, s), o in zip(looks, orders)]
 
-    def offsets_sum():
-        return sum(np.where(s, ints[i][a], (2 ** widths[i] - 1) - ints[i][a])
-                   for i, (a, s) in enumerate(looks)) if looks else 0
+    def part(i):
+        a, s = looks[i]
+        return np.where(s, ints[i][a], (2 ** widths[i] - 1) - ints[i][a])
+
+    parts = [part(i) for i in range(len(looks))]
+    osum = sum(parts) if parts else np.zeros(2 ** w, dtype=np.int64)
 
     def errors(total):
         return np.abs((total >> guard) - z)
 
     span = 2 ** guard + 1
     for _ in range(_TUNE_ROUNDS):
-        osum = offsets_sum()
         base = tiv[a_idx] + osum
         best_e = errors(base).reshape(2 ** alpha, -1).max(axis=1)
         best_d = np.zeros(2 ** alpha, dtype=np.int64)
@@ -574,22 +582,24 @@ def _tune(p: _Problem, alpha: int, guard: int, tiv, ints, widths, looks):
             best_e = np.where(better, e, best_e)
             best_d = np.where(better, d, best_d)
         tiv = tiv + best_d
-        for i, (a, s) in enumerate(looks):
-            total = tiv[a_idx] + offsets_sum()
+        tiv_k = tiv[a_idx]
+        for i in range(len(looks)):
             n = ints[i].size
-            order = orders[i]
-            zs = z[order]
-            cur = np.abs((total[order] >> guard) - zs).reshape(n, -1).max(axis=1)
+            order, zs, sign = orders[i], zs_all[i], signs[i]
+            tot = (tiv_k + osum)[order]
+            cur = np.abs((tot >> guard) - zs).reshape(n, -1).max(axis=1)
             bd = np.zeros(n, dtype=np.int64)
-            sign = np.where(s, 1, -1)[order]
             for d in (-2, -1, 1, 2):
-                e = np.abs(((total[order] + d * sign) >> guard) - zs).reshape(n, -1).max(axis=1)
+                e = np.abs(((tot + d * sign) >> guard) - zs).reshape(n, -1).max(axis=1)
                 ok = (ints[i] + d >= 0) & (ints[i] + d <= 2 ** widths[i] - 1)
                 better = ok & (e < cur - 1e-12)
                 cur = np.where(better, e, cur)
                 bd = np.where(better, d, bd)
             ints[i] = ints[i] + bd
-    total = tiv[a_idx] + offsets_sum()
+            new = part(i)
+            osum = osum - parts[i] + new
+            parts[i] = new
+    total = tiv[a_idx] + osum
     y = total >> guard
     return float(np.abs(y - z).max()), y, tiv
 

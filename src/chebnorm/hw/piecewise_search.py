@@ -17,10 +17,13 @@ With ``target`` other than ``"generic"`` (:mod:`chebnorm.hw.targets`) every
 point is priced by that target's calibrated model
 (:func:`chebnorm.hw.target_model.model_score`), the Pareto front is taken over
 (model score, bound), and its meeting points are synthesized on the target
-(``synth_xilinx``, ``synth_ice40``) -- except those whose model score exceeds
-``MODEL_SPREAD**2`` times the best one's (the model is within
-:data:`~chebnorm.hw.target_model.MODEL_SPREAD` of yosys, so they cannot win):
-the winner is the lowest target score.
+(``synth_xilinx``, ``synth_ice40``), cheapest model first, two at a time --
+except those whose model score over
+:data:`~chebnorm.hw.target_model.MODEL_SPREAD` (a lower bound of their yosys
+score: the model is within that ratio of yosys) is not below the best score
+synthesized so far, or a ``bound`` the caller got elsewhere: they cannot
+win. The winner is the lowest target score. (On ``generic`` the same pruning
+reads the target model's yosys-cell prediction.)
 
 >>> r = search("1/sqrt(x)", ("1", "4"), 10, 10, 2e-3, degrees=(1, 2), synth=False,
 ...            progress=False, workers=1)
@@ -47,7 +50,7 @@ from .sweep import pareto_png
 from .targets import TargetCost, get_target
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
-           "TARGET_COLUMNS"]
+           "TARGET_COLUMNS", "SYNTH_ROUND", "map_synth"]
 
 #: the columns of the search's CSV (``design_NAME.csv``), in order
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
@@ -59,6 +62,9 @@ TARGET_COLUMNS = ("target", "target_model", "target_score", "luts", "dsps", "car
 #: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
 ROM_CELLS_PER_BIT = 0.15
 MAX_SYNTH = 6
+#: points synthesized per round of the pruned synthesis (fixed, so the points
+#: synthesized, and the CSV, do not depend on the worker count)
+SYNTH_ROUND = 2
 #: a worker thread fits one table at a time: the certifier sets python-flint's global
 #: precision, which threads of one process (a threaded Dask worker) would share
 _FIT_LOCK = threading.Lock()
@@ -263,10 +269,19 @@ def _check_max_error(max_error) -> float:
 def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
            degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
            progress: bool = True, name: str = "design", workers: int | None = None,
-           scheduler=None, target: str = "generic") -> SearchResult:
+           scheduler=None, target: str = "generic", bound: float | None = None) -> SearchResult:
     """Cheapest certified piecewise design meeting ``max_error`` (module docstring);
     ``target`` (:func:`chebnorm.hw.targets.target_names`) prices the points by that
     target's model and synthesizes the front's meeting points on it.
+
+    The front's meeting points are synthesized cheapest model first,
+    :data:`SYNTH_ROUND` at a time; a point whose model lower bound (its
+    :func:`~chebnorm.hw.target_model.model_score` over
+    :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
+    score synthesized so far, or ``bound`` (a score synthesized elsewhere,
+    e.g. another architecture's), is not synthesized: it cannot win. The
+    cheapest point by the model is always synthesized (when ``bound`` rules
+    out every point, it alone: the winner then is it).
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
@@ -329,23 +344,9 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
 
         if shutil.which("yosys") is not None:
             chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
-            if target == "generic":
-                cost_source = "yosys cells"
-                cells = map_ordered(_cells, [designs[k] for k in chosen], desc="yosys", **par)
-                for key, n in zip(chosen, cells):
-                    points[key] = replace(points[key], yosys_cells=n)
-            else:
-                # the model is within MODEL_SPREAD s of yosys: a point whose model score
-                # exceeds s^2 times the best one's cannot beat it, and is not synthesized
-                from .target_model import MODEL_SPREAD
-
-                bound = mc(points[chosen[0]]) * MODEL_SPREAD[target] ** 2
-                chosen = [k for k in chosen if mc(points[k]) <= bound]
-                cost_source = f"yosys {get_target(target).synth.split(' -top')[0]}"
-                costs = map_ordered(_target_cost, [(designs[k], target) for k in chosen],
-                                    desc=f"yosys {target}", **par)
-                for key, c in zip(chosen, costs):
-                    points[key] = replace(points[key], target_cost=c)
+            cost_source = ("yosys cells" if target == "generic" else
+                           f"yosys {get_target(target).synth.split(' -top')[0]}")
+            _synth_pruned(points, designs, chosen, target, bound, par)
     ordered = tuple(points[k] for k in keys)
     winner = None
     if meeting:
@@ -356,6 +357,80 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
                         max_error, ordered, winner, cost_source,
                         {k: designs[k] for k in keys}, target)
+
+
+def map_synth(fn, items, *, workers: int | None = None, scheduler=None, progress=False,
+              desc: str | None = None) -> list:
+    """``[fn(x) for x in items]`` for yosys runs: on a Dask ``scheduler`` through
+    :func:`chebnorm.core.parallel.map_ordered`, else on ``workers`` threads of
+    this process (a yosys run is a child process: threads run them side by
+    side without starting a Python worker per batch).
+
+    Parameters
+    ----------
+    fn : callable
+        A function of one item (thread-safe: it writes only its own files).
+    items : iterable
+    workers : int, optional
+        Threads (default: the core count).
+    scheduler, progress, desc
+        As :func:`~chebnorm.core.parallel.map_ordered` (``progress`` and
+        ``desc`` only with a scheduler).
+
+    Returns
+    -------
+    list
+        The results in the order of ``items``.
+
+    Examples
+    --------
+    >>> map_synth(abs, [-1, 2, -3], workers=2)
+    [1, 2, 3]
+    """
+    items = list(items)
+    if scheduler is not None:
+        return map_ordered(fn, items, scheduler=scheduler, progress=progress, desc=desc)
+    workers = check_workers(workers)
+    if workers == 1 or len(items) <= 1:
+        return [fn(x) for x in items]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
+        return list(pool.map(fn, items))
+
+
+def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
+    """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
+    target model first, skipping those whose model lower bound cannot beat
+    the best score so far (or ``bound``; the first key always runs); update
+    ``points``. Returns the number synthesized."""
+    from .target_model import MODEL_SPREAD, model_score, piecewise_features
+
+    spread = MODEL_SPREAD[target]
+    model = {k: model_score(piecewise_features(designs[k]), target) for k in chosen}
+    todo = sorted(chosen, key=lambda k: (model[k], k))
+    best = math.inf if bound is None else float(bound)
+    n = 0
+    while todo:
+        run = [k for k in todo if model[k] / spread < best][:SYNTH_ROUND]
+        if n == 0 and not run:   # the cheapest by the model always (the CSV's winner row)
+            run = todo[:1]
+        if not run:
+            break
+        if target == "generic":
+            got = map_synth(_cells, [designs[k] for k in run], desc="yosys", **par)
+            for key, c in zip(run, got):
+                points[key] = replace(points[key], yosys_cells=c)
+                best = min(best, float(c))
+        else:
+            got = map_synth(_target_cost, [(designs[k], target) for k in run],
+                            desc=f"yosys {target}", **par)
+            for key, c in zip(run, got):
+                points[key] = replace(points[key], target_cost=c)
+                best = min(best, c.score)
+        n += len(run)
+        todo = [k for k in todo if k not in run]
+    return n
 
 
 def _target_cost(item) -> TargetCost:

@@ -40,7 +40,8 @@ from dataclasses import dataclass
 from .targets import DEVICE_WEIGHTS, get_target
 
 __all__ = ["DesignFeatures", "piecewise_features", "horner_features", "model_score",
-           "model_terms", "CALIBRATION", "MODEL_SPREAD", "dsp_count", "naf_weight"]
+           "model_terms", "CALIBRATION", "MODEL_SPREAD", "dsp_count", "naf_weight",
+           "multipartite_features", "table_features", "design_features"]
 
 
 @dataclass(frozen=True)
@@ -211,3 +212,57 @@ def horner_features(d) -> DesignFeatures:
     adds += [int(st.out_bits) for st in d.stages[:-1] if st.round_shift]
     adds += [int(d.raw_bits), int(d.raw_bits)]
     return DesignFeatures(multipliers=mults, adders=tuple(adds), const_multipliers=const)
+
+
+def multipartite_features(d) -> DesignFeatures:
+    """Features of a :class:`~chebnorm.hw.multipartite.MultipartiteDesign`: its
+    TIV and offset ROMs, the adders that sum the offsets (narrowest first) and
+    the TIV, and the complement of a symmetric table's address and entry
+    (priced as adder bits). No multiplier.
+
+    >>> from chebnorm.hw.multipartite import design_multipartite
+    >>> f = multipartite_features(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 10, 10))
+    >>> len(f.roms) >= 2, f.multipliers
+    (True, ())
+    """
+    roms = ((int(d.tiv_bits), int(d.sum_bits)),) + tuple(
+        (int(t.address_bits), int(t.width)) for t in d.offsets)
+    widths = sorted(int(t.width) for t in d.offsets)
+    adds, acc = [], 0
+    for w in widths[1:]:
+        acc = max(acc, w) + 1
+        adds.append(acc)
+    if widths:
+        adds.append(int(d.sum_bits))
+    adds += [int(t.field_bits - 1 + t.width) for t in d.offsets if t.symmetric]
+    return DesignFeatures(roms=roms, adders=tuple(adds))
+
+
+def table_features(d) -> DesignFeatures:
+    """Features of a :class:`~chebnorm.hw.plain_table.PlainTableDesign`: one ROM
+    of ``2**in_bits`` words.
+
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> table_features(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 6, 6)).roms
+    ((6, 6),)
+    """
+    return DesignFeatures(roms=((int(d.in_bits), int(d.out_bits)),))
+
+
+def design_features(d) -> DesignFeatures:
+    """The features of any design ``chebnorm design`` builds: a piecewise
+    (one-width or sized), multipartite or plain-table design.
+
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> design_features(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 6, 6)).roms
+    ((6, 6),)
+    """
+    arch = getattr(d, "architecture", None)
+    if arch == "multipartite":
+        return multipartite_features(d)
+    if arch == "plain_table":
+        return table_features(d)
+    if hasattr(d, "table") and hasattr(d, "widths"):
+        return piecewise_features(d)
+    raise ValueError(f"design: a {type(d).__name__}; accepted: a piecewise, multipartite or "
+                     f"plain-table design")
