@@ -39,6 +39,11 @@ def register(sub) -> None:
                    help="price by this target's mapping: generic (yosys cells; default), xc7, "
                    "xc7-nodsp (LUT equivalents: a DSP48E1 = 264.2 LUTs) or ice40 (with "
                    "nextpnr-ice40 Fmax of the winner)")
+    p.add_argument("--index", choices=("uniform", "exponent"), default="uniform",
+                   help="uniform (default): the code maps onto [LO, HI), its top bits pick "
+                   "the segment; exponent: 1/sqrt(x) only, x = code / 2^in-bits with --interval "
+                   "2^-m 1, a leading-zero count picks the binade pair, the output is a "
+                   "mantissa (--out-bits) and a shift (chebnorm.hw.exponent)")
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
@@ -66,6 +71,10 @@ def run(args) -> int:
     from chebnorm.core.textsafe import identifier
     from chebnorm.hw.targets import get_target
 
+    if getattr(args, "index", "uniform") == "exponent":
+        from .design_exponent import run_exponent
+
+        return run_exponent(args)
     name = identifier(args.name, field="name")
     target = get_target(args.target).name
     out = Path(args.output)
