@@ -27,7 +27,7 @@ def run_exponent(args) -> int:
     from chebnorm.hw.hdl.exponent import exponent_files
     from chebnorm.hw.targets import get_target, synthesize_target, target_figures
 
-    from .design import write_folder_print
+    from chebnorm.core.files import write_folder
 
     name = identifier(args.name, field="name")
     target = get_target(args.target).name
@@ -79,7 +79,8 @@ def run_exponent(args) -> int:
     if cost is not None and target != "generic":  # before writing: place and route may fail
         fig = target_figures(d.verilog(), d.module_name, target, cost=cost, latency=d.latency)
         figures = [f"winner {fig['line']}", f"timing: {fig['timing']}"]
-    write_folder_print(out, files)
+    for path in write_folder(out, dict(sorted(files.items()))):
+        print(path)
     print(f"winner: {_line(d, cost)}")
     if figures:
         print("\n".join(figures))

@@ -1,9 +1,11 @@
 """Verilog and VHDL of the exponent-indexed ``1/sqrt`` evaluator
-(:class:`~chebnorm.hw.exponent.ExponentDesign`): the core (the sized
-piecewise module, printed by :func:`chebnorm.hw.hdl.module_text`) and, after
-it, the top module: a leading-zero count, the normalizing shift, the core's
-inner code ``{~lz[0], mant[W-2:0]}``, the shift ``h = (lz + 2) >> 1``
-(delayed by the core's latency when it is pipelined) and ``y = {h, m}``.
+(:class:`~chebnorm.hw.exponent.ExponentDesign`), one flat module: a
+leading-zero count, the normalizing shift, the core's inner code
+``{~lz[0], mant[W-2:0]}``, the core itself (the sized piecewise module
+printed by :func:`chebnorm.hw.hdl.module_text`, its body inlined by
+:func:`core_parts`: the targets count the top module's cells, so no
+hierarchy), the shift ``h = (lz + 2) >> 1`` (delayed by the core's latency
+when it is pipelined) and ``y = {h, m}``.
 
 Both languages are bit for bit :meth:`ExponentDesign.evaluate`; the benches
 are the piecewise ones (every input code against the model's vector file,
@@ -24,7 +26,8 @@ from .common import SUFFIX, check_language, comment_lines, module_name, vector_f
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 
-__all__ = ["exponent_facts", "exponent_module", "exponent_testbench", "exponent_files"]
+__all__ = ["core_parts", "exponent_facts", "exponent_module", "exponent_testbench",
+           "exponent_files"]
 
 
 def _check(design):
@@ -55,7 +58,7 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
     lines += [f"lz = leading zeros of x (W = {W} for x = 0); mant = x << lz; h = (lz + 2) >> 1;",
               f"  v = mant / 2^{W - 1} (lz odd) or mant / 2^{W - 2} (lz even), v in [1, 4): "
               f"x = v * 4^-h.",
-              f"Core {module_name(d.core)}: g(v) = 1/sqrt(v) on the inner code "
+              f"Core (inlined below): g(v) = 1/sqrt(v) on the inner code "
               f"{{~lz[0], mant[{W - 2}:0]}} ({d.core.table.segment_count} segments, degree "
               f"{d.degree}).",
               f"y = {{h, m}}: h = y[{H + M - 1}:{M}], m = y[{M - 1}:0]; 1/sqrt(x) ~ 2^h * "
@@ -71,36 +74,93 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
     return lines
 
 
+#: the core's references to its ports, renamed when its body is inlined
+_RENAME = {"verilog": ((r"\bx\[", "nrm_inner[", 2), (r"\bassign y\b", "assign nrm_m", 1),
+                       (r"\bOUT_BITS\b", "M_BITS", None)),
+           "vhdl": ((r"\bx\(", "nrm_inner(", 2), (r"(?m)^(\s*)y <=", r"\1nrm_m <=", 1),
+                    (r"\bOUT_BITS\b", "M_BITS", None))}
+
+
+def core_parts(core_text: str, language: str) -> tuple[list[str], list[str], list[str]]:
+    """The core module's banner (comment lines), declarations and statements,
+    its ports renamed for inlining: ``x`` -> ``nrm_inner``, ``y`` -> ``nrm_m``,
+    ``OUT_BITS`` -> ``M_BITS``. The design is flat (one module: the targets'
+    cell counts are of the top module alone). ValueError when the core's text
+    is not shaped as the piecewise printers print it.
+
+    >>> text = chr(10).join(["// c", "module m (", "    input x", ");",
+    ...     "    wire [1:0] low = x[1:0];", "    wire idx = x[2];", "    assign y = low;",
+    ...     "endmodule"])
+    >>> core_parts(text, "verilog")
+    (['// c'], [], ['    wire [1:0] low = nrm_inner[1:0];', '    wire idx = nrm_inner[2];', '    assign nrm_m = low;'])
+    """
+    import re
+
+    lines = core_text.splitlines()
+    mark = "//" if language == "verilog" else "--"
+    banner = []
+    for line in lines:
+        if not line.startswith(mark):
+            break
+        banner.append(line)
+    try:
+        if language == "verilog":
+            start = lines.index(");") + 1
+            end = len(lines) - 1 - lines[::-1].index("endmodule")
+            decls, body = [], lines[start:end]
+        else:
+            a = next(i for i, ln in enumerate(lines) if ln.startswith("architecture rtl of "))
+            b = lines.index("begin", a)
+            end = lines.index("end architecture rtl;", b)
+            decls, body = lines[a + 1:b], lines[b + 1:end]
+    except (ValueError, StopIteration):
+        raise ValueError("core: its module text is not the piecewise printer's (no port list "
+                         "end or body found); accepted: a sized piecewise core") from None
+    text = "\n".join(body)
+    for pattern, repl, count in _RENAME[language]:
+        text, n = re.subn(pattern, repl, text)
+        if count is not None and n != count:
+            raise ValueError(f"core: {n} uses of {pattern!r} in its body, expected {count}; "
+                             f"accepted: a sized piecewise core")
+    decls = [re.sub(r"\bOUT_BITS\b", "M_BITS", ln) for ln in decls]
+    return banner, decls, text.splitlines()
+
+
 def _verilog(d, facts) -> list[str]:
     W, M, H, n = d.in_bits, d.mant_bits, d.shift_bits, d.latency
     Z = W.bit_length()
-    core = module_name(d.core)
-    out = comment_lines(facts, "verilog")
+    banner, _, body = core_parts(module_text(d.core, "verilog"), "verilog")
+    out = comment_lines(facts, "verilog") + ["//", "// The core, inlined:"] + banner
     out += [f"module {module_name(d)} #(", f"    parameter IN_BITS = {W},",
             f"    parameter OUT_BITS = {H + M}" + ("," if n else ""),
             *([f"    parameter LATENCY = {n}"] if n else []), ") (",
             *(["    input  wire                clk,"] if n else []),
             "    input  wire [IN_BITS-1:0]  x,", "    output wire [OUT_BITS-1:0] y", ");",
-            f"    reg [{Z - 1}:0] lz;", "    integer i;", "    always @(*) begin",
-            f"        lz = {Z}'d{W};", f"        for (i = 0; i < {W}; i = i + 1)",
-            f"            if (x[i]) lz = {W - 1} - i;", "    end",
-            f"    wire [{W - 1}:0] mant = x << lz;",
-            f"    wire [{W - 1}:0] inner = {{~lz[0], mant[{W - 2}:0]}};",
-            f"    wire [{Z}:0] lz2 = lz + 2'd2;",
-            f"    wire [{H - 1}:0] h0 = lz2[{H}:1];",
-            f"    wire [{M - 1}:0] m;",
-            f"    {core} core ({'.clk(clk), ' if n else ''}.x(inner), .y(m));"]
+            f"    localparam M_BITS = {M};",
+            f"    reg [{Z - 1}:0] nrm_lz;", "    integer nrm_i;", "    always @(*) begin",
+            f"        nrm_lz = {Z}'d{W};", f"        for (nrm_i = 0; nrm_i < {W}; nrm_i = nrm_i + 1)",
+            f"            if (x[nrm_i]) nrm_lz = {W - 1} - nrm_i;", "    end",
+            f"    wire [{W - 1}:0] nrm_mant = x << nrm_lz;",
+            f"    wire [{W - 1}:0] nrm_inner = {{~nrm_lz[0], nrm_mant[{W - 2}:0]}};",
+            f"    wire [{Z}:0] nrm_lz2 = nrm_lz + 2'd2;",
+            f"    wire [{H - 1}:0] nrm_h0 = nrm_lz2[{H}:1];",
+            f"    wire [{M - 1}:0] nrm_m;",
+            "    // -- the core: g(v) = 1/sqrt(v) of the inner code nrm_inner",
+            *body,
+            "    // -- the shift, delayed as the core"]
     for i in range(1, n + 1):
-        out += [f"    reg [{H - 1}:0] h{i};", f"    always @(posedge clk) h{i} <= h{i - 1};"]
-    out += [f"    assign y = {{h{n}, m}};", "endmodule", ""]
+        out += [f"    reg [{H - 1}:0] nrm_h{i};",
+                f"    always @(posedge clk) nrm_h{i} <= nrm_h{i - 1};"]
+    out += [f"    assign y = {{nrm_h{n}, nrm_m}};", "endmodule", ""]
     return out
 
 
 def _vhdl(d, facts) -> list[str]:
     W, M, H, n = d.in_bits, d.mant_bits, d.shift_bits, d.latency
     Z = W.bit_length()
-    name, core = module_name(d), module_name(d.core)
-    out = comment_lines(facts, "vhdl")
+    name = module_name(d)
+    banner, decls, body = core_parts(module_text(d.core, "vhdl"), "vhdl")
+    out = comment_lines(facts, "vhdl") + ["-- ", "-- The core, inlined:"] + banner
     generics = [f"        IN_BITS  : natural := {W};",
                 f"        OUT_BITS : natural := {H + M}" + (";" if n else "")]
     if n:
@@ -111,14 +171,16 @@ def _vhdl(d, facts) -> list[str]:
     out += ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
             f"entity {name} is", "    generic (", *generics, "    );", "    port (", *ports,
             "    );", f"end entity {name};", "", f"architecture rtl of {name} is",
-            f"    signal lz    : unsigned({Z - 1} downto 0);",
-            f"    signal mant  : std_logic_vector({W - 1} downto 0);",
-            f"    signal inner : std_logic_vector({W - 1} downto 0);",
-            f"    signal lz2   : unsigned({Z} downto 0);",
-            f"    signal m     : std_logic_vector({M - 1} downto 0);",
-            *[f"    signal h{i}    : unsigned({H - 1} downto 0);" for i in range(n + 1)],
+            f"    constant M_BITS  : natural := {M};",
+            f"    signal nrm_lz    : unsigned({Z - 1} downto 0);",
+            f"    signal nrm_mant  : std_logic_vector({W - 1} downto 0);",
+            f"    signal nrm_inner : std_logic_vector({W - 1} downto 0);",
+            f"    signal nrm_lz2   : unsigned({Z} downto 0);",
+            f"    signal nrm_m     : std_logic_vector({M - 1} downto 0);",
+            *[f"    signal nrm_h{i}    : unsigned({H - 1} downto 0);" for i in range(n + 1)],
+            *decls,
             "begin",
-            "    count : process (x)",
+            "    nrm_count : process (x)",
             f"        variable c : natural range 0 to {W};",
             "    begin",
             f"        c := {W};",
@@ -127,39 +189,38 @@ def _vhdl(d, facts) -> list[str]:
             f"                c := {W - 1} - i;",
             "            end if;",
             "        end loop;",
-            f"        lz <= to_unsigned(c, {Z});",
-            "    end process count;",
-            "    mant <= std_logic_vector(shift_left(unsigned(x), to_integer(lz)));",
-            f"    inner <= (not lz(0)) & mant({W - 2} downto 0);",
-            f"    lz2 <= resize(lz, {Z + 1}) + 2;",
-            f"    h0 <= lz2({H} downto 1);",
-            f"    core : entity work.{core}",
-            f"        port map ({'clk => clk, ' if n else ''}x => inner, y => m);"]
+            f"        nrm_lz <= to_unsigned(c, {Z});",
+            "    end process nrm_count;",
+            "    nrm_mant <= std_logic_vector(shift_left(unsigned(x), to_integer(nrm_lz)));",
+            f"    nrm_inner <= (not nrm_lz(0)) & nrm_mant({W - 2} downto 0);",
+            f"    nrm_lz2 <= resize(nrm_lz, {Z + 1}) + 2;",
+            f"    nrm_h0 <= nrm_lz2({H} downto 1);",
+            "    -- the core: g(v) = 1/sqrt(v) of the inner code nrm_inner",
+            *body]
     if n:
-        out += ["    delay : process (clk)", "    begin", "        if rising_edge(clk) then",
-                *[f"            h{i} <= h{i - 1};" for i in range(1, n + 1)],
-                "        end if;", "    end process delay;"]
-    out += [f"    y <= std_logic_vector(h{n}) & m;", "end architecture rtl;", ""]
+        out += ["    nrm_delay : process (clk)", "    begin", "        if rising_edge(clk) then",
+                *[f"            nrm_h{i} <= nrm_h{i - 1};" for i in range(1, n + 1)],
+                "        end if;", "    end process nrm_delay;"]
+    out += [f"    y <= std_logic_vector(nrm_h{n}) & nrm_m;", "end architecture rtl;", ""]
     return out
 
 
 def exponent_module(design, language: str = "verilog", *, version: str = "",
                     command: str | None = None) -> str:
-    """The core module and, after it, the top module of ``design`` in
-    ``language`` (one file; the top is ``design.module_name``).
+    """The module of ``design`` in ``language``, flat: the normalization, the
+    core's body inlined (:func:`core_parts`; one module, so a target's cell
+    count of the top is the whole design), the delayed shift.
 
     >>> from chebnorm.hw.exponent import design_exponent
     >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
     >>> v = exponent_module(d)
-    >>> v.count("endmodule"), "chebnorm_rsqrt_core core (.x(inner), .y(m));" in v
-    (2, True)
+    >>> v.count("endmodule"), "assign y = {nrm_h0, nrm_m};" in v
+    (1, True)
     """
     d = _check(design)
     check_language(language)
     facts = exponent_facts(d, version=version, command=command)
-    core = module_text(d.core, language, version=version, command=command)
-    top = _verilog(d, facts) if language == "verilog" else _vhdl(d, facts)
-    return core + "\n" + "\n".join(top)
+    return "\n".join(_verilog(d, facts) if language == "verilog" else _vhdl(d, facts))
 
 
 def exponent_testbench(design, language: str = "verilog", vectors: str | None = None) -> str:
