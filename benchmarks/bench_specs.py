@@ -16,16 +16,25 @@ For each spec (function, interval, input and output bits, faithful: error
   (``pipeline="full"``, latency = degree + 1 cycles);
 * ``multipartite``: ``design_multipartite`` (faithful, its own LUT model);
 * ``plain table``: ``design_plain_table`` (correctly rounded), only when
-  ``2**in_bits * out_bits <= 2**20`` ROM bits.
+  ``2**in_bits * out_bits <= 2**20`` ROM bits;
+* ``exp1``, ``exp2`` (``pipe``): the exponent-indexed ``1/sqrt``
+  (:func:`chebnorm.hw.exponent.design_exponent`, degree-1/2 core, its
+  segment count the cheapest of three faithful ones by the same proxy),
+  for the specs of :data:`SPEC_ARCHS` (which also trims the 20-bit specs).
 
 Each design's exhaustive maximum error is measured (piecewise: ``measure()``
-against 40-digit mpmath; tables: ``measure()``, Arb enclosures) and must be
-below one output ulp; one design per spec (the pipelined degree-2 piecewise,
-else the multipartite) is simulated over every input code in Icarus Verilog
-against the bit-accurate model. Every design is synthesized on ``generic``,
-``xc7``, ``xc7-nodsp`` and ``ice40`` (:func:`chebnorm.hw.targets.synthesize_target`)
-and placed and routed by nextpnr-ice40 for Fmax (:func:`chebnorm.hw.targets.fmax_ice40`,
-HX8K ct256, seed 1, the module between input and output registers).
+against 40-digit mpmath; tables: ``measure()``, Arb enclosures; exponent:
+the mantissa's error, ``measure()``) and must be below one output ulp; its
+certified bound is kept too. Every design is synthesized on ``generic``,
+``xc7`` (with the ``sta`` cell-delay model: the "model" Fmax), ``xc7-nodsp``
+and ``ice40`` (:func:`chebnorm.hw.targets.synthesize_target`) and placed and
+routed by nextpnr-ice40 for Fmax (:func:`chebnorm.hw.targets.fmax_ice40`,
+HX8K ct256, seed 1, the module between input and output registers). When a
+spec's rows are done, the winner on each target (:func:`winners`: fewest
+generic cells, lowest target score) is rebuilt (deterministic: the same
+design) and simulated over every input code in Icarus Verilog and in GHDL
+against the bit-accurate model (:func:`simulate_winners`; a failure is an
+error).
 
 Output: a Markdown table on stdout (deterministic row order), progress on
 stderr; ``--json PATH`` keeps every finished row (written after each one), and
