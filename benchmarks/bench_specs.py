@@ -252,7 +252,10 @@ def simulate_winners(results: dict, spec, cache, path, doc) -> None:
         row = results[f"{spec[0]} | {arch}"]
         if row.get("simulation") and row.get("simulation_vhdl"):
             continue
-        d, _ = build(spec, arch, cache)
+        d, again = build(spec, arch, cache)
+        if again["detail"] != row["detail"]:   # the row measured another design
+            raise RuntimeError(f"{spec[0]} | {arch}: rebuilt as {again['detail']!r}, measured "
+                               f"as {row['detail']!r}; delete the row and run again")
         for lang, field in (("verilog", "simulation"), ("vhdl", "simulation_vhdl")):
             if not row.get(field):
                 t0 = time.perf_counter()
