@@ -37,6 +37,7 @@ from .targets import TargetCost, fmax_ice40, synthesize_target
 from .architectures import Candidate, architecture_candidates
 from .hdl.tables import table_files, table_module
 from .table_run import simulate_table
+from .exponent import ExponentDesign, design_exponent, simulate_exponent
 
 __all__ = [
     "QFormat", "shift_round", "fit_bits",
@@ -57,4 +58,5 @@ __all__ = [
     "PlainTableDesign",
     "design_plain_table", "table_module", "table_files", "simulate_table",
     "TargetCost", "synthesize_target", "fmax_ice40", "Candidate", "architecture_candidates",
+    "ExponentDesign", "design_exponent", "simulate_exponent",
 ]
