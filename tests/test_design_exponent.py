@@ -139,3 +139,15 @@ def test_cli_design_writes_winner(tmp_path, capsys):
                      "design_rs_architectures.csv", "tb_chebnorm_rs.v", "tb_chebnorm_rs.vhd"]
     rows = (out / "design_rs_architectures.csv").read_text().splitlines()
     assert len(rows) == 3 and sum(r.endswith(",1") for r in rows[1:]) == 1
+
+
+def test_hand_built_design_is_checked(designs):
+    from dataclasses import replace
+
+    d = designs[1]
+    with pytest.raises(ValueError, match="shift_bits"):
+        replace(d, shift_bits=d.shift_bits + 1)
+    with pytest.raises(ValueError, match="core"):
+        replace(d, in_bits=W + 1, interval=(f"2^-{W}", "1"))
+    with pytest.raises(ValueError, match="interval"):
+        replace(d, interval=("0", "1"))

@@ -146,6 +146,22 @@ class ExponentDesign:
 
     architecture = "exponent"
 
+    def __post_init__(self):
+        # a hand-built design is checked as design_exponent builds it: the printers trust it
+        W = check_width(self.in_bits, "in_bits", MIN_EXP_IN_BITS, MAX_PW_IN_BITS)
+        identifier(self.name, field="name")
+        _check_interval(self.interval, W)
+        c = self.core
+        t = getattr(c, "table", None)
+        if not isinstance(c, PiecewiseDesign) or not c.sized or c.in_bits != W or \
+                t.segment_by != "exponent" or tuple(t.interval) != ("1", "4"):
+            raise ValueError("core: accepted: a sized PiecewiseDesign of an exponent table of "
+                             "1/sqrt on [1, 4) with in_bits equal to the design's "
+                             "(design_exponent builds it)")
+        if self.shift_bits != ((W + 2) >> 1).bit_length():
+            raise ValueError(f"shift_bits {self.shift_bits!r}: accepted: "
+                             f"{((W + 2) >> 1).bit_length()} (the width of (in_bits + 2) >> 1)")
+
     @property
     def module_name(self) -> str:
         return f"chebnorm_{self.name}"
