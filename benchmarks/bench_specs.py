@@ -333,7 +333,8 @@ def markdown(results: dict, specs) -> str:
             if r is None:
                 continue
             if "targets" not in r:
-                lines.append(f"| {spec[0]} | {arch} | failed: {r.get('error', '?')[:160]} "
+                what = "not run" if r.get("error", "").startswith("in_bits") else "failed"
+                lines.append(f"| {spec[0]} | {arch} | {what}: {r.get('error', '?')[:170]} "
                              f"|" + " |" * 10)
                 continue
             t = r["targets"]
