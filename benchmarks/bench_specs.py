@@ -203,10 +203,14 @@ def build(spec, arch, cache):
                                          cache.get(("segments",) + key))
         d, info = cache[key]
         if arch.endswith("pipe"):   # the same widths (the greedy ignores the registers)
-            d = design_piecewise(d.table, wi, wo, multipliers="truncated", pipeline="full",
+            p = design_piecewise(d.table, wi, wo, multipliers="truncated", pipeline="full",
                                  widths={"coef_frac": d.coef_frac, "t_keep": d.t_keep,
                                          "acc_frac": d.acc_frac[1:d.degree],
                                          "prod_frac": d.prod_frac})
+            if p.acc_frac != d.acc_frac or p.bound != d.bound:   # y's last place moved
+                p = design_piecewise(d.table, wi, wo, widths="auto", multipliers="truncated",
+                                     pipeline="full")
+            d = p
         return d, _piecewise_row(d, info)
     if arch == "multipartite":
         d = design_multipartite(expr, interval, wi, wo)
@@ -242,7 +246,8 @@ def winners(results: dict, spec) -> dict:
     for t, key in WIN_KEY.items():
         rows = [(results[f"{spec[0]} | {a}"]["targets"][t][key], i, a)
                 for i, a in enumerate(archs)
-                if (results.get(f"{spec[0]} | {a}") or {}).get("targets")]
+                if (results.get(f"{spec[0]} | {a}") or {}).get("targets")
+                and not results[f"{spec[0]} | {a}"].get("error")]   # not faithful: no winner
         if rows:
             out.setdefault(min(rows)[2], []).append(t)
     return out
