@@ -16,16 +16,25 @@ For each spec (function, interval, input and output bits, faithful: error
   (``pipeline="full"``, latency = degree + 1 cycles);
 * ``multipartite``: ``design_multipartite`` (faithful, its own LUT model);
 * ``plain table``: ``design_plain_table`` (correctly rounded), only when
-  ``2**in_bits * out_bits <= 2**20`` ROM bits.
+  ``2**in_bits * out_bits <= 2**20`` ROM bits;
+* ``exp1``, ``exp2`` (``pipe``): the exponent-indexed ``1/sqrt``
+  (:func:`chebnorm.hw.exponent.design_exponent`, degree-1/2 core, its
+  segment count the cheapest of three faithful ones by the same proxy),
+  for the specs of :data:`SPEC_ARCHS` (which also trims the 20-bit specs).
 
 Each design's exhaustive maximum error is measured (piecewise: ``measure()``
-against 40-digit mpmath; tables: ``measure()``, Arb enclosures) and must be
-below one output ulp; one design per spec (the pipelined degree-2 piecewise,
-else the multipartite) is simulated over every input code in Icarus Verilog
-against the bit-accurate model. Every design is synthesized on ``generic``,
-``xc7``, ``xc7-nodsp`` and ``ice40`` (:func:`chebnorm.hw.targets.synthesize_target`)
-and placed and routed by nextpnr-ice40 for Fmax (:func:`chebnorm.hw.targets.fmax_ice40`,
-HX8K ct256, seed 1, the module between input and output registers).
+against 40-digit mpmath; tables: ``measure()``, Arb enclosures; exponent:
+the mantissa's error, ``measure()``) and must be below one output ulp; its
+certified bound is kept too. Every design is synthesized on ``generic``,
+``xc7`` (with the ``sta`` cell-delay model: the "model" Fmax), ``xc7-nodsp``
+and ``ice40`` (:func:`chebnorm.hw.targets.synthesize_target`) and placed and
+routed by nextpnr-ice40 for Fmax (:func:`chebnorm.hw.targets.fmax_ice40`,
+HX8K ct256, seed 1, the module between input and output registers). When a
+spec's rows are done, the winner on each target (:func:`winners`: fewest
+generic cells, lowest target score) is rebuilt (deterministic: the same
+design) and simulated over every input code in Icarus Verilog and in GHDL
+against the bit-accurate model (:func:`simulate_winners`; a failure is an
+error).
 
 Output: a Markdown table on stdout (deterministic row order), progress on
 stderr; ``--json PATH`` keeps every finished row (written after each one), and
@@ -48,12 +57,15 @@ from pathlib import Path
 from tqdm import tqdm
 
 from chebnorm.approx.piecewise_fit import piecewise_fit
-from chebnorm.core.files import write_atomic
+from chebnorm.core.files import write_atomic, write_folder
+from chebnorm.hw.exponent import design_exponent, simulate_exponent
 from chebnorm.hw.multipartite import design_multipartite
-from chebnorm.hw.piecewise import design_piecewise, shape_cost, simulate_piecewise
+from chebnorm.hw.piecewise import (design_piecewise, piecewise_outputs, shape_cost,
+                                   simulate_piecewise)
 from chebnorm.hw.plain_table import design_plain_table
 from chebnorm.hw.table_run import simulate_table
 from chebnorm.hw.targets import fmax_ice40, synthesize_target, target_names
+from chebnorm.hw.vhdl import simulate_vhdl
 
 #: (label, expression, interval, in_bits, out_bits); the first is issue 28's
 SPECS = (
@@ -63,8 +75,30 @@ SPECS = (
     ("1/sqrt(x) [1,4) 14b", "1/sqrt(x)", ("1", "4"), 14, 14),
     ("sin(pi/2 x) [0,1) 16b", "sin(pi/2*x)", ("0", "1"), 16, 16),
     ("log2(1+x) [0,1) 18b", "log(1+x)/log(2)", ("0", "1"), 18, 18),
+    # the normalization unit's 1/sqrt of |N|^2 indexed by exponent (chebnorm.hw.exponent):
+    # x = k / 2^W, output a mantissa of W bits and a shift
+    ("1/sqrt(x) by exponent [2^-16,1) 16b", "1/sqrt(x)", ("2^-16", "1"), 16, 16),
+    ("1/sqrt(x) by exponent [2^-20,1) 20b", "1/sqrt(x)", ("2^-20", "1"), 20, 20),
+    ("sin(pi/2 x) [0,1) 20b", "sin(pi/2*x)", ("0", "1"), 20, 20),
+    ("log2(1+x) [0,1) 20b", "log(1+x)/log(2)", ("0", "1"), 20, 20),
+    ("1/x [1,2) 24b", "1/x", ("1", "2"), 24, 24),
 )
 ARCHS = ("pw1", "pw1 pipe", "pw2", "pw2 pipe", "multipartite", "plain table")
+#: the architectures of a spec when not :data:`ARCHS`: the exponent-indexed ones
+#: (``exp1``, ``exp2``: degree-1 and -2 cores, ``pipe``: pipeline="full"); at 20
+#: bits the degree-1 piecewise (thousands of segments), the plain table
+#: (2^20 x 20 bits, over PLAIN_LIMIT) and the multipartite (not run: its design,
+#: synthesis and placement did not fit the time of the run) are left out; at 24 bits every
+#: architecture refuses the width (each accepts at most 20 input bits): one row says so
+SPEC_ARCHS = {
+    "1/sqrt(x) by exponent [2^-16,1) 16b": ("exp1", "exp1 pipe", "exp2", "exp2 pipe"),
+    "1/sqrt(x) by exponent [2^-20,1) 20b": ("exp1", "exp2", "exp2 pipe"),
+    "sin(pi/2 x) [0,1) 20b": ("pw2", "pw2 pipe"),
+    "log2(1+x) [0,1) 20b": ("pw2", "pw2 pipe"),
+    "1/x [1,2) 24b": ("pw2",),
+}
+#: the targets' figure a winner has the lowest of
+WIN_KEY = {"generic": "cells", "xc7": "score", "xc7-nodsp": "score", "ice40": "score"}
 #: segment counts tried per degree after the first faithful one
 SWEEP = 3
 PLAIN_LIMIT = 2 ** 20
@@ -76,12 +110,14 @@ def _shape(d):
             d.multipliers == "truncated", d.prod_frac)
 
 
-def sized_piecewise(expr, interval, in_bits, out_bits, degree):
+def sized_piecewise(expr, interval, in_bits, out_bits, degree, only_k=None):
     """The cheapest faithful sized piecewise design of ``degree`` over a sweep of
-    segment counts, by :func:`shape_cost`; (design, sweep notes)."""
+    segment counts, by :func:`shape_cost`; (design, sweep notes). ``only_k``:
+    rebuild the design a finished row chose (``2^only_k`` segments) without the
+    sweep (the greedy is deterministic: the same design)."""
     fc = min(out_bits + 10, 40)
     notes, found = [], []
-    for k in range(1, in_bits - degree - 1):
+    for k in (range(1, in_bits - degree - 1) if only_k is None else (only_k,)):
         try:
             t = piecewise_fit(expr, interval, degree, segments=2 ** k, coef_frac_bits=fc,
                               centered=True, name=f"pw{degree}")
@@ -126,18 +162,55 @@ def _table_row(d, detail) -> dict:
             "verilog": d.verilog(), "top": d.module_name, "clocked": False}
 
 
+def _exponent_row(d) -> dict:
+    m = d.measure()
+    b = d.budget()
+    lsb = 2.0 ** -d.frac_bits
+    c = d.core
+    return {"detail": f"{c.table.segment_count // 2} seg/binade x 2, F={list(c.coef_frac)}, "
+                      f"T={list(c.t_keep)}, mantissa {d.mant_bits} + shift {d.shift_bits} b",
+            "bound_ulp": round(b["mantissa"] / lsb, 4),
+            "max_error_ulp": round(m["max_error"] / lsb, 4),
+            "max_rel_error": m["max_rel_error"], "latency": d.latency,
+            "verilog": d.verilog(), "top": d.module_name, "clocked": d.latency > 0}
+
+
 def build(spec, arch, cache):
     """The design of ``arch`` for ``spec`` and its row fields (measured error)."""
     _, expr, interval, wi, wo = spec
+    if wi > 20:
+        raise ValueError(f"in_bits {wi} > 20: design_piecewise, design_multipartite and "
+                         f"design_plain_table accept at most 20 input bits (each design is "
+                         f"certified and simulated over every input code)")
+    if arch.startswith("exp"):
+        degree = int(arch[3])
+        key = (spec[0], arch)
+        if key not in cache:
+            if arch.endswith("pipe"):
+                d0, _ = build(spec, arch.split()[0], cache)
+                cache[key] = design_exponent(expr, interval, wi, wo, degree=degree,
+                                             segments=d0.core.table.segment_count // 2,
+                                             pipeline="full")
+            else:
+                cache[key] = design_exponent(expr, interval, wi, wo, degree=degree)
+        d = cache[key]
+        return d, _exponent_row(d)
     if arch.startswith("pw"):
         degree = int(arch[2])
         key = (spec[0], degree)
         if key not in cache:
-            cache[key] = sized_piecewise(expr, interval, wi, wo, degree)
+            cache[key] = sized_piecewise(expr, interval, wi, wo, degree,
+                                         cache.get(("segments",) + key))
         d, info = cache[key]
-        if arch.endswith("pipe"):
-            d = design_piecewise(d.table, wi, wo, widths="auto", multipliers="truncated",
-                                 pipeline="full")
+        if arch.endswith("pipe"):   # the same widths (the greedy ignores the registers)
+            p = design_piecewise(d.table, wi, wo, multipliers="truncated", pipeline="full",
+                                 widths={"coef_frac": d.coef_frac, "t_keep": d.t_keep,
+                                         "acc_frac": d.acc_frac[1:d.degree],
+                                         "prod_frac": d.prod_frac})
+            if p.acc_frac != d.acc_frac or p.bound != d.bound:   # y's last place moved
+                p = design_piecewise(d.table, wi, wo, widths="auto", multipliers="truncated",
+                                     pipeline="full")
+            d = p
         return d, _piecewise_row(d, info)
     if arch == "multipartite":
         d = design_multipartite(expr, interval, wi, wo)
@@ -148,10 +221,60 @@ def build(spec, arch, cache):
     return d, _table_row(d, f"ROM {d.rom_bits} b, correctly rounded {d.correctly_rounded}")
 
 
-def simulate(d, arch) -> str:
+def simulate(d, arch, language: str = "verilog") -> str:
+    """Run ``d``'s exhaustive bench in Icarus Verilog or GHDL: the PASS/FAIL line."""
     with tempfile.TemporaryDirectory() as tmp:
-        r = simulate_piecewise(d, tmp) if arch.startswith("pw") else simulate_table(d, tmp)
+        if arch.startswith("exp"):
+            r = simulate_exponent(d, tmp, language)
+        elif arch.startswith("pw") and language == "verilog":
+            r = simulate_piecewise(d, tmp)
+        elif arch.startswith("pw"):
+            write_folder(Path(tmp), piecewise_outputs(d, language="vhdl"))
+            r = simulate_vhdl(tmp, d)
+        else:
+            r = simulate_table(d, tmp, language)
+    if not r.passed:
+        raise RuntimeError(f"{language} simulation of {d.module_name} failed: {r.line}")
     return r.line
+
+
+def winners(results: dict, spec) -> dict:
+    """``{arch: [targets it wins]}``: per target the measured row of the lowest figure
+    (:data:`WIN_KEY`; ties: the first in the spec's architecture order)."""
+    out: dict = {}
+    archs = SPEC_ARCHS.get(spec[0], ARCHS)
+    for t, key in WIN_KEY.items():
+        rows = [(results[f"{spec[0]} | {a}"]["targets"][t][key], i, a)
+                for i, a in enumerate(archs)
+                if (results.get(f"{spec[0]} | {a}") or {}).get("targets")
+                and not results[f"{spec[0]} | {a}"].get("error")]   # not faithful: no winner
+        if rows:
+            out.setdefault(min(rows)[2], []).append(t)
+    return out
+
+
+def simulate_winners(results: dict, spec, cache, path, doc) -> None:
+    """Simulate every winner of ``spec`` (:func:`winners`) over every input code in
+    Icarus Verilog and GHDL against the bit-accurate model (rebuilt: the same
+    deterministic design), unless its row has both results already."""
+    if spec[3] > 20:
+        return
+    for arch in winners(results, spec):
+        row = results[f"{spec[0]} | {arch}"]
+        if row.get("simulation") and row.get("simulation_vhdl"):
+            continue
+        d, again = build(spec, arch, cache)
+        if again["detail"] != row["detail"]:   # the row measured another design
+            raise RuntimeError(f"{spec[0]} | {arch}: rebuilt as {again['detail']!r}, measured "
+                               f"as {row['detail']!r}; delete the row and run again")
+        for lang, field in (("verilog", "simulation"), ("vhdl", "simulation_vhdl")):
+            if not row.get(field):
+                t0 = time.perf_counter()
+                row[field] = simulate(d, arch, lang)
+                row[f"{field}_seconds"] = round(time.perf_counter() - t0, 1)
+                tqdm.write(f"{spec[0]} | {arch}: {row[field]}", file=sys.stderr)
+        if path is not None:
+            write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
 
 
 def measure_row(spec, arch, cache, sim: bool) -> dict | None:
@@ -164,9 +287,12 @@ def measure_row(spec, arch, cache, sim: bool) -> dict | None:
     if sim:
         row["simulation"] = simulate(d, arch)
     text, top = row.pop("verilog"), row.pop("top")
-    row["targets"] = {t: synthesize_target(text, top, t).as_dict() for t in target_names()}
+    row["targets"] = {t: synthesize_target(text, top, t, timing=t == "xc7").as_dict()
+                      for t in target_names()}
     for c in row["targets"].values():
         c.pop("by_type", None)
+    ns = row["targets"]["xc7"].get("delay_ns")
+    row["fmax_xc7_model_mhz"] = round(1000.0 / ns, 1) if ns else None
     try:
         row["fmax_ice40_mhz"] = round(fmax_ice40(text, top, clocked=row.pop("clocked")), 2)
     except ValueError as e:   # e.g. a ROM needing more RAM blocks than the HX8K has
@@ -187,26 +313,44 @@ def _fmax(r: dict) -> str:
     return "does not fit HX8K" if "no BELs remaining" in err else "failed (JSON)"
 
 
+def _cell(v, fmt: str = "{:.1f}") -> str:
+    return "n/m" if v is None else fmt.format(v)
+
+
+def _wins(r: dict, targets) -> str:
+    if not targets:
+        return ""
+    sims = [lang for lang, f in (("Icarus", "simulation"), ("GHDL", "simulation_vhdl"))
+            if "PASS" in (r.get(f) or "")]
+    sim = f"{' + '.join(sims)} PASS" if sims else "not simulated"
+    return f"**{', '.join(targets)}** ({sim})"
+
+
 def markdown(results: dict, specs) -> str:
-    head = ("| spec | architecture | generic cells | xc7 LUT+DSP | xc7-nodsp LUT | ice40 LUT4 "
-            "| ice40 Fmax MHz | latency | max error / ulp |")
-    lines = [head, "|" + "---|" * 9]
+    head = ("| spec | architecture | generic cells | xc7 LUT+DSP | xc7 Fmax MHz (model) "
+            "| xc7-nodsp LUT | ice40 LUT4 | ice40 Fmax MHz | latency | certified / ulp "
+            "| max error / ulp | wins on (exhaustive simulation) |")
+    lines = [head, "|" + "---|" * 12]
     for spec in specs:
-        for arch in ARCHS:
+        won = {a: ts for a, ts in winners(results, spec).items()}
+        for arch in SPEC_ARCHS.get(spec[0], ARCHS):
             r = results.get(f"{spec[0]} | {arch}")
             if r is None:
                 continue
             if "targets" not in r:
-                lines.append(f"| {spec[0]} | {arch} | failed: {r.get('error', '?')[:90]} "
-                             f"| | | | | | |")
+                what = "not run" if r.get("error", "").startswith("in_bits") else "failed"
+                lines.append(f"| {spec[0]} | {arch} | {what}: {r.get('error', '?')[:170]} "
+                             f"|" + " |" * 10)
                 continue
             t = r["targets"]
             name = f"{arch} ({r['detail']})"
             lines.append(
                 f"| {spec[0]} | {name} | {t['generic']['cells']} | {t['xc7']['luts']} + "
-                f"{t['xc7']['dsps']}{_ram(t['xc7'])} | {t['xc7-nodsp']['luts']}"
-                f"{_ram(t['xc7-nodsp'])} | {t['ice40']['luts']}{_ram(t['ice40'])} | "
-                f"{_fmax(r)} | {r['latency']} | {r['max_error_ulp']:.3f} |")
+                f"{t['xc7']['dsps']}{_ram(t['xc7'])} | {_cell(r.get('fmax_xc7_model_mhz'))} | "
+                f"{t['xc7-nodsp']['luts']}{_ram(t['xc7-nodsp'])} | "
+                f"{t['ice40']['luts']}{_ram(t['ice40'])} | {_fmax(r)} | {r['latency']} | "
+                f"{_cell(r.get('bound_ulp'), '{:.3f}')} | {r['max_error_ulp']:.3f} | "
+                f"{_wins(r, won.get(arch))} |")
     return "\n".join(lines)
 
 
@@ -226,7 +370,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="only the issue-28 spec")
     ap.add_argument("--json", help="keep the rows here (and reuse those already there)")
-    ap.add_argument("--no-sim", action="store_true", help="skip the Icarus simulations")
+    ap.add_argument("--no-sim", action="store_true",
+                    help="skip the winners' Icarus and GHDL simulations")
     ap.add_argument("--spec", type=int, action="append", choices=range(len(SPECS)),
                     help="run only these specs (indexes into SPECS; repeatable)")
     args = ap.parse_args(argv)
@@ -240,31 +385,33 @@ def main(argv=None) -> int:
     results = doc.setdefault("results", {})
     doc["versions"] = _versions()
     cache: dict = {}
-    jobs = [(s, a) for s in specs for a in ARCHS]
-    simulated: set = {k.split(" | ")[0] for k, r in results.items() if r and r.get("simulation")}
+    for key, r in results.items():   # a finished piecewise row's segment count: no sweep again
+        label, _, arch = key.rpartition(" | ")
+        if arch in ("pw1", "pw2") and r and r.get("detail", "").split(" seg")[0].isdigit():
+            cache[("segments", label, int(arch[2]))] = int(r["detail"].split(" seg")[0]).bit_length() - 1
+    jobs = [(s, a) for s in specs for a in SPEC_ARCHS.get(s[0], ARCHS)]
     bar = tqdm(jobs, file=sys.stderr, desc="bench_specs")
-    for spec, arch in bar:
+    for n, (spec, arch) in enumerate(bar):
         key = f"{spec[0]} | {arch}"
         bar.set_postfix_str(key)
-        if key in results and (results[key] is None or "targets" in results[key]):
-            continue   # done (a failed row is tried again)
-        sim = not args.no_sim and spec[0] not in simulated and (
-            arch == "pw2 pipe" or (arch == "multipartite" and "pw2 pipe" not in
-                                   {k.split(" | ")[1] for k, r in results.items()
-                                    if k.startswith(spec[0]) and r and "targets" in r}))
-        t0 = time.perf_counter()
-        try:
-            row = measure_row(spec, arch, cache, sim)
-        except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
-            row = {"error": " ".join(str(e).split())[:300],
-                   "seconds": round(time.perf_counter() - t0, 1)}
-        if row is not None and row.get("simulation"):
-            simulated.add(spec[0])
-        results[key] = row
-        tqdm.write(f"{key}: {json.dumps(row, sort_keys=True)[:400]}", file=sys.stderr)
-        if path is not None:
-            doc["load"] = os.getloadavg()
-            write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+        if not (key in results and (results[key] is None or "targets" in results[key])):
+            t0 = time.perf_counter()
+            try:
+                row = measure_row(spec, arch, cache, False)
+            except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
+                row = {"error": " ".join(str(e).split())[:300],
+                       "seconds": round(time.perf_counter() - t0, 1)}
+            results[key] = row
+            tqdm.write(f"{key}: {json.dumps(row, sort_keys=True)[:400]}", file=sys.stderr)
+            if path is not None:
+                doc["load"] = os.getloadavg()
+                write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+        last = n + 1 == len(jobs) or jobs[n + 1][0] is not spec
+        if last and not args.no_sim:   # the spec's rows done: its winners simulated
+            try:
+                simulate_winners(results, spec, cache, path, doc)
+            except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
+                tqdm.write(f"{spec[0]}: winner simulation failed: {e}", file=sys.stderr)
     print(markdown(results, specs))
     print(f"\n{doc['versions']}; load {tuple(round(v, 2) for v in os.getloadavg())}")
     return 0

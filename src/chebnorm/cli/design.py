@@ -53,6 +53,11 @@ def register(sub) -> None:
                    "boundaries until nextpnr-ice40's Fmax (ice40) or the sta model's (xc7, "
                    "xc7-nodsp) reaches it, or the highest reached is said; the pipelined RTL "
                    "is simulated cycle by cycle over every input code before it is written")
+    p.add_argument("--index", choices=("uniform", "exponent"), default="uniform",
+                   help="uniform (default): the code maps onto [LO, HI), its top bits pick "
+                   "the segment; exponent: 1/sqrt(x) only, x = code / 2^in-bits with --interval "
+                   "2^-m 1, a leading-zero count picks the binade pair, the output is a "
+                   "mantissa (--out-bits) and a shift (chebnorm.hw.exponent)")
     p.add_argument("--name", default="design", help="module name (an identifier)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
@@ -107,6 +112,10 @@ def run(args) -> int:
     from chebnorm.core.textsafe import identifier
     from chebnorm.hw.targets import get_target
 
+    if getattr(args, "index", "uniform") == "exponent":
+        from .design_exponent import run_exponent
+
+        return run_exponent(args)
     name = identifier(args.name, field="name")
     target = get_target(args.target).name
     out = Path(args.output)

@@ -38,6 +38,7 @@ from .architectures import Candidate, architecture_candidates
 from .hdl.tables import table_files, table_module
 from .table_run import simulate_table
 from .pipeline import FrequencyWarning, PipelineResult, pipeline_to_frequency
+from .exponent import ExponentDesign, design_exponent, simulate_exponent
 
 __all__ = [
     "QFormat", "shift_round", "fit_bits",
@@ -59,4 +60,5 @@ __all__ = [
     "design_plain_table", "table_module", "table_files", "simulate_table",
     "TargetCost", "synthesize_target", "fmax_ice40", "Candidate", "architecture_candidates",
     "FrequencyWarning", "PipelineResult", "pipeline_to_frequency",
+    "ExponentDesign", "design_exponent", "simulate_exponent",
 ]

@@ -154,7 +154,9 @@ class PiecewiseDesign:
 
     @property
     def index_bits(self) -> int:
-        return self.table.index_bits
+        """The ROM address bits: ``log2`` of the segment count (a uniform table's
+        ``index_bits``; an exponent table's binade bits plus its bits per binade)."""
+        return (self.table.segment_count - 1).bit_length()
 
     def sized_signals(self) -> list[dict]:
         """The sized datapath's steps ``j = n-1 .. 0`` for the HDL printers:
@@ -193,8 +195,18 @@ class PiecewiseDesign:
         return w if wires else w["y"]
 
     def x_values(self, codes) -> list[Fraction]:
-        lo, hi = (_exact(v) for v in self.table.interval)
-        return [lo + (hi - lo) * Fraction(int(c), 2 ** self.in_bits) for c in codes]
+        """Exact ``x`` of each code: segment ``s = k >> L`` of the table, ``x = a_s
+        + (b_s - a_s) * low / 2^L`` (uniform: ``lo + (hi - lo) * k / 2^in_bits``)."""
+        L = self.local_bits
+        ends = {}
+        out = []
+        for c in codes:
+            s = int(c) >> L
+            if s not in ends:
+                ends[s] = tuple(Fraction(int(e.p), int(e.q)) for e in self.table.segment_bounds(s))
+            a, b = ends[s]
+            out.append(a + (b - a) * Fraction(int(c) & ((1 << L) - 1), 2 ** L))
+        return out
 
     def budget(self) -> dict:
         """Certified bound of ``|y - f(x)|`` over all codes, by part (floats rounded up).
@@ -760,16 +772,19 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     """
     if not isinstance(table, PiecewiseTable):
         raise ValueError("design_piecewise needs a PiecewiseTable")
-    if table.segment_by != "uniform":
-        raise ValueError(f"table {table.name!r} is segmented by {table.segment_by}; accepted "
-                         f"for hardware: a uniform table (the input code's top bits index it)")
-    in_bits = check_width(in_bits, "in-bits", table.index_bits + 1, MAX_PW_IN_BITS)
+    nseg = table.segment_count
+    if table.segment_by != "uniform" and nseg & (nseg - 1):
+        raise ValueError(f"table {table.name!r} is segmented by {table.segment_by} into {nseg} "
+                         f"segments; accepted for hardware: a uniform table, or an exponent "
+                         f"table of 2^m segments (the code's top bits index it)")
+    K = (nseg - 1).bit_length()
+    in_bits = check_width(in_bits, "in-bits", K + 1, MAX_PW_IN_BITS)
     out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
     guard_bits = check_width(guard_bits, "guard-bits", 0, 16)
     name = identifier(name or table.name, field="name")
     for v in table.interval:
         _exact(v)
-    L = in_bits - table.index_bits
+    L = in_bits - K
     rom_bits = table.coefficient_word_bits()
     proto = PiecewiseDesign(name, table, in_bits, out_bits, L, 0, QFormat(out_bits, 0), rom_bits,
                             L + 2, (), 0)

@@ -389,7 +389,7 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     if d.sized:
         return sized_piecewise_verilog(d, version=version, command=command)
     t = d.table
-    n, L, K, fc = t.degree, d.local_bits, t.index_bits, t.coef_frac_bits
+    n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
     yf = d.y_format
     mod = module_name(d)
     out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
@@ -468,7 +468,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     (3, True)
     """
     t = d.table
-    n, L, K = t.degree, d.local_bits, t.index_bits
+    n, L, K = t.degree, d.local_bits, d.index_bits
     mod = module_name(d)
     clocked = d.latency > 0
     out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")

@@ -407,7 +407,7 @@ def _piecewise_rom(b: _Body, d) -> None:
     """The coefficient ROM: ``c_j`` of the segment the top bits of ``x`` index
     (one constant array per power; one segment: the constants themselves)."""
     t = d.table
-    n, K, L = t.degree, t.index_bits, d.local_bits
+    n, K, L = t.degree, d.index_bits, d.local_bits
     if K == 0:  # one segment: constants, as the Verilog
         for j in range(n + 1):
             b.wire(f"c{j}", d.rom_bits[j], _bits(t.segments[0].integers[j], d.rom_bits[j]))
@@ -513,7 +513,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     (2, True)
     """
     t = d.table
-    n, L, K = t.degree, d.local_bits, t.index_bits
+    n, L, K = t.degree, d.local_bits, d.index_bits
     name = module_name(d)
     out = comment_lines(piecewise_facts(d, version=version, command=command), "vhdl")
     out += _entity(name, d, clocked=d.latency > 0)
