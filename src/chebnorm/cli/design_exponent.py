@@ -18,6 +18,27 @@ def run_exponent(args) -> int:
     error is below ``2E``). Writes ``chebnorm_NAME.v`` / ``.vhd`` (core and
     top), the exhaustive benches and vectors, and
     ``design_NAME_architectures.csv``; prints the winner and why the others lose.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``chebnorm design`` arguments with ``index == "exponent"``
+        (EXPR ``1/sqrt(x)``, ``interval`` ``2^-m 1`` with ``1 <= m <= in_bits``,
+        ``in_bits`` 4..20, ``out_bits``, the accuracy, ``degrees``, ``target``,
+        ``name``, ``output``).
+
+    Returns
+    -------
+    int
+        The exit status: 0 once the winner is written.
+
+    Raises
+    ------
+    ValueError
+        For an expression other than ``1/sqrt(x)``, a low end of 0, widths out
+        of range or ``--correctly-rounded``, or when no degree meets the
+        accuracy (:func:`chebnorm.cli.main` prints it as one line on stderr
+        and exits with status 2).
     """
     from pathlib import Path
 
