@@ -49,7 +49,13 @@ TIGHT = 1.25
 #: maximum: the odd float32 evaluator of sin on [1/4, 1] (degree 7, measured
 #: 1.137e-7 over both builds against 1.700e-7 stated: 1.50x; eight roundings
 #: of similar size never all reach their worst case on the same float32)
-KNOWN_LOOSE = frozenset({"CHEBNORM_OWN_SIN_ODD_F_EVAL_ERROR_BOUND"})
+#: the float32 evaluator of exp on [1, 2] (degree 6: measured 1.048e-6 against
+#: 1.877e-6 stated, 1.79x; seven roundings of up to half an ulp of values up
+#: to e^2, which never all reach their worst case on one float32). Closing
+#: these needs a bound per float32 (an exhaustive certificate), not a sharper
+#: interval analysis: issue 29 stays open on them.
+KNOWN_LOOSE = frozenset({"CHEBNORM_OWN_SIN_ODD_F_EVAL_ERROR_BOUND",
+                         "CHEBNORM_OWN_EXP_D6_F_EVAL_ERROR_BOUND"})
 
 
 def _own(key):
@@ -59,7 +65,7 @@ def _own(key):
     if key == "rsqrt_d8":  # high degree: rounding dominates in float and double
         return fit("1/sqrt(x)", ("1/2", "1"), 8, kind="minimax", name="own_rsqrt_d8")
     if key == "exp_d6":
-        return fit("exp(x)", ("0", "1"), 6, kind="minimax", name="own_exp_d6")
+        return fit("exp(x)", ("1", "2"), 6, kind="minimax", name="own_exp_d6")  # 2^23 float32s (on [0, 1]: 2^30, minutes in long double)
     if key == "rsqrt_d3_fixed":
         return fit("1/sqrt(x)", ("1/2", "1"), 3, kind="minimax", frac_bits=16,
                    name="own_rsqrt_fixed")
