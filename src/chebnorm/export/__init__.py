@@ -449,7 +449,7 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
     Notes
     -----
     Each script states the theorem
-    :math:`x \in [lo, hi] \wedge |P - F| \le A \Rightarrow |y - F| \le B`
+    :math:`x \\in [lo, hi] \\wedge |P - F| \\le A \\Rightarrow |y - F| \\le B`
     for the evaluator's fused and unfused Horner sequences; ``gappa`` proves
     it (Melquiond [1]_). The shader scripts prove the float32 constant as
     printed (the bound rounded up to a float32).

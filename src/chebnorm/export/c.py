@@ -184,13 +184,13 @@ def underflow_bound(n: int, max_t: Fraction, suffix: str, u: float) -> Fraction:
 
     Notes
     -----
-    With :math:`\eta` half the smallest subnormal and
-    :math:`\gamma_k = k u / (1 - k u)`,
+    With :math:`\\eta` half the smallest subnormal and
+    :math:`\\gamma_k = k u / (1 - k u)`,
 
     .. math::
 
-        \Delta_{\mathrm{underflow}} \le \eta\,(1 + \gamma_{2n})
-        \sum_{j=0}^{n-1} M^j, \qquad |t| \le M .
+        \\Delta_{\\mathrm{underflow}} \\le \\eta\\,(1 + \\gamma_{2n})
+        \\sum_{j=0}^{n-1} M^j, \\qquad |t| \\le M .
 
     References
     ----------
@@ -337,12 +337,12 @@ def range_problem(coeffs, max_t: Fraction, suffix: str, u: float, *, where=None)
 
     Notes
     -----
-    The check bounds every intermediate :math:`\hat a_k` of Horner's rule by
+    The check bounds every intermediate :math:`\\hat a_k` of Horner's rule by
 
     .. math::
 
-        |\hat a_k| \le (1 + \gamma_{2n})(1 + u)
-        \sum_{j \ge k} |c_j| M^{j-k} + \Delta_{\mathrm{underflow}},
+        |\\hat a_k| \\le (1 + \\gamma_{2n})(1 + u)
+        \\sum_{j \\ge k} |c_j| M^{j-k} + \\Delta_{\\mathrm{underflow}},
 
     the running-error form of Higham's bound [1]_ (eq. 5.3).
 
@@ -443,10 +443,10 @@ def horner_rounding_bound(coefficients, max_abs_x: Fraction, unit_roundoff: floa
 
     .. math::
 
-        |p(x) - \widehat{p}(x)| \le \gamma_{2n} \sum_{k=0}^{n} |c_k|\,|x|^k,
-        \qquad \gamma_k = \frac{k u}{1 - k u},
+        |p(x) - \\widehat{p}(x)| \\le \\gamma_{2n} \\sum_{k=0}^{n} |c_k|\\,|x|^k,
+        \\qquad \\gamma_k = \\frac{k u}{1 - k u},
 
-    and :math:`|x| \le M` bounds the sum by :math:`\sum_k |c_k| M^k`.
+    and :math:`|x| \\le M` bounds the sum by :math:`\\sum_k |c_k| M^k`.
 
     References
     ----------

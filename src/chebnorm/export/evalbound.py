@@ -166,19 +166,19 @@ class EvalBound:
 
     Notes
     -----
-    For Horner's rule :math:`\hat a_n = c_n`,
-    :math:`\hat a_k = \mathrm{fl}(\hat a_{k+1} \hat t + c_k)`, the error
-    :math:`e_k \ge |\hat a_k - a_k|` is carried step by step on each piece:
+    For Horner's rule :math:`\\hat a_n = c_n`,
+    :math:`\\hat a_k = \\mathrm{fl}(\\hat a_{k+1} \\hat t + c_k)`, the error
+    :math:`e_k \\ge |\\hat a_k - a_k|` is carried step by step on each piece:
 
     .. math::
 
-        e_k \le e_{k+1} (|t| + e_t) + |a_{k+1}|\, e_t
-              + \tfrac12 \mathrm{ulp}(\max|a_{k+1} t|)
-              + \tfrac12 \mathrm{ulp}(\max|a_k|),
+        e_k \\le e_{k+1} (|t| + e_t) + |a_{k+1}|\\, e_t
+              + \\tfrac12 \\mathrm{ulp}(\\max|a_{k+1} t|)
+              + \\tfrac12 \\mathrm{ulp}(\\max|a_k|),
 
     with the magnitudes enclosed by interval arithmetic on the piece, the
     last term dropped for a fused multiply-add (the larger of the two taken).
-    Its a priori form is Higham's :math:`\gamma_{2n} \sum_k |c_k| M^k`
+    Its a priori form is Higham's :math:`\\gamma_{2n} \\sum_k |c_k| M^k`
     ([1]_, eq. 5.3); the binade-aware form is usually an order of magnitude
     tighter. Gappa [2]_ proves the same bound from the script of
     :func:`chebnorm.export.gappa.gappa_script`.

@@ -329,11 +329,11 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
 
     .. math::
 
-        |\mathrm{shader}(x) - f(x)| \le A + L\,(1 + h)
-            + [\text{flush}]\; 2^{-126} \sum_{k \ge 1} k |c_k| M^{k-1},
+        |\\mathrm{shader}(x) - f(x)| \\le A + L\\,(1 + h)
+            + [\\text{flush}]\\; 2^{-126} \\sum_{k \\ge 1} k |c_k| M^{k-1},
 
     :math:`h` the proof headroom; the a priori alternative is Higham's
-    :math:`\gamma_{2n} \sum_k |c_k| M^k` [1]_ (eq. 5.3).
+    :math:`\\gamma_{2n} \\sum_k |c_k| M^k` [1]_ (eq. 5.3).
 
     References
     ----------
