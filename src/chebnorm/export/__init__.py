@@ -375,8 +375,8 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     fmt : str
         The format, one of ``formats_for(table)``.
     path : str or os.PathLike
-        The output file; replaced atomically (written beside it, then
-        renamed).
+        The output file, written atomically (a temporary file in the same
+        folder renamed into place; nothing is written when printing fails).
     command : str, optional
         The command line stated in the banner. Default ``""``.
     **options

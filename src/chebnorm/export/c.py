@@ -195,8 +195,8 @@ def underflow_bound(n: int, max_t: Fraction, suffix: str, u: float) -> Fraction:
     References
     ----------
     .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
-       2nd ed., SIAM, 2002, section 2.1 (the underflow model) and
-       eq. (5.3).
+       2nd ed., SIAM, 2002, chapter 2 (the model of arithmetic with
+       underflow) and eq. (5.3).
 
     Examples
     --------
@@ -344,7 +344,7 @@ def range_problem(coeffs, max_t: Fraction, suffix: str, u: float, *, where=None)
         |\\hat a_k| \\le (1 + \\gamma_{2n})(1 + u)
         \\sum_{j \\ge k} |c_j| M^{j-k} + \\Delta_{\\mathrm{underflow}},
 
-    the running-error form of Higham's bound [1]_ (eq. 5.3).
+    the magnitude bound behind Higham's eq. (5.3) [1]_.
 
     References
     ----------

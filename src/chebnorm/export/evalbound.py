@@ -176,8 +176,10 @@ class EvalBound:
               + \\tfrac12 \\mathrm{ulp}(\\max|a_{k+1} t|)
               + \\tfrac12 \\mathrm{ulp}(\\max|a_k|),
 
-    with the magnitudes enclosed by interval arithmetic on the piece, the
-    last term dropped for a fused multiply-add (the larger of the two taken).
+    with the magnitudes enclosed by interval arithmetic on the piece; a fused
+    multiply-add drops the product's half ulp (one rounding), and the larger
+    of the fused and unfused bounds is taken. A sum that is exact (both
+    addends on a grid the result fits) costs nothing.
     Its a priori form is Higham's :math:`\\gamma_{2n} \\sum_k |c_k| M^k`
     ([1]_, eq. 5.3); the binade-aware form is usually an order of magnitude
     tighter. Gappa [2]_ proves the same bound from the script of
