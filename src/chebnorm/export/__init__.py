@@ -34,6 +34,22 @@ def json_text(table, command: str = "") -> str:
     """The table's JSON contract (sorted keys, shortest float repr), of
     either kind of table.
 
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table.
+    command : str, optional
+        Not used: the contract records its own provenance (the parameter
+        keeps every printer's ``printer(table, command)`` signature).
+        Default ``""``.
+
+    Returns
+    -------
+    str
+        ``table.to_json()``: the JSON document ``load_table`` reads back.
+
+    Examples
+    --------
     >>> from chebnorm.approx import CoefficientTable, fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z")
     >>> CoefficientTable.from_json(json_text(t)) == t
@@ -77,6 +93,25 @@ def _kind(table) -> str:
 def formats_for(table) -> tuple[str, ...]:
     """The formats ``table`` can be exported in (sorted).
 
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table.
+
+    Returns
+    -------
+    tuple of str
+        :data:`EXPORT_FORMATS` (all seven) for a coefficient table,
+        :data:`PIECEWISE_FORMATS` for a piecewise one.
+
+    Raises
+    ------
+    ValueError
+        When ``table`` is neither a ``CoefficientTable`` nor a
+        ``PiecewiseTable``.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> formats_for(fit("x**2", ("0", "1"), 1))
@@ -91,6 +126,29 @@ def options_for(table, fmt: str) -> tuple[str, ...]:
     """The keyword options :func:`export_text` takes for ``table`` in ``fmt``
     (``fmt`` one of :func:`formats_for`'s).
 
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table.
+    fmt : str
+        The format, one of ``formats_for(table)``.
+
+    Returns
+    -------
+    tuple of str
+        The option names, in their documented order (empty when the format
+        takes none): :data:`HDL_OPTIONS` for a coefficient table in
+        ``verilog``/``vhdl``, ``("in_bits", "out_bits")`` for a piecewise
+        one there, ``("in_bits",)`` for a piecewise table's ``c``.
+
+    Raises
+    ------
+    ValueError
+        When ``table`` is of another type, ``fmt`` is not a known format, or
+        the kind of table has no such format.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> options_for(fit("x**2", ("0", "1"), 1), "vhdl")
@@ -140,16 +198,36 @@ def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bit
     Parameters
     ----------
     table : CoefficientTable or PiecewiseTable
+        The table (verified first when piecewise; analysed over every input
+        code otherwise).
     language : {"verilog", "vhdl"}
+        The HDL.
     command : str
         The command line stated in the banner.
     in_bits, out_bits : int
-        Input and output code widths.
+        Input and output code widths in bits (the accepted range is the
+        hardware design's, checked by :func:`chebnorm.hw.report.analyze` or
+        :func:`chebnorm.hw.piecewise.design_piecewise`).
     coef_frac_bits, acc_bits : int, optional
         Coefficient and accumulator fractional bits (default: the table's
-        own; output's + 3).
+        own; output's + 3). Coefficient tables only.
     rounding : {"rne", "trunc"}, optional
-        After each multiply-add (default ``"rne"``).
+        After each multiply-add (default ``"rne"``). Coefficient tables only.
+
+    Returns
+    -------
+    str
+        The HDL text: the banner (with the error budget for a Horner
+        design), the combinational module and, for degree >= 1, the
+        pipelined one.
+
+    Raises
+    ------
+    ValueError
+        When ``language`` is not an HDL, ``in_bits``/``out_bits`` are not
+        ints, ``coef_frac_bits``/``acc_bits``/``rounding`` are given with a
+        piecewise table, ``table`` is of another type, or the design cannot
+        be built at those widths.
 
     Examples
     --------
@@ -290,6 +368,35 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     ``options``) and write it to ``path`` atomically; nothing is written when
     printing fails.
 
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table.
+    fmt : str
+        The format, one of ``formats_for(table)``.
+    path : str or os.PathLike
+        The output file, written atomically (a temporary file in the same
+        folder renamed into place; nothing is written when printing fails).
+    command : str, optional
+        The command line stated in the banner. Default ``""``.
+    **options
+        The format's keyword options, as :func:`export_text` takes them
+        (``name``, ``in_bits``, ...).
+
+    Returns
+    -------
+    str
+        The text written.
+
+    Raises
+    ------
+    ValueError
+        As :func:`export_text`.
+    OSError
+        When ``path`` cannot be written.
+
+    Examples
+    --------
     >>> import os, tempfile
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="dich")
@@ -311,6 +418,48 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
     :data:`~chebnorm.export.gappa.PROOF_FORMATS` (``c`` of either kind of
     table, ``glsl``, ``wgsl``, ``hlsl``). Returns file name -> text of
     everything written (the output first).
+
+    Parameters
+    ----------
+    table : CoefficientTable or PiecewiseTable
+        The table (a piecewise table has proofs in ``c`` only).
+    fmt : {"c", "glsl", "wgsl", "hlsl"}
+        The format.
+    path : str or os.PathLike
+        The output file; the proofs go to its directory.
+    command : str, optional
+        The command line stated in the banner. Default ``""``.
+    **options
+        The format's keyword options (:func:`export_text`).
+
+    Returns
+    -------
+    dict of str to str
+        File name (no directory) -> text, the output first, then one
+        ``STEM.CONSTANT.gappa`` per stated evaluation bound.
+
+    Raises
+    ------
+    ValueError
+        When ``fmt`` has no proof, or as :func:`export_text` (checked before
+        anything is written).
+    OSError
+        When a file cannot be written.
+
+    Notes
+    -----
+    Each script states the theorem
+    :math:`x \\in [lo, hi] \\wedge |P - F| \\le A \\Rightarrow |y - F| \\le B`
+    for the evaluator's fused and unfused Horner sequences; ``gappa`` proves
+    it (Melquiond [1]_). The shader scripts prove the float32 constant as
+    printed (the bound rounded up to a float32).
+
+    References
+    ----------
+    .. [1] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
 
     Examples
     --------

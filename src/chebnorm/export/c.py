@@ -60,7 +60,10 @@ from .evalbound import BINARY32, BINARY64, Evaluator, Piece, fixed_arithmetic
 __all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
            "range_problem", "underflow_bound", "round_inward", "interval_max_abs"]
 
-# C type, literal suffix, function suffix, unit roundoff
+#: The floating types a header evaluates in, one row each: the C type, the
+#: literal suffix (``""`` or ``"f"``), the function-name suffix (``""`` or
+#: ``"_f"``) and the unit roundoff ``u`` of the type (``2**-53``, ``2**-24``)
+#: used in that evaluator's rounding bound.
 FLOAT_TYPES = (
     ("double", "", "", 2.0 ** -53),
     ("float", "f", "_f", 2.0 ** -24),
@@ -111,6 +114,21 @@ def inner_interval(table: CoefficientTable) -> tuple[float, float]:
     certified interval (``interval_float``, the nearest doubles, may lie just
     outside: ``-0.1`` is below ``-1/10``).
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table; its exact ``interval`` (text) is read with the reader of
+        :func:`chebnorm.approx.fit`. Text no reader accepts (a table built
+        by hand) falls back to ``interval_float`` unchanged.
+
+    Returns
+    -------
+    tuple of (float, float)
+        ``(lo, hi)``: the smallest double ``>=`` the exact lower endpoint and
+        the largest double ``<=`` the exact upper one.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> t = fit("0.3*x", ("-0.1", "0"), 1)
     >>> t.interval_float[0] < inner_interval(t)[0] == math.nextafter(-0.1, 0)
@@ -140,6 +158,48 @@ def underflow_bound(n: int, max_t: Fraction, suffix: str, u: float) -> Fraction:
     multiplied by ``|t|`` once per remaining step and by at most ``2n``
     factors ``1 + delta``: ``eta (1 + gamma_2n) sum_{j<n} max_t^j``.
 
+    Parameters
+    ----------
+    n : int
+        The degree (number of Horner steps), ``n >= 0``; ``0`` gives ``0``.
+    max_t : Fraction
+        A bound of ``|t|`` over the inputs, ``>= 0``.
+    suffix : {"", "f"}
+        The literal suffix naming the type: ``""`` double (``eta =
+        2**-1075``), ``"f"`` float (``eta = 2**-150``).
+    u : float
+        The unit roundoff of that type (``2**-53`` or ``2**-24``), in
+        ``(0, 1/(2n))``.
+
+    Returns
+    -------
+    Fraction
+        The exact bound, to be added to the rounding bound of
+        :func:`horner_rounding_bound`.
+
+    Raises
+    ------
+    KeyError
+        When ``suffix`` is neither ``""`` nor ``"f"``.
+
+    Notes
+    -----
+    With :math:`\\eta` half the smallest subnormal and
+    :math:`\\gamma_k = k u / (1 - k u)`,
+
+    .. math::
+
+        \\Delta_{\\mathrm{underflow}} \\le \\eta\\,(1 + \\gamma_{2n})
+        \\sum_{j=0}^{n-1} M^j, \\qquad |t| \\le M .
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, chapter 2 (the model of arithmetic with
+       underflow) and eq. (5.3).
+
+    Examples
+    --------
     >>> underflow_bound(2, Fraction(1), "f", 2.0 ** -24) < Fraction(3, 2 ** 150)
     True
     """
@@ -152,6 +212,22 @@ def round_inward(lo: float, hi: float, suffix: str) -> tuple[float, float]:
     every float32 between the results lies in ``[lo, hi]``; otherwise the
     doubles themselves).
 
+    Parameters
+    ----------
+    lo, hi : float
+        The interval's endpoints as doubles, ``lo <= hi`` (an empty result,
+        ``lo > hi`` after rounding, is possible when no float32 lies between
+        them).
+    suffix : str
+        ``"f"`` for float32; any other value leaves the doubles unchanged.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The inward-rounded endpoints, as Python floats.
+
+    Examples
+    --------
     >>> round_inward(0.1, 0.2, "f")[0] >= 0.1, round_inward(0.1, 0.2, "")
     (True, (0.1, 0.2))
     """
@@ -230,6 +306,53 @@ def range_problem(coeffs, max_t: Fraction, suffix: str, u: float, *, where=None)
     plus the underflow term: the evaluator stays finite when that is at most
     the type's largest number.
 
+    Parameters
+    ----------
+    coeffs : sequence of float
+        The coefficients in ascending powers; they are rounded to the type
+        first (a coefficient that overflows it is reported).
+    max_t : Fraction
+        A bound of ``|t|`` over the inputs, ``>= 0``.
+    suffix : {"", "f"}
+        The literal suffix naming the type: double or float.
+    u : float
+        The unit roundoff of that type.
+    where : tuple or None, optional
+        ``(lo, hi, shift, parity)``: the input interval, the table's shift
+        ``(c, s)`` or None, and the parity (0, 1) of an even/odd evaluator
+        or None. Given, a possible overflow is searched for on 4097 points
+        and by bisection, to name the first offending input. Default None.
+
+    Returns
+    -------
+    str or None
+        None when the evaluator is proven finite on ``|t| <= max_t``; else a
+        sentence saying why not (the coefficient that is not finite, the
+        first input found to overflow, or the reach of the bound).
+
+    Raises
+    ------
+    KeyError
+        When ``suffix`` is neither ``""`` nor ``"f"``.
+
+    Notes
+    -----
+    The check bounds every intermediate :math:`\\hat a_k` of Horner's rule by
+
+    .. math::
+
+        |\\hat a_k| \\le (1 + \\gamma_{2n})(1 + u)
+        \\sum_{j \\ge k} |c_j| M^{j-k} + \\Delta_{\\mathrm{underflow}},
+
+    the magnitude bound behind Higham's eq. (5.3) [1]_.
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, eq. (5.3).
+
+    Examples
+    --------
     >>> range_problem([0.0, 1e30], Fraction(10 ** 10), "f", 2.0 ** -24)
     'its intermediates may reach 1e+40 > 3.4e+38, the largest float'
     >>> range_problem([1.0, 2.0], Fraction(4), "f", 2.0 ** -24) is None
@@ -265,6 +388,19 @@ def interval_max_abs(table: CoefficientTable) -> Fraction:
     magnitude of its doubles, each padded outward by one ulp (they may lie
     just inside irrational true endpoints). The rounding bounds use it.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table; only its ``interval_float`` is read.
+
+    Returns
+    -------
+    Fraction
+        ``max(|lo^-|, |hi^+|)`` exactly, with ``lo^-``, ``hi^+`` the
+        endpoints moved one ulp outward.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> interval_max_abs(fit("x", ("-2", "1"), 1)) > 2
     True
@@ -279,6 +415,43 @@ def interval_max_abs(table: CoefficientTable) -> Fraction:
 def horner_rounding_bound(coefficients, max_abs_x: Fraction, unit_roundoff: float) -> Fraction:
     """Rigorous bound of ``|fl(p(x)) - p(x)|`` for ``|x| <= max_abs_x``
     (``gamma_2n * sum |c_k| M^k``, ``gamma_k = k u / (1 - k u)``).
+
+    Parameters
+    ----------
+    coefficients : sequence of float
+        The coefficients ``c_0 .. c_n`` in ascending powers, each exactly
+        representable in the evaluation type (the bound covers the
+        arithmetic only, not rounding the coefficients).
+    max_abs_x : Fraction
+        ``M``, a bound of ``|x|`` over the inputs, ``>= 0``.
+    unit_roundoff : float
+        ``u`` of the evaluation type (``2**-53`` double, ``2**-24``
+        float), with ``2 n u < 1``.
+
+    Returns
+    -------
+    Fraction
+        The exact bound; ``0`` for a constant (degree 0, no operation). It
+        holds for the unfused and the fused (FMA) evaluation alike, and
+        without underflow (add :func:`underflow_bound` for that).
+
+    Notes
+    -----
+    Horner's rule with :math:`n` multiplications and :math:`n` additions,
+    each rounded with relative error at most :math:`u`, satisfies
+    (Higham [1]_, eq. 5.3)
+
+    .. math::
+
+        |p(x) - \\widehat{p}(x)| \\le \\gamma_{2n} \\sum_{k=0}^{n} |c_k|\\,|x|^k,
+        \\qquad \\gamma_k = \\frac{k u}{1 - k u},
+
+    and :math:`|x| \\le M` bounds the sum by :math:`\\sum_k |c_k| M^k`.
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, eq. (5.3).
 
     Examples
     --------
@@ -522,6 +695,25 @@ def banner_head(fn: str, table, command: str) -> list[str]:
     tool and version, the generating command and the table's own provenance
     (all text through :func:`~chebnorm.core.textsafe.comment_text`).
 
+    Parameters
+    ----------
+    fn : str
+        The function name (an identifier, ``chebnorm_<name>``); the file is
+        named ``<fn>.h`` in the banner.
+    table : CoefficientTable
+        The table; its ``provenance["command"]`` is quoted (``"unknown"``
+        when absent).
+    command : str
+        The command that generated the file; empty leaves its line out.
+
+    Returns
+    -------
+    list of str
+        The opening ``/*`` and the banner lines, without the closing ``*/``
+        (the caller appends the rest of the banner).
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> head = banner_head("chebnorm_d1", fit("x", ("0", "1"), 1), "make */ evil")
     >>> head[1].startswith(" * chebnorm_d1.h -- generated by chebnorm "), "*/" in head[2]
@@ -539,6 +731,36 @@ def banner_head(fn: str, table, command: str) -> list[str]:
 def c_header(table: CoefficientTable, command: str = "") -> str:
     """The C99 header text for ``table`` (see the module docstring).
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table to print; its name must be an identifier (it makes
+        ``chebnorm_<name>`` and ``CHEBNORM_<NAME>_*``).
+    command : str, optional
+        The generating command, stated in the banner. Default ``""``
+        (no command line).
+
+    Returns
+    -------
+    str
+        The whole header, ending in a newline.
+
+    Raises
+    ------
+    ValueError
+        When the table cannot be printed as stated: a name that is not an
+        identifier, a coefficient count other than ``degree + 1``, a
+        fixed-point or quantized part in the shifted basis, fixed-point
+        integers outside ``int32_t`` or whose Horner products overflow
+        ``int64``, or a double evaluator that may overflow on the interval.
+
+    Notes
+    -----
+    ``c_header_evaluators(table, command)`` returns the same text with the
+    evaluators behind its bounds.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> h = c_header(fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="d1"))
     >>> "static inline double chebnorm_d1(double x)" in h

@@ -38,7 +38,10 @@ from .evalbound import BINARY64, Evaluator, Piece
 
 __all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound", "piecewise_evaluator"]
 
+#: The default width (bits) of a uniform table's input code ``k`` in the C
+#: evaluator ``chebnorm_NAME(uint32_t k)``.
 DEFAULT_C_IN_BITS = 24
+#: The largest accepted width of that input code (it is a ``uint32_t``).
 MAX_C_IN_BITS = 32
 _U = 2.0 ** -53
 
@@ -51,6 +54,27 @@ def piecewise_evaluator(table: PiecewiseTable, constant: str = ""):
     """The :class:`~chebnorm.export.evalbound.Evaluator` of the double
     evaluator: one piece per segment (its coefficients, certified bound and
     the range of its exact local variable ``t``), 64 subintervals each.
+
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The piecewise table; its name must be an identifier.
+    constant : str, optional
+        The name of the bound's C macro. Default ``""``:
+        ``CHEBNORM_<NAME>_EVAL_ERROR_BOUND``.
+
+    Returns
+    -------
+    Evaluator
+        The double (binary64) evaluator, its pieces on ``t`` in ``[0, 1]``
+        (``[-1/2, 1/2]`` for a centered table).
+
+    Raises
+    ------
+    ValueError
+        When a segment's Horner evaluation may leave the double range
+        (:func:`chebnorm.export.c.range_problem`), or the name is not an
+        identifier.
 
     Examples
     --------
@@ -80,6 +104,22 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
     docstring): the largest over the segments of the certified bound plus the
     local rounding bound of :func:`chebnorm.export.evalbound.horner_bound`.
 
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The piecewise table.
+
+    Returns
+    -------
+    float
+        The stated bound (rounded up to a double) of the header's
+        ``<P>_EVAL_ERROR_BOUND``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`piecewise_evaluator`.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -95,6 +135,31 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
 def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
                        in_bits: int = DEFAULT_C_IN_BITS, proof: str = "") -> str:
     """The C99 header text for a piecewise table (see the module docstring).
+
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The piecewise table; its name must be an identifier.
+    command : str, optional
+        The generating command, stated in the banner. Default ``""`` (none).
+    in_bits : int, optional
+        For a uniform table: the width of the input code ``k`` the function
+        takes, ``max(K, 1) <= in_bits <= 32`` with ``2**K`` segments.
+        Default ``DEFAULT_C_IN_BITS`` (24). Ignored for an exponent table.
+    proof : str, optional
+        The stem of the Gappa proof files named beside the bound. Default
+        ``""`` (none named).
+
+    Returns
+    -------
+    str
+        The whole header, ending in a newline.
+
+    Raises
+    ------
+    ValueError
+        When ``in_bits`` is out of range, the name is not an identifier, or
+        a segment's evaluator may leave the double range.
 
     Examples
     --------

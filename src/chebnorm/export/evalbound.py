@@ -66,6 +66,24 @@ class Arithmetic:
     ``"fixed"`` (``frac_bits``: every product rounded to ``2^-frac_bits`` to
     nearest, the sums exact).
 
+    Attributes
+    ----------
+    kind : {"float", "fixed"}
+        Floating point (round to nearest even) or integer fixed point.
+    precision : int, default 0
+        For ``"float"``: the significand bits, 53 (binary64) or 24
+        (binary32); other values print Gappa's binary32 operator.
+    emin : int, default 0
+        For ``"float"``: the exponent of the smallest normal number
+        (``-1022``, ``-126``).
+    flush : bool, default False
+        For ``"float"``: a subnormal result may be flushed to zero (GPU
+        shading languages); each rounding then also costs up to ``2**emin``
+        where a result can be subnormal.
+    frac_bits : int, default 0
+        For ``"fixed"``: the fractional bits ``F`` (``>= 0``) each product is
+        rounded to (ties up); ``0`` rounds nothing.
+
     Examples
     --------
     >>> BINARY32.gappa, fixed_arithmetic(12).gappa
@@ -87,7 +105,9 @@ class Arithmetic:
         return "float<ieee_64,ne>" if self.precision == 53 else "float<ieee_32,ne>"
 
 
+#: IEEE 754 binary64 (``double``), round to nearest even, subnormals kept
 BINARY64 = Arithmetic("float", 53, -1022)
+#: IEEE 754 binary32 (``float``), round to nearest even, subnormals kept
 BINARY32 = Arithmetic("float", 24, -126)
 #: binary32 as the shading languages allow it: subnormal results may flush to 0
 BINARY32_FTZ = Arithmetic("float", 24, -126, flush=True)
@@ -96,6 +116,20 @@ BINARY32_FTZ = Arithmetic("float", 24, -126, flush=True)
 def fixed_arithmetic(frac_bits: int) -> Arithmetic:
     """The integer Horner evaluator with ``frac_bits`` fractional bits.
 
+    Parameters
+    ----------
+    frac_bits : int
+        The fractional bits ``F`` of the integers (values are
+        ``q * 2**-F``), ``>= 0``; converted with ``int()``.
+
+    Returns
+    -------
+    Arithmetic
+        ``Arithmetic("fixed", frac_bits=F)``: each product rounded to
+        ``2**-F`` (ties up), each sum exact.
+
+    Examples
+    --------
     >>> fixed_arithmetic(24).frac_bits
     24
     """
@@ -112,6 +146,53 @@ class EvalBound:
     value printed (``total`` plus :data:`PROOF_HEADROOM`, rounded up to 12
     significand bits so its decimal form is short), ``subintervals`` the
     pieces.
+
+    Attributes
+    ----------
+    approximation : Fraction
+        ``A``, the certified ``sup |p - f|`` of the reference coefficients,
+        taken as a hypothesis.
+    local : Fraction
+        ``max_i (D_i + R_i)`` over the pieces ``X_i``: the enclosure of the
+        coefficient difference ``|sum (c_k - r_k) x^k|`` plus the bound of
+        the rounding errors, both upper bounds.
+    total : float
+        ``A + local`` rounded up to a double.
+    stated : float
+        The value an exporter prints: ``A + local (1 + PROOF_HEADROOM)``
+        rounded up to 12 significand bits; ``stated >= total``.
+    subintervals : int
+        The number of pieces of the interval (``1 .. 2**20``).
+
+    Notes
+    -----
+    For Horner's rule :math:`\\hat a_n = c_n`,
+    :math:`\\hat a_k = \\mathrm{fl}(\\hat a_{k+1} \\hat t + c_k)`, the error
+    :math:`e_k \\ge |\\hat a_k - a_k|` is carried step by step on each piece:
+
+    .. math::
+
+        e_k \\le e_{k+1} (|t| + e_t) + |a_{k+1}|\\, e_t
+              + \\tfrac12 \\mathrm{ulp}(\\max|a_{k+1} t|)
+              + \\tfrac12 \\mathrm{ulp}(\\max|a_k|),
+
+    with the magnitudes enclosed by interval arithmetic on the piece; a fused
+    multiply-add drops the product's half ulp (one rounding), and the larger
+    of the fused and unfused bounds is taken. A sum that is exact (both
+    addends on a grid the result fits) costs nothing.
+    Its a priori form is Higham's :math:`\\gamma_{2n} \\sum_k |c_k| M^k`
+    ([1]_, eq. 5.3); the binade-aware form is usually an order of magnitude
+    tighter. Gappa [2]_ proves the same bound from the script of
+    :func:`chebnorm.export.gappa.gappa_script`.
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, eq. (5.3).
+    .. [2] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
 
     Examples
     --------
@@ -279,6 +360,14 @@ def horner_bound(coeffs, ref_coeffs, approx_bound, lo: float, hi: float, arith: 
     Returns
     -------
     EvalBound
+        ``A``, the local part and the total and stated bounds.
+
+    Raises
+    ------
+    ValueError
+        When ``coeffs`` is empty or ``ref_coeffs`` has another length, when
+        ``subintervals`` is not an int in ``1 .. 2**20``, or when
+        ``lo > hi``.
 
     Examples
     --------
@@ -348,6 +437,28 @@ class Evaluator:
     name; ``pieces``: one :class:`Piece` per polynomial (a piecewise table
     has one per segment, its local variable ``t`` in ``[lo, hi]``).
 
+    Attributes
+    ----------
+    constant : str
+        The macro or shader constant that states the bound
+        (``CHEBNORM_<NAME>_F_EVAL_ERROR_BOUND``, ...).
+    function : str
+        The evaluator's name in the generated code.
+    arith : Arithmetic
+        Its arithmetic: :data:`BINARY64`, :data:`BINARY32`,
+        :data:`BINARY32_FTZ` or :func:`fixed_arithmetic`.
+    pieces : tuple of Piece
+        One per polynomial, at least one.
+    parity : {None, 0, 1}, default None
+        Horner's rule in ``t = x*x`` over the even (0) or odd (1, times
+        ``x`` at the end) coefficients; None: in ``x`` (or the shifted
+        ``t``).
+    shift : tuple or None, default None
+        ``(c, s, c_t, s_t, exact_scale)`` of a shifted table, as
+        :func:`horner_bound` takes it.
+    subintervals : int, default DEFAULT_SUBINTERVALS
+        The pieces each polynomial's range is cut into (``1 .. 2**20``).
+
     Examples
     --------
     >>> e = Evaluator("C_F_EVAL_ERROR_BOUND", "c_f", BINARY32,
@@ -378,6 +489,21 @@ class Piece:
     certified ones (``|p - f| <= approx_bound`` on ``[lo, hi]``) and its
     input range.
 
+    Attributes
+    ----------
+    coeffs : tuple of float
+        The coefficients the evaluator holds (numbers of its arithmetic),
+        ascending powers.
+    ref_coeffs : tuple of float
+        The certified coefficients, as many as ``coeffs``.
+    approx_bound : Fraction
+        Their certified ``sup |p - f|`` on ``[lo, hi]``.
+    lo, hi : float
+        The range of the evaluator's variable (``x``, or the segment's local
+        ``t``), ``lo <= hi``.
+
+    Examples
+    --------
     >>> Piece((1.0,), (1.0,), Fraction(0), 0.0, 1.0).lo
     0.0
     """

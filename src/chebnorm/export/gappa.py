@@ -207,6 +207,30 @@ def _pieces(ev: Evaluator, bound: float) -> int:
 def gappa_proofs(evaluators, stem: str) -> dict[str, str]:
     """The proof files of an exported file: ``STEM.CONSTANT.gappa`` -> script.
 
+    Parameters
+    ----------
+    evaluators : iterable of Evaluator
+        The evaluators of the exported file, one per stated bound (the
+        second item of :func:`chebnorm.export.c.c_header_evaluators`, or
+        :func:`chebnorm.export.shader.shader_evaluator`'s).
+    stem : str
+        The output file's name without its extension; the proofs are named
+        ``STEM.CONSTANT.gappa`` beside it.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> Gappa script (:func:`gappa_script` of each evaluator at
+        its stated bound), in the evaluators' order.
+
+    References
+    ----------
+    .. [1] G. Melquiond, Gappa, a tool for certifying numerical programs,
+       https://gappa.gitlabpages.inria.fr/ ; F. de Dinechin, C. Lauter,
+       G. Melquiond, "Certifying the floating-point implementation of an
+       elementary function using Gappa", IEEE Transactions on Computers
+       60(2), 2011.
+
     Examples
     --------
     >>> from chebnorm.approx import fit

@@ -36,6 +36,8 @@ __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
            "wgsl_evaluate", "gl_context", "compute_shader_source", "compute_shader_around",
            "glsl_runner", "MAX_SAMPLES"]
 
+#: The most inputs :func:`float32_inputs` returns by default (and the batch size
+#: of :func:`glsl_runner`): ``2**20``.
 MAX_SAMPLES = 2 ** 20
 _GROUP = 64
 
@@ -57,6 +59,23 @@ def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> n
     spaced in float32 order (which reaches the tiny magnitudes near a zero
     endpoint), both ends kept.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table; its interval is rounded inward to float32
+        (:func:`chebnorm.export.shader.interval32`).
+    max_samples : int, optional
+        The most inputs returned, ``>= 2``. Default :data:`MAX_SAMPLES`
+        (``2**20``).
+
+    Returns
+    -------
+    numpy.ndarray
+        A sorted float32 array of distinct inputs, every one in the table's
+        interval, at most ``max_samples`` of them.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> t = fit("1/x", ("1", "1 + 2**-20"), 1)
     >>> float32_inputs(t).size  # 2^-20 / 2^-23 steps, both ends
@@ -118,6 +137,31 @@ def compute_shader_source(table: CoefficientTable, language: str, *, es: bool = 
     """A compute shader that maps ``xs[i]`` to ``ys[i] = chebnorm_NAME(xs[i])``
     around the exported function (GLSL 4.30, or ES 3.10 with ``es``; WGSL; HLSL).
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table the shader exporters accept (plain powers of ``x``, an
+        identifier for a name).
+    language : {"glsl", "wgsl", "hlsl"}
+        The shading language.
+    es : bool, optional
+        For GLSL: ``#version 310 es`` with ``precision highp float``
+        instead of ``#version 430``. Default False.
+
+    Returns
+    -------
+    str
+        The compute shader's source: buffer ``xs`` (binding 0) in, ``ys``
+        (binding 1) out, 64 invocations per work group.
+
+    Raises
+    ------
+    ValueError
+        As :func:`chebnorm.export.shader.shader_source`: an unknown
+        language or a table it refuses.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit_target
     >>> src = compute_shader_source(fit_target("dichotomy", 1), "wgsl")
     >>> print(src.splitlines()[-2])
@@ -133,6 +177,31 @@ def compute_shader_around(body: str, fn: str, language: str, *, es: bool = False
     """The compute shader of :func:`compute_shader_source` around a given
     function text ``body`` defining ``fn`` (e.g. an exported file as shipped).
 
+    Parameters
+    ----------
+    body : str
+        Shader text that defines a function ``fn`` taking and returning one
+        32-bit float; inserted verbatim.
+    fn : str
+        The function's name, called once per input.
+    language : {"glsl", "wgsl", "hlsl"}
+        The language of ``body``.
+    es : bool, optional
+        For GLSL: ``#version 310 es`` instead of ``#version 430``. Default
+        False.
+
+    Returns
+    -------
+    str
+        The compute shader's source.
+
+    Raises
+    ------
+    ValueError
+        When ``language`` is not one of the three.
+
+    Examples
+    --------
     >>> src = compute_shader_around("float f(float x) { return x; }", "f", "glsl")
     >>> src.splitlines()[0], "ys[i] = f(xs[i]);" in src
     ('#version 430', True)
@@ -148,7 +217,32 @@ def compute_shader_around(body: str, fn: str, language: str, *, es: bool = False
 
 def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
     """Compile a compute shader with ``glslangValidator``; returns its output,
-    raises :class:`ValueError` with the messages when it does not compile."""
+    raises :class:`ValueError` with the messages when it does not compile.
+
+    Parameters
+    ----------
+    source : str
+        The compute shader (:func:`compute_shader_source`).
+    language : {"glsl", "hlsl"}
+        GLSL (``shader.comp``) or HLSL (glslang's HLSL front end, ``-D``,
+        entry point ``main``, compiled to SPIR-V).
+    timeout : float, optional
+        Seconds before the compiler is stopped (``subprocess.TimeoutExpired``).
+        Default 120.
+
+    Returns
+    -------
+    str
+        The compiler's standard output.
+
+    Raises
+    ------
+    ToolMissing
+        When ``glslangValidator`` is not on ``PATH``.
+    ValueError
+        When ``language`` is neither glsl nor hlsl, or the shader does not
+        compile (the messages, up to 600 characters).
+    """
     exe = shutil.which("glslangValidator")
     if exe is None:
         raise ToolMissing("glslangValidator is not installed; accepted: apt-get install "
@@ -172,7 +266,21 @@ _CONTEXT = None
 
 
 def gl_context():
-    """A shared headless OpenGL 4.3+ context (moderngl, EGL)."""
+    """A shared headless OpenGL 4.3+ context (moderngl, EGL).
+
+    Created on the first call and reused by every later one.
+
+    Returns
+    -------
+    moderngl.Context
+        The standalone EGL context (Mesa's llvmpipe here).
+
+    Raises
+    ------
+    ToolMissing
+        When ``moderngl`` is not installed or no OpenGL 4.3 context can be
+        created.
+    """
     global _CONTEXT
     if _CONTEXT is None:
         try:
@@ -202,7 +310,28 @@ def _outputs(raw: bytes, count: int) -> np.ndarray:
 
 def glsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
     """``chebnorm_NAME(x)`` for each float32 ``x`` of ``xs``, computed by the
-    exported GLSL in an OpenGL compute shader."""
+    exported GLSL in an OpenGL compute shader.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table the shader exporters accept.
+    xs : array_like
+        The inputs, converted to float32 (any length; in the table's
+        interval for the stated bound to apply).
+
+    Returns
+    -------
+    numpy.ndarray
+        The driver's float32 results, bit for bit, one per input.
+
+    Raises
+    ------
+    ToolMissing
+        When no OpenGL 4.3 context is available (:func:`gl_context`).
+    ValueError
+        When the table cannot be exported to GLSL.
+    """
     ctx = gl_context()
     x, groups = _inputs(xs)
     with ctx:  # make the EGL context current again (another API may have switched it)
@@ -225,7 +354,28 @@ def glsl_runner(source: str, batch: int = MAX_SAMPLES):
     """A function ``run(xs) -> ys`` that evaluates the GLSL compute shader
     ``source`` (as :func:`compute_shader_around` prints it) on float32 inputs,
     compiled once and dispatched in batches of ``batch`` inputs (buffers
-    reused), and a ``close()`` that releases the program and buffers."""
+    reused), and a ``close()`` that releases the program and buffers.
+
+    Parameters
+    ----------
+    source : str
+        A GLSL compute shader reading ``xs`` (binding 0) and writing ``ys``
+        (binding 1).
+    batch : int, optional
+        Inputs per dispatch, ``>= 1`` (the buffers hold ``4 * batch``
+        bytes). Default :data:`MAX_SAMPLES`.
+
+    Returns
+    -------
+    tuple of (callable, callable)
+        ``run(xs) -> numpy.ndarray`` (float32 results, one per input) and
+        ``close() -> None``.
+
+    Raises
+    ------
+    ToolMissing
+        When no OpenGL 4.3 context is available (:func:`gl_context`).
+    """
     ctx = gl_context()
     batch = int(batch)
     with ctx:
@@ -260,7 +410,27 @@ def glsl_runner(source: str, batch: int = MAX_SAMPLES):
 
 
 def wgsl_evaluate(table: CoefficientTable, xs) -> np.ndarray:
-    """As :func:`glsl_evaluate`, for the exported WGSL through ``wgpu``."""
+    """As :func:`glsl_evaluate`, for the exported WGSL through ``wgpu``.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table the shader exporters accept.
+    xs : array_like
+        The inputs, converted to float32.
+
+    Returns
+    -------
+    numpy.ndarray
+        The driver's float32 results, bit for bit, one per input.
+
+    Raises
+    ------
+    ToolMissing
+        When ``wgpu`` is not installed or no WebGPU adapter is found.
+    ValueError
+        When the table cannot be exported to WGSL.
+    """
     try:
         import wgpu
         from wgpu.utils.compute import compute_with_buffers

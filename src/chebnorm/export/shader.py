@@ -86,6 +86,30 @@ class ShaderLanguage:
     ``const``/``function``/``acc`` are format strings with the fields shown in
     :data:`SHADER_LANGUAGES`; ``prelude``/``postlude`` wrap the function.
 
+    Attributes
+    ----------
+    name : str
+        The language's key in :data:`SHADER_LANGUAGES` (``"glsl"``, ...).
+    title : str
+        The language and version named in the banner.
+    float_type : str
+        The name of the 32-bit float type (``float``, ``f32``).
+    suffix : str
+        The float literal suffix (``""`` or ``"f"``).
+    madd : str
+        The multiply-add called in each Horner step (``fma``, ``mad``, or a
+        macro with field ``{P}``, the macro prefix).
+    const : str
+        Format string of a constant declaration, fields ``{name}`` and
+        ``{value}``.
+    function : str
+        Format string of the function's opening, field ``{fn}``.
+    acc : str
+        Format string of the accumulator's declaration (with the qualifier
+        that forbids reassociation), fields ``{P}`` and ``{value}``.
+    prelude, postlude : tuple of str, default ()
+        Lines printed before and after the function, field ``{P}``.
+
     Examples
     --------
     >>> g = SHADER_LANGUAGES["wgsl"]
@@ -167,6 +191,27 @@ def float32_literal(value: float, suffix: str = "") -> str:
     then narrowing: double rounding); if the shortest fails either way, 9
     significant digits, then the exact decimal expansion, which always works.
 
+    Parameters
+    ----------
+    value : float
+        The number; it is rounded to float32 first (round to nearest even).
+    suffix : str, optional
+        Appended to the literal (``"f"`` for WGSL and HLSL). Default ``""``.
+
+    Returns
+    -------
+    str
+        A decimal literal in scientific notation (``d.ddde+XX``) whose value
+        rounds to ``float32(value)`` directly and through a double.
+
+    Raises
+    ------
+    ValueError
+        When ``value`` is not finite in float32 (``|value| >= 3.4e38`` after
+        rounding, an infinity or NaN).
+
+    Examples
+    --------
     >>> float32_literal(0.1), float32_literal(-1.5, "f"), float32_literal(0.0)
     ('1.0e-01', '-1.5e+00f', '0.0e+00')
     """
@@ -199,6 +244,26 @@ class ShaderBound:
     for callers), ``flush`` the subnormal-input term; ``total`` is their sum
     with ``certified`` rounded up to a double, ``total32`` up to a float32
     (the value printed as a shader constant).
+
+    Attributes
+    ----------
+    certified : Fraction
+        The certified ``sup |p - f|`` of the coefficients evaluated (the
+        double ones, or float32-exact quantized ones).
+    coefficients : Fraction
+        Always 0 (coefficient rounding is inside ``rounding``); kept for
+        callers.
+    rounding : Fraction
+        The float32 coefficient and Horner rounding part, with the proof
+        headroom (:data:`chebnorm.export.evalbound.PROOF_HEADROOM`).
+    flush : Fraction
+        ``2**-126 max |p'|`` when a subnormal input may be flushed to 0,
+        else 0.
+    total : float
+        ``certified + rounding + flush`` rounded up to a double.
+    total32 : float
+        ``total`` rounded up to a float32: the shader's
+        ``CHEBNORM_NAME_EVAL_ERROR_BOUND``.
 
     Examples
     --------
@@ -238,6 +303,45 @@ def _coefficients(table: CoefficientTable) -> tuple[list[float], Fraction, str]:
 def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     """The float32 evaluation bound of the shader printers, fused or not.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in plain powers of ``x`` (``basis="monomial"``).
+
+    Returns
+    -------
+    ShaderBound
+        The bound's parts and its double and float32 round-ups.
+
+    Raises
+    ------
+    ValueError
+        When the table is in the shifted basis (the shaders evaluate plain
+        powers of ``x``), its name is not an identifier, or its float32
+        Horner evaluation may overflow on the interval.
+
+    Notes
+    -----
+    With :math:`A` the certified bound, :math:`L` the local bound of
+    :func:`chebnorm.export.evalbound.horner_bound` (binary32, fused and
+    unfused steps, subnormal results possibly flushed) and :math:`M` a bound
+    of :math:`|x|`,
+
+    .. math::
+
+        |\\mathrm{shader}(x) - f(x)| \\le A + L\\,(1 + h)
+            + [\\text{flush}]\\; 2^{-126} \\sum_{k \\ge 1} k |c_k| M^{k-1},
+
+    :math:`h` the proof headroom; the a priori alternative is Higham's
+    :math:`\\gamma_{2n} \\sum_k |c_k| M^k` [1]_ (eq. 5.3).
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, eq. (5.3).
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> b = float32_eval_bound(fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z", name="d2"))
     >>> b.certified < b.total <= b.total32 < 2.2e-5
@@ -279,6 +383,26 @@ def shader_evaluator(table: CoefficientTable, constant: str = ""):
     function: float32 Horner's rule (fused or not, subnormals possibly
     flushed) on the float32 coefficients, over the float32 interval.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table; its name must be an identifier.
+    constant : str, optional
+        The bound's constant name. Default ``""``:
+        ``CHEBNORM_<NAME>_EVAL_ERROR_BOUND``.
+
+    Returns
+    -------
+    Evaluator
+        One piece on the C header's inner interval (extended to 0 when a
+        subnormal input may flush to it), arithmetic
+        :data:`chebnorm.export.evalbound.BINARY32_FTZ`.
+
+    Raises
+    ------
+    ValueError
+        When the table's name is not an identifier.
+
     Examples
     --------
     >>> from chebnorm.approx import fit
@@ -305,6 +429,18 @@ def interval32(table: CoefficientTable) -> tuple[float, float]:
     lies in the table's interval (the shaders' ``_LO``/``_HI`` and the GPU
     checks' input range).
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table; its exact ``interval`` is read.
+
+    Returns
+    -------
+    tuple of (float, float)
+        ``(lo, hi)`` as Python floats holding float32 values.
+
+    Examples
+    --------
     >>> from fractions import Fraction
     >>> from chebnorm.approx import fit
     >>> lo, hi = interval32(fit("x", ("-0.1", "0"), 1))
@@ -320,6 +456,33 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     ``proof``: the stem of the Gappa proof file named in the banner (empty:
     none).
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in plain powers of ``x``; its name must be an identifier.
+    language : {"glsl", "wgsl", "hlsl"}
+        The shading language (a key of :data:`SHADER_LANGUAGES`).
+    command : str, optional
+        The generating command, stated in the banner. Default ``""`` (none).
+    proof : str, optional
+        The stem of the Gappa proof file named beside the bound. Default
+        ``""`` (none).
+
+    Returns
+    -------
+    str
+        The banner, the constants (``_LO``, ``_HI``, ``_ABS_ERROR_BOUND``,
+        ``_EVAL_ERROR_BOUND``) and the function, ending in a newline.
+
+    Raises
+    ------
+    ValueError
+        When ``language`` is unknown, the table is in the shifted basis, its
+        name is not an identifier, or its float32 evaluation may overflow
+        (or its bound exceeds the float32 range).
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit
     >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 1, var="z", name="d1")
     >>> "float chebnorm_d1(float x)" in shader_source(t, "glsl")
@@ -401,6 +564,25 @@ def _up_f32(value: float) -> float:
 def glsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in GLSL.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in plain powers of ``x``; its name must be an identifier.
+    command : str, optional
+        The generating command, stated in the banner. Default ``""``.
+
+    Returns
+    -------
+    str
+        ``shader_source(table, "glsl", command)``.
+
+    Raises
+    ------
+    ValueError
+        When the table is in the shifted basis (the shaders evaluate plain
+        powers of ``x``), its name is not an identifier, or its float32
+        Horner evaluation may overflow on the interval.
+
     Examples
     --------
     >>> from chebnorm.approx import fit
@@ -414,6 +596,25 @@ def glsl_source(table: CoefficientTable, command: str = "") -> str:
 def wgsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in WGSL.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in plain powers of ``x``; its name must be an identifier.
+    command : str, optional
+        The generating command, stated in the banner. Default ``""``.
+
+    Returns
+    -------
+    str
+        ``shader_source(table, "wgsl", command)``.
+
+    Raises
+    ------
+    ValueError
+        When the table is in the shifted basis (the shaders evaluate plain
+        powers of ``x``), its name is not an identifier, or its float32
+        Horner evaluation may overflow on the interval.
+
     Examples
     --------
     >>> from chebnorm.approx import fit
@@ -425,6 +626,25 @@ def wgsl_source(table: CoefficientTable, command: str = "") -> str:
 
 def hlsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in HLSL.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        A table in plain powers of ``x``; its name must be an identifier.
+    command : str, optional
+        The generating command, stated in the banner. Default ``""``.
+
+    Returns
+    -------
+    str
+        ``shader_source(table, "hlsl", command)``.
+
+    Raises
+    ------
+    ValueError
+        When the table is in the shifted basis (the shaders evaluate plain
+        powers of ``x``), its name is not an identifier, or its float32
+        Horner evaluation may overflow on the interval.
 
     Examples
     --------

@@ -89,6 +89,45 @@ class VariantResult:
     ``measured_max``/``argmax``/``upper``/``ref_error`` are None for a
     skipped variant (``skipped`` then gives the reason).
 
+    Attributes
+    ----------
+    format : str
+        The format run, one of :data:`VERIFY_FORMATS`.
+    variant : str
+        The variant, one of ``VARIANTS[format]`` (``"float-fused"``, ...).
+    evaluator : str
+        The evaluator's name in the text (``chebnorm_NAME_f``, ...).
+    bound_name : str
+        The macro or constant that states its bound.
+    stated_bound : float or None
+        That bound as read from the text (:func:`stated_bounds`); None when
+        the text states none.
+    measured_max : float or None
+        ``max |evaluator(x) - f(x)|`` over the inputs, ``f`` in Arb at 128
+        bits at the worst input (so the maximum is attained there).
+    argmax : float or None
+        The input where ``measured_max`` is attained.
+    upper : float or None
+        ``max(measured_max, e_K + ref_error)``: a bound of the true maximum
+        over every input as far as the float64 reference's error estimate
+        holds (module docstring). The variant passes when
+        ``upper <= stated_bound``.
+    ref_error : float or None
+        The largest ``|f64(x) - f(x)|`` seen at the Arb-checked points.
+    count : int
+        The number of inputs run (``>= 0``).
+    inputs : str
+        Which inputs, in words (``"every float32 in [LO, HI]"``, a count
+        spread evenly, ...).
+    seconds : float
+        Wall time of the run (compiling included).
+    skipped : str or None, default None
+        Why the variant did not run (a missing tool or driver); None when
+        it ran.
+    notes : tuple of str, default ()
+        Remarks on the run (e.g. whether the target has FMA for a fused
+        build, the GPU driver used).
+
     Examples
     --------
     >>> r = VariantResult("c", "float", "chebnorm_t_f", "CHEBNORM_T_F_EVAL_ERROR_BOUND", 2e-6,
@@ -140,6 +179,15 @@ class VariantResult:
 @dataclass(frozen=True)
 class VerifyResult:
     """The result of :func:`verify`: one :class:`VariantResult` per variant.
+
+    Attributes
+    ----------
+    table : str
+        The table's name.
+    format : str
+        The format verified, one of :data:`VERIFY_FORMATS`.
+    variants : tuple of VariantResult
+        One per variant run or skipped, in ``VARIANTS[format]`` order.
 
     Examples
     --------
@@ -226,6 +274,19 @@ def _number(text: str) -> float | None:
 def stated_bounds(text: str) -> dict[str, float]:
     """Every ``#define NAME value`` and shader constant of an exported text
     whose value is a number (hexadecimal or decimal), by name.
+
+    Parameters
+    ----------
+    text : str
+        An exported file (C header or shader source).
+
+    Returns
+    -------
+    dict of str to float
+        Name -> value, for every ``#define`` whose first token is a C
+        hexadecimal or decimal floating literal (an ``f`` suffix allowed)
+        and every GLSL/WGSL/HLSL ``const`` float; other definitions are
+        left out. A later definition of a name replaces an earlier one.
 
     Examples
     --------
