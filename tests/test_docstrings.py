@@ -31,7 +31,8 @@ STAGES = ("core", "symbolic", "approx", "methods", "hw", "export", "raster", "cl
 #: their items run and report (xfail, not strict: a passing one shows as XPASS), and the
 #: set is emptied once the sweep of each is merged.
 PENDING = {"export"}
-PENDING |= {"hw.piecewise", "hw.targets", "hw.target_model", "hw.multipartite", "hw.piecewise_search", "hw.architectures"}
+PENDING |= {"hw.piecewise", "hw.targets", "hw.target_model", "hw.multipartite", "hw.piecewise_search",
+            "hw.architectures"}
 #: Modules of the other stages whose sweep is pending too (the compiled engine's internals).
 PENDING_MODULES: tuple[str, ...] = ()
 
@@ -81,7 +82,8 @@ def _stage(qual: str) -> str:
 
 def _pending(qual: str) -> bool:
     path = qual.split(".", 1)[1]
-    return any(path == p or path.startswith(p + ".") for p in PENDING) or qual.startswith(PENDING_MODULES)
+    return (any(path == p or path.startswith(p + ".") for p in PENDING)
+            or qual.startswith(PENDING_MODULES))
 
 
 def _params(obj) -> list[str]:

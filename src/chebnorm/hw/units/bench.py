@@ -177,7 +177,8 @@ def combinational_rows(unit: UnitDesign, rng, count: int, realistic) -> dict:
     count : int
         Realistic and random rows each.
     realistic : callable
-        ``realistic(rng, a) -> dict`` of input port -> codes, from unit normals ``a`` of shape ``(count, 3)``.
+        ``realistic(rng, a) -> dict`` of input port -> codes, from unit normals ``a``
+        of shape ``(count, 3)``.
 
     Returns
     -------

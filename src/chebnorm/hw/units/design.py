@@ -42,7 +42,8 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
     Parameters
     ----------
     kind : str
-        A registered unit name: ``"classic"``, ``"dichotomy"``, ``"quadratic"``, ``"stepper"``, ``"eta"``.
+        A registered unit name: ``"classic"``, ``"dichotomy"``, ``"quadratic"``,
+        ``"stepper"``, ``"eta"``.
     frac_bits : int, default 14
         ``F``, 1 to :data:`~chebnorm.hw.units.base.MAX_UNIT_FRAC_BITS` (26).
     comp_bits : int or None, default None
@@ -56,11 +57,14 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
         The evaluator's coefficient fractional bits; None: the table's own, or
         ``min(out_bits + 4, 30)`` for a fitted table.
     rounding : {"trunc", "rne"} or None, default None
-        The classic unit's quotient rounding (None: ``"trunc"``) or the evaluator's (None: ``"rne"``).
+        The classic unit's quotient rounding (None: ``"trunc"``) or the evaluator's
+        (None: ``"rne"``).
     log_m : int, default 4
-        The stepper's span ``m = 2**log_m`` pixels, 0 to :data:`~chebnorm.hw.units.base.MAX_LOG_M` (10).
+        The stepper's span ``m = 2**log_m`` pixels, 0 to
+        :data:`~chebnorm.hw.units.base.MAX_LOG_M` (10).
     guard : int or None, default None
-        The stepper's guard bits, 0 to :data:`~chebnorm.hw.units.base.MAX_GUARD` (24); None: ``2 * log_m``.
+        The stepper's guard bits, 0 to :data:`~chebnorm.hw.units.base.MAX_GUARD` (24);
+        None: ``2 * log_m``.
 
     Returns
     -------
