@@ -288,17 +288,18 @@ def with_cuts(design, cuts):
     Parameters
     ----------
     design : object
-        A sized piecewise design (``design_piecewise(..., widths="auto")``) or a
+        A sized piecewise design (``design_piecewise(..., widths=...)``) or a
         multipartite design, combinational or already pipelined (its cuts are replaced).
     cuts : iterable of int
-        Register positions: 0 to ``2 * degree`` for a piecewise design (0 after the ROM,
-        ``2i - 1`` after the ``i``-th multiply, ``2i`` after the ``i``-th add); 0 and 1
-        for a multipartite one.
+        Register positions, in any order (duplicates count once): 0 to ``2 * degree``
+        for a piecewise design (0 after the ROM, ``2i - 1`` after the ``i``-th
+        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite one.
 
     Returns
     -------
-    object
-        A new design of the same kind with the cuts, ``latency == len(cuts)``.
+    PiecewiseDesign or PipelinedTable
+        A new design with the cuts (a piecewise design stays one; a multipartite one
+        becomes a :class:`PipelinedTable`), ``latency == len(cuts)``.
 
     Raises
     ------
