@@ -26,10 +26,13 @@ import chebnorm  # noqa: E402
 
 STAGES = ("core", "symbolic", "approx", "methods", "hw", "export", "raster", "cli")
 
-#: Stages whose docstrings are still being rewritten on other branches: their items
-#: run and report (xfail, not strict: a passing one shows as XPASS), and the set is
-#: emptied once the sweep of each is merged.
-PENDING = {"hw"}
+#: Stages (``"hw"``) or modules (``"hw.piecewise"``: the dotted path after ``chebnorm.``,
+#: a prefix matched at a dot) whose docstrings are still being rewritten on other branches:
+#: their items run and report (xfail, not strict: a passing one shows as XPASS), and the
+#: set is emptied once the sweep of each is merged.
+PENDING: set[str] = set()
+PENDING |= {"hw.piecewise", "hw.targets", "hw.target_model", "hw.multipartite", "hw.piecewise_search",
+            "hw.architectures", "hw.exponent", "hw.hdl.exponent"}
 #: Modules of the other stages whose sweep is pending too (the compiled engine's internals).
 PENDING_MODULES: tuple[str, ...] = ()
 
@@ -78,7 +81,9 @@ def _stage(qual: str) -> str:
 
 
 def _pending(qual: str) -> bool:
-    return _stage(qual) in PENDING or qual.startswith(PENDING_MODULES)
+    path = qual.split(".", 1)[1]
+    return (any(path == p or path.startswith(p + ".") for p in PENDING)
+            or qual.startswith(PENDING_MODULES))
 
 
 def _params(obj) -> list[str]:
@@ -166,8 +171,9 @@ def test_numpydoc_sections(qual):
 
 def test_the_sweep_covers_the_facade_and_every_stage():
     """The parametrization is not empty by accident: every facade callable and every
-    stage contributes, and PENDING names only stages."""
-    assert PENDING <= set(STAGES)
+    stage contributes, and PENDING names only stages and existing modules."""
+    modules = {m.split(".", 1)[1] for m in _public_modules()}
+    assert PENDING <= set(STAGES) | modules, PENDING - set(STAGES) - modules
     stages = {_stage(q) for q in CALLABLES}
     assert stages == set(STAGES)
     for name in chebnorm.__all__:

@@ -51,6 +51,29 @@ class ErrorBudget:
     """Certified parts of the error (see module docstring); ``total`` is
     ``min(approximation + quantization, quantized) + rounding``.
 
+    Attributes
+    ----------
+    approximation : float
+        The table's certified ``sup |p - f|`` on its interval.
+    quantization : float
+        Certified ``sup |p_q - p|``: the coefficients rounded to ``coef_frac_bits``.
+    quantized : float
+        The table's re-certified ``sup |p_q - f|``.
+    rounding_steps : tuple of float
+        Per Horner step (highest power first), the bound of its rounding carried to the
+        output: ``rho_j * max|x|**j``.
+    output_rounding : float
+        Bound of the rounding to the output's fractional bits (0 when none are dropped).
+    rounding : float
+        ``sum(rounding_steps) + output_rounding``, rounded upward.
+    total : float
+        The certified bound of ``|y - f(x)|`` over the valid codes.
+    y_lsb : float
+        The output's LSB ``2**-Fy``, for expressing bounds in LSB (``total / y_lsb``).
+    gappa_rounding : float or None, default None
+        gappa's independent bound of the rounding part ``|y - p_q(x)|``; None when not
+        asked for or gappa is not installed.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -92,6 +115,30 @@ class Measurement:
     code: no relative error there), ``shading_levels`` is
     ``255 * rel_total``: the largest change of an 8-bit intensity
     ``I <= 1`` when the normal is scaled by ``y`` instead of ``f``.
+
+    Attributes
+    ----------
+    codes : int
+        Number of valid input codes measured.
+    total : float
+        ``max |y - f(x)|`` over them.
+    total_at_code : int
+        The input code where ``total`` is reached.
+    rel_total : float or None
+        ``max |y / f - 1|``; None when ``f`` is zero at some valid code.
+    approximation : float
+        ``max |p - f|`` measured.
+    quantization : float
+        ``max |p_q - p|`` measured.
+    rounding : float
+        ``max |y - p_q|``, exact (rounded upward to float).
+    step_rounding : tuple of float
+        Per Horner step (highest power first), the largest rounding error of its
+        accumulator, exact, in the accumulator's units of value.
+    overflows : int
+        How many codes saturated or wrapped somewhere in the datapath (0 for a sound design).
+    y_lsb : float
+        The output's LSB ``2**-Fy``.
 
     Examples
     --------
@@ -157,6 +204,23 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     >>> b = error_budget(d)
     >>> b.output_rounding == 2.0 ** -17, measure(d).total <= b.total
     (True, True)
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The datapath, from :func:`~chebnorm.hw.horner.design_horner`.
+    gappa : bool, default False
+        Also run gappa (when installed) for an independent bound of the rounding part.
+
+    Returns
+    -------
+    ErrorBudget
+        The certified parts and their ``total``, each a float rounded upward.
+
+    Raises
+    ------
+    ValueError
+        If gappa is asked for and fails on the datapath (see :func:`gappa_bound`).
     """
     t = design.table
     xmax = design.max_abs_x()
@@ -190,6 +254,16 @@ def measure(design: HornerDesign) -> Measurement:
     >>> m = measure(d)
     >>> m.codes, m.overflows, m.total <= error_budget(d).total
     (2400, 0, True)
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The datapath to run over its ``valid_codes``.
+
+    Returns
+    -------
+    Measurement
+        The measured errors.
     """
     lo, hi = design.valid_codes
     k = np.arange(lo, hi + 1, dtype=np.int64)
@@ -252,6 +326,17 @@ def gappa_script(design: HornerDesign) -> str:
     >>> d = design_horner(fit_target("dichotomy", 2), 12, 12, coef_bits=16)
     >>> "@ry = fixed<-16,ne>;" in gappa_script(d)     # y: 16 fractional bits, to nearest
     True
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The datapath to describe.
+
+    Returns
+    -------
+    str
+        The script text: the exact polynomial ``M0`` and the rounded datapath ``a0``
+        over the valid input range, asking for ``|a0 - M0|``.
     """
     mode = {"rne": "ne", "trunc": "dn"}[design.rounding]
     fc = design.coef_frac_bits
@@ -314,6 +399,25 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
     >>> g = gappa_bound(d)
     >>> g is None or measure(d).rounding <= g
     True
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The datapath to bound.
+    timeout : float, default 60
+        Seconds to wait for gappa.
+
+    Returns
+    -------
+    float or None
+        The bound rounded upward, or None when no ``gappa`` executable is on ``PATH``.
+
+    Raises
+    ------
+    ValueError
+        If gappa fails or gives no bound.
+    subprocess.TimeoutExpired
+        If gappa runs longer than ``timeout``.
     """
     exe = shutil.which("gappa")
     if exe is None:

@@ -30,6 +30,23 @@ class Cost:
 
     >>> Cost(multipliers=((8, 8),) * 3, adders=(16, 17), latency=3).area   # a dot product, 8-bit
     225.0
+
+    Parameters
+    ----------
+    multipliers : tuple of (int, int), default ()
+        One ``(a, b)`` pair of operand widths per multiplier (area ``a*b`` FA each).
+    adders : tuple of int, default ()
+        The width of each adder, subtractor or comparator (area ``n`` FA each).
+    sqrts : tuple of int, default ()
+        The result width of each square-root unit (area ``w*w/2`` FA each).
+    dividers : tuple of int, default ()
+        The result width of each divider (area ``w*w`` FA each).
+    mux_bits : int, default 0
+        2:1 multiplexer bits (1/2 FA each).
+    rom_bits : int, default 0
+        ROM bits (1/8 FA each).
+    latency : int, default 0
+        Pipeline latency in clock cycles (``>= 0``).
     """
 
     multipliers: tuple[tuple[int, int], ...] = ()
@@ -88,6 +105,20 @@ class Block:
     (3, 675.0, 9)
     >>> Block("chain", children=(dot, dot)).cost.latency
     6
+
+    Parameters
+    ----------
+    name : str
+        The block's label in :meth:`lines` and :meth:`as_dict`.
+    own : Cost, default Cost()
+        The block's own resources, apart from its children.
+    children : tuple of Block, default ()
+        The sub-blocks.
+    serial : bool, default True
+        True when the children follow each other (latencies add), False when they work
+        side by side (the largest latency counts); resources add either way.
+    note : str, default ""
+        A remark kept in :meth:`as_dict` (omitted when empty).
     """
 
     name: str

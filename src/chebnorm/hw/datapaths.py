@@ -41,6 +41,17 @@ def horner_block(design: HornerDesign) -> Block:
     """The polynomial evaluator: one multiplier and adder per degree, the
     input-offset adder, rounding incrementers, the output offset and clamp.
 
+    Parameters
+    ----------
+    design : HornerDesign
+        The sized evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+
+    Returns
+    -------
+    Block
+        Its cost: multipliers and adders of the exact widths, the coefficient ROM, latency
+        ``1 + 2 * degree``.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -64,6 +75,16 @@ def horner_block(design: HornerDesign) -> Block:
 def dot_block(w: int) -> Block:
     """``A.B`` of two 3-vectors of ``w``-bit components.
 
+    Parameters
+    ----------
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+
+    Returns
+    -------
+    Block
+        Three ``w x w`` multipliers, two adders, latency 3.
+
     Examples
     --------
     >>> c = dot_block(8).cost
@@ -79,6 +100,18 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
 
     With ``frac_bits = F`` the dividers are priced as in :func:`classic_normalize`:
     a ``W + F``-bit quotient of ``N << F`` (without it, a ``W``-bit quotient).
+
+    Parameters
+    ----------
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    frac_bits : int or None, default None
+        ``F``: price the dividers as ``W + F``-bit quotients; None: ``W``-bit ones.
+
+    Returns
+    -------
+    Block
+        The dot product, the square root and the three dividers in series.
 
     Examples
     --------
@@ -96,6 +129,18 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
 
 def dichotomy_unit(design: HornerDesign, w: int) -> Block:
     """Dichotomy midpoint ``(N1 + N2) p(z)`` and next level ``z' = sqrt(2 + z)``.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The polynomial evaluator of ``1/sqrt(2 + z)``; its ``in_bits`` size the next level.
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+
+    Returns
+    -------
+    Block
+        The sum, evaluator, scaling and next-level blocks in series.
 
     Examples
     --------
@@ -117,6 +162,18 @@ def dichotomy_unit(design: HornerDesign, w: int) -> Block:
 
 def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
     """Midpoint ``N_c = (N_l + N_r) p(N_l.N_r)`` and ``G, P, Q`` (seed 000, method 5).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The polynomial evaluator of ``1/sqrt(2(1 + x))``.
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+
+    Returns
+    -------
+    Block
+        The dot product, evaluator, midpoint and ``G, P`` blocks in series.
 
     Examples
     --------
@@ -140,6 +197,18 @@ def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
 def forward_difference_stepper(w: int, guard: int = 8) -> Block:
     """Per pixel ``N += D1; D1 += D2`` for each component: 6 adders, no multiplier.
 
+    Parameters
+    ----------
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    guard : int, default 8
+        Guard bits of the accumulators (``>= 0``).
+
+    Returns
+    -------
+    Block
+        Six ``w + guard``-bit adders, latency 1 (per pixel).
+
     Examples
     --------
     >>> c = forward_difference_stepper(12).cost
@@ -152,6 +221,18 @@ def forward_difference_stepper(w: int, guard: int = 8) -> Block:
 
 def eta_unit(design: HornerDesign, w: int) -> Block:
     """eta = 3 - sum of three g(N_i.N_j) (seed 003) and the threshold compare.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The polynomial evaluator ``g`` of ``sqrt(2(1 + x))/2``, instantiated three times.
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+
+    Returns
+    -------
+    Block
+        Three dot products and three evaluators side by side, then the sum and compare.
 
     Examples
     --------
@@ -181,6 +262,18 @@ def _intensity(w: int, shininess_bits: int = 7) -> Block:
 def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
     """Phong pipeline (seed 001): interpolate N, L, H; normalize each; intensity.
 
+    Parameters
+    ----------
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    normalizer : Block or None, default None
+        The normalization block used for each of N, L, H; None: :func:`classic_unit` of ``w``.
+
+    Returns
+    -------
+    Block
+        Interpolation, three normalizers side by side, intensity.
+
     Examples
     --------
     >>> p = phong_pipeline(12)
@@ -199,6 +292,18 @@ def bump_pipeline(w: int, normalizer: Block | None = None) -> Block:
     """Bump mapping on the Phong pipeline (seed 001): the perturbed normal comes
     from a texture; one added 3w-bit 2:1 multiplexer selects it over the
     interpolated normal.
+
+    Parameters
+    ----------
+    w : int
+        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    normalizer : Block or None, default None
+        The normalization block used for each of N, L, H; None: :func:`classic_unit` of ``w``.
+
+    Returns
+    -------
+    Block
+        The Phong pipeline plus a ``3w``-bit 2:1 multiplexer.
 
     Examples
     --------
@@ -228,6 +333,23 @@ def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
 
     >>> classic_normalize(np.array([[3 << 10, 4 << 10, 0]]), 12).tolist()
     [[2457, 3276, 0]]
+
+    Parameters
+    ----------
+    n : array_like of int
+        Component codes, shape ``(..., 3)``, ``W``-bit with ``W + F <= 62``
+        (int64 arithmetic, unchecked here).
+    frac_bits : int
+        ``F``: fractional bits of the vector components, ``>= 0``.
+    rounding : {"trunc", "rne"}, default "trunc"
+        The quotient's rounding: toward minus infinity, or to nearest with ties to even;
+        any other value behaves as ``"trunc"``.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Shape ``(..., 3)``: the normalized components with ``F`` fractional bits
+        (a zero vector gives zeros: ``s`` is clamped to 1).
     """
     n = np.asarray(n, dtype=np.int64)
     dot = np.sum(n * n, axis=-1)
@@ -243,6 +365,23 @@ def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
 def dichotomy_midpoint(n1, n2, z_codes, design: HornerDesign, frac_bits: int) -> np.ndarray:
     """Bit-accurate dichotomy midpoint ``(N1 + N2) * p(z)`` (seed 000, method 4),
     the product rounded to nearest-even back to ``frac_bits``.
+
+    Parameters
+    ----------
+    n1, n2 : array_like of int
+        The two normals' codes, shape ``(..., 3)``.
+    z_codes : array_like of int
+        The evaluator's input codes of ``z``, shape ``(...)``.
+    design : HornerDesign
+        The polynomial evaluator of ``1/sqrt(2 + z)``.
+    frac_bits : int
+        ``F``: fractional bits of ``n1`` and ``n2``, ``>= 0`` (not used: the product is
+        rounded back by the evaluator's ``Fy`` bits, so the result keeps ``F``).
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Shape ``(..., 3)``: the midpoint's codes with ``frac_bits`` fractional bits.
 
     Examples
     --------
@@ -283,6 +422,18 @@ def dichotomy_next_z(z_codes, design: HornerDesign) -> np.ndarray:
     >>> z, z_next = d.x_format.values(k), d.x_format.values(dichotomy_next_z(k, d))
     >>> bool(np.all(np.abs(z_next - np.sqrt(2 + z)) <= 2.0 ** -13)), bool(np.all(z_next >= z))
     (True, True)
+
+    Parameters
+    ----------
+    z_codes : array_like of int
+        Input codes of ``z`` in ``design``'s input format.
+    design : HornerDesign
+        The polynomial evaluator (its input format, ``Fx >= 0``).
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        The input codes of ``sqrt(2 + z)``, in ``[0, 2**in_bits - 1]``.
     """
     fx, k0 = design.x_format.frac_bits, design.x_format.offset_code
     x = np.asarray(z_codes, dtype=np.int64) + (2 << fx) + k0
@@ -294,6 +445,20 @@ def dot_to_code(dot, dot_frac_bits: int, design: HornerDesign) -> np.ndarray:
     """Input code of ``design`` for a dot product ``dot / 2**dot_frac_bits``:
     rounded to nearest-even to the ``Fx`` fractional bits of the input, less
     the offset, saturated to ``0 .. 2^in_bits - 1``.
+
+    Parameters
+    ----------
+    dot : array_like of int
+        Dot-product codes.
+    dot_frac_bits : int
+        Their fractional bits (``2F`` for a dot product of ``F``-bit components).
+    design : HornerDesign
+        The polynomial evaluator whose input code is wanted.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Input codes in ``[0, 2**in_bits - 1]``.
 
     Examples
     --------
@@ -329,6 +494,20 @@ def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
     ``Q = N_l`` are exact. Returns ``(G, P, Q, N_c)``, int codes ``(..., 3)``
     with ``F`` fractional bits.
 
+    Parameters
+    ----------
+    nl, nr : array_like of int
+        The span's end normals, codes of shape ``(..., 3)``.
+    design : HornerDesign
+        The polynomial evaluator of ``1/sqrt(2(1 + x))``.
+    frac_bits : int
+        ``F``: fractional bits of the vector components, ``>= 0``.
+
+    Returns
+    -------
+    G, P, Q, N_c : numpy.ndarray of int64
+        Each of shape ``(..., 3)`` with ``F`` fractional bits.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -351,6 +530,20 @@ def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarra
     exact, converted by :func:`dot_to_code`; the sum exact. Returns the codes of
     eta with the ``Fy`` fractional bits of ``design``'s output (value
     ``code / 2**Fy``, no offset).
+
+    Parameters
+    ----------
+    na, nb, nc : array_like of int
+        The three vertex normals, codes of shape ``(..., 3)``.
+    design : HornerDesign
+        The polynomial evaluator ``g`` of ``sqrt(2(1 + x))/2``.
+    frac_bits : int
+        ``F``: fractional bits of the vector components, ``>= 0``.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Shape ``(...)``: eta codes with ``design``'s ``Fy`` fractional bits.
 
     Examples
     --------
@@ -379,6 +572,20 @@ def forward_difference_setup(G, P, Q, log_m: int, guard: int):
     ``G, P, Q``: int codes ``(..., 3)``; the results have ``g`` more fractional
     bits. Equal to what :func:`forward_difference` computes from the values.
 
+    Parameters
+    ----------
+    G, P, Q : array_like of int
+        The quadratic's coefficient codes, shape ``(..., 3)``.
+    log_m : int
+        ``m = 2**log_m`` pixels per span, ``>= 0``.
+    guard : int
+        ``g``: guard bits, ``>= 0`` (exact set-up when ``g >= 2 log_m``).
+
+    Returns
+    -------
+    v0, d1, d2 : numpy.ndarray of int64
+        Start value and first and second differences, ``g`` more fractional bits.
+
     Examples
     --------
     >>> G, P, Q = np.array([1 << 8, 0, 0]), np.zeros(3, int), np.zeros(3, int)   # G = 1, F = 8
@@ -402,6 +609,18 @@ def forward_difference_codes(v0, d1, d2, m: int) -> np.ndarray:
 
     >>> forward_difference_codes(np.zeros(3, int), np.ones(3, int), np.full(3, 2), 4)[:, 0].tolist()
     [0, 1, 4, 9, 16]
+
+    Parameters
+    ----------
+    v0, d1, d2 : array_like of int
+        Start value and differences, shape ``(..., 3)``.
+    m : int
+        Steps, ``>= 0``.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Shape ``(..., m+1, 3)``: ``v_0 .. v_m``.
     """
     v, d1, d2 = (np.asarray(a, dtype=np.int64) for a in (v0, d1, d2))
     out = [v]
@@ -417,6 +636,22 @@ def forward_difference(G, P, Q, m: int, frac_bits: int, guard: int = 8) -> np.nd
     differences in fixed point (``frac_bits + guard`` fractional bits inside,
     the start values rounded once): additions only, as the hardware does it.
     ``G, P, Q``: float arrays ``(..., 3)``. Returns float values ``(..., m+1, 3)``.
+
+    Parameters
+    ----------
+    G, P, Q : array_like of float
+        The quadratic's coefficients, shape ``(..., 3)``.
+    m : int
+        Pixels per span, ``>= 1``.
+    frac_bits : int
+        Fractional bits of the result.
+    guard : int, default 8
+        Extra fractional bits inside, ``>= 0``.
+
+    Returns
+    -------
+    numpy.ndarray of float64
+        Shape ``(..., m+1, 3)``: the pixel values.
 
     Examples
     --------

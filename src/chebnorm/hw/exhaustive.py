@@ -53,6 +53,24 @@ def exact_endpoint(text, name: str = "interval") -> Fraction:
 
     >>> exact_endpoint("0.1"), exact_endpoint("1/4")
     (Fraction(1, 10), Fraction(1, 4))
+
+    Parameters
+    ----------
+    text : str, int, fractions.Fraction or sympy number
+        The endpoint, e.g. ``"0.1"``, ``"1/4"``, ``3``.
+    name : str, default "interval"
+        What the endpoint belongs to, for the message.
+
+    Returns
+    -------
+    fractions.Fraction
+        The endpoint exactly.
+
+    Raises
+    ------
+    ValueError
+        If the endpoint does not parse as a number or is irrational (``"pi"``,
+        ``"sqrt(2)"``).
     """
     v = parse_number(text)
     if not v.is_Rational:
@@ -72,6 +90,21 @@ class Reference:
     >>> r = reference("x*x", ("1", "2"), 2)
     >>> r.x(1), float(r.mid[1]), bool(r.lo[1] <= 25 / 16 <= r.hi[1])
     (Fraction(5, 4), 1.5625, True)
+
+    Attributes
+    ----------
+    expression : str
+        The function ``f`` as given.
+    variable : str
+        The name of its variable.
+    interval : tuple of (str, str)
+        The endpoints ``(lo, hi)`` as given; both rational.
+    in_bits : int
+        Width ``W`` of the input code, 1 to :data:`MAX_EXHAUSTIVE_BITS`.
+    mid : numpy.ndarray of float64
+        Approximate ``f(x_k)`` per code (length ``2**in_bits``), for searching only.
+    lo, hi : numpy.ndarray of float64
+        Rigorous enclosure ``lo[k] <= f(x_k) <= hi[k]`` per code.
     """
 
     expression: str
@@ -122,6 +155,29 @@ def reference(expression, interval, in_bits: int, var: str = "x") -> Reference:
     Traceback (most recent call last):
     ...
     ValueError: 1/x is not finite at x = 0 (code 0); accepted: an interval where the function is defined and finite at every input code
+
+    Parameters
+    ----------
+    expression : str or sympy.Expr
+        The function ``f`` of ``var``.
+    interval : tuple or list of two endpoints
+        ``(lo, hi)``, rational (strings like ``"0"``, ``"1/4"``, ``"0.1"``), ``lo < hi``.
+    in_bits : int
+        Input code width ``W``, 1 to :data:`MAX_EXHAUSTIVE_BITS` (24): ``2**W``
+        evaluations.
+    var : str, default "x"
+        The variable of ``expression``.
+
+    Returns
+    -------
+    Reference
+        ``f`` at every code: float64 midpoints and a rigorous enclosure.
+
+    Raises
+    ------
+    ValueError
+        If ``in_bits`` is out of range, ``interval`` is not two rational endpoints with
+        ``lo < hi``, ``expression`` does not parse, or ``f`` is not finite at some code.
     """
     in_bits = check_int(in_bits, "in_bits", 1, MAX_EXHAUSTIVE_BITS)
     if not (isinstance(interval, (tuple, list)) and len(interval) == 2):
@@ -182,6 +238,26 @@ def round_to_nearest(ref: Reference, frac_bits: int):
     >>> n, proved = round_to_nearest(r, 3)
     >>> n.tolist(), bool(proved.all())
     ([0, 0, 1, 2, 2, 2, 3, 4], True)
+
+    Parameters
+    ----------
+    ref : Reference
+        The values ``f(x_k)`` from :func:`reference`.
+    frac_bits : int
+        Fractional bits ``F`` of the result, -1000 to 1000; the scaled values
+        ``f(x_k) * 2**F`` must stay below ``2**50`` in magnitude.
+
+    Returns
+    -------
+    n : numpy.ndarray of int64
+        The nearest integer to ``f(x_k) * 2**F`` per code, ties to even.
+    proved : numpy.ndarray of bool
+        True where that rounding is proved.
+
+    Raises
+    ------
+    ValueError
+        If ``frac_bits`` is out of range or the scaled values do not fit 50 bits.
     """
     frac_bits = check_int(frac_bits, "frac_bits", -1000, 1000)
     slo = np.ldexp(ref.lo, frac_bits)
@@ -234,6 +310,17 @@ class ExhaustiveCheck:
 
     >>> ExhaustiveCheck.of({"upper": 1e-5, "lower": 9e-6, "at": 3, "codes": 16}).at
     3
+
+    Attributes
+    ----------
+    upper : float
+        Rigorous upper bound of ``max_k |y_k - f(x_k)|``.
+    lower : float
+        Lower bound of the same maximum (``>= 0``).
+    at : int
+        The input code where ``upper`` is reached.
+    codes : int
+        How many input codes were checked (``2**in_bits``).
     """
 
     upper: float

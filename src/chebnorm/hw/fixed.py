@@ -61,6 +61,20 @@ class QFormat:
     (1.4141998291015625, 2.4141845703125)
     >>> q.as_dict()
     {'bits': 16, 'frac_bits': 16, 'offset': 1.4141998291015625, 'offset_code': 92681, 'signed': False}
+
+    Parameters
+    ----------
+    bits : int
+        Width of a code in bits (at least 1).
+    frac_bits : int
+        Fractional bits ``F``: the weight of the least significant bit is ``2**-F``;
+        negative means a coarser than unit LSB (``2**|F|``).
+    offset_code : int, default 0
+        The offset ``O`` in units of the LSB (``O = offset_code / 2**F``), added to every
+        code; 0 for a plain Q format.
+    signed : bool, default False
+        Two's-complement codes ``-2**(bits-1) <= k < 2**(bits-1)`` when true, else
+        ``0 <= k < 2**bits``.
     """
 
     bits: int
@@ -113,6 +127,20 @@ def shift_round(v, shift: int, mode: str):
     (2, 4, -2)
     >>> shift_round(7, 1, "trunc"), shift_round(-5, 1, "trunc")
     (3, -3)
+
+    Parameters
+    ----------
+    v : int or numpy.ndarray of int64
+        The integer(s) to shift.
+    shift : int
+        Number of bits to drop, ``>= 0`` (0 returns ``v`` unchanged).
+    mode : {"trunc", "rne"}
+        Rounding mode (:data:`ROUNDINGS`); any other string behaves as ``"rne"``.
+
+    Returns
+    -------
+    int or numpy.ndarray
+        ``v / 2**shift`` rounded, of the type of ``v``.
     """
     if shift == 0:
         return v
@@ -138,6 +166,30 @@ def fit_bits(v, bits: int, *, signed: bool, overflow: str):
     >>> codes, over = fit_bits([300, 130], 8, signed=True, overflow="wrap")
     >>> codes.tolist(), over.tolist()       # 300 - 256 and 130 - 256
     ([44, -126], [True, True])
+
+    Parameters
+    ----------
+    v : int, sequence of int or numpy.ndarray
+        The code(s) to fit.
+    bits : int
+        Width of the result in bits (at least 1).
+    signed : bool
+        Two's-complement range ``[-2**(bits-1), 2**(bits-1) - 1]`` when true, else
+        ``[0, 2**bits - 1]``.
+    overflow : {"saturate", "wrap"}
+        What to do with codes outside the range (:data:`OVERFLOWS`).
+
+    Returns
+    -------
+    codes : numpy.ndarray
+        The codes forced into range.
+    overflowed : numpy.ndarray of bool
+        True where the input code was outside the range.
+
+    Raises
+    ------
+    ValueError
+        If ``overflow`` is not one of :data:`OVERFLOWS`.
     """
     lo = -(1 << (bits - 1)) if signed else 0
     hi = (1 << (bits - 1)) - 1 if signed else (1 << bits) - 1
@@ -166,6 +218,27 @@ def rounding_error_bound(frac_bits: int, mode: str, dropped_bits: int | None = N
 
     >>> rounding_error_bound(4, "rne"), rounding_error_bound(4, "trunc"), rounding_error_bound(4, "trunc", 2)
     (Fraction(1, 32), Fraction(1, 16), Fraction(3, 64))
+
+    Parameters
+    ----------
+    frac_bits : int
+        Fractional bits ``F`` of the rounded result (negative: an LSB of ``2**|F|``).
+    mode : {"trunc", "rne"}
+        Rounding mode (:data:`ROUNDINGS`).
+    dropped_bits : int or None, default None
+        Fractional bits dropped by the rounding (``>= 0``), if known; 0 means exact
+        (bound 0); None means an unknown, possibly unbounded, number.
+
+    Returns
+    -------
+    fractions.Fraction
+        The exact bound: ``2**-F / 2`` for ``"rne"``; ``2**-F`` (or
+        ``2**-F - 2**-(F + d)`` with ``d`` dropped bits) for ``"trunc"``.
+
+    Raises
+    ------
+    ValueError
+        If ``mode`` is not one of :data:`ROUNDINGS`.
     """
     ulp = Fraction(1, 2 ** frac_bits) if frac_bits >= 0 else Fraction(2 ** -frac_bits)
     if dropped_bits == 0:
@@ -185,6 +258,18 @@ def check_int64(bits: int, what: str) -> None:
     Traceback (most recent call last):
     ...
     ValueError: the accumulator needs 63 bits, which overflows the 64-bit bit-accurate model; accepted: at most 62 bits (use fewer input, coefficient or datapath bits)
+
+    Parameters
+    ----------
+    bits : int
+        The signed width the value needs.
+    what : str
+        What the value is, for the message (e.g. ``"the accumulator"``).
+
+    Raises
+    ------
+    ValueError
+        If ``bits`` exceeds :data:`INT64_BITS` (62).
     """
     if bits > INT64_BITS:
         raise ValueError(f"{what} needs {bits} bits, which overflows the 64-bit bit-accurate "

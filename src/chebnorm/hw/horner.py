@@ -45,8 +45,12 @@ from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, s
 __all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
            "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
 
+#: widest input code of a Horner design (its model and test bench run all ``2**in_bits`` codes)
 MAX_IN_BITS = 20
+#: widest output code of a Horner design
 MAX_OUT_BITS = 32
+#: largest number of fractional bits of the coefficients, the input and the output formats (and
+#: the bound of their negative counterparts)
 MAX_FRAC_BITS = 40
 
 
@@ -58,6 +62,29 @@ class Stage:
     aligned sum (``sum_frac_bits`` fractional bits); ``out_bits``: width of
     the rounded result with ``out_frac_bits`` fractional bits;
     ``coef_shifted``: the integer added, ``q_j`` aligned to the sum.
+
+    Attributes
+    ----------
+    power : int
+        ``j``: the power of ``x`` whose coefficient this step adds (``n-1`` down to 0).
+    acc_bits : int
+        Signed width of the incoming accumulator ``a_{j+1}``.
+    product_bits : int
+        Signed width of the exact product ``a_{j+1} * xs``.
+    product_shift : int
+        Left shift aligning the product to the sum's fractional bits (``>= 0``).
+    coef_shifted : int
+        The integer added: ``q_j`` aligned to ``sum_frac_bits``.
+    sum_bits : int
+        Signed width of the exact sum.
+    sum_frac_bits : int
+        Fractional bits of the exact sum.
+    out_bits : int
+        Signed width of the rounded result ``a_j``.
+    out_frac_bits : int
+        Fractional bits of ``a_j`` (the accumulator's, or the output's at ``j = 0``).
+    round_shift : int
+        Bits dropped by the rounding: ``sum_frac_bits - out_frac_bits`` (``>= 0``).
 
     Examples
     --------
@@ -82,6 +109,41 @@ class Stage:
 @dataclass(frozen=True)
 class HornerDesign:
     """A fully sized fixed-point polynomial evaluator (see module docstring).
+
+    Attributes
+    ----------
+    name : str
+        The design's name (the HDL module name is derived from it).
+    table : CoefficientTable
+        The (re-)quantized table the datapath evaluates.
+    in_bits : int
+        Width of the unsigned input code, 1 to :data:`MAX_IN_BITS`.
+    out_bits : int
+        Width of the unsigned output code, 1 to :data:`MAX_OUT_BITS`.
+    rounding : {"rne", "trunc"}
+        Rounding of every step (:data:`~chebnorm.hw.fixed.ROUNDINGS`).
+    x_format : QFormat
+        The input format: code ``k`` stands for ``(offset_code + k) / 2**Fx``.
+    y_format : QFormat
+        The output format.
+    coef_frac_bits : int
+        ``Fc``: fractional bits of the coefficients.
+    integers : tuple of int
+        The coefficients ``q_j`` (``c_j = q_j / 2**Fc``), lowest power first.
+    acc_frac_bits : int
+        ``Fa``: fractional bits of the intermediate accumulators.
+    xs_bits : int
+        Signed width of the input value ``xs = K0 + k`` fed to the multipliers.
+    stages : tuple of Stage
+        The Horner steps, highest power first (empty for degree 0).
+    top_bits : int
+        Signed width of the last step's rounded sum, before the offset and saturation.
+    raw_bits : int
+        Signed width of ``y_raw`` (after subtracting the output offset).
+    valid_codes : tuple of (int, int)
+        First and last input code whose value lies in the table's interval.
+    notes : tuple of str, default ()
+        Remarks on the sizing, for the report.
 
     Examples
     --------
@@ -196,6 +258,16 @@ def max_coef_bits(table: CoefficientTable) -> int:
     >>> from chebnorm.approx import fit_target
     >>> max_coef_bits(fit_target("dichotomy", 2))   # largest |c_j| ~ 0.68
     31
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table whose coefficients are to be quantized.
+
+    Returns
+    -------
+    int
+        The largest accepted ``coef_bits``, 0 to :data:`MAX_FRAC_BITS` (0: none fits).
     """
     _check_table(table)
     limit = 2 ** (COEF_WORD_BITS - 1) - 1
@@ -208,6 +280,24 @@ def max_coef_bits(table: CoefficientTable) -> int:
 
 def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
     """Boundary check of ``coef-bits`` against the table's int32 coefficient limit.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table the coefficients come from.
+    coef_bits : int
+        Fractional bits of the quantized coefficients; accepted: 1 to
+        ``max_coef_bits(table)``.
+
+    Returns
+    -------
+    int
+        ``coef_bits``, checked.
+
+    Raises
+    ------
+    ValueError
+        If ``coef_bits`` is not an integer or out of range, or no width fits the table.
 
     Examples
     --------
@@ -355,6 +445,45 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     >>> x, y = d.x_format.values(k), d.y_format.values(d.evaluate(k))
     >>> bool(np.max(np.abs(y - 1 / np.sqrt(2 + x))) <= error_budget(d).total)
     True
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        A fitted table (with a fixed-point part unless ``coef_bits`` is given).
+    in_bits : int
+        Width of the unsigned input code ``x``, 1 to :data:`MAX_IN_BITS` (20).
+    out_bits : int
+        Width of the unsigned output code ``y``, 1 to :data:`MAX_OUT_BITS` (32).
+    coef_bits : int or None, default None
+        Fractional bits of the coefficients, 1 to ``max_coef_bits(table)``: re-quantizes
+        the table; None keeps the table's own fixed-point part.
+    acc_bits : int or None, default None
+        Fractional bits of the intermediate accumulators, 1 to ``MAX_FRAC_BITS + 20``;
+        None means ``y_frac_bits + guard_bits``.
+    rounding : {"rne", "trunc"}, default "rne"
+        Rounding of every step: to nearest, ties to even, or toward minus infinity.
+    x_frac_bits : int or None, default None
+        Fractional bits of the input, ``-MAX_FRAC_BITS`` to :data:`MAX_FRAC_BITS`;
+        None takes the largest the interval allows.
+    y_frac_bits : int or None, default None
+        Fractional bits of the output, ``-MAX_FRAC_BITS`` to ``MAX_FRAC_BITS + 20``;
+        None takes the largest for which ``out_bits`` holds the output range.
+    guard_bits : int, default 3
+        Extra accumulator bits beyond the output's, 0 to 32 (used when ``acc_bits`` is None).
+    name : str or None, default None
+        The design's name; None uses the table's.
+
+    Returns
+    -------
+    HornerDesign
+        The sized datapath.
+
+    Raises
+    ------
+    ValueError
+        If a width is out of its range, ``rounding`` is unknown, the table has no
+        fixed-point part (and no ``coef_bits``), no input code falls in the interval,
+        ``out_bits`` cannot hold the outputs, or a wire exceeds the 62-bit model.
     """
     _check_table(table)
     in_bits = check_width(in_bits, "in-bits", 1, MAX_IN_BITS)

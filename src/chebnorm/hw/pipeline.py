@@ -64,6 +64,18 @@ def check_frequency(value, name: str = "frequency") -> float:
     """``value`` as a frequency in MHz: a finite number > 0 (text such as ``"250"``
     is read as a number).
 
+    Parameters
+    ----------
+    value : float, int or str
+        The frequency in MHz; must be finite and ``> 0``.
+    name : str, default "frequency"
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        ``value`` as a float.
+
     Raises
     ------
     ValueError
@@ -113,6 +125,20 @@ class PipelinedTable:
     >>> p = PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
     >>> p.latency, p.module_name, "parameter LATENCY = 2" in p.verilog()
     (2, 'chebnorm_multipartite', True)
+
+    Parameters
+    ----------
+    base : MultipartiteDesign
+        The combinational design, from
+        :func:`~chebnorm.hw.multipartite.design_multipartite`.
+    cuts : iterable of int
+        Sorted register positions among 0 (after the table reads) and 1 (after the
+        offsets' sum); the latency is ``len(cuts)``.
+
+    Raises
+    ------
+    ValueError
+        If ``base`` is not a multipartite design or ``cuts`` is not such a set.
     """
 
     def __init__(self, base, cuts):
@@ -153,6 +179,23 @@ def design_files(design, language: str = "verilog") -> dict:
     >>> sorted(design_files(PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"),
     ...                                                        8, 8), (0,)), "vhdl"))
     ['chebnorm_multipartite.hex', 'chebnorm_multipartite.vhd', 'tb_chebnorm_multipartite.vhd']
+
+    Parameters
+    ----------
+    design : HornerDesign, PiecewiseDesign, MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The design to print (combinational or with cuts).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text: the module, its test bench and its vector file.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is not ``"verilog"`` or ``"vhdl"``.
     """
     if getattr(design, "architecture", None) in ("multipartite", "plain_table"):
         return table_files(design, language)
@@ -176,6 +219,17 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     [['mul1'], ['rom', 'mul1'], ['rom', 'mul1', 'add1']]
     >>> cut_plans(design_piecewise(t, 8, 8))
     []
+
+    Parameters
+    ----------
+    design : object
+        A design of :mod:`chebnorm.hw`; only a sized piecewise design and a multipartite
+        design have cut points.
+
+    Returns
+    -------
+    list of tuple of int
+        The cut positions per latency 1, 2, ..., or ``[]``.
     """
     if not _pipelinable(design):
         return []
@@ -201,6 +255,18 @@ def cut_names(design, cuts) -> list[str]:
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> cut_names(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
     ['tables', 'offsets']
+
+    Parameters
+    ----------
+    design : object
+        A sized piecewise design or a multipartite design.
+    cuts : iterable of int
+        Cut positions, as :func:`cut_plans` gives them.
+
+    Returns
+    -------
+    list of str
+        One name per position, in order.
     """
     if getattr(design, "architecture", None) == "multipartite":
         return [("tables", "offsets")[c] for c in cuts]
@@ -218,6 +284,28 @@ def with_cuts(design, cuts):
     >>> d = with_cuts(design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5), (0, 1))
     >>> d.cuts, d.mult_cuts, d.latency
     ((0,), (1,), 2)
+
+    Parameters
+    ----------
+    design : object
+        A sized piecewise design (``design_piecewise(..., widths=...)``) or a
+        multipartite design, combinational or already pipelined (its cuts are replaced).
+    cuts : iterable of int
+        Register positions, in any order (duplicates count once): 0 to ``2 * degree``
+        for a piecewise design (0 after the ROM, ``2i - 1`` after the ``i``-th
+        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite one.
+
+    Returns
+    -------
+    PiecewiseDesign or PipelinedTable
+        A new design with the cuts (a piecewise design stays one; a multipartite one
+        becomes a :class:`PipelinedTable`), ``latency == len(cuts)``.
+
+    Raises
+    ------
+    ValueError
+        If the design has no cut points, ``cuts`` is not iterable, or a position is out
+        of range.
     """
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
@@ -242,6 +330,15 @@ class PipelineStep:
 
     >>> PipelineStep((1,), 1, 46.9).latency
     1
+
+    Attributes
+    ----------
+    cuts : tuple of int
+        The cut positions (:func:`cut_plans`); ``()`` for the combinational design.
+    latency : int
+        Clock cycles from input to output, ``len(cuts)``.
+    fmax_mhz : float
+        The Fmax measured on the target, MHz.
     """
 
     cuts: tuple[int, ...]
@@ -412,6 +509,14 @@ def verify_pipelined(design, *, bench_design=None):
     ``bench_design``: print the bench of this design instead (same module
     name and model, another latency) -- a deliberately wrong bench, which
     must fail (the mutation test of the check itself).
+
+    Parameters
+    ----------
+    design : object
+        A design of :mod:`chebnorm.hw`, combinational or pipelined.
+    bench_design : object or None, default None
+        A design whose test bench replaces ``design``'s (the mutation test); None
+        checks ``design`` with its own bench.
 
     Returns
     -------

@@ -45,6 +45,29 @@ class PlainTableDesign:
     >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
     >>> [int(v) for v in d.values[:3]], d.y_format.offset_code, d.y_format.frac_bits
     ([8, 7, 6], 8, 4)
+
+    Attributes
+    ----------
+    name : str
+        The design's name.
+    expression : str
+        The function ``f``.
+    variable : str
+        Its variable.
+    interval : tuple of (str, str)
+        The rational interval ``(lo, hi)``.
+    in_bits : int
+        Input code width, 1 to 20 (``MAX_TABLE_IN_BITS``).
+    out_bits : int
+        Output code width, 1 to 32.
+    y_format : QFormat
+        The output format (offset and fractional bits).
+    values : tuple of int
+        ``2**in_bits`` output codes, each ``0 <= values[k] < 2**out_bits``.
+    unproved : int
+        How many entries' rounding could not be proved (0: correctly rounded).
+    certificate : ExhaustiveCheck
+        The exhaustive bound of ``|y - f|`` over every code.
     """
 
     name: str
@@ -130,8 +153,13 @@ def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str 
         The function and its rational interval; code ``k`` of ``in_bits``
         bits stands for ``lo + (hi - lo) k / 2**in_bits``.
     in_bits, out_bits
-        Code widths (``1 <= in_bits <= 20``); the output LSB as in
-        :func:`~chebnorm.hw.multipartite.design_multipartite`.
+        Code widths (``1 <= in_bits <= 20``, ``1 <= out_bits <= 32``); the output LSB
+        as in :func:`~chebnorm.hw.multipartite.design_multipartite`.
+    name : str, default "table"
+        The design's name (the HDL module name is derived from it).
+    out_frac_bits : int or None, default None
+        Fractional bits ``F`` of the output, -60 to 60; None takes the most for which
+        ``out_bits`` hold every value (with an offset).
 
     Returns
     -------

@@ -40,6 +40,19 @@ class HardwareReport:
     """A sized design with its certified budget, its exhaustive measurement,
     its cost block and (when yosys ran) its cell count.
 
+    Attributes
+    ----------
+    design : HornerDesign
+        The sized datapath.
+    budget : ErrorBudget
+        Its certified error budget.
+    measurement : Measurement
+        Its errors measured over every valid input code.
+    block : Block
+        Its datapath blocks with their cost estimate.
+    synth : SynthResult or None
+        Yosys's cell count of the generated Verilog; None when yosys did not run.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -159,6 +172,39 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
             gappa: bool = True, synth: bool = True) -> HardwareReport:
     """Design, budget, measure (exhaustively) and optionally synthesize.
 
+    Parameters
+    ----------
+    table : CoefficientTable
+        A fitted monomial table.
+    in_bits, out_bits : int
+        Input (1 to 20) and output (1 to 32) code widths.
+    coef_bits : int or None, default None
+        Coefficient fractional bits (1 to :func:`~chebnorm.hw.horner.max_coef_bits`);
+        None keeps the table's fixed-point part.
+    acc_bits : int or None, default None
+        Accumulator fractional bits, 1 to 60; None: ``y_frac_bits + 3``.
+    rounding : {"rne", "trunc"}, default "rne"
+        Rounding of every datapath step.
+    x_frac_bits, y_frac_bits : int or None, default None
+        Fractional bits of the input and output formats; None takes the largest that fit
+        (see :func:`~chebnorm.hw.horner.design_horner`).
+    gappa : bool, default True
+        Cross-check the rounding bound with gappa when it is installed.
+    synth : bool, default True
+        Synthesize the Verilog with yosys (when installed) for the cell count.
+
+    Returns
+    -------
+    HardwareReport
+        The design with its budget, measurement, cost and cell count.
+
+    Raises
+    ------
+    ValueError
+        If ``table`` fails its re-verification (a field changed since it was made), an
+        argument is out of range (:func:`~chebnorm.hw.horner.design_horner`), or gappa
+        or yosys fails.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -195,6 +241,29 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
      'tb_chebnorm_dichotomy_d1_pipe.vhd']
     >>> hdl_outputs(r, "vhdl")["chebnorm_dichotomy_d1.hex"] == hdl_outputs(r)["chebnorm_dichotomy_d1.hex"]
     True
+
+    Parameters
+    ----------
+    report : HardwareReport
+        The analysed design; its budget goes into the banner.
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, for the banner.
+    command : str or None, default None
+        The command line that made the files, for the banner (None: no line).
+    pipelined : bool, default False
+        Also write the pipelined variant.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is not ``"verilog"`` or ``"vhdl"``.
     """
     return hdl_files(report.design, language, version=version, command=command,
                      budget=report.budget, pipelined=pipelined)
@@ -210,6 +279,22 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
     >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
     >>> sorted(verilog_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v']
+
+    Parameters
+    ----------
+    report : HardwareReport
+        The analysed design; its budget goes into the banner.
+    version : str, default ""
+        chebnorm's version, for the banner.
+    command : str or None, default None
+        The command line that made the files, for the banner (None: no line).
+    pipelined : bool, default False
+        Also write the pipelined variant.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text.
     """
     return hdl_outputs(report, "verilog", version=version, command=command, pipelined=pipelined)
 
@@ -217,6 +302,24 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
 def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     """Write every file into ``directory`` (created if missing), all or none
     (:func:`chebnorm.core.files.write_folder`): nothing is half-written.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The folder to write into (created with its parents if missing).
+    files : dict of str to str
+        File name (a plain name, no folder) -> text.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The paths written, in the order of ``files``.
+
+    Raises
+    ------
+    chebnorm.core.files.WriteError
+        If a file cannot be written (a ``ValueError`` and an ``OSError``; nothing is
+        left behind).
 
     Examples
     --------

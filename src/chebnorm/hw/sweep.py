@@ -26,9 +26,14 @@ from .verilog import synthesize_text
 __all__ = ["SweepPoint", "SweepResult", "sweep", "pareto_png", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
            "DEFAULT_ACC_BITS", "HALF_LEVEL"]
 
+#: polynomial degrees a :func:`sweep` tries by default
 DEFAULT_DEGREES = (1, 2, 3, 4)
+#: coefficient fractional bits a :func:`sweep` tries by default
 DEFAULT_COEF_BITS = (10, 14, 18)
+#: accumulator fractional bits a :func:`sweep` tries by default (degree 2 and up)
 DEFAULT_ACC_BITS = (14, 18)
+#: the shading-error goal: half a level of an 8-bit intensity (``meets_half_level``, the dashed
+#: line of the plot)
 HALF_LEVEL = 0.5
 
 COLUMNS = ("degree", "coef_bits", "acc_bits", "in_bits", "out_bits", "y_frac_bits",
@@ -43,6 +48,35 @@ class SweepPoint:
     levels, ``shading_levels``), its certified budget and its area (yosys
     cells when yosys ran, else the full-adder estimate ``area_fa``);
     ``pareto`` marks the designs no other beats on both error and area.
+
+    Attributes
+    ----------
+    degree : int
+        Polynomial degree, 1 to 4.
+    coef_bits : int
+        Fractional bits of the coefficients.
+    acc_bits : int or None
+        Fractional bits of the accumulators; None for degree 1 (no accumulator).
+    in_bits, out_bits : int
+        Input and output code widths.
+    y_frac_bits : int
+        Fractional bits of the output.
+    max_error : float
+        ``max |y - f|`` measured over every valid input code.
+    max_error_lsb : float
+        ``max_error`` in output LSBs.
+    budget : float
+        The certified bound of ``|y - f|`` (:class:`~chebnorm.hw.budget.ErrorBudget`).
+    budget_lsb : float
+        ``budget`` in output LSBs.
+    shading_levels : float
+        ``255 * max |y / f - 1|``: the worst change of an 8-bit intensity.
+    yosys_cells : int or None
+        Yosys's cell count; None when yosys did not run.
+    area_fa : float
+        The full-adder-equivalent area estimate (:class:`~chebnorm.hw.cost.Cost`).
+    pareto : bool, default False
+        True when no other point of the sweep has both less area and less error.
 
     Examples
     --------
@@ -95,6 +129,15 @@ class SweepResult:
     """All points of a sweep of one target (see :func:`sweep`), with
     ``area_source`` saying whether areas are yosys cells or estimates.
 
+    Attributes
+    ----------
+    target : str
+        The target swept (a name of :func:`chebnorm.approx.targets.get_target`).
+    points : tuple of SweepPoint
+        Every design, sorted by degree, coefficient bits, accumulator bits.
+    area_source : {"yosys", "estimate"}
+        Whether ``area`` is yosys's cell count or the full-adder estimate.
+
     Examples
     --------
     >>> s = sweep("dichotomy", degrees=(1, 2), coef_bits=(10, 14), acc_bits=(14,), in_bits=8,
@@ -146,6 +189,26 @@ def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: st
     ...                  best=(pts[0], "best"), xlabel="cost", ylabel="error", title="t")
     >>> png[1:4]
     b'PNG'
+
+    Parameters
+    ----------
+    points : sequence
+        The designs; each has ``degree`` (int) and ``pareto`` (bool) attributes.
+    x, y : callable
+        Point -> coordinate (``y`` must be > 0: log axis; ``x`` too with ``xlog``).
+    hline : tuple of (float, str)
+        A dashed horizontal line's value and legend label.
+    best : tuple of (object or None, str)
+        The point to circle (None: none) and its label.
+    xlabel, ylabel, title : str
+        Axis labels and the plot title.
+    xlog : bool, default False
+        Log scale on the ``x`` axis too.
+
+    Returns
+    -------
+    bytes
+        The PNG file's bytes, the same for the same input.
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -211,6 +274,43 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     ``workers`` local processes (default: the core count) or on a Dask
     ``scheduler`` (:func:`chebnorm.core.parallel.map_ordered`); the result is
     the same whatever runs it.
+
+    Parameters
+    ----------
+    target : str, default "dichotomy"
+        A registered target name (:func:`chebnorm.approx.targets.get_target`).
+    degrees : iterable of int, default DEFAULT_DEGREES
+        Degrees to fit, each 1 to 4.
+    coef_bits : iterable of int, default DEFAULT_COEF_BITS
+        Coefficient fractional bits, each 1 to the largest every table's int32
+        coefficients allow (:func:`~chebnorm.hw.horner.max_coef_bits`, at most 40).
+    acc_bits : iterable of int, default DEFAULT_ACC_BITS
+        Accumulator fractional bits, each 1 to 60 (degree 2 and up only).
+    in_bits, out_bits : int, default 12
+        Input (1 to 20) and output (1 to 32) code widths.
+    rounding : {"rne", "trunc"}, default "rne"
+        Rounding of every datapath step.
+    psi_max : str or float, default "pi/4"
+        The target's angle bound (passed to :func:`chebnorm.approx.fit_target`).
+    synth : bool, default True
+        Run yosys for the cell count when it is installed.
+    workers : int or None, default None
+        Local worker processes, ``>= 1``; None: the core count.
+    scheduler : object or None, default None
+        A Dask scheduler (address or client) to run on instead of local processes.
+    progress : bool, default True
+        Show a progress bar on stderr.
+
+    Returns
+    -------
+    SweepResult
+        Every point with its Pareto mark.
+
+    Raises
+    ------
+    ValueError
+        If the target is unknown or a width, degree, worker count or scheduler is out of
+        its range.
 
     Examples
     --------

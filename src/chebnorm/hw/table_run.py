@@ -23,6 +23,26 @@ def simulate_table(design, directory, language: str = "verilog") -> SimResult:
     ``directory`` and run the bench (Icarus Verilog or GHDL): every input
     code's output compared with ``design.evaluate``'s.
 
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        A table-based design with a bit-accurate ``evaluate``.
+    directory : str or os.PathLike
+        The folder to write into (created if missing); the files stay there.
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL, simulated with Icarus Verilog or GHDL.
+
+    Returns
+    -------
+    SimResult
+        The bench's verdict.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown, the simulator is missing or fails, or the files
+        cannot be written.
+
     Examples
     --------
     >>> import tempfile

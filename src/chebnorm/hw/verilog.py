@@ -21,7 +21,19 @@ __all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_tex
 
 @dataclass(frozen=True)
 class SimResult:
-    """Outcome of an Icarus Verilog run of the test bench."""
+    """Outcome of an Icarus Verilog run of the test bench.
+
+    Attributes
+    ----------
+    passed : bool
+        True when the bench printed ``PASS`` (every vector matched).
+    vectors : int
+        How many input vectors the bench checked.
+    mismatches : int
+        How many outputs differed from the model.
+    line : str
+        The bench's verdict line, e.g. ``"PASS: 256 vectors, 0 mismatches (NAME)"``.
+    """
 
     passed: bool
     vectors: int
@@ -31,7 +43,15 @@ class SimResult:
 
 @dataclass(frozen=True)
 class SynthResult:
-    """``yosys synth; stat`` of one module: total cells and cells by type."""
+    """``yosys synth; stat`` of one module: total cells and cells by type.
+
+    Attributes
+    ----------
+    cells : int
+        Total number of cells after ``synth``.
+    by_type : dict of str to int
+        Cell type (``$_AND_``, ``$_DFF_P_``, ...) -> count.
+    """
 
     cells: int
     by_type: dict
@@ -57,6 +77,11 @@ def tool_env() -> dict[str, str]:
 
     >>> tool_env()["TMPDIR"], "TMP" in tool_env()
     ('.', False)
+
+    Returns
+    -------
+    dict of str to str
+        A copy of ``os.environ`` with ``TMPDIR="."`` and without ``TMP``/``TEMP``.
     """
     env = {k: v for k, v in os.environ.items() if k not in ("TMPDIR", "TMP", "TEMP")}
     env["TMPDIR"] = "."
@@ -70,7 +95,30 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
     The two files are compiled from copies in a private temporary folder
     (``cwd``, with :func:`tool_env`), so no path and no environment variable
     reaches Icarus's internal shell commands; the bench then runs in
-    ``directory`` (where its vector file is)."""
+    ``directory`` (where its vector file is).
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The folder holding ``M.v``, ``tb_M.v`` and the bench's vector file.
+    design : object or str
+        Anything with a ``module_name`` attribute, or the module name ``M`` itself.
+    timeout : float, default 600
+        Seconds allowed for the compilation and for the run, each.
+
+    Returns
+    -------
+    SimResult
+        The bench's verdict (``passed`` False when some vector mismatched).
+
+    Raises
+    ------
+    ValueError
+        If iverilog or vvp is not installed, a file cannot be read, iverilog fails, or
+        the bench prints no PASS/FAIL line.
+    subprocess.TimeoutExpired
+        If a step runs longer than ``timeout``.
+    """
     iverilog, vvp = _need("iverilog"), _need("vvp")
     d = Path(directory)
     name = design if isinstance(design, str) else design.module_name
@@ -108,6 +156,20 @@ def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
     shell command from ``TMPDIR``) on the fixed script
     ``read_verilog design.v; synth -top TOP; stat``, ``top`` an identifier.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The Verilog file.
+    top : str
+        The module to synthesize, a Verilog identifier ``[A-Za-z_][A-Za-z0-9_]*``.
+    timeout : float, default 600
+        Seconds allowed for yosys.
+
+    Returns
+    -------
+    SynthResult
+        The cell counts of ``stat``.
+
     Raises
     ------
     ValueError
@@ -139,7 +201,27 @@ def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
 
 def synthesize_text(verilog: str, top: str, timeout: float = 600) -> SynthResult:
     """:func:`synthesize` of Verilog text (yosys reads it in a temporary
-    folder, by a fixed relative name)."""
+    folder, by a fixed relative name).
+
+    Parameters
+    ----------
+    verilog : str
+        The Verilog source.
+    top : str
+        The module to synthesize, a Verilog identifier.
+    timeout : float, default 600
+        Seconds allowed for yosys.
+
+    Returns
+    -------
+    SynthResult
+        The cell counts of ``stat``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`synthesize`: ``top`` not an identifier, yosys missing or failing.
+    """
     with tempfile.TemporaryDirectory() as tmp:
         f = Path(tmp) / "input.v"
         f.write_text(verilog, encoding="utf-8")

@@ -23,7 +23,30 @@ __all__ = ["simulate_vhdl", "vhdl_outputs"]
 def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     """Analyse ``NAME.vhd`` and ``tb_NAME.vhd`` in ``directory`` with GHDL
     (VHDL-2008), elaborate and run the bench; ``design``: a design, or the
-    entity name. The bench leaves ``NAME_vhdl_y.hex`` in ``directory``."""
+    entity name. The bench leaves ``NAME_vhdl_y.hex`` in ``directory``.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The folder holding ``NAME.vhd``, ``tb_NAME.vhd`` and the bench's vector file.
+    design : object or str
+        Anything with a ``module_name`` attribute, or the entity name itself.
+    timeout : float, default 600
+        Seconds allowed for each GHDL step (analyse, elaborate, run).
+
+    Returns
+    -------
+    SimResult
+        The bench's verdict (``passed`` False when some vector mismatched).
+
+    Raises
+    ------
+    ValueError
+        If ghdl is not installed, a GHDL step fails, or the bench prints no PASS/FAIL
+        line.
+    subprocess.TimeoutExpired
+        If a step runs longer than ``timeout``.
+    """
     ghdl = shutil.which("ghdl")
     if ghdl is None:
         raise ValueError("ghdl is not installed (needed for this step); accepted: install it "
@@ -60,6 +83,22 @@ def vhdl_outputs(report, *, version: str = "", command: str | None = None,
     >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
     >>> sorted(vhdl_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'tb_chebnorm_dichotomy_d1.vhd']
+
+    Parameters
+    ----------
+    report : HardwareReport
+        The analysed design; its budget goes into the banner.
+    version : str, default ""
+        chebnorm's version, for the banner.
+    command : str or None, default None
+        The command line that made the files, for the banner (None: no line).
+    pipelined : bool, default False
+        Also write the pipelined entity and its bench.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text.
     """
     return hdl_files(report.design, "vhdl", version=version, command=command,
                      budget=report.budget, pipelined=pipelined)

@@ -62,6 +62,21 @@ def is_piecewise(design) -> bool:
     >>> from chebnorm.hw.horner import design_horner
     >>> is_piecewise(design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10))
     False
+
+    Parameters
+    ----------
+    design : object
+        The object to classify.
+
+    Returns
+    -------
+    bool
+        True for a piecewise design, False for a Horner design.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is neither.
     """
     if isinstance(design, HornerDesign):
         return False
@@ -97,6 +112,37 @@ def banner_facts(design, language: str = "verilog", *, version: str = "",
     >>> text = module_text(d, "vhdl", version="1.0")
     >>> text.startswith("\\n".join(comment_lines(banner_facts(d, "vhdl", version="1.0"), "vhdl")))
     True
+
+    Parameters
+    ----------
+    design : HornerDesign or PiecewiseDesign
+        The design to print: a Horner evaluator
+        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
+        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+    pipelined : bool, default False
+        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
+        Horner design of degree >= 1 only).
+
+    Returns
+    -------
+    list of str
+        The banner lines, without comment marker (``""``: an empty comment line).
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a Horner or piecewise design, ``language`` is unknown, or
+        ``pipelined`` is asked for a piecewise or a degree-0 design.
     """
     _printers(design, language, pipelined)
     if is_piecewise(design):
@@ -118,6 +164,37 @@ def module_text(design, language: str = "verilog", *, pipelined: bool = False,
     >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
     >>> module_text(d) == verilog_module(d), module_text(d, "vhdl", pipelined=True) == vhdl_pipelined_module(d)
     (True, True)
+
+    Parameters
+    ----------
+    design : HornerDesign or PiecewiseDesign
+        The design to print: a Horner evaluator
+        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
+        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    pipelined : bool, default False
+        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
+        Horner design of degree >= 1 only).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The module (Verilog) or entity and architecture (VHDL) text, banner first.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a Horner or piecewise design, ``language`` is unknown, or
+        ``pipelined`` is asked for a piecewise or a degree-0 design.
     """
     module, _ = _printers(design, language, pipelined)
     if is_piecewise(design):
@@ -136,6 +213,34 @@ def testbench_text(design, language: str = "verilog", *, pipelined: bool = False
     >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
     >>> testbench_text(d, "vhdl").splitlines()[0]
     '-- tb_chebnorm_dichotomy_d1: exhaustive self-checking test bench of chebnorm_dichotomy_d1.'
+
+    Parameters
+    ----------
+    design : HornerDesign or PiecewiseDesign
+        The design to print: a Horner evaluator
+        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
+        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    pipelined : bool, default False
+        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
+        Horner design of degree >= 1 only).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The bench: every input code applied, each output compared with the vector file.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a Horner or piecewise design, ``language`` is unknown, or
+        ``pipelined`` is asked for a piecewise or a degree-0 design.
+    ValueError
+        If ``vectors`` is not an identifier (plus ``.hex``).
     """
     _, bench = _printers(design, language, pipelined)
     if is_piecewise(design) and design.latency > 0:
@@ -155,6 +260,33 @@ def hdl_text(design, language: str = "verilog", *, version: str = "", command: s
     >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
     >>> hdl_text(d) == verilog_module(d) + "\\n" + verilog_pipelined_module(d)
     True
+
+    Parameters
+    ----------
+    design : HornerDesign or PiecewiseDesign
+        The design to print: a Horner evaluator
+        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
+        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The combinational module, then (Horner, degree >= 1) the pipelined one.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a Horner or piecewise design, or ``language`` is unknown.
     """
     kw = dict(version=version, command=command, budget=budget)
     text = module_text(design, language, **kw)
@@ -175,6 +307,37 @@ def hdl_files(design, language: str = "verilog", *, version: str = "",
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
     >>> list(hdl_files(design_piecewise(t, 8, 8), "vhdl"))
     ['chebnorm_rs.vhd', 'tb_chebnorm_rs.vhd', 'chebnorm_rs.hex']
+
+    Parameters
+    ----------
+    design : HornerDesign or PiecewiseDesign
+        The design to print: a Horner evaluator
+        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
+        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+    pipelined : bool, default False
+        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
+        Horner design of degree >= 1 only).
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a Horner or piecewise design, ``language`` is unknown, or
+        ``pipelined`` is asked for a piecewise or a degree-0 design.
     """
     kw = dict(version=version, command=command, budget=budget)
     ext = SUFFIX[check_language(language)]

@@ -44,6 +44,21 @@ def check_language(language) -> str:
     Traceback (most recent call last):
     ...
     ValueError: language: unknown HDL 'spice'; accepted: verilog, vhdl
+
+    Parameters
+    ----------
+    language : object
+        The language asked for; accepted: ``"verilog"`` or ``"vhdl"``.
+
+    Returns
+    -------
+    str
+        ``language``, checked.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is not one of :data:`LANGUAGES`.
     """
     if not isinstance(language, str) or language not in LANGUAGES:
         raise ValueError(f"language: unknown HDL {str(language)[:40]!r}; accepted: "
@@ -59,6 +74,22 @@ def module_name(design) -> str:
     >>> from chebnorm.hw.horner import design_horner
     >>> module_name(design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10))
     'chebnorm_dichotomy_d1'
+
+    Parameters
+    ----------
+    design : object
+        A design of :mod:`chebnorm.hw` (Horner, piecewise, multipartite, plain table or a
+        pipelined one): anything with ``name`` and ``module_name``.
+
+    Returns
+    -------
+    str
+        ``design.module_name`` (``chebnorm_NAME``).
+
+    Raises
+    ------
+    ValueError
+        If ``design.name`` is not a safe identifier.
     """
     identifier(design.name, field="name")
     return design.module_name
@@ -66,6 +97,17 @@ def module_name(design) -> str:
 
 def pipelined_name(design) -> str:
     """Module name of the pipelined variant: ``chebnorm_NAME_pipe``.
+
+    Parameters
+    ----------
+    design : object
+        A design of :mod:`chebnorm.hw` (Horner, piecewise, multipartite, plain table or a
+        pipelined one): anything with ``name`` and ``module_name``.
+
+    Returns
+    -------
+    str
+        ``chebnorm_NAME_pipe``.
 
     Examples
     --------
@@ -86,6 +128,33 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
     budget when given (a :class:`~chebnorm.hw.budget.ErrorBudget`), and
     whether it is combinational or pipelined. Both languages state the same
     facts; only the word for the width constants is the language's own.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    language : {"verilog", "vhdl"}
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+    pipelined : bool, default False
+        State the pipelined variant's name and latency instead of the combinational one's.
+
+    Returns
+    -------
+    list of str
+        The banner lines.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown or a name is not a safe identifier.
 
     Examples
     --------
@@ -144,6 +213,21 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
     comment marker: the function, the segments, the tool, the command, the
     input and output formats, the ROM, the rounding and the certified error
     budget by part (:meth:`~chebnorm.hw.piecewise.PiecewiseDesign.budget`).
+
+    Parameters
+    ----------
+    design : PiecewiseDesign
+        The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    list of str
+        The banner lines, the same in both languages.
 
     Examples
     --------
@@ -207,6 +291,23 @@ def comment_lines(facts: list[str], language: str) -> list[str]:
     ['// Rounding: rne', '//']
     >>> comment_lines(["Rounding: rne", ""], "vhdl")
     ['-- Rounding: rne', '-- ']
+
+    Parameters
+    ----------
+    facts : list of str
+        The banner lines (no line breaks).
+    language : {"verilog", "vhdl"}
+        The HDL.
+
+    Returns
+    -------
+    list of str
+        One comment line per fact.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown.
     """
     if check_language(language) == "verilog":
         return [f"// {text}" if text else "//" for text in facts]
@@ -216,6 +317,16 @@ def comment_lines(facts: list[str], language: str) -> list[str]:
 def vector_file(design) -> str:
     """Expected ``y`` of every input code, one hex word a line (``$readmemh``;
     the VHDL benches read the same file).
+
+    Parameters
+    ----------
+    design : object
+        A design with a bit-accurate ``evaluate()`` over every input code and ``out_bits``.
+
+    Returns
+    -------
+    str
+        ``2**in_bits`` lines of ``ceil(out_bits / 4)`` lowercase hex digits each.
 
     Examples
     --------
@@ -238,6 +349,24 @@ def vectors_name(name: str, vectors: str | None) -> str:
 
     >>> vectors_name("chebnorm_f", None), vectors_name("chebnorm_f", "v.hex")
     ('chebnorm_f.hex', 'v.hex')
+
+    Parameters
+    ----------
+    name : str
+        The module name (already checked).
+    vectors : str or None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        ``NAME.hex`` or ``vectors`` as given.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) is not a safe identifier.
     """
     if vectors is None:
         return f"{name}.hex"

@@ -46,6 +46,23 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
     >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
     >>> table_facts(d)[0]
     'chebnorm_table: plain table (correctly rounded) of 1/sqrt(1+3*x) on [0, 1).'
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
+        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
+        pipeline cuts).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    list of str
+        The banner lines, the same in both languages.
     """
     kind = _kind(design)
     name = module_name(design)
@@ -108,6 +125,23 @@ def table_cuts(design) -> tuple[int, ...]:
     >>> from chebnorm.hw.plain_table import design_plain_table
     >>> table_cuts(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4))
     ()
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
+        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
+        pipeline cuts).
+
+    Returns
+    -------
+    tuple of int
+        The cut points, sorted, among 0 and 1; ``()`` for a combinational design.
+
+    Raises
+    ------
+    ValueError
+        If ``design.cuts`` is not a sorted set of 0 and 1 (or is non-empty for a plain table).
     """
     cuts = tuple(getattr(design, "cuts", ()) or ())
     if cuts and (_kind(design) != "multipartite" or not set(cuts) <= set(TABLE_CUTS)
@@ -297,6 +331,30 @@ def table_module(design, language: str = "verilog", *, version: str = "",
     >>> v = table_module(d)
     >>> "module chebnorm_table" in v, v.count(": rom = ")    # one ROM row per code + default
     (True, 17)
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
+        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
+        pipeline cuts).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The module (entity) text, banner first.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown or the cuts are invalid.
     """
     facts = table_facts(design, version=version, command=command)
     if check_language(language) == "verilog":
@@ -311,6 +369,26 @@ def table_testbench(design, language: str = "verilog") -> str:
     >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
     >>> table_testbench(d).splitlines()[0]
     '// tb_chebnorm_table: exhaustive self-checking test bench of chebnorm_table.'
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
+        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
+        pipeline cuts).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+
+    Returns
+    -------
+    str
+        The bench text: every input code applied (one per clock cycle when pipelined),
+        each output compared with ``NAME.hex``.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown.
     """
     if table_cuts(design):  # clocked: one code per cycle, checked LATENCY cycles later
         if check_language(language) == "verilog":
@@ -331,6 +409,30 @@ def table_files(design, language: str = "verilog", *, version: str = "",
     >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
     >>> list(table_files(d))
     ['chebnorm_table.v', 'tb_chebnorm_table.v', 'chebnorm_table.hex']
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
+        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
+        pipeline cuts).
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown or the cuts are invalid.
     """
     ext = SUFFIX[check_language(language)]
     name = module_name(design)

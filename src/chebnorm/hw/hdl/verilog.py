@@ -47,6 +47,23 @@ def signed_literal(value: int, bits: int) -> str:
     Traceback (most recent call last):
     ...
     ValueError: constant 8 does not fit a signed 4-bit literal
+
+    Parameters
+    ----------
+    value : int
+        The constant.
+    bits : int
+        The literal's width, ``>= 1``; ``value`` must lie in ``[-2**(bits-1), 2**(bits-1) - 1]``.
+
+    Returns
+    -------
+    str
+        The literal, e.g. ``"4'sd5"`` or ``"-4'sd8"``.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` does not fit a signed ``bits``-bit word.
     """
     if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
         raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
@@ -66,6 +83,26 @@ def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
         wire signed [9:0] a = a_q + $signed({1'b0, a_inc});
     >>> round_lines("s", "a", 12, 1, 11, "trunc")[-1]
     '    wire signed [10:0] a = a_q;'
+
+    Parameters
+    ----------
+    src : str
+        The signed wire to round.
+    dst : str
+        The name of the rounded wire (``DST_q`` and ``DST_inc`` are declared too).
+    src_bits : int
+        Width of ``src``.
+    shift : int
+        Bits to drop, ``>= 1``.
+    dst_bits : int
+        Width of ``dst`` (wide enough for the rounded value plus the increment).
+    mode : {"trunc", "rne"}
+        Rounding mode (:data:`~chebnorm.hw.fixed.ROUNDINGS`).
+
+    Returns
+    -------
+    list of str
+        Verilog declaration lines, indented by four spaces.
     """
     lines = [f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};"]
     if mode == "trunc":
@@ -89,6 +126,34 @@ def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat,
     >>> print("\\n".join(lines[-4:-2]))
         wire signed [14:0] raw = r - KY;
         assign y = raw[14] ? {OUT_BITS{1'b0}} : (raw > YMAX) ? {OUT_BITS{1'b1}} : raw[OUT_BITS-1:0];
+
+    Parameters
+    ----------
+    top : str
+        The last sum's signed wire.
+    top_bits : int
+        Its width.
+    top_frac : int
+        Its fractional bits.
+    y_format : QFormat
+        The output format (fractional bits, offset code, ``max_code``).
+    out_bits : int
+        Width of the output port ``y``.
+    rounding : {"trunc", "rne"}
+        Rounding to ``y_format.frac_bits`` when ``top_frac`` is larger.
+    min_bits : int, default 0
+        A lower bound of the working width.
+
+    Returns
+    -------
+    list of str
+        Verilog lines, ending with ``endmodule`` and an empty line.
+
+    Raises
+    ------
+    ValueError
+        If the offset code or ``max_code`` does not fit the working width (not expected: the
+        width is chosen to hold them).
     """
     shift = top_frac - y_format.frac_bits
     rw = max(min_bits, top_bits + max(0, -shift) + 1, out_bits + 2,
@@ -116,6 +181,16 @@ def bench_verdict(name: str) -> list[str]:
     >>> print("\\n".join(bench_verdict("chebnorm_f")[:2]))
             if (errors == 0)
                 $display("PASS: %0d vectors, 0 mismatches (chebnorm_f)", COUNT);
+
+    Parameters
+    ----------
+    name : str
+        The module name printed in the verdict (an identifier).
+
+    Returns
+    -------
+    list of str
+        Verilog lines, ending with ``endmodule`` and an empty line.
     """
     return ["        if (errors == 0)",
             f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
@@ -131,6 +206,29 @@ def bench_verdict(name: str) -> list[str]:
 def verilog_module(design: HornerDesign, *, version: str = "", command: str | None = None,
                    budget=None) -> str:
     """The synthesizable Verilog-2005 module of ``design``.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text, banner first.
+
+    Raises
+    ------
+    ValueError
+        If the design's name is not a safe identifier.
 
     Examples
     --------
@@ -206,6 +304,31 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     -- ``y`` after the ``degree``-th rising edge belongs to the ``x`` applied
     before the first; a new ``x`` can be applied every cycle.
 
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text of ``chebnorm_NAME_pipe``, banner first.
+
+    Raises
+    ------
+    ValueError
+        If the design has degree 0 (nothing to pipeline).
+    ValueError
+        If the design's name is not a safe identifier.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -262,6 +385,26 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     code per cycle; the output after edge ``i`` is checked against the model's
     answer for code ``i - LATENCY + 1`` (the first ``LATENCY - 1`` edges are
     the pipeline filling and are not checked).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 bench text.
+
+    Raises
+    ------
+    ValueError
+        If the design has degree 0 (nothing to pipeline).
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
 
     Examples
     --------
@@ -327,6 +470,24 @@ def _clocked_bench(design, name: str, n: int, vectors: str | None) -> str:
 def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """A self-checking test bench comparing every input code with the model.
 
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -375,6 +536,22 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     """The synthesizable Verilog-2005 module of a piecewise design ``d``
     (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`): ROM (a case on the
     index) + Horner.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`); a sized
+        one (``d.sized``) is printed by :func:`sized_piecewise_verilog`.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text, banner first.
 
     Examples
     --------
@@ -456,6 +633,21 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     and, when ``d.latency > 0``, a register stage at each cut point (``clk``
     port, ``LATENCY`` parameter): bit for bit
     :meth:`~chebnorm.hw.piecewise.PiecewiseDesign.evaluate`.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text, banner first.
 
     Examples
     --------
@@ -598,5 +790,23 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline=(0,))
     >>> piecewise_clocked_testbench(d).splitlines()[0]
     '// tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs, latency 1.'
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A sized piecewise design with pipeline cuts (``d.latency > 0``).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The Verilog bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
     return _clocked_bench(d, module_name(d), d.latency, vectors)

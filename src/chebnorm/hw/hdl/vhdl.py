@@ -176,6 +176,29 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
     >>> d = design_horner(fit_target("dichotomy", 2), 8, 8, coef_bits=12)
     >>> "entity chebnorm_dichotomy_d2 is" in vhdl_module(d)
     True
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 text, banner first.
+
+    Raises
+    ------
+    ValueError
+        If the design's name is not a safe identifier.
     """
     name = design.module_name
     n = design.degree
@@ -215,6 +238,31 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
     """The pipelined VHDL evaluator ``chebnorm_NAME_pipe``: the datapath of
     :func:`vhdl_module` with one register stage after each Horner step, as
     :func:`~chebnorm.hw.hdl.verilog.verilog_pipelined_module` (latency ``degree``).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+    budget : ErrorBudget or None, default None
+        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
+        stated in the banner; None: not stated. A piecewise design states its own.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 text of ``chebnorm_NAME_pipe``, banner first.
+
+    Raises
+    ------
+    ValueError
+        If the design has degree 0 (nothing to pipeline).
+    ValueError
+        If the design's name is not a safe identifier.
 
     Examples
     --------
@@ -372,6 +420,24 @@ def _bench(design, name: str, vectors: str | None, clocked: bool,
 def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive self-checking bench of :func:`vhdl_module` (every input code).
 
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target
@@ -388,6 +454,26 @@ def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
 def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive bench of the pipelined entity: one code per cycle, the output
     after edge ``i`` checked against code ``i - LATENCY + 1``.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 bench text.
+
+    Raises
+    ------
+    ValueError
+        If the design has degree 0 (nothing to pipeline).
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
 
     Examples
     --------
@@ -429,6 +515,22 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     variable, bit for bit the module of
     :func:`~chebnorm.hw.hdl.verilog.piecewise_verilog` (the same wire widths;
     every width change through ``wrap``, as a Verilog assignment).
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`); a sized
+        one (``d.sized``) is printed by :func:`sized_piecewise_vhdl`.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 text, banner first.
 
     Examples
     --------
@@ -486,6 +588,24 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     """Exhaustive self-checking bench of :func:`piecewise_vhdl` (every input
     code against the model's ``NAME.hex``, as the Verilog bench).
 
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The VHDL bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -502,6 +622,21 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     bit for bit :func:`~chebnorm.hw.hdl.verilog.sized_piecewise_verilog`
     (the same wire widths, the same cut registers; every width change
     through ``wrap``).
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 text, banner first.
 
     Examples
     --------
@@ -651,5 +786,23 @@ def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
     >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5, pipeline="full")
     >>> [ln.strip() for ln in piecewise_vhdl_clocked_testbench(d).splitlines() if "LATENCY  :" in ln]
     ['constant LATENCY  : natural := 2;']
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A sized piecewise design with pipeline cuts (``d.latency > 0``).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
+        ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The VHDL bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
     return _bench(d, module_name(d), vectors, clocked=True, latency=d.latency)

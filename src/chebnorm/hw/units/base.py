@@ -34,9 +34,13 @@ __all__ = ["Port", "UnitDesign", "UnitKind", "UNITS", "register", "get_unit", "u
            "vec_ports", "MAX_COMP_BITS", "MAX_UNIT_FRAC_BITS", "MAX_LOG_M", "MAX_GUARD",
            "EXHAUSTIVE_BITS"]
 
+#: widest vector component (``comp_bits``, W) a unit accepts
 MAX_COMP_BITS = 28
+#: most fractional bits (``frac_bits``, F) of a unit's components
 MAX_UNIT_FRAC_BITS = 26
+#: largest ``log_m`` of the stepper unit (``2**log_m`` pixels per span)
 MAX_LOG_M = 10
+#: most guard bits of the stepper unit's set-up
 MAX_GUARD = 24
 #: input spaces up to this many bits are tested exhaustively
 EXHAUSTIVE_BITS = 16
@@ -45,6 +49,17 @@ EXHAUSTIVE_BITS = 16
 @dataclass(frozen=True)
 class Port:
     """One port: ``bits`` wide, two's complement when ``signed``.
+
+    Attributes
+    ----------
+    name : str
+        The Verilog port name (``<vector>_x``, ``skip``, ...).
+    bits : int
+        Width, ``>= 1``.
+    signed : bool, default True
+        Two's complement when true.
+    output : bool, default False
+        An output port when true, else an input.
 
     Examples
     --------
@@ -62,6 +77,22 @@ def vec_ports(name: str, bits: int, output: bool = False,
               signed: bool = True) -> tuple[Port, ...]:
     """The three ports ``<name>_x``, ``<name>_y``, ``<name>_z``.
 
+    Parameters
+    ----------
+    name : str
+        The vector's name.
+    bits : int
+        Width of each component, ``>= 1``.
+    output : bool, default False
+        Output ports when true.
+    signed : bool, default True
+        Two's-complement components.
+
+    Returns
+    -------
+    tuple of Port
+        ``<name>_x``, ``<name>_y``, ``<name>_z``.
+
     Examples
     --------
     >>> [(p.name, p.bits, p.output) for p in vec_ports("m", 9, output=True)]
@@ -74,6 +105,29 @@ def vec_ports(name: str, bits: int, output: bool = False,
 class UnitDesign:
     """A sized normalization unit (see :mod:`chebnorm.hw.units`); ``evaluate``
     is the bit-accurate model, :func:`~chebnorm.hw.units.unit_verilog` its circuit.
+
+    Attributes
+    ----------
+    kind : str
+        The unit's name in the registry (:func:`unit_names`).
+    ports : tuple of Port
+        Inputs and outputs, in port-list order.
+    frac_bits : int
+        ``F``: fractional bits of the components, 1 to :data:`MAX_UNIT_FRAC_BITS`.
+    comp_bits : int
+        ``W``: width of the components, 2 to :data:`MAX_COMP_BITS` (``F + 2`` holds ``[-2, 2)``).
+    horner : HornerDesign or None, default None
+        The polynomial evaluator (dichotomy, quadratic, eta units); None for the others.
+    rounding : {"rne", "trunc"}, default "rne"
+        The classic unit's quotient rounding or the evaluator's.
+    log_m : int, default 0
+        The stepper's span length ``m = 2**log_m``, 0 to :data:`MAX_LOG_M`.
+    guard : int, default 0
+        The stepper's guard bits, 0 to :data:`MAX_GUARD`.
+    sizes : dict of str to int, default {}
+        Widths sized by the kind (e.g. ``m_bits``, ``eta_bits``).
+    notes : tuple of str, default ()
+        Remarks on the sizing, stated in the banner.
 
     Examples
     --------
@@ -204,6 +258,21 @@ UNITS = MappingProxyType(_UNITS)
 def register(kind: UnitKind) -> UnitKind:
     """Add ``kind`` to the registry under ``kind.name`` (a new identifier).
 
+    Parameters
+    ----------
+    kind : UnitKind
+        The unit kind; its ``name`` must be an identifier not yet registered.
+
+    Returns
+    -------
+    UnitKind
+        ``kind`` (so it can decorate or be assigned).
+
+    Raises
+    ------
+    ValueError
+        If the name is not an identifier or is already registered.
+
     Examples
     --------
     >>> register(get_unit("classic"))
@@ -221,6 +290,11 @@ def register(kind: UnitKind) -> UnitKind:
 def unit_names() -> tuple[str, ...]:
     """The registered unit names, in registration order.
 
+    Returns
+    -------
+    tuple of str
+        The names, in registration order.
+
     Examples
     --------
     >>> unit_names()
@@ -231,6 +305,21 @@ def unit_names() -> tuple[str, ...]:
 
 def get_unit(name: str) -> UnitKind:
     """The registered unit ``name``; ValueError naming the accepted names.
+
+    Parameters
+    ----------
+    name : str
+        A registered unit name (:func:`unit_names`).
+
+    Returns
+    -------
+    UnitKind
+        The unit kind.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not registered (the message lists the accepted names).
 
     Examples
     --------

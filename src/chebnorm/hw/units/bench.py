@@ -15,6 +15,18 @@ __all__ = ["unit_vectors", "combinational_rows", "unit_vector_file", "unit_testb
 def unit_normals(rng, n: int) -> np.ndarray:
     """``n`` random unit vectors ``(n, 3)``.
 
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source.
+    n : int
+        How many, ``>= 0``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(n, 3)``, each row of norm 1.
+
     Examples
     --------
     >>> v = unit_normals(np.random.default_rng(0), 4)
@@ -27,6 +39,20 @@ def unit_normals(rng, n: int) -> np.ndarray:
 
 def near(rng, a: np.ndarray, psi: float) -> np.ndarray:
     """Unit vectors at angles in [0, psi] from the rows of ``a``.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source.
+    a : numpy.ndarray
+        Unit vectors, shape ``(n, 3)``.
+    psi : float
+        The largest angle, radians; the first four rows take 0, ``psi``, ``psi/2``, 1e-3.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(n, 3)``: unit vectors at uniform random angles in ``[0, psi]``.
 
     Examples
     --------
@@ -47,6 +73,21 @@ def near(rng, a: np.ndarray, psi: float) -> np.ndarray:
 def codes(v: np.ndarray, f: int, w: int) -> np.ndarray:
     """``w``-bit codes with ``f`` fractional bits of the values ``v`` (nearest, saturated).
 
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The values.
+    f : int
+        Fractional bits.
+    w : int
+        Signed code width, ``>= 1``.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        ``v * 2**f`` rounded to nearest (ties to even), clamped to
+        ``[-2**(w-1), 2**(w-1) - 1]``.
+
     Examples
     --------
     >>> codes(np.array([0.5, -1.0, 3.0]), 4, 6).tolist()   # 3.0 saturates to 31/16
@@ -63,6 +104,16 @@ def _rand(rng, n: int, port: Port) -> np.ndarray:
 
 def edges(port: Port) -> list[int]:
     """The extreme codes of ``port``: min, -1, 0, 1, max (those it has).
+
+    Parameters
+    ----------
+    port : Port
+        The port.
+
+    Returns
+    -------
+    list of int
+        The codes among min, -1, 0, 1, max that the port holds, ascending.
 
     Examples
     --------
@@ -83,6 +134,25 @@ def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
     (quantized unit normals at angles inside the table's interval, and
     their ``z``/threshold) and ``count`` rows of uniformly random codes.
 
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    count : int, default 2000
+        Realistic and random rows each, 1 to 10**6.
+    seed : int, default 0
+        The seed of ``numpy.random.default_rng``.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Input port name -> codes, one per row.
+
+    Raises
+    ------
+    ValueError
+        If ``count`` is out of range.
+
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
@@ -97,6 +167,23 @@ def unit_vectors(unit: UnitDesign, count: int = 2000, seed: int = 0) -> dict:
 def combinational_rows(unit: UnitDesign, rng, count: int, realistic) -> dict:
     """The rows of :func:`unit_vectors` of a combinational unit;
     ``realistic(rng, a)`` makes its realistic rows from the unit normals ``a``.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    rng : numpy.random.Generator
+        The random source.
+    count : int
+        Realistic and random rows each.
+    realistic : callable
+        ``realistic(rng, a) -> dict`` of input port -> codes, from unit normals ``a``
+        of shape ``(count, 3)``.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Input port name -> codes: every code, or edges, realistic and random rows.
 
     Examples
     --------
@@ -141,6 +228,23 @@ def _layout(unit: UnitDesign) -> tuple[list[tuple[Port, int, int]], int]:
 def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
     """Rows ``{inputs, expected outputs}`` in hex (``$readmemh``).
 
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    inputs : dict of str to numpy.ndarray
+        Input port name -> codes (:func:`unit_vectors`).
+
+    Returns
+    -------
+    str
+        One hex word per row: the inputs, then the model's outputs.
+
+    Raises
+    ------
+    ValueError
+        If an input or output code does not fit its port (an internal sizing error).
+
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
@@ -177,6 +281,20 @@ def _declarations(unit: UnitDesign, layout) -> list[str]:
 
 def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> str:
     """A self-checking test bench of ``count`` rows read from ``vectors``.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    count : int
+        How many rows the vector file holds.
+    vectors : str or None, default None
+        The vector file name; None: ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The Verilog bench text.
 
     Examples
     --------

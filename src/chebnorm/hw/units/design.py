@@ -38,6 +38,44 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
     >>> u = design_unit("stepper", frac_bits=6, log_m=2)
     >>> u.clocked, [p.name for p in u.outputs], u.sizes["v_bits"]
     (True, ['v_x', 'v_y', 'v_z'], 15)
+
+    Parameters
+    ----------
+    kind : str
+        A registered unit name: ``"classic"``, ``"dichotomy"``, ``"quadratic"``,
+        ``"stepper"``, ``"eta"``.
+    frac_bits : int, default 14
+        ``F``, 1 to :data:`~chebnorm.hw.units.base.MAX_UNIT_FRAC_BITS` (26).
+    comp_bits : int or None, default None
+        ``W``, 2 to :data:`~chebnorm.hw.units.base.MAX_COMP_BITS` (28); None: ``F + 2``.
+    table : CoefficientTable or None, default None
+        The evaluator's table (dichotomy, quadratic, eta); it must approximate the unit's
+        target function. None: fitted from the method registry.
+    in_bits, out_bits : int, default 16
+        The evaluator's input (1 to 20) and output (1 to 32) code widths.
+    coef_bits : int or None, default None
+        The evaluator's coefficient fractional bits; None: the table's own, or
+        ``min(out_bits + 4, 30)`` for a fitted table.
+    rounding : {"trunc", "rne"} or None, default None
+        The classic unit's quotient rounding (None: ``"trunc"``) or the evaluator's
+        (None: ``"rne"``).
+    log_m : int, default 4
+        The stepper's span ``m = 2**log_m`` pixels, 0 to
+        :data:`~chebnorm.hw.units.base.MAX_LOG_M` (10).
+    guard : int or None, default None
+        The stepper's guard bits, 0 to :data:`~chebnorm.hw.units.base.MAX_GUARD` (24);
+        None: ``2 * log_m``.
+
+    Returns
+    -------
+    UnitDesign
+        The sized unit.
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is unknown, a width is out of its range, the table does not fit the
+        unit, or a register would exceed the 62-bit model.
     """
     spec = get_unit(kind)
     f = check_width(frac_bits, "frac-bits", 1, MAX_UNIT_FRAC_BITS)
@@ -53,6 +91,21 @@ def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = N
     """The synthesizable Verilog-2005 text of ``unit``: the unit module, then
     its helper modules (square root, divider, polynomial evaluator).
 
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text.
+
     Examples
     --------
     >>> v = unit_verilog(design_unit("classic", frac_bits=6))
@@ -65,6 +118,30 @@ def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = N
 def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version: str = "",
                  command: str | None = None) -> dict[str, str]:
     """File name -> text: the unit's Verilog, its test bench and its vectors.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    count : int, default 2000
+        Realistic and random rows each, 1 to 10**6 (ignored when every input code is tested).
+    seed : int, default 0
+        The seed of the random rows (same seed, same files).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    dict of str to str
+        File name -> file text: ``NAME.v``, ``tb_NAME.v``, ``NAME.hex``.
+
+    Raises
+    ------
+    ValueError
+        If ``count`` is out of range.
 
     Examples
     --------
@@ -82,6 +159,15 @@ def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version:
 @dataclass(frozen=True)
 class UnitReport:
     """A unit with its cost model and (when yosys ran) its cell count.
+
+    Attributes
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    block : Block
+        The unit's datapath blocks with the cost estimate.
+    synth : SynthResult or None
+        Yosys's cell count; None when yosys did not run.
 
     Examples
     --------
@@ -115,6 +201,23 @@ class UnitReport:
 
 def analyze_unit(unit: UnitDesign, *, synth: bool = True) -> UnitReport:
     """The unit's cost model and, with yosys installed and ``synth``, its cell count.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    synth : bool, default True
+        Run yosys (when installed) for the cell count.
+
+    Returns
+    -------
+    UnitReport
+        The cost model and the cell count.
+
+    Raises
+    ------
+    ValueError
+        If yosys fails.
 
     Examples
     --------

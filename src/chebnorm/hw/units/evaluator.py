@@ -28,6 +28,18 @@ def table_matches(kind: str, table: CoefficientTable) -> bool:
     """True when ``table`` approximates the function of unit ``kind``'s target
     (:data:`~chebnorm.hw.units.UNIT_TARGETS`), whatever its variable is called.
 
+    Parameters
+    ----------
+    kind : str
+        A registered unit name.
+    table : CoefficientTable
+        The candidate table.
+
+    Returns
+    -------
+    bool
+        True when the table's expression equals the target's (symbolically).
+
     Examples
     --------
     >>> from chebnorm.approx import fit
@@ -82,6 +94,23 @@ def _rne_range(lo: int, hi: int, shift: int) -> tuple[int, int]:
 def scaled_range(w: int, d: HornerDesign) -> tuple[int, int, int]:
     """Range of ``R((N1 + N2) (y + KY))`` over every code, and the width of ``y + KY``.
 
+    Parameters
+    ----------
+    w : int
+        Width of the vector components ``N1``, ``N2``.
+    d : HornerDesign
+        The evaluator whose output ``y`` scales the sum.
+
+    Returns
+    -------
+    tuple of (int, int, int)
+        The smallest and largest rounded product, and the signed width of ``y + KY``.
+
+    Raises
+    ------
+    ValueError
+        If the product exceeds the 62-bit model.
+
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
@@ -101,6 +130,16 @@ def scaled_range(w: int, d: HornerDesign) -> tuple[int, int, int]:
 def dot_range(w: int) -> tuple[int, int]:
     """Range of the dot product of two 3-vectors of ``w``-bit codes.
 
+    Parameters
+    ----------
+    w : int
+        Width of each component, ``>= 1``.
+
+    Returns
+    -------
+    tuple of (int, int)
+        The smallest and largest dot product.
+
     Examples
     --------
     >>> dot_range(4)   # codes -8..7: 3 * (-8) * 7 .. 3 * (-8) * (-8)
@@ -118,6 +157,21 @@ def check_dot(w: int, f: int, d: HornerDesign) -> None:
 
 def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
     """Lines: the exact dot product of vectors ``a``, ``b`` and its input code ``k_tag``.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        A unit with a polynomial evaluator (``unit.horner`` set).
+    a, b : str
+        The two vectors' port-name stems.
+    tag : str
+        Suffix of the declared wires (``dot_TAG``, ``k_TAG``).
+
+    Returns
+    -------
+    list of str
+        Verilog lines: the dot product, its rounding to the evaluator's input
+        fractional bits, and the saturated input code ``k_TAG``.
 
     Examples
     --------
@@ -150,6 +204,22 @@ def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
 
 def scale_lines(unit: UnitDesign, a: str, b: str, out: str, ycode: str) -> list[str]:
     """Lines: ``out_c = R((a_c + b_c) * (ycode + KY))`` for c in x, y, z.
+
+    Parameters
+    ----------
+    unit : UnitDesign
+        A unit with a polynomial evaluator (``unit.horner`` set).
+    a, b : str
+        The two vectors' port-name stems.
+    out : str
+        The output vector's stem.
+    ycode : str
+        The evaluator's output wire.
+
+    Returns
+    -------
+    list of str
+        Verilog lines, rounding to nearest-even.
 
     Examples
     --------

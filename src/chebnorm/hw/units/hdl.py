@@ -23,6 +23,22 @@ def banner(unit: UnitDesign, version: str, command: str | None, what: list[str])
     Text a user controls (command, table expression and interval) goes through
     :func:`~chebnorm.core.textsafe.comment_text`.
 
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    version : str
+        chebnorm's version.
+    command : str or None
+        The command line (None or empty: no such line).
+    what : list of str
+        The unit's description, first line after the module name.
+
+    Returns
+    -------
+    list of str
+        Verilog ``//`` comment lines.
+
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
@@ -52,6 +68,18 @@ def banner(unit: UnitDesign, version: str, command: str | None, what: list[str])
 def ports_decl(unit: UnitDesign, widths: dict) -> list[str]:
     """The port list; ``widths`` (port name -> MSB expression) overrides ``bits - 1``.
 
+    Parameters
+    ----------
+    unit : UnitDesign
+        The sized unit (:func:`~chebnorm.hw.units.design_unit`).
+    widths : dict of str to str
+        Port name -> MSB expression (e.g. ``"W-1"``) replacing ``bits - 1``.
+
+    Returns
+    -------
+    list of str
+        The port declarations, comma-separated, in ``unit.ports`` order.
+
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
@@ -73,6 +101,16 @@ def ports_decl(unit: UnitDesign, widths: dict) -> list[str]:
 
 def isqrt_module(name: str) -> list[str]:
     """Module ``name``: ``r = floor(sqrt(v))``, parameter ``RW`` result bits.
+
+    Parameters
+    ----------
+    name : str
+        The module name (an identifier).
+
+    Returns
+    -------
+    list of str
+        Verilog lines of a restoring square root: ``2*RW``-bit ``v``, ``RW``-bit ``r``.
 
     Examples
     --------
