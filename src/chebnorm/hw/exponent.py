@@ -75,6 +75,22 @@ def exponent_fields(k, in_bits: int) -> dict:
     the binade bit ``1 - lz mod 2`` and the core's inner code
     ``{binade, mant[W-2:0]}``.
 
+    Parameters
+    ----------
+    k : int or array_like of int
+        Input codes, ``0 <= k < 2^in_bits``.
+    in_bits : int
+        The code width ``W``.
+
+    Returns
+    -------
+    dict
+        ``"lz"``, ``"mant"``, ``"h"``, ``"binade"``, ``"inner"``: int64 arrays
+        of the shape of ``k``.
+
+    Examples
+    --------
+
     >>> f = exponent_fields([1, 2, 3, 255, 0], 8)
     >>> [int(v) for v in f["lz"]], [int(v) for v in f["h"]], [int(v) for v in f["inner"]]
     ([7, 6, 6, 0, 8], [4, 4, 4, 1, 5], [0, 128, 192, 255, 128])
@@ -92,6 +108,26 @@ def exponent_fields(k, in_bits: int) -> dict:
 
 def check_rsqrt(expr, var: str = "x") -> str:
     """``expr`` if it is ``1/sqrt(var)`` (any equal sympy form), else ValueError.
+
+    Parameters
+    ----------
+    expr : str or sympy.Expr
+        The function asked for.
+    var : str
+        Its variable (default ``"x"``).
+
+    Returns
+    -------
+    str
+        ``expr`` as text.
+
+    Raises
+    ------
+    ValueError
+        When ``expr`` is not ``1/sqrt(var)``, naming it and the accepted form.
+
+    Examples
+    --------
 
     >>> check_rsqrt("x**(-1/2)")
     'x**(-1/2)'
@@ -127,6 +163,27 @@ def _check_interval(interval, in_bits: int) -> int:
 class ExponentDesign:
     """The exponent-indexed ``1/sqrt`` evaluator (module docstring): a
     leading-zero count and shift in front of a sized piecewise ``core``.
+
+    Built by :func:`design_exponent`; a hand-built one is checked the same
+    way (ValueError naming the field and its accepted values).
+
+    Attributes
+    ----------
+    name : str
+        The module name stem (an identifier): the module is ``chebnorm_NAME``.
+    expression : str
+        The function, ``1/sqrt(x)`` in some equal form.
+    variable : str
+        Its variable.
+    interval : tuple of str
+        ``("2^-m", "1")``: the codes ``k >= 2^(W - m)`` are in the spec.
+    in_bits : int
+        The input code width ``W``, 4..20.
+    core : PiecewiseDesign
+        The sized piecewise evaluator of ``g(v) = 1/sqrt(v)`` on ``[1, 4)``
+        (an exponent table) on the inner code.
+    shift_bits : int
+        ``H``, the width of the shift ``h = (lz + 2) >> 1``.
 
     Examples
     --------
@@ -366,6 +423,27 @@ def simulate_exponent(design: ExponentDesign, directory, language: str = "verilo
     """Write the module, its exhaustive bench and the model's vectors into
     ``directory`` and run the bench (Icarus Verilog or GHDL): every input
     code's packed output against :meth:`ExponentDesign.evaluate`.
+
+    Parameters
+    ----------
+    design : ExponentDesign
+        The design simulated.
+    directory : str or os.PathLike
+        An existing folder the files are written into.
+    language : {"verilog", "vhdl"}
+        Icarus Verilog (default) or GHDL.
+
+    Returns
+    -------
+    object
+        The simulator's verdict (``passed``, ``line``), as
+        :func:`chebnorm.hw.verilog.simulate` and
+        :func:`chebnorm.hw.vhdl.simulate_vhdl` return it.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``language``.
 
     Examples
     --------

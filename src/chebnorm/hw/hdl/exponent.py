@@ -41,6 +41,28 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
     """The top module's banner as text lines without comment marker: what it
     evaluates, the formats, the normalization, the certified bounds.
 
+    Parameters
+    ----------
+    design : ExponentDesign
+        The design described.
+    version : str
+        The chebnorm version written in the banner.
+    command : str, optional
+        The command line that generated it (written when given).
+
+    Returns
+    -------
+    list of str
+        The banner's lines.
+
+    Raises
+    ------
+    ValueError
+        When ``design`` is not an exponent-indexed design.
+
+    Examples
+    --------
+
     >>> from chebnorm.hw.exponent import design_exponent
     >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
     >>> exponent_facts(d)[0]
@@ -87,6 +109,27 @@ def core_parts(core_text: str, language: str) -> tuple[list[str], list[str], lis
     ``OUT_BITS`` -> ``M_BITS``. The design is flat (one module: the targets'
     cell counts are of the top module alone). ValueError when the core's text
     is not shaped as the piecewise printers print it.
+
+    Parameters
+    ----------
+    core_text : str
+        The core module's text, as the sized piecewise printer prints it.
+    language : {"verilog", "vhdl"}
+        Its language.
+
+    Returns
+    -------
+    banner, declarations, statements : tuple of list of str
+        The three parts, line by line.
+
+    Raises
+    ------
+    ValueError
+        When the text has no port list end or body, or its ports are used a
+        number of times other than the printer's.
+
+    Examples
+    --------
 
     >>> text = chr(10).join(["// c", "module m (", "    input x", ");",
     ...     "    wire [1:0] low = x[1:0];", "    wire idx = x[2];", "    assign y = low;",
@@ -211,6 +254,30 @@ def exponent_module(design, language: str = "verilog", *, version: str = "",
     core's body inlined (:func:`core_parts`; one module, so a target's cell
     count of the top is the whole design), the delayed shift.
 
+    Parameters
+    ----------
+    design : ExponentDesign
+        The design printed.
+    language : {"verilog", "vhdl"}
+        The language (default Verilog).
+    version : str
+        The chebnorm version written in the banner.
+    command : str, optional
+        The command line written in the banner.
+
+    Returns
+    -------
+    str
+        The module's text.
+
+    Raises
+    ------
+    ValueError
+        For a design that is not exponent-indexed or an unknown language.
+
+    Examples
+    --------
+
     >>> from chebnorm.hw.exponent import design_exponent
     >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
     >>> v = exponent_module(d)
@@ -227,6 +294,30 @@ def exponent_testbench(design, language: str = "verilog", vectors: str | None = 
     """The exhaustive self-checking bench of the top module (the piecewise benches:
     every input code, clocked when the core is pipelined).
 
+    Parameters
+    ----------
+    design : ExponentDesign
+        The design tested.
+    language : {"verilog", "vhdl"}
+        The bench's language (default Verilog).
+    vectors : str or None, default None
+        The vector file the bench reads: an identifier, optionally with
+        ``.hex``; None: ``NAME.hex``.
+
+    Returns
+    -------
+    str
+        The bench's text.
+
+    Raises
+    ------
+    ValueError
+        For a design that is not exponent-indexed, an unknown language, or
+        ``vectors`` that is not a safe identifier.
+
+    Examples
+    --------
+
     >>> from chebnorm.hw.exponent import design_exponent
     >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
     >>> exponent_testbench(d).splitlines()[0]
@@ -241,7 +332,29 @@ def exponent_testbench(design, language: str = "verilog", vectors: str | None = 
 def exponent_files(design, language: str = "verilog", *, version: str = "",
                    command: str | None = None) -> dict[str, str]:
     """File name -> text: ``NAME.v|.vhd`` (core and top), ``tb_NAME.v|.vhd`` and
-    ``NAME.hex`` (the model's packed output for every code)."""
+    ``NAME.hex`` (the model's packed output for every code).
+
+    Parameters
+    ----------
+    design : ExponentDesign
+        The design written.
+    language : {"verilog", "vhdl"}
+        The language of the module and bench (default Verilog).
+    version : str
+        The chebnorm version written in the banner.
+    command : str, optional
+        The command line written in the banner.
+
+    Returns
+    -------
+    dict of str to str
+        File name to text.
+
+    Raises
+    ------
+    ValueError
+        For a design that is not exponent-indexed or an unknown language.
+    """
     d = _check(design)
     ext = SUFFIX[check_language(language)]
     name = module_name(d)
