@@ -223,3 +223,23 @@ def test_explicit_widths_edge_shifts(tmp_path, widths, multipliers, pipeline):
         if _HAVE[language]:
             sim = _simulate(d, tmp_path, language)
             assert sim.passed and sim.mismatches == 0, sim.line
+
+
+@pytest.mark.parametrize("centered, truncated", [(True, True), (False, False)])
+def test_sized_bound_cache_changes_nothing(centered, truncated):
+    """sized_bound with a cache shared across shapes (as _auto_shape's greedy uses it)
+    gives the same ROM and exact bounds as without: shapes that share their top
+    steps reuse the cached states, shapes that differ anywhere above must not."""
+    t = _table(*SPEC, 3, 8, fc=22, centered=centered)
+    L = 12 - 3
+    rng = np.random.default_rng(5)
+    base = {"F": [16, 15, 14, 13], "T": [L, L - 1, L - 2], "G": [15, 14], "P": [15, 14, 13]}
+    cache: dict = {}
+    for _ in range(24):
+        v = {k: [int(x) - int(rng.integers(0, 4)) for x in vals] for k, vals in base.items()}
+        if rng.random() < 0.5:   # keep the top steps: the cache's hits
+            for k in v:
+                v[k][len(v[k]) // 2:] = base[k][len(v[k]) // 2:]
+        F, T = tuple(v["F"]), tuple(max(x, 1) for x in v["T"])
+        shape = (L, 3, centered, F, T, (12, *v["G"], F[3]), truncated, tuple(v["P"]))
+        assert sized_bound(t, shape, cache=cache) == sized_bound(t, shape), shape

@@ -405,7 +405,41 @@ def _run_sized(rom, k, shape: _Shape, upto: int = -1) -> dict:
     return w
 
 
-def sized_bound(table: PiecewiseTable, shape, codes=None):
+def _fast_step(acc, low, c, st, centered: bool, Tj: int, lowbits: dict):
+    """``a_j`` of one step of :func:`_run_sized` (the same integers, fewer passes:
+    the truncated multiplier's row bits are bits of ``low``, cached in ``lowbits``)."""
+    if st["rows"]:
+        top = Tj - 1
+        q = 0
+        for i, sh, neg in st["rows"]:
+            b = st["tshift"] + i
+            if b not in lowbits:
+                lowbits[b] = (low >> b) & 1
+            bit = 1 - lowbits[b] if centered and i == top else lowbits[b]
+            q = q + bit * _shift(-acc if neg else acc, sh)
+    else:
+        tj = low >> st["tshift"]
+        if centered:
+            tj = tj - (1 << (Tj - 1))
+        q = _shift(acc * tj, st["pshift"])
+    return ((q << st["qshift"]) + (c << st["cshift"])) >> st["ashift"]
+
+
+def _prefix_key(shape, D: int, j: int) -> tuple:
+    """What the bound's state after step ``j`` depends on: ``D`` and the widths of
+    steps ``n-1 .. j`` (their ``F``, ``T``, ``G`` and product widths)."""
+    L, n, centered, F, T, G = shape[:6]
+    P = shape[7] if len(shape) > 7 and shape[7] else ()
+    trunc = bool(len(shape) > 6 and shape[6])
+    return (D, L, n, bool(centered), trunc, tuple(F[j:]), tuple(T[j:]), tuple(G[j:]),
+            tuple(P[j:]) if P else None)
+
+
+#: prefix states kept by one :func:`sized_bound` cache (each holds one wire over all codes)
+_PREFIX_CACHE_SIZE = 48
+
+
+def sized_bound(table: PiecewiseTable, shape, codes=None, cache: dict | None = None):
     """Choose the ROM and certify the sized datapath, segment by segment.
 
     Returns ``(rom, (approximation, datapath, total))``: ``rom[s][j]`` the
@@ -427,6 +461,9 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
     of ``e_j``'s interval (the truncations' bias is paid in the ROM, for
     free). ``a_0`` is y's code: ``|y - f| <= approx_s + max |e_0|`` on
     segment ``s``, rigorously (every term is enclosed; no floating point).
+    ``cache``: a dict kept by the caller across calls on one ``table`` and
+    ``codes`` (the states after each step, shared by shapes of equal top steps;
+    the results are the same integers with or without it).
 
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
@@ -455,11 +492,32 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
     if n > 0:
         rom[:, n] = nearest(Q[n], D - F[n])
         lo = hi = (rom[:, n] << (D - F[n])) - Q[n]
-    for st in sized_steps(shape):
+    # the walk keeps a_{j+1} over every code from step to step (one step each);
+    # ``cache`` (one table, one ``codes``) keeps the state after each step, keyed by
+    # what it depends on, so shapes sharing their top steps share that work
+    low = k & ((1 << L) - 1)
+    seg = k >> L
+    lowbits = cache.setdefault("lowbits", {}) if cache is not None else {}
+    acc = None
+    steps = sized_steps(shape)
+    start = 0
+    if cache is not None:
+        for idx in range(len(steps) - 1, -1, -1):
+            key = _prefix_key(shape, D, steps[idx]["j"])
+            hit = cache.pop(key, None)
+            if hit is not None:
+                cache[key] = hit   # most recently used: kept longest
+                cols, lo, hi, acc = hit
+                for jj, col in cols.items():
+                    rom[:, jj] = col
+                start = idx + 1
+                break
+    for idx in range(start, len(steps)):
+        st = steps[idx]
         j = st["j"]
-        rom_i = _int_rom(rom)
-        w = _run_sized(rom_i, k, shape, upto=j + 1) if j + 1 < n else {f"a{n}": rom_i[k >> L, n]}
-        a = w[f"a{j + 1}"].reshape(nseg, -1)
+        if acc is None:
+            acc = _int_rom(rom)[seg, n]
+        a = acc.reshape(nseg, -1)
         amin, amax = a.min(axis=1).astype(object), a.max(axis=1).astype(object)
         prods = (lo * tl, lo * th, hi * tl, hi * th)
         plo = np.minimum(np.minimum(prods[0], prods[1]), np.minimum(prods[2], prods[3])) >> L
@@ -483,6 +541,21 @@ def sized_bound(table: PiecewiseTable, shape, codes=None):
         rom[:, j] = nearest(2 * Q[j] - (lo + hi), D + 1 - F[j])
         d = (rom[:, j] << (D - F[j])) - Q[j]
         lo, hi = lo + d, hi + d
+        if j > 0:  # a_j, the next step's a_{j+1}: the model's integers (_run_sized)
+            col = _int_rom(rom[:, j:j + 1])[:, 0]
+            if col.dtype != object and acc.dtype == object:
+                col = col.astype(object)
+            elif col.dtype == object and acc.dtype != object:
+                acc = acc.astype(object)
+            acc = _fast_step(acc, low, col[seg], st, centered, T[j], lowbits)
+        else:
+            acc = None
+        if cache is not None:
+            cache[_prefix_key(shape, D, j)] = ({jj: rom[:, jj].copy() for jj in range(j, n + 1)},
+                                               lo, hi, acc)
+            keys = [key for key in cache if key != "lowbits"]
+            if len(keys) > _PREFIX_CACHE_SIZE:
+                del cache[keys[0]]
     if n == 0:  # y = c_0 shifted to G_0 bits: a truncation when F_0 > G_0
         sigma = max(0, (1 << (D - G[0])) - (1 << (D - F[0])))
         rom[:, 0] = nearest(Q[0] + sigma // 2, D - F[0])
@@ -630,6 +703,7 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     # highest order first: F_n .. F_0, T_{n-1} .. T_0, P_{n-1} .. P_0, G_{n-1} .. G_1
     order = sorted(start, key=lambda key: ("FTPG".index(key[0]), -key[1]))
     memo: dict = {}
+    bound_cache: dict = {}   # sized_bound's states of shared top steps
 
     def shape(v):
         F = tuple(v["F", j] for j in range(n + 1))
@@ -640,7 +714,7 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     def judge(v):  # (meets, area, certified total), memoised
         key = tuple(v[k] for k in order)
         if key not in memo:
-            rom, b = sized_bound(t, shape(v))
+            rom, b = sized_bound(t, shape(v), cache=bound_cache)
             ok = _meets(b, max_error, strict)
             memo[key] = (ok, shape_cost(t, shape(v), rom, rom_weight) if ok else math.inf, b[2])
         return memo[key]
