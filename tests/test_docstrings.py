@@ -31,8 +31,6 @@ STAGES = ("core", "symbolic", "approx", "methods", "hw", "export", "raster", "cl
 #: their items run and report (xfail, not strict: a passing one shows as XPASS), and the
 #: set is emptied once the sweep of each is merged.
 PENDING: set[str] = set()
-PENDING |= {"hw.piecewise", "hw.targets", "hw.target_model", "hw.multipartite", "hw.piecewise_search",
-            "hw.architectures"}
 #: Modules of the other stages whose sweep is pending too (the compiled engine's internals).
 PENDING_MODULES: tuple[str, ...] = ()
 

@@ -192,6 +192,28 @@ def prune_spread(architecture: str, target: str) -> float:
     model score (:data:`PRUNE_SPREAD`; :data:`chebnorm.hw.target_model.MODEL_SPREAD`
     for an architecture without its own measurement).
 
+    Parameters
+    ----------
+    architecture : str
+        ``"piecewise-sized"``, ``"multipartite"`` or ``"table"``; any other name
+        has no measurement of its own (the target's model spread applies).
+    target : str
+        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+
+    Returns
+    -------
+    float
+        The larger of the measured spread (:data:`PRUNE_SPREAD`) and the
+        target's :data:`~chebnorm.hw.target_model.MODEL_SPREAD`; at least 1
+        (``math.inf`` for a plain table: never pruned).
+
+    Raises
+    ------
+    ValueError
+        ``target`` is not a known target.
+
+    Examples
+    --------
     >>> prune_spread("multipartite", "xc7") >= 1
     True
     """
@@ -284,6 +306,55 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
     design are built in parallel on ``workers`` too. Every candidate carries
     its model score on ``target``.
 
+    Parameters
+    ----------
+    expr : str or sympy.Expr
+        The function ``f`` of ``var`` to evaluate.
+    interval : tuple of (str or number)
+        ``(a, b)``, the input range ``[a, b)``.
+    in_bits, out_bits : int
+        Input and output widths in bits.
+    accuracy : str
+        One of :data:`ACCURACIES`.
+    max_error : float, optional
+        The certified bound ``E`` for ``accuracy="max-error"`` (ignored
+        otherwise).
+    degrees : tuple of int, default (1, 2, 3)
+        The degrees the sized piecewise search tries (only those in ``k_start``).
+    k_start : dict of int to int, optional
+        Degree to the index bits at which its sized search starts; a degree
+        missing here is not searched (None: no sized candidate).
+    var : str, default "x"
+        The variable of ``expr``.
+    name : str, default "design"
+        The prefix of the candidates' module names.
+    target : str, default "generic"
+        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+    synth : bool, default True
+        Synthesize the built candidates (:func:`synthesize_candidates`).
+    bound : float, optional
+        A score already synthesized elsewhere (as in :func:`synthesize_candidates`).
+    prune : bool, default True
+        Skip the synthesis of candidates that cannot win by the model.
+    workers : int or None, default 1
+        Parallel workers (:func:`chebnorm.core.parallel.check_workers`).
+    scheduler : object, optional
+        A shared scheduler for the parallel runs
+        (:func:`chebnorm.core.parallel.map_ordered`).
+
+    Returns
+    -------
+    list of Candidate
+        The sized piecewise candidates (the cheapest per degree), the
+        multipartite one (when ``in_bits <= 20``) and the plain table, each
+        with ``design`` None and a ``note`` when not built.
+
+    Raises
+    ------
+    ValueError
+        ``accuracy`` is not one of :data:`ACCURACIES`, ``target`` is unknown,
+        or the designers refuse the spec (widths, interval, expression).
+
     Examples
     --------
     >>> cs = architecture_candidates("1/sqrt(1+3*x)", ("0", "1"), 6, 6,
@@ -306,6 +377,19 @@ def cheapest_candidates(cands) -> list[Candidate]:
     """``cands`` with, of the sized piecewise ones, only the cheapest per degree
     (lowest synthesized score, else lowest model score).
 
+    Parameters
+    ----------
+    cands : list of Candidate
+        As :func:`build_candidates` or :func:`synthesize_candidates` return them.
+
+    Returns
+    -------
+    list of Candidate
+        ``cands`` in their order, the sized piecewise candidates other than
+        each degree's cheapest left out (unbuilt ones are kept).
+
+    Examples
+    --------
     >>> cheapest_candidates([Candidate("table", "none", note="not built")])[0].architecture
     'table'
     """
@@ -324,6 +408,31 @@ def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: s
     model, not synthesized: :func:`synthesize_candidates` and
     :func:`cheapest_candidates` finish them.
 
+    Parameters
+    ----------
+    expr, interval, in_bits, out_bits, accuracy, max_error, degrees, k_start, var, name, target
+        As in :func:`architecture_candidates`.
+    workers : int or None, default 1
+        Parallel workers for the sized chains and the multipartite design.
+    scheduler : object, optional
+        A shared scheduler (:func:`chebnorm.core.parallel.map_ordered`).
+
+    Returns
+    -------
+    list of Candidate
+        Every sized design the walk built, the multipartite design (when
+        ``in_bits <= 20``) and the plain table (built when its ROM is at most
+        :data:`MAX_TABLE_ROM_BITS` bits), each with its ``model`` score;
+        ``cost`` is None.
+
+    Raises
+    ------
+    ValueError
+        ``accuracy`` is not one of :data:`ACCURACIES`, ``target`` is unknown,
+        or the designers refuse the spec.
+
+    Examples
+    --------
     >>> cs = build_candidates("1/sqrt(1+3*x)", ("0", "1"), 6, 6, accuracy="faithful",
     ...                       k_start={1: 2})
     >>> sorted({c.architecture for c in cs}), all(c.model > 0 for c in cs if c.design)
