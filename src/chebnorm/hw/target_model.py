@@ -56,6 +56,27 @@ class DesignFeatures:
     adders of ``a + b`` bits in LUTs, but a DSP48E1 on ``xc7`` (yosys maps
     every ``$mul`` there).
 
+    Parameters
+    ----------
+    roms : tuple of (int, int), default ()
+        ``(index_bits, word_bits)`` per ROM, each an integer in 0..4096.
+    multipliers : tuple of (int, int), default ()
+        ``(a, b)`` operand widths of each variable multiplier, integers 0..4096.
+    adders : tuple of int, default ()
+        The width of each adder, integers 0..2^20.
+    register_bits : int, default 0
+        Flip-flops, 0..2^20 (0 for a combinational design).
+    const_multipliers : tuple of (int, int, int), default ()
+        ``(a, b, naf)`` per constant multiplier, integers 0..4096.
+
+    Raises
+    ------
+    ValueError
+        An item is not a tuple of the right length, or a width is not an
+        integer (bools refused) in its range.
+
+    Examples
+    --------
     >>> DesignFeatures(roms=((5, 42),), multipliers=((10, 13),)).roms
     ((5, 42),)
     >>> DesignFeatures(adders=(-1,))
@@ -97,6 +118,18 @@ MODEL_SPREAD = {"generic": 1.165, "xc7": 1.063, "xc7-nodsp": 1.257, "ice40": 1.2
 def dsp_count(a: int, b: int) -> int:
     """DSP48E1 blocks of an ``a x b`` signed multiplier: ``ceil(max/25) * ceil(min/18)``.
 
+    Parameters
+    ----------
+    a, b : int
+        The operand widths in bits (positive; the wider goes to the 25-bit port).
+
+    Returns
+    -------
+    int
+        The DSP48E1 count, tiles of 25 x 18 bits.
+
+    Examples
+    --------
     >>> dsp_count(17, 19), dsp_count(30, 19), dsp_count(8, 8)
     (1, 4, 1)
     """
@@ -109,6 +142,29 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
     sizes (each multiplied by its constant in :func:`model_score`), and the
     fixed part (DSPs and registers at their device weights).
 
+    Parameters
+    ----------
+    f : DesignFeatures
+        The design's features.
+    target : str
+        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+
+    Returns
+    -------
+    dict of str to float
+        ``"rom"`` (bits on ``generic``, LUT-sized ROM bits on the FPGAs),
+        ``"mul"`` (sum of ``a * b``; 0 on ``xc7``, where DSPs take them),
+        ``"add"`` (adder bits, the constant multipliers' adders included off
+        ``xc7``) and ``"fixed"`` (registers, and DSPs on ``xc7``, at the device
+        weights of :data:`~chebnorm.hw.targets.DEVICE_WEIGHTS`).
+
+    Raises
+    ------
+    ValueError
+        ``target`` is not a known target.
+
+    Examples
+    --------
     >>> f = DesignFeatures(roms=((8, 10),), multipliers=((20, 12),), adders=(30,))
     >>> model_terms(f, "xc7") == {"rom": 40.0, "mul": 0.0, "add": 30.0, "fixed": 63400 / 240}
     True
@@ -140,6 +196,26 @@ def model_score(features: DesignFeatures, target: str) -> float:
     equivalents otherwise), within :data:`MODEL_SPREAD` of yosys on the
     calibration set.
 
+    Parameters
+    ----------
+    features : DesignFeatures
+        The design's features (:func:`design_features`).
+    target : str
+        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+
+    Returns
+    -------
+    float
+        ``sum(CALIBRATION[target][k] * terms[k]) + terms["fixed"]`` over the
+        terms of :func:`model_terms`.
+
+    Raises
+    ------
+    ValueError
+        ``features`` is not a :class:`DesignFeatures`, or ``target`` is unknown.
+
+    Examples
+    --------
     >>> f = DesignFeatures(roms=((5, 42),), multipliers=((17, 13), (19, 13)), adders=(20, 22, 18))
     >>> model_score(f, "xc7") > 2 * 264
     True
@@ -158,6 +234,19 @@ def piecewise_features(d) -> DesignFeatures:
     coefficient ROM (index bits x word bits), one ``acc x t`` multiplier and
     one adder per Horner step, the output rounding and saturation.
 
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A one-width or sized piecewise design.
+
+    Returns
+    -------
+    DesignFeatures
+        One ROM, one multiplier per Horner step, the steps' adders and two
+        ``out_bits + 2``-bit adders; no registers.
+
+    Examples
+    --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=12)
@@ -181,6 +270,18 @@ def naf_weight(q: int) -> int:
     """Nonzero digits of the non-adjacent form of ``q`` (a constant multiplier
     ``q * x`` is that many shifted copies of ``x`` added).
 
+    Parameters
+    ----------
+    q : int
+        Any integer (its sign is ignored).
+
+    Returns
+    -------
+    int
+        The NAF weight of ``abs(q)`` (0 for 0).
+
+    Examples
+    --------
     >>> naf_weight(7), naf_weight(0), naf_weight(-10)
     (2, 0, 2)
     """
@@ -198,6 +299,20 @@ def horner_features(d) -> DesignFeatures:
     (coefficients are constants: no ROM; the first step multiplies ``x`` by the
     constant top coefficient, priced as the adders of its non-adjacent form).
 
+    Parameters
+    ----------
+    d : HornerDesign
+        A single-polynomial design (:func:`chebnorm.hw.horner.design_horner`).
+
+    Returns
+    -------
+    DesignFeatures
+        No ROM; one variable multiplier per step after the first, one
+        constant multiplier (the first step), and the adders of the input
+        shift, the steps, their roundings and the output.
+
+    Examples
+    --------
     >>> from chebnorm.approx import fit_target
     >>> from chebnorm.hw.horner import design_horner
     >>> f = horner_features(design_horner(fit_target("dichotomy", 2), 10, 10, coef_bits=14))
@@ -220,6 +335,18 @@ def multipartite_features(d) -> DesignFeatures:
     the TIV, and the complement of a symmetric table's address and entry
     (priced as adder bits). No multiplier.
 
+    Parameters
+    ----------
+    d : MultipartiteDesign
+        As :func:`chebnorm.hw.multipartite.design_multipartite` builds it.
+
+    Returns
+    -------
+    DesignFeatures
+        The TIV and offset ROMs and the adders; no multiplier.
+
+    Examples
+    --------
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> f = multipartite_features(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 10, 10))
     >>> len(f.roms) >= 2, f.multipliers
@@ -242,6 +369,18 @@ def table_features(d) -> DesignFeatures:
     """Features of a :class:`~chebnorm.hw.plain_table.PlainTableDesign`: one ROM
     of ``2**in_bits`` words.
 
+    Parameters
+    ----------
+    d : PlainTableDesign
+        As :func:`chebnorm.hw.plain_table.design_plain_table` builds it.
+
+    Returns
+    -------
+    DesignFeatures
+        One ROM of ``in_bits`` address bits and ``out_bits``-bit words.
+
+    Examples
+    --------
     >>> from chebnorm.hw.plain_table import design_plain_table
     >>> table_features(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 6, 6)).roms
     ((6, 6),)
@@ -253,6 +392,24 @@ def design_features(d) -> DesignFeatures:
     """The features of any design ``chebnorm design`` builds: a piecewise
     (one-width or sized), multipartite or plain-table design.
 
+    Parameters
+    ----------
+    d : PiecewiseDesign, MultipartiteDesign or PlainTableDesign
+        The design.
+
+    Returns
+    -------
+    DesignFeatures
+        As :func:`piecewise_features`, :func:`multipartite_features` or
+        :func:`table_features` give them.
+
+    Raises
+    ------
+    ValueError
+        ``d`` is none of these designs.
+
+    Examples
+    --------
     >>> from chebnorm.hw.plain_table import design_plain_table
     >>> design_features(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 6, 6)).roms
     ((6, 6),)
