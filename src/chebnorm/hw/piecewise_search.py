@@ -74,6 +74,19 @@ def model_cost(d: PiecewiseDesign) -> float:
     """Area estimate in Yosys-cell units: ROM bits x :data:`ROM_CELLS_PER_BIT`,
     plus ``a * b`` per ``a x b``-bit multiplier and the width of each adder.
 
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design (:func:`chebnorm.hw.piecewise.design_piecewise`).
+
+    Returns
+    -------
+    float
+        ``segments * sum(rom_bits) * ROM_CELLS_PER_BIT`` plus, per Horner step,
+        ``acc_bits * t_bits`` (the multiplier) and the step's sum width.
+
+    Examples
+    --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=2, coef_frac_bits=12)
     >>> round(model_cost(design_piecewise(t, 8, 8)))
@@ -93,7 +106,41 @@ class DesignPoint:
     """One candidate of the design search: a uniform piecewise table's degree,
     segment count and widths, its certified error (approximation and total,
     rounding included), whether it meets the requested error, and its cost
-    (yosys cells when synthesized, else the model's estimate)."""
+    (yosys cells when synthesized, else the model's estimate).
+
+    Attributes
+    ----------
+    degree : int
+        The polynomial degree per segment, 0..8.
+    segments : int
+        The segment count ``2**k``.
+    coef_frac_bits : int
+        Fraction bits of the fitted coefficients, 0..48.
+    acc_frac_bits : int
+        Fraction bits of the Horner accumulator.
+    y_frac_bits : int
+        Fraction bits of the output.
+    rom_bits : int
+        The coefficient ROM's size in bits.
+    approx_bound : float
+        The certified approximation error (coefficients as quantized).
+    total_bound : float
+        The certified total error: approximation, Horner rounding and output
+        rounding.
+    meets : bool
+        ``total_bound <= max_error``.
+    model_cost : float
+        The area estimate in Yosys cells (:func:`model_cost`).
+    yosys_cells : int or None, default None
+        Yosys' cell count, when synthesized on ``generic``.
+    pareto : bool, default False
+        On the Pareto front of (cost, ``total_bound``).
+    target_model : float or None, default None
+        The target's model score (:func:`chebnorm.hw.target_model.model_score`;
+        a non-generic target only).
+    target_cost : TargetCost or None, default None
+        Yosys on the target, when synthesized (a non-generic target only).
+    """
 
     degree: int
     segments: int
@@ -133,7 +180,32 @@ class SearchResult:
     """What ``chebnorm design`` found: every candidate evaluated (``points``),
     the cheapest one that meets ``max_error`` (``winner``, or None), and where
     the costs came from (``cost_source``: yosys or the model); ``csv()`` gives
-    the Pareto table that the command writes."""
+    the Pareto table that the command writes.
+
+    Attributes
+    ----------
+    expression : str
+        The function searched, as text.
+    interval : tuple of (str, str)
+        ``(a, b)`` as text.
+    in_bits, out_bits : int
+        Input and output widths in bits.
+    max_error : float
+        The requested bound ``E`` (for :func:`grid` without one: the largest
+        total bound of the points).
+    points : tuple of DesignPoint
+        Every point evaluated, sorted by ``(degree, k, coef_frac_bits)``.
+    winner : DesignPoint or None
+        The cheapest point meeting ``max_error`` (None: none meets it).
+    cost_source : str
+        ``"model estimate"``, ``"yosys cells"`` or ``"yosys synth_..."`` (the
+        target's synthesis command).
+    designs : dict
+        ``(degree, k, coef_frac_bits)`` to the point's
+        :class:`~chebnorm.hw.piecewise.PiecewiseDesign`.
+    target : str, default "generic"
+        The canonical target name.
+    """
 
     expression: str
     interval: tuple[str, str]
@@ -288,6 +360,57 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     Dask ``scheduler`` (:func:`chebnorm.core.parallel.map_ordered`). The
     candidates evaluated, and so the result and its CSV, do not depend on which.
 
+    Parameters
+    ----------
+    expr : str or sympy.Expr
+        The function ``f`` of ``var``.
+    interval : tuple of (str or number)
+        ``(a, b)``, the input range.
+    in_bits : int
+        Input width, 2..20 (:data:`~chebnorm.hw.piecewise.MAX_PW_IN_BITS`).
+    out_bits : int
+        Output width, 1..32 (:data:`~chebnorm.hw.piecewise.MAX_PW_OUT_BITS`).
+    max_error : float
+        The certified total error ``E`` to meet, finite and > 0.
+    degrees : iterable of int, default (1, 2, 3)
+        The degrees to search, each 0..8; not empty.
+    max_index_bits : int, default 8
+        The largest ``k`` (``2**k`` segments) walked, 0..min(12, in_bits - 1).
+    var : str, default "x"
+        The variable of ``expr``.
+    synth : bool, default True
+        Synthesize the front's meeting points with Yosys (when installed;
+        else the model's costs stand).
+    progress : bool, default True
+        Show a progress bar.
+    name : str, default "design"
+        The tables' and modules' name.
+    workers : int or None, default None
+        Local worker processes (None: the core count; 1: in this process).
+    scheduler : object, optional
+        A Dask scheduler address or client (:func:`chebnorm.core.parallel.map_ordered`).
+    target : str, default "generic"
+        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+    bound : float, optional
+        A score synthesized elsewhere: points that cannot beat it are not
+        synthesized.
+
+    Returns
+    -------
+    SearchResult
+        Every point evaluated, the winner (None when no point meets
+        ``max_error``) and the designs.
+
+    Raises
+    ------
+    ValueError
+        A width, degree or ``max_index_bits`` out of its range, ``degrees``
+        empty, ``max_error`` not a positive finite number, an unknown
+        ``target`` or ``workers``/``scheduler`` refused, or a bad expression
+        or interval (from the first fit).
+
+    Examples
+    --------
     >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2), max_index_bits=4,
     ...            synth=False, progress=False, workers=1)
     >>> r.winner.degree, r.winner.segments, r.winner.total_bound <= 1e-2
@@ -470,6 +593,44 @@ def grid(expr, interval, in_bits: int, out_bits: int, *, index_bits=(0, 2, 4, 6,
     (optional) marks the points that meet it and picks the cheapest. Each
     point is one parallel item (``workers``, ``scheduler``: as :func:`search`).
 
+    Parameters
+    ----------
+    expr, interval, in_bits, out_bits
+        As in :func:`search` (``in_bits`` 2..20, ``out_bits`` 1..32).
+    index_bits : iterable of int, default (0, 2, 4, 6, 8)
+        The ``k`` of the ``2**k`` segment counts, each 0..min(12, in_bits - 1).
+    degrees : iterable of int, default (1, 2, 3)
+        Degrees, each 0..8.
+    coef_frac_bits : iterable of int, default (12, 16, 20)
+        Coefficient fraction bits, each 0..48.
+    max_error : float, optional
+        A bound to mark the points that meet it (finite, > 0); None: every
+        point meets.
+    var : str, default "x"
+        The variable of ``expr``.
+    synth : bool, default False
+        Count every point's cells with Yosys.
+    progress : bool, default True
+        Show a progress bar.
+    name : str, default "sweep"
+        The tables' and modules' name.
+    workers, scheduler
+        As in :func:`search`.
+
+    Returns
+    -------
+    SearchResult
+        Every grid point in ``(degree, k, coef_frac_bits)`` order, the Pareto
+        front marked, and the cheapest meeting point as ``winner``.
+
+    Raises
+    ------
+    ValueError
+        A value out of its range, an empty list, ``max_error`` not a positive
+        finite number, or a bad expression or interval.
+
+    Examples
+    --------
     >>> r = grid("1/sqrt(x)", ("1", "4"), 8, 8, index_bits=(1, 2), degrees=(1,),
     ...          coef_frac_bits=(10,), progress=False, workers=1)
     >>> [(p.segments, p.degree) for p in r.points]
