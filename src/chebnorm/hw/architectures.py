@@ -198,7 +198,7 @@ def prune_spread(architecture: str, target: str) -> float:
         ``"piecewise-sized"``, ``"multipartite"`` or ``"table"``; any other name
         has no measurement of its own (the target's model spread applies).
     target : str
-        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+        A target name (:func:`chebnorm.hw.targets.target_names`).
 
     Returns
     -------
@@ -329,7 +329,7 @@ def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accu
     name : str, default "design"
         The prefix of the candidates' module names.
     target : str, default "generic"
-        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+        A target name (:func:`chebnorm.hw.targets.target_names`).
     synth : bool, default True
         Synthesize the built candidates (:func:`synthesize_candidates`).
     bound : float, optional

@@ -390,7 +390,7 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     scheduler : object, optional
         A Dask scheduler address or client (:func:`chebnorm.core.parallel.map_ordered`).
     target : str, default "generic"
-        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+        A target name (:func:`chebnorm.hw.targets.target_names`).
     bound : float, optional
         A score synthesized elsewhere: points that cannot beat it are not
         synthesized.

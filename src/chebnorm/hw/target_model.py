@@ -147,7 +147,7 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
     f : DesignFeatures
         The design's features.
     target : str
-        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+        A target name (:func:`chebnorm.hw.targets.target_names`).
 
     Returns
     -------
@@ -201,7 +201,7 @@ def model_score(features: DesignFeatures, target: str) -> float:
     features : DesignFeatures
         The design's features (:func:`design_features`).
     target : str
-        A target name or alias (:func:`chebnorm.hw.targets.target_names`).
+        A target name (:func:`chebnorm.hw.targets.target_names`).
 
     Returns
     -------

@@ -68,6 +68,27 @@ class Target:
     """One synthesis flow: its name, the yosys command that maps the design, what
     its statistics mean, and the score weights (LUT equivalents per block).
 
+    Attributes
+    ----------
+    name : str
+        The target's name (a key of :data:`TARGETS`).
+    synth : str
+        The yosys command that maps the design, ``{top}`` standing for the
+        module name (:meth:`script` fills it in).
+    meaning : str
+        What the mapped cells are, in words.
+    device : str
+        The device whose counts give the weights (a key of
+        :data:`DEVICE_WEIGHTS`, or ``"none"``).
+    weights : dict of str to float, default {}
+        LUT equivalents per cell class (``lut``, ``ff``, ``dsp``, ``bram18``,
+        ``bram36``); empty for ``generic`` (its score counts cells).
+    timing : str, default ""
+        The delay model: ``"nextpnr"`` (place and route), ``"sta"`` (cell
+        delays, no routing) or ``"ltp"`` (gate depth).
+
+    Examples
+    --------
     >>> t = get_target("xc7-nodsp")
     >>> t.script("m"), round(t.weights["dsp"], 1), t.timing
     ('synth_xilinx -family xc7 -nodsp -top m', 264.2, 'sta')
@@ -92,6 +113,7 @@ DEVICE_WEIGHTS = {
                    "bram36": 7680 / 32},
 }
 
+#: the registered targets, name to :class:`Target`, in the order :func:`target_names` lists
 TARGETS = {
     "generic": Target("generic", "synth -top {top}", "yosys generic gate cells", "none",
                       {}, "ltp"),
@@ -110,6 +132,13 @@ TARGETS = {
 def target_names() -> list[str]:
     """The registered target names, in registry order.
 
+    Returns
+    -------
+    list of str
+        The keys of :data:`TARGETS`.
+
+    Examples
+    --------
     >>> target_names()
     ['generic', 'xc7', 'xc7-nodsp', 'ice40']
     """
@@ -119,11 +148,24 @@ def target_names() -> list[str]:
 def get_target(name) -> Target:
     """The registered :class:`Target` called ``name``.
 
+    Parameters
+    ----------
+    name : str
+        One of :func:`target_names` (exact spelling).
+
+    Returns
+    -------
+    Target
+        The registry's entry.
+
     Raises
     ------
     ValueError
-        naming the value and the accepted names.
+        ``name`` is not a str or not registered; the message names the value
+        and the accepted names.
 
+    Examples
+    --------
     >>> get_target("xc7").device
     'xc7a100t'
     >>> get_target("xc9")
@@ -166,6 +208,31 @@ class TargetCost:
     when asked, the timing model (``levels``, ``delay_ns``; ``fmax_mhz`` only
     from nextpnr, see :func:`fmax_ice40`).
 
+    Attributes
+    ----------
+    target : str
+        The target's name.
+    cells : int
+        Every mapped cell, all types.
+    luts, dsps, carries, muxes, ffs : int
+        Cells of each class (LUTs, DSP blocks, carry chains, MUXF7/8,
+        flip-flops).
+    brams : int
+        Block RAMs (18 and 36 kbit counted alike).
+    score : float
+        Cells on ``generic``; else the LUT equivalents
+        ``sum(weights[class] * count)`` (:attr:`Target.weights`).
+    by_type : dict of str to int
+        Yosys' cell counts by cell type.
+    levels : int or None, default None
+        The timing model's path length in cells (None: no timing asked).
+    delay_ns : float or None, default None
+        The ``sta`` model's path delay in ns (xc7 only).
+    timing_model : str, default ""
+        Which delay model gave ``levels``/``delay_ns``, in words.
+
+    Examples
+    --------
     >>> c = cost_from_types("ice40", {"SB_LUT4": 90, "SB_CARRY": 12, "SB_RAM40_4K": 1})
     >>> c.line()
     'ice40: 90 LUT, 0 DSP, 12 carry, 0 mux, 0 FF, 1 RAM; score 330.0 LUT equivalents'
@@ -205,6 +272,27 @@ class TargetCost:
 def cost_from_types(target: str, by_type: dict) -> TargetCost:
     """A :class:`TargetCost` of cell counts ``by_type`` (yosys ``stat``) on ``target``.
 
+    Parameters
+    ----------
+    target : str
+        One of :func:`target_names`.
+    by_type : dict of str to int
+        Cell type (``LUT6``, ``SB_CARRY``, ``$_AND_``, ...; a leading backslash
+        is ignored) to count; a type of no known class counts only in
+        ``cells``.
+
+    Returns
+    -------
+    TargetCost
+        The counts by class and the score; no timing.
+
+    Raises
+    ------
+    ValueError
+        ``target`` is not registered.
+
+    Examples
+    --------
     >>> c = cost_from_types("xc7", {"LUT6": 60, "LUT2": 4, "DSP48E1": 2, "CARRY4": 6,
     ...                             "IBUF": 16, "OBUF": 16})
     >>> c.luts, c.dsps, round(c.score, 1)
@@ -303,6 +391,8 @@ def synthesize_target(verilog_text: str, top: str, target: str = "generic", *,
     Returns
     -------
     TargetCost
+        The cell counts and score, with ``levels``, ``delay_ns`` and
+        ``timing_model`` when ``timing``.
 
     Raises
     ------
@@ -343,10 +433,25 @@ def module_ports(verilog_text: str, top: str, *,
     """``[(name, "input"|"output", width)]`` of module ``top``, as yosys elaborates it
     (parameters at their defaults), in declaration order.
 
+    Parameters
+    ----------
+    verilog_text : str
+        Verilog source holding ``top``.
+    top : str
+        The module (a Verilog identifier ``[A-Za-z_][A-Za-z0-9_]*``).
+    timeout : float, default 600
+        Seconds allowed to yosys.
+
+    Returns
+    -------
+    list of (str, str, int)
+        Each port's name, direction (``"input"`` or ``"output"``) and width in bits.
+
     Raises
     ------
     ValueError
-        when yosys fails, ``top`` is missing, or a port is ``inout``.
+        when ``top`` is not an identifier, yosys is missing or fails, ``top``
+        is missing, a port is ``inout`` or its name is not a plain identifier.
     """
     top = _check_top(top)
     with tempfile.TemporaryDirectory() as tmp:
@@ -368,6 +473,7 @@ def module_ports(verilog_text: str, top: str, *,
     return ports
 
 
+#: the name of the register wrapper module :func:`register_wrapper` writes
 WRAP = "chebnorm_fmax_wrap"
 
 
@@ -376,6 +482,29 @@ def register_wrapper(top: str, ports, *, clocked: bool) -> str:
     registers on a clock ``clk`` (so every path of ``top`` is register to
     register); with ``clocked`` the module's own 1-bit input ``clk`` gets the clock.
 
+    Parameters
+    ----------
+    top : str
+        The wrapped module's name (a Verilog identifier).
+    ports : iterable of (str, str, int)
+        Its ports as :func:`module_ports` lists them.
+    clocked : bool
+        ``top`` has a 1-bit input ``clk`` of its own, driven by the wrapper's clock.
+
+    Returns
+    -------
+    str
+        The Verilog text of the wrapper (no trailing newline): inputs
+        concatenated into ``pin_i``, outputs into ``pin_o``, in port order.
+
+    Raises
+    ------
+    ValueError
+        ``top`` is not an identifier, ``clocked`` without a 1-bit input
+        ``clk``, or no input or no output port (besides ``clk``).
+
+    Examples
+    --------
     >>> print(register_wrapper("m", [("x", "input", 2), ("y", "output", 3)], clocked=False))
     module chebnorm_fmax_wrap (input wire clk, input wire [1:0] pin_i, output reg [2:0] pin_o);
         reg [1:0] in_r;
@@ -429,11 +558,33 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
     ``seed`` fixes the placer (same seed, same result; seeds 1 and 2 gave 25.2
     and 23.1 MHz for the 16-bit degree-2 design of issue 28).
 
+    Parameters
+    ----------
+    verilog_text : str
+        Verilog source holding ``top``.
+    top : str
+        The module to place and route (a Verilog identifier).
+    clocked : bool, default False
+        ``top`` is clocked by its own 1-bit input ``clk`` (see
+        :func:`register_wrapper`).
+    freq_mhz : float, default 100.0
+        The frequency nextpnr aims at, ``0 < freq_mhz <= 1000``.
+    seed : int, default 1
+        The placer's seed, ``0 .. 2**31 - 1``.
+    timeout : float, default 900
+        Seconds allowed to each of yosys and nextpnr-ice40.
+
+    Returns
+    -------
+    float
+        The achieved Fmax in MHz (the slowest clock's, of nextpnr's report).
+
     Raises
     ------
     ValueError
-        when yosys or nextpnr-ice40 is missing or fails (e.g. the design does
-        not fit the HX8K, or needs more than 206 I/O pins).
+        ``freq_mhz`` or ``seed`` out of range, or yosys or nextpnr-ice40
+        missing or failing (e.g. the design does not fit the HX8K, or needs
+        more than :data:`ICE40_IO` = 206 I/O pins).
     """
     if isinstance(freq_mhz, bool) or not isinstance(freq_mhz, (int, float)) or \
             not 0 < freq_mhz <= 1000:
@@ -471,6 +622,36 @@ def target_figures(verilog_text: str, top: str, target: str, *, clocked: bool = 
     gate depth only) and the latency in clock cycles; ``line`` and ``timing``
     are the text lines. ``cost``: this module's :func:`synthesize_target` on
     ``target`` with ``timing``, when already known (not synthesized again).
+
+    Parameters
+    ----------
+    verilog_text : str
+        Verilog source holding ``top``.
+    top : str
+        The module (a Verilog identifier).
+    target : str
+        One of :func:`target_names`.
+    clocked : bool, default False
+        ``top`` has its own 1-bit input ``clk`` (ice40 Fmax only).
+    latency : int, default 0
+        The module's latency in clock cycles, as reported.
+    cost : TargetCost, optional
+        This module's synthesis on ``target`` with timing; used when its
+        ``target`` matches and it has ``levels``, else the module is
+        synthesized again.
+
+    Returns
+    -------
+    dict
+        :meth:`TargetCost.as_dict` plus ``latency_cycles``, ``fmax_mhz``
+        (float, or None on ``generic`` or without a delay), ``fmax_source``,
+        ``line`` and ``timing`` (the two text lines).
+
+    Raises
+    ------
+    ValueError
+        An unknown target, a bad ``top``, or a tool missing or failing
+        (:func:`synthesize_target`, :func:`fmax_ice40`).
     """
     t = get_target(target)
     if cost is None or cost.target != t.name or cost.levels is None:
