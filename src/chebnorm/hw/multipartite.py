@@ -90,6 +90,25 @@ class OffsetTable:
     or its low ``field_bits - 1`` bits, complemented when the top bit is 0,
     for a ``symmetric`` table).
 
+    Attributes
+    ----------
+    position : int
+        The lowest input bit of field ``B_i`` (0 .. ``in_bits - field_bits``).
+    field_bits : int
+        Bits of field ``B_i`` (at least 1; at least 2 when ``symmetric``).
+    slope_bits : int
+        Bits of ``C_i``, the top input bits that select the slope (0 ..
+        ``tiv_bits``).
+    symmetric : bool
+        Only half the table is stored, the other half read complemented.
+    width : int
+        Bits per entry (1 .. ``sum_bits`` of the design).
+    values : tuple of int
+        The ``2**address_bits`` entries, each in ``0 .. 2**width - 1``
+        (two's complement, taken modulo ``2**width``).
+
+    Examples
+    --------
     >>> t = OffsetTable(0, 3, 1, True, 2, (0, 1, 2, 3, 3, 2, 1, 0))
     >>> t.address_bits, t.rom_bits
     (3, 16)
@@ -134,6 +153,53 @@ class MultipartiteDesign:
     ``certificate`` is the exhaustive proof of ``max |y - f(x)|``; ``parts``
     the a priori error decomposition (floats, rounded up).
 
+    Attributes
+    ----------
+    name : str
+        The module's name without its ``chebnorm_`` prefix (an identifier).
+    expression : str
+        ``f``, as text.
+    variable : str
+        The variable of ``expression``.
+    interval : tuple of (str, str)
+        ``(lo, hi)``: code ``k`` stands for ``lo + (hi - lo) k / 2**in_bits``.
+    in_bits : int
+        Input code width, 2 .. :data:`MAX_MP_IN_BITS`.
+    out_bits : int
+        Output code width, 1 .. :data:`MAX_MP_OUT_BITS`.
+    y_format : QFormat
+        The output's fixed-point format (fraction bits ``F``, offset code).
+    guard_bits : int
+        Bits below the output LSB carried in the sum and truncated, 0..16.
+    tiv_bits : int
+        The TIV's address bits (the top input field ``A``), 1 .. ``in_bits - 1``.
+    sum_bits : int
+        The adder's width, ``guard_bits + 1`` .. 62, with
+        ``sum_bits - guard_bits <= out_bits``.
+    tiv : tuple of int
+        The ``2**tiv_bits`` table-of-initial-values entries, each in
+        ``0 .. 2**sum_bits - 1``.
+    offsets : tuple of OffsetTable
+        The offset tables, whose fields cover the low ``in_bits - tiv_bits``
+        input bits exactly, disjoint.
+    max_error : float
+        The error target met: the smaller of ``2**-F`` (faithful, a strict
+        bound) and the requested ``max_error``.
+    faithful : bool
+        Whether ``|y - f(x)| < 2**-F`` was asked.
+    certificate : ExhaustiveCheck
+        The exhaustive proof of ``max |y - f(x)|`` over every code.
+    parts : dict, default {}
+        The a priori error decomposition (:meth:`budget`).
+
+    Raises
+    ------
+    ValueError
+        A hand-built design whose widths are out of range or whose tables do
+        not match its fields (on construction).
+
+    Examples
+    --------
     >>> d = design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 10, 10)
     >>> d.module_name, d.rom_bits < 2 ** 10 * 10, bool(d.evaluate([0])[0] == d.y_format.max_code
     ...                                                  or d.evaluate([0])[0] > 0)
@@ -276,6 +342,28 @@ def output_format(mid: np.ndarray, out_bits: int, frac_bits: int | None = None) 
     ``floor(min f 2**F)`` and ``ceil(max f 2**F)`` has an ``out_bits``-bit
     code (with an offset), or ``frac_bits`` checked to fit.
 
+    Parameters
+    ----------
+    mid : numpy.ndarray
+        Values of ``f`` (e.g. at every input code), not empty.
+    out_bits : int
+        The output code width.
+    frac_bits : int, optional
+        A fraction-bit count to check instead of searching, -60..60.
+
+    Returns
+    -------
+    int
+        ``F`` in -60..60: ``frac_bits`` when given, else the largest that fits.
+
+    Raises
+    ------
+    ValueError
+        ``frac_bits`` out of range or too many for ``out_bits``, or no ``F``
+        fits.
+
+    Examples
+    --------
     >>> output_format(np.array([0.5, 1.0]), 16)
     16
     """
@@ -305,6 +393,20 @@ def table_luts(address_bits: int, width: int) -> int:
     free), plus the LUTs that multiplex the MUXF8 outputs beyond 8 bits (a
     LUT6 is a 4:1 mux).
 
+    Parameters
+    ----------
+    address_bits : int
+        The ROM's address bits, >= 0.
+    width : int
+        Bits per entry, >= 0.
+
+    Returns
+    -------
+    int
+        The LUT6 count.
+
+    Examples
+    --------
     >>> table_luts(6, 10), table_luts(8, 10), table_luts(9, 10), table_luts(10, 1)
     (10, 40, 90, 17)
     """
@@ -320,6 +422,22 @@ def lut_cost(tiv_bits: int, sum_bits: int, offsets) -> int:
 
     ``offsets``: ``(address_bits, width, field_bits, symmetric)`` per table.
 
+    Parameters
+    ----------
+    tiv_bits : int
+        The TIV's address bits.
+    sum_bits : int
+        The TIV's entry width (the final adder's width).
+    offsets : iterable of (int, int, int, bool)
+        ``(address_bits, width, field_bits, symmetric)`` per offset table.
+
+    Returns
+    -------
+    int
+        The LUT6 estimate.
+
+    Examples
+    --------
     >>> lut_cost(8, 18, [(6, 8, 4, False)])
     98
     """
@@ -617,25 +735,35 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     expr, interval, var
         The function (text, read by :func:`chebnorm.approx.parse_function`)
         and its rational interval ``(lo, hi)``: code ``k`` of ``in_bits``
-        bits stands for ``lo + (hi - lo) k / 2**in_bits``.
+        bits stands for ``lo + (hi - lo) k / 2**in_bits``. ``var`` defaults
+        to ``"x"``.
     in_bits, out_bits
-        Input and output code widths (``2 <= in_bits <= 20``). The output
+        Input and output code widths (``2 <= in_bits <= 20``,
+        ``1 <= out_bits <= 32``). The output
         LSB is ``2**-F`` with the largest ``F`` for which ``f``'s range has
         ``out_bits``-bit codes (with an offset), or ``out_frac_bits``.
     max_error, faithful
-        ``faithful``: ``|y - f(x)| < 2**-F`` for every code; ``max_error``:
-        ``|y - f(x)| <= max_error``; both: the smaller.
+        ``faithful`` (default True): ``|y - f(x)| < 2**-F`` for every code;
+        ``max_error`` (a positive finite number, default None):
+        ``|y - f(x)| <= max_error``; both: the smaller. ``faithful=False``
+        needs ``max_error``.
+    name : str, default "multipartite"
+        The module's name (an identifier; the module is ``chebnorm_<name>``).
+    out_frac_bits : int, optional
+        ``F`` fixed (-60..60, checked to fit ``out_bits``) instead of the largest.
     symmetric
-        Offset tables stored halved (True), whole (False) or either (None).
+        Offset tables stored halved (True), whole (False) or either (None,
+        the default).
     max_tables, tries
-        At most ``max_tables`` offset tables; up to ``tries`` structures are
-        built and checked, cheapest estimate first.
+        At most ``max_tables`` offset tables (1..4, default 4); up to
+        ``tries`` structures (1..10000, default 30) are built and checked,
+        cheapest estimate first.
     select, count
         ``select``: a function of a design returning its cost (e.g. LUTs
         from a synthesis run); it is called on the ``count`` certified
         candidates of least estimated cost (:func:`multipartite_candidates`)
         and the cheapest is returned. Default: the least estimate
-        (:func:`lut_cost`).
+        (:func:`lut_cost`). ``count``: 1..1000, default 6.
 
     Returns
     -------
@@ -673,6 +801,28 @@ def multipartite_candidates(expr, interval, in_bits: int, out_bits: int, *, max_
     caller that prices each by synthesis (the estimate ranks them only
     roughly: yosys's ABC compresses some tables more than others).
 
+    Parameters
+    ----------
+    expr, interval, in_bits, out_bits, max_error, faithful, var, name, out_frac_bits
+        As in :func:`design_multipartite`.
+    symmetric, max_tables, tries
+        As in :func:`design_multipartite`.
+    count : int, default 6
+        The most designs returned, 1..1000.
+
+    Returns
+    -------
+    list of MultipartiteDesign
+        At least one, each with its exhaustive certificate, least estimated
+        LUT count (:func:`lut_cost`) first, then fewest ROM bits.
+
+    Raises
+    ------
+    ValueError
+        An argument out of range (named), or no structure meets the target.
+
+    Examples
+    --------
     >>> ds = multipartite_candidates("1/sqrt(1+3*x)", ("0", "1"), 10, 10, count=2)
     >>> len(ds) >= 1 and all(d.certificate.upper < 2.0 ** -10 for d in ds)
     True
