@@ -85,14 +85,76 @@ __all__ = [
     "truncated_product",
 ]
 
+#: the widest input code of a piecewise design (the model evaluates every code)
 MAX_PW_IN_BITS = 20
+#: the widest output code of a piecewise design
 MAX_PW_OUT_BITS = 32
+#: the one-width design's rounding after each Horner step: round to nearest, ties to even
 ROUNDING = "rne"
 
 
 @dataclass(frozen=True)
 class PiecewiseDesign:
     """A sized ROM + Horner evaluator of a uniform :class:`PiecewiseTable`.
+
+    Built by :func:`design_piecewise`; two architectures share the class: the
+    one-width design (one ROM width for every coefficient, an exact product
+    and a rounding to nearest after each step) and the *sized* one (a width
+    per coefficient, ``t`` and products truncated: ``sized`` is True).
+
+    Attributes
+    ----------
+    name : str
+        The module's name without its ``chebnorm_`` prefix (an identifier).
+    table : PiecewiseTable
+        The uniform (or ``2**m``-segment exponent) table evaluated.
+    in_bits : int
+        Input code width, ``index_bits + 1`` .. :data:`MAX_PW_IN_BITS`.
+    out_bits : int
+        Output code width, 1 .. :data:`MAX_PW_OUT_BITS`.
+    local_bits : int
+        ``L = in_bits - index_bits``: the low input bits, the local variable ``t``.
+    acc_frac_bits : int
+        One-width design: fractional bits of the accumulators (y's plus the
+        guard bits).
+    y_format : QFormat
+        The output's format: ``out_bits`` bits, fraction bits ``Fy``, offset code.
+    rom_bits : tuple of int
+        Bits of each ROM column ``j = 0..n``.
+    t_bits : int
+        Width of ``t`` as multiplied (one-width: ``L + 2``, sign included;
+        sized: ``max(T_j) + 1``).
+    widths : tuple of (int, int, int)
+        Per Horner step ``j = n-1 .. 0``: the widths of its product, sum and
+        output.
+    top_frac_bits : int
+        Fractional bits of the exact top accumulator (one-width design).
+    rounding : str, default "rne"
+        The one-width design's rounding after each step (:data:`ROUNDING`).
+    coef_frac : tuple of int, default ()
+        Sized: ``F_j``, fractional bits of ROM column ``j = 0..n`` (empty: one-width).
+    t_keep : tuple of int, default ()
+        Sized: ``T_j``, the top bits of ``t`` step ``j`` multiplies by.
+    acc_frac : tuple of int, default ()
+        Sized: ``G_j``, fractional bits of accumulator ``a_j`` (``G_0`` is y's).
+    coefficients : tuple of tuple of int, default ()
+        Sized: per segment the ROM integers ``c_j`` (value ``c_j / 2**F_j``),
+        chosen by :func:`sized_bound`.
+    cuts : tuple of int, default ()
+        Pipeline registers: ``0`` after the ROM read, ``i`` after step ``i``.
+    mult_cuts : tuple of int, default ()
+        Registers between the multiply and the add of step ``i``.
+    multipliers : str, default "full"
+        ``"full"`` or ``"truncated"`` (partial-product columns below ``P_j``
+        dropped).
+    prod_frac : tuple of int, default ()
+        Sized: ``P_j``, fractional bits kept of product ``j`` (empty: the default of
+        :func:`sized_steps`).
+    q_bits : tuple of int, default ()
+        Sized, per step ``j = n-1 .. 0``: width of the truncated product.
+    bound : tuple of Fraction, default ()
+        Sized: the exact certified ``(approximation, datapath, total)``
+        bounds (:func:`sized_bound`).
 
     Examples
     --------
@@ -328,6 +390,25 @@ def sized_steps(shape) -> list[dict]:
     paid for in the coefficients (:func:`sized_bound` centres each segment's
     error). ``P_j`` defaults to ``max(G_j, F_j)``.
 
+    Parameters
+    ----------
+    shape : tuple
+        The datapath's widths ``(L, n, centered, F, T, G[, truncated, P])``:
+        local bits, degree, centred ``t``, and the tuples ``F`` (``n + 1``
+        columns), ``T`` (``n`` steps), ``G`` (``n + 1`` accumulators),
+        whether the multipliers are truncated and ``P`` (``n`` steps; empty
+        or absent: the default).
+
+    Returns
+    -------
+    list of dict
+        One dict per step ``j = n-1 .. 0`` with the keys ``j``, ``tshift``,
+        ``pf``, ``P``, ``X``, ``pshift``, ``qshift``, ``cshift``, ``ashift``
+        (ints) and ``rows``: for a truncated multiplier the partial-product
+        rows ``(i, shift, negated)`` of :func:`truncated_product`, else ``()``.
+
+    Examples
+    --------
     >>> st = sized_steps(_Shape(8, 1, False, (10, 6), (5,), (9, 6)))[0]
     >>> st["pf"], st["X"], st["pshift"], st["cshift"], st["ashift"]   # pf = G_1 + T_0
     (11, 10, 1, 0, 1)
@@ -355,6 +436,24 @@ def truncated_product(a, bits, rows):
     """``sum_i bit_i * floor(+-a * 2^-shift_i)`` over ``rows = (i, shift, negated)``:
     the truncated multiplier (``bits(i)`` gives row i's enabling bit, 0 or 1).
 
+    Parameters
+    ----------
+    a : int or numpy.ndarray of int
+        The multiplicand ``a_{j+1}`` (integer codes).
+    bits : callable
+        ``bits(i)``: bit ``i`` of ``t``'s code, 0 or 1 (an int or an integer
+        array broadcasting with ``a``).
+    rows : iterable of (int, int, bool)
+        ``(i, shift, negated)`` per row (:func:`sized_steps`' ``rows``); a
+        negative ``shift`` shifts left.
+
+    Returns
+    -------
+    int or numpy.ndarray of int
+        The truncated product, in ``a``'s type (0 for no rows).
+
+    Examples
+    --------
     >>> truncated_product(7, lambda i: 1, ((0, 2, False), (1, 1, False)))   # 7>>2 + 7>>1
     4
     """
@@ -465,6 +564,31 @@ def sized_bound(table: PiecewiseTable, shape, codes=None, cache: dict | None = N
     ``codes`` (the states after each step, shared by shapes of equal top steps;
     the results are the same integers with or without it).
 
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The table (its coefficients ``q_j / 2^Fc`` and certified bounds).
+    shape : tuple
+        The datapath's widths, as :func:`sized_steps` reads them.
+    codes : numpy.ndarray of int, optional
+        The input codes the ranges are taken over (default: every code of
+        every segment).
+    cache : dict, optional
+        A dict the caller keeps across calls with one ``table`` and ``codes``
+        (the states after each step); None: no cache.
+
+    Returns
+    -------
+    rom : list of tuple of int
+        ``rom[s][j]``: coefficient ``c_j`` of segment ``s``, with ``F_j``
+        fractional bits.
+    bounds : tuple of Fraction
+        ``(approximation, datapath, total)``: the largest over the segments,
+        exact; ``total`` is the largest per-segment sum, so ``total <=
+        approximation + datapath``.
+
+    Examples
+    --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
     >>> rom, (a, p, tot) = sized_bound(t, _Shape(6, 1, False, (10, 8), (6,), (8, 8)))
@@ -653,6 +777,24 @@ def shape_cost(table: PiecewiseTable, shape, rom, rom_weight: float = ROM_WEIGHT
     kept partial-product bits of a truncated one) plus each sum's
     width, the widths from the exact wire ranges over all codes (one model run).
 
+    Parameters
+    ----------
+    table : PiecewiseTable
+        The table (its segment count).
+    shape : tuple
+        The datapath's widths (:func:`sized_steps`).
+    rom : sequence of sequence of int
+        The ROM, per segment its coefficient integers (:func:`sized_bound`).
+    rom_weight : float, default ROM_WEIGHT
+        The price of one ROM bit against one partial-product bit (finite, >= 0).
+
+    Returns
+    -------
+    float
+        The area proxy, in partial-product-bit units.
+
+    Examples
+    --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
     >>> sh = _Shape(6, 1, False, (10, 8), (6,), (8, 8))
@@ -830,7 +972,27 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     rom_weight : float
         ``widths="auto"``: the greedy's price of one ROM bit against one
         partial-product bit (:func:`shape_cost`; default :data:`ROM_WEIGHT`,
-        generic Yosys cells; an FPGA whose LUT6 holds 64 ROM bits wants less).
+        generic Yosys cells; an FPGA whose LUT6 holds 64 ROM bits wants less);
+        a finite number >= 0.
+
+    Returns
+    -------
+    PiecewiseDesign
+        The sized design, its bound certified (:meth:`PiecewiseDesign.budget`).
+
+    Raises
+    ------
+    ValueError
+        ``table`` is not a :class:`PiecewiseTable` or not uniform (nor an
+        exponent table of ``2**m`` segments), an interval endpoint is not
+        rational; ``in_bits`` outside ``index_bits + 1`` .. 20, ``out_bits``
+        outside 1..32, ``guard_bits`` outside 0..16, ``name`` not an
+        identifier; ``multipliers`` not ``"full"``/``"truncated"``, a bad
+        ``widths`` dict, ``pipeline`` cuts outside 0..degree, ``pipeline``
+        or ``multipliers`` without ``widths``; ``max_error`` not a positive
+        finite number (or rational text) or out of reach; ``rom_weight``
+        negative or not finite; a wire wider than 64 bits; y's range does
+        not fit ``out_bits``.
 
     Examples
     --------
@@ -973,6 +1135,21 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
     """The synthesizable Verilog-2005 module: ROM (a case on the index) + Horner
     (:func:`chebnorm.hw.hdl.module_text` in Verilog).
 
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner; None or
+        empty: no such line.
+
+    Returns
+    -------
+    str
+        The module ``chebnorm_<name>``'s Verilog text.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -987,6 +1164,24 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
 
 def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
     """The exhaustive self-checking bench (expected codes from ``d.evaluate``).
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design.
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+
+    Returns
+    -------
+    str
+        The bench ``tb_chebnorm_<name>``'s text (it reads the ``.hex`` vectors
+        of :func:`piecewise_outputs`).
+
+    Raises
+    ------
+    ValueError
+        ``language`` is neither ``"verilog"`` nor ``"vhdl"``.
 
     Examples
     --------
@@ -1005,6 +1200,27 @@ def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | N
     vectors, in ``language`` (``"verilog"`` or ``"vhdl"``;
     :func:`chebnorm.hw.hdl.hdl_files`).
 
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design.
+    version, command
+        As in :func:`piecewise_verilog`.
+    language : {"verilog", "vhdl"}, default "verilog"
+        The HDL.
+
+    Returns
+    -------
+    dict of str to str
+        File name to text: ``chebnorm_<name>.v`` (or ``.vhd``), its bench
+        ``tb_chebnorm_<name>.v`` (or ``.vhd``) and ``chebnorm_<name>.hex``,
+        the expected output of every input code.
+
+    Raises
+    ------
+    ValueError
+        ``language`` is neither ``"verilog"`` nor ``"vhdl"``.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -1020,12 +1236,49 @@ def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | N
 
 
 def piecewise_cells(d: PiecewiseDesign):
-    """Yosys ``synth; stat`` of the module (a :class:`~chebnorm.hw.verilog.SynthResult`)."""
+    """Yosys ``synth; stat`` of the module (a :class:`~chebnorm.hw.verilog.SynthResult`).
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design.
+
+    Returns
+    -------
+    SynthResult
+        The cell counts of its Verilog module
+        (:func:`chebnorm.hw.verilog.synthesize_text`).
+
+    Raises
+    ------
+    ValueError
+        Yosys is missing or fails.
+    """
     return synthesize_text(piecewise_verilog(d), d.module_name)
 
 
 def simulate_piecewise(d: PiecewiseDesign, directory):
-    """Write the outputs into ``directory`` and run the bench in Icarus Verilog."""
+    """Write the outputs into ``directory`` and run the bench in Icarus Verilog.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The design.
+    directory : str or os.PathLike
+        The folder to write the Verilog files of :func:`piecewise_outputs` into
+        (created if missing; files of the same names are replaced).
+
+    Returns
+    -------
+    SimResult
+        The bench's verdict (:func:`chebnorm.hw.verilog.simulate`).
+
+    Raises
+    ------
+    ValueError
+        ``directory`` cannot be written (a ``WriteError``, also an ``OSError``),
+        or Icarus Verilog is missing or fails.
+    """
     from pathlib import Path
 
     from chebnorm.core.files import write_folder
