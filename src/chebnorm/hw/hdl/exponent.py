@@ -354,6 +354,13 @@ def exponent_files(design, language: str = "verilog", *, version: str = "",
     ------
     ValueError
         For a design that is not exponent-indexed or an unknown language.
+
+    Examples
+    --------
+    >>> from chebnorm.hw.exponent import design_exponent
+    >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
+    >>> sorted(exponent_files(d, "vhdl"))
+    ['chebnorm_rsqrt.hex', 'chebnorm_rsqrt.vhd', 'tb_chebnorm_rsqrt.vhd']
     """
     d = _check(design)
     ext = SUFFIX[check_language(language)]
