@@ -400,20 +400,31 @@ def test_refusal_from_a_spawned_cli_is_one_line(tmp_path):
 
 @pytest.mark.parametrize("path", TABLES, ids=[p.stem for p in TABLES])
 def test_committed_tables_export_byte_identically(tmp_path, capsys, path):
-    """The committed headers were written by ``chebnorm repro coefficients`` with
-    the exporter from before this change; loading (now verified) and exporting
-    reproduces them: through the library with the same command, and through
-    ``chebnorm export`` up to the one line that records its own command."""
+    """The committed headers and their Gappa proofs were written by ``chebnorm
+    repro coefficients`` (``export_with_proofs``); loading (now verified) and
+    exporting reproduces them: through the library with the same command, and
+    through ``chebnorm export --proof`` up to the one line that records its own
+    command."""
+    from chebnorm.export import export_with_proofs
+
     t = CoefficientTable.load(path)
-    committed = (COEFFS / f"chebnorm_{t.name}.h").read_text()
-    assert c_header(t, "chebnorm repro coefficients") == committed
-    out = tmp_path / "x.h"
-    code, _, err = run_cli(["export", path, "--format", "c", "-o", out], capsys)
+    stem = f"chebnorm_{t.name}"
+    committed = (COEFFS / f"{stem}.h").read_text()
+    (tmp_path / "lib").mkdir()
+    lib = export_with_proofs(t, "c", tmp_path / "lib" / f"{stem}.h", "chebnorm repro coefficients")
+    assert lib[f"{stem}.h"] == committed
+    assert len(lib) > 1   # the header and at least one proof
+    for fname, text in lib.items():
+        assert (COEFFS / fname).read_text() == text, fname
+    out = tmp_path / "cli" / f"{stem}.h"
+    out.parent.mkdir()
+    code, _, err = run_cli(["export", path, "--format", "c", "--proof", "-o", out], capsys)
     assert code == 0, err
     written = out.read_text()
-    assert f" * Command: chebnorm export {path} --format c -o {out}\n" in written
+    assert f" * Command: chebnorm export {path} --format c --proof -o {out}\n" in written
     assert re.sub(r"(?m)^ \* Command: .*$", "", written) == \
         re.sub(r"(?m)^ \* Command: .*$", "", committed)
+    assert sorted(p.name for p in out.parent.iterdir()) == sorted(lib)
     code, _, err = run_cli(["export", path, "--format", "json", "-o", tmp_path / "x.json"], capsys)
     assert code == 0 and (tmp_path / "x.json").read_text() == path.read_text()
 
