@@ -108,3 +108,24 @@ def test_worked_hardware_example_simulates(capsys, tmp_path, monkeypatch):
     out = _run(capsys, "hw", "verilog", "rsqrt.json", "--in-bits", "16", "--out-bits", "16", "-o", "hw",
                "--simulate")
     assert passed in out
+
+
+def test_architectures_per_spec_table_is_the_measured_json():
+    """Every row of the README's "Architectures per spec" table is what
+    ``benchmarks/bench_specs.py`` prints from the committed measurements
+    (``benchmarks/specs_results.json``), verbatim: a hand edit of either side
+    fails here."""
+    import json
+    import sys
+
+    bench = Path(__file__).resolve().parent.parent / "benchmarks"
+    sys.path.insert(0, str(bench))
+    try:
+        import bench_specs
+    finally:
+        sys.path.remove(str(bench))
+    doc = json.loads((bench / "specs_results.json").read_text(encoding="utf-8"))
+    rows = bench_specs.markdown(doc["results"], bench_specs.SPECS).splitlines()
+    assert len(rows) > 2 + len(bench_specs.SPECS)   # header, rule, at least a row per spec
+    missing = [r for r in rows if r not in README.splitlines()]
+    assert not missing, missing[:3]
