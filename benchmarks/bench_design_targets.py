@@ -16,8 +16,11 @@ all to the JSON file (sorted keys).
 
 measures instead what the pruning of ``design`` relies on
 (``chebnorm.hw.architectures.PRUNE_SPREAD``): every candidate the
-architectures' search builds for the spec at each width, synthesized without
-pruning, one JSON line each with its model score, yosys score and their ratio.
+architectures' search builds for the spec at each width (``--expr`` for other
+functions on [0, 1)), synthesized without pruning, one JSON line each with its
+model score, the ROM part of it, its yosys score and their ratio; all rows go
+to ``benchmarks/prune_calibration.json`` (``--calibration-json``), which
+tests/test_design_architectures.py holds PRUNE_SPREAD to.
 """
 
 from __future__ import annotations
@@ -67,18 +70,20 @@ def run(target: str, repeat: int) -> dict:
     return best
 
 
-def calibrate(bits: int, target: str) -> list[dict]:
-    """Model against yosys for every built candidate of the spec at ``bits`` bits."""
+def calibrate(bits: int, target: str, expr: str = "1/sqrt(1+3*x)") -> list[dict]:
+    """Model against yosys for every built candidate of ``expr`` on [0, 1) at ``bits`` bits."""
     from chebnorm.hw.architectures import build_candidates, synthesize_candidates
 
     ks = {d: max(0, min(bits - 2, 3 + 2 * (3 - d))) for d in (1, 2, 3)}  # as design does
-    cands = build_candidates("1/sqrt(1+3*x)", ("0", "1"), bits, bits, accuracy="faithful",
+    cands = build_candidates(expr, ("0", "1"), bits, bits, accuracy="faithful",
                              k_start=ks, target=target, workers=None)
     rows = []
     for c in synthesize_candidates(cands, target, prune=False, workers=None):
         if c.cost is not None:
-            rows.append({"bits": bits, "target": target, "architecture": c.architecture,
+            rows.append({"bits": bits, "expr": expr, "target": target,
+                         "architecture": c.architecture,
                          "description": c.description, "model": round(c.model, 1),
+                         "model_rom": round(c.model_rom, 1),
                          "yosys": round(c.cost.score, 1),
                          "ratio": round(c.model / c.cost.score, 3)})
     return rows
@@ -94,12 +99,23 @@ def main(argv=None) -> int:
                     help="model against yosys for every candidate (no timing)")
     ap.add_argument("--bits", nargs="+", type=int, default=[16, 12],
                     help="--calibrate: the spec's input and output widths")
+    ap.add_argument("--expr", nargs="+", default=["1/sqrt(1+3*x)"],
+                    help="--calibrate: the functions of x on [0, 1)")
+    ap.add_argument("--calibration-json", default=os.path.join(HERE, "prune_calibration.json"),
+                    help="--calibrate: where to write the rows ('' for nowhere)")
     args = ap.parse_args(argv)
     if args.calibrate:
-        for b in args.bits:
-            for t in args.targets:
-                for row in calibrate(b, t):
-                    print(json.dumps(row, sort_keys=True), flush=True)
+        rows = []
+        for e in args.expr:
+            for b in args.bits:
+                for t in args.targets:
+                    for row in calibrate(b, t, e):
+                        rows.append(row)
+                        print(json.dumps(row, sort_keys=True), flush=True)
+        if args.calibration_json:
+            with open(args.calibration_json, "w", encoding="utf-8") as fh:
+                json.dump({"rows": rows}, fh, indent=1, sort_keys=True)
+                fh.write("\n")
         return 0
     if args.repeat < 1:
         ap.error(f"--repeat {args.repeat}: accepted: 1 or more")

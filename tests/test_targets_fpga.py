@@ -15,8 +15,8 @@ import sys
 
 import pytest
 
-from chebnorm.hw.target_model import (MODEL_SPREAD, DesignFeatures, dsp_count, horner_features,
-                                      model_score, piecewise_features)
+from chebnorm.hw.target_model import (MODEL_SPREAD, DesignFeatures, dsp_count, dsp_mapped,
+                                      horner_features, model_score, piecewise_features)
 from chebnorm.hw.targets import (cost_from_types, fmax_ice40, get_target, register_wrapper,
                                  synthesize_target, target_names)
 
@@ -118,6 +118,42 @@ def test_dsp_tiling_is_yosys_mapping(a, b):
     assert synthesize_target(v, "m", "xc7").dsps == dsp_count(a, b)
 
 
+@no_yosys
+@pytest.mark.parametrize("a,b", [(5, 5), (5, 4), (3, 4), (2, 9), (9, 1), (12, 8)])
+def test_dsp_threshold_is_yosys_mapping(a, b):
+    """yosys leaves a product in LUTs when an operand is under 2 bits or the signed
+    product under 9 bits: the model's rule (dsp_mapped) against synth_xilinx."""
+    v = (f"module m(input wire signed [{a - 1}:0] a, input wire signed [{b - 1}:0] b, "
+         f"output wire signed [{a + b - 2}:0] p); assign p = a * b; endmodule")
+    got = synthesize_target(v, "m", "xc7").dsps
+    assert got == (dsp_count(a, b) if dsp_mapped(a, b) else 0), (a, b, got)
+
+
+@no_yosys
+@pytest.mark.parametrize("target", ["xc7", "xc7-nodsp"])
+def test_fast_flow_is_the_full_flow(target, monkeypatch):
+    """Target.fast (synth_xilinx without cells_xtra.v's blackboxes) maps, counts and
+    times a design exactly as the full synth_xilinx does (a ROM read, a product, an
+    add and a register)."""
+    import dataclasses
+
+    from chebnorm.hw import targets
+
+    v = """module r(input wire clk, input wire [7:0] a, input wire signed [7:0] b,
+                 output reg signed [17:0] y);
+        reg [9:0] rom [0:255];
+        integer i;
+        initial for (i = 0; i < 256; i = i + 1) rom[i] = (i * 37) ^ (i >> 3);
+        always @(posedge clk) y <= $signed({1'b0, rom[a]}) * b + a;
+    endmodule"""
+    fast = synthesize_target(v, "r", target, timing=True)
+    monkeypatch.setitem(targets.TARGETS, target,
+                        dataclasses.replace(targets.TARGETS[target], fast=""))
+    full = synthesize_target(v, "r", target, timing=True)
+    assert fast == full
+    assert fast.luts > 0 and fast.delay_ns > 0
+
+
 def _calibration_designs():
     from chebnorm.approx import fit_target
     from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -171,7 +207,14 @@ def test_cli_design_target_xc7(tmp_path):
     assert head[-8:] == ["target", "target_model", "target_score", "luts", "dsps", "carries",
                          "ffs", "brams"]
     win = [dict(zip(head, x.split(","))) for x in rows[1:] if x.split(",")[12] == "1"]
-    assert len(win) == 1 and win[0]["target"] == "xc7" and win[0]["target_score"]
+    assert len(win) == 1 and win[0]["target"] == "xc7" and float(win[0]["target_model"]) > 0
+    if not win[0]["target_score"]:   # the one-width best could not beat another architecture
+        import csv
+
+        with open(tmp_path / "out" / "design_rs_architectures.csv", newline="") as fh:
+            arch = list(csv.DictReader(fh))
+        won = [x for x in arch if x["winner"] == "1"]
+        assert len(won) == 1 and won[0]["architecture"] != "piecewise" and won[0]["score"], arch
     assert "winner xc7: " in r.stdout and "Fmax ~" in r.stdout
 
 

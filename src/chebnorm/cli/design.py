@@ -128,20 +128,16 @@ def run(args) -> int:
     if accuracy != "max-error" and args.no_synth:
         raise ValueError(f"--{accuracy} compares architectures by synthesis; accepted: without "
                          f"--no-synth (or --max-error E with --no-synth)")
-    others = []
-    if not args.no_synth:
-        others = _synth_others(args, _architectures(args, name, target, accuracy, max_error),
-                               target)
-    if accuracy == "correctly-rounded":
-        return _write_architectures(args, out, name, others, None)
-    if accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
-        ulps = [c.ulp for c in others if c.ulp is not None]
-        max_error = math.nextafter(min(ulps), 0.0)
-    best = _best_other(others)
-    res = _search(args, name, target, max_error, None if best is None else best.cost.score)
+    if args.no_synth:
+        others, res = [], _search(args, name, target, max_error)
+    else:
+        others, res = _synth_both(args, name, target, accuracy, max_error)
+        if res is None:   # correctly rounded: a plain table or nothing
+            return _write_architectures(args, out, name, others, None)
     csv, png = res.csv(), res.plot_png()
     files = {f"design_{name}.csv": csv, f"design_{name}.png": png}
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
+    best = _best_other(others)
     if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
         return _write_architectures(args, out, name, others, res, files)
     # the winner's place and route may fail (too large for the device): before writing
@@ -239,16 +235,18 @@ def _winner_design(res):
                 if p is res.winner)
 
 
-def _search(args, name, target, max_error, bound=None):
+def _search(args, name, target, max_error, bound=None, synth=None):
     """The one-width piecewise Pareto search (:mod:`chebnorm.hw.piecewise_search`);
     ``bound``: the other architectures' best synthesized score (a point that
-    cannot beat it is not synthesized)."""
+    cannot beat it is not synthesized); ``synth``: False for the model only
+    (default: unless ``--no-synth``)."""
     from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.hw.piecewise_search import search
 
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, max_error,
                  degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
-                 var=args.var, synth=not args.no_synth, name=name, target=target,
+                 var=args.var, synth=not args.no_synth if synth is None else synth,
+                 name=name, target=target,
                  bound=bound, **parallel_kwargs(args))
     if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
         best = min(res.points, key=lambda p: p.total_bound)
@@ -258,6 +256,36 @@ def _search(args, name, target, max_error, bound=None):
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
     return res
+
+
+def _synth_both(args, name, target, accuracy, max_error):
+    """The other architectures (built, then synthesized where the model cannot
+    rule them out) and the one-width search, overlapped: the search's
+    evaluation (Python workers) runs while yosys maps the other candidates;
+    the search's own synthesis comes last, bounded by their best score.
+    Returns ``(others, result)`` (``result`` None for a correctly rounded spec)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from chebnorm.hw.piecewise_search import synthesize_search
+
+    built = _architectures(args, name, target, accuracy, max_error)
+    if accuracy == "correctly-rounded":
+        return _synth_others(args, built, target), None
+    if accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
+        max_error = math.nextafter(min(c.ulp for c in built if c.ulp is not None), 0.0)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        job = pool.submit(_synth_others, args, built, target)
+        try:
+            res = _search(args, name, target, max_error, synth=False)
+        finally:
+            others = job.result()
+    best = _best_other(others)
+    import shutil
+
+    if shutil.which("yosys") is not None:
+        res = synthesize_search(res, bound=None if best is None else best.cost.score,
+                                **parallel_kwargs(args))
+    return others, res
 
 
 def _architectures(args, name, target, accuracy, max_error):

@@ -43,29 +43,35 @@ from .targets import get_target, synthesize_target
 
 __all__ = ["Candidate", "ACCURACIES", "MAX_TABLE_ROM_BITS", "PRUNE_SPREAD",
            "architecture_candidates", "build_candidates", "synthesize_candidates",
-           "cheapest_candidates", "prune_spread"]
+           "cheapest_candidates", "prune_spread", "prune_lower"]
 
 #: the accuracy specs ``design`` takes
 ACCURACIES = ("max-error", "faithful", "correctly-rounded")
 #: a plain table larger than this many ROM bits is not built (2^16 codes x 18 bits is
 #: 1.2 Mbit: 16k yosys cells, 7k LUT on xc7 -- it cannot win against a multipartite)
 MAX_TABLE_ROM_BITS = 1 << 18
-#: per (architecture, target): the largest ``model / yosys`` measured on the
-#: architectures' candidates (``python benchmarks/bench_design_targets.py --calibrate``);
-#: pruning divides a candidate's model score by it (or by MODEL_SPREAD, if larger)
+#: per (architecture, target): ``(logic, rom)``, the ratios by which a candidate's
+#: synthesized score may fall below the two parts of its model score: pruning takes
+#: ``(model - rom_part) / logic + rom_part / rom`` as the candidate's lower bound
+#: (:func:`prune_lower`; ``python benchmarks/bench_design_targets.py --calibrate``)
 PRUNE_SPREAD = {
-    # two specs (1/sqrt(1+3x) on [0, 1), 12 and 16 bits, faithful), every candidate the
-    # sized walk and the multipartite search built, synthesized: the largest model/yosys
-    # times 1.1. On xc7 the model puts every product in DSP48E1s; yosys maps small ones to
-    # LUTs (a 12-bit degree-1 design: model 426, yosys 162), hence the wide spread there
-    ("piecewise-sized", "generic"): 1.70, ("multipartite", "generic"): 1.52,
-    ("piecewise-sized", "xc7"): 2.90, ("multipartite", "xc7"): 1.10,
-    ("piecewise-sized", "xc7-nodsp"): 2.54, ("multipartite", "xc7-nodsp"): 1.33,
-    ("piecewise-sized", "ice40"): 1.67, ("multipartite", "ice40"): 1.90,
-    # a plain table's ROM compresses up to 7x in yosys (2^16 x 16 bits: model 115,867
-    # cells, yosys 15,986): never pruned
-    ("table", "generic"): math.inf, ("table", "xc7"): math.inf,
-    ("table", "xc7-nodsp"): math.inf, ("table", "ice40"): math.inf,
+    # every candidate the sized walk and the multipartite search built for 1/sqrt(1+3x)
+    # at 10, 12 and 16 bits and sin(x) at 14 bits (faithful, x in [0, 1)), synthesized
+    # (benchmarks/prune_calibration.json): the pair that keeps the lower bound under
+    # yosys / 1.1 on every row (10 % headroom) with the largest mean bound; exp(x) at 14
+    # bits, added after, moved no pair. Yosys maps the multipliers and adders close to
+    # the model (logic 1.0-1.27; 1.6-2.2 on xc7-nodsp, where it shares LUTs between the
+    # ROM's decoding and the multipliers) and compresses large ROMs of smooth data far
+    # below it (a 1024-segment degree-1 ROM of sin: 1.8x on xc7)
+    ("piecewise-sized", "generic"): (1.17, 2.1), ("multipartite", "generic"): (1.05, 1.6),
+    ("piecewise-sized", "xc7"): (1.12, 4.8), ("multipartite", "xc7"): (1.0, 1.0),
+    ("piecewise-sized", "xc7-nodsp"): (1.59, 4.3), ("multipartite", "xc7-nodsp"): (2.17, 1.3),
+    ("piecewise-sized", "ice40"): (1.27, 1.9), ("multipartite", "ice40"): (1.0, 2.0),
+    # a plain table's ROM compresses up to 4.5x in yosys (2^14 x 14 bits of sin: model
+    # 3608 LUT on xc7 for 2247; 2^16 x 16 bits: model 115,867 cells, yosys 15,986): never
+    # pruned
+    ("table", "generic"): (math.inf, math.inf), ("table", "xc7"): (math.inf, math.inf),
+    ("table", "xc7-nodsp"): (math.inf, math.inf), ("table", "ice40"): (math.inf, math.inf),
 }
 
 
@@ -93,6 +99,8 @@ class Candidate:
     model : float or None
         Its score by the target's calibrated model
         (:func:`chebnorm.hw.target_model.model_score`).
+    model_rom : float or None
+        The ROM part of ``model`` (:func:`chebnorm.hw.target_model.model_parts`).
 
     Examples
     --------
@@ -108,6 +116,7 @@ class Candidate:
     cost: object = None
     note: str = ""
     model: float | None = None
+    model_rom: float | None = None
 
     @property
     def verilog(self) -> str:
@@ -128,13 +137,13 @@ class Candidate:
 def _sized_chain(item) -> list:
     """One degree of the sized search (run by ``map_ordered`` on a worker): the
     sized designs at ``2**k`` segments for ``k = k0 .. k0 + 3`` that meet the
-    error, with their target model scores (``[(k, design, model)]``). The walk
-    ends early at a ``k`` whose model score, divided by the model's spread on
-    sized designs (:func:`prune_spread`), still exceeds the best one so far: a
+    error, with their target model scores and ROM parts
+    (``[(k, design, model, model_rom)]``). The walk ends early at a ``k`` whose
+    lower bound (:func:`prune_lower`) still exceeds the best model score so far: a
     larger ROM no longer pays for itself (the model alone is too rough to stop
     at the first rise: on ``xc7-nodsp`` the cheapest degree-2 design has 256
     segments, after a rise at 128)."""
-    from .target_model import model_score, piecewise_features
+    from .target_model import model_parts, piecewise_features
 
     expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target = item
     mult = "full" if get_target(target).name == "xc7" else "truncated"
@@ -149,11 +158,11 @@ def _sized_chain(item) -> list:
                                  multipliers=mult)
         except ValueError:  # not reachable at this segment count
             continue
-        model = model_score(piecewise_features(d), target)
-        if found and model / prune_spread("piecewise-sized", target) > min(
-                m for _, _, m in found):
+        model, rom = model_parts(piecewise_features(d), target)
+        if found and prune_lower("piecewise-sized", target, model, rom) > min(
+                m for _, _, m, _ in found):
             break   # even at the model's spread, costlier than a smaller k
-        found.append((k, d, model))
+        found.append((k, d, model, rom))
     return found
 
 
@@ -187,25 +196,25 @@ def _cheapest_per_degree(cands: list[Candidate]) -> list[Candidate]:
     return [best[k][1] for k in sorted(best)]
 
 
-def prune_spread(architecture: str, target: str) -> float:
-    """The ratio by which a candidate's synthesized score may fall below its
-    model score (:data:`PRUNE_SPREAD`; :data:`chebnorm.hw.target_model.MODEL_SPREAD`
-    for an architecture without its own measurement).
+def prune_spread(architecture: str, target: str) -> tuple[float, float]:
+    """The ratios by which a candidate's synthesized score may fall below the
+    logic and the ROM parts of its model score (:data:`PRUNE_SPREAD`; an
+    architecture without its own measurement gets the target's
+    :data:`~chebnorm.hw.target_model.MODEL_SPREAD` for both).
 
     Parameters
     ----------
     architecture : str
         ``"piecewise-sized"``, ``"multipartite"`` or ``"table"``; any other name
-        has no measurement of its own (the target's model spread applies).
+        has no measurement of its own.
     target : str
         A target name (:func:`chebnorm.hw.targets.target_names`).
 
     Returns
     -------
-    float
-        The larger of the measured spread (:data:`PRUNE_SPREAD`) and the
-        target's :data:`~chebnorm.hw.target_model.MODEL_SPREAD`; at least 1
-        (``math.inf`` for a plain table: never pruned).
+    tuple of float
+        ``(logic, rom)``, each at least 1 (``math.inf`` for a plain table:
+        never pruned).
 
     Raises
     ------
@@ -214,13 +223,52 @@ def prune_spread(architecture: str, target: str) -> float:
 
     Examples
     --------
-    >>> prune_spread("multipartite", "xc7") >= 1
-    True
+    >>> prune_spread("piecewise-sized", "xc7")
+    (1.12, 4.8)
     """
     from .target_model import MODEL_SPREAD
 
     t = get_target(target).name
-    return max(PRUNE_SPREAD.get((architecture, t), 1.0), MODEL_SPREAD[t])
+    logic, rom = PRUNE_SPREAD.get((architecture, t), (MODEL_SPREAD[t], MODEL_SPREAD[t]))
+    return max(1.0, logic), max(1.0, rom)
+
+
+def prune_lower(architecture: str, target: str, model: float,
+                model_rom: float | None = None) -> float:
+    """A candidate's lower bound of its synthesized score, from its model score
+    and the ROM part of it: ``(model - model_rom) / logic + model_rom / rom``
+    with :func:`prune_spread`'s ratios.
+
+    Parameters
+    ----------
+    architecture, target : str
+        As in :func:`prune_spread`.
+    model : float
+        The candidate's model score (:func:`chebnorm.hw.target_model.model_score`).
+    model_rom : float, optional
+        Its ROM part (:func:`chebnorm.hw.target_model.model_parts`); None: the
+        whole score divided by the larger ratio.
+
+    Returns
+    -------
+    float
+        The lower bound (0 for a plain table).
+
+    Raises
+    ------
+    ValueError
+        ``target`` is not a known target.
+
+    Examples
+    --------
+    >>> round(prune_lower("piecewise-sized", "xc7", 600.0, 48.0), 2)   # 552 / 1.12 + 48 / 4.8
+    502.86
+    """
+    logic, rom = prune_spread(architecture, target)
+    if model_rom is None:
+        return model / max(logic, rom)
+    r = min(max(float(model_rom), 0.0), model)
+    return (model - r) / logic + r / rom
 
 
 def synthesize_candidates(cands, target: str, *, bound: float | None = None,
@@ -246,7 +294,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
     -------
     list of Candidate
         In the order given; a candidate whose model lower bound
-        ``model / prune_spread`` is not below the best synthesized score
+        :func:`prune_lower` is not below the best synthesized score
         (``bound`` or a candidate's) keeps ``cost`` None and says so in
         ``note``. Candidates are synthesized cheapest model first,
         :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND` at a time (whatever
@@ -267,7 +315,8 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
     best = math.inf if bound is None else float(bound)
 
     def lower(c):
-        return -math.inf if c.model is None else c.model / prune_spread(c.architecture, target)
+        return -math.inf if c.model is None else prune_lower(c.architecture, target, c.model,
+                                                             c.model_rom)
 
     while todo:
         run = [i for i in todo if not prune or lower(out[i]) < best][:SYNTH_ROUND]
@@ -278,15 +327,15 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         for i, cost in zip(run, costs):
             c = out[i]
             out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, cost,
-                               c.note, c.model)
+                               c.note, c.model, c.model_rom)
             best = min(best, cost.score)
         todo = [i for i in todo if i not in run]
     for i in todo:
         c = out[i]
+        rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
         out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
-                           f"model {c.model:.1f} / {prune_spread(c.architecture, target):.3f} = "
-                           f"{lower(c):.1f} >= best synthesized {best:.1f}: cannot win",
-                           c.model)
+                           f"model {c.model:.1f}{rom}: lower bound {lower(c):.1f} >= best "
+                           f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
     return out
 
 
@@ -448,7 +497,7 @@ def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: s
 def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees, k_start,
                       var, name, target, workers, scheduler) -> list[Candidate]:
     """Every candidate of :func:`architecture_candidates`, built, not synthesized."""
-    from .target_model import design_features, model_score
+    from .target_model import design_features, model_parts, model_score
 
     e = max_error if accuracy == "max-error" else None
     out: list[Candidate] = []
@@ -466,22 +515,24 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                           f"{name}_mp"))
         built = map_ordered(_build_item, items, workers=workers, scheduler=scheduler)
         mult = "full" if get_target(target).name == "xc7" else "truncated"
-        sized = [(k, d, m) for item, res in zip(items, built) if item[0] == "sized"
-                 for k, d, m in res]
+        sized = [(k, d, m, r) for item, res in zip(items, built) if item[0] == "sized"
+                 for k, d, m, r in res]
         if not sized:
             out.append(Candidate("piecewise-sized", "no design", note="the sized search met "
                                  "the error at no degree and segment count tried"))
-        for k, d, model in sized:
+        for k, d, model, model_rom in sized:
             b = d.budget()
             out.append(Candidate("piecewise-sized", f"degree {d.degree}, {2 ** k} centred "
                                  f"segments, ROM {sum(d.rom_bits) << k} bits, {mult} multipliers",
-                                 d, float(b["total"]), float(b["y_lsb"]), model=model))
+                                 d, float(b["total"]), float(b["y_lsb"]), model=model,
+                                 model_rom=model_rom))
         if items and items[-1][0] == "multipartite":
             m = built[-1]
+            model, model_rom = model_parts(design_features(m), target)
             out.append(Candidate("multipartite", f"{len(m.offsets)} offset tables, ROM "
                                  f"{m.rom_bits} bits", m, float(m.certificate.upper),
-                                 2.0 ** -m.y_format.frac_bits,
-                                 model=model_score(design_features(m), target)))
+                                 2.0 ** -m.y_format.frac_bits, model=model,
+                                 model_rom=model_rom))
     if rom <= MAX_TABLE_ROM_BITS:
         p = design_plain_table(expr, interval, in_bits, out_bits, var=var, name=f"{name}_table")
         ok = accuracy != "correctly-rounded" or p.correctly_rounded
@@ -490,7 +541,8 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                              p if ok else None, float(p.certificate.upper),
                              2.0 ** -p.y_format.frac_bits,
                              note="" if ok else f"{p.unproved} codes' rounding not proved",
-                             model=model_score(design_features(p), target)))
+                             model=model_score(design_features(p), target),
+                             model_rom=model_parts(design_features(p), target)[1]))
     else:
         out.append(Candidate("table", f"{2 ** in_bits} entries", note=f"ROM of {rom} bits, over "
                              f"{MAX_TABLE_ROM_BITS}: not built (it cannot win)"))

@@ -50,7 +50,8 @@ from .sweep import pareto_png
 from .targets import TargetCost, get_target
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
-           "TARGET_COLUMNS", "SYNTH_ROUND", "map_synth"]
+           "TARGET_COLUMNS", "SYNTH_ROUND", "map_synth",
+           "synthesize_search"]
 
 #: the columns of the search's CSV (``design_NAME.csv``), in order
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
@@ -351,9 +352,10 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     :func:`~chebnorm.hw.target_model.model_score` over
     :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
     score synthesized so far, or ``bound`` (a score synthesized elsewhere,
-    e.g. another architecture's), is not synthesized: it cannot win. The
-    cheapest point by the model is always synthesized (when ``bound`` rules
-    out every point, it alone: the winner then is it).
+    e.g. another architecture's), is not synthesized: it cannot win
+    (:func:`synthesize_search`). Without ``bound`` the cheapest point by the
+    model is always synthesized; when ``bound`` rules out every point, none
+    is, and the winner is the cheapest by the model (not synthesized).
 
     Each degree's walk is one parallel item, and so is each Yosys run: they run
     on ``workers`` local processes (default: the core count; 1: here) or on a
@@ -460,26 +462,90 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
             front.add(key)
     for key in front:
         points[key] = replace(points[key], pareto=True)
-    cost_source = "model estimate"
     meeting = sorted((k for k in keys if points[k].meets), key=lambda k: mc(points[k]))
+    winner = min((points[k] for k in meeting),
+                 key=lambda p: (p.cost, p.total_bound, p.degree, p.segments), default=None)
+    res = SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
+                       max_error, tuple(points[k] for k in keys), winner, "model estimate",
+                       {k: designs[k] for k in keys}, target)
     if synth and meeting:
         import shutil
 
         if shutil.which("yosys") is not None:
-            chosen = [k for k in meeting if k in front][:MAX_SYNTH] or meeting[:1]
-            cost_source = ("yosys cells" if target == "generic" else
-                           f"yosys {get_target(target).synth.split(' -top')[0]}")
-            _synth_pruned(points, designs, chosen, target, bound, par)
+            res = synthesize_search(res, bound=bound, workers=workers, scheduler=scheduler,
+                                    progress=progress)
+    return res
+
+
+def synthesize_search(result: SearchResult, *, bound: float | None = None,
+                      workers: int | None = None, scheduler=None,
+                      progress: bool = False) -> SearchResult:
+    """Synthesize the meeting points of a model-only search's Pareto front on
+    its target and choose the winner by synthesis (the last step of
+    :func:`search` with ``synth=True``; separate so a caller can overlap the
+    search with other synthesis runs and pass their best score as ``bound``).
+
+    Points are synthesized cheapest model first, :data:`SYNTH_ROUND` at a
+    time, skipping a point whose model lower bound (model score over
+    :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
+    score so far or ``bound``. Without ``bound`` the cheapest point by the
+    model is always synthesized; with it, when no point can beat ``bound``,
+    none is (the winner is then the cheapest by the model, not synthesized:
+    the architecture that set ``bound`` wins).
+
+    Parameters
+    ----------
+    result : SearchResult
+        A :func:`search` result with ``synth=False`` (its points carry the
+        Pareto flags and, on an FPGA target, the model scores).
+    bound : float, optional
+        A score synthesized elsewhere.
+    workers, scheduler, progress
+        As in :func:`search`.
+
+    Returns
+    -------
+    SearchResult
+        ``result`` with the synthesized points' costs, the winner among the
+        synthesized meeting points and ``cost_source`` naming yosys.
+
+    Raises
+    ------
+    ValueError
+        ``result`` is not a SearchResult, yosys fails, or ``workers`` /
+        ``scheduler`` is refused.
+
+    Examples
+    --------
+    >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1,), max_index_bits=4,
+    ...            synth=False, progress=False, workers=1)
+    >>> synthesize_search(r, bound=0.0).winner.yosys_cells is None   # nothing beats 0 cells
+    True
+    """
+    if not isinstance(result, SearchResult):
+        raise ValueError("result: not a SearchResult; accepted: search(..., synth=False)")
+    target = get_target(result.target).name
+    workers = check_workers(workers)
+    check_scheduler(scheduler)
+    keys = sorted(result.designs)
+    points = dict(zip(keys, result.points))
+    designs = dict(result.designs)
+    mc = (lambda p: p.target_model) if target != "generic" else (lambda p: p.model_cost)
+    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: mc(points[k]))
+    if not meeting:
+        return result
+    chosen = [k for k in meeting if points[k].pareto][:MAX_SYNTH] or meeting[:1]
+    cost_source = ("yosys cells" if target == "generic" else
+                   f"yosys {get_target(target).synth.split(' -top')[0]}")
+    par = dict(workers=workers, scheduler=scheduler, progress=progress)
+    _synth_pruned(points, designs, chosen, target, bound, par)
     ordered = tuple(points[k] for k in keys)
-    winner = None
-    if meeting:
-        pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
-                                                   or p.target_cost is not None
-                                                   or cost_source == "model estimate")]
-        winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
-    return SearchResult(str(expr), tuple(str(v) for v in interval), in_bits, out_bits,
-                        max_error, ordered, winner, cost_source,
-                        {k: designs[k] for k in keys}, target)
+    pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
+                                               or p.target_cost is not None)]
+    if not pool:   # bound beat every point: the cheapest by the model, not synthesized
+        pool = [points[meeting[0]]]
+    winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
+    return replace(result, points=ordered, winner=winner, cost_source=cost_source)
 
 
 def map_synth(fn, items, *, workers: int | None = None, scheduler=None, progress=False,
@@ -536,7 +602,7 @@ def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
     n = 0
     while todo:
         run = [k for k in todo if model[k] / spread < best][:SYNTH_ROUND]
-        if n == 0 and not run:   # the cheapest by the model always (the CSV's winner row)
+        if n == 0 and not run and bound is None:   # the cheapest by the model always
             run = todo[:1]
         if not run:
             break

@@ -41,7 +41,8 @@ from .targets import DEVICE_WEIGHTS, get_target
 
 __all__ = ["DesignFeatures", "piecewise_features", "horner_features", "model_score",
            "model_terms", "CALIBRATION", "MODEL_SPREAD", "dsp_count", "naf_weight",
-           "multipartite_features", "table_features", "design_features"]
+           "multipartite_features", "table_features", "design_features", "dsp_mapped",
+           "model_parts"]
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,8 @@ class DesignFeatures:
         Flip-flops, 0..2^20 (0 for a combinational design).
     const_multipliers : tuple of (int, int, int), default ()
         ``(a, b, naf)`` per constant multiplier, integers 0..4096.
+    partial_products : tuple of int, default ()
+        Kept partial-product bits per truncated multiplier, integers 0..2^20.
 
     Raises
     ------
@@ -82,7 +85,7 @@ class DesignFeatures:
     >>> DesignFeatures(adders=(-1,))
     Traceback (most recent call last):
     ...
-    ValueError: adders/register_bits: -1; accepted: integers 0..2^20
+    ValueError: adders/partial_products/register_bits: -1; accepted: integers 0..2^20
     """
 
     roms: tuple[tuple[int, int], ...] = ()
@@ -90,6 +93,7 @@ class DesignFeatures:
     adders: tuple[int, ...] = ()
     register_bits: int = 0
     const_multipliers: tuple[tuple[int, int, int], ...] = ()
+    partial_products: tuple[int, ...] = ()
 
     def __post_init__(self):
         for name, items, n in (("roms", self.roms, 2), ("multipliers", self.multipliers, 2),
@@ -99,9 +103,10 @@ class DesignFeatures:
                                        not 0 <= v <= 4096 for v in it):
                     raise ValueError(f"{name}: {it!r} is not a pair of widths; accepted: "
                                      f"integers 0..4096")
-        for w in self.adders + (self.register_bits,):
+        for w in tuple(self.adders) + tuple(self.partial_products) + (self.register_bits,):
             if isinstance(w, bool) or not isinstance(w, int) or not 0 <= w <= 1 << 20:
-                raise ValueError(f"adders/register_bits: {w!r}; accepted: integers 0..2^20")
+                raise ValueError(f"adders/partial_products/register_bits: {w!r}; accepted: "
+                                 f"integers 0..2^20")
 
 
 #: fitted constants per target (benchmarks/calibrate_targets.py; module docstring)
@@ -137,6 +142,30 @@ def dsp_count(a: int, b: int) -> int:
     return math.ceil(hi / 25) * math.ceil(lo / 18)
 
 
+def dsp_mapped(a: int, b: int) -> bool:
+    """Whether ``synth_xilinx -family xc7`` puts an ``a x b`` signed ``$mul`` in
+    DSP48E1s: yosys's ``mul2dsp`` leaves a product in LUTs when an operand is
+    under 2 bits or the product (``a + b - 1`` bits, signed) under 9 bits
+    (``-D DSP_A_MINWIDTH=2 -D DSP_B_MINWIDTH=2 -D DSP_Y_MINWIDTH=9``).
+
+    Parameters
+    ----------
+    a, b : int
+        The operand widths in bits.
+
+    Returns
+    -------
+    bool
+        True when the product goes to DSP48E1s.
+
+    Examples
+    --------
+    >>> dsp_mapped(12, 8), dsp_mapped(5, 4), dsp_mapped(18, 1)
+    (True, False, False)
+    """
+    return min(a, b) >= 2 and a + b - 1 >= 9
+
+
 def model_terms(f: DesignFeatures, target: str) -> dict:
     """The uncalibrated terms of ``target``'s model: ROM, multiplier and adder
     sizes (each multiplied by its constant in :func:`model_score`), and the
@@ -153,7 +182,9 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
     -------
     dict of str to float
         ``"rom"`` (bits on ``generic``, LUT-sized ROM bits on the FPGAs),
-        ``"mul"`` (sum of ``a * b``; 0 on ``xc7``, where DSPs take them),
+        ``"mul"`` (sum of ``a * b`` and the truncated multipliers' kept
+        partial-product bits; 0 on ``xc7``, where DSPs take the products and
+        the LUT ones are priced in ``"fixed"`` at ``xc7-nodsp``'s constant),
         ``"add"`` (adder bits, the constant multipliers' adders included off
         ``xc7``) and ``"fixed"`` (registers, and DSPs on ``xc7``, at the device
         weights of :data:`~chebnorm.hw.targets.DEVICE_WEIGHTS`).
@@ -177,16 +208,19 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
         add += float(sum((n - 1) * (a + b) for a, b, n in f.const_multipliers if n > 1))
     if t.name == "generic":
         rom = float(sum(w * 2 ** k for k, w in f.roms))
-        return {"rom": rom, "mul": float(sum(a * b for a, b in f.multipliers)), "add": add,
+        return {"rom": rom, "mul": float(sum(a * b for a, b in f.multipliers)
+                                     + sum(f.partial_products)), "add": add,
                 "fixed": float(f.register_bits)}
     lut_in = 6 if t.name.startswith("xc7") else 4
     rom = float(sum(w * max(1, 2 ** (k - lut_in)) for k, w in f.roms))
     wts = DEVICE_WEIGHTS[t.device]
     fixed = wts["ff"] * f.register_bits
-    mul = float(sum(a * b for a, b in f.multipliers))
+    mul = float(sum(a * b for a, b in f.multipliers) + sum(f.partial_products))
     if t.name == "xc7":
-        fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b in f.multipliers)
+        fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b in f.multipliers if dsp_mapped(a, b))
         fixed += wts["dsp"] * sum(dsp_count(a, b) for a, b, n in f.const_multipliers if n > 1)
+        soft = sum(a * b for a, b in f.multipliers if not dsp_mapped(a, b))
+        fixed += CALIBRATION["xc7-nodsp"]["mul"] * (soft + sum(f.partial_products))
         mul = 0.0
     return {"rom": rom, "mul": mul, "add": add, "fixed": fixed}
 
@@ -229,10 +263,47 @@ def model_score(features: DesignFeatures, target: str) -> float:
                  + terms["fixed"])
 
 
+def model_parts(features: DesignFeatures, target: str) -> tuple[float, float]:
+    """``(score, rom_part)``: :func:`model_score` and the part of it its ROMs
+    make (``CALIBRATION[target]["rom"] * terms["rom"]``). Yosys compresses a
+    large ROM of smooth data well below the model while it maps multipliers
+    and adders close to it, so a lower bound treats the parts apart
+    (:func:`chebnorm.hw.architectures.prune_lower`).
+
+    Parameters
+    ----------
+    features : DesignFeatures
+        The design's features.
+    target : str
+        A target name.
+
+    Returns
+    -------
+    tuple of float
+        The model score and its ROM part (``0 <= rom_part <= score``).
+
+    Raises
+    ------
+    ValueError
+        As :func:`model_score`.
+
+    Examples
+    --------
+    >>> score, rom = model_parts(DesignFeatures(roms=((8, 10),), adders=(20,)), "xc7")
+    >>> round(rom, 2), round(score - rom, 2)   # 10 bits x 4 LUT6, 20 adder bits
+    (40.27, 4.25)
+    """
+    score = model_score(features, target)
+    rom = CALIBRATION[get_target(target).name]["rom"] * model_terms(features, target)["rom"]
+    return score, min(score, float(rom))
+
+
 def piecewise_features(d) -> DesignFeatures:
     """Features of a :class:`~chebnorm.hw.piecewise.PiecewiseDesign`: its
     coefficient ROM (index bits x word bits), one ``acc x t`` multiplier and
-    one adder per Horner step, the output rounding and saturation.
+    one adder per Horner step (a sized design's step ``j`` multiplies by its
+    own ``T_j`` bits of ``t``; a truncated multiplier is its kept
+    partial-product bits), the output rounding and saturation.
 
     Parameters
     ----------
@@ -242,7 +313,8 @@ def piecewise_features(d) -> DesignFeatures:
     Returns
     -------
     DesignFeatures
-        One ROM, one multiplier per Horner step, the steps' adders and two
+        One ROM, one multiplier (or truncated multiplier's partial
+        products) per Horner step, the steps' adders and two
         ``out_bits + 2``-bit adders; no registers.
 
     Examples
@@ -255,15 +327,27 @@ def piecewise_features(d) -> DesignFeatures:
     (2, 1)
     """
     n = d.degree
-    mults, adds = [], []
+    mults, adds, partial = [], [], []
     acc_w = d.rom_bits[n] if n > 0 else 0
-    for _pw, sw, ow in d.widths:
-        mults.append((int(acc_w), int(d.t_bits)))
-        adds.append(int(sw))
-        acc_w = ow
+    if getattr(d, "sized", False):
+        for st in d.sized_signals():   # each step multiplies by its own T_j bits of t
+            a = int(acc_w)
+            if st["rows"]:   # truncated: the kept bits of the shifted-multiplicand rows
+                partial.append(sum(max(0, a - sh) if sh >= 0 else a for _i, sh, _n in
+                                   st["rows"]))
+            else:
+                mults.append((a, int(st["tw"])))
+            adds.append(int(st["sw"]))
+            acc_w = st["aw"]
+    else:
+        for _pw, sw, ow in d.widths:
+            mults.append((int(acc_w), int(d.t_bits)))
+            adds.append(int(sw))
+            acc_w = ow
     adds += [d.out_bits + 2, d.out_bits + 2]  # rounding increment and saturation compare
     return DesignFeatures(roms=((int(d.index_bits), int(sum(d.rom_bits))),),
-                          multipliers=tuple(mults), adders=tuple(adds))
+                          multipliers=tuple(mults), adders=tuple(adds),
+                          partial_products=tuple(partial))
 
 
 def naf_weight(q: int) -> int:

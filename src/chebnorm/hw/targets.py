@@ -86,6 +86,15 @@ class Target:
     timing : str, default ""
         The delay model: ``"nextpnr"`` (place and route), ``"sta"`` (cell
         delays, no routing) or ``"ltp"`` (gate depth).
+    fast : str, default ""
+        The same flow without the parts that cannot change the result for a
+        design of plain RTL (empty: none): on ``xc7``, ``synth_xilinx``'s
+        ``begin`` step reads the 328 blackbox modules of ``cells_xtra.v``
+        besides ``cells_sim.v`` (43 % of a run); a design that instantiates
+        no primitive needs only ``cells_sim.v``, which declares every cell the
+        mapping produces (LUTs, CARRY4, MUXF7/8, DSP48E1, RAMB18E1/36E1,
+        flip-flops). :func:`synthesize_target` runs it first and the full
+        ``synth`` when yosys then misses a module.
 
     Examples
     --------
@@ -100,9 +109,14 @@ class Target:
     device: str
     weights: dict = field(default_factory=dict)   # cell class -> LUT equivalents
     timing: str = ""    # "nextpnr", "sta" (cell delays, no routing) or "ltp" (gate depth)
+    fast: str = ""      # the same mapping without the unneeded library reads ("" for none)
 
     def script(self, top: str) -> str:
         return self.synth.format(top=top)
+
+    def fast_script(self, top: str) -> str:
+        """The :attr:`fast` flow for ``top`` (the full :meth:`script` when there is none)."""
+        return (self.fast or self.synth).format(top=top)
 
 
 #: LUT equivalents per hard block, from the device counts (module docstring)
@@ -113,16 +127,22 @@ DEVICE_WEIGHTS = {
                    "bram36": 7680 / 32},
 }
 
+# synth_xilinx's begin step with cells_sim.v only (Target.fast), then the rest of it
+_XC7_FAST = ("read_verilog -lib -specify +/xilinx/cells_sim.v; hierarchy -check -top {{top}}; "
+             "synth_xilinx -family xc7{opts} -top {{top}} -run prepare:")
+
 #: the registered targets, name to :class:`Target`, in the order :func:`target_names` lists
 TARGETS = {
     "generic": Target("generic", "synth -top {top}", "yosys generic gate cells", "none",
                       {}, "ltp"),
     "xc7": Target("xc7", "synth_xilinx -family xc7 -top {top}",
                   "Xilinx 7-series LUT1..6, DSP48E1, CARRY4, MUXF7/8, FD*, RAMB18/36",
-                  "xc7a100t", DEVICE_WEIGHTS["xc7a100t"], "sta"),
+                  "xc7a100t", DEVICE_WEIGHTS["xc7a100t"], "sta",
+                  _XC7_FAST.format(opts="")),
     "xc7-nodsp": Target("xc7-nodsp", "synth_xilinx -family xc7 -nodsp -top {top}",
                         "Xilinx 7-series without DSP48E1: multipliers in LUTs and CARRY4",
-                        "xc7a100t", DEVICE_WEIGHTS["xc7a100t"], "sta"),
+                        "xc7a100t", DEVICE_WEIGHTS["xc7a100t"], "sta",
+                        _XC7_FAST.format(opts=" -nodsp")),
     "ice40": Target("ice40", "synth_ice40 -top {top}",
                     "Lattice iCE40 SB_LUT4, SB_CARRY, SB_DFF*, SB_RAM40_4K",
                     "ice40-hx8k", DEVICE_WEIGHTS["ice40-hx8k"], "nextpnr"),
@@ -406,12 +426,19 @@ def synthesize_target(verilog_text: str, top: str, target: str = "generic", *,
         raise ValueError("verilog_text: not a str; accepted: Verilog source text")
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "design.v").write_text(verilog_text, encoding="utf-8")
-        script = f"read_verilog design.v; {t.script(top)}; tee -q -o stat.json stat -json"
+        tail = "; tee -q -o stat.json stat -json"
         if timing and t.timing == "sta":
-            script += "; read_verilog -lib -specify +/xilinx/cells_sim.v; sta"
+            tail += "; read_verilog -lib -specify +/xilinx/cells_sim.v; sta"
         elif timing:
-            script += "; ltp -noff"
-        out = _yosys(tmp, script, f"{t.name} synthesis of {top}", timeout)
+            tail += "; ltp -noff"
+        what = f"{t.name} synthesis of {top}"
+        try:
+            out = _yosys(tmp, f"read_verilog design.v; {t.fast_script(top)}{tail}", what,
+                         timeout)
+        except ValueError as e:   # a primitive only cells_xtra.v declares: the full flow
+            if not t.fast or "is not part of the design" not in str(e):
+                raise
+            out = _yosys(tmp, f"read_verilog design.v; {t.script(top)}{tail}", what, timeout)
         by_type = _stat(tmp, top)
     cost = cost_from_types(t.name, by_type)
     if timing and t.timing == "sta":
