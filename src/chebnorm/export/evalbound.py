@@ -458,6 +458,10 @@ class Evaluator:
         :func:`horner_bound` takes it.
     subintervals : int, default DEFAULT_SUBINTERVALS
         The pieces each polynomial's range is cut into (``1 .. 2**20``).
+    target : tuple of str, default ()
+        ``(expression, variable)`` of ``f`` (the table's), for the
+        exhaustive certificate of a float32 evaluator
+        (:func:`chebnorm.export.certificate.stated_bound`); empty: none.
 
     Examples
     --------
@@ -474,6 +478,7 @@ class Evaluator:
     parity: int | None = None
     shift: tuple | None = None
     subintervals: int = DEFAULT_SUBINTERVALS
+    target: tuple = ()
 
     def bound(self) -> EvalBound:
         """The bound over every piece: the largest piece's."""
