@@ -328,3 +328,129 @@ def test_shader_bound_is_the_float_bound_in_float32():
         assert b.flush < Fraction(2) ** -100  # a subnormal input flushed to 0
         assert b.total == float_up(Fraction(c_f) + b.flush) and b.total <= b.total32
         assert np.float32(b.total32) == b.total32
+
+
+# -- the exhaustive certificate (chebnorm.export.certificate) ------------------------------
+
+
+def _every_float32(ev):
+    from chebnorm.export.certificate import float32_range
+
+    k0, k1 = float32_range(ev.pieces[0].lo, ev.pieces[0].hi)
+    k = np.arange(k0, k1 + 1, dtype=np.int64)
+    assert k0 >= 0  # the intervals below are positive
+    return k.astype(np.uint32).view(np.float32)
+
+
+def _float_evaluator(case, constant_part):
+    table = _table(_key(case))
+    text, evs = c_header_evaluators(table)
+    ev = next(e for e in evs if e.constant.endswith(constant_part))
+    return table, text, ev
+
+
+def _pure(ev, x, fused):
+    """The evaluator with every step fused, or none, written out here."""
+    from chebnorm.export.certificate import fma32
+
+    cs = [np.float32(c) for c in ev.pieces[0].coeffs]
+    if ev.parity is not None:
+        cs, t = cs[ev.parity::2], x * x
+    elif ev.shift is not None:
+        _, s, c_t, s_t, exact = ev.shift
+        d = x - np.float32(c_t)
+        t = d * np.float32(1 / s) if exact else d / np.float32(s_t)
+    else:
+        t = x
+    acc = np.full_like(x, cs[-1])
+    for c in reversed(cs[:-1]):
+        acc = fma32(acc, t, np.full_like(acc, c)) if fused else acc * t + c
+    return (acc * x if ev.parity == 1 else acc).astype(np.float64)
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.parametrize("case, part, drop", [("exp_d6", "_F_EVAL_ERROR_BOUND", 2),
+                                               ("sin_odd", "_QUANT_F_EVAL_ERROR_BOUND", "t"),
+                                               ("shifted", "_F_EVAL_ERROR_BOUND", 1)])
+def test_certificate_simulation_is_the_compiled_evaluator(case, part, drop):
+    """Every output of the compiled float evaluator (gcc -O2 -ffp-contract=off, and
+    -O2 -march=native -ffp-contract=fast) on every float32 of its interval lies in
+    the simulated [lo, hi] of all fused/unfused mixes, and each pure build's output
+    is one of its ends; the simulation with one rounding left out is caught."""
+    from chebnorm.export.certificate import float32_simulation
+    from chebnorm.export.verify import c_evaluate
+
+    table, text, ev = _float_evaluator(case, part)
+    x = _every_float32(ev)
+    lo, hi = float32_simulation(ev, x)
+    pure = float32_simulation(ev, x, pure=True)
+    bad = float32_simulation(ev, x, drop=drop, pure=True)
+    for fused in (False, True):
+        y = c_evaluate(text, ev.function, x, fused=fused).astype(np.float64)
+        assert np.all((lo <= y) & (y <= hi)), (case, fused)
+        assert np.array_equal(y, _pure(ev, x, fused)), (case, fused)  # written out here
+        assert np.array_equal(y, pure[fused]), (case, fused)  # the certificate's simulation
+        if not fused or drop == "t":  # a dropped product rounding is the unfused path's
+            assert not np.array_equal(y, bad[fused]), (case, fused, "mutation not caught")
+    assert np.any(lo < hi)  # fusing does change some results
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+def test_fma32_is_gccs_fmaf(tmp_path):
+    """The exact fma emulation against the C library's fmaf, bit for bit, on
+    seeded random triples over many binades and on ties, sticky bits and
+    subnormal results."""
+    import ctypes
+
+    from chebnorm.export.certificate import fma32
+
+    src = tmp_path / "f.c"
+    src.write_text("#include <math.h>\nvoid f(const float *a, const float *b, const float *c,"
+                   " float *o, long n) { for (long i = 0; i < n; i++) o[i] = fmaf(a[i], b[i],"
+                   " c[i]); }\n")
+    lib = tmp_path / "f.so"
+    subprocess.run([GCC, "-O2", "-fPIC", "-shared", "-fno-builtin", "-o", str(lib), str(src),
+                    "-lm"], check=True, capture_output=True)
+    f = ctypes.CDLL(str(lib)).f
+    rng = np.random.default_rng(29)
+    n = 1 << 20
+
+    def rand(lo, hi):
+        m = rng.uniform(1, 2, n) * rng.choice([-1, 1], n)
+        return np.ldexp(m, rng.integers(lo, hi, n)).astype(np.float32)
+
+    a, b = rand(-70, 70), rand(-70, 70)
+    c = np.where(rng.random(n) < 0.5, (a.astype(np.float64) * b * rng.uniform(-1.5, 1.5, n)),
+                 rand(-150, 70)).astype(np.float32)
+    one = np.float32(1 + 2.0 ** -12)
+    extra = [(one, one, np.float32(-1)), (one, one, np.float32(2.0 ** -60)),
+             (np.float32(1 + 2.0 ** -23), np.float32(1 + 2.0 ** -23), np.float32(-2.0 ** -70)),
+             (np.float32(2.0 ** -70), np.float32(2.0 ** -70), np.float32(0)),
+             (np.float32(2.0 ** -63), np.float32(1.5 * 2.0 ** -63), np.float32(-2.0 ** -126))]
+    a = np.concatenate([a, [e[0] for e in extra]]).astype(np.float32)
+    b = np.concatenate([b, [e[1] for e in extra]]).astype(np.float32)
+    c = np.concatenate([c, [e[2] for e in extra]]).astype(np.float32)
+    out = np.empty_like(a)
+    p = ctypes.POINTER(ctypes.c_float)
+    f(a.ctypes.data_as(p), b.ctypes.data_as(p), c.ctypes.data_as(p), out.ctypes.data_as(p),
+      ctypes.c_long(len(a)))
+    mine = fma32(a, b, c)
+    assert np.array_equal(mine.view(np.uint32), out.view(np.uint32))
+    assert np.any(mine != (a * b) + c)  # the triples do tell fused from unfused
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+def test_certificate_is_the_exhaustive_maximum_and_a_halved_one_is_caught(tmp_path):
+    """The certified value is the measured maximum over both builds to within the
+    stated rounding (it covers mixed fusions too, so it may be a little larger),
+    and half of it is exceeded by the measurement."""
+    from chebnorm.export.certificate import stated_bound
+
+    table, text, ev = _float_evaluator("rsqrt_d8", "_F_EVAL_ERROR_BOUND")
+    value, cert = stated_bound(ev)
+    assert cert is not None and value == cert.stated == _bounds(text)[ev.constant]
+    header = tmp_path / f"chebnorm_{table.name}.h"
+    header.write_text(text)
+    m = max(_run_c(_harness(table, str(header)), tmp_path, flags)[1] for flags in BUILDS)
+    assert m + REF_MARGIN <= float(cert.maximum) <= cert.stated <= TIGHT * m
+    assert not m <= cert.stated / 2

@@ -186,7 +186,7 @@ def _subnormal(v: np.ndarray) -> bool:
     return bool(np.any((a > 0) & (a < np.float32(2.0 ** -126))))
 
 
-def float32_simulation(ev, x, *, drop=None):
+def float32_simulation(ev, x, *, drop=None, pure=False):
     """The float32 evaluator ``ev`` run bit-exactly on the float32 inputs ``x``:
     the smallest and the largest result over every mix of fused and unfused
     Horner steps.
@@ -199,15 +199,20 @@ def float32_simulation(ev, x, *, drop=None):
         Inputs.
     drop : int or "t", optional
         For the tests only: the product of Horner step ``drop`` (counted
-        from the highest coefficient, 0 first) left unrounded (``"t"``: the
-        square ``t = x*x``), so the simulation is no longer the evaluator.
+        from the highest coefficient, 0 first) left unrounded in the unfused
+        path (``"t"``: the square ``t = x*x`` rounded toward zero), so the
+        simulation is no longer the evaluator.
+    pure : bool, default False
+        Return the every-step-unfused and every-step-fused results instead
+        (what ``-ffp-contract=off`` and ``-ffp-contract=fast`` builds compute).
 
     Returns
     -------
     tuple of numpy.ndarray or None
         ``(lo, hi)`` as float64 arrays: every mix's result lies in
-        ``[lo, hi]`` and both are some mix's; None when a flushing
-        arithmetic (``BINARY32_FTZ``) meets a subnormal value.
+        ``[lo, hi]`` and both are some mix's (``pure``: ``(unfused,
+        fused)``); None when a flushing arithmetic (``BINARY32_FTZ``) meets
+        a subnormal value.
 
     Examples
     --------
@@ -224,18 +229,23 @@ def float32_simulation(ev, x, *, drop=None):
     cs = tuple(float(c) for c in ev.pieces[0].coeffs)
     if ev.parity is not None:
         cs = cs[ev.parity::2]
-    lo, hi, subnormal = _simulate(np.asarray(x, dtype=np.float32), cs, ev.parity, ev.shift, drop)
+    lo, hi, subnormal = _simulate(np.asarray(x, dtype=np.float32), cs, ev.parity, ev.shift, drop,
+                                  pure)
     return None if subnormal and a.flush else (lo, hi)
 
 
-def _simulate(x, cs, parity, shift, drop):
+def _simulate(x, cs, parity, shift, drop, pure=False):
     """The smallest and largest float32 result over every fusion mix (float64
     arrays), and whether a subnormal value was met (a flushing arithmetic
-    may then differ)."""
+    may then differ). ``pure``: the every-step-unfused and every-step-fused
+    results instead of the smallest and largest."""
     f32 = np.float32
     seen = [x]
     if parity is not None:
-        t = x * x if drop != "t" else (x.astype(np.float64) ** 2).astype(f32)
+        t = x * x
+        if drop == "t":  # the mutation: t rounded toward zero
+            exact = x.astype(np.float64) ** 2
+            t = np.where(t.astype(np.float64) > exact, np.nextafter(t, f32(0)), t)
     elif shift is not None:
         _, s, c_t, s_t, exact = shift
         d = x - f32(c_t)
@@ -244,24 +254,28 @@ def _simulate(x, cs, parity, shift, drop):
     else:
         t = x
     seen.append(t)
+
+    def unfused(a, c, j):
+        if drop == j:  # the mutation: this step's product left unrounded
+            return (a.astype(np.float64) * t + c).astype(f32)
+        prod = a * t
+        seen.append(prod)
+        return prod + c
+
     lo = hi = np.full_like(x, f32(cs[-1]))
     for j, c in enumerate(reversed(cs[:-1])):
         c = f32(c)
-        cand = []
-        for a in (lo, hi):
-            prod = a * t if drop != j else None
-            if prod is not None:
-                seen.append(prod)
-                cand.append(prod + c)
-            else:  # the mutation: this step's product left unrounded
-                cand.append((a.astype(np.float64) * t + c).astype(f32))
-            cand.append(fma32(a, t, np.full_like(a, c)))
-        lo = np.minimum.reduce(cand)
-        hi = np.maximum.reduce(cand)
+        if pure:
+            lo, hi = unfused(lo, c, j), fma32(hi, t, np.full_like(hi, c))
+        else:
+            cand = [unfused(lo, c, j), unfused(hi, c, j),
+                    fma32(lo, t, np.full_like(lo, c)), fma32(hi, t, np.full_like(hi, c))]
+            lo, hi = np.minimum.reduce(cand), np.maximum.reduce(cand)
         seen += [lo, hi]
     if parity == 1:
         lo, hi = lo * x, hi * x
-        lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
+        if not pure:
+            lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
         seen += [lo, hi]
     return lo.astype(np.float64), hi.astype(np.float64), any(_subnormal(v) for v in seen)
 
@@ -339,9 +353,9 @@ def float32_certificate(ev, expression: str, variable: str = "x", *, drop=None
     variable : str, default "x"
         Its variable.
     drop : int or "t", optional
-        For the tests only: leave out the rounding of Horner step ``drop``'s
-        product (``"t"``: of ``t = x*x``), so the simulation no longer is the
-        evaluator (a wrong certificate a check must catch).
+        For the tests only, as :func:`float32_simulation` takes it: a
+        simulation that is no longer the evaluator (a wrong certificate a
+        check must catch).
 
     Returns
     -------
