@@ -303,7 +303,7 @@ class _Reference:
                     tc = fn.arb_series(arb_series([arb(m), 1], prec=n + 1)).coeffs()
                     ball = arb(m, r)  # [m - r, m + r] contains the piece
                     rest = fn.arb_series(arb_series([ball, 1], prec=n + 1)).coeffs()
-                except (ValueError, ZeroDivisionError):
+                except (ValueError, ArithmeticError, TypeError):
                     raise _NoReference() from None
                 tc = list(tc) + [arb(0)] * (n + 1 - len(tc))
                 rest = list(rest) + [arb(0)] * (n + 1 - len(rest))
