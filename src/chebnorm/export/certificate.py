@@ -92,6 +92,15 @@ class ExhaustiveCertificate:
     reference_error : Fraction
         The largest proved ``|q(x) - f(x)|`` of the reference (included in
         ``maximum``).
+
+    Examples
+    --------
+    >>> from chebnorm.export.evalbound import BINARY32, Evaluator, Piece
+    >>> c = (1.0, 0.5)
+    >>> cert = float32_certificate(
+    ...     Evaluator("C", "c", BINARY32, (Piece(c, c, Fraction(0), 1.0, 1.5),)), "1 + x/2")
+    >>> cert.maximum <= cert.stated and cert.reference_error < 1e-15
+    True
     """
 
     maximum: Fraction
