@@ -29,6 +29,9 @@ Every quantity is a binary64 number rounded upward (``nextafter``), so the
 result is an upper bound; the tests compare it with an exhaustive run of the
 compiled evaluator over every float32 of the interval, and the same
 bound is proved by Gappa from the script :mod:`chebnorm.export.gappa` prints.
+Where it is loose (several roundings of similar size, which never all reach
+their worst case on one input) a float32 evaluator states instead the
+exhaustive certificate of :mod:`chebnorm.export.certificate`.
 
 Examples
 --------
