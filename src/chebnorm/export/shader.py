@@ -531,15 +531,17 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
       f" in ascending powers of {var}, rounded to float32 (exact literals).")
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
-    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
-      f" {float(bound.rounding):.6e}")
     if bound.certificate is None:
+        w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
+          f" {float(bound.rounding):.6e}")
         w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half"
           " an ulp of its")
         w(f"//   largest result there, fused or not) + subnormal input flush "
           f"{float(bound.flush):.3e}."
           + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
     else:
+        w(f"//   the certified maximum of |{fn}(x) - f(x)| {float(bound.certificate.maximum):.6e}"
+          f" rounded up")
         w("//   (chebnorm.export.certificate: exhaustive, every float32 input and every fused/"
           "unfused mix run")
         w(f"//   bit-exactly against a proved enclosure of f) + subnormal input flush "
