@@ -497,8 +497,9 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
     scripts = gappa_proofs(evaluators, stem)
     if fmt in ("glsl", "wgsl", "hlsl"):  # the constant printed is the float32 rounded up
         from .gappa import gappa_script
-        scripts = {name: gappa_script(ev, float32_eval_bound(table).total32)
-                   for name in scripts}
+        shader_bound = float32_eval_bound(table)
+        if shader_bound.certificate is None:  # else: the proof is of the a-priori bound
+            scripts = {name: gappa_script(ev, shader_bound.total32) for name in scripts}
     files.update(scripts)
     write_atomic(path, text)
     for name, script in scripts.items():

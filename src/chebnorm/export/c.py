@@ -21,7 +21,12 @@ decimal value in a comment, Horner evaluators, and the bounds:
     the certified bound plus the largest local coefficient-rounding and
     evaluation error. ``chebnorm export --proof`` writes one Gappa script per
     constant (:mod:`chebnorm.export.gappa`) proving it, and the header names
-    it beside the constant.
+    it beside the constant. A float32 evaluator whose rounding dominates
+    states instead its exhaustive certificate when that is smaller
+    (:mod:`chebnorm.export.certificate`: every float32 input and every mix
+    of fused and unfused steps run bit-exactly against a proved enclosure
+    of ``f``); its comment says so and gives the a-priori bound the Gappa
+    script proves.
 ``<P>_QUANT_ABS_ERROR_BOUND``, ``<P>_QUANT_EVAL_ERROR_BOUND`` (and ``_F_``)
     for a table whose ``quantized`` part is not a plain ``fixed_point`` (a
     floating format, one fractional width per power, chosen monomials or a
@@ -570,7 +575,7 @@ def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: F
     piece = Piece(tuple(cs), tuple(float(c) for c in coeffs), Fraction(table.abs_error_bound),
                   lo, hi)
     return Evaluator(constant, name, BINARY32 if suffix == "f" else BINARY64, (piece,),
-                     shift=shift), None
+                     shift=shift, target=(table.expression, table.variable)), None
 
 
 def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, name: str,
@@ -676,9 +681,9 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
         piece = Piece(tuple(coeffs), tuple(coeffs), Fraction(q.abs_error_bound),
                       *inner_interval(table))
         ev = Evaluator(constant, f"{fn}_quant{fsuffix}", BINARY32 if suffix == "f" else BINARY64,
-                       (piece,), parity=parity)
+                       (piece,), parity=parity, target=(table.expression, table.variable))
         evaluators.append(ev)
-        w(f"#define {constant} {_literal(ev.bound().stated, '')}{_backed(ev, proof)}")
+        w(_bound_line(ev, proof))
     w(f"static const double {fn}_quant_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
         w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* x^{k} */")
@@ -852,7 +857,7 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
             continue
         emitted.append((ctype, suffix, fsuffix))
         evaluators.append(bound)
-        w(f"#define {bound.constant} {_literal(bound.bound().stated, '')}{_backed(bound, proof)}")
+        w(_bound_line(bound, proof))
     if table.fixed_point is not None:
         fp = _checked_fixed(table)
         _check_fixed_ranges(table, max_x)
@@ -862,7 +867,7 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
         ev = Evaluator(f"{macro}_Q_EVAL_ERROR_BOUND", f"{fn}_q_eval", fixed_arithmetic(fp.frac_bits),
                        (Piece(qs, qs, Fraction(fp.abs_error_bound), *inner_interval(table)),))
         evaluators.append(ev)
-        w(f"#define {ev.constant} {_literal(ev.bound().stated, '')}{_backed(ev, proof)}")
+        w(_bound_line(ev, proof))
     w("")
     w(f"static const double {fn}_coeffs[{len(coeffs)}] = {{")
     for k, c in enumerate(coeffs):
@@ -882,3 +887,20 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
 def _backed(ev, proof: str) -> str:
     """The comment naming the proof file of ``ev``'s constant (when proofs are written)."""
     return f"  /* proof: {proof}.{ev.constant}.gappa */" if proof else ""
+
+
+def _bound_line(ev, proof: str) -> str:
+    """``#define CONSTANT value`` and the evidence behind it: the Gappa proof
+    of the interval bound, or the exhaustive certificate over every float32
+    input (the proof file then proves the larger interval bound)."""
+    from .certificate import stated_bound
+
+    value, cert = stated_bound(ev)
+    line = f"#define {ev.constant} {_literal(value, '')}"
+    if cert is None:
+        return line + _backed(ev, proof)
+    proved = ev.bound().stated
+    return (line + f"  /* exhaustive: every float32 input and every fused/unfused mix checked"
+            f" (chebnorm.export.certificate; chebnorm verify re-checks); the a-priori bound"
+            f" {proved!r}" + (f" is proved by {proof}.{ev.constant}.gappa" if proof else "")
+            + " */")

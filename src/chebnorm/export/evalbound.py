@@ -29,6 +29,9 @@ Every quantity is a binary64 number rounded upward (``nextafter``), so the
 result is an upper bound; the tests compare it with an exhaustive run of the
 compiled evaluator over every float32 of the interval, and the same
 bound is proved by Gappa from the script :mod:`chebnorm.export.gappa` prints.
+Where it is loose (several roundings of similar size, which never all reach
+their worst case on one input) a float32 evaluator states instead the
+exhaustive certificate of :mod:`chebnorm.export.certificate`.
 
 Examples
 --------
@@ -458,6 +461,10 @@ class Evaluator:
         :func:`horner_bound` takes it.
     subintervals : int, default DEFAULT_SUBINTERVALS
         The pieces each polynomial's range is cut into (``1 .. 2**20``).
+    target : tuple of str, default ()
+        ``(expression, variable)`` of ``f`` (the table's), for the
+        exhaustive certificate of a float32 evaluator
+        (:func:`chebnorm.export.certificate.stated_bound`); empty: none.
 
     Examples
     --------
@@ -474,6 +481,7 @@ class Evaluator:
     parity: int | None = None
     shift: tuple | None = None
     subintervals: int = DEFAULT_SUBINTERVALS
+    target: tuple = ()
 
     def bound(self) -> EvalBound:
         """The bound over every piece: the largest piece's."""

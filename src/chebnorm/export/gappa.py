@@ -2,7 +2,9 @@
 
 :func:`gappa_script` prints, for one
 :class:`~chebnorm.export.evalbound.Evaluator`, a Gappa script whose theorem
-is its stated bound::
+is its stated bound (or, where the exporter states the smaller exhaustive
+certificate of :mod:`chebnorm.export.certificate`, the a-priori bound
+``ev.bound().stated`` that the header quotes beside it)::
 
     { x in [LO, HI] /\\ |P - F| <= A  ->  |y_unfused - F| <= B /\\ |y_fused - F| <= B }
 

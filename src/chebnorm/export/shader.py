@@ -264,6 +264,10 @@ class ShaderBound:
     total32 : float
         ``total`` rounded up to a float32: the shader's
         ``CHEBNORM_NAME_EVAL_ERROR_BOUND``.
+    certificate : ExhaustiveCertificate or None, default None
+        When the evaluation part is the exhaustive certificate of
+        :func:`chebnorm.export.certificate.stated_bound` (every float32
+        input, every fused/unfused mix) rather than the interval bound.
 
     Examples
     --------
@@ -279,6 +283,7 @@ class ShaderBound:
     flush: Fraction
     total: float
     total32: float
+    certificate: object = None
 
 
 #: quantized formats whose every number is a float32 (used as they are)
@@ -358,8 +363,10 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
                          f"within the float32 range (|values| < 3.4e38)")
+    from .certificate import stated_bound
+
     ev = shader_evaluator(table)
-    eb = ev.bound()
+    stated, cert = stated_bound(ev)
     lo32, hi32 = interval32(table)
     flush = Fraction(0)
     if lo32 < 2.0 ** -126 and hi32 > -2.0 ** -126:
@@ -368,14 +375,14 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
         # the local bound, and |p(x') - p(x)| <= 2^-126 max |p'|
         flush = _FLUSH * sum((k * abs(Fraction(c)) * m ** (k - 1)
                               for k, c in enumerate(coeffs) if k), Fraction(0))
-    total = Fraction(eb.stated) + flush
+    total = Fraction(stated) + flush
     up = float_up(total)
     up32 = float(np.float32(up))
     if up32 < up:
         up32 = float(np.nextafter(np.float32(up32), np.float32(np.inf), dtype=np.float32))
     return ShaderBound(certified=certified, coefficients=Fraction(0),
-                       rounding=Fraction(eb.stated) - certified, flush=flush, total=up,
-                       total32=up32)
+                       rounding=Fraction(stated) - certified, flush=flush, total=up,
+                       total32=up32, certificate=cert)
 
 
 def shader_evaluator(table: CoefficientTable, constant: str = ""):
@@ -421,7 +428,8 @@ def shader_evaluator(table: CoefficientTable, constant: str = ""):
     piece = Piece(c32, tuple(coeffs), certified, lo, hi)
     name = identifier(table.name, field="table.name")
     return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
-                     f"chebnorm_{name}", BINARY32_FTZ, (piece,))
+                     f"chebnorm_{name}", BINARY32_FTZ, (piece,),
+                     target=(table.expression, table.variable))
 
 
 def interval32(table: CoefficientTable) -> tuple[float, float]:
@@ -523,12 +531,24 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
       f" in ascending powers of {var}, rounded to float32 (exact literals).")
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
-    w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
-      f" {float(bound.rounding):.6e}")
-    w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half an"
-      " ulp of its")
-    w(f"//   largest result there, fused or not) + subnormal input flush {float(bound.flush):.3e}."
-      + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
+    if bound.certificate is None:
+        w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
+          f" {float(bound.rounding):.6e}")
+        w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half"
+          " an ulp of its")
+        w(f"//   largest result there, fused or not) + subnormal input flush "
+          f"{float(bound.flush):.3e}."
+          + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
+    else:
+        w(f"//   the certified maximum of |{fn}(x) - f(x)| {float(bound.certificate.maximum):.6e}"
+          f" rounded up")
+        w("//   (chebnorm.export.certificate: exhaustive, every float32 input and every fused/"
+          "unfused mix run")
+        w(f"//   bit-exactly against a proved enclosure of f) + subnormal input flush "
+          f"{float(bound.flush):.3e}.")
+        w(f"//   The a-priori bound {shader_evaluator(table).bound().stated!r} (interval "
+          f"arithmetic) is proved"
+          + (f" by {proof}.{big}_EVAL_ERROR_BOUND.gappa." if proof else " by its Gappa script."))
     w("// Assumes float32 (highp) with correctly rounded + and *, and a multiply-add that is fused"
       " or two roundings.")
     w("")
