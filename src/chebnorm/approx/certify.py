@@ -58,6 +58,7 @@ import sympy as sp
 from flint import arb, arb_poly, arb_series, ctx
 
 from chebnorm.core.numeric import arb_precision, ball_float_down, ball_float_up
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .expr import Function1D, compile_arb
 
@@ -100,6 +101,15 @@ class Certificate:
     subintervals: int
     tight: bool = True
     reason: str = ""
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("bound", self.bound), ("maximum", self.maximum), ("at", self.at),
+                ("subintervals", self.subintervals), ("tight", self.tight)] + (
+                    [("reason", self.reason)] if self.reason else [])
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
 
 def arb_enclose(value: sp.Expr) -> arb:

@@ -35,6 +35,7 @@ from chebnorm.approx import parse_function, parse_number
 from chebnorm.approx.certify import certify
 
 from chebnorm.core.numeric import float_up
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
@@ -93,6 +94,15 @@ class ErrorBudget:
     total: float
     y_lsb: float
     gappa_rounding: float | None = None
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("total", self.total), ("approximation", self.approximation),
+                ("quantization", self.quantization), ("rounding", self.rounding),
+                ("gappa_rounding", self.gappa_rounding)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def as_dict(self) -> dict:
         return {"approximation": self.approximation, "quantization": self.quantization,
@@ -160,6 +170,15 @@ class Measurement:
     step_rounding: tuple[float, ...]
     overflows: int
     y_lsb: float
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("codes", self.codes), ("total", self.total),
+                ("total_at_code", self.total_at_code), ("rel_total", self.rel_total),
+                ("overflows", self.overflows)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def total_lsb(self) -> float:

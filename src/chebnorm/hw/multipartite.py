@@ -60,6 +60,7 @@ import numpy as np
 
 from chebnorm.core.numeric import check_int, float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .exhaustive import ExhaustiveCheck, reference
 from .fixed import QFormat
@@ -222,6 +223,16 @@ class MultipartiteDesign:
     faithful: bool
     certificate: ExhaustiveCheck
     parts: dict = field(default_factory=dict)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("in_bits", self.in_bits),
+                ("out_bits", self.out_bits), ("split", self.split),
+                ("max_error", self.max_error), ("faithful", self.faithful)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def __post_init__(self):
         _check_design(self)

@@ -57,6 +57,7 @@ from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import (
     QFormat,
@@ -195,6 +196,16 @@ class PiecewiseDesign:
     prod_frac: tuple[int, ...] = ()      # P_j, j = 0..n-1: fractional bits kept of product j
     q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
     bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("segments", self.table.segment_count),
+                ("degree", self.degree), ("in_bits", self.in_bits), ("out_bits", self.out_bits),
+                ("latency", self.latency), ("multipliers", self.multipliers)] + (
+                    [("total_bound", float(self.bound[2]))] if self.bound else [])
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def module_name(self) -> str:
@@ -1004,7 +1015,7 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     >>> design_piecewise(t, 2, 8)
     Traceback (most recent call last):
     ...
-    ValueError: in-bits = 2 is out of range; accepted: 3 <= in-bits <= 20
+    ValueError: in_bits = 2 is out of range; accepted: 3 <= in_bits <= 20
     """
     if not isinstance(table, PiecewiseTable):
         raise ValueError("design_piecewise needs a PiecewiseTable")
@@ -1014,9 +1025,9 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                          f"segments; accepted for hardware: a uniform table, or an exponent "
                          f"table of 2^m segments (the code's top bits index it)")
     K = (nseg - 1).bit_length()
-    in_bits = check_width(in_bits, "in-bits", K + 1, MAX_PW_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
-    guard_bits = check_width(guard_bits, "guard-bits", 0, 16)
+    in_bits = check_width(in_bits, "in_bits", K + 1, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out_bits", 1, MAX_PW_OUT_BITS)
+    guard_bits = check_width(guard_bits, "guard_bits", 0, 16)
     name = identifier(name or table.name, field="name")
     for v in table.interval:
         _exact(v)
@@ -1108,7 +1119,7 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
             return d
     if failed is not None:
         raise failed
-    raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+    raise ValueError(f"out_bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
 
 
 def _check_weight(w) -> float:
