@@ -240,6 +240,41 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     ------
     ValueError
         If gappa is asked for and fails on the datapath (see :func:`gappa_bound`).
+
+
+    See Also
+    --------
+    measure : the errors every valid input code actually makes.
+    gappa_bound : Gappa's independent bound of the rounding part.
+    chebnorm.hw.report.analyze : design, budget and measurement together.
+
+    Notes
+    -----
+    For every valid input code, :math:`p` the table's float polynomial and
+    :math:`p_q` its quantized one (module docstring),
+
+    .. math::
+
+        |y - f(x)| \\le |p_q(x) - f(x)| + |y - p_q(x)|
+        \\le \\min(\\varepsilon_{a} + \\varepsilon_{q},\\ \\varepsilon_{pq})
+        + \\sum_{j=1}^{n-1} \\rho_j \\max_x |x|^j + \\rho_{\\mathrm{out}},
+
+    with :math:`\\varepsilon_a` the certified :math:`\\sup|p - f|`
+    (``approximation``), :math:`\\varepsilon_q` a certified
+    :math:`\\sup|p_q - p|` (``quantization``), :math:`\\varepsilon_{pq}` the
+    re-certified :math:`\\sup|p_q - f|` (``quantized``), :math:`\\rho_j` the
+    rounding of the accumulator :math:`a_j` (one unit of its last place for
+    ``"trunc"``, half of one for ``"rne"``; 0 when nothing is dropped),
+    reaching the output multiplied by :math:`x^j`, and
+    :math:`\\rho_{\\mathrm{out}}` the output's rounding. ``gappa=True`` adds
+    Gappa's own bound of the rounding part [1]_.
+
+    References
+    ----------
+    .. [1] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
     """
     t = design.table
     xmax = design.max_abs_x()
@@ -283,6 +318,19 @@ def measure(design: HornerDesign) -> Measurement:
     -------
     Measurement
         The measured errors.
+
+
+    See Also
+    --------
+    error_budget : the certified bound the measurement is checked against.
+
+    Notes
+    -----
+    The bit-accurate model (:meth:`~chebnorm.hw.horner.HornerDesign.evaluate`)
+    runs every valid code :math:`k`; ``total`` is :math:`\\max_k |y_k - f(x_k)|` with
+    :math:`f` evaluated in float64, and the parts (``approximation``,
+    ``quantization``, ``rounding``) are the same maxima of
+    :math:`|p - f|`, :math:`|p_q - p|` and :math:`|y - p_q|`.
     """
     lo, hi = design.valid_codes
     k = np.arange(lo, hi + 1, dtype=np.int64)

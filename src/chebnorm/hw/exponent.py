@@ -376,6 +376,11 @@ def design_exponent(expr, interval, in_bits: int, out_bits: int, *, degree: int 
     ValueError
         Naming the argument and the accepted range.
 
+    See Also
+    --------
+    chebnorm.hw.piecewise.design_piecewise : the mantissa's core evaluator.
+    chebnorm.hw.hdl.exponent : its Verilog and VHDL.
+
     Examples
     --------
     >>> d = design_exponent("1/sqrt(x)", ("2^-10", "1"), 10, 10, degree=2)

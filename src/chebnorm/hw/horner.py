@@ -496,6 +496,39 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         If a width is out of its range, ``rounding`` is unknown, the table has no
         fixed-point part (and no ``coef_bits``), no input code falls in the interval,
         ``out_bits`` cannot hold the outputs, or a wire exceeds the 62-bit model.
+
+
+    See Also
+    --------
+    chebnorm.hw.budget.error_budget : the certified error of the design.
+    chebnorm.hw.budget.measure : its error over every valid input code.
+    chebnorm.hw.report.analyze : design, budget, measure and synthesize at once.
+    chebnorm.hw.hdl.module_text : its Verilog or VHDL.
+
+    Notes
+    -----
+    The datapath (module docstring), for the input code :math:`k`, the
+    value :math:`x = (K_0 + k)\\, 2^{-F_x}` and the quantized coefficients
+    :math:`q_j 2^{-F_c}`:
+
+    .. math::
+
+        a_n = q_n 2^{-F_c}, \\qquad
+        a_j = R_{F_a}\\!\\left(a_{j+1} x + q_j 2^{-F_c}\\right)\\ (j = n-1, \\dots, 1),
+        \\qquad y = R_{F_y}\\!\\left(a_1 x + q_0 2^{-F_c}\\right),
+
+    each multiply-add exact and :math:`R_F` one rounding to :math:`F`
+    fractional bits; every wire is sized from its exact range over all
+    :math:`2^{W}` codes, as FloPoCo sizes its polynomial evaluators [1]_ [2]_.
+    Its certified error budget is :func:`~chebnorm.hw.budget.error_budget`.
+
+    References
+    ----------
+    .. [1] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+       with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
+    .. [2] F. de Dinechin, M. Joldes, B. Pasca, "Automatic generation of
+       polynomial-based hardware architectures for function evaluation",
+       IEEE ASAP 2010.
     """
     _check_table(table)
     in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)

@@ -786,6 +786,31 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     ValueError
         An argument out of range (named), or no structure meets the target.
 
+    See Also
+    --------
+    chebnorm.hw.plain_table.design_plain_table : one table of every output.
+    chebnorm.hw.piecewise.design_piecewise : ROM of coefficients and a Horner datapath.
+    chebnorm.hw.exhaustive : the exhaustive proof over every code.
+
+    Notes
+    -----
+    The input code is cut into fields :math:`A` and :math:`B_i`; the
+    output is one truncated sum of table lookups [1]_,
+
+    .. math::
+
+        y = \\left\\lfloor \\frac{\\left(\\mathrm{TIV}[A] + \\sum_i
+            \\mathrm{TO}_i[C_i, B_i]\\right) \\bmod 2^{S}}{2^{g}} \\right\\rfloor,
+
+    :math:`C_i` the top bits of :math:`A` (module docstring). The design
+    returned is proved over every input code against Arb enclosures of
+    :math:`f` (``certificate``).
+
+    References
+    ----------
+    .. [1] F. de Dinechin, A. Tisserand, "Multipartite table methods", IEEE
+       Transactions on Computers 54(3), 2005.
+
     Examples
     --------
     >>> d = design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 10, 10)

@@ -1005,6 +1005,36 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         negative or not finite; a wire wider than 64 bits; y's range does
         not fit ``out_bits``.
 
+    See Also
+    --------
+    chebnorm.hw.horner.design_horner : one polynomial over the whole interval.
+    chebnorm.hw.piecewise_search.search : the ``chebnorm design`` search over tables and widths.
+    chebnorm.hw.hdl.module_text : the design's Verilog or VHDL.
+
+    Notes
+    -----
+    The :math:`W`-bit code :math:`k` stands for
+    :math:`x = a + (b - a)\\, k\\, 2^{-W}`; its top :math:`K` bits address the
+    ROM of segment coefficients and the low :math:`L = W - K` bits are the
+    local variable :math:`t = (k \\bmod 2^L)\\, 2^{-L}`, as in FloPoCo's
+    ``FixFunctionByPiecewisePoly`` [1]_ [2]_. With the one-width design
+
+    .. math::
+
+        |y - f(x)| \\le \\varepsilon_{\\mathrm{table}}
+        + \\sum_{j=1}^{n-1} 2^{-(F_a + 1)} \\max |t|^j + 2^{-(F_y + 1)}
+
+    (module docstring); the sized design (``widths``) is certified per
+    segment by :func:`sized_bound`.
+
+    References
+    ----------
+    .. [1] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+       with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
+    .. [2] F. de Dinechin, M. Joldes, B. Pasca, "Automatic generation of
+       polynomial-based hardware architectures for function evaluation",
+       IEEE ASAP 2010.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit

@@ -177,6 +177,11 @@ def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str 
         With its exhaustive certificate (``<= 2**-(F+1)`` plus the
         enclosures' width when every rounding was proved).
 
+    See Also
+    --------
+    chebnorm.hw.multipartite.design_multipartite : tables and an adder, smaller ROMs.
+    chebnorm.hw.exhaustive : the proof that every entry is the nearest integer.
+
     Examples
     --------
     >>> d = design_plain_table("x/2", ("0", "1"), 3, 3, out_frac_bits=3)
