@@ -117,6 +117,12 @@ CASES = {
 }
 
 
+def test_design_search_names_max_error():
+    message = _python_message(lambda: search("1/sqrt(x)", ("1", "4"), 8, 8, -1.0, synth=False,
+                                             progress=False, workers=1))
+    assert message.startswith("max_error -1.0 is not a positive number")
+
+
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_python_names_the_argument(tables, case):
     call, says, _, _ = CASES[case]

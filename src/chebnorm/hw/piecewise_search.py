@@ -334,7 +334,7 @@ def _cells(design: PiecewiseDesign) -> int:
 def _check_max_error(max_error) -> float:
     if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) or \
             not math.isfinite(max_error) or max_error <= 0:
-        raise ValueError(f"max-error {max_error!r} is not a positive number; accepted: E > 0")
+        raise ValueError(f"max_error {max_error!r} is not a positive number; accepted: E > 0")
     return float(max_error)
 
 
