@@ -6,6 +6,7 @@ characters of dataclass text."""
 from __future__ import annotations
 
 import dataclasses
+import shutil
 import warnings
 
 import numpy as np
@@ -16,6 +17,8 @@ import chebnorm as cn
 from chebnorm import hw
 from chebnorm.approx import parse_function
 from chebnorm.hw.piecewise import design_piecewise
+from chebnorm.hw.pipeline import PipelineResult
+from chebnorm.hw.targets import TargetCost
 from chebnorm.methods import angular_drift, count_ops
 from chebnorm.raster.meshes import get_mesh
 
@@ -42,7 +45,13 @@ def results():
             hw.analyze_unit(unit, synth=False).block,
             cn.certify(parse_function("1/sqrt(2+x)"), t.coefficients, sp.Integer(0),
                        sp.Integer(1)),
-            angular_drift(m=64), count_ops("exact", 16), get_mesh("teapot"),
+            angular_drift(m=64), count_ops("exact", 16), get_mesh("teapot"), mp.certificate,
+            # what synthesis returns, built by hand (no yosys here)
+            TargetCost(target="xc7", cells=217, luts=134, dsps=1, carries=6, muxes=76, ffs=0,
+                       brams=0, score=398.2, by_type={"LUT6": 80, "LUT5": 54}, levels=13,
+                       delay_ns=7.737, timing_model="yosys sta"),
+            PipelineResult(design=d, target="ice40", frequency_mhz=50.0, met=True, latency=2,
+                           fmax_mhz=61.3, source="nextpnr-ice40", cost=None, steps=((0, 35.1),)),
         ]
 
 
@@ -62,7 +71,7 @@ def test_every_result_has_a_short_repr_and_an_html_table(results):
     assert {"HornerDesign", "ErrorBudget", "Measurement", "PiecewiseDesign", "UnitDesign",
             "UnitReport", "MultipartiteDesign", "PlainTableDesign", "ExponentDesign",
             "SweepResult", "SweepPoint", "Block", "Certificate", "DriftReport", "OpCounts",
-            "Mesh"} <= names
+            "Mesh", "ExhaustiveCheck", "TargetCost", "PipelineResult"} <= names
 
 
 def test_repr_values_are_the_objects_own(results):
@@ -92,3 +101,15 @@ def test_arrays_show_their_shape_not_their_values(results):
     mesh = next(r for r in results if type(r).__name__ == "Mesh")
     assert f"vertices={len(mesh.positions)}" in repr(mesh)
     assert isinstance(mesh.positions, np.ndarray)
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+def test_verify_variants_display_briefly():
+    from chebnorm.export.verify import verify
+
+    t = cn.fit("1/sqrt(2+x)", ("0", "1"), 2, name="rs")
+    result = verify(t, "c", inputs=1000)
+    for v in result.variants:
+        text = repr(v)
+        assert text.startswith("VariantResult(") and len(text) <= LIMIT, text
+        assert f"variant='{v.variant}'" in text and "<table>" in v._repr_html_()
