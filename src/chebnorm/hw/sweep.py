@@ -331,6 +331,20 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
         If the target is unknown or a width, degree, worker count or scheduler is out of
         its range.
 
+    See Also
+    --------
+    chebnorm.hw.horner.design_horner : one design of the grid.
+    chebnorm.hw.piecewise_search.search : the ``chebnorm design`` search of piecewise evaluators.
+
+    Notes
+    -----
+    A point :math:`p` is on the Pareto front when no other point :math:`q`
+    has both :math:`\\mathrm{area}(q) \\le \\mathrm{area}(p)` and
+    :math:`\\mathrm{levels}(q) \\le \\mathrm{levels}(p)` with one of the two
+    strict, ``levels`` being the measured error in 8-bit shading levels
+    (:attr:`SweepPoint.shading_levels`) and ``area`` Yosys' cells, or the
+    full-adder estimate without Yosys.
+
     Examples
     --------
     >>> s = sweep("dichotomy", degrees=(1, 2), coef_bits=(10, 14), acc_bits=(14,), in_bits=8,

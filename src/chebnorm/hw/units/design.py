@@ -77,6 +77,27 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
     ValueError
         If ``kind`` is unknown, a width is out of its range, the table does not fit the
         unit, or a register would exceed the 62-bit model.
+
+
+    See Also
+    --------
+    analyze_unit : its cost model and, optionally, Yosys' cell count.
+    unit_outputs : its Verilog module, test bench and vectors.
+    chebnorm.hw.horner.design_horner : the polynomial evaluator inside the units that have one.
+
+    Notes
+    -----
+    The units are the papers' normalization methods in hardware [1]_: the
+    classic :math:`N / \\sqrt{N \\cdot N}`, the dichotomy midpoint
+    :math:`(N_1 + N_2) / \\sqrt{2 + z}` with :math:`1/\\sqrt{2 + z}` by a
+    Chebyshev polynomial, the quadratic span interpolator, its
+    forward-difference stepper and the criterion :math:`\\eta`, each bit for
+    bit equal to its kernel in :mod:`chebnorm.hw.datapaths`.
+
+    References
+    ----------
+    .. [1] The four papers chebnorm reproduces (seeds 000 to 003), restated
+       with their formulas re-derived in :doc:`/papers`.
     """
     spec = get_unit(kind)
     f = check_width(frac_bits, "frac_bits", 1, MAX_UNIT_FRAC_BITS)
