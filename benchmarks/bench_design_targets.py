@@ -12,6 +12,11 @@ the machine moves the wall figures: the CPU time is the steadier one). Prints
 one JSON line per target (its winner and timing lines too) and writes them
 all to the JSON file (sorted keys).
 
+    python benchmarks/bench_design_targets.py --markdown [--json FILE]
+
+prints the README's table of the issue-28 spec from the JSON file (no run):
+``tests/test_readme_figures.py`` checks that the README shows these rows.
+
     python benchmarks/bench_design_targets.py --calibrate [--bits 16 12] [--targets ...]
 
 measures instead what the pruning of ``design`` relies on
@@ -29,6 +34,7 @@ import argparse
 import json
 import os
 import platform
+import re
 import resource
 import subprocess
 import sys
@@ -89,12 +95,71 @@ def calibrate(bits: int, target: str, expr: str = "1/sqrt(1+3*x)") -> list[dict]
     return rows
 
 
+#: the cell kinds of ``design``'s cost line, as each FPGA family names them
+CELL_NAMES = {"xc7": ("LUT", "DSP48E1", "CARRY4", "MUXF"),
+              "xc7-nodsp": ("LUT", "DSP48E1", "CARRY4", "MUXF"),
+              "ice40": ("SB_LUT4", "DSP", "SB_CARRY", "MUX")}
+
+
+def winner_text(line: str, target: str) -> str:
+    """The README's words for the winner of ``design``'s first ``winner:`` line."""
+    arch = line.split("winner: ", 1)[1].split(f": {target}:", 1)[0]
+    arch = re.sub(r",? \(?ROM \d+ bits\)?", "", arch)
+    if arch.startswith("piecewise-sized: "):
+        return "sized piecewise, " + arch[len("piecewise-sized: "):]
+    if arch.startswith("degree "):
+        return "one width, " + arch
+    return arch.replace(": ", ", ", 1)
+
+
+def cost_text(line: str, target: str) -> str:
+    """``1,502 cells`` or ``134 LUT + 1 DSP48E1 + ... (score 398.2)`` from a winner line."""
+    if target == "generic":
+        cells = int(re.search(r"(\d+) cells", line).group(1))
+        return f"{cells:,} cells"
+    m = re.search(r"(\d+) LUT, (\d+) DSP, (\d+) carry, (\d+) mux, .*?score ([\d.]+)", line)
+    counts, score = [int(v) for v in m.groups()[:4]], float(m.group(5))
+    text = " + ".join(f"{n:,} {name}" for n, name in zip(counts, CELL_NAMES[target]) if n)
+    return text + ("" if score == counts[0] else f" (score {score:.1f})")
+
+
+def timing_text(lines: list[str]) -> str:
+    """The winner's timing, three significant digits, and how it was had."""
+    timing = [ln for ln in lines if ln.startswith("timing:")]
+    if not timing:
+        return "(no device)"
+    m = re.search(r"Fmax (~ )?([\d.]+) MHz \((model|nextpnr-ice40)", timing[0])
+    if m.group(3) == "model":
+        return f"Fmax ~ {float(m.group(2)):.3g} MHz (model, no routing)"
+    return f"{float(m.group(2)):.3g} MHz (nextpnr-ice40)"
+
+
+def markdown(doc: dict) -> str:
+    """The README's table of the spec, one row per target of ``doc`` (the JSON file).
+
+    >>> doc = {"results": [{"target": "generic", "wall_s": 56.83, "cpu_s": 33.56, "lines": [
+    ...     "winner: piecewise-sized: degree 2, 128 centred segments, ROM 4608 bits, "
+    ...     "truncated multipliers: generic: 1502 cells; certified error 1.5e-05"]}]}
+    >>> print(markdown(doc).splitlines()[-1])
+    | generic | sized piecewise, degree 2, 128 centred segments, truncated multipliers | 1,502 cells | (no device) | 57 s / 34 s |
+    """
+    rows = ["| target | winner | cells / LUT, DSP, carry, MUXF | timing | wall / CPU time |",
+            "|---|---|---|---|---|"]
+    for r in doc["results"]:
+        t, lines = r["target"], r["lines"]
+        rows.append(f"| {t} | {winner_text(lines[0], t)} | {cost_text(lines[0], t)} | "
+                    f"{timing_text(lines)} | {round(r['wall_s'])} s / {round(r['cpu_s'])} s |")
+    return "\n".join(rows) + "\n"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--targets", nargs="+", default=["generic", "xc7", "xc7-nodsp", "ice40"])
     ap.add_argument("--repeat", type=int, default=3, help="runs per target (best kept)")
     ap.add_argument("--json", default=os.path.join(HERE, "design_targets_results.json"),
                     help="where to write the results ('' for nowhere)")
+    ap.add_argument("--markdown", action="store_true",
+                    help="print the README table from the --json file (no run)")
     ap.add_argument("--calibrate", action="store_true",
                     help="model against yosys for every candidate (no timing)")
     ap.add_argument("--bits", nargs="+", type=int, default=[16, 12],
@@ -104,6 +169,10 @@ def main(argv=None) -> int:
     ap.add_argument("--calibration-json", default=os.path.join(HERE, "prune_calibration.json"),
                     help="--calibrate: where to write the rows ('' for nowhere)")
     args = ap.parse_args(argv)
+    if args.markdown:
+        with open(args.json, encoding="utf-8") as fh:
+            print(markdown(json.load(fh)), end="")
+        return 0
     if args.calibrate:
         rows = []
         for e in args.expr:

@@ -29,6 +29,15 @@ TABLE = ROOT / "figures" / "coefficients" / "rsqrt_d3.json"
 START, END = "<!-- verify-rsqrt-start -->", "<!-- verify-rsqrt-end -->"
 
 
+def row_text(fmt: str, v) -> str:
+    """One Markdown row of a :class:`~chebnorm.export.verify.VariantResult`."""
+    if v.skipped is not None:
+        return f"| {fmt} | {v.variant} | `{v.evaluator}` | skipped: {v.skipped} | | | | |"
+    return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {v.measured_max:.3e} | "
+            f"{v.argmax!r} | {v.stated_bound:.3e} (`{v.bound_name}`) | "
+            f"{v.ratio:.3f} | {v.count:,} |")
+
+
 def table_text() -> tuple[str, bool]:
     """The Markdown table and whether every stated bound held."""
     table = load_table(TABLE)
@@ -38,14 +47,7 @@ def table_text() -> tuple[str, bool]:
     for fmt in ("c", "glsl", "wgsl"):
         result = verify(table, fmt)
         ok &= result.passed
-        for v in result.variants:
-            if v.skipped is not None:
-                rows.append(f"| {fmt} | {v.variant} | `{v.evaluator}` | skipped: {v.skipped} "
-                            f"| | | | |")
-                continue
-            rows.append(f"| {fmt} | {v.variant} | `{v.evaluator}` | {v.measured_max:.3e} | "
-                        f"{v.argmax!r} | {v.stated_bound:.3e} (`{v.bound_name}`) | "
-                        f"{v.ratio:.3f} | {v.count:,} |")
+        rows += [row_text(fmt, v) for v in result.variants]
     return "\n".join(rows) + "\n", ok
 
 

@@ -129,7 +129,7 @@ def test_cli_formats(tmp_path):
     for bad, word in ((("--coef-format", "binary8"), "binary8"),
                       (("--monomials", "1,x"), "comma-separated"),
                       (("--coef-frac-bits", "1,2"), "one per power"),
-                      (("--coef-format", "fixed"), "needs frac-bits")):
+                      (("--coef-format", "fixed"), "needs --coef-frac-bits")):
         r = run(*bad)
         assert r.returncode == 2 and word in r.stderr and "Traceback" not in r.stderr, r.stderr
         assert len(r.stderr.strip().splitlines()) == 1

@@ -103,17 +103,17 @@ class TestHorner:
         design_horner(quantize(d2, 18), 12, 12)  # the table's own fixed-point part
 
     @pytest.mark.parametrize("kw, msg", [
-        (dict(in_bits=0), "in-bits = 0 is out of range"),
-        (dict(in_bits=-3), "in-bits = -3 is out of range"),
-        (dict(in_bits=21), "accepted: 1 <= in-bits <= 20"),
-        (dict(out_bits=0), "out-bits = 0"),
+        (dict(in_bits=0), "^in_bits = 0 is out of range"),
+        (dict(in_bits=-3), "^in_bits = -3 is out of range"),
+        (dict(in_bits=21), "accepted: 1 <= in_bits <= 20"),
+        (dict(out_bits=0), "^out_bits = 0"),
         (dict(x_frac_bits=18), "does not fit the input format"),
-        (dict(out_bits=4, y_frac_bits=20), "cannot hold the outputs"),
-        (dict(acc_bits=60), "acc-bits"),
+        (dict(out_bits=4, y_frac_bits=20), "^out_bits 4 with y_frac_bits 20 cannot hold the outputs"),
+        (dict(acc_bits=60), "accepted: acc_bits <= 36"),
         (dict(rounding="up"), "rounding 'up' is unknown"),
-        (dict(coef_bits=32), r"accepted: 1 <= coef-bits <= 31 \(quantized coefficients are "
+        (dict(coef_bits=32), r"accepted: 1 <= coef_bits <= 31 \(quantized coefficients are "
                              r"signed 32-bit"),
-        (dict(coef_bits=0), "coef-bits = 0 is out of range; accepted: 1 <= coef-bits <= 31"),
+        (dict(coef_bits=0), "^coef_bits = 0 is out of range; accepted: 1 <= coef_bits <= 31"),
     ])
     def test_raises(self, d2, kw, msg):
         args = dict(in_bits=16, out_bits=16, coef_bits=20) | kw
@@ -306,13 +306,13 @@ class TestCLI:
         assert d["total_error_bound"] >= d["measured"]["total"]
 
     @pytest.mark.parametrize("extra, msg", [
-        (["--in-bits", "0", "--out-bits", "16", "--coef-frac-bits", "20"], "in-bits = 0"),
+        (["--in-bits", "0", "--out-bits", "16", "--coef-frac-bits", "20"], "--in-bits = 0"),
         (["--in-bits", "16", "--out-bits", "16"], "no fixed-point part"),
         (["--in-bits", "16", "--out-bits", "16", "--coef-frac-bits", "20", "--x-frac-bits", "18"],
          "does not fit the input format"),
-        (["--in-bits", "16", "--out-bits", "-2", "--coef-frac-bits", "20"], "out-bits = -2"),
+        (["--in-bits", "16", "--out-bits", "-2", "--coef-frac-bits", "20"], "--out-bits = -2"),
         (["--in-bits", "16", "--out-bits", "16", "--coef-frac-bits", "40"],
-         "accepted: 1 <= coef-bits <= 31"),
+         "accepted: 1 <= --coef-frac-bits <= 31"),
     ])
     def test_errors_leave_nothing(self, table_json, tmp_path, capsys, extra, msg):
         out = tmp_path / "out"

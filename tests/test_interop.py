@@ -103,7 +103,7 @@ def test_python_errors_name_arguments_and_the_cli_names_flags(capsys):
     assert main(["fit", "exp(x)", "--interval", "0", "1", "--degree", "3",
                  "--coef-frac-bits", "40"]) == 2
     err = capsys.readouterr().err
-    assert "frac-bits 40 overflows" in err and "accepted: frac-bits <= " in err
+    assert "--coef-frac-bits 40 overflows" in err and "accepted: --coef-frac-bits <= " in err
     assert main(["fit", "1/sqrt(x)", "--interval", "1", "3", "--degree", "1",
                  "--segment-by", "exponent"]) == 2
     assert "--interval 1/4 4" in capsys.readouterr().err
@@ -340,5 +340,6 @@ def test_piecewise_c_in_bits_named_as_argument_and_as_flag(tmp_path, capsys):
     pw.save(tmp_path / "pw.json")
     assert main(["export", str(tmp_path / "pw.json"), "--format", "c", "--in-bits", "1",
                  "-o", str(tmp_path / "pw.h")]) == 2
-    assert "error: in-bits = 1 is out of range; accepted: 2 <= in-bits" in capsys.readouterr().err
+    assert "error: --in-bits = 1 is out of range; accepted: 2 <= --in-bits" in \
+        capsys.readouterr().err
     assert not (tmp_path / "pw.h").exists()

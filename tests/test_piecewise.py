@@ -237,4 +237,4 @@ def test_cli_fit_export_hw(tmp_path):
     rep = json.loads(r.stdout)
     assert rep["within_budget"] and rep["measured"]["max_error"] <= rep["budget"]["total"]
     r = cli("hw", "verilog", "rs.json", "--in-bits", "3", "--out-bits", "10", "-o", "hw", code=2)
-    assert "in-bits = 3 is out of range; accepted: 4 <= in-bits <= 20" in r.stderr
+    assert "--in-bits = 3 is out of range; accepted: 4 <= --in-bits <= 20" in r.stderr

@@ -2,13 +2,20 @@
 drift: the first fit (its whole console block), the fixed-point comparison of
 the "Coefficient formats" section, and the worked hardware example of
 "Piecewise tables". Each test reads the quoted text from README.md itself and
-runs the command the README shows, through the installed CLI's ``main``.
+runs the command the README shows, through the installed CLI's ``main``. The
+benchmark tables (architectures per spec, the issue-28 design per target) are
+compared with the committed JSON the benchmarks wrote, printed by the
+benchmark's own formatter (nothing synthesized again); the ``chebnorm verify``
+table is measured again (a few seconds: gcc, and the GPU drivers where present).
 """
 
 from __future__ import annotations
 
+import json
+import math
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -129,3 +136,82 @@ def test_architectures_per_spec_table_is_the_measured_json():
     assert len(rows) > 2 + len(bench_specs.SPECS)   # header, rule, at least a row per spec
     missing = [r for r in rows if r not in README.splitlines()]
     assert not missing, missing[:3]
+
+
+BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def _bench_module(name: str):
+    """A script of ``benchmarks/`` imported as a module."""
+    sys.path.insert(0, str(BENCH))
+    try:
+        return __import__(name)
+    finally:
+        sys.path.remove(str(BENCH))
+
+
+def test_design_per_target_table_is_the_measured_json():
+    """The README's table of the issue-28 spec per FPGA target (winner, cells,
+    timing, wall / CPU seconds) is what ``bench_design_targets.py --markdown``
+    prints from ``benchmarks/design_targets_results.json``, verbatim; the
+    prose's ranges (load average, half the CPU time) enclose the same runs."""
+    bench = _bench_module("bench_design_targets")
+    doc = json.loads((BENCH / "design_targets_results.json").read_text(encoding="utf-8"))
+    assert all(r["status"] == 0 for r in doc["results"])
+    rows = bench.markdown(doc).splitlines()
+    assert len(rows) == 2 + len(doc["results"]) >= 6
+    missing = [r for r in rows if r not in README.splitlines()]
+    assert not missing, missing[:3]
+    text = " ".join(README.split())
+    cpu = [r["cpu_s"] for r in doc["results"]]
+    assert f"Half the CPU figure (two cores), {round(min(cpu) / 2)} to {round(max(cpu) / 2)} s" \
+        in text
+    lo = math.floor(10 * min(r["load_before"] for r in doc["results"])) / 10
+    hi = math.ceil(10 * max(max(r["load_before"], r["load_after"]) for r in doc["results"])) / 10
+    assert f"load average {lo} to {hi}" in text
+    assert f"--repeat {doc['repeat']}`" in text
+
+
+def _verify_rows():
+    """The README's ``chebnorm verify`` rows by (format, variant)."""
+    start, end = "<!-- verify-rsqrt-start -->", "<!-- verify-rsqrt-end -->"
+    block = README.split(start, 1)[1].split(end, 1)[0].strip().splitlines()[2:]
+    return {tuple(c.strip() for c in r.split("|")[1:3]): r for r in block}
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+def test_verify_table_is_what_verify_measures():
+    """Every row of the README's ``chebnorm verify`` table is measured again on
+    the committed table: the unfused C evaluators (IEEE arithmetic, the same
+    bits on any machine) verbatim; the fused and GPU rows where this machine
+    runs the same variant (FMA, llvmpipe, lavapipe) verbatim too, otherwise
+    their stated bounds and input counts (what the exporters state); and the
+    prose's "bound against measured" figures are the float row's."""
+    from chebnorm.approx import load_table
+    from chebnorm.export.verify import verify
+
+    bench = _bench_module("verify_rsqrt")
+    readme = _verify_rows()
+    assert len(readme) == 7
+    table = load_table(bench.TABLE)
+    seen = set()
+    for fmt in ("c", "glsl", "wgsl"):
+        for v in verify(table, fmt).variants:
+            if v.skipped is not None:
+                continue
+            key = (fmt, v.variant)
+            seen.add(key)
+            assert v.measured_max <= v.stated_bound
+            if key not in readme:   # another GPU driver than the README's
+                continue
+            fresh = bench.row_text(fmt, v)
+            if fmt == "c" and "fused" not in v.variant:
+                assert fresh == readme[key]
+            else:   # FMA or the driver may move the measurement: what is stated must agree
+                cells, want = fresh.split("|"), readme[key].split("|")
+                assert (cells[3], cells[6], cells[8]) == (want[3], want[6], want[8]), key
+    assert {("c", "double"), ("c", "float"), ("c", "fixed")} <= seen
+    f32 = readme[("c", "float")].split("|")
+    stated, measured = f32[6].split()[0], f32[4].strip()
+    assert f"the float and shader bound {stated} against a measured {measured}" in \
+        " ".join(README.split())

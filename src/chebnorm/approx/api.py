@@ -277,12 +277,55 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     --------
     quantize : round the coefficients and re-certify.
     chebnorm.approx.certify : the certificate of given coefficients.
+    chebnorm.approx.piecewise_fit.piecewise_fit : the piecewise fit of ``segments``.
+    chebnorm.export : the table as C, GLSL, WGSL, HLSL, Verilog, VHDL or JSON.
+    chebnorm.hw.design_horner : a bit-accurate fixed-point evaluator of the table.
 
     Notes
     -----
+    ``kind="chebyshev"`` interpolates :math:`f` at the :math:`n + 1`
+    Chebyshev points of the first kind on :math:`[a, b]`,
+
+    .. math::
+
+        x_k = \\frac{a + b}{2} + \\frac{b - a}{2}
+              \\cos\\frac{(2k + 1)\\pi}{2(n + 1)}, \\qquad k = 0, \\dots, n,
+
+    so its error is at most :math:`2 + \\frac{2}{\\pi}\\log(n + 1)` times the
+    best possible (one plus the Lebesgue constant of these points [1]_ [2]_).
+    ``kind="minimax"`` runs the Remez exchange [1]_ for the polynomial of
+    degree :math:`n` that minimizes
+
+    .. math::
+
+        \\max_{x \\in [a, b]} |p(x) - f(x)| \\quad\\text{or}\\quad
+        \\max_{x \\in [a, b]} \\left|\\frac{p(x)}{f(x)} - 1\\right|
+
+    (``error="abs"`` or ``"rel"``); its error equioscillates at :math:`n + 2`
+    points (a :class:`FitWarning` when the exchange does not converge).
+    Either way the stored float64 coefficients, as exact binary numbers, are
+    certified by :func:`chebnorm.approx.certify` (the problem Sollya's
+    ``supnorm`` solves [3]_): ``abs_error_bound`` and ``rel_error_bound``
+    are rigorous upper bounds of the two maxima above.
+
     Choice of degree: each extra degree buys roughly a factor
     ``(hi - lo) / (4 * distance to the nearest singularity)`` of accuracy; far
     from 0 at high degree prefer ``basis="shifted"``.
+
+    The first example is the degree-2 dichotomy polynomial of seed 000 [4]_.
+
+    References
+    ----------
+    .. [1] L. N. Trefethen, *Approximation Theory and Approximation
+       Practice*, SIAM, 2013 (Chebyshev interpolation, Lebesgue constants,
+       the Remez algorithm).
+    .. [2] T. J. Rivlin, *Chebyshev Polynomials*, 2nd ed., Wiley, 1990.
+    .. [3] S. Chevillard, J. Harrison, M. Joldes, C. Lauter, "Efficient and
+       accurate computation of upper bounds of approximation errors",
+       Theoretical Computer Science 412(16), 2011; Sollya,
+       https://www.sollya.org/
+    .. [4] The four papers chebnorm reproduces (seeds 000 to 003), restated
+       with their formulas re-derived in :doc:`/papers`.
 
     Examples
     --------
@@ -761,6 +804,12 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         a format or ``frac_bits`` out of range (naming the largest accepted
         ``frac_bits``), or when no rounding could be certified.
 
+    See Also
+    --------
+    fit : fit and certify (``frac_bits=`` / ``coef_format=`` quantize at once).
+    chebnorm.hw.design_horner : fixed-point hardware of a quantized table.
+    chebnorm.export : C and shader code of the table.
+
     Notes
     -----
     The error minimized is the table's ``error_kind``. With ``reoptimize``
@@ -775,6 +824,30 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     fitted with the same ``monomials`` / ``fix_constant`` (same held
     constant) is quantized from its own coefficients, otherwise the
     constrained real fit is computed first.
+
+    In fixed point (``coef_format="fixed"``) the stored polynomial is
+
+    .. math::
+
+        p_q(x) = \\sum_{j=0}^{n} q_j\\, 2^{-F_j} x^j, \\qquad
+        q_j \\in \\mathbb{Z}, \\quad |q_j| \\le 2^{W - 1} - 1,
+
+    with :math:`F_j` the ``frac_bits`` of power :math:`j` and :math:`W` =
+    ``word_bits``; ``error_bound`` is a rigorous upper bound of
+    :math:`\\max_{x \\in [a, b]} |p_q(x) - f(x)|` (of
+    :math:`|p_q(x)/f(x) - 1|` for a relative table), certified as
+    :func:`fit` certifies. Choosing the :math:`q_j` jointly by lattice
+    reduction is the method of Brisebarre and Chevillard [1]_, which Sollya's
+    ``fpminimax`` implements [2]_.
+
+    References
+    ----------
+    .. [1] N. Brisebarre, S. Chevillard, "Efficient polynomial
+       L-infinity approximations", 18th IEEE Symposium on Computer
+       Arithmetic (ARITH 18), 2007.
+    .. [2] S. Chevillard, M. Joldes, C. Lauter, "Sollya: an environment for
+       the development of numerical codes", Mathematical Software (ICMS
+       2010), LNCS 6327, Springer, 2010; https://www.sollya.org/
 
     Examples
     --------

@@ -58,6 +58,7 @@ import sympy as sp
 from flint import arb, arb_poly, arb_series, ctx
 
 from chebnorm.core.numeric import arb_precision, ball_float_down, ball_float_up
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .expr import Function1D, compile_arb
 
@@ -100,6 +101,15 @@ class Certificate:
     subintervals: int
     tight: bool = True
     reason: str = ""
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("bound", self.bound), ("maximum", self.maximum), ("at", self.at),
+                ("subintervals", self.subintervals), ("tight", self.tight)] + (
+                    [("reason", self.reason)] if self.reason else [])
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
 
 def arb_enclose(value: sp.Expr) -> arb:
@@ -409,14 +419,42 @@ def certify(fn: Function1D, coefficients: Sequence[float], lo: sp.Expr, hi: sp.E
     ValueError
         When ``g`` is not finite somewhere on the interval, or the interval holds no float64.
 
+    See Also
+    --------
+    chebnorm.fit : fits a polynomial and certifies it with this function.
+    chebnorm.quantize : re-certifies rounded coefficients.
+    Certificate : the result.
+
+    Notes
+    -----
+    On a piece :math:`X = [m - r, m + r]` of the interval, Taylor's theorem
+    with the Lagrange remainder gives, for :math:`x = m + h \\in X`,
+
+    .. math::
+
+        |g(x)| \\le \\max_{|h| \\le r} \\Bigl|\\sum_{k=0}^{3} g_k h^k\\Bigr|
+            + \\sup_{\\xi \\in X} \\frac{|g^{(4)}(\\xi)|}{4!}\\, r^4,
+        \\qquad g_k = \\frac{g^{(k)}(m)}{k!},
+
+    with the :math:`g_k` and the enclosure of :math:`g^{(4)}` over :math:`X`
+    computed in Arb ball arithmetic [2]_ and the cubic's maximum taken
+    exactly. Pieces are bisected until each bound is within
+    :math:`1 + \\mathrm{tol}` of the largest :math:`|g|` found at a point,
+    so ``maximum <= sup |g| <= bound``, and ``bound <= (1 + tol) * maximum``
+    when ``tight`` (module docstring). The polynomial is evaluated with its float64 coefficients as
+    exact binary numbers: the bound is that of the stored coefficients.
+
+    Sollya's ``supnorm`` [1]_ solves the same problem; ``tests/test_sollya.py``
+    compares the two.
+
     References
     ----------
-    Sollya's ``supnorm`` (Chevillard, Harrison, Joldes, Lauter: "Efficient and accurate
-    computation of upper bounds of approximation errors", Theoretical Computer Science
-    412(16), 2011) solves the same problem; ``tests/test_sollya.py`` compares the two.
-
-    Examples
-    --------
+    .. [1] S. Chevillard, J. Harrison, M. Joldes, C. Lauter, "Efficient and
+       accurate computation of upper bounds of approximation errors",
+       Theoretical Computer Science 412(16), 2011; Sollya,
+       https://www.sollya.org/
+    .. [2] F. Johansson, "Arb: efficient arbitrary-precision midpoint-radius
+       interval arithmetic", IEEE Transactions on Computers 66(8), 2017.
 
     Examples
     --------

@@ -15,6 +15,8 @@ import importlib
 import os
 import sys
 
+from .common import command_flags
+
 __all__ = ["main", "build_parser", "UsageError"]
 
 #: subcommand modules, in the order ``chebnorm --help`` lists them
@@ -82,9 +84,11 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    flags = None   # the command's flags by Python name, once it is parsed
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
+        flags = command_flags(parser, args)
         args.argv = ["chebnorm", *argv]
         return int(args.func(args) or 0)
     except BrokenPipeError:
@@ -98,9 +102,9 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, OSError) and exc.strerror and exc.filename and "Errno" in text:
             text = f"{exc.filename}: {exc.strerror}"  # no "[Errno 13]" noise
         message = " ".join(text.split()) or type(exc).__name__
-        from .fit import cli_phrases  # the library's ``basis='monomial'`` as a flag
+        from .fit import cli_words  # the library's ``in_bits``, ``basis='monomial'`` as flags
 
-        message = cli_phrases(message)
+        message = cli_words(message, flags or {})
         print(f"chebnorm: error: {message}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

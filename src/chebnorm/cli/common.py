@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import shlex
 import sys
 
@@ -79,6 +80,88 @@ def deprecated_alias(parser, old: str, new: str, dest: str, **kwargs) -> None:
     """
     parser.add_argument(old, dest=dest, action=_DeprecatedFlag, new_flag=new,
                         help=f"deprecated spelling of {new}", **kwargs)
+
+
+def command_flags(parser, args) -> dict[str, str]:
+    """The flags of the (sub)command ``args`` was parsed for, keyed by the
+    Python name they store into: ``{"in_bits": "--in-bits", "coef_bits":
+    "--coef-frac-bits", ...}``.
+
+    Only names with an underscore are listed (``in_bits``, ``log_m``): they
+    are the library's argument names, unambiguous in a message, where a
+    one-word name (``error``, ``name``, ``interval``) is also plain English.
+    A deprecated spelling (:func:`deprecated_alias`) never stands for a name.
+    A parser may add names of its own with the default ``flag_names`` (a dict),
+    for a library function under the command that calls a flag's value
+    differently (``piecewise_fit``'s ``coef_frac_bits`` is ``fit``'s ``frac_bits``).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The top-level parser (:func:`chebnorm.cli.build_parser`).
+    args : argparse.Namespace
+        What it parsed: the chosen subcommands are read from it.
+
+    Returns
+    -------
+    dict of str to str
+        Each destination's flag (its longest ``--`` spelling).
+
+    Examples
+    --------
+    >>> from chebnorm.cli import build_parser
+    >>> p = build_parser()
+    >>> flags = command_flags(p, p.parse_args(["hw", "verilog", "t.json", "--in-bits", "8",
+    ...                                        "--out-bits", "8", "-o", "."]))
+    >>> flags["in_bits"], flags["coef_bits"]
+    ('--in-bits', '--coef-frac-bits')
+    """
+    flags: dict[str, str] = {}
+    while parser is not None:
+        sub = None
+        for action in parser._actions:
+            if isinstance(action.choices, dict):   # the subcommands' action
+                sub = action.choices.get(getattr(args, action.dest, None))
+                continue
+            longs = [o for o in action.option_strings if o.startswith("--")]
+            if longs and "_" in action.dest and not isinstance(action, _DeprecatedFlag):
+                flags.setdefault(action.dest, max(longs, key=len))
+        flags.update(parser.get_default("flag_names") or {})
+        parser = sub
+    return flags
+
+
+def cli_flags(message: str, flags: dict[str, str]) -> str:
+    """A library message, which names the Python arguments (``in_bits``), with
+    the command line's flags instead (``--in-bits``).
+
+    A name inside a longer identifier or a dotted field of a file
+    (``quantized.frac_bits``) or an exponent (``2^in_bits``) is left alone.
+
+    Parameters
+    ----------
+    message : str
+        A ValueError's text from the library.
+    flags : dict of str to str
+        Python names to flags (:func:`command_flags`).
+
+    Returns
+    -------
+    str
+        The message in the command's words.
+
+    Examples
+    --------
+    >>> cli_flags("in_bits = 40 is out of range; accepted: 1 <= in_bits <= 20",
+    ...           {"in_bits": "--in-bits"})
+    '--in-bits = 40 is out of range; accepted: 1 <= --in-bits <= 20'
+    >>> cli_flags("field quantized.frac_bits is missing", {"frac_bits": "--coef-frac-bits"})
+    'field quantized.frac_bits is missing'
+    """
+    if not flags:
+        return message
+    names = "|".join(re.escape(n) for n in sorted(flags, key=len, reverse=True))
+    return re.sub(rf"(?<![\w.^])({names})(?![\w\[])", lambda m: flags[m.group(1)], message)
 
 
 def refuse_unused(args, where: str, **flags) -> None:

@@ -11,7 +11,7 @@ import warnings
 from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
 from chebnorm.core.textsafe import identifier
 
-from .common import command_line, deprecated_alias, print_json
+from .common import cli_flags, command_line, deprecated_alias, print_json
 
 
 def register(sub) -> None:
@@ -65,7 +65,8 @@ def register(sub) -> None:
                    "most 63 characters (it names the C function, shader and HDL module)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
-    p.set_defaults(func=run)
+    # piecewise_fit, under fit --segments, calls --coef-frac-bits coef_frac_bits
+    p.set_defaults(func=run, flag_names={"coef_frac_bits": "--coef-frac-bits"})
     # a value such as -1/8 or -pi/4 (after --interval) is an argument, not an
     # option: argparse takes a token starting with '-' for an option unless its
     # negative-number pattern matches, and this parser's only one-dash options
@@ -93,18 +94,26 @@ _CLI_WORDS = re.compile(r"(?<![\w.])(coef_frac_bits|frac_bits|coef_format|segmen
                         r"fix_constant|in_bits|out_bits)(?![\w\[])")
 _CLI_PHRASES = (("set it with var=", "set it with --var"),
                 ("interval=('1/4', '4')", "--interval 1/4 4"),
-                ("basis='monomial'", "--basis monomial"))
+                ("basis='monomial'", "--basis monomial"),
+                ("quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or chebnorm.quantize)",
+                 "quantized with `chebnorm fit ... --coef-frac-bits F`"))
 
 
-def cli_words(message: str) -> str:
-    """A library message with the argument names of :func:`chebnorm.fit` as
-    ``chebnorm fit`` spells them (``frac_bits`` -> ``frac-bits``, ``var=`` ->
-    ``--var``).
+def cli_words(message: str, flags: dict[str, str] | None = None) -> str:
+    """A library message with the argument names of the library as the command
+    line spells them: with ``flags`` (:func:`chebnorm.cli.common.command_flags`,
+    what :func:`chebnorm.cli.main` passes for every command) each name becomes
+    its flag (``in_bits`` -> ``--in-bits``, ``coef_bits`` -> ``--coef-frac-bits``);
+    without, the names of :func:`chebnorm.fit` lose their underscores
+    (``frac_bits`` -> ``frac-bits``). The phrases of :func:`cli_phrases`
+    (``var=`` -> ``--var``) are translated either way.
 
     Parameters
     ----------
     message : str
         A library's ValueError text (Python argument names).
+    flags : dict of str to str, optional
+        Python names to the command's flags.
 
     Returns
     -------
@@ -116,7 +125,11 @@ def cli_words(message: str) -> str:
     --------
     >>> cli_words("frac_bits 40 overflows int32; accepted: frac_bits <= 30")
     'frac-bits 40 overflows int32; accepted: frac-bits <= 30'
+    >>> cli_words("frac_bits 40 overflows int32", {"frac_bits": "--coef-frac-bits"})
+    '--coef-frac-bits 40 overflows int32'
     """
+    if flags is not None:
+        return cli_flags(cli_phrases(message), flags)
     return _CLI_WORDS.sub(lambda m: m.group(1).replace("_", "-"), cli_phrases(message))
 
 
@@ -146,13 +159,11 @@ def cli_phrases(message: str) -> str:
 
 def _fit_cli(args, **kw):
     """:func:`chebnorm.fit` with the command's arguments; its refusals in the CLI's words."""
-    try:
-        return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
-                   error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
-                   command=command_line(args), basis=args.basis,
-                   coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
-    except ValueError as exc:
-        raise ValueError(cli_words(str(exc))) from None
+    # its refusals name fit's arguments: chebnorm.cli.main says them as flags (cli_words)
+    return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
+               error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
+               command=command_line(args), basis=args.basis,
+               coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
 
 
 def _run_piecewise(args) -> int:
@@ -192,9 +203,9 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        On an argument :func:`chebnorm.fit` refuses, reworded with the command's flags
-        (:func:`cli_words`) (:func:`chebnorm.cli.main` prints it as one line on stderr
-        and exits with status 2).
+        On an argument :func:`chebnorm.fit` refuses (:func:`chebnorm.cli.main` prints
+        it as one line on stderr with the command's flags, :func:`cli_words`, and exits
+        with status 2).
     """
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
     if args.segments is not None or args.segment_by is not None or args.centered:

@@ -15,11 +15,12 @@ text from untrusted files).
 
 from __future__ import annotations
 
+from dataclasses import fields
 from html import escape
 
 import numpy as np
 
-__all__ = ["short", "summary_repr", "summary_html"]
+__all__ = ["short", "summary_repr", "summary_html", "field_rows"]
 
 #: the most characters one value takes in a repr
 MAX_VALUE = 60
@@ -124,3 +125,32 @@ def summary_html(self) -> str:
                    f"</td></tr>" for k, v in rows)
     return (f"<table><caption style='text-align:left'><b>{escape(type(self).__name__)}</b>"
             f"</caption>{body}</table>")
+
+
+def field_rows(self, skip=()) -> list[tuple[str, object]]:
+    """Every field of a dataclass as ``(name, value)`` rows, for an HTML table
+    (``_display_rows``): the full record where the repr shows a few.
+
+    Parameters
+    ----------
+    self : object
+        A dataclass instance.
+    skip : iterable of str, optional
+        Fields left out (e.g. bulky ones already summarized).
+
+    Returns
+    -------
+    list of (str, object)
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass
+    ... class P:
+    ...     a: int
+    ...     b: str = "x"
+    >>> field_rows(P(1)), field_rows(P(1), skip=("a",))
+    ([('a', 1), ('b', 'x')], [('b', 'x')])
+    """
+    skip = set(skip)
+    return [(f.name, getattr(self, f.name)) for f in fields(self) if f.name not in skip]

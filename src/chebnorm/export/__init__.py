@@ -299,6 +299,43 @@ def export_text(table, fmt: str, command: str = "", *, name: str | None = None,
         the format does not take (naming the accepted ones), a missing
         ``in_bits``/``out_bits``, a ``name`` that is not an identifier.
 
+    See Also
+    --------
+    chebnorm.export.export_table : the same text, written to a file.
+    chebnorm.export.export_with_proofs : with a Gappa proof of each stated bound.
+    chebnorm.export.verify.verify : compile the output and check it against the bound.
+    chebnorm.hw.design_horner : the fixed-point datapath the HDL formats print.
+
+    Notes
+    -----
+    The floating-point outputs (C, GLSL, WGSL, HLSL) state, beside the
+    table's certified bound of :math:`|p - f|`, a bound ``EVAL_ERROR_BOUND`` of
+    :math:`|\\mathrm{fl}(p(x)) - f(x)|` for the format's arithmetic: the
+    certified bound plus the rounding of the Horner evaluation, bounded by
+    interval arithmetic on pieces of the interval, every multiply-add fused or
+    not (:mod:`chebnorm.export.evalbound`). Its a priori form is Higham's [1]_:
+    for the unit roundoff :math:`u` and :math:`\\gamma_k = k u / (1 - k u)`,
+
+    .. math::
+
+        |\\mathrm{fl}(p(x)) - p(x)| \\le \\gamma_{2n} \\sum_{j=0}^{n} |c_j|\\,|x|^j.
+
+    Gappa proves each stated bound independently (``export_with_proofs``
+    [2]_). The HDL outputs print the bit-accurate
+    fixed-point evaluator of :mod:`chebnorm.hw`, in the style of FloPoCo's
+    generated operators [3]_.
+
+    References
+    ----------
+    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+       2nd ed., SIAM, 2002, eq. (5.3).
+    .. [2] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
+    .. [3] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+       with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
+
     Examples
     --------
     >>> from chebnorm.approx import fit
@@ -537,6 +574,43 @@ class _CallableModule(types.ModuleType):
         ------
         ValueError
             As :func:`export_text`; also when no format is given.
+
+        See Also
+        --------
+        chebnorm.export.export_table : the same text, written to a file.
+        chebnorm.export.export_with_proofs : with a Gappa proof of each stated bound.
+        chebnorm.export.verify.verify : compile the output and check it against the bound.
+        chebnorm.hw.design_horner : the fixed-point datapath the HDL formats print.
+
+        Notes
+        -----
+        The floating-point outputs (C, GLSL, WGSL, HLSL) state, beside the
+        table's certified bound of :math:`|p - f|`, a bound ``EVAL_ERROR_BOUND`` of
+        :math:`|\\mathrm{fl}(p(x)) - f(x)|` for the format's arithmetic: the
+        certified bound plus the rounding of the Horner evaluation, bounded by
+        interval arithmetic on pieces of the interval, every multiply-add fused or
+        not (:mod:`chebnorm.export.evalbound`). Its a priori form is Higham's [1]_:
+        for the unit roundoff :math:`u` and :math:`\\gamma_k = k u / (1 - k u)`,
+
+        .. math::
+
+            |\\mathrm{fl}(p(x)) - p(x)| \\le \\gamma_{2n} \\sum_{j=0}^{n} |c_j|\\,|x|^j.
+
+        Gappa proves each stated bound independently (``export_with_proofs``
+        [2]_). The HDL outputs print the bit-accurate
+        fixed-point evaluator of :mod:`chebnorm.hw`, in the style of FloPoCo's
+        generated operators [3]_.
+
+        References
+        ----------
+        .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*,
+           2nd ed., SIAM, 2002, eq. (5.3).
+        .. [2] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+           F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+           floating-point implementation of an elementary function using
+           Gappa", IEEE Transactions on Computers 60(2), 2011.
+        .. [3] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+           with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
 
         Examples
         --------

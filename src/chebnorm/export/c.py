@@ -95,7 +95,7 @@ def _checked_fixed(table: CoefficientTable):
             raise ValueError(f"fixed_point.integers[{k}]: expected an integer, got {q!r:.60}")
         if not -2 ** 31 <= q < 2 ** 31:
             raise ValueError(f"fixed_point.integers[{k}]: {q} does not fit the header's int32_t; "
-                             f"accepted: -2^31 <= q < 2^31 (quantize with fewer frac-bits)")
+                             f"accepted: -2^31 <= q < 2^31 (quantize with fewer frac_bits)")
     return fp
 
 

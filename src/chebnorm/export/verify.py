@@ -61,6 +61,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import arb_precision, float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 __all__ = ["verify", "VerifyResult", "VariantResult", "VERIFY_FORMATS", "VARIANTS",
            "MAX_INPUTS", "stated_bounds", "c_evaluate"]
@@ -150,6 +151,18 @@ class VariantResult:
     seconds: float
     skipped: str | None = None
     notes: tuple[str, ...] = field(default=())
+
+    def _summary(self) -> list[tuple[str, object]]:
+        if self.skipped is not None:
+            return [("format", self.format), ("variant", self.variant),
+                    ("skipped", self.skipped)]
+        return [("format", self.format), ("variant", self.variant),
+                ("measured_max", self.measured_max), ("stated_bound", self.stated_bound),
+                ("argmax", self.argmax), ("count", self.count)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def ratio(self) -> float | None:

@@ -35,6 +35,7 @@ from chebnorm.approx import parse_function, parse_number
 from chebnorm.approx.certify import certify
 
 from chebnorm.core.numeric import float_up
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
@@ -93,6 +94,15 @@ class ErrorBudget:
     total: float
     y_lsb: float
     gappa_rounding: float | None = None
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("total", self.total), ("approximation", self.approximation),
+                ("quantization", self.quantization), ("rounding", self.rounding),
+                ("gappa_rounding", self.gappa_rounding)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def as_dict(self) -> dict:
         return {"approximation": self.approximation, "quantization": self.quantization,
@@ -161,6 +171,15 @@ class Measurement:
     overflows: int
     y_lsb: float
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("codes", self.codes), ("total", self.total),
+                ("total_at_code", self.total_at_code), ("rel_total", self.rel_total),
+                ("overflows", self.overflows)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
     @property
     def total_lsb(self) -> float:
         return self.total / self.y_lsb
@@ -221,6 +240,41 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     ------
     ValueError
         If gappa is asked for and fails on the datapath (see :func:`gappa_bound`).
+
+
+    See Also
+    --------
+    measure : the errors every valid input code actually makes.
+    gappa_bound : Gappa's independent bound of the rounding part.
+    chebnorm.hw.report.analyze : design, budget and measurement together.
+
+    Notes
+    -----
+    For every valid input code, :math:`p` the table's float polynomial and
+    :math:`p_q` its quantized one (module docstring),
+
+    .. math::
+
+        |y - f(x)| \\le |p_q(x) - f(x)| + |y - p_q(x)|
+        \\le \\min(\\varepsilon_{a} + \\varepsilon_{q},\\ \\varepsilon_{pq})
+        + \\sum_{j=1}^{n-1} \\rho_j \\max_x |x|^j + \\rho_{\\mathrm{out}},
+
+    with :math:`\\varepsilon_a` the certified :math:`\\sup|p - f|`
+    (``approximation``), :math:`\\varepsilon_q` a certified
+    :math:`\\sup|p_q - p|` (``quantization``), :math:`\\varepsilon_{pq}` the
+    re-certified :math:`\\sup|p_q - f|` (``quantized``), :math:`\\rho_j` the
+    rounding of the accumulator :math:`a_j` (one unit of its last place for
+    ``"trunc"``, half of one for ``"rne"``; 0 when nothing is dropped),
+    reaching the output multiplied by :math:`x^j`, and
+    :math:`\\rho_{\\mathrm{out}}` the output's rounding. ``gappa=True`` adds
+    Gappa's own bound of the rounding part [1]_.
+
+    References
+    ----------
+    .. [1] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
     """
     t = design.table
     xmax = design.max_abs_x()
@@ -264,6 +318,19 @@ def measure(design: HornerDesign) -> Measurement:
     -------
     Measurement
         The measured errors.
+
+
+    See Also
+    --------
+    error_budget : the certified bound the measurement is checked against.
+
+    Notes
+    -----
+    The bit-accurate model (:meth:`~chebnorm.hw.horner.HornerDesign.evaluate`)
+    runs every valid code :math:`k`; ``total`` is :math:`\\max_k |y_k - f(x_k)|` with
+    :math:`f` evaluated in float64, and the parts (``approximation``,
+    ``quantization``, ``rounding``) are the same maxima of
+    :math:`|p - f|`, :math:`|p_q - p|` and :math:`|y - p_q|`.
     """
     lo, hi = design.valid_codes
     k = np.arange(lo, hi + 1, dtype=np.int64)

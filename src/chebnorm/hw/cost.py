@@ -20,6 +20,7 @@ Verilog is the real figure (:func:`chebnorm.hw.verilog.synthesize`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 __all__ = ["Cost", "Block"]
 
@@ -126,6 +127,15 @@ class Block:
     children: tuple["Block", ...] = ()
     serial: bool = True
     note: str = ""
+
+    def _summary(self) -> list[tuple[str, object]]:
+        c = self.cost
+        return [("name", self.name), ("children", len(self.children)), ("area_fa", c.area),
+                ("latency", c.latency)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def cost(self) -> Cost:

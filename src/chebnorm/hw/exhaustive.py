@@ -36,6 +36,7 @@ import sympy as sp
 
 from chebnorm.approx.expr import compare, parse_function, parse_number
 from chebnorm.core.numeric import arb_precision, check_int
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 __all__ = ["MAX_EXHAUSTIVE_BITS", "ExhaustiveCheck", "Reference", "reference", "exact_endpoint", "round_to_nearest"]
 
@@ -327,6 +328,14 @@ class ExhaustiveCheck:
     lower: float
     at: int
     codes: int
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("upper", self.upper), ("lower", self.lower), ("at", self.at),
+                ("codes", self.codes)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @classmethod
     def of(cls, bounds: dict) -> "ExhaustiveCheck":

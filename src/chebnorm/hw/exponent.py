@@ -55,6 +55,7 @@ from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS, exact_log2
 from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import check_width
 from .hdl.exponent import exponent_files, exponent_module
@@ -200,6 +201,16 @@ class ExponentDesign:
     in_bits: int
     core: PiecewiseDesign
     shift_bits: int
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("in_bits", self.in_bits),
+                ("out_bits", self.out_bits), ("degree", self.degree),
+                ("segments", self.core.table.segment_count)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     architecture = "exponent"
 
@@ -364,6 +375,11 @@ def design_exponent(expr, interval, in_bits: int, out_bits: int, *, degree: int 
     ------
     ValueError
         Naming the argument and the accepted range.
+
+    See Also
+    --------
+    chebnorm.hw.piecewise.design_piecewise : the mantissa's core evaluator.
+    chebnorm.hw.hdl.exponent : its Verilog and VHDL.
 
     Examples
     --------

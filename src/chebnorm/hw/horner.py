@@ -38,6 +38,7 @@ import sympy as sp
 
 from chebnorm.approx import CoefficientTable, parse_number, quantize
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
@@ -173,6 +174,16 @@ class HornerDesign:
     valid_codes: tuple[int, int]
     notes: tuple[str, ...] = field(default_factory=tuple)
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("degree", self.degree), ("in_bits", self.in_bits),
+                ("out_bits", self.out_bits), ("x_format", self.x_format.q_name()),
+                ("y_format", self.y_format.q_name()), ("coef_frac_bits", self.coef_frac_bits),
+                ("rounding", self.rounding)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
     @property
     def degree(self) -> int:
         return len(self.integers) - 1
@@ -250,7 +261,7 @@ def _check_table(table) -> None:
 
 
 def max_coef_bits(table: CoefficientTable) -> int:
-    """Largest ``coef-bits`` for which every coefficient of ``table`` still fits
+    """Largest ``coef_bits`` for which every coefficient of ``table`` still fits
     the signed 32-bit integers of :func:`chebnorm.approx.quantize` (at most
     :data:`MAX_FRAC_BITS`; about 31 minus the binary exponent of the
     largest coefficient).
@@ -279,7 +290,7 @@ def max_coef_bits(table: CoefficientTable) -> int:
 
 
 def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
-    """Boundary check of ``coef-bits`` against the table's int32 coefficient limit.
+    """Boundary check of ``coef_bits`` against the table's int32 coefficient limit.
 
     Parameters
     ----------
@@ -308,18 +319,18 @@ def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
     >>> check_coef_bits(t, 40)
     Traceback (most recent call last):
     ...
-    ValueError: coef-bits = 40 is out of range; accepted: 1 <= coef-bits <= 31 (quantized coefficients are signed 32-bit integers and the largest of table 'dichotomy_d2' is 0.680756)
+    ValueError: coef_bits = 40 is out of range; accepted: 1 <= coef_bits <= 31 (quantized coefficients are signed 32-bit integers and the largest of table 'dichotomy_d2' is 0.680756)
     """
     hi = max_coef_bits(table)
     if hi < 1:
         raise ValueError(f"table {table.name!r}: its largest coefficient does not fit a signed "
-                         f"{COEF_WORD_BITS}-bit integer at any coef-bits; accepted: a table with "
+                         f"{COEF_WORD_BITS}-bit integer at any coef_bits; accepted: a table with "
                          f"coefficients under 2^{COEF_WORD_BITS - 2}")
     if isinstance(coef_bits, bool) or not isinstance(coef_bits, (int, np.integer)):
-        return check_width(coef_bits, "coef-bits", 1, hi)  # raises: not an integer
+        return check_width(coef_bits, "coef_bits", 1, hi)  # raises: not an integer
     if not 1 <= int(coef_bits) <= hi:
         big = max(abs(float(c)) for c in table.coefficients)
-        raise ValueError(f"coef-bits = {coef_bits} is out of range; accepted: 1 <= coef-bits "
+        raise ValueError(f"coef_bits = {coef_bits} is out of range; accepted: 1 <= coef_bits "
                          f"<= {hi} (quantized coefficients are signed {COEF_WORD_BITS}-bit "
                          f"integers and the largest of table {table.name!r} is {big:.6g})")
     return int(coef_bits)
@@ -333,8 +344,9 @@ def _require_fixed_point(table: CoefficientTable, coef_bits):
         return table
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
-                         f"quantized with `chebnorm fit ... --coef-frac-bits F`, or give "
-                         f"--coef-frac-bits B (1 <= B <= {max_coef_bits(table)}) to quantize it here")
+                         f"quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or "
+                         f"chebnorm.quantize), or give coef_bits (1 <= coef_bits <= "
+                         f"{max_coef_bits(table)}) to quantize it here")
     return table
 
 
@@ -355,7 +367,7 @@ def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
                 break
             f -= 1
     else:
-        f = check_width(x_frac_bits, "x-frac-bits", -MAX_FRAC_BITS, MAX_FRAC_BITS)
+        f = check_width(x_frac_bits, "x_frac_bits", -MAX_FRAC_BITS, MAX_FRAC_BITS)
         k0, ok = fits(f)
         if not ok:
             best = None
@@ -368,7 +380,7 @@ def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
                              f"{table.interval[1]}] does not fit the input format of {in_bits} "
                              f"bits with {f} fractional bits (codes cover "
                              f"[{float(k0 / sp.Integer(2) ** f):.9g}, {cover_hi:.9g}]); accepted: "
-                             f"x-frac-bits <= {best}, or more input bits")
+                             f"x_frac_bits <= {best}, or more input bits")
     fmt = QFormat(bits=in_bits, frac_bits=f, offset_code=k0, signed=False)
     scale = sp.Integer(2) ** f
     k_lo = max(0, int(sp.ceiling(lo * scale)) - k0)
@@ -404,7 +416,7 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
             rshift = s - fa
             if rshift < 0:
                 raise ValueError(f"datapath frac bits {fa} exceed the exact sum's {s} fractional "
-                                 f"bits at step {j}; accepted: acc-bits <= {s}")
+                                 f"bits at step {j}; accepted: acc_bits <= {s}")
             acc = shift_round(t, rshift, rounding)
             out_bits = signed_bits(int(acc.min()), int(acc.max()))
             out_frac = fa
@@ -484,17 +496,50 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         If a width is out of its range, ``rounding`` is unknown, the table has no
         fixed-point part (and no ``coef_bits``), no input code falls in the interval,
         ``out_bits`` cannot hold the outputs, or a wire exceeds the 62-bit model.
+
+
+    See Also
+    --------
+    chebnorm.hw.budget.error_budget : the certified error of the design.
+    chebnorm.hw.budget.measure : its error over every valid input code.
+    chebnorm.hw.report.analyze : design, budget, measure and synthesize at once.
+    chebnorm.hw.hdl.module_text : its Verilog or VHDL.
+
+    Notes
+    -----
+    The datapath (module docstring), for the input code :math:`k`, the
+    value :math:`x = (K_0 + k)\\, 2^{-F_x}` and the quantized coefficients
+    :math:`q_j 2^{-F_c}`:
+
+    .. math::
+
+        a_n = q_n 2^{-F_c}, \\qquad
+        a_j = R_{F_a}\\!\\left(a_{j+1} x + q_j 2^{-F_c}\\right)\\ (j = n-1, \\dots, 1),
+        \\qquad y = R_{F_y}\\!\\left(a_1 x + q_0 2^{-F_c}\\right),
+
+    each multiply-add exact and :math:`R_F` one rounding to :math:`F`
+    fractional bits; every wire is sized from its exact range over all
+    :math:`2^{W}` codes, as FloPoCo sizes its polynomial evaluators [1]_ [2]_.
+    Its certified error budget is :func:`~chebnorm.hw.budget.error_budget`.
+
+    References
+    ----------
+    .. [1] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+       with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
+    .. [2] F. de Dinechin, M. Joldes, B. Pasca, "Automatic generation of
+       polynomial-based hardware architectures for function evaluation",
+       IEEE ASAP 2010.
     """
     _check_table(table)
-    in_bits = check_width(in_bits, "in-bits", 1, MAX_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_OUT_BITS)
+    in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
+    out_bits = check_width(out_bits, "out_bits", 1, MAX_OUT_BITS)
     if rounding not in ROUNDINGS:
         raise ValueError(f"rounding {rounding!r} is unknown; accepted: {', '.join(ROUNDINGS)}")
     if acc_bits is not None:
-        acc_bits = check_width(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
+        acc_bits = check_width(acc_bits, "acc_bits", 1, MAX_FRAC_BITS + 20)
     if y_frac_bits is not None:
-        y_frac_bits = check_width(y_frac_bits, "y-frac-bits", -MAX_FRAC_BITS, MAX_FRAC_BITS + 20)
-    guard_bits = check_width(guard_bits, "guard-bits", 0, 32)
+        y_frac_bits = check_width(y_frac_bits, "y_frac_bits", -MAX_FRAC_BITS, MAX_FRAC_BITS + 20)
+    guard_bits = check_width(guard_bits, "guard_bits", 0, 32)
     name = name or table.name
     identifier(name, field="table name")
     table = _require_fixed_point(table, coef_bits)
@@ -537,10 +582,10 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
             break
         if y_frac_bits is not None:
             lo_v, hi_v = float(v_lo), float(v_hi)
-            raise ValueError(f"out-bits {out_bits} with y-frac-bits {fy} cannot hold the outputs "
+            raise ValueError(f"out_bits {out_bits} with y_frac_bits {fy} cannot hold the outputs "
                              f"[{lo_v:.9g}, {hi_v:.9g}] of {name!r} (they need "
                              f"{unsigned_bits(int(r_valid.max()) - y_off)} bits); accepted: "
-                             f"fewer y-frac-bits or more out-bits")
+                             f"fewer y_frac_bits or more out_bits")
     raw = rounded - y_off
     y_fmt = QFormat(bits=out_bits, frac_bits=fy, offset_code=y_off, signed=False)
     raw_bits = signed_bits(min(int(raw.min()), 0), max(int(raw.max()), y_fmt.max_code))

@@ -60,6 +60,7 @@ import numpy as np
 
 from chebnorm.core.numeric import check_int, float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .exhaustive import ExhaustiveCheck, reference
 from .fixed import QFormat
@@ -222,6 +223,16 @@ class MultipartiteDesign:
     faithful: bool
     certificate: ExhaustiveCheck
     parts: dict = field(default_factory=dict)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("in_bits", self.in_bits),
+                ("out_bits", self.out_bits), ("split", self.split),
+                ("max_error", self.max_error), ("faithful", self.faithful)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def __post_init__(self):
         _check_design(self)
@@ -774,6 +785,31 @@ def design_multipartite(expr, interval, in_bits: int, out_bits: int, *, max_erro
     ------
     ValueError
         An argument out of range (named), or no structure meets the target.
+
+    See Also
+    --------
+    chebnorm.hw.plain_table.design_plain_table : one table of every output.
+    chebnorm.hw.piecewise.design_piecewise : ROM of coefficients and a Horner datapath.
+    chebnorm.hw.exhaustive : the exhaustive proof over every code.
+
+    Notes
+    -----
+    The input code is cut into fields :math:`A` and :math:`B_i`; the
+    output is one truncated sum of table lookups [1]_,
+
+    .. math::
+
+        y = \\left\\lfloor \\frac{\\left(\\mathrm{TIV}[A] + \\sum_i
+            \\mathrm{TO}_i[C_i, B_i]\\right) \\bmod 2^{S}}{2^{g}} \\right\\rfloor,
+
+    :math:`C_i` the top bits of :math:`A` (module docstring). The design
+    returned is proved over every input code against Arb enclosures of
+    :math:`f` (``certificate``).
+
+    References
+    ----------
+    .. [1] F. de Dinechin, A. Tisserand, "Multipartite table methods", IEEE
+       Transactions on Computers 54(3), 2005.
 
     Examples
     --------

@@ -57,6 +57,7 @@ from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import float_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import (
     QFormat,
@@ -195,6 +196,16 @@ class PiecewiseDesign:
     prod_frac: tuple[int, ...] = ()      # P_j, j = 0..n-1: fractional bits kept of product j
     q_bits: tuple[int, ...] = ()         # per step j = n-1..0: width of the truncated product
     bound: tuple[Fraction, Fraction, Fraction] = ()  # (approximation, datapath, total)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("segments", self.table.segment_count),
+                ("degree", self.degree), ("in_bits", self.in_bits), ("out_bits", self.out_bits),
+                ("latency", self.latency), ("multipliers", self.multipliers)] + (
+                    [("total_bound", float(self.bound[2]))] if self.bound else [])
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def module_name(self) -> str:
@@ -994,6 +1005,36 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
         negative or not finite; a wire wider than 64 bits; y's range does
         not fit ``out_bits``.
 
+    See Also
+    --------
+    chebnorm.hw.horner.design_horner : one polynomial over the whole interval.
+    chebnorm.hw.piecewise_search.search : the ``chebnorm design`` search over tables and widths.
+    chebnorm.hw.hdl.module_text : the design's Verilog or VHDL.
+
+    Notes
+    -----
+    The :math:`W`-bit code :math:`k` stands for
+    :math:`x = a + (b - a)\\, k\\, 2^{-W}`; its top :math:`K` bits address the
+    ROM of segment coefficients and the low :math:`L = W - K` bits are the
+    local variable :math:`t = (k \\bmod 2^L)\\, 2^{-L}`, as in FloPoCo's
+    ``FixFunctionByPiecewisePoly`` [1]_ [2]_. With the one-width design
+
+    .. math::
+
+        |y - f(x)| \\le \\varepsilon_{\\mathrm{table}}
+        + \\sum_{j=1}^{n-1} 2^{-(F_a + 1)} \\max |t|^j + 2^{-(F_y + 1)}
+
+    (module docstring); the sized design (``widths``) is certified per
+    segment by :func:`sized_bound`.
+
+    References
+    ----------
+    .. [1] F. de Dinechin, B. Pasca, "Designing custom arithmetic data paths
+       with FloPoCo", IEEE Design & Test of Computers 28(4), 2011.
+    .. [2] F. de Dinechin, M. Joldes, B. Pasca, "Automatic generation of
+       polynomial-based hardware architectures for function evaluation",
+       IEEE ASAP 2010.
+
     Examples
     --------
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
@@ -1004,7 +1045,7 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     >>> design_piecewise(t, 2, 8)
     Traceback (most recent call last):
     ...
-    ValueError: in-bits = 2 is out of range; accepted: 3 <= in-bits <= 20
+    ValueError: in_bits = 2 is out of range; accepted: 3 <= in_bits <= 20
     """
     if not isinstance(table, PiecewiseTable):
         raise ValueError("design_piecewise needs a PiecewiseTable")
@@ -1014,9 +1055,9 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                          f"segments; accepted for hardware: a uniform table, or an exponent "
                          f"table of 2^m segments (the code's top bits index it)")
     K = (nseg - 1).bit_length()
-    in_bits = check_width(in_bits, "in-bits", K + 1, MAX_PW_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
-    guard_bits = check_width(guard_bits, "guard-bits", 0, 16)
+    in_bits = check_width(in_bits, "in_bits", K + 1, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out_bits", 1, MAX_PW_OUT_BITS)
+    guard_bits = check_width(guard_bits, "guard_bits", 0, 16)
     name = identifier(name or table.name, field="name")
     for v in table.interval:
         _exact(v)
@@ -1108,7 +1149,7 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
             return d
     if failed is not None:
         raise failed
-    raise ValueError(f"out-bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+    raise ValueError(f"out_bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
 
 
 def _check_weight(w) -> float:

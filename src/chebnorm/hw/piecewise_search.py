@@ -335,7 +335,7 @@ def _cells(design: PiecewiseDesign) -> int:
 def _check_max_error(max_error) -> float:
     if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) or \
             not math.isfinite(max_error) or max_error <= 0:
-        raise ValueError(f"max-error {max_error!r} is not a positive number; accepted: E > 0")
+        raise ValueError(f"max_error {max_error!r} is not a positive number; accepted: E > 0")
     return float(max_error)
 
 
@@ -418,14 +418,14 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     >>> r.winner.degree, r.winner.segments, r.winner.total_bound <= 1e-2
     (1, 16, True)
     """
-    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    in_bits = check_width(in_bits, "in_bits", 2, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out_bits", 1, MAX_PW_OUT_BITS)
     max_error = _check_max_error(max_error)
     degrees = tuple(sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees}))
     if not degrees:
         raise ValueError("degrees: empty; accepted: one or more of 0..8")
     target = get_target(target).name
-    kmax = check_width(max_index_bits, "max-index-bits", 0, min(12, in_bits - 1))
+    kmax = check_width(max_index_bits, "max_index_bits", 0, min(12, in_bits - 1))
     workers = check_workers(workers)
     check_scheduler(scheduler)
     f_hi = min(MAX_COEF_FRAC_BITS, max(4, math.ceil(-math.log2(max_error)) + 6))
@@ -702,11 +702,11 @@ def grid(expr, interval, in_bits: int, out_bits: int, *, index_bits=(0, 2, 4, 6,
     >>> [(p.segments, p.degree) for p in r.points]
     [(2, 1), (4, 1)]
     """
-    in_bits = check_width(in_bits, "in-bits", 2, MAX_PW_IN_BITS)
-    out_bits = check_width(out_bits, "out-bits", 1, MAX_PW_OUT_BITS)
+    in_bits = check_width(in_bits, "in_bits", 2, MAX_PW_IN_BITS)
+    out_bits = check_width(out_bits, "out_bits", 1, MAX_PW_OUT_BITS)
     ks = sorted({check_width(k, "index bits k", 0, min(12, in_bits - 1)) for k in index_bits})
     ds = sorted({check_width(d, "degree", 0, MAX_PIECEWISE_DEGREE) for d in degrees})
-    fs = sorted({check_width(f, "coef-frac-bits", 0, MAX_COEF_FRAC_BITS) for f in coef_frac_bits})
+    fs = sorted({check_width(f, "coef_frac_bits", 0, MAX_COEF_FRAC_BITS) for f in coef_frac_bits})
     if not ks or not ds or not fs:
         raise ValueError("empty sweep list; accepted: at least one segment count, degree and "
                          "coefficient width")

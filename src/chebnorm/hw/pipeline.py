@@ -38,6 +38,8 @@ from dataclasses import dataclass, replace
 from itertools import combinations
 from pathlib import Path
 
+from chebnorm.core.display import field_rows, summary_html, summary_repr
+
 from .hdl import hdl_files, module_text
 from .hdl.tables import table_cuts, table_files, table_module
 from .targets import fmax_ice40, get_target, synthesize_target
@@ -394,6 +396,15 @@ class PipelineResult:
     source: str
     cost: object
     steps: tuple
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("target", self.target), ("frequency_mhz", self.frequency_mhz),
+                ("met", self.met), ("latency", self.latency), ("fmax_mhz", self.fmax_mhz),
+                ("source", self.source)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def extra_ffs(self) -> int:

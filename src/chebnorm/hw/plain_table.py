@@ -21,6 +21,7 @@ import numpy as np
 
 from chebnorm.core.numeric import check_int
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .exhaustive import ExhaustiveCheck, reference, round_to_nearest
 from .fixed import QFormat
@@ -80,6 +81,15 @@ class PlainTableDesign:
     values: tuple[int, ...]
     unproved: int
     certificate: ExhaustiveCheck
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("expression", self.expression),
+                ("interval", self.interval), ("in_bits", self.in_bits),
+                ("out_bits", self.out_bits), ("correctly_rounded", self.correctly_rounded)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     architecture = "plain_table"
     degree = 0   # the VHDL bench reads it (a latency of 1 when combinational)
@@ -166,6 +176,11 @@ def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str 
     PlainTableDesign
         With its exhaustive certificate (``<= 2**-(F+1)`` plus the
         enclosures' width when every rounding was proved).
+
+    See Also
+    --------
+    chebnorm.hw.multipartite.design_multipartite : tables and an adder, smaller ROMs.
+    chebnorm.hw.exhaustive : the proof that every entry is the nearest integer.
 
     Examples
     --------

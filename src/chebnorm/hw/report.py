@@ -205,6 +205,34 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
         argument is out of range (:func:`~chebnorm.hw.horner.design_horner`), or gappa
         or yosys fails.
 
+    See Also
+    --------
+    chebnorm.hw.horner.design_horner : the datapath alone.
+    chebnorm.hw.budget.error_budget : the certified budget alone.
+    chebnorm.hw.piecewise.design_piecewise : the piecewise (ROM + Horner) design.
+
+    Notes
+    -----
+    ``checks`` holds when the exhaustive measurement stays within the
+    certified budget,
+
+    .. math::
+
+        \\max_{k \\text{ valid}} |y_k - f(x_k)| \\le
+        \\min(\\varepsilon_{a} + \\varepsilon_{q},\\ \\varepsilon_{pq})
+        + \\sum_{j=1}^{n-1} \\rho_j \\max_k |x_k|^j + \\rho_{\\mathrm{out}}
+
+    (:func:`~chebnorm.hw.budget.error_budget`), and within Gappa's bound of
+    the rounding part when gappa ran [1]_; ``block`` is the cost model of
+    :mod:`chebnorm.hw.cost`, ``synth`` Yosys' cell count.
+
+    References
+    ----------
+    .. [1] G. Melquiond, Gappa, https://gappa.gitlabpages.inria.fr/ ;
+       F. de Dinechin, C. Lauter, G. Melquiond, "Certifying the
+       floating-point implementation of an elementary function using
+       Gappa", IEEE Transactions on Computers 60(2), 2011.
+
     Examples
     --------
     >>> from chebnorm.approx import fit_target

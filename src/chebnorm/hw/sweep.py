@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from chebnorm.approx import fit_target, get_target
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -102,6 +103,15 @@ class SweepPoint:
     area_fa: float
     pareto: bool = False
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("degree", self.degree), ("coef_bits", self.coef_bits),
+                ("acc_bits", self.acc_bits), ("max_error", self.max_error),
+                ("budget", self.budget), ("area_fa", self.area_fa), ("pareto", self.pareto)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
     @property
     def area(self) -> float:
         """Yosys cells when available, otherwise the FA estimate."""
@@ -149,6 +159,15 @@ class SweepResult:
     target: str
     points: tuple[SweepPoint, ...]
     area_source: str
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("target", self.target), ("points", len(self.points)),
+                ("pareto", sum(p.pareto for p in self.points)),
+                ("area_source", self.area_source)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def cheapest(self) -> SweepPoint | None:
@@ -312,6 +331,20 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
         If the target is unknown or a width, degree, worker count or scheduler is out of
         its range.
 
+    See Also
+    --------
+    chebnorm.hw.horner.design_horner : one design of the grid.
+    chebnorm.hw.piecewise_search.search : the ``chebnorm design`` search of piecewise evaluators.
+
+    Notes
+    -----
+    A point :math:`p` is on the Pareto front when no other point :math:`q`
+    has both :math:`\\mathrm{area}(q) \\le \\mathrm{area}(p)` and
+    :math:`\\mathrm{levels}(q) \\le \\mathrm{levels}(p)` with one of the two
+    strict, ``levels`` being the measured error in 8-bit shading levels
+    (:attr:`SweepPoint.shading_levels`) and ``area`` Yosys' cells, or the
+    full-adder estimate without Yosys.
+
     Examples
     --------
     >>> s = sweep("dichotomy", degrees=(1, 2), coef_bits=(10, 14), acc_bits=(14,), in_bits=8,
@@ -323,11 +356,11 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
     workers = check_workers(workers)
     check_scheduler(scheduler)
     degrees = _validate_list(degrees, "degree", 1, 4)
-    coef_bits = _validate_list(coef_bits, "coef-bits", 1, MAX_FRAC_BITS)
-    acc_bits = _validate_list(acc_bits, "acc-bits", 1, MAX_FRAC_BITS + 20)
+    coef_bits = _validate_list(coef_bits, "coef_bits", 1, MAX_FRAC_BITS)
+    acc_bits = _validate_list(acc_bits, "acc_bits", 1, MAX_FRAC_BITS + 20)
     tables = {d: fit_target(target, d, psi_max=psi_max) for d in degrees}
     # quantize keeps int32 coefficients: the real limit depends on the tables
-    coef_bits = _validate_list(coef_bits, "coef-bits", 1,
+    coef_bits = _validate_list(coef_bits, "coef_bits", 1,
                                min(max_coef_bits(t) for t in tables.values()))
     grid = [(d, c, a if d >= 2 else None) for d in degrees for c in coef_bits
             for a in (acc_bits if d >= 2 else (None,))]

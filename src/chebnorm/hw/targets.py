@@ -54,6 +54,8 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from chebnorm.core.display import field_rows, summary_html, summary_repr
+
 from .verilog import tool_env
 
 __all__ = ["Target", "TargetCost", "TARGETS", "target_names", "get_target", "synthesize_target",
@@ -271,6 +273,14 @@ class TargetCost:
     levels: int | None = None
     delay_ns: float | None = None
     timing_model: str = ""
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("target", self.target), ("cells", self.cells), ("luts", self.luts),
+                ("dsps", self.dsps), ("score", self.score), ("delay_ns", self.delay_ns)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def as_dict(self) -> dict:
         """Plain fields for JSON (sorted cell types)."""

@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from . import detmath
 from .counting import OpCounts, count_ops, generic_pair
@@ -577,6 +577,15 @@ class DriftReport:
     final_length_error: float
     final_angle_error: float
     ops: OpCounts
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("psi", self.psi), ("m", self.m), ("dtype", self.dtype),
+                ("reanchor", self.reanchor), ("max_length_error", self.max_length_error),
+                ("max_angle_error", self.max_angle_error)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
 
 def angular_drift(psi: float = math.pi / 4, m: int = 512, dtype=np.float32,

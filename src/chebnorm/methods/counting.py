@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .ops import OP_KINDS, Counted, Counter, CountingOps
 from .registry import method_kernel, method_kernels
 from .spans import check_method, resolve_table, span_levels, span_normals
@@ -110,6 +111,14 @@ class OpCounts:
     pow2_per_pixel: float
     pow2_per_span: int
     total: dict = field(default_factory=dict)
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("method", self.method), ("m", self.m), ("per_pixel", self.per_pixel),
+                ("per_span", self.per_span)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def to_dict(self) -> dict:
         return {"method": self.method, "m": self.m, "per_pixel": dict(self.per_pixel),

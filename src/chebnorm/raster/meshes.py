@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.methods import detmath
 
 __all__ = [
@@ -86,6 +87,14 @@ class Mesh:
     uv: np.ndarray | None = None
     P_u: np.ndarray | None = None
     P_v: np.ndarray | None = None
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("name", self.name), ("vertices", len(self.positions)),
+                ("faces", len(self.faces)), ("uv", self.uv is not None)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def __post_init__(self):
         pos = np.array(self.positions, dtype=np.float64)

@@ -139,6 +139,39 @@ def compare(test, reference, *, flip: bool = True) -> tuple[ImageMetrics, np.nda
     ValueError
         For images of different sizes or values out of range.
 
+    See Also
+    --------
+    chebnorm.render : the frames compared.
+    chebnorm.raster.RenderComparison : both frames and the error map, displayed.
+    ImageMetrics : the figures returned.
+
+    Notes
+    -----
+    Both frames are taken to 8-bit levels :math:`a, b \\in \\{0, \\dots, 255\\}`
+    and compared on the pixels :math:`M` either covers, with
+    :math:`d = a - b`:
+
+    .. math::
+
+        \\mathrm{max\\_abs} = \\max_M |d|, \\qquad
+        \\mathrm{MSE} = \\frac{1}{|M|}\\sum_M d^2, \\qquad
+        \\mathrm{PSNR} = 10 \\log_{10}\\frac{255^2}{\\mathrm{MSE}}
+
+    (``psnr`` None when the frames agree); ``ssim`` is the structural
+    similarity [1]_ over the whole frame (7-pixel window) and ``flip`` the
+    mean FLIP error [2]_ over :math:`M` (None unless ``flip``; 0 when the
+    frames agree).
+
+    References
+    ----------
+    .. [1] Z. Wang, A. C. Bovik, H. R. Sheikh, E. P. Simoncelli, "Image
+       quality assessment: from error visibility to structural similarity",
+       IEEE Transactions on Image Processing 13(4), 2004.
+    .. [2] P. Andersson, J. Nilsson, T. Akenine-Moller, M. Oskarsson,
+       K. Astrom, M. D. Fairchild, "FLIP: a difference evaluator for
+       alternating images", Proceedings of the ACM on Computer Graphics and
+       Interactive Techniques 3(2), 2020.
+
     Examples
     --------
     >>> import numpy as np

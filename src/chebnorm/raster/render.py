@@ -321,6 +321,45 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         For an unknown mesh, mode, method, engine or option, a size out of range,
         or tables that do not cover the spans.
 
+    See Also
+    --------
+    compare : the error of one frame against another.
+    chebnorm.span_normals : the span interpolator of ``method``.
+    chebnorm.raster.RenderComparison : two frames side by side with their error map.
+
+    Notes
+    -----
+    Every covered pixel's intensity is Blinn-Phong's [2]_ [3]_, clipped to
+    :math:`[0, 1]`:
+
+    .. math::
+
+        I = I_0 \\left(k_a + k_d \\max(0, N \\cdot L)
+            + k_s \\max(0, N \\cdot H)^n\\right),
+
+    with :math:`L` toward the light, :math:`H` the half vector and
+    :math:`n` the shininess (:class:`Lighting`). ``phong`` interpolates the
+    vertex normals linearly along each scan-line span,
+    :math:`N(t) = (1 - t) N_l + t N_r`, and normalizes them with ``method``
+    (the papers' methods [1]_, :mod:`chebnorm.methods`); ``gouraud``
+    interpolates the vertex intensities instead [4]_; ``adaptive`` skips the
+    normalization where the criterion :math:`\\eta` of seed 003 is below
+    ``eta_threshold``; ``split-gouraud`` is seed 002's highlight test and
+    ``bump`` seed 001's bump mapping [5]_.
+
+    References
+    ----------
+    .. [1] The four papers chebnorm reproduces (seeds 000 to 003), restated
+       with their formulas re-derived in :doc:`/papers`.
+    .. [2] B. T. Phong, "Illumination for computer generated pictures",
+       Communications of the ACM 18(6), 1975.
+    .. [3] J. F. Blinn, "Models of light reflection for computer synthesized
+       pictures", Computer Graphics (SIGGRAPH '77) 11(2), 1977.
+    .. [4] H. Gouraud, "Continuous shading of curved surfaces", IEEE
+       Transactions on Computers C-20(6), 1971.
+    .. [5] J. F. Blinn, "Simulation of wrinkled surfaces", Computer Graphics
+       (SIGGRAPH '78) 12(3), 1978.
+
     Examples
     --------
     >>> r = render("sphere", "phong", "exact", size=(32, 32), tess=8)

@@ -26,6 +26,7 @@ import numpy as np
 
 from chebnorm.approx.method_registry import TableSpec, unit_tables
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from ..cost import Block
 from ..horner import HornerDesign
@@ -150,6 +151,15 @@ class UnitDesign:
     guard: int = 0
     sizes: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("kind", self.kind), ("frac_bits", self.frac_bits),
+                ("comp_bits", self.comp_bits),
+                ("evaluator", None if self.horner is None else self.horner.module_name)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def spec(self) -> UnitKind:

@@ -7,6 +7,7 @@ import shutil
 from dataclasses import dataclass
 
 from chebnorm.approx import CoefficientTable
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from ..cost import Block
 from ..fixed import check_width
@@ -76,10 +77,31 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
     ValueError
         If ``kind`` is unknown, a width is out of its range, the table does not fit the
         unit, or a register would exceed the 62-bit model.
+
+
+    See Also
+    --------
+    analyze_unit : its cost model and, optionally, Yosys' cell count.
+    unit_outputs : its Verilog module, test bench and vectors.
+    chebnorm.hw.horner.design_horner : the polynomial evaluator inside the units that have one.
+
+    Notes
+    -----
+    The units are the papers' normalization methods in hardware [1]_: the
+    classic :math:`N / \\sqrt{N \\cdot N}`, the dichotomy midpoint
+    :math:`(N_1 + N_2) / \\sqrt{2 + z}` with :math:`1/\\sqrt{2 + z}` by a
+    Chebyshev polynomial, the quadratic span interpolator, its
+    forward-difference stepper and the criterion :math:`\\eta`, each bit for
+    bit equal to its kernel in :mod:`chebnorm.hw.datapaths`.
+
+    References
+    ----------
+    .. [1] The four papers chebnorm reproduces (seeds 000 to 003), restated
+       with their formulas re-derived in :doc:`/papers`.
     """
     spec = get_unit(kind)
-    f = check_width(frac_bits, "frac-bits", 1, MAX_UNIT_FRAC_BITS)
-    w = check_width(comp_bits if comp_bits is not None else f + 2, "comp-bits", 2, MAX_COMP_BITS)
+    f = check_width(frac_bits, "frac_bits", 1, MAX_UNIT_FRAC_BITS)
+    w = check_width(comp_bits if comp_bits is not None else f + 2, "comp_bits", 2, MAX_COMP_BITS)
     notes = []
     if w < f + 2:
         notes.append(f"comp-bits {w} < frac-bits + 2 = {f + 2}: +1.0 is not representable")
@@ -179,6 +201,15 @@ class UnitReport:
     unit: UnitDesign
     block: Block
     synth: SynthResult | None
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("unit", self.unit.kind), ("module", self.unit.module_name),
+                ("area_fa", self.block.cost.area),
+                ("yosys_cells", None if self.synth is None else self.synth.cells)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def as_dict(self) -> dict:
         u = self.unit

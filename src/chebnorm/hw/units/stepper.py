@@ -38,7 +38,7 @@ class StepperUnit(UnitKind):
 
     def design(self, f, w, notes, *, table, in_bits, out_bits, coef_bits, rounding, log_m,
                guard) -> UnitDesign:
-        log_m = check_width(log_m, "log-m", 0, MAX_LOG_M)
+        log_m = check_width(log_m, "log_m", 0, MAX_LOG_M)
         guard = check_width(guard if guard is not None else 2 * log_m, "guard", 0, MAX_GUARD)
         m = 1 << log_m
         big = 1 << (w - 1)
