@@ -16,7 +16,9 @@ import sympy as sp
 import chebnorm as cn
 from chebnorm import hw
 from chebnorm.approx import parse_function
+from chebnorm.hw.architectures import Candidate
 from chebnorm.hw.piecewise import design_piecewise
+from chebnorm.hw.piecewise_search import search as hw_search
 from chebnorm.hw.pipeline import PipelineResult
 from chebnorm.hw.targets import TargetCost
 from chebnorm.methods import angular_drift, count_ops
@@ -35,6 +37,8 @@ def results():
         pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16, name="pw")
         unit = hw.design_unit("classic", frac_bits=6)
         mp = hw.design_multipartite("1/sqrt(x)", ("1", "4"), 8, 8)
+        search = hw_search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2),
+                           max_index_bits=4, synth=False, progress=False, workers=1)
         sw = hw.sweep("dichotomy", degrees=(1,), coef_bits=(10,), acc_bits=(14,), in_bits=6,
                       out_bits=6, synth=False, workers=1, progress=False)
         return [
@@ -52,6 +56,9 @@ def results():
                        delay_ns=7.737, timing_model="yosys sta"),
             PipelineResult(design=d, target="ice40", frequency_mhz=50.0, met=True, latency=2,
                            fmax_mhz=61.3, source="nextpnr-ice40", cost=None, steps=((0, 35.1),)),
+            search, search.winner,
+            Candidate("multipartite", "2 offset tables", mp, 1e-3, 2 ** -8, model=80.5,
+                      model_rom=60.0),
         ]
 
 
@@ -71,7 +78,8 @@ def test_every_result_has_a_short_repr_and_an_html_table(results):
     assert {"HornerDesign", "ErrorBudget", "Measurement", "PiecewiseDesign", "UnitDesign",
             "UnitReport", "MultipartiteDesign", "PlainTableDesign", "ExponentDesign",
             "SweepResult", "SweepPoint", "Block", "Certificate", "DriftReport", "OpCounts",
-            "Mesh", "ExhaustiveCheck", "TargetCost", "PipelineResult"} <= names
+            "Mesh", "ExhaustiveCheck", "TargetCost", "PipelineResult", "SearchResult",
+            "DesignPoint", "Candidate"} <= names
 
 
 def test_repr_values_are_the_objects_own(results):

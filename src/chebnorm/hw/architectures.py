@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS
 
+from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
 
 from .hdl import module_text
@@ -117,6 +118,18 @@ class Candidate:
     note: str = ""
     model: float | None = None
     model_rom: float | None = None
+
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("architecture", self.architecture), ("description", self.description),
+                ("error", self.error), ("score", None if self.cost is None else self.cost.score),
+                ("model", self.model), ("note", self.note)]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return self._summary() + [("ulp", self.ulp), ("model_rom", self.model_rom),
+                                  ("cost", self.cost), ("design", type(self.design).__name__)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     @property
     def verilog(self) -> str:

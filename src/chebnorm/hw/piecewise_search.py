@@ -42,6 +42,7 @@ from dataclasses import dataclass, replace
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DEGREE
 from chebnorm.approx.piecewise_fit import piecewise_fit
+from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.core.textsafe import csv_cell
 
 from .fixed import check_width
@@ -158,6 +159,15 @@ class DesignPoint:
     target_model: float | None = None   # the target's model score (non-generic target)
     target_cost: TargetCost | None = None   # yosys on the target (non-generic target)
 
+    def _summary(self) -> list[tuple[str, object]]:
+        return [("degree", self.degree), ("segments", self.segments),
+                ("coef_frac_bits", self.coef_frac_bits), ("total_bound", self.total_bound),
+                ("meets", self.meets), ("cost", self.cost)]
+
+    _display_rows = field_rows
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
+
     @property
     def cost(self) -> float:
         if self.target_model is not None:
@@ -218,6 +228,23 @@ class SearchResult:
     cost_source: str
     designs: dict
     target: str = "generic"
+
+    def _summary(self) -> list[tuple[str, object]]:
+        w = self.winner
+        return [("expression", self.expression), ("target", self.target),
+                ("max_error", self.max_error), ("points", len(self.points)),
+                ("winner", None if w is None else
+                 f"degree {w.degree}, {w.segments} segments, {w.coef_frac_bits} bits"),
+                ("cost_source", self.cost_source)]
+
+    def _display_rows(self) -> list[tuple[str, object]]:
+        return self._summary() + [("interval", self.interval), ("in_bits", self.in_bits),
+                                  ("out_bits", self.out_bits),
+                                  ("designs", f"{len(self.designs)} piecewise designs"),
+                                  ("winner (full)", self.winner)]
+
+    __repr__ = summary_repr
+    _repr_html_ = summary_html
 
     def csv(self) -> str:
         """The CSV of every point (:data:`COLUMNS`; a non-generic target adds
