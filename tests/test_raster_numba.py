@@ -208,6 +208,42 @@ def test_fused_slerp_float32_rounding_fixup(monkeypatch):
     assert len(fix) == 1
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("method", method_names())
+def test_fused_phong_image_only_identical(method, dtype, monkeypatch):
+    # extra_maps=False: the reference's image and mask, no triangle or |N| map; a map the
+    # frame does not fill is never written (its pool memory keeps what was there)
+    calls = _spy(monkeypatch, "phong")
+    ref = render("teapot", "phong", method, size=(256, 200), dtype=dtype, engine="numpy")
+    got = render("teapot", "phong", method, size=(256, 200), dtype=dtype, engine="numba",
+                 extra_maps=False)
+    assert calls and calls[-1] is not None   # the fused path drew it (after a warm-up)
+    assert _same(got.image, ref.image) and _same(got.mask, ref.mask), method
+    assert got.triangle is None and got.normal_length is None
+    assert got.fragments == ref.fragments and got.stats == ref.stats
+    # a full frame after an image-only one (the pool's maps) is whole again
+    _check_identical(get_mesh("teapot"), method, (256, 200), dtype)
+
+
+def test_fused_slerp_float32_image_only_fixup(monkeypatch):
+    # the hard float32 sines are marked in the triangle map even when it is not returned
+    fix = _spy(monkeypatch, "_slerp_fixup")
+    ref = render("teapot", "phong", "slerp", size=(640, 640), dtype=np.float32, engine="numpy")
+    got = render("teapot", "phong", "slerp", size=(640, 640), dtype=np.float32,
+                 engine="numba", extra_maps=False)
+    assert len(fix) == 1
+    assert _same(got.image, ref.image) and _same(got.mask, ref.mask)
+
+
+def test_image_only_numpy_engine_and_bad_value():
+    ref = render("sphere", "phong", "exact", size=SIZE, tess=8, engine="numpy")
+    got = render("sphere", "phong", "exact", size=SIZE, tess=8, engine="numpy",
+                 extra_maps=False)
+    assert _same(got.image, ref.image) and got.triangle is None and got.normal_length is None
+    with pytest.raises(ValueError, match="extra_maps"):
+        render("sphere", "phong", "exact", size=SIZE, tess=8, extra_maps="no")
+
+
 @pytest.mark.parametrize("lighting", [dict(shininess=2.0), dict(shininess=1.0, ka=0.0),
                                       dict(half_vector="triangle", shininess=2.0),
                                       dict(I0=2.5, light=(0.3, 1.0, -0.2), ks=0.9)])
