@@ -394,43 +394,35 @@ def row_buckets(r0, nrows, height):
 
 # --------------------------------------------------------------- row spans
 @njit()
-def _row_geom_part(xy, width, first, ids, rlo, rhi, row_n, gc, ga, ge, gs):
-    """Rows ``rlo .. rhi-1`` of :func:`row_spans`: the geometry of every (row,
-    triangle) pair ``q`` of the row buckets (:func:`span_geom`: count ``gc``, first
-    pixel ``ga``, edges and swap packed in ``ge``, ``sa, sb, xl, xr`` in ``gs``) and each
-    row's number of spans into ``row_n[r + 1]``."""
+def _row_geom_part(xy, width, first, ids, rlo, rhi, row_n, gc):
+    """Rows ``rlo .. rhi-1`` of :func:`row_spans`: the pixel count ``gc`` of every (row,
+    triangle) pair ``q`` of the row buckets (:func:`span_geom`) and each row's number of
+    spans into ``row_n[r + 1]``.  Only the counts are kept: the write pass computes the
+    geometry again (the same function, so the same bits), cheaper than writing and
+    reading it back (56 bytes a pair)."""
     for r in range(rlo, rhi):
         n = 0
         for q in range(first[r], first[r + 1]):
-            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, ids[q], r, width)
+            c = span_geom(xy, ids[q], r, width)[0]
             gc[q] = c
-            if c <= 0:
-                continue
-            ga[q] = a
-            ge[q] = pa | (qa << 2) | (p << 4) | (qq << 6) | (np.int64(swap) << 8)
-            gs[q, 0] = sa
-            gs[q, 1] = sb
-            gs[q, 2] = xl
-            gs[q, 3] = xr
-            n += 1
+            n += c > 0
         row_n[r + 1] = n
 
 
 @njit()
-def _row_write_part(attrs, first, ids, rlo, rhi, row_start, gc, ga, ge, gs, tri, row, c0, count,
-                    m, t0, dt, left, right):
-    """Rows ``rlo .. rhi-1``: the spans from the geometry of :func:`_row_geom_part`
-    (:func:`span_write`), row ``r``'s from ``row_start[r]`` on."""
+def _row_write_part(xy, width, attrs, first, ids, rlo, rhi, row_start, gc, tri, row, c0,
+                    count, m, t0, dt, left, right):
+    """Rows ``rlo .. rhi-1``: the spans of the pairs :func:`_row_geom_part` counted
+    (:func:`span_geom`, :func:`span_write`), row ``r``'s from ``row_start[r]`` on."""
     for r in range(rlo, rhi):
         n = row_start[r]
         for q in range(first[r], first[r + 1]):
-            c = gc[q]
-            if c <= 0:
+            if gc[q] <= 0:
                 continue
-            e = ge[q]
-            span_write(attrs, ids[q], r, n, c, ga[q], e & 3, (e >> 2) & 3, gs[q, 0],
-                       (e >> 4) & 3, (e >> 6) & 3, gs[q, 1], (e >> 8) != 0, gs[q, 2],
-                       gs[q, 3], tri, row, c0, count, m, t0, dt, left, right)
+            i = ids[q]
+            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, r, width)
+            span_write(attrs, i, r, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, tri, row,
+                       c0, count, m, t0, dt, left, right)
             n += 1
 
 
@@ -440,9 +432,10 @@ def row_spans(xy, attrs, width, height, work=None):
     right, row_start, by_row)``; row ``r``'s spans are ``row_start[r] ..
     row_start[r+1]-1``, in ``setup_spans``' order within the row (so ties of the z-test
     still go to the earliest fragment), ``by_row`` the identity.  A frame reads each
-    span's data once per row: in this order the reads are sequential.  The geometry of
-    each (row, triangle) pair is computed once (the count pass keeps it for the write
-    pass); with ``work`` (a :class:`.workspace.Workspace`, for the geometry) the spans
+    span's data once per row: in this order the reads are sequential.  The count pass
+    keeps only each (row, triangle) pair's pixel count, the write pass computes the
+    pair's geometry again (less memory traffic than keeping it); with ``work`` (a
+    :class:`.workspace.Workspace`, for the counts) the spans
     are views of this thread's :func:`.workspace.span_buffers`, valid until its next
     such call.  ``tests/raster_oracles.py`` holds the pair-by-pair oracle.
 
@@ -484,15 +477,14 @@ def row_spans(xy, attrs, width, height, work=None):
     parts = [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
     row_start = scratch(work, "row_start", height + 1, np.int64)
     row_start[0] = 0
-    geom = (scratch(work, "gc", P, np.int64), scratch(work, "ga", P, np.int64),
-            scratch(work, "ge", P, np.int64), scratch(work, "gs", (P, 4)))
-    run_with_caller([(_row_geom_part, (xy, int(width), first, ids, lo, hi, row_start, *geom))
+    gc = scratch(work, "gc", P, np.int64)
+    run_with_caller([(_row_geom_part, (xy, int(width), first, ids, lo, hi, row_start, gc))
                      for lo, hi in parts])
     np.cumsum(row_start, out=row_start)
     S = int(row_start[-1])
     out = span_arrays(S, Kc) if work is None else span_buffers(S, Kc)
-    run_with_caller([(_row_write_part, (attrs, first, ids, lo, hi, row_start, *geom, *out))
-                     for lo, hi in parts])
+    run_with_caller([(_row_write_part, (xy, int(width), attrs, first, ids, lo, hi, row_start,
+                                        gc, *out)) for lo, hi in parts])
     tri, row, c0, count, m, t0, dt, left, right = out
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
                            right=right, row_start=row_start, by_row=_identity(S))
