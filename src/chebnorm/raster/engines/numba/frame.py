@@ -46,10 +46,10 @@ from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vect
 from .calibration import (DetOps, calibrated, dot3, dot3_select, f32_round, pow_calibrated,
                           powers, trig64, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, threads
-from .kernels import dichotomy_denominators
+from .kernels import dichotomy_denominators_into
 from .rasterize import row_spans
 from .setup import method_setup, span_input, widest_dot
-from .workspace import give, keep_maps, output_maps, take
+from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
 
@@ -61,12 +61,13 @@ MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLE
 
 # ------------------------------------------------------------ dichotomy prep
 @njit()
-def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
-    """Per-span denominators of every level and, per depth, whether any pixel of any
-    span is off the dyadic grid (then every pixel of that depth is picked), as
-    the dichotomy kernel of :mod:`.kernels` computes them."""
+def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count, Lmax, r):
+    """Per-span denominators of every level into ``r`` (``(S, max(Lmax, 1))``, ``Lmax``
+    the deepest level) and, per depth, whether any pixel of any span is off the dyadic
+    grid (then every pixel of that depth is picked), as the dichotomy kernel of
+    :mod:`.kernels` computes them."""
     S = levels.shape[0]
-    r, Lmax = dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
+    dichotomy_denominators_into(nl, nr, levels, coeffs, exact, kc, r)
     off = np.zeros(Lmax + 1, np.bool_)
     tcb = np.empty(1, nl.dtype)
     for i in range(S):
@@ -80,7 +81,7 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
             if u - np.floor(u) != 0:
                 off[L] = True
                 break
-    return r, off
+    return off
 
 
 # ---------------------------------------------------------------- shading
@@ -669,8 +670,11 @@ def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
             kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
             levels = np.ascontiguousarray(lv, np.int64)
-            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
-                                     sp.count)
+            lmax = int(levels.max())
+            # the frame's denominators in kept memory (fresh ones: 2000 page faults a frame)
+            R = scratch(work, "dichotomy_r", (S, max(lmax, 1)), dtype)
+            off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
+                                  sp.count, lmax, R)
     return dt_, A, B, C, sc, sc2, levels, R, off, kd
 
 

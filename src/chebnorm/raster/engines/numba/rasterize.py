@@ -15,7 +15,7 @@ import numpy as np
 from ...spans import Spans, fit_camera
 from ...spans import project as reference_project
 from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
-from .workspace import scratch, span_arrays, span_buffers
+from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
            "span_geom", "span_write", "row_buckets", "row_spans", "project", "default_camera_of"]
@@ -253,49 +253,41 @@ def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
 
 # --------------------------------------------------------- triangle set-up
 @njit()
-def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
-    """``NumpyEngine.setup``: front-facing triangles and their corners."""
+def _gather_setup(pos, nrm, xy, inv_w, faces, cull, tri, txy, attrs, tiw, tpos, tnrm):
+    """``NumpyEngine.setup``: front-facing triangles and their corners, into the flat
+    buffers ``tri`` (ids), ``txy``, ``attrs``, ``tiw``, ``tpos``, ``tnrm`` (room for every
+    face); the number of front-facing triangles."""
     F = faces.shape[0]
-    keep = np.empty(F, np.bool_)
+    n = 0
     for i in range(F):
         a, b, c = faces[i, 0], faces[i, 1], faces[i, 2]
         area = ((xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1])
                 - (xy[c, 0] - xy[a, 0]) * (xy[b, 1] - xy[a, 1]))
-        keep[i] = area < 0 if cull else area != 0
-    n = 0
-    for i in range(F):
-        n += keep[i]
-    tri = np.empty(n, np.int64)
-    n = 0
-    for i in range(F):
-        if keep[i]:
-            tri[n] = i
-            n += 1
-    txy = np.empty((n, 3, 2))
-    attrs = np.empty((n, 3, 7))
-    tiw = np.empty((n, 3))
-    tpos = np.empty((n, 3, 3))
-    tnrm = np.empty((n, 3, 3))
+        keep = area < 0 if cull else area != 0
+        tri[n] = i
+        n += keep
     for k in range(n):
         i = tri[k]
         for v in range(3):
             q = faces[i, v]
-            txy[k, v, 0] = xy[q, 0]
-            txy[k, v, 1] = xy[q, 1]
-            attrs[k, v, 0] = inv_w[q]
-            tiw[k, v] = inv_w[q]
+            e = 3 * k + v
+            txy[2 * e] = xy[q, 0]
+            txy[2 * e + 1] = xy[q, 1]
+            attrs[7 * e] = inv_w[q]
+            tiw[e] = inv_w[q]
             for c in range(3):
-                attrs[k, v, 1 + c] = nrm[q, c]
-                attrs[k, v, 4 + c] = pos[q, c]
-                tnrm[k, v, c] = nrm[q, c]
-                tpos[k, v, c] = pos[q, c]
-    return tri, txy, attrs, tiw, tpos, tnrm
+                attrs[7 * e + 1 + c] = nrm[q, c]
+                attrs[7 * e + 4 + c] = pos[q, c]
+                tnrm[3 * e + c] = nrm[q, c]
+                tpos[3 * e + c] = pos[q, c]
+    return n
 
 
 def gather_setup(mesh, xy, inv_w, cull):
     """The per-triangle arrays of ``NumpyEngine.setup``, gathered in compiled code: front
     triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``, and
-    the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``.
+    the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``:
+    C-contiguous views of buffers kept between frames (:func:`.workspace.setup_buffers`).
 
     Parameters
     ----------
@@ -313,12 +305,16 @@ def gather_setup(mesh, xy, inv_w, cull):
     tuple of numpy.ndarray
         ``(tri, xy, inv_w, pos, nrm, attrs)`` as described above.
     """
-    tri, txy, attrs, iw, pos, nrm = _gather_setup(
-        np.ascontiguousarray(mesh.positions, np.float64),
-        np.ascontiguousarray(mesh.normals, np.float64), np.ascontiguousarray(xy, np.float64),
-        np.ascontiguousarray(inv_w, np.float64), np.ascontiguousarray(mesh.faces, np.int64),
-        bool(cull))
-    return tri, txy, iw, pos, nrm, attrs
+    faces = np.ascontiguousarray(mesh.faces, np.int64)
+    bufs = setup_buffers(len(faces))
+    n = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
+                      np.ascontiguousarray(mesh.normals, np.float64),
+                      np.ascontiguousarray(xy, np.float64),
+                      np.ascontiguousarray(inv_w, np.float64), faces, bool(cull), *bufs)
+    b_tri, b_xy, b_attrs, b_iw, b_pos, b_nrm = bufs
+    return (b_tri[:n], b_xy[:6 * n].reshape(n, 3, 2), b_iw[:3 * n].reshape(n, 3),
+            b_pos[:9 * n].reshape(n, 3, 3), b_nrm[:9 * n].reshape(n, 3, 3),
+            b_attrs[:21 * n].reshape(n, 3, 7))
 
 
 # ------------------------------------------------------------- span set-up
