@@ -660,12 +660,17 @@ def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
         if mode == 4:       # K.SLERP.setup, compiled
             sc, sc2 = method_setup(mode, A, B, None, None, coeffs, start_left, count_max,
                                    ops, work)
-        elif mode == 5:     # quadratic_setup, compiled
-            A, B, C = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
-                                   coeffs, start_left, count_max, ops, work)
-        elif mode == 6:     # angular_setup, compiled
-            A, B, sc = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
-                                    coeffs, start_left, count_max, ops, work)
+        elif mode in (5, 6):
+            # sp.t0.astype(dtype), sp.dt.astype(dtype) in kept memory (no fresh pages)
+            t0c, dtc = scratch(work, "t0c", S, dtype), scratch(work, "dtc", S, dtype)
+            t0c[...] = sp.t0
+            dtc[...] = sp.dt
+            if mode == 5:   # quadratic_setup, compiled
+                A, B, C = method_setup(mode, A, B, t0c, dtc, coeffs, start_left, count_max,
+                                       ops, work)
+            else:           # angular_setup, compiled
+                A, B, sc = method_setup(mode, A, B, t0c, dtc, coeffs, start_left, count_max,
+                                        ops, work)
         elif mode == 7:     # dichotomy
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
             kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
