@@ -117,9 +117,7 @@ def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd,
 @njit()
 def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs):
     """Row ``rr``: in ``bs`` the winning span of each pixel (largest ``1/w``, ties to the
-    earliest span; -1: none).  The test ``bs[x] < 0 or w > bw[x]`` as selects, not
-    branches (the same winners: a span's pixels are distinct, so each is tested once per
-    span against the earlier spans' best)."""
+    earliest span; -1: none)."""
     for x in range(width):
         bs[x] = -1
     for k in range(row_start[rr], row_start[rr + 1]):
