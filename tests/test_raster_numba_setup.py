@@ -317,6 +317,38 @@ def _reused_after_drop(mesh):
     return r.normal_length.base.ctypes.data == p
 
 
+def test_setup_buffers_kept_and_never_shared_with_a_live_setup():
+    """The triangle set-up's arrays are views of kept buffers: a set-up still referenced
+    keeps its buffers (a second set-up gets others, its values intact), a dropped one's
+    are the next set-up's (no fresh pages: a page fault per 4 KiB), and a frame drawn
+    on reused buffers has the reference's bytes."""
+    from chebnorm.raster.engines import get_engine
+
+    eng = get_engine("numba")
+    mesh = get_mesh("teapot")
+    a = eng.setup(mesh, None, (64, 48), True)
+    a_attrs = a.attrs.copy()
+    b = eng.setup(mesh, None, (96, 80), True)      # another camera: other values
+    assert not np.shares_memory(a.attrs, b.attrs) and _same(a.attrs, a_attrs)
+    assert all(x.flags.c_contiguous for x in (b.xy, b.inv_w, b.pos, b.nrm, b.attrs))
+    assert _setup_reused_after_drop(eng, mesh)
+    ref = render(mesh, "phong", "exact", size=(96, 80), engine="numpy")
+    for _ in range(2):
+        got = render(mesh, "phong", "exact", size=(96, 80), engine="numba")
+        assert _same(got.image, ref.image) and _same(got.triangle, ref.triangle)
+
+
+def _setup_reused_after_drop(eng, mesh):
+    """A dropped set-up's buffers are the next one's, views of a kept set (outside an
+    assert statement)."""
+    st = eng.setup(mesh, None, (64, 48), True)
+    kept = [bufs for bufs in workspace._SETUP if st.attrs.base is bufs[2]]
+    p = st.attrs.ctypes.data
+    del st
+    st = eng.setup(mesh, None, (64, 48), True)
+    return len(kept) == 1 and st.attrs.base is kept[0][2] and st.attrs.ctypes.data == p
+
+
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")     # the reference on NaN normals
 def test_end_pass_on_row_spans(dtype):

@@ -251,7 +251,8 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
            camera: Camera | None = None, tables=None, dtype=np.float64,
            eta_threshold: float = 0.005, q: float = 1.0 / 255.0, bump: str = "full",
            height_map: HeightMap | None = None, k: float | None = None, cull: bool = True,
-           span_normals=None, engine: str | None = "auto") -> RenderResult:
+           span_normals=None, engine: str | None = "auto",
+           extra_maps: bool = True) -> RenderResult:
     """Render ``mesh`` (a :class:`Mesh`, a name or a file path) with one
     shading mode.
 
@@ -271,7 +272,10 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     ``engine``: ``"numpy"`` (the reference, :mod:`chebnorm.raster.engines.numpy`),
     ``"numba"`` (compiled, and for ``phong`` the fused, threaded frame:
     :mod:`chebnorm.raster.engines.numba`; the same image bytes) or ``"auto"`` (numba
-    when installed).
+    when installed).  ``extra_maps``: ``phong`` and ``adaptive`` also return the
+    triangle and ``|N|`` maps (False: only the image and its mask, as a GPU frame
+    gives them; ``triangle`` and ``normal_length`` are None and the compiled frame
+    neither computes nor writes them: 16 of its 25 bytes per pixel).
 
     Parameters
     ----------
@@ -309,6 +313,8 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
         A replacement span interpolator.
     engine : str, optional
         ``"numpy"``, ``"numba"`` or ``"auto"``.
+    extra_maps : bool, optional
+        Also the triangle and ``|N|`` maps (``phong``, ``adaptive``).
 
     Returns
     -------
@@ -382,6 +388,8 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     else:
         method = None
     check_options(shading, bump, eta_threshold, q)
+    if not isinstance(extra_maps, (bool, np.bool_)):
+        raise ValueError(f"extra_maps must be True or False; got {extra_maps!r}")
     mesh = get_mesh(mesh, tess)
     if span_normals is None:   # a compiling engine compiles on a small frame, before the clock
         compile_seconds = eng.warm_up(
@@ -403,9 +411,11 @@ def render(mesh="teapot", shading: str = "phong", method: str | None = "exact", 
     if shading == "gouraud":
         out = shading_modes.gouraud(eng, st, lighting)
     elif shading == "phong":
-        out = shading_modes.phong(eng, st, method, spec, builtin=span_normals is None, **kw)
+        out = shading_modes.phong(eng, st, method, spec, builtin=span_normals is None,
+                                  extra_maps=bool(extra_maps), **kw)
     elif shading == "adaptive":
-        out = shading_modes.phong(eng, st, method, spec, skip_eta=eta_threshold, **kw)
+        out = shading_modes.phong(eng, st, method, spec, skip_eta=eta_threshold,
+                                  extra_maps=bool(extra_maps), **kw)
     elif shading == "split-gouraud":
         out = shading_modes.split_gouraud(eng, st, lighting, q)
     else:

@@ -110,7 +110,7 @@ def interpolated_normals(engine, sp, cols, method, interp, tables, dtype, sel=No
 
 
 def phong(engine, st, method, spec, *, lighting, interp, tables, dtype, skip_eta=None,
-          builtin=True) -> ModeResult:
+          builtin=True, extra_maps=True) -> ModeResult:
     """``phong`` (and, with ``skip_eta``, ``adaptive``: no normalization on triangles
     with ``eta < skip_eta``, seed 003).
 
@@ -136,6 +136,9 @@ def phong(engine, st, method, spec, *, lighting, interp, tables, dtype, skip_eta
         ``adaptive``'s threshold.
     builtin : bool
         Whether ``interp`` is the registry's interpolator.
+    extra_maps : bool
+        Also the triangle and ``|N|`` maps (False: ``triangle`` and ``normal_length``
+        are None; the whole-frame path then neither computes nor writes them).
 
     Returns
     -------
@@ -143,7 +146,7 @@ def phong(engine, st, method, spec, *, lighting, interp, tables, dtype, skip_eta
     """
     if skip_eta is None and builtin and engine.supports_frame(spec):
         try:
-            return engine.phong_frame(st, spec, lighting, tables, dtype)
+            return engine.phong_frame(st, spec, lighting, tables, dtype, extra_maps)
         except FrameUnsupported:
             pass    # the same bytes, step by step
     per_pixel_h = lighting.half_vector == "pixel"
@@ -181,6 +184,8 @@ def phong(engine, st, method, spec, *, lighting, interp, tables, dtype, skip_eta
     else:
         H = triangle_half_vectors(st)[sp.tri[sp.frag_span[vis]]]
     img, mask, tri, nlen = engine.shade(st, sp, vis, N, H, lighting)
+    if not extra_maps:
+        tri = nlen = None
     return ModeResult(img, mask, sp.n_fragments, stats, triangle=tri, normal_length=nlen)
 
 

@@ -284,7 +284,8 @@ class Engine:
         """Whether :meth:`phong_frame` draws method ``spec``."""
         return False
 
-    def phong_frame(self, st, spec, lighting, tables, dtype) -> ModeResult:
-        """A whole ``phong`` frame at once; raises :class:`FrameUnsupported` where the
-        engine cannot promise the reference's bytes."""
+    def phong_frame(self, st, spec, lighting, tables, dtype, extra_maps=True) -> ModeResult:
+        """A whole ``phong`` frame at once (``extra_maps`` False: without the triangle and
+        ``|N|`` maps); raises :class:`FrameUnsupported` where the engine cannot promise
+        the reference's bytes."""
         raise FrameUnsupported(self.name)

@@ -104,5 +104,5 @@ class NumbaEngine(NumpyEngine):
     def supports_frame(self, spec) -> bool:
         return kernels_support(spec) and frame.supports(spec)
 
-    def phong_frame(self, st, spec, lighting, tables, dtype):
-        return frame.phong(st, spec, lighting, tables, dtype)
+    def phong_frame(self, st, spec, lighting, tables, dtype, extra_maps=True):
+        return frame.phong(st, spec, lighting, tables, dtype, extra_maps)

@@ -46,10 +46,10 @@ from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vect
 from .calibration import (DetOps, calibrated, dot3, dot3_select, f32_round, pow_calibrated,
                           powers, trig64, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, threads
-from .kernels import dichotomy_denominators
+from .kernels import dichotomy_denominators_into
 from .rasterize import row_spans
 from .setup import method_setup, span_input, widest_dot
-from .workspace import give, keep_maps, output_maps, take
+from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
 
@@ -61,12 +61,13 @@ MODES = {id(K.NONE): 0, id(K.EXACT): 1, id(K.NEWTON): 2, id(K.LYON): 3, id(K.SLE
 
 # ------------------------------------------------------------ dichotomy prep
 @njit()
-def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
-    """Per-span denominators of every level and, per depth, whether any pixel of any
-    span is off the dyadic grid (then every pixel of that depth is picked), as
-    the dichotomy kernel of :mod:`.kernels` computes them."""
+def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count, Lmax, r):
+    """Per-span denominators of every level into ``r`` (``(S, max(Lmax, 1))``, ``Lmax``
+    the deepest level) and, per depth, whether any pixel of any span is off the dyadic
+    grid (then every pixel of that depth is picked), as the dichotomy kernel of
+    :mod:`.kernels` computes them."""
     S = levels.shape[0]
-    r, Lmax = dichotomy_denominators(nl, nr, levels, coeffs, exact, kc)
+    dichotomy_denominators_into(nl, nr, levels, coeffs, exact, kc, r)
     off = np.zeros(Lmax + 1, np.bool_)
     tcb = np.empty(1, nl.dtype)
     for i in range(S):
@@ -80,7 +81,7 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count):
             if u - np.floor(u) != 0:
                 off[L] = True
                 break
-    return r, off
+    return off
 
 
 # ---------------------------------------------------------------- shading
@@ -123,13 +124,52 @@ def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right
         s = by_row[k]
         lo = left[s, 0]
         dw = right[s, 0] - lo
+        a = t0[s]
+        d = dt[s]
+        x0 = c0[s]
         for j in range(count[s]):
-            t = min(max(t0[s] + j * dt[s], 0.0), 1.0)
+            t = min(max(a + j * d, 0.0), 1.0)
             w = lo + t * dw
-            x = c0[s] + j
+            x = x0 + j
             if bs[x] < 0 or w > bw[x]:
                 bs[x] = s
                 bw[x] = w
+
+
+@njit()
+def _row_background(img, mask, tri_map, nlen, base, width, want):
+    """The background of a row (0, False, -1, NaN; overwritten where a fragment lands):
+    the triangle map where ``want & 1``, the ``|N|`` map where ``want & 2``."""
+    if want == 3:
+        for x in range(width):
+            img[base + x] = 0.0
+            mask[base + x] = False
+            tri_map[base + x] = -1
+            nlen[base + x] = np.nan
+        return
+    for x in range(width):
+        img[base + x] = 0.0
+        mask[base + x] = False
+    if want & 1:
+        for x in range(width):
+            tri_map[base + x] = -1
+    if want & 2:
+        for x in range(width):
+            nlen[base + x] = np.nan
+
+
+@njit()
+def _row_winners(bs, wx, ws, width):
+    """The covered pixels of a row in ``x`` order (``wx``) with their spans (``ws``);
+    their number.  Branch-free: every ``x`` is written, the count advances where
+    ``bs[x] >= 0`` (``wx``, ``ws`` have room for the whole row)."""
+    nw = 0
+    for x in range(width):
+        s = bs[x]
+        wx[nw] = x
+        ws[nw] = s
+        nw += s >= 0
+    return nw
 
 
 @njit(inline=True)
@@ -208,11 +248,12 @@ def _linear_row(mode, n0, n1, n2, a0, a1, a2, d0, d1, d2, tc, kc, out0, out1, ou
 @njit()
 def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
            A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
-           light, orders, part, parts, img, mask, tri_map, nlen, stop=0):
+           light, orders, want, part, parts, img, mask, tri_map, nlen, stop=0):
     """The visibility and shading passes, one scan line at a time, on the rows
     ``part, part + parts, ...`` (threads run the parts at once: each writes every pixel
-    of its own rows of the four output maps, the background where no fragment lands:
-    0, False, -1, NaN). Returns the number of slerp float32 pixels whose
+    of its own rows of the output maps, the background where no fragment lands:
+    0, False, -1, NaN; the triangle map only where ``want & 1``, the ``|N|`` map only
+    where ``want & 2``). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
 
     Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
@@ -247,17 +288,8 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
     for rr in range(part, height, parts):
         base = rr * W
         _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
-        nw = 0
-        for x in range(W):
-            # the background (overwritten where a fragment lands), the winners listed
-            img[base + x] = 0.0
-            mask[base + x] = False
-            tri_map[base + x] = -1
-            nlen[base + x] = np.nan
-            if bs[x] >= 0:
-                wx[nw] = x
-                ws[nw] = bs[x]
-                nw += 1
+        _row_background(img, mask, tri_map, nlen, base, W, want)
+        nw = _row_winners(bs, wx, ws, W)
         if nw == 0:
             continue
         for k in range(nw):
@@ -309,7 +341,7 @@ def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left
         if stop == 3:
             continue
         _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
-                   bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw)
+                   bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, want, nw)
     return hard
 
 
@@ -329,9 +361,11 @@ def _tri_half_row(ws, stri, Htri, h0, h1, h2, nw):
 
 @njit()
 def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv, nl,
-               pw, hh, ll, ok, skip, img, mask, tri_map, nlen, nw):
+               pw, hh, ll, ok, skip, img, mask, tri_map, nlen, want, nw):
     """``Lighting.intensity(N @ L, N . H)`` clipped, and ``|N|``, at the row's winners, into
-    the four maps (row offset ``base``)."""
+    the maps (row offset ``base``; the triangle map where ``want & 1``, the ``|N|`` map
+    where ``want & 2``; a ``skip`` pixel's triangle entry is ``-2 - span``, its other
+    entries are the fix-up's to overwrite)."""
     l0, l1, l2 = L[0], L[1], L[2]
     I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
     fastpow = light[5] != 0.0
@@ -347,14 +381,18 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
         av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
     for k in range(nw):
         p = base + wx[k]
-        if skip[k]:
-            skip[k] = False
-            tri_map[p] = -2 - ws[k]
-            continue
         img[p] = av[k]
         mask[p] = True
-        tri_map[p] = face_id[stri[ws[k]]]
-        nlen[p] = nl[k]
+    if want & 1:
+        for k in range(nw):
+            tri_map[base + wx[k]] = face_id[stri[ws[k]]]
+    if want & 2:
+        for k in range(nw):
+            nlen[base + wx[k]] = nl[k]
+    for k in range(nw):
+        if skip[k]:
+            skip[k] = False
+            tri_map[base + wx[k]] = -2 - ws[k]
 
 
 @njit()
@@ -539,7 +577,7 @@ def _dichotomy_px(a0, a1, a2, b0, b1, b2, R, i, L, need_b, scale, tc):
 
 @njit()
 def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, per_pixel_h,
-                 Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen, face_id):
+                 Htri, stri, L, eye, light, orders, img, mask, tri_map, nlen, face_id, want):
     """Shade the slerp pixels whose sines :mod:`detmath` gave (``sa``, ``sb``), as
     :func:`_frame` does the others."""
     for q in range(pix.shape[0]):
@@ -563,8 +601,9 @@ def _slerp_fixup(pix, span, sa, sb, width, c0, t0, dt, left, right, A, B, sc2, p
         img[p] = _intensity(N0, N1, N2, h0, h1, h2, L[0], L[1], L[2], orders[0], orders[1],
                             light[0], light[1], light[2], light[3], light[4])
         mask[p] = True
-        tri_map[p] = face_id[stri[s]]
-        nlen[p] = np.sqrt(dot3(N0, N1, N2, N0, N1, N2, orders[2]))
+        tri_map[p] = face_id[stri[s]]     # the marks of the hard pixels overwritten
+        if want & 2:
+            nlen[p] = np.sqrt(dot3(N0, N1, N2, N0, N1, N2, orders[2]))
 
 
 # ------------------------------------------------------------------ driver
@@ -619,22 +658,30 @@ def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
         if mode == 4:       # K.SLERP.setup, compiled
             sc, sc2 = method_setup(mode, A, B, None, None, coeffs, start_left, count_max,
                                    ops, work)
-        elif mode == 5:     # quadratic_setup, compiled
-            A, B, C = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
-                                   coeffs, start_left, count_max, ops, work)
-        elif mode == 6:     # angular_setup, compiled
-            A, B, sc = method_setup(mode, A, B, sp.t0.astype(dtype), sp.dt.astype(dtype),
-                                    coeffs, start_left, count_max, ops, work)
+        elif mode in (5, 6):
+            # sp.t0.astype(dtype), sp.dt.astype(dtype) in kept memory (no fresh pages)
+            t0c, dtc = scratch(work, "t0c", S, dtype), scratch(work, "dtc", S, dtype)
+            t0c[...] = sp.t0
+            dtc[...] = sp.dt
+            if mode == 5:   # quadratic_setup, compiled
+                A, B, C = method_setup(mode, A, B, t0c, dtc, coeffs, start_left, count_max,
+                                       ops, work)
+            else:           # angular_setup, compiled
+                A, B, sc = method_setup(mode, A, B, t0c, dtc, coeffs, start_left, count_max,
+                                        ops, work)
         elif mode == 7:     # dichotomy
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
             kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
             levels = np.ascontiguousarray(lv, np.int64)
-            R, off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
-                                     sp.count)
+            lmax = int(levels.max())
+            # the frame's denominators in kept memory (fresh ones: 2000 page faults a frame)
+            R = scratch(work, "dichotomy_r", (S, max(lmax, 1)), dtype)
+            off = _dichotomy_prep(A, B, levels, cf, coeffs is None, kd, sp.t0, sp.dt,
+                                  sp.count, lmax, R)
     return dt_, A, B, C, sc, sc2, levels, R, off, kd
 
 
-def phong(st, spec, lighting, tables, dtype):
+def phong(st, spec, lighting, tables, dtype, extra_maps=True):
     """The ``phong`` frame of ``render`` as a
     :class:`~chebnorm.raster.engines.base.ModeResult`: set-up ``st`` (with ``L``),
     method entry ``spec`` (:func:`supports` holds for it), ``lighting``, and ``tables``,
@@ -658,16 +705,19 @@ def phong(st, spec, lighting, tables, dtype):
         Coefficient tables by method name.
     dtype : numpy dtype
         The span interpolator's arithmetic.
+    extra_maps : bool, optional
+        Also the triangle and ``|N|`` maps (False: the result's ``triangle`` and
+        ``normal_length`` are None, and the frame neither computes nor writes them).
 
     Returns
     -------
     ModeResult
         The frame, the same bytes as the numpy engine's.
     """
-    return _phong(st, spec, lighting, tables, dtype, None)
+    return _phong(st, spec, lighting, tables, dtype, None, extra_maps)
 
 
-def _phong(st, spec, lighting, tables, dtype, clock):
+def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
     """:func:`phong`; ``clock`` (None, or :func:`stage_times`' stage recorder) is called
     with each stage's name once the stage is done."""
     tick = clock or _no_clock
@@ -684,7 +734,8 @@ def _phong(st, spec, lighting, tables, dtype, clock):
     sp = row_spans(st.xy, attrs, st.width, st.height, work)
     tick("spans")
     # the output maps: the memory of an earlier frame's once the user dropped it (else
-    # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows
+    # 25 MB of fresh pages at 1024x1024); the frame writes every pixel of its rows of
+    # the maps it fills (a map it does not fill is never touched: no pages mapped)
     maps = output_maps(st.width * st.height)
     S = len(sp.count)
     stats = {}
@@ -707,12 +758,15 @@ def _phong(st, spec, lighting, tables, dtype, clock):
     L = np.ascontiguousarray(st.L, np.float64)
     eye = np.asarray(st.camera.eye, np.float64)
     ords = np.array(orders, np.int64)
+    # maps filled: 1 triangle, 2 |N| (the float32 slerp marks its hard pixels in the
+    # triangle map, so it fills that one anyway)
+    want = 3 if extra_maps else (1 if mode == 4 and dt_ is not np.float64 else 0)
     face_id = np.ascontiguousarray(st.tri, np.int64)
     args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
     img, mask, tri_map, nlen = maps
     common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
               *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
-              per_pixel_h, Htri, L, eye, light, ords)
+              per_pixel_h, Htri, L, eye, light, ords, want)
     k = min(threads(), st.height)
     tick("method set-up")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
@@ -728,7 +782,7 @@ def _phong(st, spec, lighting, tables, dtype, clock):
         psi = sc[span]
         sa, sb = detmath.sin((kc[5] - tc) * psi), detmath.sin(tc * psi)
         _slerp_fixup(pix, span, sa, sb, st.width, *args, A, B, sc2, per_pixel_h, Htri, sp.tri,
-                     L, eye, light, ords, img, mask, tri_map, nlen, face_id)
+                     L, eye, light, ords, img, mask, tri_map, nlen, face_id, want)
     give(work)
     keep_maps(maps)
     tick("shading")
@@ -736,11 +790,12 @@ def _phong(st, spec, lighting, tables, dtype, clock):
         # numpy computes N @ L for one row by another route than BLAS
         raise FrameUnsupported("fewer than two pixels covered")
     shape = (st.height, st.width)
+    extra = (tri_map.reshape(shape), nlen.reshape(shape)) if extra_maps else (None, None)
     return ModeResult(img.reshape(shape), mask.reshape(shape), int(sp.count.sum()), stats,
-                      triangle=tri_map.reshape(shape), normal_length=nlen.reshape(shape))
+                      triangle=extra[0], normal_length=extra[1])
 
 
-def stage_times(st, spec, lighting, tables=None, dtype=np.float64):
+def stage_times(st, spec, lighting, tables=None, dtype=np.float64, extra_maps=True):
     """Process CPU time (all threads) and wall time of each stage of :func:`phong`'s
     frame, for the benchmark's ``--stages``: ``{stage: (cpu_s, wall_s)}`` in order:
     ``spans`` (row spans), ``ends`` (unit end normals, the method's checks, tables),
@@ -751,7 +806,7 @@ def stage_times(st, spec, lighting, tables=None, dtype=np.float64):
 
     Parameters
     ----------
-    st, spec, lighting, tables, dtype
+    st, spec, lighting, tables, dtype, extra_maps
         As :func:`phong` takes them.
 
     Returns
@@ -764,7 +819,7 @@ def stage_times(st, spec, lighting, tables=None, dtype=np.float64):
     def clock(name):
         marks.append((name, time.process_time(), time.perf_counter()))
 
-    _phong(st, spec, lighting, tables, dtype, clock)
+    _phong(st, spec, lighting, tables, dtype, clock, extra_maps)
     out = {}
     for (_, c0, w0), (name, c1, w1) in zip(marks, marks[1:]):
         out[name] = (c1 - c0, w1 - w0)

@@ -26,7 +26,8 @@ from chebnorm.methods.spans import MAX_LEVELS, SpanNormals, check_span_input, sp
 from ...spans import Spans
 from .jit import HAVE_NUMBA, njit
 
-__all__ = ["supports", "fast_span_normals", "dichotomy_denominators", "quadratic_setup",
+__all__ = ["supports", "fast_span_normals", "dichotomy_denominators",
+           "dichotomy_denominators_into", "quadratic_setup",
            "angular_setup", "fast_half_vectors", "fast_shade"]
 
 
@@ -199,6 +200,15 @@ def dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
     for i in range(S):
         Lmax = max(Lmax, levels[i])
     r = np.empty((S, max(Lmax, 1)), nl.dtype)
+    dichotomy_denominators_into(nl, nr, levels, coeffs, exact, kc, r)
+    return r, Lmax
+
+
+@njit
+def dichotomy_denominators_into(nl, nr, levels, coeffs, exact, kc, r):
+    """:func:`dichotomy_denominators`' ``r`` written into ``r`` (at least ``(S, Lmax)``;
+    a caller's buffer kept between frames, so no fresh pages)."""
+    S = levels.shape[0]
     for i in range(S):
         z = (nl[0, i] * nr[0, i] + nl[1, i] * nr[1, i] + nl[2, i] * nr[2, i]) * kc[0]
         L = levels[i]
@@ -214,7 +224,6 @@ def dichotomy_denominators(nl, nr, levels, coeffs, exact, kc):
             r[i, lev] = rr
             if lev < L - 1:
                 z = s * rr
-    return r, Lmax
 
 
 @njit

@@ -15,7 +15,7 @@ import numpy as np
 from ...spans import Spans, fit_camera
 from ...spans import project as reference_project
 from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
-from .workspace import scratch, span_arrays, span_buffers
+from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
            "span_geom", "span_write", "row_buckets", "row_spans", "project", "default_camera_of"]
@@ -253,49 +253,41 @@ def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
 
 # --------------------------------------------------------- triangle set-up
 @njit()
-def _gather_setup(pos, nrm, xy, inv_w, faces, cull):
-    """``NumpyEngine.setup``: front-facing triangles and their corners."""
+def _gather_setup(pos, nrm, xy, inv_w, faces, cull, tri, txy, attrs, tiw, tpos, tnrm):
+    """``NumpyEngine.setup``: front-facing triangles and their corners, into the flat
+    buffers ``tri`` (ids), ``txy``, ``attrs``, ``tiw``, ``tpos``, ``tnrm`` (room for every
+    face); the number of front-facing triangles."""
     F = faces.shape[0]
-    keep = np.empty(F, np.bool_)
+    n = 0
     for i in range(F):
         a, b, c = faces[i, 0], faces[i, 1], faces[i, 2]
         area = ((xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1])
                 - (xy[c, 0] - xy[a, 0]) * (xy[b, 1] - xy[a, 1]))
-        keep[i] = area < 0 if cull else area != 0
-    n = 0
-    for i in range(F):
-        n += keep[i]
-    tri = np.empty(n, np.int64)
-    n = 0
-    for i in range(F):
-        if keep[i]:
-            tri[n] = i
-            n += 1
-    txy = np.empty((n, 3, 2))
-    attrs = np.empty((n, 3, 7))
-    tiw = np.empty((n, 3))
-    tpos = np.empty((n, 3, 3))
-    tnrm = np.empty((n, 3, 3))
+        keep = area < 0 if cull else area != 0
+        tri[n] = i
+        n += keep
     for k in range(n):
         i = tri[k]
         for v in range(3):
             q = faces[i, v]
-            txy[k, v, 0] = xy[q, 0]
-            txy[k, v, 1] = xy[q, 1]
-            attrs[k, v, 0] = inv_w[q]
-            tiw[k, v] = inv_w[q]
+            e = 3 * k + v
+            txy[2 * e] = xy[q, 0]
+            txy[2 * e + 1] = xy[q, 1]
+            attrs[7 * e] = inv_w[q]
+            tiw[e] = inv_w[q]
             for c in range(3):
-                attrs[k, v, 1 + c] = nrm[q, c]
-                attrs[k, v, 4 + c] = pos[q, c]
-                tnrm[k, v, c] = nrm[q, c]
-                tpos[k, v, c] = pos[q, c]
-    return tri, txy, attrs, tiw, tpos, tnrm
+                attrs[7 * e + 1 + c] = nrm[q, c]
+                attrs[7 * e + 4 + c] = pos[q, c]
+                tnrm[3 * e + c] = nrm[q, c]
+                tpos[3 * e + c] = pos[q, c]
+    return n
 
 
 def gather_setup(mesh, xy, inv_w, cull):
     """The per-triangle arrays of ``NumpyEngine.setup``, gathered in compiled code: front
     triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``, and
-    the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``.
+    the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``:
+    C-contiguous views of buffers kept between frames (:func:`.workspace.setup_buffers`).
 
     Parameters
     ----------
@@ -313,12 +305,16 @@ def gather_setup(mesh, xy, inv_w, cull):
     tuple of numpy.ndarray
         ``(tri, xy, inv_w, pos, nrm, attrs)`` as described above.
     """
-    tri, txy, attrs, iw, pos, nrm = _gather_setup(
-        np.ascontiguousarray(mesh.positions, np.float64),
-        np.ascontiguousarray(mesh.normals, np.float64), np.ascontiguousarray(xy, np.float64),
-        np.ascontiguousarray(inv_w, np.float64), np.ascontiguousarray(mesh.faces, np.int64),
-        bool(cull))
-    return tri, txy, iw, pos, nrm, attrs
+    faces = np.ascontiguousarray(mesh.faces, np.int64)
+    bufs = setup_buffers(len(faces))
+    n = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
+                      np.ascontiguousarray(mesh.normals, np.float64),
+                      np.ascontiguousarray(xy, np.float64),
+                      np.ascontiguousarray(inv_w, np.float64), faces, bool(cull), *bufs)
+    b_tri, b_xy, b_attrs, b_iw, b_pos, b_nrm = bufs
+    return (b_tri[:n], b_xy[:6 * n].reshape(n, 3, 2), b_iw[:3 * n].reshape(n, 3),
+            b_pos[:9 * n].reshape(n, 3, 3), b_nrm[:9 * n].reshape(n, 3, 3),
+            b_attrs[:21 * n].reshape(n, 3, 7))
 
 
 # ------------------------------------------------------------- span set-up
@@ -394,43 +390,35 @@ def row_buckets(r0, nrows, height):
 
 # --------------------------------------------------------------- row spans
 @njit()
-def _row_geom_part(xy, width, first, ids, rlo, rhi, row_n, gc, ga, ge, gs):
-    """Rows ``rlo .. rhi-1`` of :func:`row_spans`: the geometry of every (row,
-    triangle) pair ``q`` of the row buckets (:func:`span_geom`: count ``gc``, first
-    pixel ``ga``, edges and swap packed in ``ge``, ``sa, sb, xl, xr`` in ``gs``) and each
-    row's number of spans into ``row_n[r + 1]``."""
+def _row_geom_part(xy, width, first, ids, rlo, rhi, row_n, gc):
+    """Rows ``rlo .. rhi-1`` of :func:`row_spans`: the pixel count ``gc`` of every (row,
+    triangle) pair ``q`` of the row buckets (:func:`span_geom`) and each row's number of
+    spans into ``row_n[r + 1]``.  Only the counts are kept: the write pass computes the
+    geometry again (the same function, so the same bits), cheaper than writing and
+    reading it back (56 bytes a pair)."""
     for r in range(rlo, rhi):
         n = 0
         for q in range(first[r], first[r + 1]):
-            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, ids[q], r, width)
+            c = span_geom(xy, ids[q], r, width)[0]
             gc[q] = c
-            if c <= 0:
-                continue
-            ga[q] = a
-            ge[q] = pa | (qa << 2) | (p << 4) | (qq << 6) | (np.int64(swap) << 8)
-            gs[q, 0] = sa
-            gs[q, 1] = sb
-            gs[q, 2] = xl
-            gs[q, 3] = xr
-            n += 1
+            n += c > 0
         row_n[r + 1] = n
 
 
 @njit()
-def _row_write_part(attrs, first, ids, rlo, rhi, row_start, gc, ga, ge, gs, tri, row, c0, count,
-                    m, t0, dt, left, right):
-    """Rows ``rlo .. rhi-1``: the spans from the geometry of :func:`_row_geom_part`
-    (:func:`span_write`), row ``r``'s from ``row_start[r]`` on."""
+def _row_write_part(xy, width, attrs, first, ids, rlo, rhi, row_start, gc, tri, row, c0,
+                    count, m, t0, dt, left, right):
+    """Rows ``rlo .. rhi-1``: the spans of the pairs :func:`_row_geom_part` counted
+    (:func:`span_geom`, :func:`span_write`), row ``r``'s from ``row_start[r]`` on."""
     for r in range(rlo, rhi):
         n = row_start[r]
         for q in range(first[r], first[r + 1]):
-            c = gc[q]
-            if c <= 0:
+            if gc[q] <= 0:
                 continue
-            e = ge[q]
-            span_write(attrs, ids[q], r, n, c, ga[q], e & 3, (e >> 2) & 3, gs[q, 0],
-                       (e >> 4) & 3, (e >> 6) & 3, gs[q, 1], (e >> 8) != 0, gs[q, 2],
-                       gs[q, 3], tri, row, c0, count, m, t0, dt, left, right)
+            i = ids[q]
+            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, r, width)
+            span_write(attrs, i, r, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, tri, row,
+                       c0, count, m, t0, dt, left, right)
             n += 1
 
 
@@ -440,9 +428,10 @@ def row_spans(xy, attrs, width, height, work=None):
     right, row_start, by_row)``; row ``r``'s spans are ``row_start[r] ..
     row_start[r+1]-1``, in ``setup_spans``' order within the row (so ties of the z-test
     still go to the earliest fragment), ``by_row`` the identity.  A frame reads each
-    span's data once per row: in this order the reads are sequential.  The geometry of
-    each (row, triangle) pair is computed once (the count pass keeps it for the write
-    pass); with ``work`` (a :class:`.workspace.Workspace`, for the geometry) the spans
+    span's data once per row: in this order the reads are sequential.  The count pass
+    keeps only each (row, triangle) pair's pixel count, the write pass computes the
+    pair's geometry again (less memory traffic than keeping it); with ``work`` (a
+    :class:`.workspace.Workspace`, for the counts) the spans
     are views of this thread's :func:`.workspace.span_buffers`, valid until its next
     such call.  ``tests/raster_oracles.py`` holds the pair-by-pair oracle.
 
@@ -484,15 +473,14 @@ def row_spans(xy, attrs, width, height, work=None):
     parts = [(cuts[q], cuts[q + 1]) for q in range(k) if cuts[q] < cuts[q + 1]]
     row_start = scratch(work, "row_start", height + 1, np.int64)
     row_start[0] = 0
-    geom = (scratch(work, "gc", P, np.int64), scratch(work, "ga", P, np.int64),
-            scratch(work, "ge", P, np.int64), scratch(work, "gs", (P, 4)))
-    run_with_caller([(_row_geom_part, (xy, int(width), first, ids, lo, hi, row_start, *geom))
+    gc = scratch(work, "gc", P, np.int64)
+    run_with_caller([(_row_geom_part, (xy, int(width), first, ids, lo, hi, row_start, gc))
                      for lo, hi in parts])
     np.cumsum(row_start, out=row_start)
     S = int(row_start[-1])
     out = span_arrays(S, Kc) if work is None else span_buffers(S, Kc)
-    run_with_caller([(_row_write_part, (attrs, first, ids, lo, hi, row_start, *geom, *out))
-                     for lo, hi in parts])
+    run_with_caller([(_row_write_part, (xy, int(width), attrs, first, ids, lo, hi, row_start,
+                                        gc, *out)) for lo, hi in parts])
     tri, row, c0, count, m, t0, dt, left, right = out
     return SimpleNamespace(tri=tri, row=row, x0=c0, count=count, m=m, t0=t0, dt=dt, left=left,
                            right=right, row_start=row_start, by_row=_identity(S))

@@ -14,7 +14,7 @@ import threading
 import numpy as np
 
 __all__ = ["Workspace", "take", "give", "output_maps", "keep_maps", "scratch", "span_arrays",
-           "span_buffers"]
+           "span_buffers", "setup_buffers"]
 
 
 class Workspace:
@@ -131,6 +131,57 @@ def keep_maps(maps):
     with _MAPS_LOCK:
         _MAPS.append(tuple(maps))
         del _MAPS[:-_KEEP_MAPS]
+
+
+#: buffer sets of the triangle set-up (:func:`setup_buffers`), at most :data:`_KEEP_SETUP`
+_SETUP: list = []
+
+
+_KEEP_SETUP = 2
+
+
+#: elements per face of each set-up buffer: ids, xy (3x2), attributes (3x7), 1/w (3),
+#: positions (3x3), normals (3x3); their dtypes
+_SETUP_WIDTH = (1, 6, 21, 3, 9, 9)
+
+
+_SETUP_DTYPES = (np.int64, np.float64, np.float64, np.float64, np.float64, np.float64)
+
+
+def setup_buffers(faces):
+    """Six flat uninitialised buffers for the triangle set-up of a mesh of ``faces``
+    faces (ids, ``xy``, attributes, ``1/w``, positions, normals: :data:`_SETUP_WIDTH`
+    elements a face): a kept set nobody else references any more (the arrays of an
+    earlier frame's set-up, views included, all dropped: ``sys.getrefcount``), else a new
+    set, kept for later frames (fresh pages: a page fault per 4 KiB, 1300 a frame for
+    the teapot).  The caller's views keep the set busy until they are dropped.
+
+    Parameters
+    ----------
+    faces : int
+        Faces of the mesh (an upper bound on the front-facing ones).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Six flat buffers, at least ``faces * width`` long each.
+
+    Examples
+    --------
+    >>> a = setup_buffers(10); p = a[1].ctypes.data; del a
+    >>> setup_buffers(10)[1].ctypes.data == p    # dropped: the same memory again
+    True
+    """
+    with _MAPS_LOCK:
+        for bufs in _SETUP:
+            if (bufs[0].size >= faces and bufs[0].size <= 2 * faces + 64
+                    and all(sys.getrefcount(bufs[k]) == 2 for k in range(len(bufs)))):
+                return bufs
+        n = faces + faces // 8 + 16
+        bufs = tuple(np.empty(n * w, dt) for w, dt in zip(_SETUP_WIDTH, _SETUP_DTYPES))
+        _SETUP.append(bufs)
+        del _SETUP[:-_KEEP_SETUP]
+        return bufs
 
 
 def scratch(work, name, shape, dtype=np.float64):
