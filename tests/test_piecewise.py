@@ -238,3 +238,44 @@ def test_cli_fit_export_hw(tmp_path):
     assert rep["within_budget"] and rep["measured"]["max_error"] <= rep["budget"]["total"]
     r = cli("hw", "verilog", "rs.json", "--in-bits", "3", "--out-bits", "10", "-o", "hw", code=2)
     assert "--in-bits = 3 is out of range; accepted: 4 <= --in-bits <= 20" in r.stderr
+
+
+def test_one_width_run_in_int64_only_where_proved_exact():
+    """design_piecewise sizes the one-width datapath on every code with Python
+    integers, or in int64 where _int64_fits proves no value can overflow: the
+    same wires and the same design either way, and the proof is not vacuous (a
+    degree-3 table at 30 coefficient bits, forced into int64 without it, wraps)."""
+    import chebnorm.hw.piecewise as P
+
+    k = np.arange(2 ** 16, dtype=np.int64)
+    for expr, deg, seg, fc in (("1/sqrt(1+3*x)", 1, 256, 19), ("1/sqrt(1+3*x)", 3, 16, 22),
+                               ("sin(x)", 3, 4, 30)):
+        t = piecewise_fit(expr, ("0", "1"), deg, segments=seg, coef_frac_bits=fc)
+        d = P.design_piecewise(t, 16, 18)
+        keep = P._int64_fits
+        P._int64_fits = lambda *a: False
+        try:
+            assert P.design_piecewise(t, 16, 18) == d
+        finally:
+            P._int64_fits = keep
+        for fa, fy in ((10 ** 6, 0), (d.acc_frac_bits, d.y_format.frac_bits)):
+            got = P._run(d, k.astype(object), fa, fy)
+            exact = _run_objects(P, d, k, fa, fy)
+            for key in ("top", "rounded"):
+                assert [int(v) for v in got[key]] == [int(v) for v in exact[key]], (expr, fa)
+    t = piecewise_fit("sin(x)", ("0", "1"), 3, segments=4, coef_frac_bits=30)
+    d = P.design_piecewise(t, 16, 18)
+    assert not P._int64_fits(d, 10 ** 6, 0)
+    wrapped = P._run(d, k, 10 ** 6, 0)   # int64 forced: overflows
+    exact = _run_objects(P, d, k, 10 ** 6, 0)
+    assert [int(v) for v in wrapped["top"]] != [int(v) for v in exact["top"]]
+
+
+def _run_objects(P, d, k, fa, fy):
+    """P._run on Python integers throughout (the int64 shortcut switched off)."""
+    keep = P._int64_fits
+    P._int64_fits = lambda *a: False
+    try:
+        return P._run(d, k.astype(object), fa, fy)
+    finally:
+        P._int64_fits = keep

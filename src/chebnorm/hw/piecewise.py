@@ -338,7 +338,47 @@ def _exact(text: str) -> Fraction:
     return Fraction(int(v.p), int(v.q))
 
 
+def _int64_fits(d, fa, fy) -> bool:
+    """Whether :func:`_run` at ``fa``/``fy`` stays exact in int64 for every code:
+    the same operations on magnitude bounds (Python integers: ``|t| <= 2^L``,
+    ``|v >> s| <= |v| >> s``, a rounding adds 1), every value and every
+    ``2^shift`` of a rounding below ``2^62``, every rounding shift below 62
+    (numpy's ``>>`` floors like Python's at any shift; ``<<`` would wrap)."""
+    limit = 1 << 62
+    cols = [max(abs(int(v)) for v in col) for col in zip(*(seg.integers
+                                                           for seg in d.table.segments))]
+    fc, n, L = d.table.coef_frac_bits, d.table.degree, d.local_bits
+    tmax = 1 << L
+    acc, accf = cols[n], fc
+    bounds = [acc, tmax]
+    for j in range(n - 1, -1, -1):
+        prod = acc * tmax
+        pf = accf + L
+        sf = max(pf, fc)
+        total = (prod << (sf - pf)) + (cols[j] << (sf - fc))
+        bounds += [prod, total]
+        if j > 0:
+            f_out = min(fa, sf)
+            sh = sf - f_out
+            if sh >= 62:
+                return False
+            acc, accf = (total >> sh) + 1, f_out
+            bounds += [acc, total + (1 << sh)]
+        else:
+            acc, accf = total, sf
+    shift = accf - fy
+    if shift >= 62:
+        return False
+    bounds.append((acc >> shift) + 1 + (1 << max(shift, 0)) if shift >= 0 else acc << -shift)
+    return max(bounds) < limit
+
+
 def _run(d, k, fa, fy) -> dict:
+    """The one-width datapath's wires for codes ``k`` at ``fa`` accumulator and
+    ``fy`` output fractional bits; an object array of ``k`` is run in int64
+    instead whenever :func:`_int64_fits` proves it exact (the same integers)."""
+    if k.dtype == object and _int64_fits(d, fa, fy):
+        k = k.astype(np.int64)
     rom = d._rom(k.dtype)
     s = (k >> d.local_bits).astype(np.int64)
     t = d._t(k)
