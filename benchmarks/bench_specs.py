@@ -2,6 +2,7 @@
 checked exhaustively, synthesized by yosys, timed by nextpnr-ice40.
 
     python benchmarks/bench_specs.py [--quick] [--json PATH] [--no-sim] [--spec I ...]
+    python benchmarks/bench_specs.py --sim-missing --json PATH [--spec I ...]
 
 For each spec (function, interval, input and output bits, faithful: error
 < 1 ulp of the output) and each architecture:
@@ -40,6 +41,10 @@ Output: a Markdown table on stdout (deterministic row order), progress on
 stderr; ``--json PATH`` keeps every finished row (written after each one), and
 a rerun with the same ``--json`` reuses the rows finished there (delete the
 file to measure afresh; a failed row is tried again). A row that fails records the error and the run goes on.
+``--sim-missing`` only runs GHDL for the rows of ``--json`` that have an Icarus
+PASS and no GHDL record (:func:`simulate_missing`: each design rebuilt and
+checked to be the measured one, pipelined ones clocked code by code), the
+cheapest first, and writes ``simulation_vhdl`` and its seconds into each row.
 """
 
 from __future__ import annotations
