@@ -2,6 +2,7 @@
 checked exhaustively, synthesized by yosys, timed by nextpnr-ice40.
 
     python benchmarks/bench_specs.py [--quick] [--json PATH] [--no-sim] [--spec I ...]
+    python benchmarks/bench_specs.py --sim-missing --json PATH [--spec I ...]
 
 For each spec (function, interval, input and output bits, faithful: error
 < 1 ulp of the output) and each architecture:
@@ -40,6 +41,10 @@ Output: a Markdown table on stdout (deterministic row order), progress on
 stderr; ``--json PATH`` keeps every finished row (written after each one), and
 a rerun with the same ``--json`` reuses the rows finished there (delete the
 file to measure afresh; a failed row is tried again). A row that fails records the error and the run goes on.
+``--sim-missing`` only runs GHDL for the rows of ``--json`` that have an Icarus
+PASS and no GHDL record (:func:`simulate_missing`: each design rebuilt and
+checked to be the measured one, pipelined ones clocked code by code), the
+cheapest first, and writes ``simulation_vhdl`` and its seconds into each row.
 """
 
 from __future__ import annotations
@@ -139,10 +144,14 @@ def sized_piecewise(expr, interval, in_bits, out_bits, degree, only_k=None):
     return d, {"segments": 2 ** k, "sweep": notes, "proxy": round(cost, 1)}
 
 
+def _piecewise_detail(d, info) -> str:
+    return f"{info['segments']} seg, F={list(d.coef_frac)}, T={list(d.t_keep)}"
+
+
 def _piecewise_row(d, info) -> dict:
     m = d.measure()
     lsb = Fraction(1, 2 ** d.y_format.frac_bits)
-    return {"detail": f"{info['segments']} seg, F={list(d.coef_frac)}, T={list(d.t_keep)}",
+    return {"detail": _piecewise_detail(d, info),
             "sweep": info["sweep"], "bound_ulp": round(d.budget()["total"] / float(lsb), 4),
             "max_error_ulp": round(m["max_error"] / float(lsb), 4), "latency": d.latency,
             "verilog": d_verilog(d), "top": d.module_name, "clocked": d.latency > 0}
@@ -162,21 +171,26 @@ def _table_row(d, detail) -> dict:
             "verilog": d.verilog(), "top": d.module_name, "clocked": False}
 
 
+def _exponent_detail(d) -> str:
+    c = d.core
+    return (f"{c.table.segment_count // 2} seg/binade x 2, F={list(c.coef_frac)}, "
+            f"T={list(c.t_keep)}, mantissa {d.mant_bits} + shift {d.shift_bits} b")
+
+
 def _exponent_row(d) -> dict:
     m = d.measure()
     b = d.budget()
     lsb = 2.0 ** -d.frac_bits
-    c = d.core
-    return {"detail": f"{c.table.segment_count // 2} seg/binade x 2, F={list(c.coef_frac)}, "
-                      f"T={list(c.t_keep)}, mantissa {d.mant_bits} + shift {d.shift_bits} b",
+    return {"detail": _exponent_detail(d),
             "bound_ulp": round(b["mantissa"] / lsb, 4),
             "max_error_ulp": round(m["max_error"] / lsb, 4),
             "max_rel_error": m["max_rel_error"], "latency": d.latency,
             "verilog": d.verilog(), "top": d.module_name, "clocked": d.latency > 0}
 
 
-def build(spec, arch, cache):
-    """The design of ``arch`` for ``spec`` and its row fields (measured error)."""
+def build(spec, arch, cache, measure: bool = True):
+    """The design of ``arch`` for ``spec`` and its row fields (measured error;
+    without ``measure`` only its ``detail`` and ``latency``: no exhaustive error)."""
     _, expr, interval, wi, wo = spec
     if wi > 20:
         raise ValueError(f"in_bits {wi} > 20: design_piecewise, design_multipartite and "
@@ -194,6 +208,8 @@ def build(spec, arch, cache):
             else:
                 cache[key] = design_exponent(expr, interval, wi, wo, degree=degree)
         d = cache[key]
+        if not measure:
+            return d, {"detail": _exponent_detail(d), "latency": d.latency}
         return d, _exponent_row(d)
     if arch.startswith("pw"):
         degree = int(arch[2])
@@ -211,6 +227,8 @@ def build(spec, arch, cache):
                 p = design_piecewise(d.table, wi, wo, widths="auto", multipliers="truncated",
                                      pipeline="full")
             d = p
+        if not measure:
+            return d, {"detail": _piecewise_detail(d, info), "latency": d.latency}
         return d, _piecewise_row(d, info)
     if arch == "multipartite":
         d = design_multipartite(expr, interval, wi, wo)
@@ -221,8 +239,9 @@ def build(spec, arch, cache):
     return d, _table_row(d, f"ROM {d.rom_bits} b, correctly rounded {d.correctly_rounded}")
 
 
-def simulate(d, arch, language: str = "verilog") -> str:
-    """Run ``d``'s exhaustive bench in Icarus Verilog or GHDL: the PASS/FAIL line."""
+def simulate(d, arch, language: str = "verilog", timeout: float = 600) -> str:
+    """Run ``d``'s exhaustive bench in Icarus Verilog or GHDL: the PASS/FAIL line
+    (``timeout``: seconds per GHDL step of a piecewise design)."""
     with tempfile.TemporaryDirectory() as tmp:
         if arch.startswith("exp"):
             r = simulate_exponent(d, tmp, language)
@@ -230,7 +249,7 @@ def simulate(d, arch, language: str = "verilog") -> str:
             r = simulate_piecewise(d, tmp)
         elif arch.startswith("pw"):
             write_folder(Path(tmp), piecewise_outputs(d, language="vhdl"))
-            r = simulate_vhdl(tmp, d)
+            r = simulate_vhdl(tmp, d, timeout=timeout)
         else:
             r = simulate_table(d, tmp, language)
     if not r.passed:
@@ -275,6 +294,57 @@ def simulate_winners(results: dict, spec, cache, path, doc) -> None:
                 tqdm.write(f"{spec[0]} | {arch}: {row[field]}", file=sys.stderr)
         if path is not None:
             write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+
+
+def missing_vhdl(results: dict, specs) -> list:
+    """``[(spec, arch)]``: the rows of ``specs`` with an Icarus PASS and no GHDL
+    record, the cheapest (fewest input bits) first."""
+    rows = []
+    for spec in specs:
+        for arch in SPEC_ARCHS.get(spec[0], ARCHS):
+            r = results.get(f"{spec[0]} | {arch}") or {}
+            if "PASS" in (r.get("simulation") or "") and not r.get("simulation_vhdl"):
+                rows.append((spec, arch))
+    return sorted(rows, key=lambda sa: sa[0][3])
+
+
+def simulate_missing(doc: dict, specs, path: Path, timeout: float = 3600) -> None:
+    """GHDL over every input code for the rows of :func:`missing_vhdl`: each
+    design rebuilt (deterministic) and checked to be the row's (``detail``:
+    segments, widths, ROM bits; ``latency``), then its VHDL (a pipelined one
+    clock by clock) against the bit-accurate model; ``simulation_vhdl`` and
+    ``simulation_vhdl_seconds`` written into the row, the file rewritten
+    (atomic) after each one and nothing else changed. A mismatch, a rebuilt
+    design that differs, or a bench that checked fewer codes raises
+    ``RuntimeError`` (nothing recorded for that row)."""
+    results = doc["results"]
+    cache = _segment_cache(results)
+    for spec, arch in missing_vhdl(results, specs):
+        key = f"{spec[0]} | {arch}"
+        row = results[key]
+        d, again = build(spec, arch, cache, measure=False)
+        if (again["detail"], again["latency"]) != (row["detail"], row["latency"]):
+            raise RuntimeError(f"{key}: rebuilt as {again['detail']!r} (latency "
+                               f"{again['latency']}), measured as {row['detail']!r} (latency "
+                               f"{row['latency']}): not the same design")
+        t0 = time.perf_counter()
+        line = simulate(d, arch, "vhdl", timeout=timeout)
+        seconds = round(time.perf_counter() - t0, 1)
+        if not line.startswith(f"PASS: {2 ** spec[3]} vectors, 0 mismatches"):
+            raise RuntimeError(f"{key}: GHDL did not check all {2 ** spec[3]} codes: {line}")
+        row["simulation_vhdl"], row["simulation_vhdl_seconds"] = line, seconds
+        write_atomic(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+        tqdm.write(f"{key}: {line} in {seconds} s", file=sys.stderr)
+
+
+def _segment_cache(results: dict) -> dict:
+    """A build cache holding each finished piecewise row's segment count (no sweep again)."""
+    cache: dict = {}
+    for key, r in results.items():
+        label, _, arch = key.rpartition(" | ")
+        if arch in ("pw1", "pw2") and r and r.get("detail", "").split(" seg")[0].isdigit():
+            cache[("segments", label, int(arch[2]))] = int(r["detail"].split(" seg")[0]).bit_length() - 1
+    return cache
 
 
 def measure_row(spec, arch, cache, sim: bool) -> dict | None:
@@ -374,6 +444,9 @@ def main(argv=None) -> int:
                     help="skip the winners' Icarus and GHDL simulations")
     ap.add_argument("--spec", type=int, action="append", choices=range(len(SPECS)),
                     help="run only these specs (indexes into SPECS; repeatable)")
+    ap.add_argument("--sim-missing", action="store_true",
+                    help="only GHDL for the --json rows with an Icarus PASS and no GHDL "
+                         "record (rebuilt, checked to be the same design)")
     args = ap.parse_args(argv)
     specs = SPECS[:1] if args.quick else SPECS
     if args.spec:
@@ -382,13 +455,18 @@ def main(argv=None) -> int:
     doc = {"results": {}}
     if path is not None and path.exists():
         doc = json.loads(path.read_text(encoding="utf-8"))
+    if args.sim_missing:
+        if path is None or not path.exists():
+            ap.error("--sim-missing needs --json PATH of an existing results file")
+        try:
+            simulate_missing(doc, specs, path)
+        except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
+            print(f"bench_specs: {' '.join(str(e).split())[:400]}", file=sys.stderr)
+            return 1
+        return 0
     results = doc.setdefault("results", {})
     doc["versions"] = _versions()
-    cache: dict = {}
-    for key, r in results.items():   # a finished piecewise row's segment count: no sweep again
-        label, _, arch = key.rpartition(" | ")
-        if arch in ("pw1", "pw2") and r and r.get("detail", "").split(" seg")[0].isdigit():
-            cache[("segments", label, int(arch[2]))] = int(r["detail"].split(" seg")[0]).bit_length() - 1
+    cache = _segment_cache(results)
     jobs = [(s, a) for s in specs for a in SPEC_ARCHS.get(s[0], ARCHS)]
     bar = tqdm(jobs, file=sys.stderr, desc="bench_specs")
     for n, (spec, arch) in enumerate(bar):
