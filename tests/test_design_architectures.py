@@ -194,3 +194,53 @@ def test_search_bound_skips_points_that_cannot_win():
     assert r.winner.target_model == min(p.target_model for p in r.points if p.meets)
     full = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, **kw)
     assert sum(p.target_cost is not None for p in full.points) >= 1
+
+
+def test_one_queue_for_candidates_and_search_points(monkeypatch):
+    """synthesize_with_search: candidates and the search front's points in one
+    queue by lower bound, two at a time; with yosys replaced by fixed scores
+    (each within its lower bound), it finds the best score of synthesizing
+    everything, never skips a job whose lower bound is below that best, runs
+    the same jobs with one worker or two, and says why it skipped one."""
+    from chebnorm.hw import architectures as A
+    from chebnorm.hw.piecewise_search import search, synthesis_queue
+
+    res = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2), max_index_bits=4,
+                 synth=False, progress=False, workers=1, target="xc7")
+    queue = synthesis_queue(res)
+    assert queue and all(low > 0 for _, low in queue)
+    # candidates: one far below the points, one far above, one near the best point
+    pt_low = min(low for _, low in queue)
+    cands = _fake_candidates([0.5 * pt_low, 10.0 * pt_low, 1.2 * pt_low])
+    cands = [A.Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None, "",
+                         c.model, 0.0) for c in cands]
+    true = {"m0": 0.9 * pt_low * 1.2, "m1": 11.0 * pt_low, "m2": 1.3 * pt_low}
+    calls = []
+
+    def fake(item):
+        kind, payload = item
+        calls.append(payload[1] if kind == "arch" else payload[0].name + str(payload[0].index_bits))
+        if kind == "arch":
+            return type("C", (), {"score": true[payload[1]], "line": lambda self: "x"})()
+        low = dict(queue)[next(k for k in res.designs if res.designs[k] is payload[0])]
+        return type("C", (), {"score": 1.05 * low, "line": lambda self: "x"})()
+
+    monkeypatch.setattr(A, "_synth_job", fake)
+    one, r1 = A.synthesize_with_search(cands, res, "xc7", workers=1)
+    first = list(calls)
+    calls.clear()
+    two, r2 = A.synthesize_with_search(cands, res, "xc7", workers=2)
+    assert sorted(calls) == sorted(first) and [c.note for c in one] == [c.note for c in two]
+    w1, w2 = r1.winner, r2.winner
+    assert (w1.degree, w1.segments, w1.coef_frac_bits, w1.cost) == \
+        (w2.degree, w2.segments, w2.coef_frac_bits, w2.cost)
+    best = min([c.cost.score for c in one if c.cost is not None] +
+               [p.target_cost.score for p in r1.points if p.target_cost is not None])
+    assert best == min(list(true.values()) + [1.05 * low for _, low in queue])
+    lows = {c.design.module_name: A.prune_lower(c.architecture, "xc7", c.model, c.model_rom)
+            for c in cands}
+    for c in one:
+        if c.cost is None:
+            assert lows[c.design.module_name] >= best and "cannot win" in c.note
+    assert one[1].cost is None   # ten times the points' models: never synthesized
+    assert first[0] == "m0"      # the lowest bound first

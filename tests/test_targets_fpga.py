@@ -147,11 +147,16 @@ def test_fast_flow_is_the_full_flow(target, monkeypatch):
         always @(posedge clk) y <= $signed({1'b0, rom[a]}) * b + a;
     endmodule"""
     fast = synthesize_target(v, "r", target, timing=True)
+    # the sta model on the kept netlist, later, is the sta model in the run
+    later = targets.sta_from_netlist(synthesize_target(v, "r", target, netlist=True))
+    assert (later.levels, later.delay_ns) == (fast.levels, fast.delay_ns)
     monkeypatch.setitem(targets.TARGETS, target,
                         dataclasses.replace(targets.TARGETS[target], fast=""))
     full = synthesize_target(v, "r", target, timing=True)
-    assert fast == full
+    assert fast == full and later == full
     assert fast.luts > 0 and fast.delay_ns > 0
+    with pytest.raises(ValueError, match="netlist"):
+        targets.sta_from_netlist(full)
 
 
 def _calibration_designs():

@@ -235,11 +235,11 @@ def _winner_design(res):
                 if p is res.winner)
 
 
-def _search(args, name, target, max_error, bound=None, synth=None):
+def _search(args, name, target, max_error, bound=None, synth=None, workers=None):
     """The one-width piecewise Pareto search (:mod:`chebnorm.hw.piecewise_search`);
     ``bound``: the other architectures' best synthesized score (a point that
     cannot beat it is not synthesized); ``synth``: False for the model only
-    (default: unless ``--no-synth``)."""
+    (default: unless ``--no-synth``); ``workers``: instead of ``--workers``."""
     from chebnorm.approx.piecewise_table import parse_segments
     from chebnorm.hw.piecewise_search import search
 
@@ -247,7 +247,8 @@ def _search(args, name, target, max_error, bound=None, synth=None):
                  degrees=args.degrees, max_index_bits=_max_index_bits(args, parse_segments),
                  var=args.var, synth=not args.no_synth if synth is None else synth,
                  name=name, target=target,
-                 bound=bound, **parallel_kwargs(args))
+                 bound=bound, **dict(parallel_kwargs(args), **(
+                     {} if workers is None else {"workers": workers, "scheduler": None})))
     if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
@@ -259,33 +260,32 @@ def _search(args, name, target, max_error, bound=None, synth=None):
 
 
 def _synth_both(args, name, target, accuracy, max_error):
-    """The other architectures (built, then synthesized where the model cannot
-    rule them out) and the one-width search, overlapped: the search's
-    evaluation (Python workers) runs while yosys maps the other candidates;
-    the search's own synthesis comes last, bounded by their best score.
+    """The other architectures and the one-width search, built and evaluated,
+    then synthesized in one queue in order of their lower bounds, each skipped
+    once it cannot beat the best score so far
+    (:func:`chebnorm.hw.architectures.synthesize_with_search`).
     Returns ``(others, result)`` (``result`` None for a correctly rounded spec)."""
+    import shutil
     from concurrent.futures import ThreadPoolExecutor
 
-    from chebnorm.hw.piecewise_search import synthesize_search
+    from chebnorm.hw.architectures import cheapest_candidates, synthesize_with_search
 
     built = _architectures(args, name, target, accuracy, max_error)
-    if accuracy == "correctly-rounded":
-        return _synth_others(args, built, target), None
+    if accuracy == "correctly-rounded" or shutil.which("yosys") is None:
+        others = _synth_others(args, built, target)   # yosys missing: its error, one line
+        if accuracy == "correctly-rounded":
+            return others, None
     if accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
         max_error = math.nextafter(min(c.ulp for c in built if c.ulp is not None), 0.0)
+    # the search evaluates its points here, in one thread (no worker start-up to pay),
+    # while yosys maps the first round of candidates; its points join from round two
     with ThreadPoolExecutor(max_workers=1) as pool:
-        job = pool.submit(_synth_others, args, built, target)
+        job = pool.submit(_search, args, name, target, max_error, synth=False, workers=1)
         try:
-            res = _search(args, name, target, max_error, synth=False)
+            others, res = synthesize_with_search(built, job, target, **parallel_kwargs(args))
         finally:
-            others = job.result()
-    best = _best_other(others)
-    import shutil
-
-    if shutil.which("yosys") is not None:
-        res = synthesize_search(res, bound=None if best is None else best.cost.score,
-                                **parallel_kwargs(args))
-    return others, res
+            job.cancel()
+    return cheapest_candidates(others), res
 
 
 def _architectures(args, name, target, accuracy, max_error):

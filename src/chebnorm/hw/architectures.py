@@ -38,13 +38,14 @@ from chebnorm.core.parallel import map_ordered
 from .hdl import module_text
 from .multipartite import design_multipartite
 from .piecewise import design_piecewise
-from .piecewise_search import SYNTH_ROUND, map_synth
+from .piecewise_search import (SYNTH_ROUND, map_synth, synthesis_queue, synthesize_point,
+                               with_costs)
 from .plain_table import design_plain_table
 from .targets import get_target, synthesize_target
 
 __all__ = ["Candidate", "ACCURACIES", "MAX_TABLE_ROM_BITS", "PRUNE_SPREAD",
            "architecture_candidates", "build_candidates", "synthesize_candidates",
-           "cheapest_candidates", "prune_spread", "prune_lower"]
+           "cheapest_candidates", "prune_spread", "prune_lower", "synthesize_with_search"]
 
 #: the accuracy specs ``design`` takes
 ACCURACIES = ("max-error", "faithful", "correctly-rounded")
@@ -191,8 +192,12 @@ def _build_item(item):
 
 def _synth_item(item):
     """Yosys on one candidate, with the target's delay model (the winner's
-    timing line reads it: no second synthesis)."""
+    timing line reads it: no second synthesis); on xc7 the mapped netlist
+    instead, the sta model running on the winner's alone
+    (:func:`chebnorm.hw.targets.sta_from_netlist`)."""
     verilog, top, target = item
+    if get_target(target).timing == "sta":   # the sta model later, on the winner's netlist
+        return synthesize_target(verilog, top, target, netlist=True)
     return synthesize_target(verilog, top, target, timing=True)
 
 
@@ -350,6 +355,96 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
                            f"model {c.model:.1f}{rom}: lower bound {lower(c):.1f} >= best "
                            f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
     return out
+
+
+def _synth_job(item):
+    """One yosys run of :func:`synthesize_with_search`: a candidate or a search point."""
+    kind, payload = item
+    return _synth_item(payload) if kind == "arch" else synthesize_point(payload)
+
+
+def synthesize_with_search(cands, result, target: str, *, workers: int | None = None,
+                           scheduler=None):
+    """Synthesize the built candidates and the one-width search's front in one
+    pruned queue: every job (a candidate, or a meeting point of the search's
+    Pareto front, :func:`~chebnorm.hw.piecewise_search.synthesis_queue`) in
+    order of its lower bound (:func:`prune_lower`; a search point's model
+    over ``MODEL_SPREAD``), :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND`
+    at a time; a job whose lower bound is not below the best score
+    synthesized so far is skipped (it cannot win). The first round takes
+    candidates only, so the search may still be running then (``result`` a
+    future); its points join the queue from the second round. The same jobs
+    run whatever ``workers`` and however long the search takes (each round
+    is fixed before it starts), so the result is deterministic.
+
+    Parameters
+    ----------
+    cands : list of Candidate
+        As :func:`build_candidates` returns them.
+    result : SearchResult or concurrent.futures.Future
+        The one-width search with ``synth=False``
+        (:func:`chebnorm.hw.piecewise_search.search`), or a future of it
+        (waited for after the first round).
+    target : str
+        A target name (:func:`chebnorm.hw.targets.target_names`).
+    workers, scheduler
+        Parallel yosys runs (:func:`chebnorm.hw.piecewise_search.map_synth`).
+
+    Returns
+    -------
+    tuple of (list of Candidate, SearchResult)
+        The candidates with their costs (a skipped one keeps ``cost`` None and
+        says why in ``note``) and the search result with its points' costs
+        and winner (:func:`chebnorm.hw.piecewise_search.with_costs`).
+
+    Raises
+    ------
+    ValueError
+        ``target`` is unknown, or yosys is missing or fails.
+    """
+    from chebnorm.core.parallel import check_workers
+
+    t = get_target(target).name
+    workers = check_workers(workers)
+    out = list(cands)
+    jobs = [(prune_lower(c.architecture, t, c.model, c.model_rom) if c.model is not None
+             else -math.inf, 0, i) for i, c in enumerate(out) if c.design is not None]
+    todo = sorted(jobs, key=lambda j: (j[0], j[1], j[2]))
+    best, costs, merged, rounds = math.inf, {}, False, 0
+    while True:
+        if rounds >= 1 and not merged:   # the search's points join from round two
+            if hasattr(result, "result"):
+                result = result.result()
+            todo = sorted(todo + [(low, 1, key) for key, low in synthesis_queue(result)],
+                          key=lambda j: (j[0], j[1], j[2]))
+            merged = True
+        rounds += 1
+        run = [j for j in todo if j[0] < best][:SYNTH_ROUND]
+        if not run:
+            if merged:
+                break
+            continue
+        items = [("arch", (out[j[2]].verilog, out[j[2]].design.module_name, t)) if j[1] == 0
+                 else ("point", (result.designs[j[2]], t)) for j in run]
+        for j, cost in zip(run, map_synth(_synth_job, items, workers=workers,
+                                          scheduler=scheduler)):
+            if j[1] == 0:
+                c = out[j[2]]
+                out[j[2]] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp,
+                                      cost, c.note, c.model, c.model_rom)
+                best = min(best, cost.score)
+            else:
+                costs[j[2]] = cost
+                best = min(best, float(cost) if t == "generic" else cost.score)
+        todo = [j for j in todo if j not in run]
+    for low, kind, i in todo:
+        if kind == 0:
+            c = out[i]
+            rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
+            out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
+                               f"model {c.model:.1f}{rom}: lower bound {low:.1f} >= best "
+                               f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
+    return out, with_costs(result, costs)
 
 
 def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,

@@ -52,7 +52,7 @@ from .targets import TargetCost, get_target
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
            "TARGET_COLUMNS", "SYNTH_ROUND", "map_synth",
-           "synthesize_search"]
+           "synthesize_search", "synthesis_queue", "synthesize_point", "with_costs"]
 
 #: the columns of the search's CSV (``design_NAME.csv``), in order
 COLUMNS = ("degree", "segments", "coef_frac_bits", "acc_frac_bits", "y_frac_bits",
@@ -557,21 +557,130 @@ def synthesize_search(result: SearchResult, *, bound: float | None = None,
     keys = sorted(result.designs)
     points = dict(zip(keys, result.points))
     designs = dict(result.designs)
-    mc = (lambda p: p.target_model) if target != "generic" else (lambda p: p.model_cost)
-    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: mc(points[k]))
-    if not meeting:
+    chosen = [k for k, _ in synthesis_queue(result)]
+    if not chosen:
         return result
-    chosen = [k for k in meeting if points[k].pareto][:MAX_SYNTH] or meeting[:1]
-    cost_source = ("yosys cells" if target == "generic" else
-                   f"yosys {get_target(target).synth.split(' -top')[0]}")
     par = dict(workers=workers, scheduler=scheduler, progress=progress)
     _synth_pruned(points, designs, chosen, target, bound, par)
+    return with_costs(result, {k: (points[k].target_cost if target != "generic" else
+                                   points[k].yosys_cells) for k in chosen
+                               if points[k].target_cost is not None
+                               or points[k].yosys_cells is not None})
+
+
+def synthesis_queue(result: SearchResult) -> list[tuple[tuple[int, int, int], float]]:
+    """The points of a model-only search that synthesis may pick the winner
+    from, with their lower bounds: the meeting points of the Pareto front
+    (at most ``MAX_SYNTH``, cheapest model first; none on the front: the
+    cheapest meeting point), each with its model score over
+    :data:`~chebnorm.hw.target_model.MODEL_SPREAD` (a lower bound of its
+    synthesized score).
+
+    Parameters
+    ----------
+    result : SearchResult
+        A :func:`search` result with ``synth=False``.
+
+    Returns
+    -------
+    list of (tuple, float)
+        ``((degree, k, coef_frac_bits), lower bound)`` per point, cheapest
+        model first (empty when no point meets the error).
+
+    Examples
+    --------
+    >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1,), max_index_bits=4,
+    ...            synth=False, progress=False, workers=1)
+    >>> [k for k, _ in synthesis_queue(r)][0][:2]   # degree 1, 16 segments
+    (1, 4)
+    """
+    from .target_model import MODEL_SPREAD
+
+    target = get_target(result.target).name
+    keys = sorted(result.designs)
+    points = dict(zip(keys, result.points))
+    mc = (lambda p: p.target_model) if target != "generic" else (lambda p: p.model_cost)
+    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: (mc(points[k]), k))
+    chosen = [k for k in meeting if points[k].pareto][:MAX_SYNTH] or meeting[:1]
+    return [(k, mc(points[k]) / MODEL_SPREAD[target]) for k in chosen]
+
+
+def synthesize_point(item):
+    """Yosys on one search point (a :class:`~chebnorm.hw.piecewise.PiecewiseDesign`
+    and a target name): generic cells (an int) on ``generic``, else the
+    target's :class:`~chebnorm.hw.targets.TargetCost` with its delay model.
+
+    Parameters
+    ----------
+    item : tuple
+        ``(design, target)``.
+
+    Returns
+    -------
+    int or TargetCost
+
+    Raises
+    ------
+    ValueError
+        Yosys is missing or fails.
+    """
+    design, target = item
+    if get_target(target).name == "generic":
+        return _cells(design)
+    return _target_cost((design, target))
+
+
+def with_costs(result: SearchResult, costs: dict) -> SearchResult:
+    """``result`` with the synthesized ``costs`` of some of its points and the
+    winner chosen among the synthesized meeting points (none synthesized:
+    the cheapest meeting point by the model, not synthesized).
+
+    Parameters
+    ----------
+    result : SearchResult
+        A :func:`search` result with ``synth=False``.
+    costs : dict
+        ``(degree, k, coef_frac_bits)`` to :func:`synthesize_point`'s result.
+
+    Returns
+    -------
+    SearchResult
+        Costs set (``yosys_cells`` on generic, ``target_cost`` otherwise), the
+        winner, ``cost_source`` naming yosys.
+
+    Raises
+    ------
+    ValueError
+        A key of ``costs`` is not a point of ``result``.
+
+    Examples
+    --------
+    >>> r = search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1,), max_index_bits=4,
+    ...            synth=False, progress=False, workers=1)
+    >>> k = synthesis_queue(r)[0][0]
+    >>> with_costs(r, {k: 40}).winner.yosys_cells
+    40
+    """
+    target = get_target(result.target).name
+    keys = sorted(result.designs)
+    points = dict(zip(keys, result.points))
+    for k, c in costs.items():
+        if k not in points:
+            raise ValueError(f"costs: {k!r} is not a point of the search")
+        points[k] = (replace(points[k], yosys_cells=int(c)) if target == "generic" else
+                     replace(points[k], target_cost=c))
     ordered = tuple(points[k] for k in keys)
+    mc = (lambda p: p.target_model) if target != "generic" else (lambda p: p.model_cost)
+    meeting = sorted((k for k in keys if points[k].meets), key=lambda k: (mc(points[k]), k))
+    if not meeting:
+        return replace(result, points=ordered)
     pool = [p for p in ordered if p.meets and (p.yosys_cells is not None
                                                or p.target_cost is not None)]
-    if not pool:   # bound beat every point: the cheapest by the model, not synthesized
+    if not pool:   # a bound beat every point: the cheapest by the model, not synthesized
         pool = [points[meeting[0]]]
     winner = min(pool, key=lambda p: (p.cost, p.total_bound, p.degree, p.segments))
+    cost_source = ("yosys cells" if target == "generic" else
+                   f"yosys {get_target(target).synth.split(' -top')[0]}")
     return replace(result, points=ordered, winner=winner, cost_source=cost_source)
 
 
@@ -656,6 +765,9 @@ def _target_cost(item) -> TargetCost:
     from .targets import synthesize_target
 
     design, target = item
+    if get_target(target).timing == "sta":   # the sta model later, on the winner's netlist
+        return synthesize_target(module_text(design, "verilog"), design.module_name, target,
+                                 netlist=True)
     return synthesize_target(module_text(design, "verilog"), design.module_name, target,
                              timing=True)
 
