@@ -113,7 +113,7 @@ def test_bad_input_names_the_argument(kwargs, word):
 
 @pytest.mark.parametrize("argv,word", [
     (["--interval", "0", "1", "--in-bits", "10"], "interval"),
-    (["--interval", "2^-8", "1", "--in-bits", "24"], "in_bits"),
+    (["--interval", "2^-8", "1", "--in-bits", "24"], "--in-bits"),   # the CLI names its flag
     (["--interval", "2^-8", "1", "--in-bits", "10", "--correctly-rounded"], "correctly-rounded"),
 ])
 def test_cli_bad_input_one_line_exit_2(tmp_path, capsys, argv, word):

@@ -401,6 +401,18 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
     ------
     ValueError
         ``target`` is unknown, or yosys is missing or fails.
+
+    Examples
+    --------
+    Nothing built and no point meeting the error: nothing to synthesize.
+
+    >>> from chebnorm.hw.piecewise_search import search
+    >>> r = search("1/sqrt(x)", ("1", "4"), 6, 6, 1e-9, degrees=(1,), max_index_bits=2,
+    ...            synth=False, progress=False, workers=1)
+    >>> cands, res = synthesize_with_search([Candidate("table", "none", note="not built")],
+    ...                                     r, "generic")
+    >>> cands[0].note, res.winner is None
+    ('not built', True)
     """
     from chebnorm.core.parallel import check_workers
 

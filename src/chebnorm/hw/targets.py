@@ -502,6 +502,13 @@ def sta_from_netlist(cost: TargetCost, *, timeout: float = 600) -> TargetCost:
     ------
     ValueError
         ``cost`` has no netlist, its target has no ``sta`` model, or yosys fails.
+
+    Examples
+    --------
+    >>> sta_from_netlist(cost_from_types("xc7", {"LUT6": 1}))
+    Traceback (most recent call last):
+    ...
+    ValueError: cost: no kept netlist of an xc7 synthesis; accepted: synthesize_target(..., netlist=True) on xc7 or xc7-nodsp
     """
     t = get_target(cost.target)
     if t.timing != "sta" or not cost.netlist:
