@@ -24,7 +24,44 @@ from .kernels import supports as kernels_support
 from .rasterize import (default_camera_of, fast_lerp, fast_setup_spans, fast_zbuffer,
                         gather_setup, project)
 
-__all__ = ["HAVE_NUMBA", "NumbaEngine"]
+__all__ = ["HAVE_NUMBA", "NumbaEngine", "GatheredSetup"]
+
+
+class GatheredSetup(Setup):
+    """A :class:`~chebnorm.raster.engines.base.Setup` whose corner ``inv_w``, ``pos`` and
+    ``nrm`` are copies of ``attrs``' columns made when first read (the fused frame reads
+    ``attrs`` alone: the set-up then writes 40 % fewer bytes; the other shading modes
+    read them, the same values, C-contiguous, as the numpy engine's)."""
+
+    @property
+    def inv_w(self):
+        if self._inv_w is None:
+            self._inv_w = np.ascontiguousarray(self.attrs[..., 0])
+        return self._inv_w
+
+    @inv_w.setter
+    def inv_w(self, value):
+        self._inv_w = value
+
+    @property
+    def pos(self):
+        if self._pos is None:
+            self._pos = np.ascontiguousarray(self.attrs[..., 4:7])
+        return self._pos
+
+    @pos.setter
+    def pos(self, value):
+        self._pos = value
+
+    @property
+    def nrm(self):
+        if self._nrm is None:
+            self._nrm = np.ascontiguousarray(self.attrs[..., 1:4])
+        return self._nrm
+
+    @nrm.setter
+    def nrm(self, value):
+        self._nrm = value
 
 
 class NumbaEngine(NumpyEngine):
@@ -71,8 +108,8 @@ class NumbaEngine(NumpyEngine):
         # the same camera (remembered per mesh positions) and gathers, compiled
         cam = camera or default_camera_of(mesh.positions, w, h)
         xy, inv_w = project(cam, mesh.positions, w, h)
-        tri, txy, iw, pos, nrm, attrs = gather_setup(mesh, xy, inv_w, cull)
-        return Setup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, attrs)
+        tri, txy, iw, pos, nrm, attrs = gather_setup(mesh, xy, inv_w, cull, corners=False)
+        return GatheredSetup(mesh, cam, w, h, None, tri, txy, iw, pos, nrm, attrs)
 
     def rasterize(self, xy, attrs, width, height):
         sp = fast_setup_spans(xy, attrs, width, height)

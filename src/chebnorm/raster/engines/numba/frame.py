@@ -40,15 +40,15 @@ import numpy as np
 from chebnorm.methods import detmath
 from chebnorm.methods import kernels as K
 from chebnorm.methods.registry import method_kernel
-from chebnorm.methods.spans import MAX_LEVELS
+from chebnorm.methods.spans import MAX_LEVELS, check_dtype
 
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
-from .calibration import (DetOps, calibrated, dot3, dot3_select, f32_round, pow_calibrated,
-                          powers, trig64, trig_calibrated)
-from .jit import HAVE_NUMBA, njit, run, threads
+from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f32_round,
+                          pow_calibrated, powers, trig64, trig_calibrated)
+from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
-from .rasterize import row_spans
-from .setup import method_setup, span_input, widest_dot
+from .rasterize import count_rows, row_buckets, row_spans, span_geom, span_write
+from .setup import end_checks, method_setup, span_input, widest_dot
 from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
@@ -115,13 +115,12 @@ def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd,
 
 
 @njit()
-def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right, bw, bs):
-    """Row ``rr``: in ``bs`` the winning span of each pixel (largest ``1/w``, ties to the
-    earliest span; -1: none)."""
+def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs):
+    """The winning span of each pixel of a row in ``bs`` (spans ``k0 .. k1-1``, the row's
+    in ``setup_spans``' order: largest ``1/w``, ties to the earliest span; -1: none)."""
     for x in range(width):
         bs[x] = -1
-    for k in range(row_start[rr], row_start[rr + 1]):
-        s = by_row[k]
+    for s in range(k0, k1):
         lo = left[s, 0]
         dw = right[s, 0] - lo
         a = t0[s]
@@ -131,25 +130,15 @@ def _row_visibility(rr, width, row_start, by_row, c0, count, t0, dt, left, right
             t = min(max(a + j * d, 0.0), 1.0)
             w = lo + t * dw
             x = x0 + j
-            if bs[x] < 0 or w > bw[x]:
-                bs[x] = s
-                bw[x] = w
+            win = (bs[x] < 0) | (w > bw[x])    # selects, not branches (bw[x] unset where
+            bs[x] = s if win else bs[x]        # bs[x] < 0: the ``|`` makes it moot)
+            bw[x] = w if win else bw[x]
 
 
 @njit()
-def _row_background(img, mask, tri_map, nlen, base, width, want):
-    """The background of a row (0, False, -1, NaN; overwritten where a fragment lands):
+def _row_background(tri_map, nlen, base, width, want):
+    """The background of a row's extra maps (-1, NaN; overwritten where a fragment lands):
     the triangle map where ``want & 1``, the ``|N|`` map where ``want & 2``."""
-    if want == 3:
-        for x in range(width):
-            img[base + x] = 0.0
-            mask[base + x] = False
-            tri_map[base + x] = -1
-            nlen[base + x] = np.nan
-        return
-    for x in range(width):
-        img[base + x] = 0.0
-        mask[base + x] = False
     if want & 1:
         for x in range(width):
             tri_map[base + x] = -1
@@ -159,15 +148,19 @@ def _row_background(img, mask, tri_map, nlen, base, width, want):
 
 
 @njit()
-def _row_winners(bs, wx, ws, width):
+def _row_winners(bs, wx, ws, width, img, mask, base):
     """The covered pixels of a row in ``x`` order (``wx``) with their spans (``ws``);
-    their number.  Branch-free: every ``x`` is written, the count advances where
-    ``bs[x] >= 0`` (``wx``, ``ws`` have room for the whole row)."""
+    their number.  Also the row's image background (0, overwritten where a fragment
+    lands) and its mask (``bs[x] >= 0``) from offset ``base``.  Branch-free: every ``x``
+    is written, the count advances where ``bs[x] >= 0`` (``wx``, ``ws`` have room for the
+    whole row)."""
     nw = 0
     for x in range(width):
         s = bs[x]
         wx[nw] = x
         ws[nw] = s
+        img[base + x] = 0.0
+        mask[base + x] = s >= 0
         nw += s >= 0
     return nw
 
@@ -246,103 +239,171 @@ def _linear_row(mode, n0, n1, n2, a0, a1, a2, d0, d1, d2, tc, kc, out0, out1, ou
 
 
 @njit()
-def _frame(width, height, mode, row_start, by_row, stri, c0, count, t0, dt, left, right,
-           A, B, C, sc, sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye,
-           light, orders, want, part, parts, img, mask, tri_map, nlen, stop=0):
-    """The visibility and shading passes, one scan line at a time, on the rows
-    ``part, part + parts, ...`` (threads run the parts at once: each writes every pixel
-    of its own rows of the output maps, the background where no fragment lands:
-    0, False, -1, NaN; the triangle map only where ``want & 1``, the ``|N|`` map only
-    where ``want & 2``). Returns the number of slerp float32 pixels whose
-    sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map).
-
-    Per row: the z-test (:func:`_row_visibility`), the winners listed in ``x`` order,
-    then each quantity of the shading for all of them in one loop (gathers first, then
-    loops of arithmetic alone, which LLVM vectorizes: ``sqrt`` and division are
-    correctly rounded in every lane, so the bits are the scalar ones).
-
-    ``stop`` (profiling only, :func:`stage_times`): 0 draws the frame; 1, 2, 3 stop each
-    row after its visibility and background, its normals, its half vectors."""
-    hard = 0
-    l0, l1, l2 = L[0], L[1], L[2]
-    ey0, ey1, ey2 = eye[0], eye[1], eye[2]
-    o2 = orders[2]
+def _row_buffers(width, A, mode):
+    """A thread's scratch rows for :func:`_row_pass` (``A``: an array in the method's
+    dtype): ``(bw, bs, wx, ws, wt, tc, ga, sx, n0, n1, n2, h0, h1, h2, av, bv, nl, pw, hh,
+    ll, ok, skip, nd, sab, sw)``."""
     W = width
-    bw = np.empty(W)
-    bs = np.empty(W, np.int64)
-    wx = np.empty(W, np.int64)
-    ws = np.empty(W, np.int64)
-    wt = np.empty(W)
-    tc = np.empty(W, A.dtype)
-    ga = np.empty((6, W), A.dtype)
-    sx = np.empty((3, W), A.dtype)
-    n0, n1, n2 = np.empty(W), np.empty(W), np.empty(W)
-    h0, h1, h2 = np.empty(W), np.empty(W), np.empty(W)
-    av, bv, nl, pw = np.empty(W), np.empty(W), np.empty(W), np.empty(W)
-    hh, ll = np.empty(W), np.empty(W)
-    ok = np.empty(W, np.bool_)
-    skip = np.zeros(W, np.bool_)
-    nd = np.empty((3, _TREE_MAX + 1), A.dtype)
-    sab = np.empty(2, A.dtype)
-    sw = np.empty((9, W) if mode == 4 else (9, 1))
-    for rr in range(part, height, parts):
-        base = rr * W
-        _row_visibility(rr, W, row_start, by_row, c0, count, t0, dt, left, right, bw, bs)
-        _row_background(img, mask, tri_map, nlen, base, W, want)
-        nw = _row_winners(bs, wx, ws, W)
-        if nw == 0:
-            continue
+    return (np.empty(W), np.empty(W, np.int64), np.empty(W, np.int64), np.empty(W, np.int64),
+            np.empty(W), np.empty(W, A.dtype), np.empty((6, W), A.dtype),
+            np.empty((3, W), A.dtype), np.empty(W), np.empty(W), np.empty(W), np.empty(W),
+            np.empty(W), np.empty(W), np.empty(W), np.empty(W), np.empty(W), np.empty(W),
+            np.empty(W), np.empty(W), np.empty(W, np.bool_), np.zeros(W, np.bool_),
+            np.empty((3, _TREE_MAX + 1), A.dtype), np.empty(2, A.dtype),
+            np.empty((9, W) if mode == 4 else (9, 1)))
+
+
+@njit()
+def _row_pass(rr, width, k0, k1, mode, stri, c0, count, t0, dt, left, right, A, B, C, sc, sc2,
+              levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye, light, orders,
+              want, img, mask, tri_map, nlen, stop, buf):
+    """Row ``rr`` of the frame from its spans ``k0 .. k1-1`` (in ``setup_spans``' order):
+    the z-test (:func:`_row_visibility`), the background and the winners listed in ``x``
+    order (:func:`_row_winners`), then each quantity of the shading for all of them in one
+    loop (gathers first, then loops of arithmetic alone, which LLVM vectorizes: ``sqrt``
+    and division are correctly rounded in every lane, so the bits are the scalar ones).
+    Returns ``(covered pixels, slerp float32 pixels whose sine needs detmath)``.
+
+    ``stop`` (profiling only, :func:`stage_times`): 0 draws the row; 1, 2, 3 stop after
+    its visibility and background, its normals, its half vectors."""
+    (bw, bs, wx, ws, wt, tc, ga, sx, n0, n1, n2, h0, h1, h2, av, bv, nl, pw, hh, ll, ok, skip,
+     nd, sab, sw) = buf
+    W = width
+    base = rr * W
+    _row_visibility(W, k0, k1, c0, count, t0, dt, left, right, bw, bs)
+    nw = _row_winners(bs, wx, ws, W, img, mask, base)
+    if want:
+        _row_background(tri_map, nlen, base, W, want)
+    if nw == 0:
+        return 0, 0
+    for k in range(nw):
+        s = ws[k]
+        tu = t0[s] + (wx[k] - c0[s]) * dt[s]
+        tc[k] = tu                       # the reference's t.astype(dtype)
+        wt[k] = min(max(tu, 0.0), 1.0)
+    if stop == 1:
+        return nw, 0
+    hard = 0
+    # the method's normals, widened to float64
+    if mode == 0:
         for k in range(nw):
             s = ws[k]
-            tu = t0[s] + (wx[k] - c0[s]) * dt[s]
-            tc[k] = tu                       # the reference's t.astype(dtype)
-            wt[k] = min(max(tu, 0.0), 1.0)
-        if stop == 1:
-            continue
-        # the method's normals, widened to float64
-        if mode == 0:
-            for k in range(nw):
-                s = ws[k]
-                t = wt[k]
-                lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
-                n0[k] = lo1 + t * (right[s, 1] - lo1)
-                n1[k] = lo2 + t * (right[s, 2] - lo2)
-                n2[k] = lo3 + t * (right[s, 3] - lo3)
-        elif mode <= 3:
-            for k in range(nw):
-                s = ws[k]
-                for c in range(3):
-                    ga[c, k] = A[c, s]
-                    ga[3 + c, k] = B[c, s]
-            _linear_row(mode, n0, n1, n2, ga[0], ga[1], ga[2], ga[3], ga[4], ga[5], tc, kc, n0,
-                        n1, n2, nw)
-        elif mode == 5 or mode == 6:
-            _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1,
-                      n2, nw)
-        elif mode == 4:
-            hard += _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, light[6] != 0.0, sw, ok,
-                               sab, skip, n0, n1, n2, nw)
-        else:
-            _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw)
-        if stop == 2:
-            continue
-        # half vectors
-        if per_pixel_h:
-            for k in range(nw):
-                s = ws[k]
-                t = wt[k]
-                q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
-                h0[k] = q0 + t * (right[s, 4] - q0)
-                h1[k] = q1 + t * (right[s, 5] - q1)
-                h2[k] = q2 + t * (right[s, 6] - q2)
-            _half_row(h0, h1, h2, ey0, ey1, ey2, l0, l1, l2, nw, o2)
-        else:
-            _tri_half_row(ws, stri, Htri, h0, h1, h2, nw)
-        if stop == 3:
-            continue
-        _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av,
-                   bv, nl, pw, hh, ll, ok, skip, img, mask, tri_map, nlen, want, nw)
+            t = wt[k]
+            lo1, lo2, lo3 = left[s, 1], left[s, 2], left[s, 3]
+            n0[k] = lo1 + t * (right[s, 1] - lo1)
+            n1[k] = lo2 + t * (right[s, 2] - lo2)
+            n2[k] = lo3 + t * (right[s, 3] - lo3)
+    elif mode <= 3:
+        for k in range(nw):
+            s = ws[k]
+            for c in range(3):
+                ga[c, k] = A[c, s]
+                ga[3 + c, k] = B[c, s]
+        _linear_row(mode, n0, n1, n2, ga[0], ga[1], ga[2], ga[3], ga[4], ga[5], tc, kc, n0,
+                    n1, n2, nw)
+    elif mode == 5 or mode == 6:
+        _step_row(mode, k0, k1, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw)
+    elif mode == 4:
+        hard = _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, light[6] != 0.0, sw, ok, sab, skip,
+                          n0, n1, n2, nw)
+    else:
+        _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw)
+    if stop == 2:
+        return nw, hard
+    # half vectors
+    if per_pixel_h:
+        for k in range(nw):
+            s = ws[k]
+            t = wt[k]
+            q0, q1, q2 = left[s, 4], left[s, 5], left[s, 6]
+            h0[k] = q0 + t * (right[s, 4] - q0)
+            h1[k] = q1 + t * (right[s, 5] - q1)
+            h2[k] = q2 + t * (right[s, 6] - q2)
+        _half_row(h0, h1, h2, eye[0], eye[1], eye[2], L[0], L[1], L[2], nw, orders[2])
+    else:
+        _tri_half_row(ws, stri, Htri, h0, h1, h2, nw)
+    if stop == 3:
+        return nw, hard
+    _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv,
+               nl, pw, hh, ll, ok, skip, img, tri_map, nlen, want, nw)
+    return nw, hard
+
+
+@njit()
+def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right, A, B, C, sc,
+           sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye, light, orders,
+           want, part, parts, img, mask, tri_map, nlen, stop=0):
+    """The visibility and shading passes over the frame's spans (numbered row by row,
+    row ``r``'s ``row_start[r] .. row_start[r+1]-1``), one scan line at a time
+    (:func:`_row_pass`), on the rows ``part, part + parts, ...`` (threads run the parts at
+    once: each writes every pixel of its own rows of the output maps, the background where
+    no fragment lands: 0, False, -1, NaN; the triangle map only where ``want & 1``, the
+    ``|N|`` map only where ``want & 2``). Returns the number of slerp float32 pixels whose
+    sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map)."""
+    buf = _row_buffers(width, A, mode)
+    hard = 0
+    for rr in range(part, height, parts):
+        hard += _row_pass(rr, width, row_start[rr], row_start[rr + 1], mode, stri, c0, count, t0,
+                          dt, left, right, A, B, C, sc, sc2, levels, R, off, kc, kd, is64,
+                          face_id, per_pixel_h, Htri, L, eye, light, orders, want, img, mask,
+                          tri_map, nlen, stop, buf)[1]
     return hard
+
+
+@njit()
+def _frame_rows(width, height, mode, xy, attrs, first, ids, maxrow, eorders, proto, kc,
+                face_id, per_pixel_h, Htri, L, eye, light, orders, want, part, parts, img, mask,
+                tri_map, nlen, out, stop=0):
+    """The whole frame of a linear method (modes 0-3) scan line by scan line, on the rows
+    ``part, part + parts, ...``: each row's spans (:func:`.rasterize.span_geom`,
+    :func:`.rasterize.span_write` on the triangles crossing it, ``first``/``ids`` of
+    :func:`.rasterize.row_buckets`, in triangle order as :func:`.rasterize.row_spans`
+    numbers them) into row-sized arrays, their unit end normals and the checks of
+    ``check_span_input`` (:func:`.setup.end_checks`, modes 1-3; normals in the dtype of
+    ``proto``), then :func:`_row_pass`. The spans never leave the cache: no frame-sized
+    span arrays are written or read. ``out``: [a check failed (then the frame stops: the
+    caller draws it step by step, with the reference's errors), fragments, covered
+    pixels]. ``stop`` 4 (profiling): the rows' spans and checks alone."""
+    Kc = attrs.shape[2]
+    M = max(maxrow, 1)
+    ltri, lrow, lc0 = np.empty(M, np.int64), np.empty(M, np.int64), np.empty(M, np.int64)
+    lcount, lm = np.empty(M, np.int64), np.empty(M, np.int64)
+    lt0, ldt = np.empty(M), np.empty(M)
+    lleft, lright = np.empty((M, Kc)), np.empty((M, Kc))
+    lA, lB = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
+    C = np.zeros((3, 1), proto.dtype)
+    sc = np.zeros(1, proto.dtype)
+    levels = np.zeros(1, np.int64)
+    R = np.zeros((1, 1), proto.dtype)
+    off = np.zeros(1, np.bool_)
+    buf = _row_buffers(width, lA, mode)
+    nfrag = 0
+    ncov = 0
+    for rr in range(part, height, parts):
+        n = 0
+        for q in range(first[rr], first[rr + 1]):
+            i = ids[q]
+            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, rr, width)
+            if c <= 0:
+                continue
+            span_write(attrs, i, rr, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, ltri, lrow,
+                       lc0, lcount, lm, lt0, ldt, lleft, lright)
+            nfrag += c
+            n += 1
+        if mode >= 1 and n > 0:
+            if not end_checks(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], n,
+                              lA, lB):
+                out[0] = 1
+                return
+        if stop == 4:
+            continue
+        ncov += _row_pass(rr, width, 0, n, mode, ltri, lc0, lcount, lt0, ldt, lleft, lright, lA,
+                          lB, C, sc, sc, levels, R, off, kc, kc, True, face_id, per_pixel_h,
+                          Htri, L, eye, light, orders, want, img, mask, tri_map, nlen, stop,
+                          buf)[0]
+    out[0] = 0
+    out[1] = nfrag
+    out[2] = ncov
 
 
 @njit()
@@ -361,7 +422,7 @@ def _tri_half_row(ws, stri, Htri, h0, h1, h2, nw):
 
 @njit()
 def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv, nl,
-               pw, hh, ll, ok, skip, img, mask, tri_map, nlen, want, nw):
+               pw, hh, ll, ok, skip, img, tri_map, nlen, want, nw):
     """``Lighting.intensity(N @ L, N . H)`` clipped, and ``|N|``, at the row's winners, into
     the maps (row offset ``base``; the triangle map where ``want & 1``, the ``|N|`` map
     where ``want & 2``; a ``skip`` pixel's triangle entry is ``-2 - span``, its other
@@ -374,15 +435,15 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
         N0, N1, N2 = n0[k], n1[k], n2[k]
         av[k] = _clamp0(dot3_select(N0, N1, N2, l0, l1, l2, o0))
         bv[k] = _clamp0(dot3_select(N0, N1, N2, h0[k], h1[k], h2[k], o1))
-        nl[k] = np.sqrt(dot3_select(N0, N1, N2, N0, N1, N2, o2))
+    if want & 2:
+        for k in range(nw):
+            nl[k] = np.sqrt(dot3_select(n0[k], n1[k], n2[k], n0[k], n1[k], n2[k], o2))
     powers(bv, sh, fastpow, hh, ll, ok, pw, nw)
     for k in range(nw):
         v = I0 * (ka + kdif * av[k] + ks * pw[k])
         av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
-    for k in range(nw):
-        p = base + wx[k]
-        img[p] = av[k]
-        mask[p] = True
+    for k in range(nw):     # (the mask is :func:`_row_winners`')
+        img[base + wx[k]] = av[k]
     if want & 1:
         for k in range(nw):
             tri_map[base + wx[k]] = face_id[stri[ws[k]]]
@@ -396,11 +457,10 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
 
 
 @njit()
-def _step_row(mode, rr, row_start, by_row, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw):
-    """Stepping kernels (5 quadratic, 6 angular) on row ``rr``: every pixel of each span
-    in order, the winners' normals (in ``x`` order) widened to float64."""
-    for q in range(row_start[rr], row_start[rr + 1]):
-        s = by_row[q]
+def _step_row(mode, k0, k1, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw):
+    """Stepping kernels (5 quadratic, 6 angular) on a row (spans ``k0 .. k1-1``): every
+    pixel of each span in order, the winners' normals (in ``x`` order) widened to float64."""
+    for s in range(k0, k1):
         x0 = c0[s]
         v0, v1, v2 = A[0, s], A[1, s], A[2, s]
         e0, e1, e2 = B[0, s], B[1, s], B[2, s]
@@ -730,6 +790,10 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
         attrs = np.concatenate([st.inv_w[..., None], st.nrm, st.pos], axis=2)
     if not per_pixel_h:
         attrs = attrs[..., :4]
+    mode = MODES[id(method_kernel(spec))]
+    dt_ = _rows_dtype(spec, mode, dtype)
+    if dt_ is not None:     # a linear method: the frame row by row, spans and all
+        return _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps)
     work = take()    # scratch arrays of an earlier frame (pages mapped)
     sp = row_spans(st.xy, attrs, st.width, st.height, work)
     tick("spans")
@@ -739,7 +803,6 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
     maps = output_maps(st.width * st.height)
     S = len(sp.count)
     stats = {}
-    mode = MODES[id(method_kernel(spec))]
     # the unit end normals, the checks of check_span_input and the values it derives,
     # compiled (.setup: the reference runs where a check fails)
     ends, dot_min = (widest_dot(sp, spec, dtype, mode <= 3, work)
@@ -748,23 +811,14 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
     tick("ends")
     dt_, A, B, C, sc, sc2, levels, R, off, kd = _mode_arrays(mode, spec, sp, tables, dtype,
                                                              ends, work)
-    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
     C = np.ascontiguousarray(C)
-    Htri = (np.ascontiguousarray(triangle_half_vectors(st), np.float64) if not per_pixel_h
-            else np.zeros((1, 3)))
-    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess,
-                      float(pow_calibrated(float(lighting.shininess))),
-                      float(mode == 4 and trig_calibrated())], np.float64)
-    L = np.ascontiguousarray(st.L, np.float64)
-    eye = np.asarray(st.camera.eye, np.float64)
-    ords = np.array(orders, np.int64)
+    kc, Htri, light, L, eye, ords, face_id = _frame_args(st, lighting, mode, dt_, orders)
     # maps filled: 1 triangle, 2 |N| (the float32 slerp marks its hard pixels in the
     # triangle map, so it fills that one anyway)
     want = 3 if extra_maps else (1 if mode == 4 and dt_ is not np.float64 else 0)
-    face_id = np.ascontiguousarray(st.tri, np.int64)
     args = (sp.x0, sp.t0, sp.dt, sp.left, sp.right)
     img, mask, tri_map, nlen = maps
-    common = (st.width, st.height, mode, sp.row_start, sp.by_row, sp.tri, sp.x0, sp.count,
+    common = (st.width, st.height, mode, sp.row_start, sp.tri, sp.x0, sp.count,
               *args[1:], A, B, C, sc, sc2, levels, R, off, kc, kd, dt_ is np.float64, face_id,
               per_pixel_h, Htri, L, eye, light, ords, want)
     k = min(threads(), st.height)
@@ -773,7 +827,7 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
         for stop, name in ((1, "visibility"), (2, "normals"), (3, "half vectors")):
             run([(_frame, (*common, q, k, *maps, stop)) for q in range(k)])
             tick(name)
-    nh = sum(run([(_frame, (*common, q, k, *maps)) for q in range(k)]))
+    nh = sum(run_with_caller([(_frame, (*common, q, k, *maps)) for q in range(k)]))
     if nh:
         pix = np.flatnonzero(tri_map < -1)
         span = -2 - tri_map[pix]
@@ -792,6 +846,82 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
     shape = (st.height, st.width)
     extra = (tri_map.reshape(shape), nlen.reshape(shape)) if extra_maps else (None, None)
     return ModeResult(img.reshape(shape), mask.reshape(shape), int(sp.count.sum()), stats,
+                      triangle=extra[0], normal_length=extra[1])
+
+
+def _rows_dtype(spec, mode, dtype):
+    """The dtype of a linear method's row-by-row frame (:func:`_frame_rows`): float64 for
+    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3; None where the frame
+    takes the frame-sized span arrays instead (a method with a table, whose choice needs
+    every span first; no :func:`.calibration.ends_orders`; a dtype the reference refuses,
+    which it then refuses with its own error)."""
+    if mode > 3 or spec.table is not None:
+        return None
+    if mode == 0:
+        return np.float64
+    if ends_orders() is None:
+        return None
+    try:
+        return check_dtype(dtype)
+    except (TypeError, ValueError):
+        return None
+
+
+def _frame_args(st, lighting, mode, dt_, orders):
+    """The constant arrays every frame kernel takes: ``(kc, Htri, light, L, eye, ords,
+    face_id)``."""
+    per_pixel_h = lighting.half_vector == "pixel"
+    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
+    Htri = (np.ascontiguousarray(triangle_half_vectors(st), np.float64) if not per_pixel_h
+            else np.zeros((1, 3)))
+    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess,
+                      float(pow_calibrated(float(lighting.shininess))),
+                      float(mode == 4 and trig_calibrated())], np.float64)
+    L = np.ascontiguousarray(st.L, np.float64)
+    eye = np.asarray(st.camera.eye, np.float64)
+    return (kc, Htri, light, L, eye, np.array(orders, np.int64),
+            np.ascontiguousarray(st.tri, np.int64))
+
+
+def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
+    """:func:`phong` of a linear method (modes 0-3; ``dt_`` from :func:`_rows_dtype`): the
+    row buckets, then :func:`_frame_rows` on the threads (every row's spans, checks,
+    visibility and shading in one pass); FrameUnsupported where a check fails (the step by
+    step path then gives the reference's error)."""
+    tick = clock or _no_clock
+    per_pixel_h = lighting.half_vector == "pixel"
+    xy = np.ascontiguousarray(st.xy, np.float64)
+    attrs = np.ascontiguousarray(attrs, np.float64)
+    height = int(st.height)
+    first, ids = row_buckets(*count_rows(np.ascontiguousarray(xy[..., 1]), height), height)
+    maxrow = int(np.diff(first).max()) if height else 0
+    kc, Htri, light, L, eye, ords, face_id = _frame_args(st, lighting, mode, dt_, orders)
+    eo = ends_orders() if mode else None
+    eorders = np.array(eo if eo is not None else (0, 0), np.int64)
+    maps = output_maps(st.width * st.height)
+    k = min(threads(), height)
+    outs = np.zeros((k, 3), np.int64)
+    common = (st.width, height, mode, xy, attrs, first, ids, maxrow, eorders, kc, kc, face_id,
+              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0)
+    tick("spans")
+    if clock is not None:     # the frame's passes, cumulatively, for stage_times
+        for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
+            run([(_frame_rows, (*common, q, k, *maps, outs[q], stop)) for q in range(k)])
+            tick(name)
+            if name == "ends":
+                tick("method set-up")
+    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q])) for q in range(k)])
+    tick("shading")
+    if outs[:, 0].any():
+        raise FrameUnsupported("a span failed a check of check_span_input")
+    keep_maps(maps)
+    if outs[:, 2].sum() < 2:
+        # numpy computes N @ L for one row by another route than BLAS
+        raise FrameUnsupported("fewer than two pixels covered")
+    img, mask, tri_map, nlen = maps
+    shape = (st.height, st.width)
+    extra = (tri_map.reshape(shape), nlen.reshape(shape)) if extra_maps else (None, None)
+    return ModeResult(img.reshape(shape), mask.reshape(shape), int(outs[:, 1].sum()), {},
                       triangle=extra[0], normal_length=extra[1])
 
 
@@ -825,6 +955,8 @@ def stage_times(st, spec, lighting, tables=None, dtype=np.float64, extra_maps=Tr
         out[name] = (c1 - c0, w1 - w0)
     # the frame's passes ran cumulatively: each stage is its run minus the one before
     cum = ["visibility", "normals", "half vectors", "shading"]
+    if _rows_dtype(spec, MODES[id(method_kernel(spec))], dtype) is not None:
+        cum.insert(0, "ends")    # the row-by-row frame: "ends" is its rows' spans and checks
     runs = {n: out[n] for n in cum}
     for a, b in zip(cum, cum[1:]):
         out[b] = (runs[b][0] - runs[a][0], runs[b][1] - runs[a][1])

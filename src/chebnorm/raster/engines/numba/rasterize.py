@@ -253,10 +253,10 @@ def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
 
 # --------------------------------------------------------- triangle set-up
 @njit()
-def _gather_setup(pos, nrm, xy, inv_w, faces, cull, tri, txy, attrs, tiw, tpos, tnrm):
+def _gather_setup(pos, nrm, xy, inv_w, faces, cull, corners, tri, txy, attrs, tiw, tpos, tnrm):
     """``NumpyEngine.setup``: front-facing triangles and their corners, into the flat
-    buffers ``tri`` (ids), ``txy``, ``attrs``, ``tiw``, ``tpos``, ``tnrm`` (room for every
-    face); the number of front-facing triangles."""
+    buffers ``tri`` (ids), ``txy``, ``attrs``, and (``corners``) ``tiw``, ``tpos``, ``tnrm``
+    (room for every face); the number of front-facing triangles."""
     F = faces.shape[0]
     n = 0
     for i in range(F):
@@ -274,16 +274,19 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull, tri, txy, attrs, tiw, tpos, 
             txy[2 * e] = xy[q, 0]
             txy[2 * e + 1] = xy[q, 1]
             attrs[7 * e] = inv_w[q]
-            tiw[e] = inv_w[q]
             for c in range(3):
                 attrs[7 * e + 1 + c] = nrm[q, c]
                 attrs[7 * e + 4 + c] = pos[q, c]
-                tnrm[3 * e + c] = nrm[q, c]
-                tpos[3 * e + c] = pos[q, c]
+    if corners:
+        for e in range(3 * n):
+            tiw[e] = attrs[7 * e]
+            for c in range(3):
+                tnrm[3 * e + c] = attrs[7 * e + 1 + c]
+                tpos[3 * e + c] = attrs[7 * e + 4 + c]
     return n
 
 
-def gather_setup(mesh, xy, inv_w, cull):
+def gather_setup(mesh, xy, inv_w, cull, corners=True):
     """The per-triangle arrays of ``NumpyEngine.setup``, gathered in compiled code: front
     triangle ids, ``xy (T,3,2)``, ``inv_w (T,3)``, positions and normals ``(T,3,3)``, and
     the corner attributes of :func:`~chebnorm.raster.engines.numba.frame.phong`'s spans, ``[1/w, normal, position] (T,3,7)``:
@@ -299,6 +302,9 @@ def gather_setup(mesh, xy, inv_w, cull):
         ``1/w`` per vertex.
     cull : bool
         Drop back-facing triangles.
+    corners : bool, optional
+        Also ``inv_w``, ``pos`` and ``nrm`` (False: None for those three, copies of
+        ``attrs``' columns; the fused frame reads ``attrs`` alone).
 
     Returns
     -------
@@ -310,8 +316,12 @@ def gather_setup(mesh, xy, inv_w, cull):
     n = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
                       np.ascontiguousarray(mesh.normals, np.float64),
                       np.ascontiguousarray(xy, np.float64),
-                      np.ascontiguousarray(inv_w, np.float64), faces, bool(cull), *bufs)
+                      np.ascontiguousarray(inv_w, np.float64), faces, bool(cull), bool(corners),
+                      *bufs)
     b_tri, b_xy, b_attrs, b_iw, b_pos, b_nrm = bufs
+    if not corners:
+        return (b_tri[:n], b_xy[:6 * n].reshape(n, 3, 2), None, None, None,
+                b_attrs[:21 * n].reshape(n, 3, 7))
     return (b_tri[:n], b_xy[:6 * n].reshape(n, 3, 2), b_iw[:3 * n].reshape(n, 3),
             b_pos[:9 * n].reshape(n, 3, 3), b_nrm[:9 * n].reshape(n, 3, 3),
             b_attrs[:21 * n].reshape(n, 3, 7))
@@ -326,9 +336,10 @@ def span_geom(xy, i, r, width):
     y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
     y = r + 0.5
     # edges (0,1), (1,2), (2,0): hit when min <= y < max; the first and last hit
-    h0 = min(y0, y1) <= y and y < max(y0, y1)
-    h1 = min(y1, y2) <= y and y < max(y1, y2)
-    h2 = min(y2, y0) <= y and y < max(y2, y0)
+    # (``&``, not ``and``: no branch to mispredict, the hit edges change from span to span)
+    h0 = (min(y0, y1) <= y) & (y < max(y0, y1))
+    h1 = (min(y1, y2) <= y) & (y < max(y1, y2))
+    h2 = (min(y2, y0) <= y) & (y < max(y2, y0))
     if np.int64(h0) + np.int64(h1) + np.int64(h2) != 2:
         return 0, 0, 0, 0, 0.0, 0, 0, 0.0, False, 0.0, 0.0
     e1 = 0 if h0 else 1
@@ -350,6 +361,16 @@ def span_geom(xy, i, r, width):
 
 
 @njit(inline=True)
+def _span_attrs(attrs, i, n, pa, qa, sa, p, q, sb, swap, left, right, K):
+    """The ``K`` end attributes of span ``n`` (see :func:`span_write`)."""
+    for k in range(K):
+        va = attrs[i, pa, k] + sa * (attrs[i, qa, k] - attrs[i, pa, k])
+        vb = attrs[i, p, k] + sb * (attrs[i, q, k] - attrs[i, p, k])
+        left[n, k] = vb if swap else va
+        right[n, k] = va if swap else vb
+
+
+@njit(inline=True)
 def span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, row, c0, count,
                 m, t0, dt, left, right):
     """Span ``n``: row ``r`` of triangle ``i`` (from :func:`span_geom`)."""
@@ -357,11 +378,14 @@ def span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, ro
     row[n] = r
     c0[n] = a
     count[n] = c
-    for k in range(attrs.shape[2]):
-        va = attrs[i, pa, k] + sa * (attrs[i, qa, k] - attrs[i, pa, k])
-        vb = attrs[i, p, k] + sb * (attrs[i, q, k] - attrs[i, p, k])
-        left[n, k] = vb if swap else va
-        right[n, k] = va if swap else vb
+    K = attrs.shape[2]
+    # a column count known to the compiler unrolls the loop (the frame's 7 or 4 columns)
+    if K == 7:
+        _span_attrs(attrs, i, n, pa, qa, sa, p, q, sb, swap, left, right, 7)
+    elif K == 4:
+        _span_attrs(attrs, i, n, pa, qa, sa, p, q, sb, swap, left, right, 4)
+    else:
+        _span_attrs(attrs, i, n, pa, qa, sa, p, q, sb, swap, left, right, K)
     ws = xr - xl
     d = 1.0 / ws
     dt[n] = d

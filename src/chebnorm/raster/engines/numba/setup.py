@@ -33,7 +33,7 @@ from .jit import f2i, i2f, njit, run_with_caller, threads
 from .kernels import angular_setup
 from .workspace import scratch
 
-__all__ = ["widest_dot", "span_input", "end_arrays", "method_setup"]
+__all__ = ["widest_dot", "span_input", "end_arrays", "method_setup", "end_checks"]
 
 
 #: the position tolerance of ``check_span_input`` (pixels at ``t`` in [-tol, 1 + tol])
@@ -163,6 +163,76 @@ def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, 
     red[2] = 1.0 if t0nz else 0.0
     red[3] = cmax
     red[4] = nhard
+
+
+@njit()
+def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B):
+    """The unit end normals of spans ``0 .. n-1`` of a linear method into ``A`` and
+    ``B - A`` into ``B`` ((3, n), their dtype), as :func:`_ends_part` computes them, and
+    whether every check of ``check_span_input`` passes on them (False: one fails).  The
+    fused frame's per-row set-up (:func:`chebnorm.raster.engines.numba.frame.phong`).
+
+    Only the outcome of the checks is wanted here (no cosines, no depths), so two of
+    them take a shortcut that decides as the reference does: ``| |N| - 1 | <= UNIT_TOL``
+    holds wherever ``|N.N - 1| <= UNIT_TOL`` (``| |N| - 1 | = |N.N - 1| / (|N| + 1)``, half
+    of that, and the square root's rounding is far below the other half), and the
+    cosine ``N_l.N_r / (|N_l| |N_r|)`` of two such normals is above ``-1 + ANTIPARALLEL_TOL``
+    wherever ``N_l.N_r > -1/2``; elsewhere the reference's own expressions decide.
+
+    Parameters
+    ----------
+    left, right : numpy.ndarray
+        The spans' end attributes ``(>= n, K)``, the normal in columns 1-3.
+    m, t0, dt, count : numpy.ndarray
+        The spans' pixel counts and steps, as :func:`.rasterize.row_spans` gives them.
+    o_ein, o_norm : int
+        The summation orders of :func:`.calibration.ends_orders`.
+    n : int
+        The number of spans.
+    A, B : numpy.ndarray
+        The outputs described above.
+
+    Returns
+    -------
+    bool
+        Whether every check passed.
+    """
+    ok = True
+    for i in range(n):
+        a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
+        r = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
+        a0, a1, a2 = a0 / r, a1 / r, a2 / r
+        b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
+        r = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
+        b0, b1, b2 = b0 / r, b1 / r, b2 / r
+        A[0, i], A[1, i], A[2, i] = a0, a1, a2
+        B[0, i], B[1, i], B[2, i] = b0, b1, b2
+        for c in range(3):
+            B[c, i] = B[c, i] - A[c, i]
+        fin = (np.isfinite(a0) & np.isfinite(a1) & np.isfinite(a2) & np.isfinite(b0)
+               & np.isfinite(b1) & np.isfinite(b2) & np.isfinite(t0[i]) & np.isfinite(dt[i]))
+        last = t0[i] + (count[i] - 1) * dt[i]
+        pos = ((m[i] >= 1) & (dt[i] > 0.0) & (count[i] >= 1) & (t0[i] >= -_POS_TOL)
+               & (last <= 1.0 + _POS_TOL))
+        sa = dot3(a0, a1, a2, a0, a1, a2, o_ein)
+        sb = dot3(b0, b1, b2, b0, b1, b2, o_ein)
+        d = dot3(a0, a1, a2, b0, b1, b2, o_ein)
+        easy = (abs(sa - 1.0) <= UNIT_TOL) & (abs(sb - 1.0) <= UNIT_TOL) & (d > -0.5)
+        if fin and pos and easy:
+            continue
+        if not (fin and pos):
+            ok = False
+            continue
+        # the reference's expressions (_ends_part's)
+        qa, qb = np.sqrt(sa), np.sqrt(sb)
+        if abs(qa - 1.0) > UNIT_TOL or abs(qb - 1.0) > UNIT_TOL:
+            ok = False
+        if o_norm != o_ein:
+            qa = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
+            qb = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
+        if 1.0 + d / (qa * qb) <= ANTIPARALLEL_TOL:
+            ok = False
+    return ok
 
 
 @njit()
