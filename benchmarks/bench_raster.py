@@ -304,6 +304,8 @@ def main(argv=None):
     ap.add_argument("--peer", choices=["llvmpipe"], default=None,
                     help="time the phong frame of every method against Mesa llvmpipe drawing "
                          "the same frame (moderngl, EGL), interleaved; prints the rate ratios")
+    ap.add_argument("--methods", nargs="+", default=None, choices=list(available_methods()),
+                    help="with --peer or --stages: only these methods (default every one)")
     ap.add_argument("--stages", action="store_true",
                     help="per-stage CPU time of the numba engine's phong frame, every method")
     ap.add_argument("--image-only", action="store_true",
@@ -315,7 +317,7 @@ def main(argv=None):
     size = tuple(args.size)
     if args.stages:
         load_before = os.getloadavg()
-        res = stages(mesh, size, list(available_methods()), args.repeat,
+        res = stages(mesh, size, args.methods or list(available_methods()), args.repeat,
                      extra_maps=not args.image_only)
         if args.json:
             print(json.dumps(res, indent=2))
@@ -323,7 +325,7 @@ def main(argv=None):
             print_stages(res, mesh, size, load_before, args.image_only)
         return
     if args.peer:
-        methods = list(available_methods())
+        methods = args.methods or list(available_methods())
         res = peer_llvmpipe(mesh, size, methods, args.repeat if args.repeat_set else 7,
                             engine=args.engine[0])
         if args.json:

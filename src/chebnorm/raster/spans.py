@@ -57,7 +57,24 @@ class Camera:
     fov_y: float = np.radians(30.0)
 
     def frame(self):
-        """Rows: right, up, back (unit, right-handed)."""
+        """Rows: right, up, back (unit, right-handed); read only, computed once per camera
+        (a frame calls it twice: projection and light)."""
+        try:
+            key = (tuple(map(float, self.eye)), tuple(map(float, self.target)),
+                   tuple(map(float, self.up)))
+        except (TypeError, ValueError):
+            key = None
+        got = _FRAMES.get(key) if key is not None else None
+        if got is None:
+            got = self._frame()
+            got.flags.writeable = False
+            if key is not None:
+                if len(_FRAMES) >= 64:
+                    _FRAMES.clear()
+                _FRAMES[key] = got
+        return got
+
+    def _frame(self):
         eye, target = np.asarray(self.eye, float), np.asarray(self.target, float)
         back = eye - target
         back /= np.linalg.norm(back)
@@ -67,6 +84,10 @@ class Camera:
             raise ValueError(f"camera up {self.up} is parallel to the view direction")
         right /= nr
         return np.stack([right, np.cross(back, right), back])
+
+
+#: {(eye, target, up): frame}: :meth:`Camera.frame` of recent cameras
+_FRAMES: dict = {}
 
 
 def default_camera(center, radius, direction=(2.0, -3.0, 1.8), fov_y=np.radians(30.0)) -> Camera:

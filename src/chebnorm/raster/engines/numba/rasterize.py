@@ -253,20 +253,25 @@ def fast_lerp(sp: Spans, cols, sel) -> np.ndarray:
 
 # --------------------------------------------------------- triangle set-up
 @njit()
-def _gather_setup(pos, nrm, xy, inv_w, faces, cull, corners, tri, txy, attrs, tiw, tpos, tnrm):
-    """``NumpyEngine.setup``: front-facing triangles and their corners, into the flat
-    buffers ``tri`` (ids), ``txy``, ``attrs``, and (``corners``) ``tiw``, ``tpos``, ``tnrm``
-    (room for every face); the number of front-facing triangles."""
-    F = faces.shape[0]
+def _front_faces(xy, faces, cull, tri):
+    """``NumpyEngine.setup``'s front-facing triangles (ids into ``tri``, room for every
+    face); their number."""
     n = 0
-    for i in range(F):
+    for i in range(faces.shape[0]):
         a, b, c = faces[i, 0], faces[i, 1], faces[i, 2]
         area = ((xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1])
                 - (xy[c, 0] - xy[a, 0]) * (xy[b, 1] - xy[a, 1]))
         keep = area < 0 if cull else area != 0
         tri[n] = i
         n += keep
-    for k in range(n):
+    return n
+
+
+@njit()
+def _gather_part(pos, nrm, xy, inv_w, faces, tri, lo, hi, corners, txy, attrs, tiw, tpos, tnrm):
+    """Front triangles ``lo .. hi-1`` (ids ``tri``): their corners into the flat buffers
+    ``txy``, ``attrs`` and (``corners``) ``tiw``, ``tpos``, ``tnrm``."""
+    for k in range(lo, hi):
         i = tri[k]
         for v in range(3):
             q = faces[i, v]
@@ -278,12 +283,11 @@ def _gather_setup(pos, nrm, xy, inv_w, faces, cull, corners, tri, txy, attrs, ti
                 attrs[7 * e + 1 + c] = nrm[q, c]
                 attrs[7 * e + 4 + c] = pos[q, c]
     if corners:
-        for e in range(3 * n):
+        for e in range(3 * lo, 3 * hi):
             tiw[e] = attrs[7 * e]
             for c in range(3):
                 tnrm[3 * e + c] = attrs[7 * e + 1 + c]
                 tpos[3 * e + c] = attrs[7 * e + 4 + c]
-    return n
 
 
 def gather_setup(mesh, xy, inv_w, cull, corners=True):
@@ -313,12 +317,16 @@ def gather_setup(mesh, xy, inv_w, cull, corners=True):
     """
     faces = np.ascontiguousarray(mesh.faces, np.int64)
     bufs = setup_buffers(len(faces))
-    n = _gather_setup(np.ascontiguousarray(mesh.positions, np.float64),
-                      np.ascontiguousarray(mesh.normals, np.float64),
-                      np.ascontiguousarray(xy, np.float64),
-                      np.ascontiguousarray(inv_w, np.float64), faces, bool(cull), bool(corners),
-                      *bufs)
+    xy = np.ascontiguousarray(xy, np.float64)
     b_tri, b_xy, b_attrs, b_iw, b_pos, b_nrm = bufs
+    n = _front_faces(xy, faces, bool(cull), b_tri)
+    k = min(threads(), max(1, n // 2048))       # the gather split over the threads
+    cuts = [n * q // k for q in range(k + 1)]
+    data = (np.ascontiguousarray(mesh.positions, np.float64),
+            np.ascontiguousarray(mesh.normals, np.float64), xy,
+            np.ascontiguousarray(inv_w, np.float64), faces, b_tri)
+    run_with_caller([(_gather_part, (*data, cuts[q], cuts[q + 1], bool(corners), b_xy, b_attrs,
+                                     b_iw, b_pos, b_nrm)) for q in range(k)])
     if not corners:
         return (b_tri[:n], b_xy[:6 * n].reshape(n, 3, 2), None, None, None,
                 b_attrs[:21 * n].reshape(n, 3, 7))
