@@ -47,7 +47,7 @@ from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f3
                           pow_calibrated, powers, trig64, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
-from .rasterize import count_rows, row_buckets, row_spans, span_geom, span_write
+from .rasterize import part_buckets, row_spans, span_geom, span_write
 from .setup import end_checks, method_setup, span_input, widest_dot
 from .workspace import give, keep_maps, output_maps, scratch, take
 
@@ -351,13 +351,12 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
 
 
 @njit()
-def _frame_rows(width, height, mode, xy, attrs, first, ids, maxrow, eorders, proto, kc,
-                face_id, per_pixel_h, Htri, L, eye, light, orders, want, part, parts, img, mask,
-                tri_map, nlen, out, stop=0):
+def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h, Htri,
+                L, eye, light, orders, want, part, parts, img, mask, tri_map, nlen, out, stop=0):
     """The whole frame of a linear method (modes 0-3) scan line by scan line, on the rows
     ``part, part + parts, ...``: each row's spans (:func:`.rasterize.span_geom`,
-    :func:`.rasterize.span_write` on the triangles crossing it, ``first``/``ids`` of
-    :func:`.rasterize.row_buckets`, in triangle order as :func:`.rasterize.row_spans`
+    :func:`.rasterize.span_write` on the triangles crossing it, found by
+    :func:`.rasterize.part_buckets`, in triangle order as :func:`.rasterize.row_spans`
     numbers them) into row-sized arrays, their unit end normals and the checks of
     ``check_span_input`` (:func:`.setup.end_checks`, modes 1-3; normals in the dtype of
     ``proto``), then :func:`_row_pass`. The spans never leave the cache: no frame-sized
@@ -365,7 +364,8 @@ def _frame_rows(width, height, mode, xy, attrs, first, ids, maxrow, eorders, pro
     caller draws it step by step, with the reference's errors), fragments, covered
     pixels]. ``stop`` 4 (profiling): the rows' spans and checks alone."""
     Kc = attrs.shape[2]
-    M = max(maxrow, 1)
+    first, ids, widest = part_buckets(xy, height, part, parts)
+    M = max(widest, 1)
     ltri, lrow, lc0 = np.empty(M, np.int64), np.empty(M, np.int64), np.empty(M, np.int64)
     lcount, lm = np.empty(M, np.int64), np.empty(M, np.int64)
     lt0, ldt = np.empty(M), np.empty(M)
@@ -379,9 +379,10 @@ def _frame_rows(width, height, mode, xy, attrs, first, ids, maxrow, eorders, pro
     buf = _row_buffers(width, lA, mode)
     nfrag = 0
     ncov = 0
-    for rr in range(part, height, parts):
+    for jr in range(first.shape[0] - 1):
+        rr = part + jr * parts
         n = 0
-        for q in range(first[rr], first[rr + 1]):
+        for q in range(first[jr], first[jr + 1]):
             i = ids[q]
             c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, rr, width)
             if c <= 0:
@@ -893,16 +894,14 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
     xy = np.ascontiguousarray(st.xy, np.float64)
     attrs = np.ascontiguousarray(attrs, np.float64)
     height = int(st.height)
-    first, ids = row_buckets(*count_rows(np.ascontiguousarray(xy[..., 1]), height), height)
-    maxrow = int(np.diff(first).max()) if height else 0
     kc, Htri, light, L, eye, ords, face_id = _frame_args(st, lighting, mode, dt_, orders)
     eo = ends_orders() if mode else None
     eorders = np.array(eo if eo is not None else (0, 0), np.int64)
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
     outs = np.zeros((k, 3), np.int64)
-    common = (st.width, height, mode, xy, attrs, first, ids, maxrow, eorders, kc, kc, face_id,
-              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0)
+    common = (st.width, height, mode, xy, attrs, eorders, kc, kc, face_id, per_pixel_h, Htri, L,
+              eye, light, ords, 3 if extra_maps else 0)
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):

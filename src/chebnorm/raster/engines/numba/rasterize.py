@@ -18,7 +18,8 @@ from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
-           "span_geom", "span_write", "row_buckets", "row_spans", "project", "default_camera_of"]
+           "span_geom", "span_write", "row_buckets", "part_buckets", "row_spans", "project",
+           "default_camera_of"]
 
 
 # --------------------------------------------------------------- span set-up
@@ -418,6 +419,55 @@ def row_buckets(r0, nrows, height):
             ids[fill[r]] = i
             fill[r] += 1
     return first, ids
+
+
+@njit(inline=True)
+def _ceil_div(a, b):
+    """``ceil(a / b)`` for ``a >= 0``, ``b >= 1`` (a shift for 1 and 2 threads: an integer
+    division per triangle costs more than the rest of its row count)."""
+    if b == 1:
+        return a
+    if b == 2:
+        return (a + 1) >> 1
+    return (a + b - 1) // b
+
+
+@njit()
+def part_buckets(xy, height, part, parts):
+    """:func:`row_buckets` of the rows ``part, part + parts, ...`` alone (a thread's rows
+    of the frame), from the screen corners ``xy (T, 3, 2)`` (rows as :func:`count_rows`
+    finds them): ``(first, ids, widest)``, the ``j``-th of those rows' triangles
+    ``ids[first[j]:first[j+1]]`` in triangle order, ``widest`` the most triangles of a
+    row.  Each thread finds its own rows' triangles: no serial pass over the frame."""
+    T = xy.shape[0]
+    nj = max((height - part + parts - 1) // parts, 0)
+    first = np.zeros(nj + 1, np.int64)
+    lo = np.empty(T, np.int64)
+    hi = np.empty(T, np.int64)
+    for i in range(T):
+        y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
+        a = min(max(np.ceil(min(y0, y1, y2) - 0.5), 0.0), float(height))
+        b = min(max(np.ceil(max(y0, y1, y2) - 0.5), 0.0), float(height))
+        r0 = np.int64(a)
+        r1 = max(np.int64(b), r0)
+        # the first of this thread's rows at or after r0, and past the last one before r1
+        j0 = _ceil_div(r0 - part, parts) if r0 > part else 0
+        j1 = _ceil_div(r1 - part, parts) if r1 > part else 0
+        lo[i] = j0
+        hi[i] = j1
+        for j in range(j0, j1):
+            first[j + 1] += 1
+    widest = 0
+    for j in range(nj):
+        widest = max(widest, first[j + 1])
+        first[j + 1] += first[j]
+    fill = first[:-1].copy()
+    ids = np.empty(first[nj], np.int64)
+    for i in range(T):
+        for j in range(lo[i], hi[i]):
+            ids[fill[j]] = i
+            fill[j] += 1
+    return first, ids, widest
 
 
 # --------------------------------------------------------------- row spans
