@@ -392,6 +392,58 @@ def test_trig_shortcut_is_correctly_rounded_where_taken():
                 assert err <= Fraction(44, 100) * ulp + ulp / 2 ** 10
 
 
+def _sin_small(x):
+    n = len(x)
+    out, ok = np.empty(n), np.empty(n, np.bool_)
+    calibration.sin_small(np.ascontiguousarray(x, np.float64), out, ok, n)
+    return out, ok
+
+
+def test_sin_small_gives_libm_bits():
+    # the float64 reference is math.sin (detmath): other arguments than the calibration's,
+    # the range's edges, powers of two, and arguments the shortcut hands to the library
+    import math
+
+    rng = np.random.default_rng(91)
+    edges = np.array([0.126, 2.0 ** -26, 2.0 ** -27] + [2.0 ** -k for k in range(2, 60)])
+    x = np.concatenate([rng.random(500_000) * 0.126, rng.random(200_000) * 2.0 ** -5,
+                        2.0 ** rng.uniform(-70, -2.9, 100_000), rng.uniform(0.126, 1.5, 5000),
+                        (edges[:, None] * (1.0 + np.arange(-16, 17) * 2.0 ** -52)).ravel(),
+                        [0.0, -0.0, 2.0 ** -600, -0.01, np.nan, np.inf, -np.inf]])
+    ref = np.fromiter((math.sin(v) if math.isfinite(v) else math.nan for v in x.tolist()),
+                      float, len(x))
+    got, ok = _sin_small(x)
+    nan = np.isnan(ref)
+    assert (np.isnan(got) == nan).all() and got[~nan].tobytes() == ref[~nan].tobytes()
+    # nearly all of [0, 0.126) is the shortcut's; nothing outside it
+    inside = (x >= 2.0 ** -500) & (x < 0.126)
+    assert ok[inside].mean() > 0.97 and not ok[~inside].any()
+
+
+def test_sin_small_margin_holds_where_taken():
+    # independent of the C library (mpmath at 200 bits): where the shortcut is taken,
+    # its value is within (0.5 - 0.004 - 0.3 x**2) ulp of sin x (what the margin argument
+    # of calibration.sin_small needs, with room: 0.496 - 3 x**2 and at most 1.34 x**2
+    # of its own error)
+    import mpmath
+    from fractions import Fraction
+
+    rng = np.random.default_rng(6)
+    x = np.concatenate([rng.random(400) * 0.126, rng.random(200) * 2.0 ** -6,
+                        0.126 - rng.random(100) * 2.0 ** -8])
+    got, ok = _sin_small(x)
+    with mpmath.workprec(200):
+        for v, y, k in zip(x, got, ok):
+            if not k:
+                continue
+            exact = mpmath.sin(mpmath.mpf(float(v)))
+            ulp = Fraction(np.spacing(y))
+            m, e = exact.man_exp
+            err = abs(Fraction(float(y)) - Fraction(int(m)) * Fraction(2) ** int(e))
+            xx = Fraction(float(v)) ** 2
+            assert err <= (Fraction(496, 1000) - 3 * xx + Fraction(134, 100) * xx) * ulp
+
+
 def test_trig_calibrated():
     assert calibration.trig_calibrated() == HAVE_NUMBA
 

@@ -14,6 +14,7 @@ the frame's shortcuts for ``b ** n`` and float64 ``sin``/``cos``; :func:`det` is
 from __future__ import annotations
 
 import math
+import platform
 from functools import lru_cache
 
 import numpy as np
@@ -24,7 +25,8 @@ from chebnorm.methods.ops import NumpyOps
 from .jit import HAVE_NUMBA, f2i, fma, i2f, njit
 
 __all__ = ["dot3", "dot3_select", "dots", "calibrated", "first_orders", "f32_round", "det", "DetOps",
-           "powers", "pow_calibrated", "trig64", "trig_calibrated", "ends_orders"]
+           "powers", "pow_calibrated", "trig64", "sin_small", "trig_calibrated",
+           "ends_orders"]
 
 
 # ------------------------------------------------------- reduction orders
@@ -430,18 +432,67 @@ def trig64(kind, x, out, ok, w, n):
             out[i] = np.sin(x[i]) if kind == 0 else np.cos(x[i])
 
 
+#: :func:`sin_small`'s range: ``sin`` of a double in ``[2**-500, 0.126)``.  There glibc's
+#: ``sin`` (s_sin.c, glibc >= 2.28; older ones round correctly, which is stronger) returns
+#: ``x`` below ``2**-26`` and otherwise ``do_sin``'s ``TAYLOR_SIN``: ``x + t`` rounded once,
+#: ``t = ((s1 + xx (s2 + ...)) x) xx`` (``xx = x*x``, minimax ``s1 .. s5``; fused or not,
+#: at most 5 roundings).  So the library returns the double nearest ``x + tau`` with
+#: ``|tau - (sin x - x)| <= 8 u x**3/6 + 0.0006 x u`` (``u = 2**-53``; the second term
+#: the polynomial's approximation error, 0.00055 x u at most on ``[0, 0.126]``, mpmath).
+#: :func:`sin_small` computes ``y + e`` (``y = x + t`` rounded, ``e`` its rounding error,
+#: exact by Fast2Sum) with a Taylor ``t`` of the same form, within the same bound
+#: (approximation error 0.0013 x u).  As ``ulp(y) >= 0.997 x u`` here, the two values are
+#: within ``(2.7 x**2 + 0.002)`` ulp of ``sin x`` each way; where ``|e|`` is at most
+#: ``(0.496 - 3 x**2)`` ulp and ``y`` is not a power of two, the library's ``x + tau`` is
+#: less than half an ulp from ``y``: it returns ``y``.  (Below ``2**-26``: ``|t| < 0.34``
+#: ulp, so ``y = x``, the library's value.)  About one argument in 200 of ``0.02`` fails the
+#: test (one in eight with :func:`trig64`'s library-wide 0.44), and :func:`sin_small`'s
+#: loop has no table look-up: it vectorizes.  :func:`trig_calibrated` checks it too.
+_SIN_SMALL = 0.126
+
+
+_SIN_MARGIN = 0.496
+
+
+_SIN_MARGIN_X2 = 3.0
+
+
+@njit()
+def sin_small(x, out, ok, n):
+    """``out[i] = sin(x[i])``, float64, with the bits of the C library's (glibc): from
+    the Taylor polynomial where the margin test above admits it (``x[i]`` in
+    ``[2**-500, 0.126)``), the library's call elsewhere; ``ok[i]``: without the call."""
+    for i in range(n):
+        v = x[i]
+        xx = v * v
+        t = ((-1.0 / 6.0 + xx * (1.0 / 120.0 + xx * (-1.0 / 5040.0 + xx * (
+            1.0 / 362880.0 + xx * (-1.0 / 39916800.0))))) * v) * xx
+        y = v + t
+        e = t - (y - v)          # exact (Fast2Sum, |t| < |v|)
+        bits = f2i(y)
+        ulp = i2f((((bits >> 52) & 0x7FF) - 52) << 52)
+        ok[i] = ((v >= _TRIG_LO) & (v < _SIN_SMALL) & ((bits & 0xFFFFFFFFFFFFF) != 0)
+                 & (abs(e) <= (_SIN_MARGIN - _SIN_MARGIN_X2 * xx) * ulp))
+        out[i] = y
+    for i in range(n):
+        if not ok[i]:
+            out[i] = np.sin(x[i])
+
+
 @lru_cache(maxsize=1)
 def trig_calibrated() -> bool:
-    """Whether the frame may take :func:`trig64`'s shortcut: numba installed and the
-    shortcut gave :func:`math.sin`'s and :func:`math.cos`'s bits (the float64
-    reference's) on 200 000 probes each on this machine (random arguments in ``(0,
-    1.5]``, small ones, table points ``k/64`` a few ulp either side, and arguments the
-    shortcut hands to the library).
+    """Whether the frame may take :func:`trig64`'s and :func:`sin_small`'s shortcuts:
+    numba installed, the C library glibc (the margins are its bounds), and the shortcuts
+    gave :func:`math.sin`'s and :func:`math.cos`'s bits (the float64 reference's) on
+    200 000 probes each on this machine (random arguments in ``(0, 1.5]``, small ones,
+    table points ``k/64`` a few ulp either side, and arguments the shortcut hands to the
+    library), :func:`sin_small` also on 100 000 more below 0.126 (and a few ulp either
+    side of 0.126, ``2**-26`` and powers of two).
 
     >>> trig_calibrated() == HAVE_NUMBA
     True
     """
-    if not HAVE_NUMBA:
+    if not HAVE_NUMBA or platform.libc_ver()[0] != "glibc":
         return False
     rng = np.random.default_rng(20261123)
     grid = np.arange(97) / 64.0
@@ -452,11 +503,22 @@ def trig_calibrated() -> bool:
     out, ok, w = np.empty(n), np.empty(n, np.bool_), np.empty((5, n))
     for kind, fn in ((0, math.sin), (1, math.cos)):
         trig64(kind, x, out, ok, w, n)
-        ref = np.fromiter((fn(v) if math.isfinite(v) else math.nan for v in x.tolist()),
-                          np.float64, n)
-        if not (((out == ref) | (np.isnan(out) & np.isnan(ref))).all() and ok.mean() > 0.5):
+        if not (_same(out, x, fn) and ok.mean() > 0.5):
             return False
-    return True
+    edges = np.array([_SIN_SMALL, 2.0 ** -26] + [2.0 ** -k for k in range(3, 40)])
+    xs = np.concatenate([x, rng.random(50_000) * _SIN_SMALL, rng.random(50_000) * 0.02,
+                         (edges[:, None] * (1.0 + np.arange(-8, 9) * 2.0 ** -52)).ravel()])
+    out, ok = np.empty(len(xs)), np.empty(len(xs), np.bool_)
+    sin_small(xs, out, ok, len(xs))
+    return _same(out, xs, math.sin) and bool(ok[n:n + 100_000].mean() > 0.9)
+
+
+def _same(out, x, fn):
+    """Whether ``out`` is ``fn`` of ``x`` element by element, bit for bit (NaN where not
+    finite)."""
+    ref = np.fromiter((fn(v) if math.isfinite(v) else math.nan for v in x.tolist()),
+                      np.float64, len(x))
+    return bool(((out == ref) | (np.isnan(out) & np.isnan(ref))).all())
 
 
 @lru_cache(maxsize=None)

@@ -44,7 +44,7 @@ from chebnorm.methods.spans import MAX_LEVELS, check_dtype
 
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
 from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f32_round,
-                          pow_calibrated, powers, trig64, trig_calibrated)
+                          pow_calibrated, powers, sin_small, trig_calibrated)
 from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_spans, span_geom, span_write
@@ -485,14 +485,14 @@ def _step_row(mode, k0, k1, c0, count, A, B, C, sc, bs, sx, wx, n0, n1, n2, nw):
 def _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, fastsin, sw, ok, sab, skip, n0, n1, n2, nw):
     """Slerp (mode 4) at the row's winners; the number of float32 pixels whose sine is in
     doubt (``skip``: for :mod:`detmath`, see :func:`phong`). ``fastsin``: float64 sines
-    by :func:`trig64` (rows 0-3 of ``sw`` the arguments and sines, 4-8 its scratch)."""
+    by :func:`sin_small` (rows 0-3 of ``sw`` the arguments and sines)."""
     if is64 and fastsin:
         for k in range(nw):
             s = ws[k]
             sw[0, k] = (kc[5] - tc[k]) * sc[s]
             sw[1, k] = tc[k] * sc[s]
-        trig64(0, sw[0], sw[2], ok, sw[4:], nw)
-        trig64(0, sw[1], sw[3], ok, sw[4:], nw)
+        sin_small(sw[0], sw[2], ok, nw)
+        sin_small(sw[1], sw[3], ok, nw)
         for k in range(nw):
             s = ws[k]
             wa = sw[2, k] * sc2[s]

@@ -28,7 +28,7 @@ from chebnorm.methods.spans import (ANTIPARALLEL_TOL, COVER_SLACK, MAX_LEVELS, P
                                     span_levels)
 
 from ...meshes import unit
-from .calibration import dot3, ends_orders, f32_round, trig64, trig_calibrated
+from .calibration import dot3, ends_orders, f32_round, sin_small, trig64, trig_calibrated
 from .jit import f2i, i2f, njit, run_with_caller, threads
 from .kernels import angular_setup
 from .workspace import scratch
@@ -478,21 +478,23 @@ def _trig(kind, x, is64, buf):
 @njit()
 def _slerp_part(A, B, k, is64, fast, lo, hi, psi_out, inv_out, hard):
     """``psi = max(arccos(min(N_l.N_r, 1)), TINY)``, ``inv = 1/sin(psi)`` (``fast``: the
-    float64 sines by :func:`trig64`)."""
+    float64 sines by :func:`sin_small`)."""
     if is64 and fast:
-        m = hi - lo
-        w = np.empty((6, m))
-        ok = np.empty(m, np.bool_)
-        for j in range(m):
-            i = lo + j
-            d = A[0, i] * B[0, i] + A[1, i] * B[1, i] + A[2, i] * B[2, i]
-            w[0, j] = max(np.arccos(min(d, k[0])), k[3])
-        trig64(0, w[0], psi_out[lo:hi], ok, w[1:], m)
-        for j in range(m):
-            i = lo + j
-            inv_out[i] = k[0] / psi_out[i]
-            psi_out[i] = w[0, j]
-            hard[i] = False
+        # in blocks of _BLOCK spans: the scratch rows stay in the cache
+        w = np.empty((6, _BLOCK))
+        ok = np.empty(_BLOCK, np.bool_)
+        for b0 in range(lo, hi, _BLOCK):
+            m = min(hi - b0, _BLOCK)
+            for j in range(m):
+                i = b0 + j
+                d = A[0, i] * B[0, i] + A[1, i] * B[1, i] + A[2, i] * B[2, i]
+                w[0, j] = max(np.arccos(min(d, k[0])), k[3])
+            sin_small(w[0], psi_out[b0:b0 + m], ok, m)
+            for j in range(m):
+                i = b0 + j
+                inv_out[i] = k[0] / psi_out[i]
+                psi_out[i] = w[0, j]
+                hard[i] = False
         return 0
     buf = np.empty(1, A.dtype)
     n = 0
@@ -546,7 +548,7 @@ def _quadratic_part(A, B, t0, dt, k, coeffs, exact, start_left, lo, hi, V, D1, D
 def _angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, K2, hard):
     """The first two pixels of ``angular_steps`` (``two``: the frame has spans of two
     or more pixels, else ``P1 = P0``) and ``2 cos(phi)`` (``fast``: the float64 sines
-    and cosines by :func:`trig64`, :func:`_angular_fast`)."""
+    by :func:`sin_small`, cosines by :func:`trig64`, :func:`_angular_fast`)."""
     if is64 and fast:
         _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard)
         return 0
@@ -588,10 +590,20 @@ def _angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, 
 @njit()
 def _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard):
     """:func:`_angular_part` in float64, its cosines and sines of ``phi`` and of the
-    start angle computed for the spans ``lo .. hi-1`` at once (:func:`trig64`)."""
+    start angle computed for the spans ``lo .. hi-1`` at once (:func:`trig64`,
+    :func:`sin_small`)."""
+    # in blocks of _BLOCK spans: the scratch rows stay in the cache
+    w = np.empty((11, _BLOCK))
+    ok = np.empty(_BLOCK, np.bool_)
+    for b0 in range(lo, hi, _BLOCK):
+        _angular_block(A, B, t0, dt, k, two, start_left, b0, min(hi, b0 + _BLOCK), P0, P1,
+                       K2, hard, w, ok)
+
+
+@njit(inline=True)
+def _angular_block(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard, w, ok):
+    """:func:`_angular_fast` on the spans ``lo .. hi-1`` (at most ``_BLOCK``)."""
     m = hi - lo
-    w = np.empty((11, m))
-    ok = np.empty(m, np.bool_)
     for j in range(m):
         i = lo + j
         c = min(A[0, i] * B[0, i] + A[1, i] * B[1, i] + A[2, i] * B[2, i], k[0])
@@ -599,10 +611,10 @@ def _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard):
         w[0, j] = psi * dt[i]
         w[1, j] = t0[i] * psi
     trig64(1, w[0], w[2], ok, w[6:], m)
-    trig64(0, w[0], w[3], ok, w[6:], m)
+    sin_small(w[0], w[3], ok, m)
     if not start_left:
         trig64(1, w[1], w[4], ok, w[6:], m)
-        trig64(0, w[1], w[5], ok, w[6:], m)
+        sin_small(w[1], w[5], ok, m)
     for j in range(m):
         i = lo + j
         a0, a1, a2 = A[0, i], A[1, i], A[2, i]
@@ -626,6 +638,10 @@ def _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard):
         else:
             P1[0, i], P1[1, i], P1[2, i] = q0, q1, q2
         hard[i] = False
+
+
+#: spans per block of the float64 slerp and angular set-up (scratch rows of this length)
+_BLOCK = 512
 
 
 def _consts(dtype):
