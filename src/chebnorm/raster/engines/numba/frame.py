@@ -115,10 +115,18 @@ def _intensity(N0, N1, N2, h0, h1, h2, l0, l1, l2, order_l, order_h, I0, ka, kd,
 
 
 @njit()
-def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs):
+def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs, tx):
     """The winning span of each pixel of a row in ``bs`` (spans ``k0 .. k1-1``, the row's
-    in ``setup_spans``' order: largest ``1/w``, ties to the earliest span; -1: none)."""
-    for x in range(width):
+    in ``setup_spans``' order: largest ``1/w``, ties to the earliest span; -1: none) and
+    its ``t`` (unclipped, float64) in ``tx``, over the row's covered range ``[xlo,
+    xhi)``, which it returns (``bs`` and ``tx`` are not written outside it; ``xlo >=
+    xhi``: no span)."""
+    xlo = width
+    xhi = 0
+    for s in range(k0, k1):
+        xlo = min(xlo, c0[s])
+        xhi = max(xhi, c0[s] + count[s])
+    for x in range(xlo, xhi):
         bs[x] = -1
     for s in range(k0, k1):
         lo = left[s, 0]
@@ -127,12 +135,15 @@ def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs):
         d = dt[s]
         x0 = c0[s]
         for j in range(count[s]):
-            t = min(max(a + j * d, 0.0), 1.0)
+            tu = a + j * d
+            t = min(max(tu, 0.0), 1.0)
             w = lo + t * dw
-            x = x0 + j
+            x = np.uint64(x0 + j)    # unsigned: no negative-index wrap-around in the loop
             win = (bs[x] < 0) | (w > bw[x])    # selects, not branches (bw[x] unset where
             bs[x] = s if win else bs[x]        # bs[x] < 0: the ``|`` makes it moot)
             bw[x] = w if win else bw[x]
+            tx[x] = tu if win else tx[x]
+    return xlo, xhi
 
 
 @njit()
@@ -148,20 +159,32 @@ def _row_background(tri_map, nlen, base, width, want):
 
 
 @njit()
-def _row_winners(bs, wx, ws, width, img, mask, base):
-    """The covered pixels of a row in ``x`` order (``wx``) with their spans (``ws``);
-    their number.  Also the row's image background (0, overwritten where a fragment
-    lands) and its mask (``bs[x] >= 0``) from offset ``base``.  Branch-free: every ``x``
-    is written, the count advances where ``bs[x] >= 0`` (``wx``, ``ws`` have room for the
-    whole row)."""
-    nw = 0
+def _row_winners(bs, tx, xlo, xhi, wx, ws, tc, wt, width, img, mask, base):
+    """The covered pixels of a row in ``x`` order (``wx``) with their spans (``ws``),
+    their ``t`` in the dtype (``tc``: the reference's ``t.astype(dtype)``) and clipped to
+    [0, 1] in float64 (``wt``), from :func:`_row_visibility`'s ``bs``, ``tx`` over its
+    range ``[xlo, xhi)``; their number.  Also the row's image background (0, overwritten
+    where a fragment lands) and its mask (``bs[x] >= 0``, False outside the range) from
+    offset ``base``.  Branch-free: every ``x`` of the range is written, the count
+    advances where ``bs[x] >= 0`` (``wx``, ``ws``, ``tc``, ``wt`` have room for the whole
+    row)."""
+    irow = img[base:base + width]      # row views: indices known >= 0 (a plain fill)
+    mrow = mask[base:base + width]
     for x in range(width):
+        irow[x] = 0.0
+        mrow[x] = False
+    nw = 0
+    for x in range(xlo, xhi):
         s = bs[x]
         wx[nw] = x
         ws[nw] = s
-        img[base + x] = 0.0
-        mask[base + x] = s >= 0
+        wt[nw] = tx[x]
+        mrow[x] = s >= 0
         nw += s >= 0
+    for k in range(nw):
+        tu = wt[k]
+        tc[k] = tu                       # the reference's t.astype(dtype)
+        wt[k] = min(max(tu, 0.0), 1.0)
     return nw
 
 
@@ -270,17 +293,12 @@ def _row_pass(rr, width, k0, k1, mode, stri, c0, count, t0, dt, left, right, A, 
      nd, sab, sw) = buf
     W = width
     base = rr * W
-    _row_visibility(W, k0, k1, c0, count, t0, dt, left, right, bw, bs)
-    nw = _row_winners(bs, wx, ws, W, img, mask, base)
+    xlo, xhi = _row_visibility(W, k0, k1, c0, count, t0, dt, left, right, bw, bs, av)
+    nw = _row_winners(bs, av, xlo, xhi, wx, ws, tc, wt, W, img, mask, base)
     if want:
         _row_background(tri_map, nlen, base, W, want)
     if nw == 0:
         return 0, 0
-    for k in range(nw):
-        s = ws[k]
-        tu = t0[s] + (wx[k] - c0[s]) * dt[s]
-        tc[k] = tu                       # the reference's t.astype(dtype)
-        wt[k] = min(max(tu, 0.0), 1.0)
     if stop == 1:
         return nw, 0
     hard = 0
@@ -444,13 +462,13 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
         v = I0 * (ka + kdif * av[k] + ks * pw[k])
         av[k] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
     for k in range(nw):     # (the mask is :func:`_row_winners`')
-        img[base + wx[k]] = av[k]
+        img[np.uint64(base + wx[k])] = av[k]
     if want & 1:
         for k in range(nw):
-            tri_map[base + wx[k]] = face_id[stri[ws[k]]]
+            tri_map[np.uint64(base + wx[k])] = face_id[stri[ws[k]]]
     if want & 2:
         for k in range(nw):
-            nlen[base + wx[k]] = nl[k]
+            nlen[np.uint64(base + wx[k])] = nl[k]
     for k in range(nw):
         if skip[k]:
             skip[k] = False
