@@ -48,7 +48,7 @@ from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f3
 from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_spans, span_geom, span_write
-from .setup import end_checks, method_setup, span_input, widest_dot
+from .setup import _angular_part, _slerp_part, end_checks, method_setup, span_input, widest_dot
 from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
@@ -370,17 +370,26 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
 
 @njit()
 def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h, Htri,
-                L, eye, light, orders, want, part, parts, img, mask, tri_map, nlen, out, stop=0):
-    """The whole frame of a linear method (modes 0-3) scan line by scan line, on the rows
-    ``part, part + parts, ...``: each row's spans (:func:`.rasterize.span_geom`,
-    :func:`.rasterize.span_write` on the triangles crossing it, found by
-    :func:`.rasterize.part_buckets`, in triangle order as :func:`.rasterize.row_spans`
-    numbers them) into row-sized arrays, their unit end normals and the checks of
-    ``check_span_input`` (:func:`.setup.end_checks`, modes 1-3; normals in the dtype of
-    ``proto``), then :func:`_row_pass`. The spans never leave the cache: no frame-sized
-    span arrays are written or read. ``out``: [a check failed (then the frame stops: the
-    caller draws it step by step, with the reference's errors), fragments, covered
-    pixels]. ``stop`` 4 (profiling): the rows' spans and checks alone."""
+                L, eye, light, orders, want, quick, part, parts, img, mask, tri_map, nlen, out,
+                stop=0):
+    """The whole frame of a method without a table, linear (modes 0-3), slerp (4) or
+    angular (6), scan line by scan line, on the rows ``part, part + parts, ...``: each
+    row's spans (:func:`.rasterize.span_geom`, :func:`.rasterize.span_write` on the
+    triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
+    :func:`.rasterize.row_spans` numbers them) into row-sized arrays, their unit end
+    normals and the checks of ``check_span_input`` (:func:`.setup.end_checks`, modes 1-6;
+    normals in the dtype of ``proto``), the method's per-span set-up (modes 4 and 6:
+    :func:`.setup._slerp_part`, :func:`.setup._angular_part`; ``quick``: their float64
+    sines by the library-exact shortcuts), then :func:`_row_pass`. The spans never leave
+    the cache: no frame-sized span arrays are written or read.
+
+    The angular set-up depends on two facts about the whole frame: whether every span
+    starts at its left end (``t0 == 0``) and whether any span has two pixels or more.
+    The rows assume the usual answers (no, yes) and report the facts: ``out``: [1 a check
+    failed (then the frame stops: the caller draws it step by step, with the reference's
+    errors), 2 a set-up value the shortcuts cannot promise (the frame stops: the caller
+    draws it with the frame-sized spans), fragments, covered pixels, any ``t0 != 0``,
+    largest span]. ``stop`` 4 (profiling): the rows' spans, checks and set-up alone."""
     Kc = attrs.shape[2]
     first, ids, widest = part_buckets(xy, height, part, parts)
     M = max(widest, 1)
@@ -390,13 +399,21 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     lleft, lright = np.empty((M, Kc)), np.empty((M, Kc))
     lA, lB = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
     C = np.zeros((3, 1), proto.dtype)
-    sc = np.zeros(1, proto.dtype)
     levels = np.zeros(1, np.int64)
     R = np.zeros((1, 1), proto.dtype)
     off = np.zeros(1, np.bool_)
+    # modes 4 and 6: the per-span set-up (slerp: psi, 1/sin psi; angular: the first two
+    # pixels and 2 cos phi), setup._consts' constants
+    ks = np.array([1.0, 2.0, 4.0, 1e-30], proto.dtype)
+    sc, sc2 = np.zeros(M, proto.dtype), np.zeros(M, proto.dtype)
+    hard = np.zeros(M, np.bool_)
+    P0, P1 = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
+    is64 = proto.itemsize == 8
     buf = _row_buffers(width, lA, mode)
     nfrag = 0
     ncov = 0
+    t0nz = False
+    cmax = 0
     for jr in range(first.shape[0] - 1):
         rr = part + jr * parts
         n = 0
@@ -411,18 +428,35 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             n += 1
         if mode >= 1 and n > 0:
             if not end_checks(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], n,
-                              lA, lB):
+                              lA, lB, mode <= 3):
                 out[0] = 1
                 return
+        if mode >= 4:
+            for s in range(n):
+                t0nz |= lt0[s] != 0.0
+                cmax = max(cmax, lcount[s])
+        A, B = lA, lB
+        if mode == 4 and n > 0:
+            if _slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
+                out[0] = 2
+                return
+        elif mode == 6 and n > 0:
+            if _angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
+                             hard):
+                out[0] = 2
+                return
+            A, B = P0, P1
         if stop == 4:
             continue
-        ncov += _row_pass(rr, width, 0, n, mode, ltri, lc0, lcount, lt0, ldt, lleft, lright, lA,
-                          lB, C, sc, sc, levels, R, off, kc, kc, True, face_id, per_pixel_h,
+        ncov += _row_pass(rr, width, 0, n, mode, ltri, lc0, lcount, lt0, ldt, lleft, lright, A,
+                          B, C, sc, sc2, levels, R, off, kc, kc, is64, face_id, per_pixel_h,
                           Htri, L, eye, light, orders, want, img, mask, tri_map, nlen, stop,
                           buf)[0]
     out[0] = 0
     out[1] = nfrag
     out[2] = ncov
+    out[3] = t0nz
+    out[4] = cmax
 
 
 @njit()
@@ -811,8 +845,11 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
         attrs = attrs[..., :4]
     mode = MODES[id(method_kernel(spec))]
     dt_ = _rows_dtype(spec, mode, dtype)
-    if dt_ is not None:     # a linear method: the frame row by row, spans and all
-        return _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps)
+    if dt_ is not None:     # no table: the frame row by row, spans and all
+        res = _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps)
+        if res is not None:
+            return res
+        # the rows' assumptions did not hold: the frame with the frame-sized spans
     work = take()    # scratch arrays of an earlier frame (pages mapped)
     sp = row_spans(st.xy, attrs, st.width, st.height, work)
     tick("spans")
@@ -869,21 +906,26 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
 
 
 def _rows_dtype(spec, mode, dtype):
-    """The dtype of a linear method's row-by-row frame (:func:`_frame_rows`): float64 for
-    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3; None where the frame
-    takes the frame-sized span arrays instead (a method with a table, whose choice needs
-    every span first; no :func:`.calibration.ends_orders`; a dtype the reference refuses,
-    which it then refuses with its own error)."""
-    if mode > 3 or spec.table is not None:
+    """The dtype of a method's row-by-row frame (:func:`_frame_rows`): float64 for
+    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3, float64 for slerp
+    and angular (modes 4 and 6) in float64; None where the frame takes the frame-sized
+    span arrays instead (a method with a table, whose choice needs every span first; the
+    dichotomy and quadratic; slerp and angular in float32, whose set-up may need the
+    reference's functions; no :func:`.calibration.ends_orders`; a dtype the reference
+    refuses, which it then refuses with its own error)."""
+    if mode in (5, 7) or spec.table is not None:
         return None
     if mode == 0:
         return np.float64
     if ends_orders() is None:
         return None
     try:
-        return check_dtype(dtype)
+        dt_ = check_dtype(dtype)
     except (TypeError, ValueError):
         return None
+    if mode in (4, 6) and dt_ is not np.float64:
+        return None
+    return dt_
 
 
 def _frame_args(st, lighting, mode, dt_, orders):
@@ -903,10 +945,12 @@ def _frame_args(st, lighting, mode, dt_, orders):
 
 
 def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
-    """:func:`phong` of a linear method (modes 0-3; ``dt_`` from :func:`_rows_dtype`): the
-    row buckets, then :func:`_frame_rows` on the threads (every row's spans, checks,
-    visibility and shading in one pass); FrameUnsupported where a check fails (the step by
-    step path then gives the reference's error)."""
+    """:func:`phong` of a method without a table (modes 0-4, 6; ``dt_`` from
+    :func:`_rows_dtype`): the row buckets, then :func:`_frame_rows` on the threads (every
+    row's spans, checks, set-up, visibility and shading in one pass); FrameUnsupported
+    where a check fails (the step by step path then gives the reference's errors); None
+    where the frame-sized spans must draw it instead (a set-up value the shortcuts cannot
+    promise, or the angular set-up's assumptions about the whole frame did not hold)."""
     tick = clock or _no_clock
     per_pixel_h = lighting.half_vector == "pixel"
     xy = np.ascontiguousarray(st.xy, np.float64)
@@ -915,11 +959,12 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
     kc, Htri, light, L, eye, ords, face_id = _frame_args(st, lighting, mode, dt_, orders)
     eo = ends_orders() if mode else None
     eorders = np.array(eo if eo is not None else (0, 0), np.int64)
+    quick = bool(mode in (4, 6) and dt_ is np.float64 and trig_calibrated())
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
-    outs = np.zeros((k, 3), np.int64)
-    common = (st.width, height, mode, xy, attrs, eorders, kc, kc, face_id, per_pixel_h, Htri, L,
-              eye, light, ords, 3 if extra_maps else 0)
+    outs = np.zeros((k, 5), np.int64)
+    common = (st.width, height, mode, xy, attrs, eorders, np.zeros(1, dt_), kc, face_id,
+              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick)
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
@@ -929,8 +974,14 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
                 tick("method set-up")
     run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q])) for q in range(k)])
     tick("shading")
-    if outs[:, 0].any():
+    if (outs[:, 0] == 1).any():
         raise FrameUnsupported("a span failed a check of check_span_input")
+    # slerp's and angular's set-up: every value promised (no hard span); angular's also
+    # assumed what the whole frame decides (setup.method_setup's start_left, count_max)
+    if (outs[:, 0] == 2).any() or (mode == 6 and outs[:, 1].sum() and not (
+            outs[:, 3].any() and outs[:, 4].max() >= 2)):
+        keep_maps(maps)
+        return None
     keep_maps(maps)
     if outs[:, 2].sum() < 2:
         # numpy computes N @ L for one row by another route than BLAS

@@ -166,9 +166,10 @@ def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, 
 
 
 @njit()
-def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B):
-    """The unit end normals of spans ``0 .. n-1`` of a linear method into ``A`` and
-    ``B - A`` into ``B`` ((3, n), their dtype), as :func:`_ends_part` computes them, and
+def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True):
+    """The unit end normals of spans ``0 .. n-1`` into ``A`` and ``B - A`` (a linear
+    method; ``diff`` False: ``B``) into ``B`` ((3, n), their dtype), as :func:`_ends_part`
+    computes them, and
     whether every check of ``check_span_input`` passes on them (False: one fails).  The
     fused frame's per-row set-up (:func:`chebnorm.raster.engines.numba.frame.phong`).
 
@@ -191,6 +192,8 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B):
         The number of spans.
     A, B : numpy.ndarray
         The outputs described above.
+    diff : bool, optional
+        ``B - A`` into ``B`` (the linear methods' difference), else ``B``.
 
     Returns
     -------
@@ -209,9 +212,10 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B):
         b0, b1, b2 = b0 / r, b1 / r, b2 / r
         A[0, i], A[1, i], A[2, i] = a0, a1, a2
         B[0, i], B[1, i], B[2, i] = b0, b1, b2
-        B[0, i] -= A[0, i]           # in the dtype, as the reference subtracts
-        B[1, i] -= A[1, i]
-        B[2, i] -= A[2, i]
+        if diff:
+            B[0, i] -= A[0, i]           # in the dtype, as the reference subtracts
+            B[1, i] -= A[1, i]
+            B[2, i] -= A[2, i]
         ti, di = t0[i], dt[i]
         last = ti + (count[i] - 1) * di
         sa = dot3(a0, a1, a2, a0, a1, a2, o_ein)
