@@ -309,6 +309,19 @@ def test_pow_shortcut_gives_pow_bits(n):
     assert inside.sum() > 10_000 and ok[inside].mean() > 0.85
 
 
+@pytest.mark.parametrize("n", [3, 4, 32, 33, 65536])
+def test_pow_shortcut_zero_base_is_pow_without_a_call(n):
+    # a clipped N.H is often +-0: the shortcut takes it (ok) and gives pow's signed zero
+    # (C99 F.9.4.4: pow(-0, odd n) = -0, pow(-0, even n) = +0), checked against the C
+    # library's pow itself
+    b = np.array([0.0, -0.0, 0.0, -0.0])
+    ref = detmath.power(b, float(n))
+    got, ok = _powers(b, n, True)
+    assert got.tobytes() == ref.tobytes()
+    assert ok.all()
+    assert np.signbit(got[1]) == bool(n % 2)
+
+
 @pytest.mark.parametrize("n", [3, 32, 1000, 65536])
 def test_pow_shortcut_near_one_margin_gives_pow_bits(n):
     # b in [exp(-64/n), 1]: the shortcut's margin is 0.48 ulp there (glibc's bound for

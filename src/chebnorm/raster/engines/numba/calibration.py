@@ -281,7 +281,7 @@ def _pow_int(b, n, hh, ll, ok, out, nw):
     the low part is within :data:`_POW_MARGIN` ulp (:data:`_POW_MARGIN_NEAR` where
     ``b[k] >= exp(-_POW_NEAR_LOG / n)``); ``ok[k]`` False where the caller
     must call ``pow`` (the result near a rounding tie, at a power of two, tiny, huge
-    or not finite, or ``b[k]`` NaN)."""
+    or not finite, or ``b[k]`` NaN; a zero ``b[k]`` is ``pow``'s by C99 F.9.4.4)."""
     for k in range(nw):
         hh[k] = b[k]
         ll[k] = 0.0
@@ -297,15 +297,20 @@ def _pow_int(b, n, hh, ll, ok, out, nw):
     # |n log b| <= _POW_NEAR_LOG for b in [near, 1] (b <= 1 here: b > 1 takes the wide
     # margin); np.exp's rounding moves the cut by an ulp, far inside the bound's slack
     near = np.exp(-_POW_NEAR_LOG / n)
+    odd = (n & 1) == 1
     for k in range(nw):
         x = b[k]
         h = hh[k]
         bits = f2i(h)
         ulp = i2f((((bits >> 52) & 0x7FF) - 52) << 52)
         margin = _POW_MARGIN_NEAR if (x >= near) & (x <= 1.0) else _POW_MARGIN
-        ok[k] = ((x >= _POW_TINY) & (h >= _POW_TINY) & (x <= _POW_HUGE) & (h <= _POW_HUGE)
-                 & ((bits & 0xFFFFFFFFFFFFF) != 0) & (abs(ll[k]) <= margin * ulp))
-        out[k] = h
+        # a zero base (a clipped N.H, often): C99 F.9.4.4 fixes pow(+-0, n) for an
+        # integer n > 0: +-0 (the base) for odd n, +0 for even n; no call needed
+        zero = x == 0.0
+        ok[k] = zero | ((x >= _POW_TINY) & (h >= _POW_TINY) & (x <= _POW_HUGE)
+                        & (h <= _POW_HUGE) & ((bits & 0xFFFFFFFFFFFFF) != 0)
+                        & (abs(ll[k]) <= margin * ulp))
+        out[k] = (x if odd else 0.0) if zero else h
 
 
 @njit()
