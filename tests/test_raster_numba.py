@@ -10,6 +10,7 @@ from chebnorm.methods import detmath, method_names, span_normals
 from chebnorm.raster import get_mesh, render, setup_spans, zbuffer
 from chebnorm.raster.engines import resolve_engine
 from chebnorm.raster.engines.numba import calibration, frame, kernels, rasterize
+from chebnorm.raster.meshes import Mesh
 from chebnorm.raster.engines.numba.jit import HAVE_NUMBA
 
 pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba is not installed "
@@ -260,6 +261,35 @@ def test_fused_phong_identical_lighting(lighting):
 def test_fused_phong_tiny_frames(size):
     for method in ("exact", "none", "quadratic"):
         _check_identical(get_mesh("sphere", 8), method, size)
+
+
+def _sliver():
+    """A strip of triangles far thinner than a pixel: at 31 x 31 it covers three pixels,
+    each span one pixel wide."""
+    xs = np.linspace(-1.0, 1.0, 11)
+    pos = np.array([[x, y, 0.0] for x in xs for y in (-0.004, 0.004)])
+    nrm = np.array([[np.sin(0.5 * x), 25.0 * y, np.cos(0.5 * x)] for x, y, _ in pos])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    faces = []
+    for i in range(10):
+        a, b, c, d = 2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3
+        faces += [[a, b, c], [b, d, c], [a, c, b], [b, c, d]]
+    return Mesh("sliver", pos, nrm, np.array(faces, np.int64))
+
+
+@pytest.mark.parametrize("method", ["slerp", "angular"])
+def test_fused_rows_slerp_angular(method, monkeypatch):
+    # float64 slerp and angular are drawn row by row (spans, set-up and all) ...
+    rows = _spy(monkeypatch, "_phong_rows")
+    _check_identical(get_mesh("teapot"), method, (256, 200))
+    assert rows and rows[-1] is not None     # (the first render's warm-up frame first)
+    # ... and where angular's assumptions about the whole frame fail (every span one
+    # pixel wide: no second pixel to start the recurrence from), the rows give the frame
+    # up and the frame-sized spans draw it, the same bytes
+    rows.clear()
+    got = _check_identical(_sliver(), method, (31, 31))
+    assert got.mask.sum() >= 2 and got.mask.sum(axis=1).max() == 1
+    assert len(rows) == 1 and (rows[0] is None) == (method == "angular")
 
 
 def test_fused_falls_back_without_calibration(monkeypatch):
