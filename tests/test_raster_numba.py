@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from chebnorm.methods import detmath, method_names, span_normals
+from chebnorm.methods import default_tables, detmath, method_names, span_normals
 from chebnorm.raster import get_mesh, render, setup_spans, zbuffer
 from chebnorm.raster.engines import resolve_engine
 from chebnorm.raster.engines.numba import calibration, frame, kernels, rasterize
@@ -187,9 +187,11 @@ def _spy(monkeypatch, name):
     return calls
 
 
-def _check_identical(mesh, method, size, dtype=np.float64, lighting=None):
-    ref = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numpy")
-    got = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numba")
+def _check_identical(mesh, method, size, dtype=np.float64, lighting=None, tables=None):
+    ref = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numpy",
+                 tables=tables)
+    got = render(mesh, "phong", method, size=size, dtype=dtype, lighting=lighting, engine="numba",
+                 tables=tables)
     for name in ("image", "mask", "triangle", "normal_length"):
         assert _same(getattr(got, name), getattr(ref, name)), (method, name)
     assert got.fragments == ref.fragments and got.stats == ref.stats
@@ -290,6 +292,29 @@ def test_fused_rows_slerp_angular(method, monkeypatch):
     got = _check_identical(_sliver(), method, (31, 31))
     assert got.mask.sum() >= 2 and got.mask.sum(axis=1).max() == 1
     assert len(rows) == 1 and (rows[0] is None) == (method == "angular")
+
+
+def test_fused_rows_quadratic_table_assumed_then_checked(monkeypatch):
+    # the quadratic's table is chosen by every span of the frame: the rows assume the
+    # table of the last frame of that kind (the default one the first time) and check it
+    # once every span is known; a wrong guess draws the frame again with the frame-sized
+    # spans (the same bytes and stats as numpy, tables widened or not)
+    monkeypatch.setattr(frame, "_TABLE_GUESS", {})
+    rows = _spy(monkeypatch, "_phong_rows")
+    got = _check_identical(get_mesh("teapot"), "quadratic", (256, 200))
+    assert got.stats["table_psi_max"] == "9*pi/32"     # wider than the default pi/4
+    assert rows[-1] is None                             # so the guess failed
+    rows.clear()
+    _check_identical(get_mesh("teapot"), "quadratic", (256, 200))
+    assert len(rows) == 1 and rows[0] is not None       # the second frame: rows
+    rows.clear()
+    got = _check_identical(get_mesh("teapot"), "quadratic", (320, 240))
+    assert "table_psi_max" not in got.stats and len(rows) == 1 and rows[0] is not None
+    # a caller's table is the rows' table
+    tables = default_tables(psi_max="10*pi/32")
+    rows.clear()
+    _check_identical(get_mesh("teapot"), "quadratic", (256, 200), tables=tables)
+    assert rows and rows[-1] is not None    # (after the warm-up frame of that kind)
 
 
 def test_fused_falls_back_without_calibration(monkeypatch):

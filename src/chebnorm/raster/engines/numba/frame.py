@@ -34,6 +34,7 @@ promise the reference's bytes for a method, and :func:`phong` raises
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -48,7 +49,8 @@ from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f3
 from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_spans, span_geom, span_write
-from .setup import _angular_part, _slerp_part, end_checks, method_setup, span_input, widest_dot
+from .setup import (_angular_part, _clear_table, _ends_part, _quadratic_part, _slerp_part,
+                    end_checks, method_setup, span_input, widest_dot)
 from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
@@ -370,26 +372,32 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
 
 @njit()
 def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h, Htri,
-                L, eye, light, orders, want, quick, part, parts, img, mask, tri_map, nlen, out,
-                stop=0):
-    """The whole frame of a method without a table, linear (modes 0-3), slerp (4) or
-    angular (6), scan line by scan line, on the rows ``part, part + parts, ...``: each
+                L, eye, light, orders, want, quick, cf, part, parts, img, mask, tri_map, nlen,
+                out, fout, stop=0):
+    """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5) or angular
+    (6), scan line by scan line, on the rows ``part, part + parts, ...``: each
     row's spans (:func:`.rasterize.span_geom`, :func:`.rasterize.span_write` on the
     triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
     :func:`.rasterize.row_spans` numbers them) into row-sized arrays, their unit end
     normals and the checks of ``check_span_input`` (:func:`.setup.end_checks`, modes 1-6;
-    normals in the dtype of ``proto``), the method's per-span set-up (modes 4 and 6:
-    :func:`.setup._slerp_part`, :func:`.setup._angular_part`; ``quick``: their float64
-    sines by the library-exact shortcuts), then :func:`_row_pass`. The spans never leave
-    the cache: no frame-sized span arrays are written or read.
+    :func:`.setup._ends_part` for mode 5, which also needs the cosines; normals in the
+    dtype of ``proto``), the method's per-span set-up (modes 4-6:
+    :func:`.setup._slerp_part`, :func:`.setup._quadratic_part` with the table's
+    coefficients ``cf`` (ascending; ``cf`` empty: exact), :func:`.setup._angular_part`;
+    ``quick``: their float64 sines by the library-exact shortcuts), then
+    :func:`_row_pass`. The spans never leave the cache: no frame-sized span arrays are
+    written or read.
 
-    The angular set-up depends on two facts about the whole frame: whether every span
-    starts at its left end (``t0 == 0``) and whether any span has two pixels or more.
-    The rows assume the usual answers (no, yes) and report the facts: ``out``: [1 a check
-    failed (then the frame stops: the caller draws it step by step, with the reference's
-    errors), 2 a set-up value the shortcuts cannot promise (the frame stops: the caller
-    draws it with the frame-sized spans), fragments, covered pixels, any ``t0 != 0``,
-    largest span]. ``stop`` 4 (profiling): the rows' spans, checks and set-up alone."""
+    The set-up of modes 5 and 6 depends on facts about the whole frame: whether every
+    span starts at its left end (``t0 == 0``), whether any span has two pixels or more,
+    and (mode 5) the table, chosen by the smallest ``N_l.N_r`` and cosine of all spans.
+    The rows assume the usual answers (no, yes, the table ``cf``) and report the facts:
+    ``out``: [1 a check failed (then the frame stops: the caller draws it step by step,
+    with the reference's errors), 2 a set-up value the shortcuts cannot promise (the frame
+    stops: the caller draws it with the frame-sized spans), fragments, covered pixels,
+    any ``t0 != 0``, largest span]; ``fout``: [smallest ``N_l.N_r``, smallest cosine
+    clipped to [-1, 1]] (mode 5). ``stop`` 4 (profiling): the rows' spans, checks and
+    set-up alone."""
     Kc = attrs.shape[2]
     first, ids, widest = part_buckets(xy, height, part, parts)
     M = max(widest, 1)
@@ -408,7 +416,15 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     sc, sc2 = np.zeros(M, proto.dtype), np.zeros(M, proto.dtype)
     hard = np.zeros(M, np.bool_)
     P0, P1 = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
+    P2 = np.empty((3, M), proto.dtype)
+    lcos, llev = np.empty(M), np.zeros(M, np.int64)
+    red = np.zeros(5)
+    exact = cf.shape[0] == 0
+    cfx = np.zeros(1, proto.dtype) if exact else cf
+    dmin = np.inf
+    clo = np.inf
     is64 = proto.itemsize == 8
+    Cm = P2 if mode == 5 else C        # the quadratic's second differences
     buf = _row_buffers(width, lA, mode)
     nfrag = 0
     ncov = 0
@@ -426,7 +442,16 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                        lc0, lcount, lm, lt0, ldt, lleft, lright)
             nfrag += c
             n += 1
-        if mode >= 1 and n > 0:
+        if mode == 5 and n > 0:
+            _ends_part(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], False,
+                       _NO_THRESHOLDS, 0, n, lA, lB, False, lcos, llev, hard, red)
+            if red[0] != 0.0:
+                out[0] = 1
+                return
+            dmin = min(dmin, red[1])
+            for s in range(n):
+                clo = min(clo, min(max(lcos[s], -1.0), 1.0))
+        elif mode >= 1 and n > 0:
             if not end_checks(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], n,
                               lA, lB, mode <= 3):
                 out[0] = 1
@@ -440,6 +465,9 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             if _slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
                 out[0] = 2
                 return
+        elif mode == 5 and n > 0:
+            _quadratic_part(lA, lB, lt0, ldt, ks, cfx, exact, False, 0, n, P0, P1, P2)
+            A, B = P0, P1
         elif mode == 6 and n > 0:
             if _angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
                              hard):
@@ -449,7 +477,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
         if stop == 4:
             continue
         ncov += _row_pass(rr, width, 0, n, mode, ltri, lc0, lcount, lt0, ldt, lleft, lright, A,
-                          B, C, sc, sc2, levels, R, off, kc, kc, is64, face_id, per_pixel_h,
+                          B, Cm, sc, sc2, levels, R, off, kc, kc, is64, face_id, per_pixel_h,
                           Htri, L, eye, light, orders, want, img, mask, tri_map, nlen, stop,
                           buf)[0]
     out[0] = 0
@@ -457,6 +485,8 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     out[2] = ncov
     out[3] = t0nz
     out[4] = cmax
+    fout[0] = dmin
+    fout[1] = clo
 
 
 @njit()
@@ -599,6 +629,10 @@ def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
             m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
                                        B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
         n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+
+
+#: no dichotomy depth thresholds (:func:`.setup._ends_part` of a method without a tree)
+_NO_THRESHOLDS = np.zeros(1)
 
 
 #: the dichotomy builds a span's whole halving tree when it has at most this many nodes
@@ -846,7 +880,8 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
     mode = MODES[id(method_kernel(spec))]
     dt_ = _rows_dtype(spec, mode, dtype)
     if dt_ is not None:     # no table: the frame row by row, spans and all
-        res = _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps)
+        res = _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec,
+                          tables)
         if res is not None:
             return res
         # the rows' assumptions did not hold: the frame with the frame-sized spans
@@ -907,13 +942,13 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
 
 def _rows_dtype(spec, mode, dtype):
     """The dtype of a method's row-by-row frame (:func:`_frame_rows`): float64 for
-    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3, float64 for slerp
-    and angular (modes 4 and 6) in float64; None where the frame takes the frame-sized
-    span arrays instead (a method with a table, whose choice needs every span first; the
-    dichotomy and quadratic; slerp and angular in float32, whose set-up may need the
+    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3, float64 for slerp,
+    quadratic and angular (modes 4-6) in float64; None where the frame takes the
+    frame-sized span arrays instead (the dichotomy; a table method other than the
+    quadratic; slerp, quadratic and angular in float32, whose set-up may need the
     reference's functions; no :func:`.calibration.ends_orders`; a dtype the reference
     refuses, which it then refuses with its own error)."""
-    if mode in (5, 7) or spec.table is not None:
+    if mode == 7 or (spec.table is not None and mode != 5):
         return None
     if mode == 0:
         return np.float64
@@ -923,7 +958,7 @@ def _rows_dtype(spec, mode, dtype):
         dt_ = check_dtype(dtype)
     except (TypeError, ValueError):
         return None
-    if mode in (4, 6) and dt_ is not np.float64:
+    if mode in (4, 5, 6) and dt_ is not np.float64:
         return None
     return dt_
 
@@ -944,13 +979,55 @@ def _frame_args(st, lighting, mode, dt_, orders):
             np.ascontiguousarray(st.tri, np.int64))
 
 
-def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
-    """:func:`phong` of a method without a table (modes 0-4, 6; ``dt_`` from
+#: the quadratic's table of the last frame, by (method, image size, triangles): the rows
+#: assume it again (the table is chosen by every span of the frame, known only once the
+#: rows are done; a frame where it does not hold is drawn again, with the frame-sized
+#: spans); at most :data:`_TABLE_GUESSES` kinds of frame are remembered
+_TABLE_GUESS: dict = {}
+
+
+_TABLE_GUESSES = 64
+
+
+def _rows_table(spec, tables, st):
+    """The quadratic's table the rows assume: ``(key, table)``; the caller's where it
+    gave one, else the last such frame's (the default table the first time)."""
+    key = (spec.name, int(st.width), int(st.height), len(st.xy))
+    if tables is not None:    # the caller's (or the default where it gave none for it)
+        return key, _clear_table(spec, tables, None)[1]
+    if len(_TABLE_GUESS) > _TABLE_GUESSES:
+        _TABLE_GUESS.clear()
+    if key not in _TABLE_GUESS:
+        _TABLE_GUESS[key] = _clear_table(spec, None, None)[1]
+    return key, _TABLE_GUESS[key]
+
+
+def _table_holds(spec, tables, guess, key, dmin, clo, stats):
+    """Whether the table the rows assumed (``guess``) is the one the frame's spans choose
+    (``auto_tables`` on the smallest ``N_l.N_r``, ``dmin``, then ``span_input``'s
+    coverage test on the smallest cosine, ``clo``); fills ``stats`` as ``auto_tables``
+    does and remembers the frame's table for the next frame."""
+    one = SimpleNamespace(count=(1,))    # auto_tables reads len(sp.count) alone here
+    tabs = auto_tables(spec, one, [[1, 2, 3]], tables, stats, dot_min=dmin)
+    clear, table = _clear_table(spec, tabs, clo)
+    if not clear:
+        return False      # resolve_table decides: the frame-sized spans
+    if tables is None:
+        _TABLE_GUESS[key] = table
+    if table is None or guess is None:
+        return table is guess
+    return table is guess or (np.asarray(table.coefficients, np.float64).tobytes()
+                              == np.asarray(guess.coefficients, np.float64).tobytes())
+
+
+def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=None,
+                tables=None):
+    """:func:`phong` of a method drawn row by row (modes 0-6; ``dt_`` from
     :func:`_rows_dtype`): the row buckets, then :func:`_frame_rows` on the threads (every
     row's spans, checks, set-up, visibility and shading in one pass); FrameUnsupported
     where a check fails (the step by step path then gives the reference's errors); None
     where the frame-sized spans must draw it instead (a set-up value the shortcuts cannot
-    promise, or the angular set-up's assumptions about the whole frame did not hold)."""
+    promise, or the rows' assumptions about the whole frame did not hold)."""
     tick = clock or _no_clock
     per_pixel_h = lighting.half_vector == "pixel"
     xy = np.ascontiguousarray(st.xy, np.float64)
@@ -960,36 +1037,52 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps):
     eo = ends_orders() if mode else None
     eorders = np.array(eo if eo is not None else (0, 0), np.int64)
     quick = bool(mode in (4, 6) and dt_ is np.float64 and trig_calibrated())
+    cf = np.zeros(0, dt_)
+    if mode == 5:
+        key, guess = _rows_table(spec, tables, st)
+        if guess is not None:
+            cf = np.array([dt_(c) for c in guess.coefficients], dt_)
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
     outs = np.zeros((k, 5), np.int64)
+    fouts = np.zeros((k, 2))
     common = (st.width, height, mode, xy, attrs, eorders, np.zeros(1, dt_), kc, face_id,
-              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick)
+              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf)
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
-            run([(_frame_rows, (*common, q, k, *maps, outs[q], stop)) for q in range(k)])
+            run([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], stop))
+                 for q in range(k)])
             tick(name)
             if name == "ends":
                 tick("method set-up")
-    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q])) for q in range(k)])
+    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q]))
+                     for q in range(k)])
     tick("shading")
     if (outs[:, 0] == 1).any():
         raise FrameUnsupported("a span failed a check of check_span_input")
-    # slerp's and angular's set-up: every value promised (no hard span); angular's also
-    # assumed what the whole frame decides (setup.method_setup's start_left, count_max)
-    if (outs[:, 0] == 2).any() or (mode == 6 and outs[:, 1].sum() and not (
-            outs[:, 3].any() and outs[:, 4].max() >= 2)):
-        keep_maps(maps)
-        return None
     keep_maps(maps)
+    # the set-up of modes 4-6: every value promised (no hard span); quadratic and angular
+    # also assumed what the whole frame decides (setup.method_setup's start_left and
+    # count_max, the quadratic's table)
+    stats = {}
+    spans = outs[:, 1].sum() > 0
+    if (outs[:, 0] == 2).any():
+        return None
+    if mode in (5, 6) and spans and not (outs[:, 3].any()
+                                         and (mode == 5 or outs[:, 4].max() >= 2)):
+        return None
+    if mode == 5 and spans and not _table_holds(spec, tables, guess, key,
+                                                np.float64(fouts[:, 0].min()),
+                                                float(fouts[:, 1].min()), stats):
+        return None
     if outs[:, 2].sum() < 2:
         # numpy computes N @ L for one row by another route than BLAS
         raise FrameUnsupported("fewer than two pixels covered")
     img, mask, tri_map, nlen = maps
     shape = (st.height, st.width)
     extra = (tri_map.reshape(shape), nlen.reshape(shape)) if extra_maps else (None, None)
-    return ModeResult(img.reshape(shape), mask.reshape(shape), int(outs[:, 1].sum()), {},
+    return ModeResult(img.reshape(shape), mask.reshape(shape), int(outs[:, 1].sum()), stats,
                       triangle=extra[0], normal_length=extra[1])
 
 

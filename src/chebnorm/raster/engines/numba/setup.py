@@ -343,26 +343,37 @@ def widest_dot(sp, spec, dtype, diff, work=None):
     return ends, (None if ends.bad else ends.dot_min)
 
 
+def _clear_table(spec, tables, c_lo):
+    """``(True, table)`` where the table of method ``spec`` in ``tables`` (None or absent:
+    the default) clearly covers spans whose smallest cosine is ``c_lo`` (clipped to
+    [-1, 1]; None: no span needs it) or is None; ``(False, None)`` where
+    ``resolve_table`` must decide (see :func:`_table`)."""
+    method = spec.name
+    defaults = tables is None or method not in tables
+    table = default_tables()[method] if defaults else tables[method]
+    if table is None:
+        return True, None
+    if isinstance(table, CoefficientTable):
+        if c_lo is None:
+            return True, table
+        scale = float(method_kernel(spec).table_scale)
+        lo, hi = table.interval_float
+        need_lo = scale * float(c_lo)
+        if hi >= scale and not lo > need_lo + COVER_SLACK:
+            return True, table
+    return False, None
+
+
 def _table(spec, tables, ends, tree):
     """``resolve_table(spec, tables, cos, levels)``: the reference runs unless the table
     clearly covers the spans (its upper end at ``table_scale``, its lower end below what
     the spans need, a comparison of exact values)."""
-    method = spec.name
-    defaults = tables is None or method not in tables
-    table = default_tables()[method] if defaults else tables[method]
-    levels = ends.levels if tree else None
-    if table is None:
-        return None
-    if isinstance(table, CoefficientTable):
-        scale = float(method_kernel(spec).table_scale)
-        lo, hi = table.interval_float
-        c_lo, c_lo_deep, deep = _cos_range(ends.cos, ends.levels, tree)
-        if tree and not deep:
-            return table
-        need_lo = scale * float(c_lo_deep if tree else c_lo)
-        if hi >= scale and not lo > need_lo + COVER_SLACK:
-            return table
-    return resolve_table(spec, tables, ends.cos, levels)
+    c_lo, c_lo_deep, deep = _cos_range(ends.cos, ends.levels, tree)
+    clear, table = _clear_table(spec, tables, None if tree and not deep
+                               else (c_lo_deep if tree else c_lo))
+    if clear:
+        return table
+    return resolve_table(spec, tables, ends.cos, ends.levels if tree else None)
 
 
 def span_input(spec, sp, tables, dtype, ends, diff):
