@@ -153,11 +153,13 @@ def _row_background(tri_map, nlen, base, width, want):
     """The background of a row's extra maps (-1, NaN; overwritten where a fragment lands):
     the triangle map where ``want & 1``, the ``|N|`` map where ``want & 2``."""
     if want & 1:
+        trow = tri_map[base:base + width]     # row views: a plain fill (no index checks)
         for x in range(width):
-            tri_map[base + x] = -1
+            trow[x] = -1
     if want & 2:
+        nrow = nlen[base:base + width]
         for x in range(width):
-            nlen[base + x] = np.nan
+            nrow[x] = np.nan
 
 
 @njit()
