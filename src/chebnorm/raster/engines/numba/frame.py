@@ -280,10 +280,9 @@ def _row_buffers(width, A, mode):
             np.empty((9, W) if mode == 4 else (9, 1)))
 
 
-@njit()
-def _row_pass(rr, width, k0, k1, mode, stri, c0, count, t0, dt, left, right, A, B, C, sc, sc2,
-              levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye, light, orders,
-              want, img, mask, tri_map, nlen, stop, buf):
+@njit(inline=True)
+def _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want, maps, stop,
+              buf):
     """Row ``rr`` of the frame from its spans ``k0 .. k1-1`` (in ``setup_spans``' order):
     the z-test (:func:`_row_visibility`), the background and the winners listed in ``x``
     order (:func:`_row_winners`), then each quantity of the shading for all of them in one
@@ -292,7 +291,17 @@ def _row_pass(rr, width, k0, k1, mode, stri, c0, count, t0, dt, left, right, A, 
     Returns ``(covered pixels, slerp float32 pixels whose sine needs detmath)``.
 
     ``stop`` (profiling only, :func:`stage_times`): 0 draws the row; 1, 2, 3 stop after
-    its visibility and background, its normals, its half vectors."""
+    its visibility and background, its normals, its half vectors.
+
+    Inlined into its callers (numba's IR), with its arrays in tuples (``spans``: ``(stri,
+    c0, count, t0, dt, left, right)``, ``meth``: ``(A, B, C, sc, sc2, levels, R, off, kc,
+    kd)``, ``shade``: ``(face_id, Htri, L, eye, light, orders)``, ``maps``: ``(img, mask,
+    tri_map, nlen)``) made once per frame: no call per row, so no reference counting of
+    some fifty arrays per row (atomic operations on counts both threads share)."""
+    stri, c0, count, t0, dt, left, right = spans
+    A, B, C, sc, sc2, levels, R, off, kc, kd = meth
+    face_id, Htri, L, eye, light, orders = shade
+    img, mask, tri_map, nlen = maps
     (bw, bs, wx, ws, wt, tc, ga, sx, n0, n1, n2, h0, h1, h2, av, bv, nl, pw, hh, ll, ok, skip,
      nd, sab, sw) = buf
     W = width
@@ -363,12 +372,15 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
     ``|N|`` map only where ``want & 2``). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map)."""
     buf = _row_buffers(width, A, mode)
+    spans = (stri, c0, count, t0, dt, left, right)
+    meth = (A, B, C, sc, sc2, levels, R, off, kc, kd)
+    shade = (face_id, Htri, L, eye, light, orders)
+    maps = (img, mask, tri_map, nlen)
     hard = 0
     for rr in range(part, height, parts):
-        hard += _row_pass(rr, width, row_start[rr], row_start[rr + 1], mode, stri, c0, count, t0,
-                          dt, left, right, A, B, C, sc, sc2, levels, R, off, kc, kd, is64,
-                          face_id, per_pixel_h, Htri, L, eye, light, orders, want, img, mask,
-                          tri_map, nlen, stop, buf)[1]
+        k0, k1 = row_start[rr], row_start[rr + 1]
+        hard += _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want,
+                          maps, stop, buf)[1]
     return hard
 
 
@@ -426,7 +438,13 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     dmin = np.inf
     clo = np.inf
     is64 = proto.itemsize == 8
-    Cm = P2 if mode == 5 else C        # the quadratic's second differences
+    # the row pass's arrays: the row's spans, the method's (the set-up's where it has
+    # one: quadratic v, d1, d2; angular p0, p1), the shading's, the maps
+    Am, Bm = (P0, P1) if mode == 5 or mode == 6 else (lA, lB)
+    spans = (ltri, lc0, lcount, lt0, ldt, lleft, lright)
+    meth = (Am, Bm, P2 if mode == 5 else C, sc, sc2, levels, R, off, kc, kc)
+    shade = (face_id, Htri, L, eye, light, orders)
+    maps = (img, mask, tri_map, nlen)
     buf = _row_buffers(width, lA, mode)
     nfrag = 0
     ncov = 0
@@ -462,26 +480,21 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             for s in range(n):
                 t0nz |= lt0[s] != 0.0
                 cmax = max(cmax, lcount[s])
-        A, B = lA, lB
         if mode == 4 and n > 0:
             if _slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
                 out[0] = 2
                 return
         elif mode == 5 and n > 0:
             _quadratic_part(lA, lB, lt0, ldt, ks, cfx, exact, False, 0, n, P0, P1, P2)
-            A, B = P0, P1
         elif mode == 6 and n > 0:
             if _angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
                              hard):
                 out[0] = 2
                 return
-            A, B = P0, P1
         if stop == 4:
             continue
-        ncov += _row_pass(rr, width, 0, n, mode, ltri, lc0, lcount, lt0, ldt, lleft, lright, A,
-                          B, Cm, sc, sc2, levels, R, off, kc, kc, is64, face_id, per_pixel_h,
-                          Htri, L, eye, light, orders, want, img, mask, tri_map, nlen, stop,
-                          buf)[0]
+        ncov += _row_pass(rr, width, 0, n, mode, spans, meth, shade, is64, per_pixel_h, want,
+                          maps, stop, buf)[0]
     out[0] = 0
     out[1] = nfrag
     out[2] = ncov
