@@ -627,23 +627,32 @@ def _slerp_row(ws, tc, A, B, sc, sc2, kc, is64, fastsin, sw, ok, sab, skip, n0, 
 
 @njit()
 def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
-    """Dichotomy (mode 7) at the row's winners."""
-    cur = -1
-    tree = False
-    for k in range(nw):
+    """Dichotomy (mode 7) at the row's winners: per run of one span's winners (a span's
+    winners are adjacent) its whole halving tree (:func:`_dichotomy_tree`, when small
+    enough), then each pixel's pick (:func:`_dichotomy_pick`); deeper spans descend per
+    pixel (:func:`_dichotomy_px`). ``nd``: the thread's scratch (``3 (_TREE_MAX + 1)``
+    elements), used flat: node ``m`` at ``3 m .. 3 m + 2``."""
+    w = nd.reshape(-1)
+    k = 0
+    while k < nw:
         s = ws[k]
         lv = levels[s]
-        if s != cur:    # a span's winners are adjacent: its tree once
-            cur = s
-            tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
-            if tree:
-                _dichotomy_tree(A, B, R, s, lv, nd)
+        need = off[lv]
+        scale = kd[2 + lv]
+        tree = (np.int64(1) << lv) <= min(4 * count[s] + 8, _TREE_MAX)
         if tree:
-            m0, m1, m2 = _dichotomy_pick(nd, lv, off[lv], kd[2 + lv], tc[k])
-        else:
-            m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
-                                       B[2, s], R, s, lv, off[lv], kd[2 + lv], tc[k])
-        n0[k], n1[k], n2[k] = np.float64(m0), np.float64(m1), np.float64(m2)
+            _dichotomy_tree(A, B, R, s, lv, w)
+        while True:     # the run of span s's winners (one loop: one exit to mispredict)
+            q = np.uint64(k)
+            if tree:
+                m0, m1, m2 = _dichotomy_pick(w, lv, need, scale, tc[q])
+            else:
+                m0, m1, m2 = _dichotomy_px(A[0, s], A[1, s], A[2, s], B[0, s], B[1, s],
+                                           B[2, s], R, s, lv, need, scale, tc[q])
+            n0[q], n1[q], n2[q] = np.float64(m0), np.float64(m1), np.float64(m2)
+            k += 1
+            if k >= nw or ws[np.uint64(k)] != s:
+                break
 
 
 #: no dichotomy depth thresholds (:func:`.setup._ends_part` of a method without a tree)
@@ -653,39 +662,69 @@ _NO_THRESHOLDS = np.zeros(1)
 #: the dichotomy builds a span's whole halving tree when it has at most this many nodes
 #: (and not many more than the span has pixels); deeper spans descend per pixel
 _TREE_MAX = 1 << 12
+_TREE_LEVELS = 12
+
+
+def _bfs_nodes(levels):
+    """The inner nodes of a halving tree of depth ``levels`` in breadth-first order (every
+    node after both ends of its interval): ``(3 m, 3 half, depth)`` per node ``m`` (the
+    midpoint of ``[m - half, m + half]``), unsigned. A tree of depth ``L`` is the first
+    ``2**L - 1`` of them, ``3 m`` and ``3 half`` shifted right by ``levels - L``."""
+    m, h, d = [], [], []
+    for lev in range(levels):
+        half = 1 << (levels - 1 - lev)
+        for p in range(1 << lev):
+            m.append(3 * (2 * p + 1) * half)
+            h.append(3 * half)
+            d.append(lev)
+    return (np.array(m, np.uint64), np.array(h, np.uint64), np.array(d, np.uint64))
+
+
+_BFS_M3, _BFS_H3, _BFS_D = _bfs_nodes(_TREE_LEVELS)
+_U1, _U2 = np.uint64(1), np.uint64(2)
 
 
 @njit(inline=True)
-def _dichotomy_tree(A, B, R, i, L, nd):
-    """Every node of span ``i``'s halving tree of depth ``L`` into ``nd[:, 0 .. 2**L]``:
-    the midpoint of an interval at depth ``d`` is ``(A + B) R[i, d]`` of its ends, as
-    :func:`_dichotomy_px` computes it on its way down."""
+def _dichotomy_tree(A, B, R, i, L, w):
+    """Every node of span ``i``'s halving tree of depth ``L`` into ``w[3 m .. 3 m + 2]``,
+    ``m = 0 .. 2**L``: the midpoint of an interval at depth ``d`` is ``(A + B) R[i, d]``
+    of its ends, as :func:`_dichotomy_px` computes it on its way down; the nodes in
+    breadth-first order from a table (one loop, no per-level loops and their divisions)."""
     top = np.int64(1) << L
-    for c in range(3):
-        nd[c, 0] = A[c, i]
-        nd[c, top] = B[c, i]
-    step = top
-    for d in range(L):
-        half = step >> 1
-        r = R[i, d]
-        for m in range(half, top, step):
-            for c in range(3):
-                nd[c, m] = (nd[c, m - half] + nd[c, m + half]) * r
-        step = half
+    sh = np.uint64(_TREE_LEVELS - L)
+    iu = np.uint64(i)
+    t3 = np.uint64(3 * top)
+    w[0], w[1], w[2] = A[0, iu], A[1, iu], A[2, iu]
+    w[t3], w[t3 + _U1], w[t3 + _U2] = B[0, iu], B[1, iu], B[2, iu]
+    for t in range(top - 1):
+        tu = np.uint64(t)
+        m = _BFS_M3[tu] >> sh
+        h = _BFS_H3[tu] >> sh
+        r = R[iu, _BFS_D[tu]]
+        lo = m - h
+        hi = m + h
+        w[m] = (w[lo] + w[hi]) * r
+        w[m + _U1] = (w[lo + _U1] + w[hi + _U1]) * r
+        w[m + _U2] = (w[lo + _U2] + w[hi + _U2]) * r
 
 
 @njit(inline=True)
-def _dichotomy_pick(nd, L, need_b, scale, tc):
-    """:func:`_dichotomy_px` from the span's whole tree ``nd``."""
+def _dichotomy_pick(w, L, need_b, scale, tc):
+    """:func:`_dichotomy_px` from the span's whole tree ``w`` (node ``m`` at ``3 m``); a
+    node index ``k = -1`` is the reference's numpy index: node ``2**L``."""
     u = tc * scale
     kf = np.floor(u)
     fr = u - kf
     k = np.int64(kf)
+    top = np.int64(1) << L
+    a = np.uint64(3 * (k + (top + 1 if k < 0 else 0)))
+    a1, a2 = a + _U1, a + _U2
     if not need_b:
-        return nd[0, k], nd[1, k], nd[2, k]
-    kb = min(k + 1, np.int64(1) << L)
-    return (nd[0, k] + fr * (nd[0, kb] - nd[0, k]), nd[1, k] + fr * (nd[1, kb] - nd[1, k]),
-            nd[2, k] + fr * (nd[2, kb] - nd[2, k]))
+        return w[a], w[a1], w[a2]
+    b = np.uint64(3 * min(k + 1, top))
+    b1, b2 = b + _U1, b + _U2
+    return (w[a] + fr * (w[b] - w[a]), w[a1] + fr * (w[b1] - w[a1]),
+            w[a2] + fr * (w[b2] - w[a2]))
 
 
 @njit(inline=True)
