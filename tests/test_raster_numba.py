@@ -317,6 +317,56 @@ def test_fused_rows_quadratic_table_assumed_then_checked(monkeypatch):
     assert rows and rows[-1] is not None    # (after the warm-up frame of that kind)
 
 
+def test_span_level_libm_is_span_levels():
+    # the dichotomy depth of the spans ends_part leaves to the reference (1/dt near a
+    # power of two, the cosine near a depth threshold), compiled with the C library's
+    # log2 and acos, against the reference's span_levels, span by span
+    from chebnorm.methods.spans import PICK_TOL, span_levels
+    from chebnorm.raster.engines.numba.setup import levels_calibrated, span_level_libm
+    rng = np.random.default_rng(7)
+    ulps = 1.0 + np.arange(-40, 41) * 2.0 ** -52
+    width = np.concatenate([(2.0 ** np.arange(0, 11)[:, None] * ulps).ravel(),
+                            (2.0 ** np.arange(0, 11)[:, None] * (1 + rng.uniform(-2e-6, 2e-6, 200))).ravel(),
+                            rng.uniform(0.5, 300.0, 5_000)])
+    dt = 1.0 / width
+    t0 = rng.uniform(0.0, 1.0, dt.size) * dt * rng.integers(0, 2, dt.size)
+    count = np.maximum(1, np.minimum(np.floor(width), 12).astype(np.int64))
+    theta = 2.0 * math.acos(1.0 - PICK_TOL) * 2.0 ** rng.integers(0, 6, dt.size)
+    cos = np.cos(theta) * (1.0 + rng.uniform(-3e-6, 3e-6, dt.size))
+    cos[::2] = rng.uniform(-0.5, 1.0, cos[::2].size)
+    ref = span_levels(dt, t0, count, cos)
+    got = np.array([span_level_libm(a, b, n, c) for a, b, n, c in zip(dt, t0, count, cos)])
+    assert (got == ref).all()
+    assert levels_calibrated()
+    # 1/dt not a finite normal number: left to the reference's own function
+    assert span_level_libm(1e-320, 0.0, 1, 1.0) == -1
+
+
+def test_fused_rows_dichotomy(monkeypatch):
+    # the dichotomy drawn row by row: its table and its depths off the dyadic grid
+    # assumed, checked once the rows are done; the same bytes as numpy
+    rows = _spy(monkeypatch, "_phong_rows")
+    _check_identical(get_mesh("teapot"), "dichotomy", (256, 200))
+    rows.clear()
+    _check_identical(get_mesh("teapot"), "dichotomy", (256, 200))
+    assert len(rows) == 1 and rows[0] is not None
+    # a depth the rows assumed off the dyadic grid whose pixels all turn out on it (made
+    # so by clearing what the rows found): the rows give the frame up, the frame-sized
+    # spans draw it
+    real = frame.run_with_caller
+
+    def run(jobs):
+        out = real(jobs)
+        if jobs[0][0] is frame._frame_rows:
+            for _, args in jobs:
+                args[-1][1, :] = False     # offs[q]: no pixel of any depth off its grid
+        return out
+    monkeypatch.setattr(frame, "run_with_caller", run)
+    rows.clear()
+    _check_identical(get_mesh("teapot"), "dichotomy", (256, 200))
+    assert len(rows) == 1 and rows[0] is None
+
+
 def test_fused_falls_back_without_calibration(monkeypatch):
     monkeypatch.setattr(frame, "calibrated", lambda: None)
     calls = _spy(monkeypatch, "_frame")

@@ -31,7 +31,13 @@ class GatheredSetup(Setup):
     """A :class:`~chebnorm.raster.engines.base.Setup` whose corner ``inv_w``, ``pos`` and
     ``nrm`` are copies of ``attrs``' columns made when first read (the fused frame reads
     ``attrs`` alone: the set-up then writes 40 % fewer bytes; the other shading modes
-    read them, the same values, C-contiguous, as the numpy engine's)."""
+    read them, the same values, C-contiguous, as the numpy engine's).
+
+    Attributes
+    ----------
+    mesh, camera, width, height, L, tri, xy, inv_w, pos, nrm, attrs
+        As :class:`~chebnorm.raster.engines.base.Setup`'s.
+    """
 
     @property
     def inv_w(self):

@@ -41,16 +41,17 @@ import numpy as np
 from chebnorm.methods import detmath
 from chebnorm.methods import kernels as K
 from chebnorm.methods.registry import method_kernel
-from chebnorm.methods.spans import MAX_LEVELS, check_dtype
+from chebnorm.methods.spans import MAX_LEVELS, check_dtype, span_levels
 
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
 from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f32_round,
                           pow_calibrated, powers, sin_small, trig_calibrated)
-from .jit import HAVE_NUMBA, njit, run, run_with_caller, threads
+from .jit import HAVE_NUMBA, njit, objmode, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_spans, span_geom, span_write
-from .setup import (_angular_part, _clear_table, _ends_part, _quadratic_part, _slerp_part,
-                    end_checks, method_setup, span_input, widest_dot)
+from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, ends_part, quadratic_part,
+                    slerp_part, end_checks, levels_calibrated, method_setup, span_input,
+                    span_level_libm, widest_dot)
 from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
@@ -68,11 +69,35 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count, Lmax, r):
     the deepest level) and, per depth, whether any pixel of any span is off the dyadic
     grid (then every pixel of that depth is picked), as the dichotomy kernel of
     :mod:`.kernels` computes them."""
-    S = levels.shape[0]
     dichotomy_denominators_into(nl, nr, levels, coeffs, exact, kc, r)
     off = np.zeros(Lmax + 1, np.bool_)
-    tcb = np.empty(1, nl.dtype)
-    for i in range(S):
+    _off_grid(levels, kc, t0, dt, count, np.empty(1, nl.dtype), off)
+    return off
+
+
+def _span_level(dt, t0, count, cos):
+    """The reference's dichotomy depth of one span (:func:`chebnorm.methods.spans.span_levels`,
+    the C library's ``log2`` and ``arccos``), for :func:`_reference_level`."""
+    return int(span_levels(np.array([dt]), np.array([t0]), np.array([count], np.int64),
+                           np.array([cos]))[0])
+
+
+@njit(nogil=False)
+def _reference_level(dt, t0, count, cos):
+    """:func:`_span_level` from compiled code (the interpreter, under the GIL: a span whose
+    ``log2(1/dt)`` is near an integer or whose cosine is near a depth threshold, a few
+    per frame)."""
+    with objmode(lv="int64"):
+        lv = _span_level(dt, t0, count, cos)
+    return lv
+
+
+@njit()
+def _off_grid(levels, kc, t0, dt, count, tcb, off):
+    """``off[L]`` set where a pixel of a span of depth ``L`` (spans ``0 .. len(levels)-1``)
+    is off the dyadic grid of that depth (``t`` in the dtype of ``tcb``, its scratch;
+    depths already set are not looked at again)."""
+    for i in range(levels.shape[0]):
         L = levels[i]
         if off[L]:
             continue
@@ -83,7 +108,6 @@ def _dichotomy_prep(nl, nr, levels, coeffs, exact, kc, t0, dt, count, Lmax, r):
             if u - np.floor(u) != 0:
                 off[L] = True
                 break
-    return off
 
 
 # ---------------------------------------------------------------- shading
@@ -386,32 +410,37 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
 
 @njit()
 def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h, Htri,
-                L, eye, light, orders, want, quick, cf, part, parts, img, mask, tri_map, nlen,
-                out, fout, stop=0):
-    """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5) or angular
-    (6), scan line by scan line, on the rows ``part, part + parts, ...``: each
+                L, eye, light, orders, want, quick, cf, kd, part, parts, img, mask, tri_map,
+                nlen, out, fout, offs, stop=0):
+    """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5), angular
+    (6) or dichotomy (7), scan line by scan line, on the rows ``part, part + parts, ...``:
+    each
     row's spans (:func:`.rasterize.span_geom`, :func:`.rasterize.span_write` on the
     triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
     :func:`.rasterize.row_spans` numbers them) into row-sized arrays, their unit end
     normals and the checks of ``check_span_input`` (:func:`.setup.end_checks`, modes 1-6;
-    :func:`.setup._ends_part` for mode 5, which also needs the cosines; normals in the
-    dtype of ``proto``), the method's per-span set-up (modes 4-6:
-    :func:`.setup._slerp_part`, :func:`.setup._quadratic_part` with the table's
-    coefficients ``cf`` (ascending; ``cf`` empty: exact), :func:`.setup._angular_part`;
-    ``quick``: their float64 sines by the library-exact shortcuts), then
-    :func:`_row_pass`. The spans never leave the cache: no frame-sized span arrays are
-    written or read.
+    :func:`.setup.ends_part` for modes 5 and 7, which also need the cosines and the
+    dichotomy depths; normals in the dtype of ``proto``), the method's per-span set-up
+    (modes 4-7: :func:`.setup.slerp_part`, :func:`.setup.quadratic_part` with the
+    table's coefficients ``cf`` (ascending; ``cf`` empty: exact),
+    :func:`.setup.angular_part`, the dichotomy's denominators
+    (:func:`.kernels.dichotomy_denominators_into`, ``kd`` its constants); ``quick``: the
+    float64 sines by the library-exact shortcuts), then :func:`_row_pass`. The spans
+    never leave the cache: no frame-sized span arrays are written or read.
 
-    The set-up of modes 5 and 6 depends on facts about the whole frame: whether every
-    span starts at its left end (``t0 == 0``), whether any span has two pixels or more,
-    and (mode 5) the table, chosen by the smallest ``N_l.N_r`` and cosine of all spans.
-    The rows assume the usual answers (no, yes, the table ``cf``) and report the facts:
-    ``out``: [1 a check failed (then the frame stops: the caller draws it step by step,
-    with the reference's errors), 2 a set-up value the shortcuts cannot promise (the frame
-    stops: the caller draws it with the frame-sized spans), fragments, covered pixels,
-    any ``t0 != 0``, largest span]; ``fout``: [smallest ``N_l.N_r``, smallest cosine
-    clipped to [-1, 1]] (mode 5). ``stop`` 4 (profiling): the rows' spans, checks and
-    set-up alone."""
+    The set-up of modes 5-7 depends on facts about the whole frame: whether every span
+    starts at its left end (``t0 == 0``), whether any span has two pixels or more, the
+    table (modes 5 and 7), chosen by the smallest ``N_l.N_r`` and cosine of all spans,
+    and (mode 7) per depth whether any pixel of the frame is off the dyadic grid. The rows
+    assume the usual answers (no, yes, the table ``cf``, every depth off the grid) and
+    report the facts: ``out``: [1 a check failed (then the frame stops: the caller draws
+    it step by step, with the reference's errors), 2 a set-up value the shortcuts cannot
+    promise (the frame stops: the caller draws it with the frame-sized spans),
+    fragments, covered pixels, any ``t0 != 0``, largest span, any span deeper than 0];
+    ``fout``: [smallest ``N_l.N_r``, smallest cosine clipped to [-1, 1] (mode 7: of the
+    spans deeper than 0)]; ``offs`` (mode 7, ``(2, MAX_LEVELS + 1)``): per depth, whether
+    a span has it, whether a pixel is off its grid. ``stop`` 4 (profiling): the rows'
+    spans, checks and set-up alone."""
     Kc = attrs.shape[2]
     first, ids, widest = part_buckets(xy, height, part, parts)
     M = max(widest, 1)
@@ -437,12 +466,19 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     cfx = np.zeros(1, proto.dtype) if exact else cf
     dmin = np.inf
     clo = np.inf
+    deep = False
+    Rr = np.empty((M, MAX_LEVELS), proto.dtype)     # the dichotomy's denominators
+    offall = np.ones(MAX_LEVELS + 1, np.bool_)      # assumed: every depth off the grid
+    tcb = np.empty(1, proto.dtype)
     is64 = proto.itemsize == 8
     # the row pass's arrays: the row's spans, the method's (the set-up's where it has
     # one: quadratic v, d1, d2; angular p0, p1), the shading's, the maps
     Am, Bm = (P0, P1) if mode == 5 or mode == 6 else (lA, lB)
     spans = (ltri, lc0, lcount, lt0, ldt, lleft, lright)
-    meth = (Am, Bm, P2 if mode == 5 else C, sc, sc2, levels, R, off, kc, kc)
+    if mode == 7:
+        meth = (Am, Bm, C, sc, sc2, llev, Rr, offall, kc, kd)
+    else:
+        meth = (Am, Bm, P2 if mode == 5 else C, sc, sc2, levels, R, off, kc, kd)
     shade = (face_id, Htri, L, eye, light, orders)
     maps = (img, mask, tri_map, nlen)
     buf = _row_buffers(width, lA, mode)
@@ -462,15 +498,34 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                        lc0, lcount, lm, lt0, ldt, lleft, lright)
             nfrag += c
             n += 1
-        if mode == 5 and n > 0:
-            _ends_part(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], False,
-                       _NO_THRESHOLDS, 0, n, lA, lB, False, lcos, llev, hard, red)
+        if (mode == 5 or mode == 7) and n > 0:
+            tree = mode == 7
+            ends_part(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], tree,
+                       DEPTH_THRESHOLDS if tree else _NO_THRESHOLDS, 0, n, lA, lB, False, lcos,
+                       llev, hard, red)
             if red[0] != 0.0:
                 out[0] = 1
                 return
+            if red[4] != 0.0:     # depths the reference's span_levels must compute
+                for s in range(n):
+                    if hard[s]:
+                        lv = span_level_libm(ldt[s], lt0[s], lcount[s], lcos[s])
+                        if lv < 0:     # 1/dt not a finite normal number
+                            lv = _reference_level(ldt[s], lt0[s], lcount[s], lcos[s])
+                        llev[s] = lv
+                        if lv > MAX_LEVELS:
+                            out[0] = 1
+                            return
             dmin = min(dmin, red[1])
-            for s in range(n):
-                clo = min(clo, min(max(lcos[s], -1.0), 1.0))
+            for s in range(n):     # _cos_range's minimum (tree: of the spans deeper than 0)
+                if not tree or llev[s] > 0:
+                    clo = min(clo, min(max(lcos[s], -1.0), 1.0))
+                    deep |= tree
+            if tree:
+                dichotomy_denominators_into(lA, lB, llev[:n], cfx, exact, kd, Rr)
+                for s in range(n):
+                    offs[0, llev[s]] = True
+                _off_grid(llev[:n], kd, lt0, ldt, lcount, tcb, offs[1])
         elif mode >= 1 and n > 0:
             if not end_checks(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], n,
                               lA, lB, mode <= 3):
@@ -481,13 +536,13 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                 t0nz |= lt0[s] != 0.0
                 cmax = max(cmax, lcount[s])
         if mode == 4 and n > 0:
-            if _slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
+            if slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
                 out[0] = 2
                 return
         elif mode == 5 and n > 0:
-            _quadratic_part(lA, lB, lt0, ldt, ks, cfx, exact, False, 0, n, P0, P1, P2)
+            quadratic_part(lA, lB, lt0, ldt, ks, cfx, exact, False, 0, n, P0, P1, P2)
         elif mode == 6 and n > 0:
-            if _angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
+            if angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
                              hard):
                 out[0] = 2
                 return
@@ -500,6 +555,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     out[2] = ncov
     out[3] = t0nz
     out[4] = cmax
+    out[5] = deep
     fout[0] = dmin
     fout[1] = clo
 
@@ -655,7 +711,7 @@ def _dichotomy_row(ws, tc, count, A, B, R, levels, off, kd, nd, n0, n1, n2, nw):
                 break
 
 
-#: no dichotomy depth thresholds (:func:`.setup._ends_part` of a method without a tree)
+#: no dichotomy depth thresholds (:func:`.setup.ends_part` of a method without a tree)
 _NO_THRESHOLDS = np.zeros(1)
 
 
@@ -996,13 +1052,13 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
 
 def _rows_dtype(spec, mode, dtype):
     """The dtype of a method's row-by-row frame (:func:`_frame_rows`): float64 for
-    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3, float64 for slerp,
-    quadratic and angular (modes 4-6) in float64; None where the frame takes the
-    frame-sized span arrays instead (the dichotomy; a table method other than the
-    quadratic; slerp, quadratic and angular in float32, whose set-up may need the
-    reference's functions; no :func:`.calibration.ends_orders`; a dtype the reference
-    refuses, which it then refuses with its own error)."""
-    if mode == 7 or (spec.table is not None and mode != 5):
+    ``none`` (mode 0, no checks), ``check_dtype(dtype)`` for modes 1-3, float64 for
+    modes 4-7 in float64; None where the frame takes the frame-sized span arrays instead
+    (modes 4-7 in float32, whose set-up may need the reference's functions; the
+    dichotomy without :func:`.setup.levels_calibrated`; a method with a table of another
+    kind; no :func:`.calibration.ends_orders`; a dtype the
+    reference refuses, which it then refuses with its own error)."""
+    if spec.table is not None and mode not in (5, 7):
         return None
     if mode == 0:
         return np.float64
@@ -1012,7 +1068,9 @@ def _rows_dtype(spec, mode, dtype):
         dt_ = check_dtype(dtype)
     except (TypeError, ValueError):
         return None
-    if mode in (4, 5, 6) and dt_ is not np.float64:
+    if mode >= 4 and dt_ is not np.float64:
+        return None
+    if mode == 7 and not levels_calibrated():
         return None
     return dt_
 
@@ -1048,11 +1106,11 @@ def _rows_table(spec, tables, st):
     gave one, else the last such frame's (the default table the first time)."""
     key = (spec.name, int(st.width), int(st.height), len(st.xy))
     if tables is not None:    # the caller's (or the default where it gave none for it)
-        return key, _clear_table(spec, tables, None)[1]
+        return key, clear_table(spec, tables, None)[1]
     if len(_TABLE_GUESS) > _TABLE_GUESSES:
         _TABLE_GUESS.clear()
     if key not in _TABLE_GUESS:
-        _TABLE_GUESS[key] = _clear_table(spec, None, None)[1]
+        _TABLE_GUESS[key] = clear_table(spec, None, None)[1]
     return key, _TABLE_GUESS[key]
 
 
@@ -1063,7 +1121,7 @@ def _table_holds(spec, tables, guess, key, dmin, clo, stats):
     does and remembers the frame's table for the next frame."""
     one = SimpleNamespace(count=(1,))    # auto_tables reads len(sp.count) alone here
     tabs = auto_tables(spec, one, [[1, 2, 3]], tables, stats, dot_min=dmin)
-    clear, table = _clear_table(spec, tabs, clo)
+    clear, table = clear_table(spec, tabs, clo)
     if not clear:
         return False      # resolve_table decides: the frame-sized spans
     if tables is None:
@@ -1092,33 +1150,35 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
     eorders = np.array(eo if eo is not None else (0, 0), np.int64)
     quick = bool(mode in (4, 6) and dt_ is np.float64 and trig_calibrated())
     cf = np.zeros(0, dt_)
-    if mode == 5:
+    if mode in (5, 7):
         key, guess = _rows_table(spec, tables, st)
         if guess is not None:
             cf = np.array([dt_(c) for c in guess.coefficients], dt_)
+    kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dt_)
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
-    outs = np.zeros((k, 5), np.int64)
+    outs = np.zeros((k, 6), np.int64)
     fouts = np.zeros((k, 2))
+    offs = np.zeros((k, 2, MAX_LEVELS + 1), np.bool_)
     common = (st.width, height, mode, xy, attrs, eorders, np.zeros(1, dt_), kc, face_id,
-              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf)
+              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf, kd)
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
-            run([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], stop))
+            run([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], offs[q], stop))
                  for q in range(k)])
             tick(name)
             if name == "ends":
                 tick("method set-up")
-    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q]))
+    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], offs[q]))
                      for q in range(k)])
     tick("shading")
     if (outs[:, 0] == 1).any():
         raise FrameUnsupported("a span failed a check of check_span_input")
     keep_maps(maps)
-    # the set-up of modes 4-6: every value promised (no hard span); quadratic and angular
-    # also assumed what the whole frame decides (setup.method_setup's start_left and
-    # count_max, the quadratic's table)
+    # the set-up of modes 4-7: every value promised (no hard span); modes 5-7 also assumed
+    # what the whole frame decides (setup.method_setup's start_left and count_max, the
+    # table, the dichotomy's depths off the dyadic grid)
     stats = {}
     spans = outs[:, 1].sum() > 0
     if (outs[:, 0] == 2).any():
@@ -1126,9 +1186,12 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
     if mode in (5, 6) and spans and not (outs[:, 3].any()
                                          and (mode == 5 or outs[:, 4].max() >= 2)):
         return None
-    if mode == 5 and spans and not _table_holds(spec, tables, guess, key,
-                                                np.float64(fouts[:, 0].min()),
-                                                float(fouts[:, 1].min()), stats):
+    if mode == 7 and (offs[:, 0].any(axis=0) & ~offs[:, 1].any(axis=0)).any():
+        return None
+    clo = None if mode == 7 and not outs[:, 5].any() else float(fouts[:, 1].min())
+    if mode in (5, 7) and spans and not _table_holds(spec, tables, guess, key,
+                                                     np.float64(fouts[:, 0].min()), clo,
+                                                     stats):
         return None
     if outs[:, 2].sum() < 2:
         # numpy computes N @ L for one row by another route than BLAS

@@ -22,11 +22,14 @@ try:  # pragma: no cover - exercised by whichever environment runs the tests
     from numba.core.extending import intrinsic as _intrinsic
     #: whether numba is installed (else every function here runs as plain Python)
     HAVE_NUMBA = True
+    #: numba's ``objmode`` (a block of compiled code run by the interpreter, under the GIL)
+    objmode = numba.objmode
 except ImportError:  # pragma: no cover
     numba = None
     HAVE_NUMBA = False
+    objmode = None
 
-__all__ = ["HAVE_NUMBA", "njit", "fma", "f2i", "i2f", "threads", "pool", "run",
+__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "threads", "pool", "run",
            "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
 
 
@@ -80,7 +83,7 @@ def announce_slow(work, what: str = "the raster engine"):
         watcher.join()
 
 
-def njit(fn=None, *, inline=False):
+def njit(fn=None, *, inline=False, nogil=True):
     """numba's ``njit`` (cached, ``nogil``, no fast-math, numpy's error model), usable
     as ``@njit`` or ``@njit(inline=True)``; ``inline``: inlined into its callers in
     numba's IR (per-pixel helpers: no call, no reference counting of the arrays passed
@@ -92,6 +95,8 @@ def njit(fn=None, *, inline=False):
         The function to compile (``@njit``); None for ``@njit(...)``.
     inline : bool
         Inline into callers (``inline="always"``) instead of calling.
+    nogil : bool
+        Release the GIL (False for a function with an ``objmode`` block, which takes it).
 
     Returns
     -------
@@ -101,7 +106,7 @@ def njit(fn=None, *, inline=False):
     def deco(f):
         if not HAVE_NUMBA:
             return f
-        return numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy",
+        return numba.njit(cache=True, nogil=nogil, fastmath=False, error_model="numpy",
                           inline="always" if inline else "never")(f)
     return deco(fn) if fn is not None else deco
 

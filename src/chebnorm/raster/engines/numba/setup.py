@@ -16,6 +16,8 @@ those spans or on all, so the user gets exactly the reference's values and error
 from __future__ import annotations
 
 import math
+import platform
+from functools import lru_cache
 from types import SimpleNamespace
 
 import numpy as np
@@ -29,11 +31,12 @@ from chebnorm.methods.spans import (ANTIPARALLEL_TOL, COVER_SLACK, MAX_LEVELS, P
 
 from ...meshes import unit
 from .calibration import dot3, ends_orders, f32_round, sin_small, trig64, trig_calibrated
-from .jit import f2i, i2f, njit, run_with_caller, threads
+from .jit import HAVE_NUMBA, f2i, i2f, njit, run_with_caller, threads
 from .kernels import angular_setup
 from .workspace import scratch
 
-__all__ = ["widest_dot", "span_input", "end_arrays", "method_setup", "end_checks"]
+__all__ = ["widest_dot", "span_input", "end_arrays", "method_setup", "end_checks",
+           "span_level_libm", "levels_calibrated"]
 
 
 #: the position tolerance of ``check_span_input`` (pixels at ``t`` in [-tol, 1 + tol])
@@ -47,7 +50,7 @@ _NEAR_INT = 1e-6
 
 #: ``cos(theta_max 2**n)``, ``theta_max = 2 acos(1 - PICK_TOL)`` of ``span_levels``, while
 #: ``theta_max 2**n < pi`` (past the last, every span angle is below ``theta_max 2**n``)
-_THRESHOLDS = np.array([math.cos(2.0 * math.acos(1.0 - PICK_TOL) * 2.0 ** n) for n in range(8)
+DEPTH_THRESHOLDS = np.array([math.cos(2.0 * math.acos(1.0 - PICK_TOL) * 2.0 ** n) for n in range(8)
                         if 2.0 * math.acos(1.0 - PICK_TOL) * 2.0 ** n < math.pi])
 
 
@@ -66,8 +69,110 @@ def _depth_base(dt):
     return base, i2f((base + 1023) << 52)
 
 
+#: ``theta_max`` of ``span_levels`` (the largest node angle of the linear pick)
+_THETA_MAX = 2.0 * math.acos(1.0 - PICK_TOL)
+
+
 @njit()
-def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A, B,
+def span_level_libm(dt, t0, count, cos):
+    """The dichotomy depth of one span as :func:`chebnorm.methods.spans.span_levels`
+    computes it, its ``log2`` and ``arccos`` the C library's (numba calls ``log2`` and
+    ``acos``, as :mod:`chebnorm.methods.detmath` does through :func:`math.log2` and
+    :func:`math.acos`; :func:`levels_calibrated` checks that they agree), for the spans
+    whose depth :func:`ends_part` leaves to the reference; -1 where ``1/dt`` is not a
+    finite normal number (the reference's own function decides those).
+
+    Parameters
+    ----------
+    dt, t0 : float
+        The span's step and first position.
+    count : int
+        Its pixels.
+    cos : float
+        ``N_l.N_r``.
+
+    Returns
+    -------
+    int
+        The depth, or -1.
+
+    Examples
+    --------
+    >>> from chebnorm.methods.spans import span_levels
+    >>> int(span_levels([0.25], [0.1], [3], [0.9])[0]) == span_level_libm(0.25, 0.1, 3, 0.9)
+    True
+    """
+    bits = f2i(1.0 / dt)
+    ex = (bits >> 52) & 0x7FF
+    if bits <= 0 or ex == 0 or ex == 0x7FF:
+        return -1
+    base = np.int64(max(np.ceil(np.log2(1.0 / dt) - 1e-12), 0.0))
+    scale = i2f((base + 1023) << 52)      # np.ldexp(1.0, base), exactly
+    off = False
+    for j in range(count):
+        u = (t0 + j * dt) * scale
+        if abs(u - np.rint(u)) > 1e-9 * max(1.0, abs(u)):
+            off = True
+            break
+    if not off:
+        return base
+    psi = np.arccos(min(max(cos, -1.0), 1.0))
+    need = np.int64(max(np.ceil(np.log2(max(psi, 1e-300) / _THETA_MAX)), 0.0))
+    return max(base, need)
+
+
+@lru_cache(maxsize=1)
+def levels_calibrated() -> bool:
+    """Whether compiled code's ``log2`` and ``arccos`` give :func:`math.log2`'s and
+    :func:`math.acos`'s bits (the reference's, :mod:`chebnorm.methods.detmath`) on
+    probes around every power of two the depths meet and over ``[-1, 1]``, and
+    :func:`span_level_libm` the reference's depths on spans near its hard cases.
+
+    Returns
+    -------
+    bool
+        True where :func:`span_level_libm` may stand in for ``span_levels``.
+
+    Examples
+    --------
+    >>> levels_calibrated() == (HAVE_NUMBA and platform.libc_ver()[0] == "glibc")
+    True
+    """
+    if not HAVE_NUMBA or platform.libc_ver()[0] != "glibc":
+        return False
+    rng = np.random.default_rng(20261128)
+    ulps = 1.0 + np.arange(-16, 17) * 2.0 ** -52
+    x = np.concatenate([(2.0 ** np.arange(-20, 40)[:, None] * ulps).ravel(),
+                        2.0 ** rng.uniform(-20, 40, 20_000)])
+    c = np.concatenate([rng.uniform(-1.0, 1.0, 20_000), np.cos(_THETA_MAX * 2.0 ** np.arange(8)),
+                        [-1.0, 1.0, 0.0]])
+    got_l, got_a = _libm_pair(x, c)
+    if (got_l.tobytes() != np.array([math.log2(v) for v in x]).tobytes()
+            or got_a.tobytes() != np.array([math.acos(v) for v in c]).tobytes()):
+        return False
+    dt = 1.0 / np.concatenate([(2.0 ** np.arange(0, 12)[:, None] * ulps).ravel(),
+                               rng.uniform(1.0, 64.0, 2_000)])
+    t0 = rng.uniform(0.0, 0.5, dt.size) * dt
+    count = rng.integers(1, 9, dt.size)
+    cos = rng.uniform(0.3, 1.0, dt.size)
+    ref = span_levels(dt, t0, count, cos)
+    got = np.array([span_level_libm(a, b, n, q) for a, b, n, q in zip(dt, t0, count, cos)])
+    return got.tobytes() == ref.astype(np.int64).tobytes()
+
+
+@njit()
+def _libm_pair(x, c):
+    """``log2(x)`` and ``arccos(c)`` element by element, compiled."""
+    a, b = np.empty(x.shape[0]), np.empty(c.shape[0])
+    for i in range(x.shape[0]):
+        a[i] = np.log2(x[i])
+    for i in range(c.shape[0]):
+        b[i] = np.arccos(c[i])
+    return a, b
+
+
+@njit()
+def ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A, B,
                diff, cos, levels, hard, red):
     """Spans ``lo .. hi-1``: the unit end normals ``unit(left[:, 1:4])``,
     ``unit(right[:, 1:4])`` in the dtype of ``A``, ``B`` (3, S) (``diff``: ``B - A``
@@ -168,7 +273,7 @@ def _ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, 
 @njit()
 def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True):
     """The unit end normals of spans ``0 .. n-1`` into ``A`` and ``B - A`` (a linear
-    method; ``diff`` False: ``B``) into ``B`` ((3, n), their dtype), as :func:`_ends_part`
+    method; ``diff`` False: ``B``) into ``B`` ((3, n), their dtype), as :func:`ends_part`
     computes them, and
     whether every check of ``check_span_input`` passes on them (False: one fails).  The
     fused frame's per-row set-up (:func:`chebnorm.raster.engines.numba.frame.phong`).
@@ -240,7 +345,7 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True)
                 and np.isfinite(dt[i])):
             ok = False
             continue
-        # _ends_part's expressions
+        # ends_part's expressions
         qa = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_ein))
         qb = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_ein))
         if abs(qa - 1.0) > UNIT_TOL or abs(qb - 1.0) > UNIT_TOL:
@@ -281,7 +386,7 @@ def _parts(n):
 
 
 class _Ends:
-    """What the compiled pass over the spans found (see :func:`_ends_part`)."""
+    """What the compiled pass over the spans found (see :func:`ends_part`)."""
 
     def __init__(self, sp, tree, orders, dtype, diff, work):
         S = len(sp.count)
@@ -292,8 +397,8 @@ class _Ends:
         self.hard = scratch(work, "hard", S, np.bool_)
         parts = _parts(S)
         red = np.zeros((len(parts), 5))
-        run_with_caller([(_ends_part, (left, right, sp.m, sp.t0, sp.dt, sp.count, orders[0],
-                                       orders[1], tree, _THRESHOLDS, lo, hi, self.A, self.B,
+        run_with_caller([(ends_part, (left, right, sp.m, sp.t0, sp.dt, sp.count, orders[0],
+                                       orders[1], tree, DEPTH_THRESHOLDS, lo, hi, self.A, self.B,
                                        diff, self.cos, self.levels, self.hard, red[q]))
                          for q, (lo, hi) in enumerate(parts)])
         self.bad = bool(red[:, 0].any())
@@ -309,7 +414,7 @@ class _Ends:
 def widest_dot(sp, spec, dtype, diff, work=None):
     """``(ends, smallest N_l.N_r)`` of the spans' unit end normals (the einsum of
     ``auto_tables``) for method ``spec``, the normals in ``dtype`` (if float32
-    or float64; ``diff``: see :func:`_ends_part`); ``(ends, None)`` when a check of
+    or float64; ``diff``: see :func:`ends_part`); ``(ends, None)`` when a check of
     ``check_span_input`` fails on them, ``(None, None)`` without :func:`ends_orders`
     (then the reference runs); arrays from ``work`` (a :class:`Workspace`) if given.
 
@@ -343,7 +448,7 @@ def widest_dot(sp, spec, dtype, diff, work=None):
     return ends, (None if ends.bad else ends.dot_min)
 
 
-def _clear_table(spec, tables, c_lo):
+def clear_table(spec, tables, c_lo):
     """``(True, table)`` where the table of method ``spec`` in ``tables`` (None or absent:
     the default) clearly covers spans whose smallest cosine is ``c_lo`` (clipped to
     [-1, 1]; None: no span needs it) or is None; ``(False, None)`` where
@@ -369,7 +474,7 @@ def _table(spec, tables, ends, tree):
     clearly covers the spans (its upper end at ``table_scale``, its lower end below what
     the spans need, a comparison of exact values)."""
     c_lo, c_lo_deep, deep = _cos_range(ends.cos, ends.levels, tree)
-    clear, table = _clear_table(spec, tables, None if tree and not deep
+    clear, table = clear_table(spec, tables, None if tree and not deep
                                else (c_lo_deep if tree else c_lo))
     if clear:
         return table
@@ -491,7 +596,7 @@ def _trig(kind, x, is64, buf):
 
 
 @njit()
-def _slerp_part(A, B, k, is64, fast, lo, hi, psi_out, inv_out, hard):
+def slerp_part(A, B, k, is64, fast, lo, hi, psi_out, inv_out, hard):
     """``psi = max(arccos(min(N_l.N_r, 1)), TINY)``, ``inv = 1/sin(psi)`` (``fast``: the
     float64 sines by :func:`sin_small`)."""
     if is64 and fast:
@@ -527,7 +632,7 @@ def _slerp_part(A, B, k, is64, fast, lo, hi, psi_out, inv_out, hard):
 
 
 @njit()
-def _quadratic_part(A, B, t0, dt, k, coeffs, exact, start_left, lo, hi, V, D1, D2):
+def quadratic_part(A, B, t0, dt, k, coeffs, exact, start_left, lo, hi, V, D1, D2):
     """``v``, ``d1``, ``d2`` of ``quadratic_steps`` (``coeffs`` ascending, in the dtype)."""
     for i in range(lo, hi):
         a0, a1, a2 = A[0, i], A[1, i], A[2, i]
@@ -560,7 +665,7 @@ def _quadratic_part(A, B, t0, dt, k, coeffs, exact, start_left, lo, hi, V, D1, D
 
 
 @njit()
-def _angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, K2, hard):
+def angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, K2, hard):
     """The first two pixels of ``angular_steps`` (``two``: the frame has spans of two
     or more pixels, else ``P1 = P0``) and ``2 cos(phi)`` (``fast``: the float64 sines
     by :func:`sin_small`, cosines by :func:`trig64`, :func:`_angular_fast`)."""
@@ -604,7 +709,7 @@ def _angular_part(A, B, t0, dt, k, is64, fast, two, start_left, lo, hi, P0, P1, 
 
 @njit()
 def _angular_fast(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard):
-    """:func:`_angular_part` in float64, its cosines and sines of ``phi`` and of the
+    """:func:`angular_part` in float64, its cosines and sines of ``phi`` and of the
     start angle computed for the spans ``lo .. hi-1`` at once (:func:`trig64`,
     :func:`sin_small`)."""
     # in blocks of _BLOCK spans: the scratch rows stay in the cache
@@ -703,7 +808,7 @@ def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=No
     if mode == 4:
         psi, inv = scratch(work, "sc", S, dtype), scratch(work, "sc2", S, dtype)
         hard = scratch(work, "hard2", S, np.bool_)
-        nh = sum(run_with_caller([(_slerp_part, (A, B, k, is64, quick, lo, hi, psi, inv, hard))
+        nh = sum(run_with_caller([(slerp_part, (A, B, k, is64, quick, lo, hi, psi, inv, hard))
                                   for lo, hi in parts]))
         if nh:
             h = np.flatnonzero(hard)
@@ -713,12 +818,12 @@ def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=No
     if mode == 5:
         cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
         V, D1, D2 = (scratch(work, name, (3, S), dtype) for name in ("P0", "P1", "P2"))
-        run_with_caller([(_quadratic_part, (A, B, t0, dt, k, cf, coeffs is None, start_left, lo,
+        run_with_caller([(quadratic_part, (A, B, t0, dt, k, cf, coeffs is None, start_left, lo,
                                             hi, V, D1, D2)) for lo, hi in parts])
         return V, D1, D2
     P0, P1 = scratch(work, "P0", (3, S), dtype), scratch(work, "P1", (3, S), dtype)
     K2, hard = scratch(work, "sc", S, dtype), scratch(work, "hard2", S, np.bool_)
-    nh = sum(run_with_caller([(_angular_part, (A, B, t0, dt, k, is64, quick, count_max >= 2,
+    nh = sum(run_with_caller([(angular_part, (A, B, t0, dt, k, is64, quick, count_max >= 2,
                                                start_left, lo, hi, P0, P1, K2, hard))
                               for lo, hi in parts]))
     if nh:
