@@ -338,8 +338,13 @@ def test_span_level_libm_is_span_levels():
     got = np.array([span_level_libm(a, b, n, c) for a, b, n, c in zip(dt, t0, count, cos)])
     assert (got == ref).all()
     assert levels_calibrated()
-    # 1/dt not a finite normal number: left to the reference's own function
+    # 1/dt not a finite normal number: left to the reference's own function, which the
+    # rows call from compiled code (objmode) for those
     assert span_level_libm(1e-320, 0.0, 1, 1.0) == -1
+    with np.errstate(all="ignore"):    # (the reference's 1/1e-320 overflows)
+        for args in [(1e-320, 0.0, 1, 1.0), (0.25, 0.1, 3, 0.9), (dt[5], t0[5], count[5], cos[5])]:
+            ref = int(span_levels(*[np.array([a]) for a in args])[0])
+            assert frame._reference_level(*args) == ref
 
 
 def test_fused_rows_dichotomy(monkeypatch):
