@@ -1210,7 +1210,10 @@ def stage_times(st, spec, lighting, tables=None, dtype=np.float64, extra_maps=Tr
     ``method set-up``, then the frame's passes over the rows, each timed alone
     (the frame run up to it minus the frame run up to the one before):
     ``visibility`` (z-test, background, winners), ``normals`` (the method's),
-    ``half vectors``, ``shading`` (dot products, ``pow``, the output maps).
+    ``half vectors``, ``shading`` (dot products, ``pow``, the output maps). A frame
+    drawn row by row (:func:`_frame_rows`: every method in float64) has no frame-sized
+    spans: its ``ends`` is the rows' spans, checks and the method's set-up together
+    (``spans`` and ``method set-up`` are then about zero).
 
     Parameters
     ----------
@@ -1234,7 +1237,7 @@ def stage_times(st, spec, lighting, tables=None, dtype=np.float64, extra_maps=Tr
     # the frame's passes ran cumulatively: each stage is its run minus the one before
     cum = ["visibility", "normals", "half vectors", "shading"]
     if _rows_dtype(spec, MODES[id(method_kernel(spec))], dtype) is not None:
-        cum.insert(0, "ends")    # the row-by-row frame: "ends" is its rows' spans and checks
+        cum.insert(0, "ends")    # the row-by-row frame: "ends" is its rows' spans, checks, set-up
     runs = {n: out[n] for n in cum}
     for a, b in zip(cum, cum[1:]):
         out[b] = (runs[b][0] - runs[a][0], runs[b][1] - runs[a][1])
