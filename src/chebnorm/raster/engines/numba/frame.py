@@ -23,6 +23,16 @@ frame-sized z-buffer, per-fragment normals, half vectors and dot products):
    winners only, half vector, Blinn-Phong intensity, ``|N|`` and the triangle id,
    each output pixel written once.
 
+In float64 (and for the linear methods in float32 too) the three steps run row by row
+instead (:func:`_frame_rows`): each thread builds a scan line's spans, their checks and
+the method's set-up in row-sized arrays and draws the line at once, so no frame-sized
+span array is written or read. What the set-up needs from the whole frame (the table
+of the dichotomy and the quadratic, chosen by the widest span; whether a span starts
+past its left end; whether a span has two pixels; the dichotomy's depths off the dyadic
+grid) is assumed and checked once every row is done; where an assumption fails, the
+frame is drawn again by steps 1-3 (the table assumed is the last such frame's, so this
+happens on the first frame of a kind).
+
 Every float operation is the reference's, in its order and dtype (no ``fastmath``).
 The library reductions (``N @ L``, ``einsum``, ``norm``) are summed in the orders
 :func:`.calibration.calibrated` found; :func:`supports` says whether the frame can
