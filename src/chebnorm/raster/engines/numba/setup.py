@@ -270,6 +270,17 @@ def ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A
     red[4] = nhard
 
 
+@njit(inline=True)
+def _unit_ends(left, right, i, o_norm):
+    """Span ``i``'s end normals (columns 1-3 of ``left``, ``right``) divided by their
+    ``np.linalg.norm`` (summed in order ``o_norm``), as ``unit`` computes them."""
+    a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
+    r = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
+    b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
+    q = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
+    return a0 / r, a1 / r, a2 / r, b0 / q, b1 / q, b2 / q
+
+
 @njit()
 def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True):
     """The unit end normals of spans ``0 .. n-1`` into ``A`` and ``B - A`` (a linear
@@ -309,12 +320,7 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True)
     # whether every span is clearly fine; NaN and infinities fail its comparisons
     easy = 0
     for i in range(n):
-        a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
-        r = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
-        a0, a1, a2 = a0 / r, a1 / r, a2 / r
-        b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
-        r = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
-        b0, b1, b2 = b0 / r, b1 / r, b2 / r
+        a0, a1, a2, b0, b1, b2 = _unit_ends(left, right, i, o_norm)
         A[0, i], A[1, i], A[2, i] = a0, a1, a2
         B[0, i], B[1, i], B[2, i] = b0, b1, b2
         if diff:
@@ -334,12 +340,7 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True)
     # some span is not clearly fine: the reference's checks, span by span
     ok = True
     for i in range(n):
-        a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
-        r = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
-        a0, a1, a2 = a0 / r, a1 / r, a2 / r
-        b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
-        r = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
-        b0, b1, b2 = b0 / r, b1 / r, b2 / r
+        a0, a1, a2, b0, b1, b2 = _unit_ends(left, right, i, o_norm)
         if not (np.isfinite(a0) and np.isfinite(a1) and np.isfinite(a2) and np.isfinite(b0)
                 and np.isfinite(b1) and np.isfinite(b2) and np.isfinite(t0[i])
                 and np.isfinite(dt[i])):
