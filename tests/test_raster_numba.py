@@ -364,7 +364,7 @@ def test_fused_rows_dichotomy(monkeypatch):
         out = real(jobs)
         if jobs[0][0] is frame._frame_rows:
             for _, args in jobs:
-                args[-1][1, :] = False     # offs[q]: no pixel of any depth off its grid
+                args[-2][1, :] = False     # offs[q] (then stop): no pixel of any depth off its grid
         return out
     monkeypatch.setattr(frame, "run_with_caller", run)
     rows.clear()

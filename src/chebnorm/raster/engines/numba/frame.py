@@ -59,9 +59,9 @@ from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f3
 from .jit import HAVE_NUMBA, njit, objmode, run, run_with_caller, threads
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_spans, span_geom, span_write
-from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, ends_part, quadratic_part,
-                    slerp_part, end_checks, levels_calibrated, method_setup, span_input,
-                    span_level_libm, widest_dot)
+from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, cos_range, ends_part,
+                    quadratic_part, slerp_part, end_checks, levels_calibrated, method_setup,
+                    setup_consts, span_input, span_level_libm, widest_dot)
 from .workspace import give, keep_maps, output_maps, scratch, take
 
 __all__ = ["MODES", "supports", "phong", "stage_times"]
@@ -397,7 +397,7 @@ def _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, wa
 @njit()
 def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right, A, B, C, sc,
            sc2, levels, R, off, kc, kd, is64, face_id, per_pixel_h, Htri, L, eye, light, orders,
-           want, part, parts, img, mask, tri_map, nlen, stop=0):
+           want, part, parts, img, mask, tri_map, nlen, stop):
     """The visibility and shading passes over the frame's spans (numbered row by row,
     row ``r``'s ``row_start[r] .. row_start[r+1]-1``), one scan line at a time
     (:func:`_row_pass`), on the rows ``part, part + parts, ...`` (threads run the parts at
@@ -420,8 +420,8 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
 
 @njit()
 def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h, Htri,
-                L, eye, light, orders, want, quick, cf, kd, part, parts, img, mask, tri_map,
-                nlen, out, fout, offs, stop=0):
+                L, eye, light, orders, want, quick, cf, kd, ks, part, parts, img, mask,
+                tri_map, nlen, out, fout, offs, stop):
     """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5), angular
     (6) or dichotomy (7), scan line by scan line, on the rows ``part, part + parts, ...``:
     each
@@ -434,7 +434,8 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     (modes 4-7: :func:`.setup.slerp_part`, :func:`.setup.quadratic_part` with the
     table's coefficients ``cf`` (ascending; ``cf`` empty: exact),
     :func:`.setup.angular_part`, the dichotomy's denominators
-    (:func:`.kernels.dichotomy_denominators_into`, ``kd`` its constants); ``quick``: the
+    (:func:`.kernels.dichotomy_denominators_into`, ``kd`` its constants; ``ks``:
+    :func:`.setup.setup_consts` in the dtype); ``quick``: the
     float64 sines by the library-exact shortcuts), then :func:`_row_pass`. The spans
     never leave the cache: no frame-sized span arrays are written or read.
 
@@ -464,8 +465,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     R = np.zeros((1, 1), proto.dtype)
     off = np.zeros(1, np.bool_)
     # modes 4 and 6: the per-span set-up (slerp: psi, 1/sin psi; angular: the first two
-    # pixels and 2 cos phi), setup._consts' constants
-    ks = np.array([1.0, 2.0, 4.0, 1e-30], proto.dtype)
+    # pixels and 2 cos phi) with the constants ks (setup_consts)
     sc, sc2 = np.zeros(M, proto.dtype), np.zeros(M, proto.dtype)
     hard = np.zeros(M, np.bool_)
     P0, P1 = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
@@ -527,10 +527,9 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                             out[0] = 1
                             return
             dmin = min(dmin, red[1])
-            for s in range(n):     # _cos_range's minimum (tree: of the spans deeper than 0)
-                if not tree or llev[s] > 0:
-                    clo = min(clo, min(max(lcos[s], -1.0), 1.0))
-                    deep |= tree
+            lo, lo_deep, dp = cos_range(lcos, llev, tree, n)   # (tree: of the spans deeper
+            clo = min(clo, lo_deep if tree else lo)             # than 0)
+            deep |= dp
             if tree:
                 dichotomy_denominators_into(lA, lB, llev[:n], cfx, exact, kd, Rr)
                 for s in range(n):
@@ -902,6 +901,12 @@ def supports(spec) -> bool:
             and calibrated() is not None)
 
 
+def _dichotomy_consts(dtype):
+    """The dichotomy's constants ``kd`` in ``dtype``: ``[2, 1, 2**0, ..., 2**MAX_LEVELS]``
+    (:func:`.kernels.dichotomy_denominators_into`, :func:`_off_grid`)."""
+    return np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
+
+
 def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
     """The per-span arrays of method ``mode`` the frame's kernels take: ``(dtype, A, B,
     C, sc, sc2, levels, R, off, kd)`` (placeholders of size 1 where the mode has none;
@@ -938,7 +943,7 @@ def _mode_arrays(mode, spec, sp, tables, dtype, ends, work):
                                         ops, work)
         elif mode == 7:     # dichotomy
             cf = np.array([0.0] if coeffs is None else [dtype(c) for c in coeffs], dtype)
-            kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dtype)
+            kd = _dichotomy_consts(dtype)
             levels = np.ascontiguousarray(lv, np.int64)
             lmax = int(levels.max())
             # the frame's denominators in kept memory (fresh ones: 2000 page faults a frame)
@@ -1038,7 +1043,8 @@ def _phong(st, spec, lighting, tables, dtype, clock, extra_maps=True):
         for stop, name in ((1, "visibility"), (2, "normals"), (3, "half vectors")):
             run([(_frame, (*common, q, k, *maps, stop)) for q in range(k)])
             tick(name)
-    nh = sum(run_with_caller([(_frame, (*common, q, k, *maps)) for q in range(k)]))
+    # ``stop`` passed (0) as stage_times passes it: one compiled signature, not two
+    nh = sum(run_with_caller([(_frame, (*common, q, k, *maps, 0)) for q in range(k)]))
     if nh:
         pix = np.flatnonzero(tri_map < -1)
         span = -2 - tri_map[pix]
@@ -1164,14 +1170,15 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
         key, guess = _rows_table(spec, tables, st)
         if guess is not None:
             cf = np.array([dt_(c) for c in guess.coefficients], dt_)
-    kd = np.array([2.0, 1.0] + [float(2 ** lv) for lv in range(MAX_LEVELS + 1)], dt_)
+    kd = _dichotomy_consts(dt_)
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
     outs = np.zeros((k, 6), np.int64)
     fouts = np.zeros((k, 2))
     offs = np.zeros((k, 2, MAX_LEVELS + 1), np.bool_)
     common = (st.width, height, mode, xy, attrs, eorders, np.zeros(1, dt_), kc, face_id,
-              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf, kd)
+              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf, kd,
+              setup_consts(dt_))
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
@@ -1180,7 +1187,7 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
             tick(name)
             if name == "ends":
                 tick("method set-up")
-    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], offs[q]))
+    run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], offs[q], 0))
                      for q in range(k)])
     tick("shading")
     if (outs[:, 0] == 1).any():

@@ -36,7 +36,7 @@ from .kernels import angular_setup
 from .workspace import scratch
 
 __all__ = ["widest_dot", "span_input", "end_arrays", "method_setup", "end_checks",
-           "span_level_libm", "levels_calibrated"]
+           "span_level_libm", "levels_calibrated", "setup_consts", "cos_range"]
 
 
 #: the position tolerance of ``check_span_input`` (pixels at ``t`` in [-tol, 1 + tol])
@@ -365,13 +365,14 @@ def end_checks(left, right, m, t0, dt, count, o_ein, o_norm, n, A, B, diff=True)
 
 
 @njit()
-def _cos_range(cos, levels, tree):
-    """(smallest cosine, smallest cosine of a span with ``levels > 0``, any such span),
-    cosines clipped to [-1, 1] (the values ``_needed_range`` takes the minimum of)."""
+def cos_range(cos, levels, tree, n):
+    """(smallest cosine, smallest cosine of a span with ``levels > 0``, any such span) of
+    the first ``n`` spans, cosines clipped to [-1, 1] (the values ``_needed_range`` takes
+    the minimum of; the row-by-row frame takes it row by row)."""
     lo = np.inf
     lo_deep = np.inf
     deep = False
-    for i in range(cos.shape[0]):
+    for i in range(n):
         c = min(max(cos[i], -1.0), 1.0)
         lo = min(lo, c)
         if tree and levels[i] > 0:
@@ -474,7 +475,7 @@ def _table(spec, tables, ends, tree):
     """``resolve_table(spec, tables, cos, levels)``: the reference runs unless the table
     clearly covers the spans (its upper end at ``table_scale``, its lower end below what
     the spans need, a comparison of exact values)."""
-    c_lo, c_lo_deep, deep = _cos_range(ends.cos, ends.levels, tree)
+    c_lo, c_lo_deep, deep = cos_range(ends.cos, ends.levels, tree, ends.cos.shape[0])
     clear, table = clear_table(spec, tables, None if tree and not deep
                                else (c_lo_deep if tree else c_lo))
     if clear:
@@ -765,7 +766,20 @@ def _angular_block(A, B, t0, dt, k, two, start_left, lo, hi, P0, P1, K2, hard, w
 _BLOCK = 512
 
 
-def _consts(dtype):
+def setup_consts(dtype):
+    """The constants ``(1, 2, 4, 1e-30)`` in ``dtype`` that :func:`slerp_part`,
+    :func:`quadratic_part` and :func:`angular_part` take (``k``).
+
+    Parameters
+    ----------
+    dtype : type
+        ``numpy.float32`` or ``numpy.float64``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The four constants.
+    """
     return np.array([1.0, 2.0, 4.0, 1e-30], dtype)
 
 
@@ -802,7 +816,7 @@ def method_setup(mode, A, B, t0, dt, coeffs, start_left, count_max, ops, work=No
     """
     dtype = A.dtype.type
     S = A.shape[1]
-    k = _consts(dtype)
+    k = setup_consts(dtype)
     is64 = dtype is np.float64
     quick = is64 and trig_calibrated()
     parts = _parts(S)
