@@ -69,7 +69,7 @@ class TestMeshes:
         r = render(m, "phong", "exact", size=SMALL)
         assert r.pixels > 1000
 
-    def test_raises(self, tmp_path):
+    def test_raises(self, tmp_path, monkeypatch):
         with pytest.raises(ValueError, match="unknown mesh 'cube'"):
             get_mesh("cube")
         with pytest.raises(ValueError, match="does not exist"):
@@ -86,6 +86,13 @@ class TestMeshes:
             Mesh("bad", pos, nrm_nan, [[0, 1, 3]])
         with pytest.raises(ValueError, match="length"):
             Mesh("bad", pos, 2 * nrm, [[0, 1, 3]])
+        # the triangle map is int32: a mesh with more faces than it can index is refused
+        # (MAX_FACES lowered here: 2**31 faces would not fit in memory)
+        import chebnorm.raster.meshes as meshes
+        monkeypatch.setattr(meshes, "MAX_FACES", 1)
+        with pytest.raises(ValueError, match="at most 1 faces .* int32.* got 2"):
+            Mesh("big", pos, nrm, [[0, 1, 3], [1, 2, 3]])
+        monkeypatch.undo()
         bad_file = tmp_path / "flat.obj"
         bad_file.write_text("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")
         with pytest.raises(ValueError, match="degenerate|no triangles"):

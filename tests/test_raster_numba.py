@@ -94,6 +94,11 @@ def test_render_identical(mesh, mode, method, dtype):
     for name in ("triangle", "normal_length"):
         a, b = getattr(got, name), getattr(ref, name)
         assert (a is None and b is None) or _same(a, b)
+    # the triangle map is int32 (meshes.MAX_FACES), -1 on the background, a face elsewhere
+    if ref.triangle is not None:
+        assert ref.triangle.dtype == np.int32
+        assert (ref.triangle[~ref.mask] == -1).all()
+        assert ((ref.triangle[ref.mask] >= 0) & (ref.triangle[ref.mask] < len(m.faces))).all()
 
 
 def test_engine_names():

@@ -31,7 +31,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.methods import detmath
 
 __all__ = [
-    "Mesh", "MESH_NAMES", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
+    "Mesh", "MESH_NAMES", "MAX_FACES", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
     "teapot", "load_mesh", "crease_normals", "unit",
 ]
 
@@ -42,6 +42,9 @@ MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")
 AREA_RTOL = 1e-14
 #: vertex normals must have |n| within this of 1
 UNIT_ATOL = 1e-6
+#: the most faces a mesh may have: a frame's triangle map is int32 (a GPU's primitive
+#: id is 32 bits too)
+MAX_FACES = 2**31 - 1
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,6 +114,9 @@ class Mesh:
             raise ValueError(f"mesh {name!r}: faces must have shape (F, 3) with F >= 1; got {fac.shape}")
         if not np.issubdtype(fac.dtype, np.integer):
             raise ValueError(f"mesh {name!r}: faces must be integer indices; got dtype {fac.dtype}")
+        if len(fac) > MAX_FACES:
+            raise ValueError(f"mesh {name!r}: at most {MAX_FACES} faces (the triangle map is "
+                             f"int32); got {len(fac)}")
         fac = fac.astype(np.int64)
         bad = ~np.isfinite(pos).all(axis=1)
         if bad.any():

@@ -184,7 +184,8 @@ class RenderResult(ImageFrame):
     stats : dict
         What the mode reports (a flat dict of numbers).
     triangle : numpy.ndarray, optional
-        Index of the visible triangle per pixel, -1 on background.
+        Index of the visible triangle per pixel (int32: a mesh has at most
+        :data:`~chebnorm.raster.meshes.MAX_FACES` faces), -1 on background.
     normal_length : numpy.ndarray, optional
         ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background.
     compile_seconds : float
@@ -201,7 +202,7 @@ class RenderResult(ImageFrame):
     triangles: int
     fragments: int
     stats: dict = field(default_factory=dict)
-    #: (H, W) index into mesh.faces of the visible triangle, -1 on background
+    #: (H, W) int32 index into mesh.faces of the visible triangle, -1 on background
     triangle: np.ndarray | None = None
     #: (H, W) ``|N|`` of the pixel normal before shading (phong, adaptive), NaN on background
     normal_length: np.ndarray | None = None

@@ -54,7 +54,8 @@ class NumpyEngine(Engine):
     def shade(self, st, sp, vis, N, H, lighting):
         vals = lighting.intensity(N @ st.L, dot(N, H))
         img, mask = to_image(st, sp, vis, vals)
-        return (img, mask, pixel_map(st, sp, vis, st.tri[sp.tri[sp.frag_span[vis]]], -1),
+        tri = st.tri[sp.tri[sp.frag_span[vis]]].astype(np.int32)   # int32: meshes.MAX_FACES
+        return (img, mask, pixel_map(st, sp, vis, tri, -1),
                 pixel_map(st, sp, vis, np.linalg.norm(N, axis=1), np.nan))
 
 

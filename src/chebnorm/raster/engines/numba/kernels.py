@@ -485,7 +485,7 @@ def _shade_kernel(ndotl, ndoth, N, pixel, tri_of, light, n_pixels):
     # light: I0, ka, kd, ks, shininess
     img = np.zeros(n_pixels, np.float64)
     mask = np.zeros(n_pixels, np.bool_)
-    tri = np.full(n_pixels, -1, np.int64)
+    tri = np.full(n_pixels, -1, np.int32)     # the triangle map is int32 (MAX_FACES)
     nlen = np.full(n_pixels, np.nan, np.float64)
     I0, ka, kd, ks, sh = light[0], light[1], light[2], light[3], light[4]
     for i in range(pixel.shape[0]):

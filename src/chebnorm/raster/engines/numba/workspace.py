@@ -85,12 +85,12 @@ _MAPS_LOCK = threading.Lock()
 _KEEP_MAPS = 2
 
 
-_MAP_DTYPES = (np.float64, np.bool_, np.int64, np.float64)
+_MAP_DTYPES = (np.float64, np.bool_, np.int32, np.float64)
 
 
 def output_maps(npx):
     """Four uninitialised flat arrays for a frame's image, mask, triangle and ``|N|``
-    maps (float64, bool, int64, float64), each ``npx`` long: a set of an earlier frame
+    maps (float64, bool, int32, float64), each ``npx`` long: a set of an earlier frame
     that only this pool still references (``sys.getrefcount``: the user dropped every
     view of it), else new arrays.  Hand the set back with :func:`keep_maps` once the
     frame is drawn.
