@@ -56,9 +56,9 @@ from chebnorm.methods.spans import MAX_LEVELS, check_dtype, span_levels
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
 from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f32_round,
                           pow_calibrated, powers, sin_small, trig_calibrated)
-from .jit import HAVE_NUMBA, njit, objmode, run, run_with_caller, threads
+from .jit import HAVE_NUMBA, njit, objmode, run, run_with_caller, threads, unowned
 from .kernels import dichotomy_denominators_into
-from .rasterize import part_buckets, row_spans, span_geom, span_write
+from .rasterize import part_buckets, row_span_set, row_spans
 from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, cos_range, ends_part,
                     quadratic_part, slerp_part, end_checks, levels_calibrated, method_setup,
                     setup_consts, span_input, span_level_libm, widest_dot)
@@ -330,8 +330,10 @@ def _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, wa
     Inlined into its callers (numba's IR), with its arrays in tuples (``spans``: ``(stri,
     c0, count, t0, dt, left, right)``, ``meth``: ``(A, B, C, sc, sc2, levels, R, off, kc,
     kd)``, ``shade``: ``(face_id, Htri, L, eye, light, orders)``, ``maps``: ``(img, mask,
-    tri_map, nlen)``) made once per frame: no call per row, so no reference counting of
-    some fifty arrays per row (atomic operations on counts both threads share)."""
+    tri_map, nlen)``) made once per frame: no call per row for itself.  The kernels it
+    calls are not inlined; its callers hand it views that count no references
+    (:func:`.jit.unowned`), so those calls do no atomic operations on reference counts
+    both threads share."""
     stri, c0, count, t0, dt, left, right = spans
     A, B, C, sc, sc2, levels, R, off, kc, kd = meth
     face_id, Htri, L, eye, light, orders = shade
@@ -405,16 +407,18 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
     no fragment lands: 0, False, -1, NaN; the triangle map only where ``want & 1``, the
     ``|N|`` map only where ``want & 2``). Returns the number of slerp float32 pixels whose
     sine needs :mod:`detmath` (marked ``-2 - span`` in the triangle map)."""
-    buf = _row_buffers(width, A, mode)
-    spans = (stri, c0, count, t0, dt, left, right)
-    meth = (A, B, C, sc, sc2, levels, R, off, kc, kd)
-    shade = (face_id, Htri, L, eye, light, orders)
-    maps = (img, mask, tri_map, nlen)
+    buf_own = _row_buffers(width, A, mode)
+    buf = unowned(buf_own)     # views that count no references (as in _frame_rows)
+    spans = unowned((stri, c0, count, t0, dt, left, right))
+    meth = unowned((A, B, C, sc, sc2, levels, R, off, kc, kd))
+    shade = unowned((face_id, Htri, L, eye, light, orders))
+    maps = unowned((img, mask, tri_map, nlen))
     hard = 0
     for rr in range(part, height, parts):
         k0, k1 = row_start[rr], row_start[rr + 1]
         hard += _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want,
                           maps, stop, buf)[1]
+    _keep(buf_own, buf_own)
     return hard
 
 
@@ -425,8 +429,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5), angular
     (6) or dichotomy (7), scan line by scan line, on the rows ``part, part + parts, ...``:
     each
-    row's spans (:func:`.rasterize.span_geom`, :func:`.rasterize.span_write` on the
-    triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
+    row's spans (:func:`.rasterize.row_span_set` on the triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
     :func:`.rasterize.row_spans` numbers them) into row-sized arrays, their unit end
     normals and the checks of ``check_span_input`` (:func:`.setup.end_checks`, modes 1-6;
     :func:`.setup.ends_part` for modes 5 and 7, which also need the cosines and the
@@ -480,9 +483,24 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     Rr = np.empty((M, MAX_LEVELS), proto.dtype)     # the dichotomy's denominators
     offall = np.ones(MAX_LEVELS + 1, np.bool_)      # assumed: every depth off the grid
     tcb = np.empty(1, proto.dtype)
+    gi, gf = np.empty((8, M), np.int64), np.empty((4, M))     # row_span_set's scratch
     is64 = proto.itemsize == 8
     # the row pass's arrays: the row's spans, the method's (the set-up's where it has
     # one: quadratic v, d1, d2; angular p0, p1), the shading's, the maps
+    buf_own = _row_buffers(width, lA, mode)
+    # the loop's arrays as views that count no references (jit.unowned): the row loop
+    # passes them to kernels that are not inlined, and two threads counting references
+    # to the same arrays bounce those counts' cache lines between the cores.  The
+    # arguments are the caller's; ``own`` and ``buf_own`` keep the rest alive (_keep)
+    own = (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off,
+           sc, sc2, hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf)
+    (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off, sc, sc2,
+     hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf) = unowned(own)
+    buf = unowned(buf_own)
+    (xy, attrs, eorders, kc, face_id, Htri, L, eye, light, orders, cf, kd, ks, img, mask,
+     tri_map, nlen, out, fout, offs) = unowned((xy, attrs, eorders, kc, face_id, Htri, L, eye,
+                                                light, orders, cf, kd, ks, img, mask, tri_map,
+                                                nlen, out, fout, offs))
     Am, Bm = (P0, P1) if mode == 5 or mode == 6 else (lA, lB)
     spans = (ltri, lc0, lcount, lt0, ldt, lleft, lright)
     if mode == 7:
@@ -491,23 +509,15 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
         meth = (Am, Bm, P2 if mode == 5 else C, sc, sc2, levels, R, off, kc, kd)
     shade = (face_id, Htri, L, eye, light, orders)
     maps = (img, mask, tri_map, nlen)
-    buf = _row_buffers(width, lA, mode)
     nfrag = 0
     ncov = 0
     t0nz = False
     cmax = 0
     for jr in range(first.shape[0] - 1):
         rr = part + jr * parts
-        n = 0
-        for q in range(first[jr], first[jr + 1]):
-            i = ids[q]
-            c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, rr, width)
-            if c <= 0:
-                continue
-            span_write(attrs, i, rr, n, c, a, pa, qa, sa, p, qq, sb, swap, xl, xr, ltri, lrow,
-                       lc0, lcount, lm, lt0, ldt, lleft, lright)
-            nfrag += c
-            n += 1
+        n, c = row_span_set(xy, attrs, ids, first[jr], first[jr + 1], rr, width, ltri, lrow,
+                            lc0, lcount, lm, lt0, ldt, lleft, lright, gi, gf)
+        nfrag += c
         if (mode == 5 or mode == 7) and n > 0:
             tree = mode == 7
             ends_part(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], tree,
@@ -567,6 +577,15 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     out[5] = deep
     fout[0] = dmin
     fout[1] = clo
+    _keep(own, buf_own)
+
+
+@njit()
+def _keep(own, buf):
+    """Nothing: a use of :func:`_frame_rows`' (:func:`_frame`'s) owners after its loop, so
+    numba releases them only then (the loop works on views of them that count no
+    references)."""
+    return None
 
 
 @njit()

@@ -30,7 +30,7 @@ except ImportError:  # pragma: no cover
     objmode = None
 
 __all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "threads", "pool", "run",
-           "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
+           "run_with_caller", "NumbaCompileWarning", "announce_slow", "unowned", "ANNOUNCE_AFTER"]
 
 
 class NumbaCompileWarning(UserWarning):
@@ -145,7 +145,50 @@ if HAVE_NUMBA:
         def codegen(context, builder, signature, args):
             return builder.bitcast(args[0], _ir.DoubleType())
         return sig, codegen
+    @_intrinsic
+    def unowned(typingctx, arr):
+        """Views of ``arr`` (an array, or a tuple of arrays and other values: each array
+        viewed, the rest passed through) that own no reference: the same data, shape and
+        strides with a null meminfo, so passing them to a compiled function that is not
+        inlined costs no atomic reference count (two threads counting the references of
+        the same array bounce its cache line between their cores).  A view must not
+        outlive the arrays' owner: a kernel's own arguments, or arrays the kernel keeps
+        referenced until its views are no longer used."""
+        if isinstance(arr, _types.Array):
+            arrays = None
+        elif isinstance(arr, _types.BaseTuple):
+            arrays = [isinstance(t, _types.Array) for t in arr.types]
+        else:
+            return None
+        sig = arr(arr)
+
+        def view(context, builder, typ, value):
+            from numba.core import cgutils
+            src = context.make_array(typ)(context, builder, value=value)
+            out = context.make_array(typ)(context, builder)
+            for name in ("data", "shape", "strides", "itemsize", "nitems"):
+                setattr(out, name, getattr(src, name))
+            out.meminfo = cgutils.get_null_value(out.meminfo.type)
+            out.parent = cgutils.get_null_value(out.parent.type)
+            return out._getvalue()
+
+        def codegen(context, builder, signature, args):
+            if arrays is None:
+                return view(context, builder, arr, args[0])
+            items = []
+            for k, (typ, is_array) in enumerate(zip(arr.types, arrays)):
+                item = builder.extract_value(args[0], k)
+                if is_array:
+                    item = view(context, builder, typ, item)
+                else:
+                    context.nrt.incref(builder, typ, item)
+                items.append(item)
+            return context.make_tuple(builder, arr, items)
+        return sig, codegen
 else:  # pragma: no cover
+    def unowned(arr):
+        raise RuntimeError("numba is not installed")
+
     def f2i(x):
         raise RuntimeError("numba is not installed")
 

@@ -18,7 +18,7 @@ from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
-           "span_geom", "span_write", "row_buckets", "part_buckets", "row_spans", "project",
+           "span_geom", "span_write", "row_span_set", "row_buckets", "part_buckets", "row_spans", "project",
            "default_camera_of"]
 
 
@@ -403,6 +403,33 @@ def span_write(attrs, i, r, n, c, a, pa, qa, sa, p, q, sb, swap, xl, xr, tri, ro
 
 
 @njit()
+def row_span_set(xy, attrs, ids, q0, q1, r, width, tri, row, c0, count, m, t0, dt, left, right,
+                 gi, gf):
+    """Row ``r``'s spans of the triangles ``ids[q0:q1]`` (in that order, those without a
+    pixel dropped) into ``tri, row, ... right`` from index 0, as :func:`span_geom` finds
+    and :func:`span_write` writes them, in two passes: every triangle's edges and span
+    ends first (kept in the scratch ``gi``, ``(8, M)`` int64, and ``gf``, ``(4, M)``
+    float64), then the spans' attributes.  Each pass's iterations are independent of
+    each other (one long chain of dependent loads, divisions and roundings per triangle
+    otherwise).  Returns ``(spans, fragments)``."""
+    n = 0
+    nfrag = 0
+    for q in range(q0, q1):
+        i = ids[q]
+        c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, r, width)
+        gi[0, n], gi[1, n], gi[2, n], gi[3, n] = i, c, a, pa
+        gi[4, n], gi[5, n], gi[6, n], gi[7, n] = qa, p, qq, swap
+        gf[0, n], gf[1, n], gf[2, n], gf[3, n] = sa, sb, xl, xr
+        nfrag += c
+        n += c > 0
+    for k in range(n):
+        span_write(attrs, gi[0, k], r, k, gi[1, k], gi[2, k], gi[3, k], gi[4, k], gf[0, k],
+                   gi[5, k], gi[6, k], gf[1, k], gi[7, k] != 0, gf[2, k], gf[3, k], tri, row,
+                   c0, count, m, t0, dt, left, right)
+    return n, nfrag
+
+
+@njit()
 def row_buckets(r0, nrows, height):
     """The triangles crossing each row, in triangle order: row ``r``'s are
     ``ids[first[r]:first[r+1]]``."""
@@ -455,12 +482,21 @@ def part_buckets(xy, height, part, parts):
         j1 = _ceil_div(r1 - part, parts) if r1 > part else 0
         lo[i] = j0
         hi[i] = j1
-        for j in range(j0, j1):
-            first[j + 1] += 1
+    # the rows' triangle counts as differences (two updates a triangle, not one a row:
+    # neighbouring triangles share rows, and each update waits on the one before), then
+    # summed into the counts and those into the buckets' starts
+    for i in range(T):
+        first[lo[i]] += 1
+        first[hi[i]] -= 1
     widest = 0
+    count = 0
+    start = 0
     for j in range(nj):
-        widest = max(widest, first[j + 1])
-        first[j + 1] += first[j]
+        count += first[j]
+        first[j] = start
+        start += count
+        widest = max(widest, count)
+    first[nj] = start
     fill = first[:-1].copy()
     ids = np.empty(first[nj], np.int64)
     for i in range(T):
