@@ -162,8 +162,9 @@ def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs, tx):
     for s in range(k0, k1):
         xlo = min(xlo, c0[s])
         xhi = max(xhi, c0[s] + count[s])
-    for x in range(xlo, xhi):
-        bs[x] = -1
+    bv = bs[xlo:max(xhi, xlo)]     # a view from 0: a plain fill (no negative-index check)
+    for x in range(bv.shape[0]):
+        bv[x] = -1
     for s in range(k0, k1):
         lo = left[s, 0]
         dw = right[s, 0] - lo
@@ -171,7 +172,9 @@ def _row_visibility(width, k0, k1, c0, count, t0, dt, left, right, bw, bs, tx):
         d = dt[s]
         x0 = c0[s]
         for j in range(count[s]):
-            tu = a + j * d
+            # j (below 2**31: at most the width) through int32, which converts to float64
+            # four lanes at a time (an int64 one lane at a time); the same value
+            tu = a + np.float64(np.int32(j)) * d
             t = min(max(tu, 0.0), 1.0)
             w = lo + t * dw
             x = np.uint64(x0 + j)    # unsigned: no negative-index wrap-around in the loop
