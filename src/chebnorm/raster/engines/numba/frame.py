@@ -476,7 +476,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     hard = np.zeros(M, np.bool_)
     P0, P1 = np.empty((3, M), proto.dtype), np.empty((3, M), proto.dtype)
     P2 = np.empty((3, M), proto.dtype)
-    lcos, llev = np.empty(M), np.zeros(M, np.int64)
+    lcos, llev, ldd = np.empty(M), np.zeros(M, np.int64), np.empty(M)
     red = np.zeros(5)
     exact = cf.shape[0] == 0
     cfx = np.zeros(1, proto.dtype) if exact else cf
@@ -496,9 +496,11 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     # to the same arrays bounce those counts' cache lines between the cores.  The
     # arguments are the caller's; ``own`` and ``buf_own`` keep the rest alive (_keep)
     own = (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off,
-           sc, sc2, hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf)
+           sc, sc2, hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf,
+           ldd)
     (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off, sc, sc2,
-     hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf) = unowned(own)
+     hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf,
+     ldd) = unowned(own)
     buf = unowned(buf_own)
     (xy, attrs, eorders, kc, face_id, Htri, L, eye, light, orders, cf, kd, ks, img, mask,
      tri_map, nlen, out, fout, offs) = unowned((xy, attrs, eorders, kc, face_id, Htri, L, eye,
@@ -525,7 +527,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             tree = mode == 7
             ends_part(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], tree,
                        DEPTH_THRESHOLDS if tree else _NO_THRESHOLDS, 0, n, lA, lB, False, lcos,
-                       llev, hard, red)
+                       llev, hard, red, ldd)
             if red[0] != 0.0:
                 out[0] = 1
                 return

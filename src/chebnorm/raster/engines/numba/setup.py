@@ -173,97 +173,88 @@ def _libm_pair(x, c):
 
 @njit()
 def ends_part(left, right, m, t0, dt, count, o_ein, o_norm, tree, thr, lo, hi, A, B,
-               diff, cos, levels, hard, red):
+              diff, cos, levels, hard, red, dsc):
     """Spans ``lo .. hi-1``: the unit end normals ``unit(left[:, 1:4])``,
     ``unit(right[:, 1:4])`` in the dtype of ``A``, ``B`` (3, S) (``diff``: ``B - A``
     into ``B``), their cosine as ``check_span_input`` computes it, and (``tree``) the
     dichotomy depth of ``span_levels`` (``hard[i]``: the depth is numpy's to compute).
     ``red``: [any check failed, smallest ``N_l.N_r`` (einsum), any ``t0 != 0``, largest
-    count, hard spans]."""
-    bad = False
-    dmin = np.inf
-    t0nz = False
+    count, hard spans]; ``dsc``: scratch (the spans' ``N_l.N_r``).
+
+    The normals, cosines and checks are one loop of arithmetic and comparisons alone
+    (LLVM vectorizes it; NaN and infinities fail its comparisons), the depths a loop of
+    their own.  Where a check fails the caller stops (the reference's checks then raise),
+    so the other outputs are only promised where none does."""
+    nbad = 0
+    t0nz = 0
     cmax = 0
-    nhard = 0
     for i in range(lo, hi):
-        a0, a1, a2 = left[i, 1], left[i, 2], left[i, 3]
-        r = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
-        a0, a1, a2 = a0 / r, a1 / r, a2 / r
-        b0, b1, b2 = right[i, 1], right[i, 2], right[i, 3]
-        r = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
-        b0, b1, b2 = b0 / r, b1 / r, b2 / r
+        a0, a1, a2, b0, b1, b2 = _unit_ends(left, right, i, o_norm)
         A[0, i], A[1, i], A[2, i] = a0, a1, a2
         B[0, i], B[1, i], B[2, i] = b0, b1, b2
         if diff:
             for c in range(3):
                 B[c, i] = B[c, i] - A[c, i]
         hard[i] = False
-        if not (np.isfinite(a0) and np.isfinite(a1) and np.isfinite(a2) and np.isfinite(b0)
-                and np.isfinite(b1) and np.isfinite(b2) and np.isfinite(t0[i])
-                and np.isfinite(dt[i])):
-            bad = True
-            cos[i] = np.nan
-            levels[i] = 0
-            continue
         # _as_vectors: | |N| - 1 | <= UNIT_TOL, |N| by einsum; the cosine's |N| by norm
         qa = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_ein))
         qb = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_ein))
-        if abs(qa - 1.0) > UNIT_TOL or abs(qb - 1.0) > UNIT_TOL:
-            bad = True
+        fine = (abs(qa - 1.0) <= UNIT_TOL) & (abs(qb - 1.0) <= UNIT_TOL)
         if o_norm != o_ein:
             qa = np.sqrt(dot3(a0, a1, a2, a0, a1, a2, o_norm))
             qb = np.sqrt(dot3(b0, b1, b2, b0, b1, b2, o_norm))
         d = dot3(a0, a1, a2, b0, b1, b2, o_ein)
         c = d / (qa * qb)
         cos[i] = c
-        if 1.0 + c <= ANTIPARALLEL_TOL:
-            bad = True
-        dmin = min(dmin, d)
-        # _positions
-        if m[i] < 1 or dt[i] <= 0.0 or count[i] < 1:
-            bad = True
-        last = t0[i] + (count[i] - 1) * dt[i]
-        if t0[i] < -_POS_TOL or last > 1.0 + _POS_TOL:
-            bad = True
-        if t0[i] != 0.0:
-            t0nz = True
-        cmax = max(cmax, count[i])
-        if not tree:
-            continue
-        # span_levels: the base depth ceil(log2(1/dt) - 1e-12), the exponent of 1/dt (a
-        # mantissa near 1/2: log2 near an integer, numpy's to round) ...
-        base, scale = _depth_base(dt[i])
-        if base < 0:
-            hard[i] = True
-            nhard += 1
-            levels[i] = 0
-            continue
-        off = False
-        for j in range(count[i]):
-            u = (t0[i] + j * dt[i]) * scale
-            if abs(u - np.rint(u)) > 1e-9 * max(1.0, abs(u)):
-                off = True
-                break
-        L = base
-        if off:
-            # ... then off the grid ceil(log2(arccos(c) / theta_max)): the smallest n >= 0
-            # with c >= cos(theta_max 2**n) (thr[n]; 7 past the last), c near a threshold
-            # numpy's to round
-            cc = min(max(c, -1.0), 1.0)
-            need = thr.shape[0]
-            for q in range(thr.shape[0]):
-                if abs(cc - thr[q]) < _NEAR_INT:
-                    hard[i] = True
-                    nhard += 1
+        dsc[i] = d
+        # _positions (count - 1 through int32: it converts to float64 four lanes at once)
+        ti, di, ci = t0[i], dt[i], count[i]
+        last = ti + np.float64(np.int32(ci - 1)) * di
+        fine &= ((1.0 + c > ANTIPARALLEL_TOL) & (abs(ti) < np.inf) & (abs(di) < np.inf)
+                 & (m[i] >= 1) & (di > 0.0) & (ci >= 1) & (ti >= -_POS_TOL)
+                 & (last <= 1.0 + _POS_TOL))
+        nbad += not fine
+        t0nz |= ti != 0.0
+        cmax = max(cmax, ci)
+    dmin = np.inf
+    for i in range(lo, hi):
+        dmin = min(dmin, dsc[i])
+    nhard = 0
+    if tree:
+        for i in range(lo, hi):
+            # span_levels: the base depth ceil(log2(1/dt) - 1e-12), the exponent of 1/dt
+            # (a mantissa near 1/2: log2 near an integer, numpy's to round) ...
+            base, scale = _depth_base(dt[i])
+            if base < 0:
+                hard[i] = True
+                nhard += 1
+                levels[i] = 0
+                continue
+            off = False
+            for j in range(count[i]):
+                u = (t0[i] + j * dt[i]) * scale
+                if abs(u - np.rint(u)) > 1e-9 * max(1.0, abs(u)):
+                    off = True
                     break
-                if cc > thr[q]:
-                    need = q
-                    break
-            L = max(base, np.int64(need))
-        levels[i] = L
-        if L > MAX_LEVELS:
-            bad = True
-    red[0] = 1.0 if bad else 0.0
+            L = base
+            if off:
+                # ... then off the grid ceil(log2(arccos(c) / theta_max)): the smallest
+                # n >= 0 with c >= cos(theta_max 2**n) (thr[n]; 7 past the last), c near a
+                # threshold numpy's to round
+                cc = min(max(cos[i], -1.0), 1.0)
+                need = thr.shape[0]
+                for q in range(thr.shape[0]):
+                    if abs(cc - thr[q]) < _NEAR_INT:
+                        hard[i] = True
+                        nhard += 1
+                        break
+                    if cc > thr[q]:
+                        need = q
+                        break
+                L = max(base, np.int64(need))
+            levels[i] = L
+            nbad += L > MAX_LEVELS
+    red[0] = 1.0 if nbad > 0 else 0.0
     red[1] = dmin
     red[2] = 1.0 if t0nz else 0.0
     red[3] = cmax
@@ -397,17 +388,20 @@ class _Ends:
         self.cos = scratch(work, "cos", S)
         self.levels = scratch(work, "levels", S, np.int64)
         self.hard = scratch(work, "hard", S, np.bool_)
+        dsc = scratch(work, "dsc", S)
         parts = _parts(S)
         red = np.zeros((len(parts), 5))
         run_with_caller([(ends_part, (left, right, sp.m, sp.t0, sp.dt, sp.count, orders[0],
                                        orders[1], tree, DEPTH_THRESHOLDS, lo, hi, self.A, self.B,
-                                       diff, self.cos, self.levels, self.hard, red[q]))
+                                       diff, self.cos, self.levels, self.hard, red[q], dsc))
                          for q, (lo, hi) in enumerate(parts)])
         self.bad = bool(red[:, 0].any())
         self.dot_min = np.float64(red[:, 1].min())
         self.start_left = not red[:, 2].any()
         self.count_max = int(red[:, 3].max())
-        if tree and red[:, 4].any():     # depths numpy computes (log2 near an integer)
+        # depths numpy computes (log2 near an integer); where a check failed the reference
+        # runs instead (its depths are not wanted)
+        if tree and not self.bad and red[:, 4].any():
             h = np.flatnonzero(self.hard)
             self.levels[h] = span_levels(sp.dt[h], sp.t0[h], sp.count[h], self.cos[h])
             self.bad = self.bad or bool((self.levels[h] > MAX_LEVELS).any())
