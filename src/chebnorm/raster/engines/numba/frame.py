@@ -395,7 +395,7 @@ def _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, wa
     if stop == 3:
         return nw, hard
     _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv,
-               nl, pw, hh, ll, ok, skip, img, tri_map, nlen, want, nw)
+               nl, pw, hh, ll, ok, skip, hard, img, tri_map, nlen, want, nw)
     return nw, hard
 
 
@@ -609,11 +609,11 @@ def _tri_half_row(ws, stri, Htri, h0, h1, h2, nw):
 
 @njit()
 def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, face_id, av, bv, nl,
-               pw, hh, ll, ok, skip, img, tri_map, nlen, want, nw):
+               pw, hh, ll, ok, skip, nskip, img, tri_map, nlen, want, nw):
     """``Lighting.intensity(N @ L, N . H)`` clipped, and ``|N|``, at the row's winners, into
     the maps (row offset ``base``; the triangle map where ``want & 1``, the ``|N|`` map
     where ``want & 2``; a ``skip`` pixel's triangle entry is ``-2 - span``, its other
-    entries are the fix-up's to overwrite)."""
+    entries are the fix-up's to overwrite; ``nskip``: how many there are)."""
     l0, l1, l2 = L[0], L[1], L[2]
     I0, ka, kdif, ks, sh = light[0], light[1], light[2], light[3], light[4]
     fastpow = light[5] != 0.0
@@ -637,6 +637,8 @@ def _light_row(base, n0, n1, n2, h0, h1, h2, L, light, orders, wx, ws, stri, fac
     if want & 2:
         for k in range(nw):
             nlen[np.uint64(base + wx[k])] = nl[k]
+    if nskip == 0:
+        return
     for k in range(nw):
         if skip[k]:
             skip[k] = False
