@@ -421,7 +421,7 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
         k0, k1 = row_start[rr], row_start[rr + 1]
         hard += _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want,
                           maps, stop, buf)[1]
-    _keep(buf_own, buf_own)
+    _keep(buf_own, None)
     return hard
 
 
@@ -431,8 +431,8 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                 tri_map, nlen, out, fout, offs, stop):
     """The whole frame of a linear method (modes 0-3), slerp (4), quadratic (5), angular
     (6) or dichotomy (7), scan line by scan line, on the rows ``part, part + parts, ...``:
-    each
-    row's spans (:func:`.rasterize.row_span_set` on the triangles crossing it, found by :func:`.rasterize.part_buckets`, in triangle order as
+    each row's spans (:func:`.rasterize.row_span_set` on the triangles crossing it,
+    found by :func:`.rasterize.part_buckets`, in triangle order as
     :func:`.rasterize.row_spans` numbers them) into row-sized arrays, their unit end
     normals and the checks of ``check_span_input`` (:func:`.setup.end_checks`, modes 1-6;
     :func:`.setup.ends_part` for modes 5 and 7, which also need the cosines and the

@@ -1,5 +1,6 @@
-"""The compiled engine's floor: the numba import guard, :func:`njit`, three LLVM
-intrinsics (``fma``, ``f2i``, ``i2f``: LLVM intrinsics, callable from compiled code only) and the one thread pool of the process.
+"""The compiled engine's floor: the numba import guard, :func:`njit`, four intrinsics
+(``fma``, ``f2i``, ``i2f``: LLVM operations; ``unowned``: array views that count no
+references; callable from compiled code only) and the one thread pool of the process.
 
 Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
 cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
@@ -29,8 +30,8 @@ except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
     objmode = None
 
-__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "threads", "pool", "run",
-           "run_with_caller", "NumbaCompileWarning", "announce_slow", "unowned", "ANNOUNCE_AFTER"]
+__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "threads", "pool",
+           "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
 
 
 class NumbaCompileWarning(UserWarning):
@@ -145,6 +146,7 @@ if HAVE_NUMBA:
         def codegen(context, builder, signature, args):
             return builder.bitcast(args[0], _ir.DoubleType())
         return sig, codegen
+
     @_intrinsic
     def unowned(typingctx, arr):
         """Views of ``arr`` (an array, or a tuple of arrays and other values: each array

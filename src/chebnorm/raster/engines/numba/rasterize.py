@@ -18,8 +18,8 @@ from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
-           "span_geom", "span_write", "row_span_set", "row_buckets", "part_buckets", "row_spans", "project",
-           "default_camera_of"]
+           "span_geom", "span_write", "row_span_set", "row_buckets", "part_buckets",
+           "row_spans", "project", "default_camera_of"]
 
 
 # --------------------------------------------------------------- span set-up
