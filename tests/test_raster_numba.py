@@ -270,6 +270,31 @@ def test_fused_phong_tiny_frames(size):
         _check_identical(get_mesh("sphere", 8), method, size)
 
 
+@pytest.mark.parametrize("dtype", [np.float64, np.int32, np.bool_])
+def test_stream_row_is_slice_assignment(dtype):
+    """The frame's rows streamed to its maps (non-temporal stores on the 16-byte aligned
+    middle, plain ones at both ends): every dtype of the maps, every start offset and
+    length around the 16-byte blocks, an unaligned view as the destination; nothing
+    outside the row is touched."""
+    rng = np.random.default_rng(30)
+    big = np.zeros(300 * 8 + 64, np.uint8)
+    for shift in (0, 1, 8):           # the destination's base address mod 16 varies
+        raw = big[shift:shift + 300 * np.dtype(dtype).itemsize]
+        dst = raw.view(dtype) if raw.ctypes.data % np.dtype(dtype).itemsize == 0 else None
+        if dst is None:
+            continue
+        for start in (0, 1, 3, 7, 16, 33):
+            for n in (0, 1, 2, 5, 15, 16, 17, 31, 64, 100, 250):
+                if start + n > len(dst):
+                    continue
+                src = rng.integers(-9, 9, n + 3).astype(dtype)    # longer than n
+                before = dst.copy()
+                frame._stream_row(dst, start, src, n)     # (a thread sees its own stores)
+                want = before.copy()
+                want[start:start + n] = src[:n]
+                assert _same(dst, want), (shift, start, n)
+
+
 def _sliver():
     """A strip of triangles far thinner than a pixel: at 31 x 31 it covers three pixels,
     each span one pixel wide."""

@@ -21,7 +21,9 @@ frame-sized z-buffer, per-fragment normals, half vectors and dot products):
    span's pixel normals by the method's kernel (stepping kernels step through every
    pixel of the span, the others are evaluated only where the span won) and, for the
    winners only, half vector, Blinn-Phong intensity, ``|N|`` and the triangle id,
-   each output pixel written once.
+   into the line's own maps (in the cache), which are then streamed to the frame's
+   (:func:`_stream_row`: non-temporal stores, so a map line is written without first
+   being read; the frame's 25 bytes a pixel are its largest memory traffic).
 
 In float64 (and for the linear methods in float32 too) the three steps run row by row
 instead (:func:`_frame_rows`): each thread builds a scan line's spans, their checks and
@@ -56,7 +58,8 @@ from chebnorm.methods.spans import MAX_LEVELS, check_dtype, span_levels
 from ..base import FrameUnsupported, ModeResult, auto_tables, triangle_half_vectors
 from .calibration import (DetOps, calibrated, dot3, dot3_select, ends_orders, f32_round,
                           pow_calibrated, powers, sin_small, trig_calibrated)
-from .jit import HAVE_NUMBA, njit, objmode, run, run_with_caller, threads, unowned
+from .jit import (HAVE_NUMBA, njit, objmode, run, run_with_caller, store_fence, stream16,
+                  threads, unowned)
 from .kernels import dichotomy_denominators_into
 from .rasterize import part_buckets, row_span_set, row_spans
 from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, cos_range, ends_part,
@@ -320,11 +323,13 @@ def _row_buffers(width, A, mode):
 @njit(inline=True)
 def _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want, maps, stop,
               buf):
-    """Row ``rr`` of the frame from its spans ``k0 .. k1-1`` (in ``setup_spans``' order):
-    the z-test (:func:`_row_visibility`), the background and the winners listed in ``x``
-    order (:func:`_row_winners`), then each quantity of the shading for all of them in one
-    loop (gathers first, then loops of arithmetic alone, which LLVM vectorizes: ``sqrt``
-    and division are correctly rounded in every lane, so the bits are the scalar ones).
+    """Row ``rr`` of the maps ``maps`` from the row's spans ``k0 .. k1-1`` (in
+    ``setup_spans``' order; the frame loops pass row 0 of one line's maps, streamed to
+    the frame's afterwards): the z-test (:func:`_row_visibility`), the background and
+    the winners listed in ``x`` order (:func:`_row_winners`), then each quantity of the
+    shading for all of them in one loop (gathers first, then loops of arithmetic alone,
+    which LLVM vectorizes: ``sqrt`` and division are correctly rounded in every lane, so
+    the bits are the scalar ones).
     Returns ``(covered pixels, slerp float32 pixels whose sine needs detmath)``.
 
     ``stop`` (profiling only, :func:`stage_times`): 0 draws the row; 1, 2, 3 stop after
@@ -415,13 +420,25 @@ def _frame(width, height, mode, row_start, stri, c0, count, t0, dt, left, right,
     spans = unowned((stri, c0, count, t0, dt, left, right))
     meth = unowned((A, B, C, sc, sc2, levels, R, off, kc, kd))
     shade = unowned((face_id, Htri, L, eye, light, orders))
-    maps = unowned((img, mask, tri_map, nlen))
+    img, mask, tri_map, nlen = unowned((img, mask, tri_map, nlen))
+    # the row's maps, drawn here and then streamed to the frame's (as in _frame_rows)
+    rows_own = (np.empty(width), np.empty(width, np.bool_), np.empty(width, tri_map.dtype),
+                np.empty(width))
+    rmaps = unowned(rows_own)
     hard = 0
     for rr in range(part, height, parts):
         k0, k1 = row_start[rr], row_start[rr + 1]
-        hard += _row_pass(rr, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want,
-                          maps, stop, buf)[1]
-    _keep(buf_own, None)
+        hard += _row_pass(0, width, k0, k1, mode, spans, meth, shade, is64, per_pixel_h, want,
+                          rmaps, stop, buf)[1]
+        base = rr * width
+        _stream_row(img, base, rmaps[0], width)
+        _stream_row(mask, base, rmaps[1], width)
+        if want & 1:
+            _stream_row(tri_map, base, rmaps[2], width)
+        if want & 2:
+            _stream_row(nlen, base, rmaps[3], width)
+    store_fence()     # the streamed rows, visible to the caller
+    _keep(buf_own, rows_own)
     return hard
 
 
@@ -491,16 +508,19 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     # the row pass's arrays: the row's spans, the method's (the set-up's where it has
     # one: quadratic v, d1, d2; angular p0, p1), the shading's, the maps
     buf_own = _row_buffers(width, lA, mode)
+    # the row's maps, drawn here and then streamed to the frame's (_stream_row)
+    rimg, rmask = np.empty(width), np.empty(width, np.bool_)
+    rtri, rnlen = np.empty(width, tri_map.dtype), np.empty(width)
     # the loop's arrays as views that count no references (jit.unowned): the row loop
     # passes them to kernels that are not inlined, and two threads counting references
     # to the same arrays bounce those counts' cache lines between the cores.  The
     # arguments are the caller's; ``own`` and ``buf_own`` keep the rest alive (_keep)
     own = (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off,
            sc, sc2, hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf,
-           ldd)
+           ldd, rimg, rmask, rtri, rnlen)
     (ltri, lrow, lc0, lcount, lm, lt0, ldt, lleft, lright, lA, lB, C, levels, R, off, sc, sc2,
      hard, P0, P1, P2, lcos, llev, red, cfx, Rr, offall, tcb, first, ids, gi, gf,
-     ldd) = unowned(own)
+     ldd, rimg, rmask, rtri, rnlen) = unowned(own)
     buf = unowned(buf_own)
     (xy, attrs, eorders, kc, face_id, Htri, L, eye, light, orders, cf, kd, ks, img, mask,
      tri_map, nlen, out, fout, offs) = unowned((xy, attrs, eorders, kc, face_id, Htri, L, eye,
@@ -513,7 +533,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     else:
         meth = (Am, Bm, P2 if mode == 5 else C, sc, sc2, levels, R, off, kc, kd)
     shade = (face_id, Htri, L, eye, light, orders)
-    maps = (img, mask, tri_map, nlen)
+    rmaps = (rimg, rmask, rtri, rnlen)
     nfrag = 0
     ncov = 0
     t0nz = False
@@ -530,6 +550,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                        llev, hard, red, ldd)
             if red[0] != 0.0:
                 out[0] = 1
+                store_fence()
                 return
             if red[4] != 0.0:     # depths the reference's span_levels must compute
                 for s in range(n):
@@ -540,6 +561,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
                         llev[s] = lv
                         if lv > MAX_LEVELS:
                             out[0] = 1
+                            store_fence()
                             return
             dmin = min(dmin, red[1])
             lo, lo_deep, dp = cos_range(lcos, llev, tree, n)   # (tree: of the spans deeper
@@ -554,6 +576,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             if not end_checks(lleft, lright, lm, lt0, ldt, lcount, eorders[0], eorders[1], n,
                               lA, lB, mode <= 3):
                 out[0] = 1
+                store_fence()
                 return
         if mode >= 4:
             for s in range(n):
@@ -562,6 +585,7 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
         if mode == 4 and n > 0:
             if slerp_part(lA, lB, ks, is64, quick, 0, n, sc, sc2, hard):
                 out[0] = 2
+                store_fence()
                 return
         elif mode == 5 and n > 0:
             quadratic_part(lA, lB, lt0, ldt, ks, cfx, exact, False, 0, n, P0, P1, P2)
@@ -569,11 +593,21 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
             if angular_part(lA, lB, lt0, ldt, ks, is64, quick, True, False, 0, n, P0, P1, sc,
                              hard):
                 out[0] = 2
+                store_fence()
                 return
         if stop == 4:
             continue
-        ncov += _row_pass(rr, width, 0, n, mode, spans, meth, shade, is64, per_pixel_h, want,
-                          maps, stop, buf)[0]
+        # the row into the row's maps (row 0 of them), then streamed to the frame's
+        ncov += _row_pass(0, width, 0, n, mode, spans, meth, shade, is64, per_pixel_h, want,
+                          rmaps, stop, buf)[0]
+        base = rr * width
+        _stream_row(img, base, rimg, width)
+        _stream_row(mask, base, rmask, width)
+        if want & 1:
+            _stream_row(tri_map, base, rtri, width)
+        if want & 2:
+            _stream_row(nlen, base, rnlen, width)
+    store_fence()     # the streamed rows, visible to the caller
     out[0] = 0
     out[1] = nfrag
     out[2] = ncov
@@ -583,6 +617,27 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
     fout[0] = dmin
     fout[1] = clo
     _keep(own, buf_own)
+
+
+@njit()
+def _stream_row(dst, start, src, n):
+    """``dst[start:start + n] = src[:n]`` (the same dtype, both C-contiguous), the
+    16-byte aligned middle with non-temporal stores (:func:`.jit.stream16`: a map's line
+    is written without first being read into the cache, which the frame's 25 bytes a
+    pixel would otherwise cost twice); the caller fences (:func:`.jit.store_fence`)."""
+    isz = dst.itemsize
+    a = np.int64(dst.ctypes.data) + start * isz
+    head = min(((16 - (a & 15)) & 15) // isz, n)
+    for x in range(head):
+        dst[start + x] = src[x]
+    s0 = head * isz
+    nb = (n - head) * isz
+    body = nb - nb % 16
+    d0 = start * isz + s0
+    for o in range(0, body, 16):
+        stream16(dst, d0 + o, src, s0 + o)
+    for x in range(head + body // isz, n):
+        dst[start + x] = src[x]
 
 
 @njit()

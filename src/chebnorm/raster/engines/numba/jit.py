@@ -1,6 +1,8 @@
-"""The compiled engine's floor: the numba import guard, :func:`njit`, four intrinsics
+"""The compiled engine's floor: the numba import guard, :func:`njit`, six intrinsics
 (``fma``, ``f2i``, ``i2f``: LLVM operations; ``unowned``: array views that count no
-references; callable from compiled code only) and the one thread pool of the process.
+references; ``stream16`` and ``store_fence``: stores that bypass the caches, and the
+fence that orders them; callable from compiled code only) and the one thread pool of
+the process.
 
 Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
 cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
@@ -30,7 +32,8 @@ except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
     objmode = None
 
-__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "threads", "pool",
+__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "stream16",
+           "store_fence", "threads", "pool",
            "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
 
 
@@ -187,8 +190,58 @@ if HAVE_NUMBA:
                 items.append(item)
             return context.make_tuple(builder, arr, items)
         return sig, codegen
+
+    @_intrinsic
+    def stream16(typingctx, dst, d, src, s):
+        """Copy the 16 bytes at byte offset ``s`` of array ``src`` to byte offset ``d``
+        of array ``dst`` with a non-temporal store (LLVM ``!nontemporal``: the line is
+        written to memory without being read into the cache first).  The destination
+        address must be a multiple of 16 and both ranges inside their (C-contiguous)
+        arrays; the stores are weakly ordered: :func:`store_fence` before another
+        thread reads them."""
+        if not all(isinstance(a, _types.Array) and a.layout == "C" for a in (dst, src)):
+            return None
+        sig = _types.void(dst, _types.int64, src, _types.int64)
+
+        def codegen(context, builder, signature, args):
+            i8p = _ir.IntType(8).as_pointer()
+            vt = _ir.VectorType(_ir.IntType(64), 2)
+            a = context.make_array(signature.args[0])(context, builder, value=args[0])
+            b = context.make_array(signature.args[2])(context, builder, value=args[2])
+            dp = builder.bitcast(builder.gep(builder.bitcast(a.data, i8p), [args[1]]),
+                                 vt.as_pointer())
+            sp = builder.bitcast(builder.gep(builder.bitcast(b.data, i8p), [args[3]]),
+                                 vt.as_pointer())
+            v = builder.load(sp, align=1)
+            st = builder.store(v, dp, align=16)
+            st.set_metadata("nontemporal",
+                            builder.module.add_metadata([_ir.Constant(_ir.IntType(32), 1)]))
+            return context.get_dummy_value()
+        return sig, codegen
+
+    @_intrinsic
+    def store_fence(typingctx):
+        """A store fence (``sfence`` on x86, LLVM's ``fence release`` elsewhere): the
+        stores of :func:`stream16` before it are visible to other threads after it."""
+        sig = _types.void()
+
+        def codegen(context, builder, signature, args):
+            if "x86" in builder.module.triple or "i386" in builder.module.triple:
+                fn = builder.module.declare_intrinsic("llvm.x86.sse.sfence", [],
+                                                      _ir.FunctionType(_ir.VoidType(), []))
+                builder.call(fn, [])
+            else:  # pragma: no cover - not x86
+                builder.fence("release")
+            return context.get_dummy_value()
+        return sig, codegen
 else:  # pragma: no cover
     def unowned(arr):
+        raise RuntimeError("numba is not installed")
+
+    def stream16(dst, d, src, s):
+        raise RuntimeError("numba is not installed")
+
+    def store_fence():
         raise RuntimeError("numba is not installed")
 
     def f2i(x):
