@@ -1,8 +1,8 @@
-"""The compiled engine's floor: the numba import guard, :func:`njit`, six intrinsics
-(``fma``, ``f2i``, ``i2f``: LLVM operations; ``unowned``: array views that count no
-references; ``stream16`` and ``store_fence``: stores that bypass the caches, and the
-fence that orders them; callable from compiled code only) and the one thread pool of
-the process.
+"""The compiled engine's floor: the numba import guard, :func:`njit`, seven intrinsics
+(``fma``, ``f2i``, ``i2f``, ``prefetch``: LLVM operations; ``unowned``: array views
+that count no references; ``stream16`` and ``store_fence``: stores that bypass the
+caches, and the fence that orders them; callable from compiled code only) and the one
+thread pool of the process.
 
 Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
 cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
@@ -32,7 +32,8 @@ except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
     objmode = None
 
-__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "stream16",
+__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "prefetch",
+           "stream16",
            "store_fence", "threads", "pool",
            "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
 
@@ -192,6 +193,31 @@ if HAVE_NUMBA:
         return sig, codegen
 
     @_intrinsic
+    def prefetch(typingctx, arr, i):
+        """A hint to bring the cache line of element ``i`` of the C-contiguous array
+        ``arr`` (``i`` counted in its flat order; ``0 <= i < arr.size``) into the cache
+        (LLVM's ``prefetch``: no value, no fault, no effect on the results)."""
+        if not (isinstance(arr, _types.Array) and arr.layout == "C"):
+            return None
+        sig = _types.void(arr, _types.int64)
+
+        def codegen(context, builder, signature, args):
+            ary = context.make_array(signature.args[0])(context, builder, value=args[0])
+            i8p = _ir.IntType(8).as_pointer()
+            i32 = _ir.IntType(32)
+            size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
+            off = builder.mul(args[1], _ir.Constant(_ir.IntType(64), size))
+            ptr = builder.gep(builder.bitcast(ary.data, i8p), [off])
+            fn = builder.module.declare_intrinsic("llvm.prefetch", [i8p],
+                                                  _ir.FunctionType(_ir.VoidType(),
+                                                                   [i8p, i32, i32, i32]))
+            # a read (0), kept in every cache level (3), of data (1)
+            builder.call(fn, [ptr, _ir.Constant(i32, 0), _ir.Constant(i32, 3),
+                              _ir.Constant(i32, 1)])
+            return context.get_dummy_value()
+        return sig, codegen
+
+    @_intrinsic
     def stream16(typingctx, dst, d, src, s):
         """Copy the 16 bytes at byte offset ``s`` of array ``src`` to byte offset ``d``
         of array ``dst`` with a non-temporal store (LLVM ``!nontemporal``: the line is
@@ -236,6 +262,9 @@ if HAVE_NUMBA:
         return sig, codegen
 else:  # pragma: no cover
     def unowned(arr):
+        raise RuntimeError("numba is not installed")
+
+    def prefetch(arr, i):
         raise RuntimeError("numba is not installed")
 
     def stream16(dst, d, src, s):

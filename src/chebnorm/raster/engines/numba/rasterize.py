@@ -14,7 +14,7 @@ import numpy as np
 
 from ...spans import Spans, fit_camera
 from ...spans import project as reference_project
-from .jit import HAVE_NUMBA, fma, njit, run_with_caller, threads
+from .jit import HAVE_NUMBA, fma, njit, prefetch, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
 __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
@@ -409,13 +409,20 @@ def row_span_set(xy, attrs, ids, q0, q1, r, width, tri, row, c0, count, m, t0, d
     pixel dropped) into ``tri, row, ... right`` from index 0, as :func:`span_geom` finds
     and :func:`span_write` writes them, in two passes: every triangle's edges and span
     ends first (kept in the scratch ``gi``, ``(8, M)`` int64, and ``gf``, ``(4, M)``
-    float64), then the spans' attributes.  Each pass's iterations are independent of
-    each other (one long chain of dependent loads, divisions and roundings per triangle
-    otherwise).  Returns ``(spans, fragments)``."""
+    float64), then the spans' attributes (``attrs`` C-contiguous; the first pass asks
+    for each triangle's attributes, :func:`.jit.prefetch`).  Each pass's iterations are
+    independent of each other (one long chain of dependent loads, divisions and
+    roundings per triangle otherwise).  Returns ``(spans, fragments)``."""
     n = 0
     nfrag = 0
     for q in range(q0, q1):
         i = ids[q]
+        # the attributes the second pass reads, asked for now (a triangle's first row
+        # finds them in the last-level cache at best)
+        na = 3 * attrs.shape[2]
+        for e in range(0, na, 8):
+            prefetch(attrs, i * na + e)
+        prefetch(attrs, i * na + na - 1)
         c, a, pa, qa, sa, p, qq, sb, swap, xl, xr = span_geom(xy, i, r, width)
         gi[0, n], gi[1, n], gi[2, n], gi[3, n] = i, c, a, pa
         gi[4, n], gi[5, n], gi[6, n], gi[7, n] = qa, p, qq, swap
