@@ -1172,20 +1172,58 @@ def _rows_dtype(spec, mode, dtype):
     return dt_
 
 
-def _frame_args(st, lighting, mode, dt_, orders):
+def _frame_args(st, lighting, mode, dt_, orders, light_only=False):
     """The constant arrays every frame kernel takes: ``(kc, Htri, light, L, eye, ords,
-    face_id)``."""
+    face_id)`` (``light_only``: those of this frame alone, ``(Htri, L, eye, face_id)``;
+    :func:`_rows_consts` has the others)."""
     per_pixel_h = lighting.half_vector == "pixel"
-    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
     Htri = (np.ascontiguousarray(triangle_half_vectors(st), np.float64) if not per_pixel_h
-            else np.zeros((1, 3)))
-    light = np.array([lighting.I0, lighting.ka, lighting.kd, lighting.ks, lighting.shininess,
-                      float(pow_calibrated(float(lighting.shininess))),
-                      float(mode == 4 and trig_calibrated())], np.float64)
+            else _NO_HTRI)
     L = np.ascontiguousarray(st.L, np.float64)
     eye = np.asarray(st.camera.eye, np.float64)
-    return (kc, Htri, light, L, eye, np.array(orders, np.int64),
-            np.ascontiguousarray(st.tri, np.int64))
+    face_id = np.ascontiguousarray(st.tri, np.int64)
+    if light_only:
+        return Htri, L, eye, face_id
+    kc, light, ords = _rows_consts(mode, dt_, lighting, orders)[:3]
+    return kc, Htri, light, L, eye, ords, face_id
+
+
+#: the triangle half vectors' placeholder of a frame with per-pixel half vectors (read
+#: by no kernel)
+_NO_HTRI = np.zeros((1, 3))
+
+#: :func:`_rows_consts`' arrays by what they depend on (at most :data:`_CONSTS_KEPT`)
+_CONSTS: dict = {}
+
+
+_CONSTS_KEPT = 64
+
+
+def _rows_consts(mode, dt_, lighting, orders):
+    """The constant arrays of a frame's kernels that depend on the method, dtype,
+    lighting and reduction orders alone, made once: ``(kc, light, ords, eorders, quick,
+    cf, kd, proto, ks)`` (``cf`` empty: the quadratic's table is the frame's).  The
+    kernels only read them; every frame of a kind shares them (after a frame the
+    interpreter's and numpy's code is out of the cache: each small array made costs
+    microseconds)."""
+    light_key = (float(lighting.I0), float(lighting.ka), float(lighting.kd),
+                 float(lighting.ks), float(lighting.shininess))
+    key = (mode, np.dtype(dt_).char, light_key, tuple(orders))
+    got = _CONSTS.get(key)
+    if got is not None:
+        return got
+    kc = np.array([3.0, 0.5, 0.375, 1.25, 1.875, 1.0], dt_)
+    light = np.array([*light_key, float(pow_calibrated(light_key[4])),
+                      float(mode == 4 and trig_calibrated())], np.float64)
+    eo = ends_orders() if mode else None
+    eorders = np.array(eo if eo is not None else (0, 0), np.int64)
+    quick = bool(mode in (4, 6) and dt_ is np.float64 and trig_calibrated())
+    got = (kc, light, np.array(orders, np.int64), eorders, quick, np.zeros(0, dt_),
+           _dichotomy_consts(dt_), np.zeros(1, dt_), setup_consts(dt_))
+    if len(_CONSTS) >= _CONSTS_KEPT:
+        _CONSTS.clear()
+    _CONSTS[key] = got
+    return got
 
 
 #: the quadratic's table of the last frame, by (method, image size, triangles): the rows
@@ -1242,24 +1280,20 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
     xy = np.ascontiguousarray(st.xy, np.float64)
     attrs = np.ascontiguousarray(attrs, np.float64)
     height = int(st.height)
-    kc, Htri, light, L, eye, ords, face_id = _frame_args(st, lighting, mode, dt_, orders)
-    eo = ends_orders() if mode else None
-    eorders = np.array(eo if eo is not None else (0, 0), np.int64)
-    quick = bool(mode in (4, 6) and dt_ is np.float64 and trig_calibrated())
-    cf = np.zeros(0, dt_)
+    kc, light, ords, eorders, quick, cf, kd, proto, ks = _rows_consts(mode, dt_, lighting,
+                                                                      orders)
+    Htri, L, eye, face_id = _frame_args(st, lighting, mode, dt_, orders, light_only=True)
     if mode in (5, 7):
         key, guess = _rows_table(spec, tables, st)
         if guess is not None:
             cf = np.array([dt_(c) for c in guess.coefficients], dt_)
-    kd = _dichotomy_consts(dt_)
     maps = output_maps(st.width * st.height)
     k = min(threads(), height)
     outs = np.zeros((k, 6), np.int64)
     fouts = np.zeros((k, 2))
     offs = np.zeros((k, 2, MAX_LEVELS + 1), np.bool_)
-    common = (st.width, height, mode, xy, attrs, eorders, np.zeros(1, dt_), kc, face_id,
-              per_pixel_h, Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf, kd,
-              setup_consts(dt_))
+    common = (st.width, height, mode, xy, attrs, eorders, proto, kc, face_id, per_pixel_h,
+              Htri, L, eye, light, ords, 3 if extra_maps else 0, quick, cf, kd, ks)
     tick("spans")
     if clock is not None:     # the frame's passes, cumulatively, for stage_times
         for stop, name in ((4, "ends"), (1, "visibility"), (2, "normals"), (3, "half vectors")):
@@ -1271,33 +1305,35 @@ def _phong_rows(st, lighting, attrs, mode, dt_, orders, clock, extra_maps, spec=
     run_with_caller([(_frame_rows, (*common, q, k, *maps, outs[q], fouts[q], offs[q], 0))
                      for q in range(k)])
     tick("shading")
-    if (outs[:, 0] == 1).any():
+    # the threads' reports as Python ints, read once (after the frame the interpreter's
+    # and numpy's code is out of the cache: each small numpy call costs microseconds)
+    status, frags, covered, t0nz, cmax, deep = zip(*outs.tolist())
+    if 1 in status:
         raise FrameUnsupported("a span failed a check of check_span_input")
     keep_maps(maps)
     # the set-up of modes 4-7: every value promised (no hard span); modes 5-7 also assumed
     # what the whole frame decides (setup.method_setup's start_left and count_max, the
     # table, the dichotomy's depths off the dyadic grid)
     stats = {}
-    spans = outs[:, 1].sum() > 0
-    if (outs[:, 0] == 2).any():
+    spans = sum(frags) > 0
+    if 2 in status:
         return None
-    if mode in (5, 6) and spans and not (outs[:, 3].any()
-                                         and (mode == 5 or outs[:, 4].max() >= 2)):
+    if mode in (5, 6) and spans and not (any(t0nz) and (mode == 5 or max(cmax) >= 2)):
         return None
     if mode == 7 and (offs[:, 0].any(axis=0) & ~offs[:, 1].any(axis=0)).any():
         return None
-    clo = None if mode == 7 and not outs[:, 5].any() else float(fouts[:, 1].min())
-    if mode in (5, 7) and spans and not _table_holds(spec, tables, guess, key,
-                                                     np.float64(fouts[:, 0].min()), clo,
-                                                     stats):
-        return None
-    if outs[:, 2].sum() < 2:
+    if mode in (5, 7) and spans:
+        clo = None if mode == 7 and not any(deep) else float(fouts[:, 1].min())
+        if not _table_holds(spec, tables, guess, key, np.float64(fouts[:, 0].min()), clo,
+                            stats):
+            return None
+    if sum(covered) < 2:
         # numpy computes N @ L for one row by another route than BLAS
         raise FrameUnsupported("fewer than two pixels covered")
     img, mask, tri_map, nlen = maps
     shape = (st.height, st.width)
     extra = (tri_map.reshape(shape), nlen.reshape(shape)) if extra_maps else (None, None)
-    return ModeResult(img.reshape(shape), mask.reshape(shape), int(outs[:, 1].sum()), stats,
+    return ModeResult(img.reshape(shape), mask.reshape(shape), sum(frags), stats,
                       triangle=extra[0], normal_length=extra[1])
 
 
