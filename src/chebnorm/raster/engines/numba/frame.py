@@ -622,9 +622,9 @@ def _frame_rows(width, height, mode, xy, attrs, eorders, proto, kc, face_id, per
 @njit()
 def _stream_row(dst, start, src, n):
     """``dst[start:start + n] = src[:n]`` (the same dtype, both C-contiguous), the
-    16-byte aligned middle with non-temporal stores (:func:`.jit.stream16`: a map's line
+    16-byte aligned middle with non-temporal stores (``jit.stream16``: a map's line
     is written without first being read into the cache, which the frame's 25 bytes a
-    pixel would otherwise cost twice); the caller fences (:func:`.jit.store_fence`)."""
+    pixel would otherwise cost twice); the caller fences (``jit.store_fence``)."""
     isz = dst.itemsize
     a = np.int64(dst.ctypes.data) + start * isz
     head = min(((16 - (a & 15)) & 15) // isz, n)

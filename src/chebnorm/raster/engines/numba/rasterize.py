@@ -410,7 +410,7 @@ def row_span_set(xy, attrs, ids, q0, q1, r, width, tri, row, c0, count, m, t0, d
     and :func:`span_write` writes them, in two passes: every triangle's edges and span
     ends first (kept in the scratch ``gi``, ``(8, M)`` int64, and ``gf``, ``(4, M)``
     float64), then the spans' attributes (``attrs`` C-contiguous; the first pass asks
-    for each triangle's attributes, :func:`.jit.prefetch`).  Each pass's iterations are
+    for each triangle's attributes, ``jit.prefetch``).  Each pass's iterations are
     independent of each other (one long chain of dependent loads, divisions and
     roundings per triangle otherwise).  Returns ``(spans, fragments)``."""
     n = 0
