@@ -11,11 +11,8 @@ the benches too).
 
 from __future__ import annotations
 
-from chebnorm.approx import PiecewiseTable, load_table
-from chebnorm.export import (EXPORT_FORMATS, HDL_FORMATS, export_table, export_with_proofs,
-                             options_for)
-
 from .common import command_line, deprecated_alias
+from .vocab import EXPORT_FORMATS
 
 #: export option -> (argparse dest, flag)
 _FLAGS = {"in_bits": ("in_bits", "--in-bits"), "out_bits": ("out_bits", "--out-bits"),
@@ -89,6 +86,9 @@ def run(args) -> int:
         refuses (:func:`chebnorm.cli.main` prints it as one line on stderr, the
         library's argument names as the command's flags, and exits with status 2).
     """
+    from chebnorm.approx import PiecewiseTable, load_table
+    from chebnorm.export import HDL_FORMATS, export_table, export_with_proofs, options_for
+
     if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
     given = _given(args)

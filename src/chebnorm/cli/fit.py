@@ -8,10 +8,8 @@ import re
 import sys
 import warnings
 
-from chebnorm.approx import COEF_FORMATS as FORMATS, MAX_DEGREE, FitWarning, fit, warnings_of
-from chebnorm.core.textsafe import identifier
-
 from .common import cli_flags, command_line, deprecated_alias, print_json
+from .vocab import COEF_FORMATS as FORMATS, MAX_DEGREE
 
 
 def register(sub) -> None:
@@ -160,6 +158,8 @@ def cli_phrases(message: str) -> str:
 def _fit_cli(args, **kw):
     """:func:`chebnorm.fit` with the command's arguments; its refusals in the CLI's words."""
     # its refusals name fit's arguments: chebnorm.cli.main says them as flags (cli_words)
+    from chebnorm.approx import fit
+
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
                error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
@@ -207,6 +207,9 @@ def run(args) -> int:
         it as one line on stderr with the command's flags, :func:`cli_words`, and exits
         with status 2).
     """
+    from chebnorm.approx import FitWarning, warnings_of
+    from chebnorm.core.textsafe import identifier
+
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import json
 
-from chebnorm.approx import CoefficientTable, PiecewiseTable, load_table
-
 from .common import command_line, deprecated_alias, print_json, refuse_unused
 from .parallel_options import add_parallel_args
+from .vocab import UNIT_NAMES, UNIT_TARGETS
 
 
 def _design_args(p) -> None:
@@ -48,8 +47,6 @@ def register(sub) -> None:
         parsers of ``hw`` sets ``func``, its runner: :func:`run_verilog`,
         :func:`run_report`, :func:`run_unit` or :func:`run_sweep`.
     """
-    from chebnorm.hw.units import UNIT_TARGETS, unit_names
-
     hw = sub.add_parser("hw", help="bit-accurate hardware: Verilog, error budget, sweep",
                         description="Fixed-point Horner evaluators of a coefficient table: "
                         "Verilog checked in Icarus Verilog, sized by Yosys; error budgets "
@@ -81,7 +78,7 @@ def register(sub) -> None:
                    "ice40: LUT/DSP/carry/RAM/FF, Fmax (ice40: nextpnr-ice40; xc7: a model) "
                    "and latency")
     r.add_argument("--unit", action="append", default=[], metavar="KIND",
-                   help=f"also cost a normalization unit ({', '.join(unit_names())}; "
+                   help=f"also cost a normalization unit ({', '.join(UNIT_NAMES)}; "
                    "repeatable): model area beside yosys cells; units with an evaluator "
                    "use TABLE and its widths")
     _unit_width_args(r)
@@ -90,7 +87,7 @@ def register(sub) -> None:
     u = hsub.add_parser("unit", help="Verilog of a normalization unit, its test bench, vectors",
                         description="A normalization unit as synthesizable Verilog, bit-for-bit "
                         "equal to the Python kernels, with a self-checking test bench.")
-    u.add_argument("kind", choices=unit_names())
+    u.add_argument("kind", choices=UNIT_NAMES)
     targets = list(dict.fromkeys(UNIT_TARGETS.values()))
     u.add_argument("--table", metavar="TABLE.json", default=None,
                    help="table of the unit's evaluator (default: the degree-2 fit of "
@@ -137,9 +134,11 @@ def register(sub) -> None:
     s.set_defaults(func=run_sweep)
 
 
-def _coefficient_table(table, path, command: str) -> CoefficientTable:
+def _coefficient_table(table, path, command: str):
     """``table`` (read from ``path``), refused naming ``command`` when it is a
     piecewise table."""
+    from chebnorm.approx import CoefficientTable
+
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"piecewise table {str(path)!r}: {command} reads a coefficient "
                          f"table; accepted: a table fitted without --segments, --segment-by "
@@ -191,6 +190,7 @@ def run_verilog(args) -> int:
     """
     from chebnorm import __version__
     from chebnorm.hw.hdl import pipelined_name
+    from chebnorm.approx import PiecewiseTable, load_table
     from chebnorm.hw.report import hdl_outputs, write_outputs
 
     _check_output(args.output)
@@ -267,6 +267,7 @@ def run_report(args) -> int:
         that does nothing for the table given (:func:`chebnorm.cli.main` prints it as
         one line on stderr and exits with status 2).
     """
+    from chebnorm.approx import PiecewiseTable, load_table
     from chebnorm.hw.units import analyze_unit, get_unit, table_matches
 
     for kind in args.unit:
@@ -386,6 +387,7 @@ def run_unit(args) -> int:
     from chebnorm import __version__
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs
+    from chebnorm.approx import load_table
     from chebnorm.hw.verilog import simulate
 
     _check_output(args.output)

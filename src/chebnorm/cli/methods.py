@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .common import print_json
 
 _KEYS = ("add", "mul", "div", "sqrt", "trig", "cmp")
@@ -64,6 +62,8 @@ def run(args) -> int:
         (accepted: 0 <= PSI < pi radians) (:func:`chebnorm.cli.main` prints it as one
         line on stderr and exits with status 2).
     """
+    import numpy as np
+
     from chebnorm.methods import analyze, angular_drift, method_names
 
     if args.dtype not in ("float32", "float64"):

@@ -6,6 +6,7 @@ from __future__ import annotations
 import time
 
 from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json, refuse_unused
+from .vocab import BUMP_VARIANTS, MESH_NAMES, RENDER_METHODS, SHADING_MODES
 
 
 def register(sub) -> None:
@@ -18,8 +19,6 @@ def register(sub) -> None:
         ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
-    from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES, available_methods
-
     p = sub.add_parser("render", help="render a mesh and measure the shading error",
                        description="Render a mesh with a shading mode and compare it with a "
                        "reference render (default phong:exact): max/mean error in 8-bit levels, "
@@ -29,7 +28,7 @@ def register(sub) -> None:
     p.add_argument("--shading", default="phong", help=f"{'|'.join(SHADING_MODES)} (default phong)")
     p.add_argument("--method", default=None,
                    help=f"normalization method for phong/adaptive/bump: "
-                   f"{'|'.join(available_methods())} (default exact; checked by render)")
+                   f"{'|'.join(RENDER_METHODS)} (default exact; checked by render)")
     p.add_argument("--size", nargs=2, type=int, default=(512, 512), metavar=("W", "H"),
                    help="image size in pixels (default 512 512)")
     p.add_argument("--tess", type=int, default=None, help="tessellation level (mesh default)")

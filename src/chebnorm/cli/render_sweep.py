@@ -7,6 +7,7 @@ import re
 
 from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, refuse_unused
 from .parallel_options import add_parallel_args, parallel_kwargs
+from .vocab import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
 
 #: the CSV and the image folder inside ``-o DIR``
 CSV_NAME = "render_sweep.csv"
@@ -23,8 +24,6 @@ def register(sub) -> None:
         ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
         default is :func:`run`.
     """
-    from chebnorm.raster import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
-
     p = sub.add_parser("render-sweep", help="render a grid of cases and measure their errors",
                        description="Render every mesh x tessellation x size x shininess x "
                        "shading x method (x bump variant) and compare each with its reference "

@@ -29,11 +29,6 @@ import time
 from importlib.metadata import PackageNotFoundError, entry_points, version
 from pathlib import Path
 
-from chebnorm.approx import TARGETS, fit_target, target_names
-from chebnorm.core.files import write_atomic
-from chebnorm.export import export_with_proofs, json_text
-from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
-
 from .parallel_options import add_parallel_args, parallel_kwargs
 
 #: fractional bits of the fixed-point part of the exported tables
@@ -61,6 +56,10 @@ def export_coefficients(out: Path, **_options) -> list[Path]:
     list of pathlib.Path
         The files written, two per target and degree.
     """
+    from chebnorm.approx import TARGETS, fit_target, target_names
+    from chebnorm.core.files import write_atomic
+    from chebnorm.export import export_with_proofs, json_text
+
     folder = out / "coefficients"
     folder.mkdir(parents=True, exist_ok=True)
     written = []
@@ -210,6 +209,9 @@ def run(args) -> int:
         ``--workers``/``--scheduler`` (:func:`chebnorm.cli.main` prints it as one line
         on stderr and exits with status 2).
     """
+    from chebnorm.core.files import write_atomic
+    from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
+
     available = jobs()
     if args.list:
         for name in available:

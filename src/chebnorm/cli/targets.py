@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from chebnorm.approx import TARGETS, target_names
-
 from .common import print_json
 
 
@@ -47,6 +45,8 @@ def run(args) -> int:
         (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
         2).
     """
+    from chebnorm.approx import TARGETS, target_names
+
     rows = []
     for name in target_names():
         t = TARGETS[name]

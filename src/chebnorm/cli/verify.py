@@ -12,9 +12,7 @@ from __future__ import annotations
 import json
 import sys
 
-from chebnorm.approx import load_table
-from chebnorm.core.files import write_atomic
-from chebnorm.export.verify import MAX_INPUTS, VARIANTS, VERIFY_FORMATS, verify
+from .vocab import MAX_INPUTS, VARIANTS, VERIFY_FORMATS
 
 
 def register(sub) -> None:
@@ -80,6 +78,10 @@ def run(args) -> int:
         (:func:`chebnorm.cli.main` prints it as one line on stderr and exits with status
         2).
     """
+    from chebnorm.approx import load_table
+    from chebnorm.core.files import write_atomic
+    from chebnorm.export.verify import verify
+
     if args.format not in VERIFY_FORMATS:
         raise ValueError(f"unknown format {args.format[:40]!r} for verify; accepted: "
                          f"{', '.join(VERIFY_FORMATS)}")

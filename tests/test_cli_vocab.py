@@ -1,0 +1,59 @@
+"""The command line's parsers import no stage, and the words they use are the library's."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from chebnorm.cli import vocab
+
+
+def test_every_copy_is_the_library_value():
+    import chebnorm.approx as approx
+    import chebnorm.export as export
+    import chebnorm.export.verify as verify
+    import chebnorm.hw.units as units
+    import chebnorm.raster as raster
+
+    library = {"COEF_FORMATS": approx.COEF_FORMATS, "MAX_DEGREE": approx.MAX_DEGREE,
+               "EXPORT_FORMATS": export.EXPORT_FORMATS, "VERIFY_FORMATS": verify.VERIFY_FORMATS,
+               "VARIANTS": verify.VARIANTS, "MAX_INPUTS": verify.MAX_INPUTS,
+               "UNIT_TARGETS": units.UNIT_TARGETS, "UNIT_NAMES": units.unit_names(),
+               "MESH_NAMES": raster.MESH_NAMES, "SHADING_MODES": raster.SHADING_MODES,
+               "BUMP_VARIANTS": raster.BUMP_VARIANTS, "RENDER_METHODS": raster.available_methods()}
+    assert sorted(library) == sorted(vocab.__all__)
+    for name, value in library.items():
+        assert getattr(vocab, name) == value, name
+
+
+# the process is the point: the test's own process has every stage loaded already
+_PROBE = """
+import sys
+import chebnorm.cli as cli
+cli.build_parser()
+stages = ("approx", "core", "export", "hw", "methods", "raster", "symbolic")
+heavy = ("numpy", "scipy", "sympy", "mpmath", "flint", "numba", "matplotlib")
+loaded = sorted(m for m in sys.modules
+                if m.split(".")[0] in heavy or m.split(".")[:2] in [["chebnorm", s] for s in stages])
+print(",".join(loaded))
+"""
+
+
+def test_the_parsers_load_no_stage():
+    out = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"], ["fit", "--help"],
+                                  ["hw", "report", "--help"], ["render", "--help"]])
+def test_help_loads_no_stage(argv):
+    code = ("import sys, chebnorm.cli as cli\n"
+            "try:\n    cli.main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+            "heavy = ('numpy', 'sympy', 'numba', 'flint', 'chebnorm.approx', 'chebnorm.raster')\n"
+            "print(','.join(sorted(m for m in sys.modules if m.startswith(heavy))), file=sys.stderr)\n")
+    out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True)
+    assert out.returncode == 0
+    assert out.stdout.strip(), "the help or the version was printed"
+    assert out.stderr.strip() == ""
