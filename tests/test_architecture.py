@@ -15,6 +15,7 @@ the tree and shows the checker reports it.
 from __future__ import annotations
 
 import ast
+import functools
 import shutil
 from pathlib import Path
 
@@ -22,8 +23,10 @@ import pytest
 
 import chebnorm
 
-PACKAGE = Path(chebnorm.__file__).parent
-REPO = PACKAGE.parent.parent
+#: the source tree these tests sit in (not the installed package, which may be a copy
+#: in site-packages after ``pip install .``)
+REPO = Path(__file__).resolve().parent.parent
+PACKAGE = REPO / "src" / "chebnorm"
 CLIENTS = ("paper_repro", "benchmarks")  # public-API users outside the library
 IMPORTERS = {"import_module", "__import__"}
 #: the only places allowed an import whose module name is computed, and why;
@@ -36,19 +39,23 @@ DYNAMIC_IMPORTS = {
 
 def read_layers(package: Path) -> dict[str, tuple[str, ...]]:
     """The ``LAYERS`` literal of ``package/__init__.py`` (the one written rule)."""
-    tree = ast.parse((package / "__init__.py").read_text(encoding="utf-8"))
+    return _layers_of((package / "__init__.py").read_text(encoding="utf-8"), package)
+
+
+def _layers_of(text: str, where) -> dict[str, tuple[str, ...]]:
+    tree = ast.parse(text)
     for node in tree.body:
         if isinstance(node, (ast.Assign, ast.AnnAssign)):
             targets = node.targets if isinstance(node, ast.Assign) else [node.target]
             if any(isinstance(t, ast.Name) and t.id == "LAYERS" for t in targets):
                 return {k: tuple(v) for k, v in ast.literal_eval(node.value).items()}
-    raise AssertionError(f"{package / '__init__.py'} defines no literal LAYERS")
+    raise AssertionError(f"{where}/__init__.py defines no literal LAYERS")
 
 
-def _root_names(package: Path) -> set[str]:
-    """Names the package root binds at import time (module level, not inside a
-    function such as the lazy ``__getattr__``)."""
-    tree = ast.parse((package / "__init__.py").read_text(encoding="utf-8"))
+def _root_names(text: str) -> set[str]:
+    """Names the package root (source ``text``) binds at import time (module level,
+    not inside a function such as the lazy ``__getattr__``)."""
+    tree = ast.parse(text)
     names = set()
 
     def walk(node):
@@ -142,21 +149,55 @@ class _Visitor(ast.NodeVisitor):
         self.generic_visit(node)
 
 
-def references(path: Path, package_parts: list[str]):
-    v = _Visitor(package_parts)
-    v.visit(ast.parse(path.read_text(encoding="utf-8"), filename=str(path)))
-    return v.refs
+@functools.lru_cache(maxsize=None)
+def references(text: str, package_parts: tuple[str, ...], filename: str = "<source>"):
+    """The references of one module's source (cached: the injection tests check
+    trees that differ from the pristine one in a single file)."""
+    v = _Visitor(list(package_parts))
+    v.visit(ast.parse(text, filename=filename))
+    return tuple(v.refs)
 
 
-def layer_violations(repo: Path) -> list[str]:
-    """Every breach of the layer rule in the tree at ``repo`` (a folder with
-    ``src/chebnorm`` and optionally ``paper_repro/``, ``benchmarks/``)."""
-    package = repo / "src" / "chebnorm"
-    layers = read_layers(package)
-    root_names = _root_names(package)
+class Tree:
+    """A source tree on disk, with files replaced or added in memory
+    (``overlay``: path relative to ``root``, POSIX form -> text)."""
+
+    def __init__(self, root: Path, overlay: dict[str, str] | None = None):
+        self.root = Path(root)
+        self.overlay = dict(overlay or {})
+
+    def read(self, rel: str) -> str:
+        if rel in self.overlay:
+            return self.overlay[rel]
+        return (self.root / rel).read_text(encoding="utf-8")
+
+    def exists(self, rel: str) -> bool:
+        return rel in self.overlay or (self.root / rel).is_file()
+
+    def py_files(self, folder: str) -> list[str]:
+        base = self.root / folder
+        found = {p.relative_to(self.root).as_posix() for p in base.rglob("*.py")} \
+            if base.is_dir() else set()
+        found |= {k for k in self.overlay if k.startswith(folder + "/") and k.endswith(".py")}
+        return sorted(found)
+
+    def appended(self, rel: str, line: str) -> "Tree":
+        """This tree with ``line`` appended to the file ``rel`` (created if missing)."""
+        old = self.read(rel) if self.exists(rel) else ""
+        return Tree(self.root, {**self.overlay, rel: old + "\n" + line + "\n"})
+
+
+def layer_violations(repo) -> list[str]:
+    """Every breach of the layer rule in the tree at ``repo`` (a folder, or a
+    :class:`Tree`, with ``src/chebnorm`` and optionally ``paper_repro/``,
+    ``benchmarks/``)."""
+    tree = repo if isinstance(repo, Tree) else Tree(repo)
+    init = tree.read("src/chebnorm/__init__.py")
+    layers = _layers_of(init, tree.root / "src" / "chebnorm")
+    root_names = _root_names(init)
     bad = []
-    for path in sorted(package.rglob("*.py")):
-        rel = path.relative_to(package)
+    for relpath in tree.py_files("src/chebnorm"):
+        rel = Path(relpath).relative_to("src/chebnorm")
         parts = ["chebnorm", *rel.parent.parts]
         where = f"chebnorm/{rel.as_posix()}"
         if len(rel.parts) == 1:
@@ -169,7 +210,7 @@ def layer_violations(repo: Path) -> list[str]:
             if stage not in layers:
                 bad.append(f"{where}: stage {stage!r} is not declared in LAYERS")
                 continue
-        for line, name, how, funcs in references(path, parts):
+        for line, name, how, funcs in references(tree.read(relpath), tuple(parts), relpath):
             head = name.split(".")
             loc = f"{where}:{line}: {how} {name}"
             if head[0] in CLIENTS:
@@ -202,11 +243,10 @@ def layer_violations(repo: Path) -> list[str]:
                 bad.append(f"{loc}: chebnorm.{target} is not a stage nor a name the root "
                            "binds at import time (a lazy facade name): import the stage module")
     for client in CLIENTS:
-        folder = repo / client
-        for path in sorted(folder.rglob("*.py")) if folder.is_dir() else ():
-            rel = path.relative_to(repo)
-            parts = list(rel.parent.parts)
-            for line, name, how, _ in references(path, parts):
+        for relpath in tree.py_files(client):
+            rel = Path(relpath)
+            parts = tuple(rel.parent.parts)
+            for line, name, how, _ in references(tree.read(relpath), parts, relpath):
                 head = name.split(".")
                 if head[0] == "chebnorm" and any(_private(p) for p in head[1:]):
                     bad.append(f"{rel.as_posix()}:{line}: {how} {name}: {client} uses the public "
@@ -322,24 +362,26 @@ class TestCheckerCatches:
 
     @pytest.mark.parametrize("relpath,line,needle", INJECTIONS,
                              ids=[f"{i}-{p.split('/')[-1]}" for i, (p, _, _) in enumerate(INJECTIONS)])
-    def test_injected_import_is_reported(self, pristine, tmp_path, relpath, line, needle):
-        tree = tmp_path / "tree"
-        shutil.copytree(pristine, tree)
-        target = tree / relpath
-        target.parent.mkdir(parents=True, exist_ok=True)
-        old = target.read_text(encoding="utf-8") if target.exists() else ""
-        target.write_text(old + "\n" + line + "\n", encoding="utf-8")
-        bad = layer_violations(tree)
+    def test_injected_import_is_reported(self, pristine, relpath, line, needle):
+        bad = layer_violations(Tree(pristine).appended(relpath, line))
         assert bad, f"{line!r} in {relpath} went unnoticed"
         if needle is not None:
             assert any(needle in b for b in bad), bad
         assert all(relpath.split("/")[-1] in b or relpath.split("/")[-2] in b for b in bad), bad
 
-    def test_lazy_facade_in_root_is_allowed(self, pristine, tmp_path):
+    def test_the_overlay_is_what_is_checked(self, pristine, tmp_path):
+        """An injection written to a real copy of the tree is reported the same as
+        through the in-memory overlay the other tests use."""
+        relpath, line = "src/chebnorm/hw/fixed.py", "from chebnorm import raster"
         tree = tmp_path / "tree"
         shutil.copytree(pristine, tree)
-        init = tree / "src" / "chebnorm" / "__init__.py"
-        init.write_text(init.read_text(encoding="utf-8") + '''
+        target = tree / relpath
+        target.write_text(target.read_text(encoding="utf-8") + "\n" + line + "\n", encoding="utf-8")
+        on_disk = layer_violations(tree)
+        assert on_disk and on_disk == layer_violations(Tree(pristine).appended(relpath, line))
+
+    def test_lazy_facade_in_root_is_allowed(self, pristine):
+        tree = Tree(pristine).appended("src/chebnorm/__init__.py", '''
 
 def __getattr__(name):
     """Lazy facade: cn.fit imports chebnorm.approx on first use."""
@@ -350,27 +392,21 @@ def __getattr__(name):
     if name == "render":
         return importlib.import_module("chebnorm.raster").render
     raise AttributeError(name)
-''', encoding="utf-8")
+''')
         assert layer_violations(tree) == []
         # ... but a stage may not reach a later one through a facade name
-        spans = tree / "src" / "chebnorm" / "raster" / "spans.py"
-        spans.write_text(spans.read_text(encoding="utf-8") + "\nimport chebnorm\nf = chebnorm.fit\n",
-                         encoding="utf-8")
+        tree = tree.appended("src/chebnorm/raster/spans.py", "import chebnorm\nf = chebnorm.fit")
         assert any("chebnorm.fit is not a stage" in b for b in layer_violations(tree))
 
-    def test_rule_comes_from_layers(self, pristine, tmp_path):
+    def test_rule_comes_from_layers(self, pristine):
         """Widening LAYERS (raster may import hw) makes that import legal: the
         checker has no rule of its own."""
-        tree = tmp_path / "tree"
-        shutil.copytree(pristine, tree)
-        spans = tree / "src" / "chebnorm" / "raster" / "spans.py"
-        spans.write_text(spans.read_text(encoding="utf-8") + "\nfrom chebnorm.hw import fixed\n",
-                         encoding="utf-8")
+        tree = Tree(pristine).appended("src/chebnorm/raster/spans.py", "from chebnorm.hw import fixed")
         assert layer_violations(tree) != []
-        init = tree / "src" / "chebnorm" / "__init__.py"
-        text = init.read_text(encoding="utf-8")
+        init = "src/chebnorm/__init__.py"
+        text = tree.read(init)
         old = '"raster": ("core", "symbolic", "approx", "methods"),'
         assert old in text
-        init.write_text(text.replace(old, '"raster": ("core", "symbolic", "approx", "methods", "hw"),'),
-                        encoding="utf-8")
-        assert layer_violations(tree) == []
+        widened = Tree(pristine, {**tree.overlay, init: text.replace(
+            old, '"raster": ("core", "symbolic", "approx", "methods", "hw"),')})
+        assert layer_violations(widened) == []
