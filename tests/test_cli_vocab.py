@@ -20,9 +20,9 @@ def test_every_copy_is_the_library_value():
     library = {"COEF_FORMATS": approx.COEF_FORMATS, "MAX_DEGREE": approx.MAX_DEGREE,
                "EXPORT_FORMATS": export.EXPORT_FORMATS, "VERIFY_FORMATS": verify.VERIFY_FORMATS,
                "VARIANTS": verify.VARIANTS, "MAX_INPUTS": verify.MAX_INPUTS,
-               "UNIT_TARGETS": units.UNIT_TARGETS, "UNIT_NAMES": units.unit_names(),
+               "UNIT_NAMES": units.unit_names(),
                "MESH_NAMES": raster.MESH_NAMES, "SHADING_MODES": raster.SHADING_MODES,
-               "BUMP_VARIANTS": raster.BUMP_VARIANTS, "RENDER_METHODS": raster.available_methods()}
+               "BUMP_VARIANTS": raster.BUMP_VARIANTS}
     assert sorted(library) == sorted(vocab.__all__)
     for name, value in library.items():
         assert getattr(vocab, name) == value, name
@@ -47,7 +47,8 @@ def test_the_parsers_load_no_stage():
 
 
 @pytest.mark.parametrize("argv", [["--help"], ["--version"], ["fit", "--help"],
-                                  ["hw", "report", "--help"], ["render", "--help"]])
+                                  ["hw", "report", "--help"], ["render-sweep", "--help"],
+                                  ["design", "--help"], ["verify", "--help"]])
 def test_help_loads_no_stage(argv):
     code = ("import sys, chebnorm.cli as cli\n"
             "try:\n    cli.main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
@@ -57,3 +58,16 @@ def test_help_loads_no_stage(argv):
     assert out.returncode == 0
     assert out.stdout.strip(), "the help or the version was printed"
     assert out.stderr.strip() == ""
+
+
+def test_helps_naming_registries_are_filled_in_when_printed():
+    """``render --help`` names the registered methods, ``hw unit --help`` the units'
+    targets: read from the registries when the help is printed."""
+    from chebnorm.hw.units import UNIT_TARGETS
+    from chebnorm.raster import available_methods
+    from conftest import run_cli
+
+    out = run_cli("render", "--help").out  # argparse may wrap the list inside a name
+    assert "|".join(available_methods()) in "".join(out.split())
+    out = " ".join(run_cli("hw", "unit", "--help").out.split())
+    assert all(t in out for t in UNIT_TARGETS.values())

@@ -226,3 +226,26 @@ def add_lighting_options(p, engine_help: str) -> None:
                    help="split-gouraud: specular threshold at edge maxima (default 1/255)")
     p.add_argument("--engine", default="auto", choices=("auto", "numpy", "numba"),
                    help=engine_help)
+
+
+def help_when_printed(parser, action, text) -> None:
+    """Set ``action``'s help to ``text()`` when ``parser``'s help is printed, not
+    when it is built: for a help that names what a stage registers (building the
+    parsers imports no stage, so ``--help`` answers at once).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The (sub)command's parser.
+    action : argparse.Action
+        One of its arguments (what ``add_argument`` returned).
+    text : callable
+        Called with no argument when the help is printed; returns the help text.
+    """
+    format_help = parser.format_help
+
+    def formatted():
+        action.help = text()
+        return format_help()
+
+    parser.format_help = formatted

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
-from .common import command_line, deprecated_alias, print_json, refuse_unused
+from .common import command_line, deprecated_alias, help_when_printed, print_json, refuse_unused
 from .parallel_options import add_parallel_args
-from .vocab import UNIT_NAMES, UNIT_TARGETS
+from .vocab import UNIT_NAMES
 
 
 def _design_args(p) -> None:
@@ -33,6 +33,14 @@ def _unit_width_args(p) -> None:
     p.add_argument("--log-m", type=int, default=None, help="stepper: m = 2^LOG_M pixels, 0..10")
     p.add_argument("--guard", type=int, default=None,
                    help="stepper: guard bits, 0..24 (default 2 LOG_M: exact set-up)")
+
+
+def _unit_table_help() -> str:
+    from chebnorm.hw.units import UNIT_TARGETS  # the units' registry (a stage)
+
+    targets = list(dict.fromkeys(UNIT_TARGETS.values()))
+    return ("table of the unit's evaluator (default: the degree-2 fit of "
+            f"{', '.join(targets[:-1])} or {targets[-1]} for psi_max = pi/4)")
 
 
 def register(sub) -> None:
@@ -88,10 +96,10 @@ def register(sub) -> None:
                         description="A normalization unit as synthesizable Verilog, bit-for-bit "
                         "equal to the Python kernels, with a self-checking test bench.")
     u.add_argument("kind", choices=UNIT_NAMES)
-    targets = list(dict.fromkeys(UNIT_TARGETS.values()))
-    u.add_argument("--table", metavar="TABLE.json", default=None,
-                   help="table of the unit's evaluator (default: the degree-2 fit of "
-                   f"{', '.join(targets[:-1])} or {targets[-1]} for psi_max = pi/4)")
+    table = u.add_argument("--table", metavar="TABLE.json", default=None,
+                           help="table of the unit's evaluator (default: the degree-2 fit of "
+                           "its registered target for psi_max = pi/4)")
+    help_when_printed(u, table, _unit_table_help)
     u.add_argument("--in-bits", type=int, default=16, help="evaluator input width, 1..20")
     u.add_argument("--out-bits", type=int, default=16, help="evaluator output width, 1..32")
     u.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None, metavar="B",

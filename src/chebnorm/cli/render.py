@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import time
 
-from .common import ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, print_json, refuse_unused
-from .vocab import BUMP_VARIANTS, MESH_NAMES, RENDER_METHODS, SHADING_MODES
+from .common import (ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, help_when_printed,
+                     print_json, refuse_unused)
+from .vocab import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
 
 
 def register(sub) -> None:
@@ -26,9 +27,10 @@ def register(sub) -> None:
     p.add_argument("--mesh", default="teapot",
                    help=f"{'|'.join(MESH_NAMES)} or an .obj/.ply/.stl path (default teapot)")
     p.add_argument("--shading", default="phong", help=f"{'|'.join(SHADING_MODES)} (default phong)")
-    p.add_argument("--method", default=None,
-                   help=f"normalization method for phong/adaptive/bump: "
-                   f"{'|'.join(RENDER_METHODS)} (default exact; checked by render)")
+    method = p.add_argument("--method", default=None,
+                            help="normalization method for phong/adaptive/bump: a registered "
+                            "method (default exact; checked by render)")
+    help_when_printed(p, method, _method_help)
     p.add_argument("--size", nargs=2, type=int, default=(512, 512), metavar=("W", "H"),
                    help="image size in pixels (default 512 512)")
     p.add_argument("--tess", type=int, default=None, help="tessellation level (mesh default)")
@@ -54,6 +56,13 @@ def register(sub) -> None:
 
 #: accepted --crease-angle, degrees
 CREASE_RANGE = (0.0, 180.0)
+
+
+def _method_help() -> str:
+    from chebnorm.raster import available_methods  # the registry, which a caller may extend
+
+    return (f"normalization method for phong/adaptive/bump: {'|'.join(available_methods())} "
+            f"(default exact; checked by render)")
 
 
 def _crease_radians(deg):

@@ -12,8 +12,8 @@ so the two cannot drift apart.
 from __future__ import annotations
 
 __all__ = ["COEF_FORMATS", "MAX_DEGREE", "EXPORT_FORMATS", "VERIFY_FORMATS", "VARIANTS",
-           "MAX_INPUTS", "UNIT_TARGETS", "UNIT_NAMES", "MESH_NAMES", "SHADING_MODES",
-           "BUMP_VARIANTS", "RENDER_METHODS"]
+           "MAX_INPUTS", "UNIT_NAMES", "MESH_NAMES", "SHADING_MODES",
+           "BUMP_VARIANTS"]
 
 #: :data:`chebnorm.approx.COEF_FORMATS`
 COEF_FORMATS = ("fixed", "binary16", "bfloat16", "binary32", "binary64")
@@ -29,8 +29,6 @@ VARIANTS = {"c": ("double", "double-fused", "float", "float-fused", "fixed", "qu
             "glsl": ("llvmpipe",), "wgsl": ("lavapipe",), "hlsl": ("glslang",)}
 #: :data:`chebnorm.export.verify.MAX_INPUTS`
 MAX_INPUTS = 2 ** 31
-#: :data:`chebnorm.hw.units.UNIT_TARGETS`
-UNIT_TARGETS = {"dichotomy": "dichotomy", "quadratic": "midpoint", "eta": "eta_term"}
 #: :func:`chebnorm.hw.units.unit_names`
 UNIT_NAMES = ("dichotomy", "classic", "quadratic", "stepper", "eta")
 #: :data:`chebnorm.raster.MESH_NAMES`
@@ -39,5 +37,3 @@ MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")
 SHADING_MODES = ("gouraud", "phong", "adaptive", "split-gouraud", "bump")
 #: :data:`chebnorm.raster.BUMP_VARIANTS`
 BUMP_VARIANTS = ("full", "square", "object")
-#: :func:`chebnorm.raster.available_methods`
-RENDER_METHODS = ("exact", "none", "newton", "lyon", "slerp", "dichotomy", "quadratic", "angular")
