@@ -42,7 +42,7 @@ HERE = Path(__file__).resolve().parent
 #: per-test durations of the last full run: node id -> [setup, call, teardown] seconds
 DURATIONS = HERE / "durations.json"
 #: a test whose recorded duration reaches this belongs to the full suite only
-SLOW_SECONDS = 2.0
+SLOW_SECONDS = 1.0
 
 #: the Debian package of each external tool the tests use (what .ci/run installs)
 TOOL_PACKAGES = {
@@ -78,9 +78,6 @@ def pytest_addoption(parser):
 
 
 def pytest_configure(config):
-    config.addinivalue_line("markers", "slow: the full suite only (see tests/conftest.py)")
-    config.addinivalue_line("markers", "requires_tool(*names): skip unless every external "
-                                       "tool named is on PATH")
     path = config.getoption("--store-durations")
     if path and not hasattr(config, "workerinput"):  # xdist workers report to the controller
         config.pluginmanager.register(_DurationRecorder(Path(path)), "chebnorm-durations")
