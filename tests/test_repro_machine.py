@@ -296,6 +296,13 @@ def test_non_editable_install_writes_the_committed_outputs(tmp_path):
     where = subprocess.run([str(py), "-c", probe],
                            env=env, capture_output=True, text=True, cwd=tmp_path, check=True).stdout
     assert all(line.startswith(site) for line in where.split()), where   # installed, not src
+    # the layer rule is checked on the source tree beside the tests, whatever is installed,
+    # run from another folder
+    rule = subprocess.run([str(py), "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           str(src / "tests" / "test_architecture.py")], env=env,
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600, check=False)
+    assert rule.returncode == 0, rule.stdout[-3000:]
+    assert " passed" in rule.stdout.splitlines()[-1] and "skipped" not in rule.stdout.splitlines()[-1]
     shutil.rmtree(src / "build", ignore_errors=True)
     before = {**_hashes(src / "figures"), **{f"ledger/{k}": v for k, v in
                                              _hashes(src / "paper_repro").items() if "." in k
