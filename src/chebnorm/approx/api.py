@@ -253,7 +253,7 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     fix_constant : bool, optional
         Hold the constant coefficient at ``f(0)`` rounded to its format.
     segments : int or str, optional
-        ``2**k`` segments: a piecewise table instead
+        ``2**k`` segments, or ``"auto"`` with ``max_error``: a piecewise table instead
         (:func:`~chebnorm.approx.piecewise_fit.piecewise_fit`).
     segment_by : {"uniform", "exponent"}, optional
         How a piecewise table's segments are indexed.
@@ -266,8 +266,12 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         (a finite number > 0). Degrees that a de la Vallee Poussin lower
         bound rules out are not fitted; the others are fitted and certified
         from the lowest up. ``provenance["degree_search"]`` records every
-        degree tried and why it lost. Not with ``degree``, nor with
-        piecewise tables.
+        degree tried and why it lost. The search stops (ValueError) when
+        four certified degrees in a row gain under 1% (the
+        rounding floor of float64 coefficients), or at ``MAX_DEGREE``. Not
+        with ``degree``, except with ``segments="auto"``: then the fewest
+        segments (``2**k``) whose piecewise table of ``degree`` is certified
+        to ``max_error`` (``provenance["segment_search"]``).
 
     Returns
     -------
@@ -441,21 +445,31 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     ``provenance["degree_search"]``."""
     import dataclasses
 
-    if degree is not None and max_error is not None:
-        raise ValueError(f"degree {degree!r} and max_error {max_error!r} are both given; "
-                         f"accepted: one of them (max_error chooses the degree)")
     if degree is None and max_error is None:
         raise ValueError(f"degree is missing; accepted: an integer 0 <= degree <= "
                          f"{MAX_DEGREE}, or max_error=E (a finite number > 0) for the "
                          f"smallest degree whose certified error is at most E")
+    if kw["segments"] == "auto":
+        if degree is None or max_error is None:
+            raise ValueError("segments='auto' needs both the degree and max_error: the "
+                             "fewest segments whose certified error at that degree is at "
+                             "most max_error; accepted: fit(expr, interval, degree, "
+                             "segments='auto', max_error=E)")
+    elif degree is not None and max_error is not None:
+        raise ValueError(f"degree {degree!r} and max_error {max_error!r} are both given; "
+                         f"accepted: one of them (max_error chooses the degree), or both with "
+                         f"segments='auto' (max_error chooses the segment count)")
     if isinstance(max_error, bool) or not isinstance(max_error, (int, float, np.integer,
                                                                  np.floating)) \
             or not math.isfinite(float(max_error)) or not max_error > 0:
         raise ValueError(f"max_error {max_error!r}: accepted: a finite number > 0, e.g. "
                          f"1e-6 or 2**-20")
+    if kw["segments"] == "auto":
+        return _fit_segments_auto(expr, interval, degree, float(max_error), kw)
     if kw["segments"] is not None or kw["segment_by"] is not None or kw["centered"]:
         raise ValueError("max_error with segments, segment_by or centered: accepted: "
-                         "max_error for one polynomial (give the degree of a piecewise table)")
+                         "max_error for one polynomial (give the degree and "
+                         "segments='auto' for a piecewise table)")
     max_error = float(max_error)
     error = kw["error"]
     # the arguments are checked once, by a degree-0 check of fit's own
@@ -479,7 +493,7 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
             first = max(int(k) for k in mons)
         except (TypeError, ValueError):
             first = 0
-    tried = []
+    tried, bounds = [], []
     best = None
     for n in range(first, top + 1):
         if lower[n] > max_error:
@@ -494,15 +508,80 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
         if ok:
             best = table
             break
+        bounds.append(bound)
+        if len(bounds) >= STALL_DEGREES and bounds[-STALL_DEGREES] <= 1.01 * min(
+                bounds[-STALL_DEGREES:]):
+            tried.append(f"stopped: {STALL_DEGREES} degrees in a row gained less than 1% "
+                         f"(the float64 coefficients' rounding floor)")
+            break
     if best is None:
         raise ValueError(f"no degree up to {MAX_DEGREE} reaches max_error {max_error:.6g} "
-                         f"for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: {'; '.join(tried[-3:])}); "
+                         f"for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: {'; '.join(tried[-4:])}); "
                          f"accepted: a larger max_error, or piecewise tables (segments)")
     provenance = dict(best.provenance)
     provenance["max_error"] = repr(max_error)
     provenance["degree_search"] = "; ".join(tried)
     with construction("fitted"):  # the same table, its search recorded
         return dataclasses.replace(best, provenance=provenance)
+
+
+def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
+    """:func:`fit` with ``segments="auto"``: the fewest segments (``2**k``,
+    ``k <= 12``) whose piecewise table of ``degree`` is certified to
+    ``max_error``; counts whose best error per segment a de la Vallee Poussin
+    bound puts above ``max_error`` are not fitted. The search is recorded in
+    ``provenance["segment_search"]``."""
+    import dataclasses
+
+    from .piecewise_table import segment_bounds, segment_count
+
+    error = kw["error"]
+    expr_in, var = as_expression(expr, kw["var"])
+    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
+    try:
+        lo, hi = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    iv = Interval(lo, hi)
+    segment_by = kw["segment_by"] or "uniform"
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) \
+            or not 0 <= degree <= MAX_DEGREE:
+        raise ValueError(f"degree {degree!r}: accepted: an integer 0 <= degree <= {MAX_DEGREE}")
+    tried = []
+    fields = {k: v for k, v in kw.items() if k not in ("segments", "segment_by")}
+    for k in range(0, 13):
+        try:
+            count = segment_count(segment_by, iv.lo, iv.hi, k)
+        except ValueError:
+            break
+        lower = 0.0
+        for s in range(count):
+            a, b = (float(v) for v in segment_bounds(segment_by, iv.lo, iv.hi, k, s))
+            lower = max(lower, _dlvp_bounds(fn, a, b, error, int(degree))[int(degree)])
+            if lower > max_error:
+                break
+        if lower > max_error:
+            tried.append(f"{count}: ruled out (best error >= {lower:.3e}, de la Vallee Poussin)")
+            continue
+        table = fit(expr, interval, degree, segments=2 ** k, segment_by=segment_by, **fields)
+        bound = table.abs_error_bound if error == "abs" else table.rel_error_bound
+        ok = bound is not None and bound <= max_error
+        tried.append(f"{count}: certified {bound:.3e}" + (" <= " if ok else " > ")
+                     + f"{max_error:.3e}")
+        if ok:
+            provenance = dict(table.provenance)
+            provenance["max_error"] = repr(max_error)
+            provenance["segment_search"] = "; ".join(tried)
+            with construction("fitted"):  # the same table, its search recorded
+                return dataclasses.replace(table, provenance=provenance)
+    raise ValueError(f"no segment count up to 2^12 reaches max_error {max_error:.6g} at "
+                     f"degree {degree} for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: "
+                     f"{'; '.join(tried[-3:])}); accepted: a larger max_error, a higher "
+                     f"degree or more coefficient bits (frac_bits)")
+
+
+#: the degree search stops when this many certified degrees in a row gain under 1%
+STALL_DEGREES = 4
 
 
 def _delivered_bound(table, error: str) -> float | None:
@@ -547,7 +626,11 @@ def degree_lower_bounds(fn: Function1D, iv: Interval, error: str, top: int) -> l
     list of float
         ``top + 1`` lower bounds (0.0 where the signs do not alternate).
     """
-    a, b = iv.lo_in, iv.hi_in
+    return _dlvp_bounds(fn, iv.lo_in, iv.hi_in, error, top)
+
+
+def _dlvp_bounds(fn: Function1D, a: float, b: float, error: str, top: int) -> list[float]:
+    """:func:`degree_lower_bounds` on the float interval ``[a, b]``."""
     m = min(max(2 * top + 8, 64), 256)
     k = np.arange(m)
     t_nodes = np.cos(np.pi * (k + 0.5) / m)

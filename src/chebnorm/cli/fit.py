@@ -32,7 +32,12 @@ def register(sub) -> None:
     p.add_argument("--var", default="x", help="the variable of EXPR (default x)")
     p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
                    help='exact endpoints, e.g. "sqrt(2)" 2 or 0.1 0.3 (decimals are exact)')
-    p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
+    p.add_argument("--degree", type=int, default=None,
+                   help=f"0..{MAX_DEGREE} (or --max-error)")
+    p.add_argument("--max-error", default=None, metavar="E",
+                   help="instead of --degree: the smallest degree whose certified error "
+                   "(|p - f|, or |p/f - 1| with --error rel; of the quantized coefficients "
+                   "with a format) is <= E, e.g. 1e-6 or 2^-20; the degrees tried are printed")
     p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
     p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
     p.add_argument("--coef-frac-bits", dest="frac_bits", type=_int_list, default=None,
@@ -160,6 +165,11 @@ def cli_phrases(message: str) -> str:
 def _fit_cli(args, **kw):
     """:func:`chebnorm.fit` with the command's arguments; its refusals in the CLI's words."""
     # its refusals name fit's arguments: chebnorm.cli.main says them as flags (cli_words)
+    max_error = getattr(args, "max_error", None)
+    if max_error is not None:
+        from .design import _max_error
+
+        kw["max_error"] = _max_error(max_error)
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
                error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
@@ -208,6 +218,15 @@ def run(args) -> int:
         with status 2).
     """
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
+    if (args.degree is None) == (getattr(args, "max_error", None) is None):
+        raise ValueError(("--degree and --max-error are both given" if args.degree is not None
+                          else "--degree is missing")
+                         + f"; accepted: one of --degree N (0..{MAX_DEGREE}) or --max-error E "
+                         f"(the smallest degree whose certified error is <= E)")
+    if args.max_error is not None and (args.segments is not None or args.segment_by is not None
+                                       or args.centered):
+        raise ValueError("--max-error with --segments, --segment-by or --centered: accepted: "
+                         "--max-error for one polynomial (give --degree for a piecewise table)")
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)
     mon = args.monomials
@@ -234,6 +253,9 @@ def _report(args, table) -> int:
     elif not args.output:
         print(f"{table.name}: {table.kind} degree {table.degree} fit of {table.expression} "
               f"on [{table.interval[0]}, {table.interval[1]}]")
+        if "degree_search" in table.provenance:
+            print(f"degree search (--max-error {float(table.provenance['max_error']):.6e}): "
+                  f"{table.provenance['degree_search']}")
         powers_of = table.variable if table.shift is None else (
             f"t = ({table.variable} - {table.shift[0]!r})/{table.shift[1]!r}")
         print("coefficients (ascending powers of {}): {}".format(
