@@ -381,7 +381,7 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
     (16, True)
     """
-    if max_error is not None or degree is None:
+    if max_error is not None or degree is None or segments == "auto":
         return _fit_max_error(expr, interval, degree, max_error, dict(
             kind=kind, error=error, var=var, name=name, frac_bits=frac_bits, command=command,
             basis=basis, coef_format=coef_format, monomials=monomials,

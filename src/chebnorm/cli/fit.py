@@ -56,7 +56,8 @@ def register(sub) -> None:
     p.add_argument("--segments", default=None, metavar="2^k",
                    help="piecewise table of 2^k segments, 0 <= k <= 12 (per binade with "
                    "--segment-by exponent); coefficients in one fixed-point format "
-                   "(--coef-frac-bits, default 24)")
+                   "(--coef-frac-bits, default 24); auto with --degree and --max-error: "
+                   "the fewest segments certified to E")
     p.add_argument("--segment-by", default=None, choices=("uniform", "exponent"),
                    help="uniform (default: top k bits of the input) or exponent (a float's "
                    "exponent and top mantissa bits; interval [2^e0, 2^e1])")
@@ -179,6 +180,10 @@ def _fit_cli(args, **kw):
 def _run_piecewise(args) -> int:
     table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
                      segment_by=args.segment_by or "uniform", centered=args.centered)
+    if "segment_search" in table.provenance:
+        print(f"segment search (--max-error {float(table.provenance['max_error']):.6e}): "
+              f"{table.provenance['segment_search']}", file=sys.stdout if not args.json
+              else sys.stderr)
     if args.output:
         table.save(args.output)
     if args.json:
@@ -218,15 +223,23 @@ def run(args) -> int:
         with status 2).
     """
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
-    if (args.degree is None) == (getattr(args, "max_error", None) is None):
-        raise ValueError(("--degree and --max-error are both given" if args.degree is not None
-                          else "--degree is missing")
-                         + f"; accepted: one of --degree N (0..{MAX_DEGREE}) or --max-error E "
-                         f"(the smallest degree whose certified error is <= E)")
-    if args.max_error is not None and (args.segments is not None or args.segment_by is not None
-                                       or args.centered):
+    if args.degree is None and args.max_error is None:
+        raise ValueError(f"the following arguments are required: --degree N (0..{MAX_DEGREE}), "
+                         f"or --max-error E instead (the smallest degree whose certified error "
+                         f"is <= E)")
+    auto = args.segments == "auto"
+    if auto and (args.degree is None or args.max_error is None):
+        raise ValueError("--segments auto needs --degree N and --max-error E: the fewest "
+                         "segments whose certified error at that degree is <= E")
+    if args.degree is not None and args.max_error is not None and not auto:
+        raise ValueError(f"--degree and --max-error are both given; accepted: one of --degree "
+                         f"N (0..{MAX_DEGREE}) or --max-error E (the smallest degree whose "
+                         f"certified error is <= E), or both with --segments auto")
+    if args.max_error is not None and not auto and (
+            args.segments is not None or args.segment_by is not None or args.centered):
         raise ValueError("--max-error with --segments, --segment-by or --centered: accepted: "
-                         "--max-error for one polynomial (give --degree for a piecewise table)")
+                         "--max-error for one polynomial, or --segments auto --degree N "
+                         "--max-error E for the fewest segments")
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)
     mon = args.monomials
