@@ -739,7 +739,7 @@ class Function1D:
         """
         from .removable import analyse
 
-        return analyse(self.expr, self.var)
+        return analyse(self.expr, self.var, compile_arb, enclose)
 
     @functools.cached_property
     def numpy(self) -> Callable[[np.ndarray], np.ndarray]:

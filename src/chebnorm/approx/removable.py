@@ -50,7 +50,6 @@ segment, which avoids the cancellation of ``N/D`` there.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 from typing import Callable
@@ -65,6 +64,8 @@ __all__ = ["Removable", "analyse"]
 
 #: highest order of a common zero that is looked for
 MAX_ORDER = 8
+#: most zeros of the denominator examined in one window, and their largest size
+MAX_POINTS, MAX_OPS = 16, 40
 #: terms of the Taylor polynomial at x0 used for point values
 POINT_TERMS = 40
 #: a ball closer than this (relative to max(1, |x0|)) to x0 is also evaluated
@@ -91,14 +92,14 @@ class _Point:
     x0: sp.Expr
     k: int
     x0_float: float
+    constant: Callable  # x0 as a ball at the working precision
     cache: dict = field(default_factory=dict)
 
     def ball(self) -> arb:
         key = ("ball", ctx.prec)
         b = self.cache.get(key)
         if b is None:
-            from .expr import compile_arb
-            b = self.cache[key] = compile_arb(self.x0, sp.Dummy(), series=False)(arb(0))
+            b = self.cache[key] = self.constant(arb(0))
         return b
 
 
@@ -116,11 +117,15 @@ class Removable:
         Its variable.
     num, den : sympy.Expr
         ``expr == num/den``, ``den`` depending on ``var``.
+    compile_arb : callable
+        :func:`chebnorm.approx.expr.compile_arb`.
+    enclose : callable
+        :func:`chebnorm.approx.expr.enclose`.
     """
 
-    def __init__(self, expr: sp.Expr, var: sp.Symbol, num: sp.Expr, den: sp.Expr):
-        from .expr import compile_arb
-
+    def __init__(self, expr: sp.Expr, var: sp.Symbol, num: sp.Expr, den: sp.Expr,
+                 compile_arb: Callable, enclose: Callable):
+        self.compile_arb, self.enclose = compile_arb, enclose
         self.expr, self.var, self.num, self.den = expr, var, num, den
         self.num_series = compile_arb(num, var, series=True)
         self.den_series = compile_arb(den, var, series=True)
@@ -132,8 +137,7 @@ class Removable:
     def _prove(self, x0: sp.Expr) -> _Point | None:
         if x0 in self._proved:
             return self._proved[x0]
-        from .expr import enclose
-
+        enclose = self.enclose
         point = None
         ball = enclose(x0, 128)
         if ball is not None and abs(ball) < arb(2) ** 1000:
@@ -147,19 +151,39 @@ class Removable:
                     continue
                 d_ball = enclose(dk, 128)
                 if k >= 1 and d_ball is not None and not d_ball.contains(0):
-                    point = _Point(x0, k, float(ball.mid()))
+                    point = _Point(x0, k, float(ball.mid()),
+                                   self.compile_arb(x0, sp.Dummy(), series=False))
                 break
         self._proved[x0] = point
         return point
 
     def _solve(self, domain) -> tuple[list[sp.Expr], bool]:
-        """Real zeros of ``den`` in ``domain``; ``(zeros, complete)``."""
+        """Real zeros of ``den`` in ``domain``; ``(zeros, complete)``. A polynomial
+        ``den``: the real roots of its linear and quadratic factors (a common zero
+        of higher algebraic degree is not looked for)."""
+        if self.den.is_polynomial(self.var):
+            try:
+                _, factors = sp.factor_list(self.den, self.var)
+            except Exception:  # noqa: BLE001
+                return [], True
+            zeros = []
+            for fac, _ in factors:
+                if sp.degree(fac, self.var) <= 2:
+                    zeros += [z for z in sp.roots(fac, self.var, filter="R")
+                              if domain.contains(z) is sp.true]
+            return zeros[:MAX_POINTS], True
         try:
             sol = sp.solveset(self.den, self.var, domain)
         except Exception:  # noqa: BLE001 -- sympy gives up: no point is proved
             return [], False
+        if sol is sp.S.EmptySet:
+            return [], True
         if isinstance(sol, sp.FiniteSet):
-            return [z for z in sol if z.is_real is not False and not z.free_symbols], True
+            # a root sympy cannot write in closed form (CRootOf) or a large radical
+            # is not tried: proving N zero there is out of simplify's reach
+            return [z for z in list(sol)[:MAX_POINTS] if z.is_real is not False
+                    and not z.free_symbols and not z.has(sp.CRootOf)
+                    and sp.count_ops(z) <= MAX_OPS], True
         return [], False
 
     def points(self, lo: float, hi: float) -> tuple[_Point, ...]:
@@ -419,8 +443,8 @@ def _meet(a: arb, b: arb) -> arb:
         return a
 
 
-@functools.lru_cache(maxsize=256)
-def analyse(expr: sp.Expr, var: sp.Symbol) -> Removable | None:
+def analyse(expr: sp.Expr, var: sp.Symbol, compile_arb: Callable,
+            enclose: Callable) -> Removable | None:
     """The removable-singularity evaluators of ``expr``, or None when ``expr``
     has no denominator in ``var`` (or none of its zeros is removable).
 
@@ -430,6 +454,9 @@ def analyse(expr: sp.Expr, var: sp.Symbol) -> Removable | None:
         The function.
     var : sympy.Symbol
         Its variable.
+    compile_arb, enclose : callable
+        The Arb compiler and constant enclosure of :mod:`chebnorm.approx.expr`
+        (passed in: this module is imported by that one).
 
     Returns
     -------
@@ -442,10 +469,10 @@ def analyse(expr: sp.Expr, var: sp.Symbol) -> Removable | None:
         num, den = sp.fraction(sp.together(expr))
     except Exception:  # noqa: BLE001
         return None
-    if not den.has(var):
-        return None
+    if not den.has(var) or not num.has(var):
+        return None  # no denominator, or a constant numerator: every zero of D is a pole
     try:
-        r = Removable(expr, var, num, den)
+        r = Removable(expr, var, num, den, compile_arb, enclose)
         if not r.any_points:
             return None
     except ValueError:  # an operation the Arb compiler does not know
