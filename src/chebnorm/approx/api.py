@@ -497,14 +497,13 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     best = None
     for n in range(first, top + 1):
         if lower[n] > max_error:
-            tried.append(f"{n}: ruled out (best error >= {lower[n]:.3e}, de la Vallee Poussin)")
+            tried.append(f"{n}: ruled out (>= {lower[n]:.2e})")
             continue
         table = fit(expr, interval, n, **{k: v for k, v in kw.items()
                                            if k not in ("segments", "segment_by", "centered")})
         bound = _delivered_bound(table, error)
         ok = bound is not None and bound <= max_error
-        tried.append(f"{n}: certified {bound:.3e}" + (" <= " if ok else " > ")
-                     + f"{max_error:.3e}")
+        tried.append(f"{n}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
         if ok:
             best = table
             break
@@ -520,7 +519,7 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
                          f"accepted: a larger max_error, or piecewise tables (segments)")
     provenance = dict(best.provenance)
     provenance["max_error"] = repr(max_error)
-    provenance["degree_search"] = "; ".join(tried)
+    provenance["degree_search"] = _search_text(tried, "degrees tried")
     with construction("fitted"):  # the same table, its search recorded
         return dataclasses.replace(best, provenance=provenance)
 
@@ -561,23 +560,36 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
             if lower > max_error:
                 break
         if lower > max_error:
-            tried.append(f"{count}: ruled out (best error >= {lower:.3e}, de la Vallee Poussin)")
+            tried.append(f"{count}: ruled out (>= {lower:.2e})")
             continue
         table = fit(expr, interval, degree, segments=2 ** k, segment_by=segment_by, **fields)
         bound = table.abs_error_bound if error == "abs" else table.rel_error_bound
         ok = bound is not None and bound <= max_error
-        tried.append(f"{count}: certified {bound:.3e}" + (" <= " if ok else " > ")
-                     + f"{max_error:.3e}")
+        tried.append(f"{count}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
         if ok:
             provenance = dict(table.provenance)
             provenance["max_error"] = repr(max_error)
-            provenance["segment_search"] = "; ".join(tried)
+            provenance["segment_search"] = _search_text(tried, "segment counts tried")
             with construction("fitted"):  # the same table, its search recorded
                 return dataclasses.replace(table, provenance=provenance)
     raise ValueError(f"no segment count up to 2^12 reaches max_error {max_error:.6g} at "
                      f"degree {degree} for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: "
                      f"{'; '.join(tried[-3:])}); accepted: a larger max_error, a higher "
                      f"degree or more coefficient bits (frac_bits)")
+
+
+def _search_text(tried: list[str], what: str) -> str:
+    """The search's record for provenance (at most 1000 characters: the middle
+    entries are elided when it would be longer). "ruled out (>= L)": a de la
+    Vallee Poussin lower bound L of the best error above E; "certified B": the
+    certified bound B of that fit, compared with E = ``max_error``."""
+    head = f"{what}: "
+    text = head + "; ".join(tried)
+    k = len(tried)
+    while len(text) > 1000 and k > 2:
+        k -= 1
+        text = head + "; ".join(tried[:k // 2] + ["..."] + tried[len(tried) - (k - k // 2):])
+    return text
 
 
 #: the degree search stops when this many certified degrees in a row gain under 1%

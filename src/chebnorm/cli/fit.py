@@ -195,7 +195,7 @@ def _run_piecewise(args) -> int:
     table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
                      segment_by=args.segment_by or "uniform", centered=args.centered)
     if "segment_search" in table.provenance:
-        print(f"segment search (--max-error {float(table.provenance['max_error']):.6e}): "
+        print(f"--max-error {float(table.provenance['max_error']):.6e}, "
               f"{table.provenance['segment_search']}", file=sys.stdout if not args.json
               else sys.stderr)
     if args.output:
@@ -281,7 +281,7 @@ def _report(args, table) -> int:
         print(f"{table.name}: {table.kind} degree {table.degree} fit of {table.expression} "
               f"on [{table.interval[0]}, {table.interval[1]}]")
         if "degree_search" in table.provenance:
-            print(f"degree search (--max-error {float(table.provenance['max_error']):.6e}): "
+            print(f"--max-error {float(table.provenance['max_error']):.6e}, "
                   f"{table.provenance['degree_search']}")
         powers_of = table.variable if table.shift is None else (
             f"t = ({table.variable} - {table.shift[0]!r})/{table.shift[1]!r}")
