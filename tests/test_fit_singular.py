@@ -89,6 +89,8 @@ def test_float_and_mpmath_values_near_the_point(expr):
     with mpmath.workprec(200):
         want = np.array([float(ref(mpmath.mpf(x))) for x in xs])
     assert np.all(np.abs(got - want) <= 4 * np.spacing(np.abs(want)))
+    assert float(f.numpy(0.0)) == float(ref(mpmath.mpf(0)))  # a scalar, as np.float64 too
+    assert f.numpy(np.zeros((2, 1))).shape == (2, 1)
     with mpmath.workprec(113):
         for x in [0.0, 1e-30, -2.0 ** -60, 0.25, -0.375]:
             v = f.mpmath(mpmath.mpf(x))

@@ -366,9 +366,11 @@ class Removable:
     def wrap_numpy(self, plain: Callable, arb_value: Callable) -> Callable:
         def value(x):
             x = np.asarray(x, dtype=float)
+            shape = x.shape
+            flat_x = np.array(x.reshape(-1))
             with np.errstate(all="ignore"):
-                y = np.array(plain(x), dtype=float, copy=True) * np.ones_like(x)
-            flat_x, flat_y = x.reshape(-1), y.reshape(-1)
+                flat_y = np.array(plain(flat_x), dtype=float) * np.ones_like(flat_x)
+            y = flat_y.reshape(shape)  # a view: the corrections below show in it
             fin = flat_x[np.isfinite(flat_x)]
             if fin.size == 0:
                 return y
