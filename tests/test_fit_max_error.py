@@ -66,7 +66,6 @@ def test_exp_smallest_degree_for_2_to_the_minus_24():
     assert float(t.provenance["max_error"]) == E
 
 
-@pytest.mark.slow
 def test_lower_bounds_are_below_every_polynomial_error():
     """The pruning bounds never exceed the error of an actual polynomial of that degree
     (the minimax fit's error, measured in mpmath): a degree they rule out cannot win."""

@@ -194,10 +194,6 @@ def _max_error(text) -> float:
 def _run_piecewise(args) -> int:
     table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
                      segment_by=args.segment_by or "uniform", centered=args.centered)
-    if "segment_search" in table.provenance:
-        print(f"--max-error {float(table.provenance['max_error']):.6e}, "
-              f"{table.provenance['segment_search']}", file=sys.stdout if not args.json
-              else sys.stderr)
     if args.output:
         table.save(args.output)
     if args.json:
@@ -206,6 +202,9 @@ def _run_piecewise(args) -> int:
         print(f"{table.name}: {table.segment_count} {table.segment_by} segments, {table.fit} "
               f"degree {table.degree} of {table.expression} on [{table.interval[0]}, "
               f"{table.interval[1]}], coefficients * 2^-{table.coef_frac_bits}")
+        if "segment_search" in table.provenance:
+            print(f"--max-error {float(table.provenance['max_error']):.6e}, "
+                  f"{table.provenance['segment_search']}")
         print(f"certified max over segments |p_s - f| <= {table.abs_error_bound:.6e}"
               + ("" if table.rel_error_bound is None
                  else f", |p_s/f - 1| <= {table.rel_error_bound:.6e}"))
