@@ -21,7 +21,7 @@ from .schema import BASES, ERROR_KINDS, KINDS, MAX_DEGREE, versions
 from .table import CoefficientTable, FixedPoint, Quantized
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
-           "FitWarning"]
+           "FitWarning", "degree_lower_bounds"]
 
 
 class FitWarning(UserWarning):
@@ -160,6 +160,12 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
             y = np.full(x.shape, np.nan, dtype=complex)
         y = y * np.ones_like(x)
     bad = ~np.isfinite(y) | (np.abs(y.imag) > 1e-12 * np.maximum(1.0, np.abs(y.real)))
+    if bad.any() and fn.removable is not None:
+        # a removable singularity (sin(x)/x at 0): the continuous extension's value
+        with np.errstate(all="ignore"):
+            fixed = np.asarray(fn.numpy(x[bad]), dtype=float)
+        y[bad] = np.where(np.isfinite(fixed), fixed, y[bad])
+        bad[bad] = ~np.isfinite(fixed)
     if bad.any():
         where = x[np.argmax(bad)]
         raise ValueError(f"{fn.expr} is not finite and real on [{iv.lo}, {iv.hi}] "
@@ -194,11 +200,11 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
     return cert_abs, cert_rel
 
 
-def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs", *,
+def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", error: str = "abs", *,
         var: str = "x", name: str | None = None, frac_bits=None,
         command: str | None = None, basis: str = "monomial", coef_format: str | None = None,
         monomials=None, fix_constant: bool = False, segments=None, segment_by: str | None = None,
-        centered: bool = False):
+        centered: bool = False, max_error: float | None = None):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     Every table carries rigorous bounds of both its absolute and its relative
@@ -217,8 +223,9 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     interval : pair
         ``(lo, hi)``: exact constants as text (``"sqrt(2)"``, ``"0.1"`` is
         1/10), sympy numbers, ints, or floats (at their exact binary value).
-    degree : int
-        ``0 <= degree <= MAX_DEGREE``.
+    degree : int, optional
+        ``0 <= degree <= MAX_DEGREE``. Give either ``degree`` or ``max_error``
+        (exactly one of them).
     kind : {"chebyshev", "minimax"}, optional
         Interpolation at the Chebyshev nodes (mpmath), or the Remez exchange.
     error : {"abs", "rel"}, optional
@@ -246,12 +253,25 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     fix_constant : bool, optional
         Hold the constant coefficient at ``f(0)`` rounded to its format.
     segments : int or str, optional
-        ``2**k`` segments: a piecewise table instead
+        ``2**k`` segments, or ``"auto"`` with ``max_error``: a piecewise table instead
         (:func:`~chebnorm.approx.piecewise_fit.piecewise_fit`).
     segment_by : {"uniform", "exponent"}, optional
         How a piecewise table's segments are indexed.
     centered : bool, optional
         Piecewise: each segment's polynomial in ``t - 1/2``.
+    max_error : float, optional
+        Instead of ``degree``: the smallest degree whose certified error --
+        ``|p - f|`` or ``|p/f - 1|`` as ``error``, of the quantized
+        coefficients when a format is given -- is at most ``max_error``
+        (a finite number > 0). Degrees that a de la Vallee Poussin lower
+        bound rules out are not fitted; the others are fitted and certified
+        from the lowest up. ``provenance["degree_search"]`` records every
+        degree tried and why it lost. The search stops (ValueError) when
+        four certified degrees in a row gain under 1% (the
+        rounding floor of float64 coefficients), or at ``MAX_DEGREE``. Not
+        with ``degree``, except with ``segments="auto"``: then the fewest
+        segments (``2**k``) whose piecewise table of ``degree`` is certified
+        to ``max_error`` (``provenance["segment_search"]``).
 
     Returns
     -------
@@ -361,6 +381,12 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
     >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
     (16, True)
     """
+    if max_error is not None or degree is None or segments == "auto":
+        return _fit_max_error(expr, interval, degree, max_error, dict(
+            kind=kind, error=error, var=var, name=name, frac_bits=frac_bits, command=command,
+            basis=basis, coef_format=coef_format, monomials=monomials,
+            fix_constant=fix_constant, segments=segments, segment_by=segment_by,
+            centered=centered))
     name = _table_name(name)
     expr, var = as_expression(expr, var)
     if segments is not None or segment_by is not None or centered:
@@ -411,6 +437,242 @@ def fit(expr, interval, degree: int, kind: str = "chebyshev", error: str = "abs"
         table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
                          monomials=monomials, fix_constant=fix_constant)
     return table
+
+
+def _fit_max_error(expr, interval, degree, max_error, kw):
+    """:func:`fit` with ``max_error``: the smallest degree whose certified error
+    is at most ``max_error`` (see the parameter), the search recorded in
+    ``provenance["degree_search"]``."""
+    import dataclasses
+
+    if degree is None and max_error is None:
+        raise ValueError(f"degree is missing; accepted: an integer 0 <= degree <= "
+                         f"{MAX_DEGREE}, or max_error=E (a finite number > 0) for the "
+                         f"smallest degree whose certified error is at most E")
+    if kw["segments"] == "auto":
+        if degree is None or max_error is None:
+            raise ValueError("segments='auto' needs both the degree and max_error: the "
+                             "fewest segments whose certified error at that degree is at "
+                             "most max_error; accepted: fit(expr, interval, degree, "
+                             "segments='auto', max_error=E)")
+    elif degree is not None and max_error is not None:
+        raise ValueError(f"degree {degree!r} and max_error {max_error!r} are both given; "
+                         f"accepted: one of them (max_error chooses the degree), or both with "
+                         f"segments='auto' (max_error chooses the segment count)")
+    if isinstance(max_error, bool) or not isinstance(max_error, (int, float, np.integer,
+                                                                 np.floating)) \
+            or not math.isfinite(float(max_error)) or not max_error > 0:
+        raise ValueError(f"max_error {max_error!r}: accepted: a finite number > 0, e.g. "
+                         f"1e-6 or 2**-20")
+    if kw["segments"] == "auto":
+        return _fit_segments_auto(expr, interval, degree, float(max_error), kw)
+    if kw["segments"] is not None or kw["segment_by"] is not None or kw["centered"]:
+        raise ValueError("max_error with segments, segment_by or centered: accepted: "
+                         "max_error for one polynomial (give the degree and "
+                         "segments='auto' for a piecewise table)")
+    max_error = float(max_error)
+    error = kw["error"]
+    # the arguments are checked once, by a degree-0 check of fit's own
+    quantized = kw["frac_bits"] is not None or kw["coef_format"] is not None
+    constrained = kw["monomials"] is not None or kw["fix_constant"]
+    _check_fit_args(0, kw["kind"], error, kw["basis"], quantized, constrained)
+    expr_in, var = as_expression(expr, kw["var"])
+    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
+    try:
+        lo, hi = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    iv = Interval(lo, hi)
+    check_interval(fn, iv)
+    lower = degree_lower_bounds(fn, iv, error, MAX_DEGREE)
+    mons = kw["monomials"]
+    top = MAX_DEGREE
+    first = 0
+    if mons is not None:
+        try:
+            first = max(int(k) for k in mons)
+        except (TypeError, ValueError):
+            first = 0
+    tried, bounds = [], []
+    best = None
+    for n in range(first, top + 1):
+        if lower[n] > max_error:
+            tried.append(f"{n}: ruled out (>= {lower[n]:.2e})")
+            continue
+        table = fit(expr, interval, n, **{k: v for k, v in kw.items()
+                                           if k not in ("segments", "segment_by", "centered")})
+        bound = _delivered_bound(table, error)
+        ok = bound is not None and bound <= max_error
+        tried.append(f"{n}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        if ok:
+            best = table
+            break
+        bounds.append(bound)
+        if len(bounds) >= STALL_DEGREES and bounds[-STALL_DEGREES] <= 1.01 * min(
+                bounds[-STALL_DEGREES:]):
+            tried.append(f"stopped: {STALL_DEGREES} degrees in a row gained less than 1% "
+                         f"(the float64 coefficients' rounding floor)")
+            break
+    if best is None:
+        raise ValueError(f"no degree up to {MAX_DEGREE} reaches max_error {max_error:.6g} "
+                         f"for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: {'; '.join(tried[-4:])}); "
+                         f"accepted: a larger max_error, or piecewise tables (segments)")
+    provenance = dict(best.provenance)
+    provenance["max_error"] = repr(max_error)
+    provenance["degree_search"] = _search_text(tried, "degrees tried")
+    with construction("fitted"):  # the same table, its search recorded
+        return dataclasses.replace(best, provenance=provenance)
+
+
+def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
+    """:func:`fit` with ``segments="auto"``: the fewest segments (``2**k``,
+    ``k <= 12``) whose piecewise table of ``degree`` is certified to
+    ``max_error``; counts whose best error per segment a de la Vallee Poussin
+    bound puts above ``max_error`` are not fitted. The search is recorded in
+    ``provenance["segment_search"]``."""
+    import dataclasses
+
+    from .piecewise_table import segment_bounds, segment_count
+
+    error = kw["error"]
+    expr_in, var = as_expression(expr, kw["var"])
+    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
+    try:
+        lo, hi = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    iv = Interval(lo, hi)
+    segment_by = kw["segment_by"] or "uniform"
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) \
+            or not 0 <= degree <= MAX_DEGREE:
+        raise ValueError(f"degree {degree!r}: accepted: an integer 0 <= degree <= {MAX_DEGREE}")
+    tried = []
+    fields = {k: v for k, v in kw.items() if k not in ("segments", "segment_by")}
+    for k in range(0, 13):
+        try:
+            count = segment_count(segment_by, iv.lo, iv.hi, k)
+        except ValueError:
+            break
+        lower = 0.0
+        for s in range(count):
+            a, b = (float(v) for v in segment_bounds(segment_by, iv.lo, iv.hi, k, s))
+            lower = max(lower, _dlvp_bounds(fn, a, b, error, int(degree))[int(degree)])
+            if lower > max_error:
+                break
+        if lower > max_error:
+            tried.append(f"{count}: ruled out (>= {lower:.2e})")
+            continue
+        table = fit(expr, interval, degree, segments=2 ** k, segment_by=segment_by, **fields)
+        bound = table.abs_error_bound if error == "abs" else table.rel_error_bound
+        ok = bound is not None and bound <= max_error
+        tried.append(f"{count}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        if ok:
+            provenance = dict(table.provenance)
+            provenance["max_error"] = repr(max_error)
+            provenance["segment_search"] = _search_text(tried, "segment counts tried")
+            with construction("fitted"):  # the same table, its search recorded
+                return dataclasses.replace(table, provenance=provenance)
+    raise ValueError(f"no segment count up to 2^12 reaches max_error {max_error:.6g} at "
+                     f"degree {degree} for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: "
+                     f"{'; '.join(tried[-3:])}); accepted: a larger max_error, a higher "
+                     f"degree or more coefficient bits (frac_bits)")
+
+
+def _search_text(tried: list[str], what: str) -> str:
+    """The search's record for provenance (at most 1000 characters: the middle
+    entries are elided when it would be longer). "ruled out (>= L)": a de la
+    Vallee Poussin lower bound L of the best error above E; "certified B": the
+    certified bound B of that fit, compared with E = ``max_error``."""
+    head = f"{what}: "
+    text = head + "; ".join(tried)
+    k = len(tried)
+    while len(text) > 1000 and k > 2:
+        k -= 1
+        text = head + "; ".join(tried[:k // 2] + ["..."] + tried[len(tried) - (k - k // 2):])
+    return text
+
+
+#: the degree search stops when this many certified degrees in a row gain under 1%
+STALL_DEGREES = 4
+
+
+def _delivered_bound(table, error: str) -> float | None:
+    """The certified bound of the coefficients ``table`` delivers (quantized
+    when it is), absolute or relative as ``error``."""
+    q = table.quantized
+    if q is not None:
+        return q.abs_error_bound if error == "abs" else q.rel_error_bound
+    fp = getattr(table, "fixed_point", None)
+    if fp is not None:
+        return fp.abs_error_bound if error == "abs" else getattr(fp, "rel_error_bound", None)
+    return table.abs_error_bound if error == "abs" else table.rel_error_bound
+
+
+def degree_lower_bounds(fn: Function1D, iv: Interval, error: str, top: int) -> list[float]:
+    """Cheap lower bounds of the best error at each degree ``0..top`` (0 when
+    none is found): de la Vallee Poussin's theorem on the Chebyshev
+    interpolant of degree ``n``.
+
+    If ``f - p`` (or ``(f - p)/f``) takes alternating signs at ``n + 2``
+    ordered points, every polynomial of degree ``n`` has an error at least
+    the smallest of those ``|f - p|``. ``p`` is the float64 Chebyshev
+    interpolant truncated to degree ``n``, the points the extrema of
+    ``T_{n+1}``; the bound is lowered by ``64`` units of float64's rounding
+    of ``max |f|`` (relative: of 1) so that sampling noise never rules out a
+    degree that could win. A pruning aid of the degree search: a degree it
+    rules out would need an error above the bound.
+
+    Parameters
+    ----------
+    fn : Function1D
+        The function.
+    iv : Interval
+        The interval.
+    error : {"abs", "rel"}
+        The error measured.
+    top : int
+        The highest degree.
+
+    Returns
+    -------
+    list of float
+        ``top + 1`` lower bounds (0.0 where the signs do not alternate).
+    """
+    return _dlvp_bounds(fn, iv.lo_in, iv.hi_in, error, top)
+
+
+def _dlvp_bounds(fn: Function1D, a: float, b: float, error: str, top: int) -> list[float]:
+    """:func:`degree_lower_bounds` on the float interval ``[a, b]``."""
+    m = min(max(2 * top + 8, 64), 256)
+    k = np.arange(m)
+    t_nodes = np.cos(np.pi * (k + 0.5) / m)
+    with np.errstate(all="ignore"):
+        fv = np.asarray(fn.numpy(0.5 * (a + b) + 0.5 * (b - a) * t_nodes), dtype=float)
+    out = [0.0] * (top + 1)
+    if not np.all(np.isfinite(fv)):
+        return out
+    # Chebyshev coefficients of the interpolant of degree m - 1 (discrete cosine transform)
+    coef = np.array([2.0 / m * np.sum(fv * np.cos(np.pi * j * (k + 0.5) / m)) for j in range(m)])
+    coef[0] /= 2
+    scale = float(np.max(np.abs(fv))) or 1.0
+    noise = 64 * 2.0 ** -52 * (scale if error == "abs" else 1.0) * max(1.0, np.sum(np.abs(coef)) / scale)
+    for n in range(top + 1):
+        t = np.cos(np.pi * np.arange(n + 2) / (n + 1))
+        x = 0.5 * (a + b) + 0.5 * (b - a) * t
+        with np.errstate(all="ignore"):
+            f = np.asarray(fn.numpy(x), dtype=float)
+            e = f - np.polynomial.chebyshev.chebval(t, coef[:n + 1])
+            if error == "rel":
+                e = e / f
+        if not np.all(np.isfinite(e)):
+            continue
+        s = np.sign(e)
+        if np.all(s[1:] == -s[:-1]) and np.all(s != 0):
+            out[n] = max(0.0, float(np.min(np.abs(e))) - noise)
+    # the best error does not grow with the degree: E_n >= E_{n+1} >= its bound
+    for n in range(top - 1, -1, -1):
+        out[n] = max(out[n], out[n + 1])
+    return out
 
 
 def as_expression(expr, var="x"):

@@ -730,15 +730,32 @@ class Function1D:
     var: sp.Symbol
 
     @functools.cached_property
+    def removable(self):
+        """The removable singularities of ``f`` (:mod:`.removable`), or None.
+
+        Where ``f = N/D`` is 0/0 at a point but has a proved finite limit
+        (``sin(x)/x`` at 0), every evaluator returns that continuous
+        extension, rigorously in Arb (see :mod:`chebnorm.approx.removable`).
+        """
+        from .removable import analyse
+
+        return analyse(self.expr, self.var, compile_arb, enclose)
+
+    @functools.cached_property
     def numpy(self) -> Callable[[np.ndarray], np.ndarray]:
         f = sp.lambdify(self.var, self.expr, [{"_clib": clib}, "scipy", "numpy"],
                         printer=_CLibraryPrinter)
+        if self.removable is not None:
+            g = self.removable.wrap_numpy(f, self.arb)
+            return lambda x: g(x) * np.ones_like(x, dtype=float)
         return lambda x: np.asarray(f(np.asarray(x, dtype=float)), dtype=float) * np.ones_like(x, dtype=float)
 
     @functools.cached_property
     def mpmath(self) -> Callable:
         f = sp.lambdify(self.var, self.expr, "mpmath")
         expr, var = self.expr, self.var
+        if self.removable is not None:
+            f = self.removable.wrap_mpmath(f, self.arb)
 
         def value(x):
             try:
@@ -751,11 +768,13 @@ class Function1D:
 
     @functools.cached_property
     def arb(self) -> Callable[[arb], arb]:
-        return compile_arb(self.expr, self.var, series=False)
+        f = compile_arb(self.expr, self.var, series=False)
+        return f if self.removable is None else self.removable.wrap_arb(f)
 
     @functools.cached_property
     def arb_series(self) -> Callable[[arb_series], arb_series]:
-        return compile_arb(self.expr, self.var, series=True)
+        f = compile_arb(self.expr, self.var, series=True)
+        return f if self.removable is None else self.removable.wrap_arb(f)
 
     def __str__(self) -> str:
         return str(self.expr)

@@ -30,7 +30,12 @@ def register(sub) -> None:
     p.add_argument("--var", default="x", help="the variable of EXPR (default x)")
     p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
                    help='exact endpoints, e.g. "sqrt(2)" 2 or 0.1 0.3 (decimals are exact)')
-    p.add_argument("--degree", type=int, required=True, help=f"0..{MAX_DEGREE}")
+    p.add_argument("--degree", type=int, default=None,
+                   help=f"0..{MAX_DEGREE} (or --max-error)")
+    p.add_argument("--max-error", default=None, metavar="E",
+                   help="instead of --degree: the smallest degree whose certified error "
+                   "(|p - f|, or |p/f - 1| with --error rel; of the quantized coefficients "
+                   "with a format) is <= E, e.g. 1e-6 or 2^-20; the degrees tried are printed")
     p.add_argument("--kind", default="chebyshev", help="chebyshev (default) or minimax")
     p.add_argument("--error", default="abs", help="error minimized by minimax: abs (default) or rel")
     p.add_argument("--coef-frac-bits", dest="frac_bits", type=_int_list, default=None,
@@ -49,7 +54,8 @@ def register(sub) -> None:
     p.add_argument("--segments", default=None, metavar="2^k",
                    help="piecewise table of 2^k segments, 0 <= k <= 12 (per binade with "
                    "--segment-by exponent); coefficients in one fixed-point format "
-                   "(--coef-frac-bits, default 24)")
+                   "(--coef-frac-bits, default 24); auto with --degree and --max-error: "
+                   "the fewest segments certified to E")
     p.add_argument("--segment-by", default=None, choices=("uniform", "exponent"),
                    help="uniform (default: top k bits of the input) or exponent (a float's "
                    "exponent and top mantissa bits; interval [2^e0, 2^e1])")
@@ -160,10 +166,29 @@ def _fit_cli(args, **kw):
     # its refusals name fit's arguments: chebnorm.cli.main says them as flags (cli_words)
     from chebnorm.approx import fit
 
+    max_error = getattr(args, "max_error", None)
+    if max_error is not None:
+        kw["max_error"] = _max_error(max_error)
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
                error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
                coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
+
+
+def _max_error(text) -> float:
+    """``--max-error`` as a float: a number or an exact expression such as ``2^-20``."""
+    import math
+
+    from chebnorm.approx import parse_number
+
+    try:
+        value = float(parse_number(str(text).replace("^", "**")))
+    except (ValueError, TypeError, OverflowError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. 1e-6 or "
+                         f"2^-20")
+    return value
 
 
 def _run_piecewise(args) -> int:
@@ -177,6 +202,9 @@ def _run_piecewise(args) -> int:
         print(f"{table.name}: {table.segment_count} {table.segment_by} segments, {table.fit} "
               f"degree {table.degree} of {table.expression} on [{table.interval[0]}, "
               f"{table.interval[1]}], coefficients * 2^-{table.coef_frac_bits}")
+        if "segment_search" in table.provenance:
+            print(f"--max-error {float(table.provenance['max_error']):.6e}, "
+                  f"{table.provenance['segment_search']}")
         print(f"certified max over segments |p_s - f| <= {table.abs_error_bound:.6e}"
               + ("" if table.rel_error_bound is None
                  else f", |p_s/f - 1| <= {table.rel_error_bound:.6e}"))
@@ -211,6 +239,23 @@ def run(args) -> int:
     from chebnorm.core.textsafe import identifier
 
     identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
+    if args.degree is None and args.max_error is None:
+        raise ValueError(f"the following arguments are required: --degree N (0..{MAX_DEGREE}), "
+                         f"or --max-error E instead (the smallest degree whose certified error "
+                         f"is <= E)")
+    auto = args.segments == "auto"
+    if auto and (args.degree is None or args.max_error is None):
+        raise ValueError("--segments auto needs --degree N and --max-error E: the fewest "
+                         "segments whose certified error at that degree is <= E")
+    if args.degree is not None and args.max_error is not None and not auto:
+        raise ValueError(f"--degree and --max-error are both given; accepted: one of --degree "
+                         f"N (0..{MAX_DEGREE}) or --max-error E (the smallest degree whose "
+                         f"certified error is <= E), or both with --segments auto")
+    if args.max_error is not None and not auto and (
+            args.segments is not None or args.segment_by is not None or args.centered):
+        raise ValueError("--max-error with --segments, --segment-by or --centered: accepted: "
+                         "--max-error for one polynomial, or --segments auto --degree N "
+                         "--max-error E for the fewest segments")
     if args.segments is not None or args.segment_by is not None or args.centered:
         return _run_piecewise(args)
     mon = args.monomials
@@ -237,6 +282,9 @@ def _report(args, table) -> int:
     elif not args.output:
         print(f"{table.name}: {table.kind} degree {table.degree} fit of {table.expression} "
               f"on [{table.interval[0]}, {table.interval[1]}]")
+        if "degree_search" in table.provenance:
+            print(f"--max-error {float(table.provenance['max_error']):.6e}, "
+                  f"{table.provenance['degree_search']}")
         powers_of = table.variable if table.shift is None else (
             f"t = ({table.variable} - {table.shift[0]!r})/{table.shift[1]!r}")
         print("coefficients (ascending powers of {}): {}".format(
