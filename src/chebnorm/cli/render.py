@@ -159,7 +159,7 @@ def run(args) -> int:
     """
     import numpy as np
 
-    from chebnorm.core.files import write_all
+    from chebnorm.core.files import check_writable, write_all
     from chebnorm.raster import Lighting, compare, error_map_rgb, get_mesh, render
     from chebnorm.raster.metrics import image_bytes, image_format
 
@@ -172,6 +172,7 @@ def run(args) -> int:
                 image_format(path)
             except ValueError as exc:
                 raise ValueError(f"{option}: {exc}") from None
+    check_writable(p for p in (args.out, args.error_map) if p)  # before the renders, not after
     lighting = Lighting(shininess=args.shininess, half_vector=args.half_vector)
     mesh = get_mesh(args.mesh, args.tess, _crease_radians(args.crease_angle))
     common = dict(size=tuple(args.size), lighting=lighting, engine=args.engine,

@@ -36,7 +36,8 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["write_atomic", "write_all", "write_folder", "make_folder", "WriteError"]
+__all__ = ["write_atomic", "write_all", "write_folder", "make_folder", "check_writable",
+           "WriteError"]
 
 
 class WriteError(OSError, ValueError):
@@ -239,6 +240,36 @@ def write_all(items) -> None:
     finally:
         for tmp, _, _ in staged:
             _unlink_quietly(tmp)
+
+
+def check_writable(paths) -> None:
+    """Refuse, before any work, the destinations :func:`write_all` would refuse:
+    the same checks, and for a file to be replaced atomically a temporary file
+    created and removed in its folder (``/proc`` and read-only folders say no
+    only then). Nothing is written.
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        The destinations a command will write once its work is done.
+
+    Raises
+    ------
+    WriteError
+        Naming the first destination that cannot be written and why, as
+        :func:`write_all` would after the work.
+
+    Examples
+    --------
+    >>> check_writable(["/proc/x.png"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    chebnorm.core.files.WriteError: cannot write '/proc/x.png': cannot create a file in folder '/proc' ...
+    """
+    for path in paths:
+        how, given, target = _plan(path)
+        if how == "atomic":
+            _unlink_quietly(_stage(given, target, b""))
 
 
 def write_atomic(path, data: str | bytes) -> None:
