@@ -202,7 +202,7 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
 
 def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", error: str = "abs", *,
         var: str = "x", name: str | None = None, frac_bits=None,
-        command: str | None = None, basis: str = "monomial", coef_format: str | None = None,
+        command: str | None = None, basis: str = "auto", coef_format: str | None = None,
         monomials=None, fix_constant: bool = False, segments=None, segment_by: str | None = None,
         centered: bool = False, max_error: float | None = None):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
@@ -241,11 +241,16 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         piecewise table, the one fixed-point format (default 24).
     command : str, optional
         The command recorded in ``provenance["command"]``.
-    basis : {"monomial", "shifted"}, optional
+    basis : {"auto", "monomial", "shifted"}, optional
         ``"shifted"`` stores the polynomial in ``t = (x - c)/s`` (``c`` the
         midpoint, ``s`` a power of two at least the half-width; recorded in
         ``table.shift``), well conditioned on narrow or offset intervals where
-        plain powers of ``x`` lose accuracy.
+        plain powers of ``x`` lose accuracy. ``"auto"`` (the default) keeps
+        plain powers unless their binary32 Horner evaluation would lose what
+        the fit gained and the shifted basis does better
+        (:mod:`chebnorm.approx.basis_choice`; the choice and its reason in
+        ``table.basis_choice``); quantized, constrained and piecewise fits
+        are in plain powers.
     coef_format : {"fixed", "binary16", "bfloat16", "binary32", "binary64"}, optional
         Also quantize the coefficients to this format (:func:`quantize`).
     monomials : sequence of int, optional
@@ -291,7 +296,9 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     -----
     FitWarning
         The Remez exchange did not converge, a minimax fit lost to a simpler
-        polynomial, or a bound missed its tightness (the bounds still hold).
+        polynomial, a bound missed its tightness (the bounds still hold), or
+        (``basis="auto"``) the float32 evaluator's estimated error exceeds 4x
+        (fit + float32 rounding floor) in every basis.
 
     See Also
     --------
@@ -370,7 +377,7 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
 
     The shifted basis where monomials lose accuracy:
 
-    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax")
+    >>> m = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="monomial")
     >>> s = fit("sin(x)", ("100", "101"), 12, kind="minimax", basis="shifted")
     >>> s.shift, s.abs_error_bound < 1e-16, m.abs_error_bound > 1e-3
     ((100.5, 0.5), True, True)
@@ -409,10 +416,14 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         raise ValueError(f"relative error is undefined: {fn.expr} vanishes on [{iv.lo}, {iv.hi}]; "
                          f"accepted for error='rel': an interval where the function has no zero")
 
+    mons, fixc = monomials if constrained and not quantized else None, fix_constant and not quantized
+    fitted, choice = None, None
+    if basis == "auto":
+        basis, fitted, choice = _auto_basis(fn, iv, degree, kind, error, mons, fixc,
+                                            quantized or constrained)
     shift = shift_for(iv.lo_f, iv.hi_f) if basis == "shifted" else None
-    coeffs, notes, extra, cert_abs, cert_rel = _real_fit(
-        fn, iv, degree, kind, error, shift, monomials if constrained and not quantized else None,
-        fix_constant and not quantized)
+    coeffs, notes, extra, cert_abs, cert_rel = _real_fit(fn, iv, degree, kind, error, shift, mons,
+                                                         fixc, fitted)
     _warn(notes)
     provenance = dict(versions())
     provenance.update(extra)
@@ -432,7 +443,7 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
             max_abs_error=cert_abs.maximum, max_abs_at=cert_abs.at,
             max_rel_error=None if cert_rel is None else cert_rel.maximum,
             max_rel_at=None if cert_rel is None else cert_rel.at,
-            provenance=provenance, shift=shift)
+            provenance=provenance, shift=shift, basis_choice=choice)
     if quantized:
         table = quantize(table, frac_bits, coef_format=coef_format or "fixed",
                          monomials=monomials, fix_constant=fix_constant)
@@ -723,17 +734,49 @@ def as_expression(expr, var="x"):
     return expr, var
 
 
-def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant):
-    """The real coefficients of :func:`fit` (constrained to ``monomials`` /
-    ``fix_constant`` when given), their notes, provenance entries and
-    certificates."""
-    constrained = monomials is not None or fix_constant
-    if constrained:
+def _fit_real(fn, iv, degree, kind, error, shift, monomials, fix_constant):
+    """``(coefficients, notes, provenance entries)`` of the real fit of
+    :func:`fit` (constrained to ``monomials`` / ``fix_constant`` when given)."""
+    if monomials is not None or fix_constant:
         mons = _monomials(monomials, degree, fix_constant)
         fixed = _fixed_constant(fn, "binary64", None) if fix_constant else {}
-        coeffs, notes, extra = _constrained_fit(fn, iv, degree, mons, fixed, error, report=True)
-    else:
-        coeffs, notes, extra = _fit_coefficients(fn, iv, degree, kind, error, shift)
+        return _constrained_fit(fn, iv, degree, mons, fixed, error, report=True)
+    return _fit_coefficients(fn, iv, degree, kind, error, shift)
+
+
+def _auto_basis(fn, iv, degree, kind, error, monomials, fix_constant, forced: bool):
+    """``(basis, fitted, BasisChoice)`` of ``basis="auto"``: ``fitted`` the
+    :func:`_fit_real` result in the chosen basis. The shifted basis is offered
+    to a plain fit of degree >= 2 whose shift has a nonzero centre (a centre
+    0 only scales by a power of two); its warning joins the fit's notes."""
+    from .basis_choice import choose
+
+    shift = shift_for(iv.lo_f, iv.hi_f)
+    offer = not forced and degree >= 2 and shift[0] != 0
+    fits = {}
+
+    def candidates(basis):
+        if basis == "shifted" and not offer:
+            return None
+        s = shift if basis == "shifted" else None
+        fits[basis] = _fit_real(fn, iv, degree, kind, error, s, monomials, fix_constant)
+        return fits[basis][0], s
+
+    choice, note = choose(fn.numpy, iv.lo_f, iv.hi_f, candidates)
+    coeffs, notes, extra = fits[choice.basis]
+    if note and not forced:
+        notes = [*notes, note]
+    return choice.basis, (coeffs, notes, extra), choice
+
+
+def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant, fitted=None):
+    """The real coefficients of :func:`fit` (``fitted``: :func:`_fit_real`'s
+    result, when already computed), their notes, provenance entries and
+    certificates."""
+    constrained = monomials is not None or fix_constant
+    coeffs, notes, extra = fitted or _fit_real(fn, iv, degree, kind, error, shift, monomials,
+                                               fix_constant)
+    notes = list(notes)
     cert_abs, cert_rel = _certify_both(fn, coeffs, iv, error == "rel", shift)
     if kind == "minimax" or constrained:
         # a fit in fewer powers may lose to a lower-degree one: only the zero polynomial
@@ -755,9 +798,9 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
         raise ValueError(f"kind {kind!r} is unknown; accepted: {', '.join(KINDS)}")
     if error not in ERROR_KINDS:
         raise ValueError(f"error kind {error!r} is unknown; accepted: {', '.join(ERROR_KINDS)}")
-    if basis not in BASES:
-        raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(BASES)}")
-    if basis != "monomial" and (quantized or constrained):
+    if basis not in ("auto", *BASES):
+        raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(('auto', *BASES))}")
+    if basis == "shifted" and (quantized or constrained):
         raise ValueError("quantized coefficients (frac_bits, coef_format, monomials, "
                          "fix_constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
@@ -773,7 +816,7 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
     """:func:`fit` with ``segments``/``segment_by``/``centered``: a piecewise table."""
     from .piecewise_fit import piecewise_fit
 
-    if basis != "monomial":
+    if basis not in ("auto", "monomial"):
         raise ValueError(f"basis {basis} applies to one polynomial; accepted with segments, "
                          f"segment_by or centered: basis monomial (centered evaluates each "
                          f"segment about its middle)")

@@ -33,6 +33,7 @@ import numpy as np
 
 from chebnorm.core.display import summary_html, summary_repr
 
+from .basis_choice import BasisChoice, read_basis_choice
 from .contract import Table
 from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
                      MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
@@ -227,6 +228,9 @@ class CoefficientTable(Table):
         ``(c, s)`` of the shifted basis, or None for monomials in ``x``.
     quantized : Quantized or None
         Coefficients in a chosen format (fixed point per power or floating), re-certified.
+    basis_choice : BasisChoice or None
+        How ``fit(..., basis="auto")`` chose the basis, and why
+        (:mod:`chebnorm.approx.basis_choice`); None for an explicit basis.
 
     Examples
     --------
@@ -263,6 +267,8 @@ class CoefficientTable(Table):
     #: None (the default, absent from the JSON): plain monomials in ``x``
     shift: tuple[float, float] | None = None
     quantized: Quantized | None = None
+    #: how ``basis="auto"`` chose the basis (None, absent from the JSON: an explicit basis)
+    basis_choice: BasisChoice | None = None
 
     WHAT = "coefficient table"
     MAX_BYTES = MAX_TABLE_BYTES
@@ -522,6 +528,8 @@ class CoefficientTable(Table):
             del d["shift"]  # plain monomials: the JSON of schema 1 as it always was
         else:
             d["shift"] = list(self.shift)
+        if self.basis_choice is None:
+            del d["basis_choice"]  # an explicit basis: the JSON as it always was
         if self.fixed_point is not None:
             d["fixed_point"]["integers"] = list(self.fixed_point.integers)
         if self.quantized is not None:
@@ -694,7 +702,8 @@ class CoefficientTable(Table):
 
 # -- reading: every field checked, each refusal naming its field ---------------
 
-_OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None, "quantized": None}
+_OPTIONAL = {"fixed_point": None, "provenance": {}, "shift": None, "quantized": None,
+             "basis_choice": None}
 
 
 def _claims(d, prefix: str = "") -> dict[str, float | None]:
@@ -893,7 +902,11 @@ def _read_fields(cls, d) -> dict[str, Any]:
         max_rel_error=max_rel, max_rel_at=max_rel_at,
         fixed_point=_read_fixed(d["fixed_point"], degree),
         provenance=prov, schema_version=SCHEMA_VERSION, shift=shift,
-        quantized=_read_quantized(d["quantized"], degree))
+        quantized=_read_quantized(d["quantized"], degree),
+        basis_choice=read_basis_choice(d["basis_choice"], "monomial" if shift is None else "shifted",
+                                       coefficients, shift,
+                                       tuple(number(v, f"interval_float[{i}]")
+                                             for i, v in enumerate(interval_float))))
 
 
 # -- verifying: every stated bound re-proved for exactly the stored numbers -----

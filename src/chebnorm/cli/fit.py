@@ -61,10 +61,13 @@ def register(sub) -> None:
                    "exponent and top mantissa bits; interval [2^e0, 2^e1])")
     p.add_argument("--centered", action="store_true",
                    help="piecewise: evaluate each segment in t - 1/2 (smaller coefficients)")
-    p.add_argument("--basis", default="monomial", choices=("monomial", "shifted"),
-                   help="monomial (default): powers of VAR; shifted: powers of t = (VAR - c)/s, "
-                   "c the midpoint, s a power of two (well conditioned on narrow or offset "
-                   "intervals, where monomials lose accuracy; exported to C, not to hw/shaders)")
+    p.add_argument("--basis", default="auto", choices=("auto", "monomial", "shifted"),
+                   help="auto (default): monomial unless its float32 Horner evaluation would "
+                   "lose what the fit gained and shifted does better (the choice and why in "
+                   "the table's basis_choice); monomial: powers of VAR; shifted: powers of "
+                   "t = (VAR - c)/s, c the midpoint, s a power of two (well conditioned on "
+                   "narrow or offset intervals, where monomials lose accuracy; exported to C, "
+                   "not to hw/shaders)")
     p.add_argument("--name", default="table", help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
                    "most 63 characters (it names the C function, shader and HDL module)")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
@@ -287,6 +290,9 @@ def _report(args, table) -> int:
                   f"{table.provenance['degree_search']}")
         powers_of = table.variable if table.shift is None else (
             f"t = ({table.variable} - {table.shift[0]!r})/{table.shift[1]!r}")
+        if table.basis_choice is not None and table.shift is not None:
+            print(f"basis: shifted, chosen by --basis auto "
+                  f"({table.basis_choice.reason.split('. ')[0]})")
         print("coefficients (ascending powers of {}): {}".format(
             powers_of, ", ".join(f"{c:.17g}" for c in table.coefficients)))
         print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
