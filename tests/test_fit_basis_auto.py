@@ -12,6 +12,7 @@ import json
 import math
 import shutil
 import subprocess
+import sys
 import warnings
 from fractions import Fraction
 
@@ -161,7 +162,8 @@ def test_rounding_estimate_bounds_simulated_float32_horner(basis):
 
 
 def test_half_ulp_is_binary32_half_ulp():
-    xs = np.array([1.0, 1.5, 2.0 - 2.0 ** -23, 2.0, 3.0, 0.1, 1e-30, 100.0])
+    xs = np.array([1.0, 1.5, 2.0 - 2.0 ** -23, 2.0, 3.0, 0.1, 1e-30, 100.0, 2.0 ** -126, 1e-40,
+                   2.0 ** -149])
     for v, h in zip(xs, half_ulp(xs)):
         f = np.float32(v)
         ulp = float(np.nextafter(f, np.float32(np.inf))) - float(f)
@@ -278,3 +280,13 @@ def test_bad_basis_names_the_accepted_values():
         fit("exp(x)", (0, 1), 3, basis="shifted", coef_format="binary32")
     pw = fit("exp(x)", (0, 1), 2, segments=2)   # the default with segments: powers of t
     assert pw.segment_count == 2
+
+
+def test_float32_overflow_is_said_and_round_trips():
+    """exp on [90, 91] exceeds binary32 (3.4e38) in every basis: no float32
+    evaluator, said once; the C header indeed has none."""
+    with pytest.warns(FitWarning, match="no float32 evaluator"):
+        t = fit("exp(x)", (90, 91), 3)
+    assert all(v["rounding"] == sys.float_info.max for v in t.basis_choice.estimates.values())
+    assert CoefficientTable.from_json(t.to_json()) == t
+    assert "_F_EVAL_ERROR_BOUND" not in c_header(t)

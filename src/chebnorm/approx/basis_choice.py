@@ -46,13 +46,20 @@ True
 
 from __future__ import annotations
 
+import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = ["BasisChoice", "half_ulp", "rounding_estimate", "sample_points", "choose", "read_basis_choice",
-           "REACH", "WARN"]
+           "REACH", "WARN", "OVERFLOW"]
 
+#: the estimate of an evaluator that overflows binary32 (the largest double: JSON
+#: holds no infinity)
+OVERFLOW = sys.float_info.max
+#: the largest finite binary32
+FLOAT32_MAX = float(np.finfo(np.float32).max)
 #: a basis reaches the floor when its estimate is within this factor of (fit + floor)
 REACH = 2.0
 #: a FitWarning when the chosen basis's estimate exceeds this factor of (fit + floor)
@@ -129,7 +136,8 @@ def sample_points(lo: float, hi: float, n: int = SAMPLES) -> np.ndarray:
 
 def half_ulp(v) -> np.ndarray:
     """Half an ulp of binary32 at ``|v|`` (the largest error of rounding ``v``
-    to nearest; normal range): ``2^(e - 24)`` for ``2^e <= |v| < 2^(e + 1)``.
+    to nearest): ``2^(e - 24)`` for ``2^e <= |v| < 2^(e + 1)``, and ``2^-150``
+    below the normal range (``e < -126``).
 
     Parameters
     ----------
@@ -147,7 +155,8 @@ def half_ulp(v) -> np.ndarray:
     True
     """
     v = np.abs(np.asarray(v, dtype=np.float64))
-    return np.where(v == 0, 0.0, np.ldexp(1.0, np.frexp(v)[1] - 25))
+    # subnormals: the spacing 2^-149 throughout
+    return np.where(v == 0, 0.0, np.ldexp(1.0, np.maximum(np.frexp(v)[1] - 25, -150)))
 
 
 def _variable(x: np.ndarray, shift):
@@ -180,7 +189,8 @@ def rounding_estimate(coeffs, x, shift=None) -> float:
     -------
     float
         ``max`` over the points of ``e_0`` (module docstring): the estimated
-        largest ``|evaluator - p|``.
+        largest ``|evaluator - p|``; :data:`OVERFLOW` when a coefficient or
+        a partial value is beyond binary32's range (no float32 evaluator).
 
     Examples
     --------
@@ -189,18 +199,24 @@ def rounding_estimate(coeffs, x, shift=None) -> float:
     0.0
     """
     c = np.asarray(coeffs, dtype=np.float64)
-    held = c.astype(np.float32).astype(np.float64)
-    dc = np.abs(c - held)
-    t, et = _variable(np.asarray(x, dtype=np.float64), shift)
-    at = np.abs(t)
-    a = np.full_like(t, held[-1])
-    e = np.full_like(t, dc[-1])
-    for k in range(len(c) - 2, -1, -1):
-        prod = a * t
-        new = prod + held[k]
-        e = e * (at + et) + np.abs(a) * et + half_ulp(prod) + half_ulp(new) + dc[k]
-        a = new
-    return float(np.max(e))
+    with np.errstate(all="ignore"):
+        held = c.astype(np.float32).astype(np.float64)
+        dc = np.abs(c - held)
+        t, et = _variable(np.asarray(x, dtype=np.float64), shift)
+        at = np.abs(t)
+        a = np.full_like(t, held[-1])
+        e = np.full_like(t, dc[-1])
+        big = np.abs(a)
+        for k in range(len(c) - 2, -1, -1):
+            prod = a * t
+            new = prod + held[k]
+            e = e * (at + et) + np.abs(a) * et + half_ulp(prod) + half_ulp(new) + dc[k]
+            a = new
+            big = np.maximum(big, np.maximum(np.abs(prod), np.abs(new)))
+        worst = float(np.max(e))
+    if not (math.isfinite(worst) and float(np.max(big)) <= FLOAT32_MAX):
+        return OVERFLOW
+    return worst
 
 
 def _horner64(coeffs, x, shift):
@@ -225,6 +241,8 @@ def _rule(estimates: dict, floor: float) -> tuple[str, str]:
         return _reaches(estimates[b], floor)
 
     def say(b):
+        if estimates[b]["rounding"] == OVERFLOW:
+            return f"{b}: overflows binary32"
         return (f"{b}: float32 estimate {total(b):.3g} (fit {estimates[b]['fit']:.3g} + "
                 f"rounding {estimates[b]['rounding']:.3g})")
 
@@ -301,7 +319,11 @@ def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
     basis, reason = _rule(estimates, floor)
     chosen = estimates[basis]
     note = ""
-    if chosen["fit"] + chosen["rounding"] > WARN * (chosen["fit"] + floor):
+    if chosen["rounding"] == OVERFLOW:
+        note = (f"no float32 evaluator: a coefficient or a Horner value is beyond binary32's "
+                f"range in every basis tried ({reason}); accepted: a double evaluator, or an "
+                f"interval where f and its polynomial stay within binary32")
+    elif chosen["fit"] + chosen["rounding"] > WARN * (chosen["fit"] + floor):
         note = (f"the float32 evaluator's estimated error {chosen['fit'] + chosen['rounding']:.3g} "
                 f"exceeds {WARN:g}x (fit {chosen['fit']:.3g} + float32 floor {floor:.3g}) in "
                 f"every basis tried ({reason}); accepted: a double evaluator, a lower "
