@@ -19,7 +19,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from chebnorm.approx import CoefficientTable, FitWarning, fit
+from chebnorm.approx import CoefficientTable, FitWarning, fit, quantize
 from chebnorm.approx.basis_choice import half_ulp, rounding_estimate, sample_points
 from chebnorm.export.c import c_header
 from chebnorm.export.evalbound import BINARY32, horner_bound
@@ -290,3 +290,20 @@ def test_float32_overflow_is_said_and_round_trips():
     assert all(v["rounding"] == sys.float_info.max for v in t.basis_choice.estimates.values())
     assert CoefficientTable.from_json(t.to_json()) == t
     assert "_F_EVAL_ERROR_BOUND" not in c_header(t)
+
+
+def test_quantize_refits_an_auto_shifted_table_in_powers_of_x():
+    """quantize(fit(...)) keeps working where auto chose the shifted basis: the
+    same answer as fitting in powers of x and quantizing, the choice recorded
+    as forced; an explicitly shifted table is still refused."""
+    auto = fit("log(x)", (1, 2), 8, kind="minimax")
+    assert auto.basis == "shifted"
+    q = quantize(auto, coef_format="binary32")
+    ref = quantize(fit("log(x)", (1, 2), 8, kind="minimax", basis="monomial"),
+                   coef_format="binary32")
+    assert q.shift is None and q.coefficients == ref.coefficients
+    assert q.quantized == ref.quantized
+    assert q.basis_choice.basis == "monomial" and q.basis_choice.reason.startswith("quantized")
+    assert CoefficientTable.from_json(q.to_json()) == q
+    with pytest.raises(ValueError, match="shifted variable"):
+        quantize(fit("log(x)", (1, 2), 8, kind="minimax", basis="shifted"), coef_format="binary32")

@@ -786,6 +786,28 @@ def _real_fit(fn, iv, degree, kind, error, shift, monomials, fix_constant, fitte
     return coeffs, notes, extra, cert_abs, cert_rel
 
 
+def _in_powers_of_x(table: CoefficientTable) -> CoefficientTable:
+    """A table whose shifted basis ``basis="auto"`` chose, refitted in powers of
+    ``x`` (what quantization rounds), its choice recorded as forced; any other
+    table as it is (an explicitly shifted one is refused by the caller)."""
+    if table.shift is None or table.basis_choice is None:
+        return table
+    import dataclasses
+
+    from .basis_choice import BasisChoice, choose
+
+    mono = fit(table.expression, table.interval, table.degree, kind=table.kind,
+               error=table.error_kind, var=table.variable, name=table.name, basis="monomial",
+               command=table.provenance.get("command"))
+    fn = parse_function(table.expression, table.variable)
+    only, _ = choose(fn.numpy, *mono.interval_float,
+                     lambda b: (mono.coefficients, None) if b == "monomial" else None)
+    choice = BasisChoice("monomial", f"quantized: coefficients in powers of x; {only.reason}",
+                         only.floor, only.estimates)
+    with construction("fitted"):
+        return dataclasses.replace(mono, basis_choice=choice)
+
+
 def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
                     constrained: bool = False) -> int:
     """``degree`` as an int, after checking :func:`fit`'s arguments."""
@@ -1076,7 +1098,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     Parameters
     ----------
     table : CoefficientTable
-        A table in the monomial basis (from :func:`fit` or ``load``).
+        A table in the monomial basis (from :func:`fit` or ``load``); one
+        whose shifted basis ``basis="auto"`` chose is first refitted in
+        powers of ``x``.
     frac_bits : int or sequence of int, optional
         Fixed point (``coef_format="fixed"``, required there): coefficient
         ``k`` stored with ``frac_bits`` fractional bits (one integer, or one
@@ -1105,7 +1129,8 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     Raises
     ------
     ValueError
-        For a table that is not a CoefficientTable or is in the shifted basis,
+        For a table that is not a CoefficientTable or was fitted with
+        ``basis="shifted"``,
         a format or ``frac_bits`` out of range (naming the largest accepted
         ``frac_bits``), or when no rounding could be certified.
 
@@ -1169,6 +1194,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         raise ValueError(f"word_bits {word_bits!r} is not accepted; accepted: an integer "
                          f"2 <= word_bits <= 53 (the coefficients stay exact doubles)")
     table.verify()  # a table changed behind the frozen dataclass's back is re-proved
+    table = _in_powers_of_x(table)
     table.require_monomial("quantize")
 
     from .rounding import FORMATS, Problem, greedy as greedy_integers, round_coefficients

@@ -125,8 +125,9 @@ def sample_points(lo: float, hi: float, n: int = SAMPLES) -> np.ndarray:
 
     Examples
     --------
-    >>> sample_points(0.0, 1.0, 3).tolist()
-    [0.0, 0.5, 1.0]
+    >>> x = sample_points(0.0, 2.0, 5)
+    >>> float(x[0]), float(x[-1]), bool(abs(x[2] - 1.0) < 1e-15), bool(x[1] < 0.3)
+    (0.0, 2.0, True, True)
     """
     k = np.arange(n)
     x = (lo + hi) / 2 - (hi - lo) / 2 * np.cos(np.pi * k / (n - 1))
