@@ -56,7 +56,8 @@ def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = Non
     Returns
     -------
     CoefficientTable
-        The certified table, named ``<name>_d<degree>``.
+        The certified table, named ``<name>_d<degree>``, in powers of the
+        target's variable (``basis="monomial"``: the papers' polynomials).
 
     Raises
     ------
