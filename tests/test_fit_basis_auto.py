@@ -307,3 +307,30 @@ def test_quantize_refits_an_auto_shifted_table_in_powers_of_x():
     assert CoefficientTable.from_json(q.to_json()) == q
     with pytest.raises(ValueError, match="shifted variable"):
         quantize(fit("log(x)", (1, 2), 8, kind="minimax", basis="shifted"), coef_format="binary32")
+
+
+CASES = [("1/sqrt(x)", (1, 4), 11), ("log(x)", (1, 2), 8), ("log(x)", (1, 4), 11),
+         ("sqrt(x)", (1, 4), 9), ("exp(x)", (0, 1), 5), ("exp(x)", (0, 1), 8),
+         ("atan(x)", (0, 1), 15), ("1/sqrt(2+x)", ("sqrt(2)", 2), 4),
+         ("sin(x)", ("100", "101"), 12), ("cos(x)", ("1/2", "3/2"), 10)]
+
+
+@pytest.mark.parametrize("expr, iv, degree", CASES)
+def test_where_a_basis_reaches_2x_the_chosen_one_does(expr, iv, degree):
+    """The issue's rule, judged by the rigorous float32 bounds of
+    :func:`chebnorm.export.evalbound.horner_bound` (not the estimate the
+    choice used): where plain powers or the shifted basis is within 2x of
+    (its fit bound + the float32 floor), the chosen basis is too."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitWarning)
+        auto = fit(expr, iv, degree, kind="minimax")
+        tables = {b: fit(expr, iv, degree, kind="minimax", basis=b)
+                  for b in ("monomial", "shifted")}
+    floor = auto.basis_choice.floor
+
+    def reaches(t):
+        return _float32_bound(t) <= 2 * (t.abs_error_bound + floor)
+
+    assert tables[auto.basis].coefficients == auto.coefficients
+    if any(reaches(t) for t in tables.values()):
+        assert reaches(auto), {b: _float32_bound(t) for b, t in tables.items()}
