@@ -334,3 +334,18 @@ def test_where_a_basis_reaches_2x_the_chosen_one_does(expr, iv, degree):
     assert tables[auto.basis].coefficients == auto.coefficients
     if any(reaches(t) for t in tables.values()):
         assert reaches(auto), {b: _float32_bound(t) for b, t in tables.items()}
+
+
+def test_no_warning_where_float32_arithmetic_itself_is_the_limit():
+    """pi*x at degree 3 is fitted to 1e-17, far below float32: its evaluator
+    exceeds 4x (fit + floor) as any float32 Horner evaluation of degree 3
+    would (three roundings and pi rounded), not for its conditioning -- under
+    4 gamma_6 max|f| -- so no warning."""
+    from chebnorm.approx import warnings_of
+
+    t = fit("pi*x", ("0.1", "0.3"), 3)
+    m = t.basis_choice.estimates[t.basis]
+    assert m["fit"] + m["rounding"] > 4 * (m["fit"] + t.basis_choice.floor)
+    gamma6 = 6 * 2.0 ** -24 / (1 - 6 * 2.0 ** -24)
+    assert m["rounding"] <= 4 * gamma6 * (math.pi * 0.3)
+    assert warnings_of(t) == []

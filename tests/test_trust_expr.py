@@ -294,6 +294,11 @@ def test_certificate_says_when_a_cap_stopped_it():
     assert capped.bound >= full.maximum  # still rigorous
 
 
+def _fit_warnings(table):
+    """The table's warnings but basis="auto"'s on its float32 evaluator."""
+    return [w for w in warnings_of(table) if not w.startswith("the float32 evaluator")]
+
+
 def test_unconverged_remez_is_reported(tmp_path, capsys, monkeypatch):
     # the exchange converges on Runge's function at degree 30 since the float64
     # exchange with its high-precision polish; cap its iterations to make it stop short
@@ -311,7 +316,10 @@ def test_unconverged_remez_is_reported(tmp_path, capsys, monkeypatch):
             "minimax",
             "-o", str(tmp_path / "t.json")]
     assert main(args) == 0
-    err = capsys.readouterr().err.strip().splitlines()
+    # degree 30 in powers of x on [-1, 1]: coefficients up to 5e7, so basis="auto" also
+    # says (one more line) that the float32 evaluator is useless; the fit's own warning:
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines()
+           if not ln.startswith("chebnorm: warning: the float32 evaluator")]
     assert len(err) == 1 and err[0].startswith("chebnorm: warning: the Remez exchange did not "
                                                "converge")
     t = CoefficientTable.load(tmp_path / "t.json")
@@ -320,11 +328,12 @@ def test_unconverged_remez_is_reported(tmp_path, capsys, monkeypatch):
     # the capped exchange alone is rescued by the exchange on a growing point set
     monkeypatch.setattr(api, "remez", lambda *a, **k: real(*a, **{**k, "max_iter": 2}))
     rescued = fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30, kind="minimax")
-    assert not warnings_of(rescued) and "exchange" in rescued.provenance
+    assert not _fit_warnings(rescued) and "exchange" in rescued.provenance
     monkeypatch.undo()
     # uncapped, it converges and is better than Chebyshev interpolation, with no warning
+    # on the fit (its float32 evaluator's is said: about 29 against a fit of 1.3e-3)
     m = fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30, kind="minimax")
-    assert not warnings_of(m)
+    assert not _fit_warnings(m) and len(warnings_of(m)) == 1
     assert m.abs_error_bound < fit("1/(1+25*(x-1/8)^2)", ("-1", "1"), 30).abs_error_bound
 
 

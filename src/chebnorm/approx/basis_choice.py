@@ -36,6 +36,15 @@ unless the shifted one is at least twice as good. The choice, the numbers and
 the reason are recorded in the table (:class:`BasisChoice`) and re-checked
 when it is read.
 
+A FitWarning says when the chosen basis still makes the float32 evaluator
+poor: ``A + E > 4 (A + F)`` and ``E > 4 gamma_2n max|f|``, the second being
+Higham's a priori bound of Horner's rule at condition number 1
+(``gamma_2n = 2n u / (1 - 2n u)``, ``u = 2^-24``, ``n`` the degree): what
+any float32 Horner evaluation of degree ``n`` may cost, however well the
+basis suits ``f``. A fit far more accurate than float32 (``A`` well below
+``F``) thus warns only when the coefficients' conditioning, not the float32
+arithmetic itself, spoils its evaluator.
+
 Examples
 --------
 >>> import numpy as np
@@ -272,6 +281,12 @@ def _numbers(coeffs, x, shift, fx):
     return {"fit": fit, "rounding": rounding_estimate(coeffs, x, shift)}
 
 
+def _gamma(k: int) -> float:
+    """Higham's ``gamma_k = k u / (1 - k u)`` of binary32 (``u = 2^-24``)."""
+    u = 2.0 ** -24
+    return k * u / (1 - k * u)
+
+
 def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
     """Choose among fitted candidates.
 
@@ -291,7 +306,9 @@ def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
     -------
     tuple
         ``(BasisChoice, note)``: the choice, and a warning text when the
-        chosen estimate exceeds :data:`WARN` times (fit + floor), else "".
+        chosen estimate exceeds :data:`WARN` times (fit + floor) and its
+        rounding part :data:`WARN` times ``gamma_2n max|f|`` (module
+        docstring), or when it overflows binary32; else "".
 
     Examples
     --------
@@ -308,15 +325,18 @@ def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
         except (TypeError, ValueError, ArithmeticError):
             fx = np.full_like(x, np.nan)
     finite = np.abs(fx[np.isfinite(fx)])
-    floor = float(half_ulp(np.max(finite))) if finite.size else 0.0
-    estimates = {}
+    fmax = float(np.max(finite)) if finite.size else 0.0
+    floor = float(half_ulp(fmax))
+    estimates, degree = {}, 0
     fitted = candidates("monomial")
     if fitted is not None:
         estimates["monomial"] = _numbers(fitted[0], x, fitted[1], fx)
+        degree = len(fitted[0]) - 1
     if not estimates or not _reaches(estimates["monomial"], floor):
         fitted = candidates("shifted")
         if fitted is not None:
             estimates["shifted"] = _numbers(fitted[0], x, fitted[1], fx)
+            degree = len(fitted[0]) - 1
     basis, reason = _rule(estimates, floor)
     chosen = estimates[basis]
     note = ""
@@ -324,11 +344,13 @@ def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
         note = (f"no float32 evaluator: a coefficient or a Horner value is beyond binary32's "
                 f"range in every basis tried ({reason}); accepted: a double evaluator, or an "
                 f"interval where f and its polynomial stay within binary32")
-    elif chosen["fit"] + chosen["rounding"] > WARN * (chosen["fit"] + floor):
+    elif (chosen["fit"] + chosen["rounding"] > WARN * (chosen["fit"] + floor)
+          and chosen["rounding"] > WARN * _gamma(2 * degree) * fmax):
         note = (f"the float32 evaluator's estimated error {chosen['fit'] + chosen['rounding']:.3g} "
-                f"exceeds {WARN:g}x (fit {chosen['fit']:.3g} + float32 floor {floor:.3g}) in "
-                f"every basis tried ({reason}); accepted: a double evaluator, a lower "
-                f"degree or a narrower interval (segments)")
+                f"exceeds {WARN:g}x (fit {chosen['fit']:.3g} + float32 floor {floor:.3g}), and "
+                f"its rounding {WARN:g}x what Horner's rule costs at condition number 1 "
+                f"({_gamma(2 * degree) * fmax:.3g}), in every basis tried ({reason}); accepted: "
+                f"a double evaluator, a lower degree or a narrower interval (segments)")
     return BasisChoice(basis, reason, floor, estimates), note
 
 
