@@ -9,12 +9,21 @@ import sys
 import pytest
 
 from chebnorm.cli import main
+from conftest import run_cli
+from quiet_cli import run_cli_quiet
 
 
 def run(*args):
-    """Run the real console entry point in a subprocess (no shared state)."""
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True)
-    return proc.returncode, proc.stdout, proc.stderr
+    """``chebnorm ARGS`` in this process: (status, stdout, stderr)."""
+    r = run_cli(*args)
+    return r.code, r.out, r.err
+
+
+def run_quiet(*args):
+    """:func:`run` for the tests reading stderr whole: a Python warning fails them,
+    as it would reach a console's stderr."""
+    r = run_cli_quiet(*args)
+    return r.code, r.out, r.err
 
 
 def test_fit_json_acceptance_c5():
@@ -67,13 +76,12 @@ def test_fit_export_targets_round_trip(tmp_path, capsys):
     (["nonsense"], "invalid choice"),
 ])
 def test_bad_input_one_line_status_2(args, needle, tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True,
-                          cwd=tmp_path)
-    assert proc.returncode == 2
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and needle in lines[0], proc.stderr
-    assert "Traceback" not in proc.stderr
-    assert proc.stdout == ""
+    proc = run_cli_quiet(*args, cwd=tmp_path)
+    assert proc.code == 2
+    lines = proc.err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.err
+    assert "Traceback" not in proc.err
+    assert proc.out == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written
 
 
@@ -89,7 +97,7 @@ DEPRECATED = "is deprecated and will be removed in the next release; use "
 
 
 def _fit_json(tmp_path, flag):
-    rc, out, err = run("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", flag, "12",
+    rc, out, err = run_quiet("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", flag, "12",
                        "--json")
     assert rc == 0, err
     return json.loads(out), err
@@ -118,8 +126,8 @@ def test_hw_deprecated_aliases(tmp_path, argv, old, new):
     t = tmp_path / "t.json"
     fit_target("dichotomy", 2).save(t)
     argv = [str(t) if a == "T" else a for a in argv]
-    rc_new, out_new, err_new = run(*argv, *new)
-    rc_old, out_old, err_old = run(*argv, *old)
+    rc_new, out_new, err_new = run_quiet(*argv, *new)
+    rc_old, out_old, err_old = run_quiet(*argv, *old)
     assert rc_new == rc_old == 0, err_new + err_old
     assert err_new == ""
     assert err_old == f"chebnorm: warning: {old[0]} {DEPRECATED}{new[0]}\n"
@@ -140,7 +148,8 @@ def test_help_names_each_quantity_once():
 
 def test_closed_output_pipe_stops_quietly():
     # `chebnorm fit ... | head -1` when the output outgrows the pipe: the reader is gone; the command
-    # must neither print an error nor a traceback, and ends as SIGPIPE would (141)
+    # must neither print an error nor a traceback, and ends as SIGPIPE would (141).
+    # A child process: the closed pipe and the interpreter's flush at exit are the point.
     proc = subprocess.Popen([sys.executable, "-m", "chebnorm", "fit", "exp(x)", "--interval",
                              "0", "1", "--degree", "4", "--kind", "minimax"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
