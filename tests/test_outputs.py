@@ -14,6 +14,7 @@ from PIL import Image
 
 from chebnorm.core.files import WriteError, make_folder, write_atomic
 from chebnorm.raster import IMAGE_FORMATS, get_mesh, load_mesh, write_image, write_png
+from conftest import run_cli
 from quiet_cli import run_cli_quiet as cli
 
 
@@ -93,8 +94,9 @@ class TestImages:
         assert list(tmp_path.iterdir()) == []
 
     def test_render_cli_outputs(self, tmp_path):
-        r = cli("render", "--mesh", "sphere", "--tess", "6", "--size", "48", "48",
-                "--out", "a.jpg", "--error-map", "e.png", cwd=tmp_path)
+        # stderr not read: numba may announce a slow warm-up (NumbaCompileWarning)
+        r = run_cli("render", "--mesh", "sphere", "--tess", "6", "--size", "48", "48",
+                    "--out", "a.jpg", "--error-map", "e.png", cwd=tmp_path)
         assert r.code == 0, r.err
         for name, fmt in (("a.jpg", "JPEG"), ("e.png", "PNG")):
             assert _mode(tmp_path / name) == 0o644
@@ -212,7 +214,7 @@ class TestMeshFiles:
     def test_render_cli_crease_angle(self, tmp_path):
         _write(tmp_path, "t.obj", TILTED_OBJ)
         base = ["render", "--mesh", "t.obj", "--size", "32", "32", "--json"]
-        ok = [cli(*base, cwd=tmp_path), cli(*base, "--crease-angle", "45", cwd=tmp_path)]
+        ok = [run_cli(*base, cwd=tmp_path), run_cli(*base, "--crease-angle", "45", cwd=tmp_path)]
         assert all(r.code == 0 for r in ok), [r.err for r in ok]
         for bad in ("-1", "180.5", "nan", "inf"):
             r = cli(*base, "--crease-angle", bad, cwd=tmp_path)
