@@ -5,7 +5,6 @@ and VHDL (GHDL) bit-identical to the model over every code; bad input refused.""
 
 from __future__ import annotations
 
-import shutil
 from fractions import Fraction
 
 import numpy as np
@@ -13,11 +12,11 @@ import pytest
 
 from chebnorm.cli import main
 from chebnorm.hw.exponent import design_exponent, exponent_fields, simulate_exponent
+from conftest import requires_tool
 
-needs_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                    reason="iverilog not installed")
-needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-needs_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys not installed")
+needs_iverilog = requires_tool("iverilog")
+needs_ghdl = requires_tool("ghdl")
+needs_yosys = requires_tool("yosys")
 
 W = 10
 

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
 from dataclasses import astuple, replace
 from pathlib import Path
@@ -31,14 +30,12 @@ from chebnorm.approx import CoefficientTable, fit
 from chebnorm.approx.contract import construction
 from chebnorm.approx.table import MAX_TEXT
 from chebnorm.cli import main
-from conftest import requires_tool, run_cli, run_process
+from conftest import requires_tool, run_cli, run_process, tool_missing
 from chebnorm.export import c_header
 
 ROOT = Path(__file__).resolve().parents[1]
 COEFFS = ROOT / "figures" / "coefficients"
 TABLES = sorted(COEFFS.glob("*.json"))
-GCC = shutil.which("gcc")
-IVERILOG = shutil.which("iverilog")
 needs_gcc = requires_tool("gcc")
 needs_iverilog = requires_tool("iverilog")
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
@@ -467,7 +464,7 @@ TEXT_FIELDS = [
 def strip_c_comments(path: Path) -> str:
     """The header as gcc sees it with comments removed (trigraphs, line splices
     and all), directives kept: the code, and nothing but the code."""
-    proc = subprocess.run([GCC, "-std=c99", "-trigraphs", "-fpreprocessed", "-dD", "-E", "-P",
+    proc = subprocess.run(["gcc", "-std=c99", "-trigraphs", "-fpreprocessed", "-dD", "-E", "-P",
                            "-x", "c", str(path)], capture_output=True, text=True, check=True)
     return "\n".join(line.rstrip() for line in proc.stdout.splitlines() if line.strip())
 
@@ -475,7 +472,7 @@ def strip_c_comments(path: Path) -> str:
 def compile_c(tmp: Path, header: Path) -> None:
     main_c = tmp / "main.c"
     main_c.write_text(f'#include "{header.name}"\nint main(void) {{ return 0; }}\n')
-    proc = subprocess.run([GCC, *CFLAGS, "-c", "-o", str(tmp / "main.o"), str(main_c)],
+    proc = subprocess.run(["gcc", *CFLAGS, "-c", "-o", str(tmp / "main.o"), str(main_c)],
                           cwd=header.parent, capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
 
@@ -512,7 +509,8 @@ def clean(tmp_path_factory):
     assert main(["export", str(BASE), "-o", str(tmp / "chebnorm_dichotomy_d2.h")]) == 0
     assert main(["hw", "verilog", str(BASE), "--in-bits", "8", "--out-bits", "8",
                  "-o", str(tmp)]) == 0
-    c = strip_c_comments(tmp / "chebnorm_dichotomy_d2.h") if GCC else None
+    have_gcc = tool_missing("gcc") is None
+    c = strip_c_comments(tmp / "chebnorm_dichotomy_d2.h") if have_gcc else None
     v = strip_verilog_comments((tmp / "chebnorm_dichotomy_d2.v").read_text())
     tb = strip_verilog_comments((tmp / "tb_chebnorm_dichotomy_d2.v").read_text())
     return c, v, tb
@@ -608,7 +606,7 @@ def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     assert strip_verilog_comments(text) == clean[1]
     pipe = verilog_pipelined_module(hostile, version=bad, command=bad)
     (tmp_path / "m.v").write_text(text + "\n" + pipe)
-    proc = subprocess.run([IVERILOG, "-g2005", "-Wall", "-o", str(tmp_path / "a.out"),
+    proc = subprocess.run(["iverilog", "-g2005", "-Wall", "-o", str(tmp_path / "a.out"),
                            str(tmp_path / "m.v")], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     with pytest.raises(ValueError, match=r"^name: 'x\\n`define' is not an identifier"):
