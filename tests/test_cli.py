@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from dataclasses import astuple
 
 import pytest
 
@@ -13,22 +14,9 @@ from conftest import run_cli
 from quiet_cli import run_cli_quiet
 
 
-def run(*args):
-    """``chebnorm ARGS`` in this process: (status, stdout, stderr)."""
-    r = run_cli(*args)
-    return r.code, r.out, r.err
-
-
-def run_quiet(*args):
-    """:func:`run` for the tests reading stderr whole: a Python warning fails them,
-    as it would reach a console's stderr."""
-    r = run_cli_quiet(*args)
-    return r.code, r.out, r.err
-
-
 def test_fit_json_acceptance_c5():
-    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
-                       "--degree", "2", "--kind", "chebyshev", "--json")
+    rc, out, err = astuple(run_cli("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)",
+                                   "2", "--degree", "2", "--kind", "chebyshev", "--json"))
     assert rc == 0, err
     d = json.loads(out)
     for key in ("coefficients", "max_abs_error", "abs_error_bound", "max_rel_error", "rel_error_bound",
@@ -41,8 +29,8 @@ def test_fit_json_acceptance_c5():
 
 
 def test_fit_minimax_acceptance():
-    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
-                       "--degree", "2", "--kind", "minimax", "--json")
+    rc, out, err = astuple(run_cli("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)",
+                                   "2", "--degree", "2", "--kind", "minimax", "--json"))
     d = json.loads(out)
     assert abs(d["max_abs_error"] - 2.016e-5) < 1e-8
     assert d["abs_error_bound"] >= d["max_abs_error"]
@@ -97,8 +85,8 @@ DEPRECATED = "is deprecated and will be removed in the next release; use "
 
 
 def _fit_json(tmp_path, flag):
-    rc, out, err = run_quiet("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", flag, "12",
-                       "--json")
+    rc, out, err = astuple(run_cli_quiet("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree",
+                                         "2", flag, "12", "--json"))
     assert rc == 0, err
     return json.loads(out), err
 
@@ -126,8 +114,8 @@ def test_hw_deprecated_aliases(tmp_path, argv, old, new):
     t = tmp_path / "t.json"
     fit_target("dichotomy", 2).save(t)
     argv = [str(t) if a == "T" else a for a in argv]
-    rc_new, out_new, err_new = run_quiet(*argv, *new)
-    rc_old, out_old, err_old = run_quiet(*argv, *old)
+    rc_new, out_new, err_new = astuple(run_cli_quiet(*argv, *new))
+    rc_old, out_old, err_old = astuple(run_cli_quiet(*argv, *old))
     assert rc_new == rc_old == 0, err_new + err_old
     assert err_new == ""
     assert err_old == f"chebnorm: warning: {old[0]} {DEPRECATED}{new[0]}\n"
@@ -141,7 +129,7 @@ def test_help_names_each_quantity_once():
     for argv, flags in ((["fit"], ["--coef-frac-bits"]),
                         (["hw", "unit"], ["--coef-frac-bits", "--vector-frac-bits"]),
                         (["hw", "sweep"], ["--coef-frac-bits"])):
-        rc, out, _ = run(*argv, "--help")
+        rc, out, _ = astuple(run_cli(*argv, "--help"))
         assert rc == 0 and all(f in out for f in flags)
         assert "deprecated spelling of" in out
 

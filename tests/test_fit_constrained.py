@@ -38,17 +38,15 @@ def test_a_minimax_fit_worse_than_zero_says_so():
     assert any("zero polynomial" in w for w in warnings_of(t))
 
 
-def _cli(*args):
-    """``chebnorm fit ARGS`` in this process; a FitWarning escaping as a Python
-    warning (a second "zero polynomial" line in a console) fails the test."""
-    return run_cli_quiet("fit", *args)
-
-
 def test_cli_negative_endpoints_and_one_warning_line():
     for lo, hi in (("-1/8", "1/8"), ("-pi/4", "pi/4"), ("(-1/8)", "1/8")):
-        r = _cli("sin(x)", "--interval", lo, hi, "--degree", "5", "--kind", "minimax", "--json")
+        r = run_cli_quiet("fit", "sin(x)", "--interval", lo, hi, "--degree", "5", "--kind",
+                          "minimax", "--json")
         assert r.code == 0, r.err
-    r = _cli("sin(1/x)", "--interval", "0.001", "1", "--degree", "30", "--kind", "minimax")
+    # quiet: a FitWarning escaping as a Python warning (a second "zero polynomial"
+    # line in a console) fails the test
+    r = run_cli_quiet("fit", "sin(1/x)", "--interval", "0.001", "1", "--degree", "30", "--kind",
+                      "minimax")
     assert r.code == 0
     lines = [ln for ln in r.err.splitlines() if "zero polynomial" in ln]
     assert len(lines) == 1 and lines[0].startswith("chebnorm: warning: ")
