@@ -115,7 +115,7 @@ def test_reader_never_raises_anything_but_value_error(text):
        st.integers(0, 3), st.sampled_from(["chebyshev", "minimax"]))
 def test_fit_never_a_traceback_and_bounds_hold(tmp_path_factory, text, interval, degree, kind):
     out = tmp_path_factory.mktemp("fit") / "T.json"
-    status, _, err = astuple(run_cli(["fit", text, "--interval", *interval, "--degree", degree,
+    status, _, err = astuple(run_cli(["fit", text, "--interval", *interval, "--degree", str(degree),
                                       "--kind", kind, "-o", out]))
     check_status(status, err)
     if status == 0:
