@@ -37,8 +37,7 @@ def test_faithful_design_compares_every_architecture(tmp_path, capsys):
     assert "winner:" in text
 
 
-@needs_yosys
-@needs_iverilog
+@requires_tool("yosys", "iverilog")  # one marker: the hook reads the closest only
 def test_each_architecture_winner_simulates_over_every_code(tmp_path):
     from chebnorm.hw.piecewise import simulate_piecewise
     from chebnorm.hw.table_run import simulate_table

@@ -74,8 +74,7 @@ def test_bound_holds_at_every_code_exactly(designs, degree):
     assert m["max_rel_error"] < d.budget()["relative"]
 
 
-@needs_iverilog
-@needs_ghdl
+@requires_tool("iverilog", "ghdl")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("degree,pipeline", [(2, None), (1, "full")])
 def test_hdl_bit_identical_every_code(designs, tmp_path, degree, pipeline):
     d = designs[degree] if pipeline is None else design_exponent(

@@ -151,8 +151,7 @@ def test_impossible_frequency_warns_with_the_highest(multipartite):
     assert res.latency == len(res.design.cuts) if res.latency else True
 
 
-@need_pnr
-@need_iverilog
+@requires_tool("nextpnr-ice40", "yosys", "iverilog")  # one marker: the hook reads the closest only
 def test_cli_pipelines_the_winner_to_the_asked_frequency(tmp_path, multipartite):
     from chebnorm.hw.targets import fmax_ice40
 

@@ -403,8 +403,7 @@ def _hw(tmp_path, table_path, in_bits, out_bits, *extra):
     return out, proc.out
 
 
-@need_ghdl
-@need_iverilog
+@requires_tool("ghdl", "iverilog", "vvp")  # one marker: the hook reads the closest only
 @pytest.mark.slow
 def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
     """Acceptance: 65,536 codes, 0 mismatches in GHDL, and GHDL's outputs equal
@@ -422,8 +421,7 @@ def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
     assert vhdl == (out / "chebnorm_dichotomy_d2.hex").read_text().split()
 
 
-@need_ghdl
-@need_iverilog
+@requires_tool("ghdl", "iverilog", "vvp")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("table,bits,kw", [
     ("rsqrt_d3.json", 9, {"rounding": "trunc"}),
     ("midpoint_d1.json", 8, {}),

@@ -528,8 +528,7 @@ def _check_outcome(code, err, field, produced):
     return True
 
 
-@needs_gcc
-@needs_iverilog
+@requires_tool("gcc", "iverilog")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("path,valid,field", TEXT_FIELDS, ids=[f[2] for f in TEXT_FIELDS])
 def test_injection_in_every_text_field(tmp_path, capsys, clean, path, valid, field):
     c_ref, v_ref, tb_ref = clean
@@ -615,8 +614,7 @@ def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
         verilog_testbench(d, vectors='a.hex"); $finish; //.hex')
 
 
-@needs_gcc
-@needs_iverilog
+@requires_tool("gcc", "iverilog")  # one marker: the hook reads the closest only
 def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
     """The command line (here the table's own file name) reaches the banners."""
     # the full path holds "*/", line breaks, a trigraph, U+2028 and a backslash
