@@ -5,7 +5,6 @@ did not check every code, and that a pass writes only the two GHDL fields."""
 from __future__ import annotations
 
 import json
-import shutil
 import sys
 from pathlib import Path
 
@@ -62,7 +61,7 @@ def test_a_bench_short_of_codes_is_not_recorded(tmp_path, monkeypatch):
     assert path.read_bytes() == before
 
 
-@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+@pytest.mark.requires_tool("ghdl")
 def test_a_pass_writes_only_the_two_ghdl_fields(tmp_path):
     path = tmp_path / "r.json"
     doc = _doc()

@@ -5,21 +5,18 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from dataclasses import astuple
 
 import pytest
 
 from chebnorm.cli import main
-
-
-def run(*args):
-    """Run the real console entry point in a subprocess (no shared state)."""
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True)
-    return proc.returncode, proc.stdout, proc.stderr
+from conftest import run_cli
+from quiet_cli import run_cli_quiet
 
 
 def test_fit_json_acceptance_c5():
-    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
-                       "--degree", "2", "--kind", "chebyshev", "--json")
+    rc, out, err = astuple(run_cli("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)",
+                                   "2", "--degree", "2", "--kind", "chebyshev", "--json"))
     assert rc == 0, err
     d = json.loads(out)
     for key in ("coefficients", "max_abs_error", "abs_error_bound", "max_rel_error", "rel_error_bound",
@@ -32,8 +29,8 @@ def test_fit_json_acceptance_c5():
 
 
 def test_fit_minimax_acceptance():
-    rc, out, err = run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
-                       "--degree", "2", "--kind", "minimax", "--json")
+    rc, out, err = astuple(run_cli("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)",
+                                   "2", "--degree", "2", "--kind", "minimax", "--json"))
     d = json.loads(out)
     assert abs(d["max_abs_error"] - 2.016e-5) < 1e-8
     assert d["abs_error_bound"] >= d["max_abs_error"]
@@ -67,13 +64,12 @@ def test_fit_export_targets_round_trip(tmp_path, capsys):
     (["nonsense"], "invalid choice"),
 ])
 def test_bad_input_one_line_status_2(args, needle, tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True, text=True,
-                          cwd=tmp_path)
-    assert proc.returncode == 2
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and needle in lines[0], proc.stderr
-    assert "Traceback" not in proc.stderr
-    assert proc.stdout == ""
+    proc = run_cli_quiet(*args, cwd=tmp_path)
+    assert proc.code == 2
+    lines = proc.err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.err
+    assert "Traceback" not in proc.err
+    assert proc.out == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written
 
 
@@ -89,8 +85,8 @@ DEPRECATED = "is deprecated and will be removed in the next release; use "
 
 
 def _fit_json(tmp_path, flag):
-    rc, out, err = run("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", flag, "12",
-                       "--json")
+    rc, out, err = astuple(run_cli_quiet("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree",
+                                         "2", flag, "12", "--json"))
     assert rc == 0, err
     return json.loads(out), err
 
@@ -118,8 +114,8 @@ def test_hw_deprecated_aliases(tmp_path, argv, old, new):
     t = tmp_path / "t.json"
     fit_target("dichotomy", 2).save(t)
     argv = [str(t) if a == "T" else a for a in argv]
-    rc_new, out_new, err_new = run(*argv, *new)
-    rc_old, out_old, err_old = run(*argv, *old)
+    rc_new, out_new, err_new = astuple(run_cli_quiet(*argv, *new))
+    rc_old, out_old, err_old = astuple(run_cli_quiet(*argv, *old))
     assert rc_new == rc_old == 0, err_new + err_old
     assert err_new == ""
     assert err_old == f"chebnorm: warning: {old[0]} {DEPRECATED}{new[0]}\n"
@@ -133,14 +129,15 @@ def test_help_names_each_quantity_once():
     for argv, flags in ((["fit"], ["--coef-frac-bits"]),
                         (["hw", "unit"], ["--coef-frac-bits", "--vector-frac-bits"]),
                         (["hw", "sweep"], ["--coef-frac-bits"])):
-        rc, out, _ = run(*argv, "--help")
+        rc, out, _ = astuple(run_cli(*argv, "--help"))
         assert rc == 0 and all(f in out for f in flags)
         assert "deprecated spelling of" in out
 
 
 def test_closed_output_pipe_stops_quietly():
     # `chebnorm fit ... | head -1` when the output outgrows the pipe: the reader is gone; the command
-    # must neither print an error nor a traceback, and ends as SIGPIPE would (141)
+    # must neither print an error nor a traceback, and ends as SIGPIPE would (141).
+    # A child process: the closed pipe and the interpreter's flush at exit are the point.
     proc = subprocess.Popen([sys.executable, "-m", "chebnorm", "fit", "exp(x)", "--interval",
                              "0", "1", "--degree", "4", "--kind", "minimax"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)

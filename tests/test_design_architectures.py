@@ -6,16 +6,15 @@ accuracy specs; ``--max-error`` as an exact expression."""
 from __future__ import annotations
 
 import csv
-import shutil
 
 import pytest
 
 from chebnorm.cli import main
 from chebnorm.hw.architectures import architecture_candidates
+from conftest import requires_tool
 
-needs_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys not installed")
-needs_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                    reason="iverilog not installed")
+needs_yosys = requires_tool("yosys")
+needs_iverilog = requires_tool("iverilog")
 SPEC = ["1/sqrt(1+3*x)", "--interval", "0", "1", "--in-bits", "8", "--out-bits", "8"]
 
 
@@ -38,8 +37,7 @@ def test_faithful_design_compares_every_architecture(tmp_path, capsys):
     assert "winner:" in text
 
 
-@needs_yosys
-@needs_iverilog
+@requires_tool("yosys", "iverilog")  # one marker: the hook reads the closest only
 def test_each_architecture_winner_simulates_over_every_code(tmp_path):
     from chebnorm.hw.piecewise import simulate_piecewise
     from chebnorm.hw.table_run import simulate_table

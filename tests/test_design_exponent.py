@@ -5,7 +5,6 @@ and VHDL (GHDL) bit-identical to the model over every code; bad input refused.""
 
 from __future__ import annotations
 
-import shutil
 from fractions import Fraction
 
 import numpy as np
@@ -13,11 +12,11 @@ import pytest
 
 from chebnorm.cli import main
 from chebnorm.hw.exponent import design_exponent, exponent_fields, simulate_exponent
+from conftest import requires_tool
 
-needs_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                    reason="iverilog not installed")
-needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-needs_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys not installed")
+needs_iverilog = requires_tool("iverilog")
+needs_ghdl = requires_tool("ghdl")
+needs_yosys = requires_tool("yosys")
 
 W = 10
 
@@ -75,8 +74,7 @@ def test_bound_holds_at_every_code_exactly(designs, degree):
     assert m["max_rel_error"] < d.budget()["relative"]
 
 
-@needs_iverilog
-@needs_ghdl
+@requires_tool("iverilog", "ghdl")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("degree,pipeline", [(2, None), (1, "full")])
 def test_hdl_bit_identical_every_code(designs, tmp_path, degree, pipeline):
     d = designs[degree] if pipeline is None else design_exponent(

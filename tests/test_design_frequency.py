@@ -11,9 +11,6 @@ with the reason when the tool is absent.
 from __future__ import annotations
 
 import re
-import shutil
-import subprocess
-import sys
 import warnings
 
 import pytest
@@ -21,20 +18,14 @@ import pytest
 from chebnorm.hw.pipeline import (FrequencyWarning, PipelinedTable, check_frequency, cut_names,
                                   cut_plans, design_files, pipeline_to_frequency,
                                   verify_pipelined, with_cuts)
+from conftest import requires_tool, run_cli
+from quiet_cli import run_cli_quiet
 
 SPEC = ["1/sqrt(1+3*x)", "--interval", "0", "1", "--in-bits", "10", "--out-bits", "10",
         "--faithful", "--target", "ice40"]
 
-need_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                   reason="iverilog (Icarus Verilog) is not installed")
-need_pnr = pytest.mark.skipif(shutil.which("nextpnr-ice40") is None or
-                              shutil.which("yosys") is None,
-                              reason="nextpnr-ice40 or yosys is not installed")
-
-
-def _cli(*argv):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
-                          text=True, timeout=1800)
+need_iverilog = requires_tool("iverilog")
+need_pnr = requires_tool("nextpnr-ice40", "yosys")
 
 
 @pytest.fixture(scope="module")
@@ -59,17 +50,17 @@ def sized():
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "inf", "fast", "-0"])
 def test_bad_frequency_exits_2_with_one_line(tmp_path, value):
     out = tmp_path / "o"
-    r = _cli("design", *SPEC, "--frequency", value, "-o", str(out))
-    assert r.returncode == 2, r.stderr
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "--frequency" in lines[0] and "MHz > 0" in lines[0], r.stderr
+    r = run_cli_quiet("design", *SPEC, "--frequency", value, "-o", out)
+    assert r.code == 2, r.err
+    lines = r.err.strip().splitlines()
+    assert len(lines) == 1 and "--frequency" in lines[0] and "MHz > 0" in lines[0], r.err
     assert not out.exists()  # refused before the search: nothing written
 
 
 def test_frequency_needs_a_device(tmp_path):
-    r = _cli("design", *SPEC[:-1], "generic", "--frequency", "50", "-o", str(tmp_path / "o"))
-    assert r.returncode == 2
-    assert r.stderr.count("\n") == 1 and "ice40, xc7 or xc7-nodsp" in r.stderr
+    r = run_cli_quiet("design", *SPEC[:-1], "generic", "--frequency", "50", "-o", tmp_path / "o")
+    assert r.code == 2
+    assert r.err.count("\n") == 1 and "ice40, xc7 or xc7-nodsp" in r.err
 
 
 @pytest.mark.parametrize("value", [0, -1.0, float("nan"), float("inf"), "x", None, True])
@@ -122,7 +113,7 @@ def test_cycle_accurate_simulation_catches_a_wrong_latency(kind, sized, multipar
     assert not bad.passed and bad.mismatches > 0, bad.line
 
 
-@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl is not installed")
+@pytest.mark.requires_tool("ghdl")
 @pytest.mark.parametrize("kind", ["sized", "multipartite"])
 def test_pipelined_vhdl_cycle_accurate(tmp_path, kind, sized, multipartite):
     from chebnorm.hw.vhdl import simulate_vhdl
@@ -160,8 +151,7 @@ def test_impossible_frequency_warns_with_the_highest(multipartite):
     assert res.latency == len(res.design.cuts) if res.latency else True
 
 
-@need_pnr
-@need_iverilog
+@requires_tool("nextpnr-ice40", "yosys", "iverilog")  # one marker: the hook reads the closest only
 def test_cli_pipelines_the_winner_to_the_asked_frequency(tmp_path, multipartite):
     from chebnorm.hw.targets import fmax_ice40
 
@@ -169,16 +159,16 @@ def test_cli_pipelines_the_winner_to_the_asked_frequency(tmp_path, multipartite)
     comb = pipeline_to_frequency(multipartite, "ice40", 1, warn=False).fmax_mhz
     ask = round(comb * 1.15)
     out = tmp_path / "o"
-    r = _cli("design", *SPEC, "--frequency", str(ask), "-o", str(out))
-    assert r.returncode == 0, r.stderr
+    r = run_cli("design", *SPEC, "--frequency", str(ask), "-o", out)
+    assert r.code == 0, r.err
     m = re.search(r"pipelined for (\d+) MHz \((met|NOT met)\): latency (\d+) cycles?, Fmax "
-                  r"([\d.]+) MHz \(nextpnr-ice40.*?\), (\d+) extra FFs", r.stdout)
-    assert m, r.stdout
-    assert int(m.group(1)) == ask and m.group(2) == "met", r.stdout
+                  r"([\d.]+) MHz \(nextpnr-ice40.*?\), (\d+) extra FFs", r.out)
+    assert m, r.out
+    assert int(m.group(1)) == ask and m.group(2) == "met", r.out
     latency, fmax, ffs = int(m.group(3)), float(m.group(4)), int(m.group(5))
     assert latency > 0 and fmax >= ask and ffs > 0
     assert "cycle-accurate simulation (Icarus Verilog, every code): PASS: 1024 vectors, 0 " \
-           "mismatches" in r.stdout
+           "mismatches" in r.out
     # the written module is the pipelined one, and an independent run meets the frequency
     (vfile,) = [p for p in out.glob("*.v")]
     text = vfile.read_text(encoding="utf-8")
@@ -190,13 +180,13 @@ def test_cli_pipelines_the_winner_to_the_asked_frequency(tmp_path, multipartite)
 
 @need_pnr
 def test_cli_impossible_frequency_exits_0_with_one_line(tmp_path):
-    r = _cli("design", "1/sqrt(1+3*x)", "--interval", "0", "1", "--in-bits", "6",
-             "--out-bits", "6", "--faithful", "--target", "ice40", "--frequency", "2000",
-             "-o", str(tmp_path / "o"))
-    assert r.returncode == 0, r.stderr
-    warn = [ln for ln in r.stderr.splitlines() if ln.startswith("chebnorm: warning:")]
+    r = run_cli("design", "1/sqrt(1+3*x)", "--interval", "0", "1", "--in-bits", "6",
+                "--out-bits", "6", "--faithful", "--target", "ice40", "--frequency", "2000",
+                "-o", tmp_path / "o")
+    assert r.code == 0, r.err
+    warn = [ln for ln in r.err.splitlines() if ln.startswith("chebnorm: warning:")]
     assert len(warn) == 1 and re.search(r"2000 MHz not reached: the highest is \d+\.\d\d MHz "
-                                        r"at latency \d+", warn[0]), r.stderr
+                                        r"at latency \d+", warn[0]), r.err
 
 
 def test_pipelined_table_keeps_the_model(multipartite):

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import glob
 import os
-import shutil
 import subprocess
 from fractions import Fraction
 from pathlib import Path
@@ -40,8 +39,6 @@ from chebnorm.export.shader import float32_eval_bound, shader_evaluator
 
 ROOT = Path(__file__).resolve().parents[1]
 REGISTERED = sorted(glob.glob(str(ROOT / "figures" / "coefficients" / "*.json")))
-GCC = shutil.which("gcc")
-GAPPA = shutil.which("gappa")
 BUILDS = (("-O2", "-ffp-contract=off"), ("-O2", "-march=native", "-mfma", "-ffp-contract=fast"))
 REF_MARGIN = 2.0 ** -56
 TIGHT = 1.25
@@ -159,7 +156,7 @@ def _run_c(src: str, tmp: Path, flags) -> list[float]:
     c = tmp / "h.c"
     c.write_text(src)
     exe = tmp / "h"
-    subprocess.run([GCC, *flags, "-o", str(exe), str(c), "-lm"], check=True,
+    subprocess.run(["gcc", *flags, "-o", str(exe), str(c), "-lm"], check=True,
                    capture_output=True)
     out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
     return [float(v) for v in out.split()]
@@ -181,7 +178,7 @@ def _key(case):
     return str(ROOT / "figures" / "coefficients" / case) if case.endswith(".json") else case
 
 
-@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.requires_tool("gcc")
 @pytest.mark.parametrize("case", CASES)
 def test_bounds_hold_over_every_float32_and_are_tight(case, tmp_path):
     table = _table(_key(case))
@@ -210,7 +207,7 @@ def test_bounds_hold_over_every_float32_and_are_tight(case, tmp_path):
     assert not [x for x in loose if x[0] not in KNOWN_LOOSE], loose
 
 
-@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.requires_tool("gcc")
 def test_piecewise_bound_holds_over_every_input_code(tmp_path):
     table = _own("piecewise")
     ev = piecewise_evaluator(table)
@@ -235,7 +232,7 @@ int main(void) {
 """
     for flags in BUILDS:
         (tmp_path / "pw.c").write_text(src)
-        subprocess.run([GCC, *flags, "-o", str(tmp_path / "pw"), str(tmp_path / "pw.c"), "-lm"],
+        subprocess.run(["gcc", *flags, "-o", str(tmp_path / "pw"), str(tmp_path / "pw.c"), "-lm"],
                        check=True, capture_output=True)
         m = float(subprocess.run([str(tmp_path / "pw")], check=True, capture_output=True,
                                  text=True).stdout)
@@ -250,7 +247,7 @@ def test_tighter_than_the_a_priori_formula_on_rsqrt_d3_float():
 
 
 def _gappa(script: str, timeout: float = 600) -> subprocess.CompletedProcess:
-    return subprocess.run([GAPPA], input=script, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(["gappa"], input=script, capture_output=True, text=True, timeout=timeout)
 
 
 def _all_evaluators():
@@ -268,7 +265,7 @@ def _all_evaluators():
     return out
 
 
-@pytest.mark.skipif(GAPPA is None, reason="gappa is not installed (CI installs it)")
+@pytest.mark.requires_tool("gappa")
 @pytest.mark.parametrize("index", range(len(CASES) * 4 + 1))
 def test_gappa_proves_every_stated_bound(index):
     evs = _all_evaluators()
@@ -280,7 +277,7 @@ def test_gappa_proves_every_stated_bound(index):
     assert "not satisfied" not in r.stderr
 
 
-@pytest.mark.skipif(GAPPA is None, reason="gappa is not installed (CI installs it)")
+@pytest.mark.requires_tool("gappa")
 @pytest.mark.parametrize("constant", ["CHEBNORM_RSQRT_D3_Q_EVAL_ERROR_BOUND",
                                       "CHEBNORM_RSQRT_D3_F_EVAL_ERROR_BOUND"])
 def test_gappa_refuses_a_tampered_bound(constant):
@@ -368,7 +365,7 @@ def _pure(ev, x, fused):
     return (acc * x if ev.parity == 1 else acc).astype(np.float64)
 
 
-@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.requires_tool("gcc")
 @pytest.mark.parametrize("case, part, drop", [("exp_d6", "_F_EVAL_ERROR_BOUND", 2),
                                                ("sin_odd", "_QUANT_F_EVAL_ERROR_BOUND", "t"),
                                                ("shifted", "_F_EVAL_ERROR_BOUND", 1)])
@@ -395,7 +392,7 @@ def test_certificate_simulation_is_the_compiled_evaluator(case, part, drop):
     assert np.any(lo < hi)  # fusing does change some results
 
 
-@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.requires_tool("gcc")
 def test_fma32_is_gccs_fmaf(tmp_path):
     """The exact fma emulation against the C library's fmaf, bit for bit, on
     seeded random triples over many binades and on ties, sticky bits and
@@ -409,7 +406,7 @@ def test_fma32_is_gccs_fmaf(tmp_path):
                    " float *o, long n) { for (long i = 0; i < n; i++) o[i] = fmaf(a[i], b[i],"
                    " c[i]); }\n")
     lib = tmp_path / "f.so"
-    subprocess.run([GCC, "-O2", "-fPIC", "-shared", "-fno-builtin", "-o", str(lib), str(src),
+    subprocess.run(["gcc", "-O2", "-fPIC", "-shared", "-fno-builtin", "-o", str(lib), str(src),
                     "-lm"], check=True, capture_output=True)
     f = ctypes.CDLL(str(lib)).f
     rng = np.random.default_rng(29)
@@ -439,7 +436,7 @@ def test_fma32_is_gccs_fmaf(tmp_path):
     assert np.any(mine != (a * b) + c)  # the triples do tell fused from unfused
 
 
-@pytest.mark.skipif(GCC is None, reason="gcc is not installed")
+@pytest.mark.requires_tool("gcc")
 def test_certificate_is_the_exhaustive_maximum_and_a_halved_one_is_caught(tmp_path):
     """The certified value is the measured maximum over both builds to within the
     stated rounding (it covers mixed fusions too, so it may be a little larger),
@@ -456,7 +453,7 @@ def test_certificate_is_the_exhaustive_maximum_and_a_halved_one_is_caught(tmp_pa
     assert not m <= cert.stated / 2
 
 
-@pytest.mark.skipif(GAPPA is None, reason="gappa is not installed (CI installs it)")
+@pytest.mark.requires_tool("gappa")
 @pytest.mark.parametrize("fmt, suffix", [("c", ".h"), ("glsl", ".glsl")])
 def test_a_certified_constant_names_its_evidence_and_its_proof_holds(fmt, suffix, tmp_path):
     """Where the exhaustive certificate is stated, the text says so, gives the

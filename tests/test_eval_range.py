@@ -14,9 +14,7 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
 import subprocess
-import sys
 from fractions import Fraction
 
 import numpy as np
@@ -25,13 +23,10 @@ import pytest
 import chebnorm as cn
 from chebnorm.approx import fit
 from chebnorm.export import c_header
+from conftest import requires_tool
+from quiet_cli import run_cli_quiet as cli
 
-needs_gcc = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc needed")
-
-
-def cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *map(str, args)], cwd=cwd,
-                          capture_output=True, text=True, timeout=600)
+needs_gcc = requires_tool("gcc")
 
 
 def _macro(text, name):
@@ -83,14 +78,14 @@ def test_shaders_refuse_an_overflowing_evaluator(big, fmt):
 
 def test_cli_item3(tmp_path):
     assert cli("fit", "1e30*x", "--interval", "0", "1e10", "--degree", "1", "--name", "big",
-               "-o", "G.json", cwd=tmp_path).returncode == 0
+               "-o", "G.json", cwd=tmp_path).code == 0
     r = cli("export", "G.json", "--format", "c", "-o", "G.h", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     assert "F_EVAL_ERROR_BOUND" not in (tmp_path / "G.h").read_text()
     for fmt in ("glsl", "wgsl", "hlsl"):
         r = cli("export", "G.json", "--format", fmt, "-o", f"G.{fmt}", cwd=tmp_path)
-        assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-        assert "overflows at x = " in r.stderr and "accepted:" in r.stderr
+        assert r.code == 2 and r.err.count("\n") == 1, r.err
+        assert "overflows at x = " in r.err and "accepted:" in r.err
         assert not (tmp_path / f"G.{fmt}").exists()
 
 
@@ -98,16 +93,16 @@ def test_cli_item3(tmp_path):
                                   ["--interval", "100", "101", "--basis", "shifted"]])
 def test_item6_tables_it_wrote_itself(tmp_path, args):
     r = cli("fit", "exp(x)", *args, "--degree", "3", "-o", "F.json", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     r = cli("export", "F.json", "--format", "c", "-o", "F.h", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     h = (tmp_path / "F.h").read_text()
     assert "is not finite in float" in h and "_F_EVAL_ERROR_BOUND" not in h
     assert _macro(h, "EVAL_ERROR_BOUND") >= _macro(h, "ABS_ERROR_BOUND")
     for fmt in ("glsl", "wgsl", "hlsl"):
         r = cli("export", "F.json", "--format", fmt, "-o", f"F.{fmt}", cwd=tmp_path)
-        assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-        assert "Traceback" not in r.stderr and "accepted:" in r.stderr
+        assert r.code == 2 and r.err.count("\n") == 1, r.err
+        assert "Traceback" not in r.err and "accepted:" in r.err
 
 
 @needs_gcc
@@ -171,10 +166,10 @@ def test_hw_report_json_with_a_zero_of_f(tmp_path):
     """f(0) = 0 at a valid code: the measured relative error is undefined
     there; ``hw report --json`` failed on the NaN ('not JSON compliant')."""
     assert cli("fit", "0.3*x", "--interval", "-0.1", "0", "--degree", "1", "-o", "L.json",
-               cwd=tmp_path).returncode == 0
+               cwd=tmp_path).code == 0
     r = cli("hw", "report", "L.json", "--in-bits", "8", "--out-bits", "8", "--coef-frac-bits",
             "12", "--no-gappa", "--no-synth", "--json", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     import json
-    d = json.loads(r.stdout)
+    d = json.loads(r.out)
     assert d["measured"]["rel_total"] is None and d["measured"]["shading_levels"] is None

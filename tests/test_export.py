@@ -4,7 +4,6 @@ mpmath within the header's own bounds."""
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 
 import mpmath
@@ -13,9 +12,9 @@ import pytest
 
 from chebnorm.approx import fit, fit_target
 from chebnorm.export import EXPORT_FORMATS, FORMATS, TABLE_FORMATS, c_header, export_table
+from conftest import requires_tool
 
-GCC = shutil.which("gcc")
-needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc is not installed (apt-get install gcc)")
+needs_gcc = requires_tool("gcc")
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 
 DRIVER = r"""
@@ -49,7 +48,7 @@ def compile_and_run(tmp_path, table, xs):
     (tmp_path / "main.c").write_text(DRIVER.format(name=f"chebnorm_{name}", fn=f"chebnorm_{name}",
                                                    macro=f"CHEBNORM_{name.upper()}"))
     exe = tmp_path / "main"
-    proc = subprocess.run([GCC, *CFLAGS, "-o", str(exe), str(tmp_path / "main.c")],
+    proc = subprocess.run(["gcc", *CFLAGS, "-o", str(exe), str(tmp_path / "main.c")],
                           capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     run = subprocess.run([str(exe)], input="".join(f"{float(x).hex()}\n" for x in xs),

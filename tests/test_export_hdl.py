@@ -6,7 +6,6 @@ and a piecewise table now has VHDL, bit for bit its model (GHDL, every input cod
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 from fractions import Fraction
 
@@ -23,12 +22,11 @@ from chebnorm.hw import hdl
 from chebnorm.hw.hdl import hdl_files, module_text, vector_file
 from chebnorm.hw.piecewise import design_piecewise
 from chebnorm.hw.report import analyze
+from conftest import requires_tool, run_cli
 
-GCC, GHDL, IVERILOG = shutil.which("gcc"), shutil.which("ghdl"), shutil.which("iverilog")
-needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc is not installed (apt-get install gcc)")
-needs_ghdl = pytest.mark.skipif(GHDL is None, reason="ghdl is not installed (apt-get install ghdl)")
-needs_iverilog = pytest.mark.skipif(IVERILOG is None,
-                                    reason="iverilog is not installed (apt-get install iverilog)")
+needs_gcc = requires_tool("gcc")
+needs_ghdl = requires_tool("ghdl")
+needs_iverilog = requires_tool("iverilog")
 
 #: piecewise tables covering the datapath's cases: uncentred and centred local
 #: variable, one segment (no ROM), degree 0 (no Horner step), degree 3, negative values
@@ -100,7 +98,7 @@ def test_piecewise_c_compiles_and_agrees_with_the_table(tables, tmp_path, name, 
         f"#include <stdio.h>\n#include \"chebnorm_{name}.h\"\nint main(void) {{ "
         f"for (uint32_t k = 0; k < {n}u; k++) printf(\"%a\\n\", chebnorm_{name}(k)); "
         "return 0; }\n")
-    subprocess.run([GCC, "-std=c99", "-O2", "-Wall", "-Werror", "m.c", "-o", "m", "-lm"],
+    subprocess.run(["gcc", "-std=c99", "-O2", "-Wall", "-Werror", "m.c", "-o", "m", "-lm"],
                    cwd=tmp_path, check=True)
     out = subprocess.run(["./m"], cwd=tmp_path, check=True, capture_output=True, text=True)
     ys = [float.fromhex(v) for v in out.stdout.split()]
@@ -190,7 +188,7 @@ def test_cli_piecewise_vhdl(tables, tmp_path, capsys):
                  "-o", str(tmp_path / "rc.vhd")]) == 0
     text = (tmp_path / "rc.vhd").read_text()
     assert "entity chebnorm_rc is" in text and "_pipe" not in text
-    subprocess.run([GHDL, "-a", "--std=08", "rc.vhd"], cwd=tmp_path, check=True)
+    subprocess.run(["ghdl", "-a", "--std=08", "rc.vhd"], cwd=tmp_path, check=True)
     assert main(["hw", "verilog", str(path), "--in-bits", "10", "--out-bits", "10", "--lang",
                  "vhdl", "--simulate", "-o", str(tmp_path / "hw")]) == 0
     out = capsys.readouterr().out
@@ -201,7 +199,9 @@ def test_cli_piecewise_vhdl(tables, tmp_path, capsys):
 
 # ------------------------------------------------------- Python equals the CLI
 def _cli_text(argv, out) -> tuple[str, str]:
-    assert main([*argv, "-o", str(out)]) == 0
+    """The file ``chebnorm ARGV -o OUT`` writes, and the command its banner names."""
+    r = run_cli(*argv, "-o", out)
+    assert r.code == 0, r.err
     text = out.read_text()
     command = re.search(r"^(?://|--|/?\s?\*) Command: (.*)$", text, re.M).group(1)
     return text, command

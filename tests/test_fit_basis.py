@@ -5,9 +5,7 @@ gcc for the emitted C, the de la Vallee Poussin alternation for the minimax
 property."""
 
 import math
-import shutil
 import subprocess
-import sys
 
 import mpmath
 import pytest
@@ -15,6 +13,7 @@ import pytest
 from chebnorm.approx import CoefficientTable, fit, parse_function, parse_number
 from chebnorm.approx.fitting import cheb_to_monomial, remez, shift_for
 from chebnorm.export.c import c_header
+from quiet_cli import run_cli_quiet
 
 
 def _p_exact(table, x):
@@ -90,12 +89,11 @@ def test_consumers_without_shifted_evaluation_refuse(tmp_path):
         fit("exp(x)", ("0", "1"), 2, basis="shifted", frac_bits=12)
     path = tmp_path / "s.json"
     s.save(path)
-    r = subprocess.run([sys.executable, "-m", "chebnorm", "export", str(path), "--format", "glsl",
-                        "-o", str(tmp_path / "s.glsl")], capture_output=True, text=True)
-    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "shifted" in r.stderr
+    r = run_cli_quiet("export", path, "--format", "glsl", "-o", tmp_path / "s.glsl")
+    assert r.code == 2 and r.err.count("\n") == 1 and "shifted" in r.err
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.requires_tool("gcc")
 def test_c_shifted_evaluator_within_its_bound(tmp_path):
     t = fit("log(x)", ("1000000", "1000001"), 6, kind="minimax", basis="shifted", name="lg")
     (tmp_path / "lg.h").write_text(c_header(t))

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 from fractions import Fraction
 
 import pytest
@@ -14,6 +12,7 @@ import pytest
 from chebnorm.approx import (CoefficientTable, fit, fit_target, quantize, sollya,
                              target_names)
 from chebnorm.approx.rounding import FLOAT_FORMATS, representable, round_to_float
+from quiet_cli import run_cli_quiet
 
 needs_sollya = pytest.mark.skipif(not sollya.available(),
                                   reason="sollya is not installed (apt-get install sollya)")
@@ -116,23 +115,21 @@ def test_quantized_fields_reverified_on_load():
 
 
 def test_cli_formats(tmp_path):
-    run = lambda *a: subprocess.run([sys.executable, "-m", "chebnorm", "fit", "sin(x)",
-                                     "--interval", "0", "pi/4", "--degree", "5", *a],
-                                    capture_output=True, text=True)
+    run = lambda *a: run_cli_quiet("fit", "sin(x)", "--interval", "0", "pi/4", "--degree", "5", *a)
     ok = run("--kind", "minimax", "--coef-format", "binary32", "--monomials", "1,3,5", "--json")
-    assert ok.returncode == 0, ok.stderr
-    q = json.loads(ok.stdout)["quantized"]
+    assert ok.code == 0, ok.err
+    q = json.loads(ok.out)["quantized"]
     assert q["format"] == "binary32" and q["monomials"] == [1, 3, 5]
     ok = run("--coef-frac-bits", "12,13,14,15,16,17", "-o", str(tmp_path / "t.json"))
-    assert ok.returncode == 0, ok.stderr
+    assert ok.code == 0, ok.err
     assert CoefficientTable.load(tmp_path / "t.json").quantized.frac_bits == (12, 13, 14, 15, 16, 17)
     for bad, word in ((("--coef-format", "binary8"), "binary8"),
                       (("--monomials", "1,x"), "comma-separated"),
                       (("--coef-frac-bits", "1,2"), "one per power"),
                       (("--coef-format", "fixed"), "needs --coef-frac-bits")):
         r = run(*bad)
-        assert r.returncode == 2 and word in r.stderr and "Traceback" not in r.stderr, r.stderr
-        assert len(r.stderr.strip().splitlines()) == 1
+        assert r.code == 2 and word in r.err and "Traceback" not in r.err, r.err
+        assert len(r.err.strip().splitlines()) == 1
 
 
 @needs_sollya

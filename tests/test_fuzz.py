@@ -14,9 +14,8 @@ formats), 300 command lines; 1040 inputs in all, about 30 s on one core.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
+from dataclasses import astuple
 from pathlib import Path
 
 import mpmath
@@ -26,22 +25,10 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.expr import parse_function, read_expression
-from chebnorm.cli import main
+from conftest import run_cli
 
 FUZZ = dict(derandomize=True, deadline=None, database=None,
             suppress_health_check=list(HealthCheck))
-
-
-def run_cli(argv) -> tuple[int, str, str]:
-    """``chebnorm ARGV`` in-process: (status, stdout, stderr); any exception but
-    SystemExit escapes (a traceback is a failure)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = main([str(a) for a in argv])
-        except SystemExit as exc:  # argparse's --help / --version
-            status = exc.code if isinstance(exc.code, int) else 2
-    return status, out.getvalue(), err.getvalue()
 
 
 def check_status(status: int, err: str) -> None:
@@ -128,8 +115,8 @@ def test_reader_never_raises_anything_but_value_error(text):
        st.integers(0, 3), st.sampled_from(["chebyshev", "minimax"]))
 def test_fit_never_a_traceback_and_bounds_hold(tmp_path_factory, text, interval, degree, kind):
     out = tmp_path_factory.mktemp("fit") / "T.json"
-    status, _, err = run_cli(["fit", text, "--interval", *interval, "--degree", degree,
-                              "--kind", kind, "-o", out])
+    status, _, err = astuple(run_cli(["fit", text, "--interval", *interval, "--degree", str(degree),
+                                      "--kind", kind, "-o", out]))
     check_status(status, err)
     if status == 0:
         check_bound(CoefficientTable.load(out))  # readable, and the bound holds
@@ -142,7 +129,7 @@ def test_fit_never_a_traceback_and_bounds_hold(tmp_path_factory, text, interval,
 def real_table(tmp_path_factory) -> dict:
     path = tmp_path_factory.mktemp("real") / "E.json"
     assert run_cli(["fit", "exp(x)", "--interval", "0", "1", "--degree", "3",
-                    "--coef-frac-bits", "20", "-o", path])[0] == 0
+                    "--coef-frac-bits", "20", "-o", path]).code == 0
     return json.loads(path.read_text())
 
 
@@ -211,7 +198,7 @@ def test_table_json_mutations(real_table, tmp_path):
         src.write_text(json.dumps(doc))
         out = tmp_path / f"out.{fmt}"
         out.unlink(missing_ok=True)
-        status, _, err = run_cli(["export", src, "--format", fmt, "-o", out])
+        status, _, err = astuple(run_cli(["export", src, "--format", fmt, "-o", out]))
         check_status(status, err)
         if status == 2:
             seen["refused"] += 1
@@ -290,7 +277,7 @@ def command_lines(draw):
 def small_table(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("small") / "T.json"
     assert run_cli(["fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2",
-                    "--degree", "2", "--coef-frac-bits", "14", "-o", path])[0] == 0
+                    "--degree", "2", "--coef-frac-bits", "14", "-o", path]).code == 0
     return path
 
 
@@ -305,7 +292,7 @@ def test_command_lines(small_table, tmp_path):
         out.unlink(missing_ok=True)
         if argv[0] in ("fit", "export"):
             argv += ["-o", out]
-        status, stdout, err = run_cli(argv)
+        status, stdout, err = astuple(run_cli(argv))
         check_status(status, err)
         counts[status] += 1
         if status == 0 and "--json" in argv and not ("-o" in argv and argv[0] == "export"):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
-import shutil
+from dataclasses import astuple
 from fractions import Fraction
 
 import numpy as np
@@ -20,11 +20,11 @@ from chebnorm.hw.datapaths import (bump_pipeline, classic_normalize, classic_uni
                                    quadratic_midpoint_unit, forward_difference_stepper)
 from chebnorm.hw.fixed import fit_bits, rounding_error_bound, signed_bits
 from chebnorm.hw.report import analyze, verilog_outputs, write_outputs
+from conftest import requires_tool, run_cli
 
-no_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                 reason="iverilog (Icarus Verilog) is not installed")
-no_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
-no_gappa = pytest.mark.skipif(shutil.which("gappa") is None, reason="gappa is not installed")
+no_iverilog = requires_tool("iverilog")
+no_yosys = requires_tool("yosys")
+no_gappa = requires_tool("gappa")
 
 
 @pytest.fixture(scope="module")
@@ -287,19 +287,12 @@ class TestCLI:
         d2.save(p)
         return p
 
-    def run(self, argv, capsys):
-        from chebnorm.cli import main
-
-        code = main(argv)
-        out, err = capsys.readouterr()
-        return code, out, err
-
     def test_report_json(self, table_json, capsys):
         import json
 
-        code, out, _ = self.run(["hw", "report", str(table_json), "--in-bits", "12",
-                                 "--out-bits", "12", "--coef-frac-bits", "16", "--json",
-                                 "--no-synth", "--no-gappa"], capsys)
+        code, out, _ = astuple(run_cli(["hw", "report", str(table_json), "--in-bits", "12",
+                                        "--out-bits", "12", "--coef-frac-bits", "16", "--json",
+                                        "--no-synth", "--no-gappa"]))
         assert code == 0
         d = json.loads(out)
         assert set(d["x_format"]) >= {"frac_bits", "offset"}
@@ -317,14 +310,14 @@ class TestCLI:
     def test_errors_leave_nothing(self, table_json, tmp_path, capsys, extra, msg):
         out = tmp_path / "out"
         out.mkdir()
-        code, _, err = self.run(["hw", "verilog", str(table_json), *extra, "-o", str(out)], capsys)
+        code, _, err = astuple(run_cli(["hw", "verilog", str(table_json), *extra, "-o", str(out)]))
         assert code == 2 and msg in err and err.count("\n") == 1
         assert list(out.iterdir()) == []
 
     def test_verilog_writes(self, table_json, tmp_path, capsys):
-        code, out, _ = self.run(["hw", "verilog", str(table_json), "--in-bits", "10",
-                                 "--out-bits", "10", "--coef-frac-bits", "16", "-o", str(tmp_path)],
-                                capsys)
+        code, out, _ = astuple(run_cli(["hw", "verilog", str(table_json), "--in-bits", "10",
+                                        "--out-bits", "10", "--coef-frac-bits", "16",
+                                        "-o", str(tmp_path)]))
         assert code == 0
         names = sorted(p.name for p in tmp_path.iterdir())
         assert "chebnorm_dichotomy_d2.v" in names and "tb_chebnorm_dichotomy_d2.v" in names

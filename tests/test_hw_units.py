@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
+from dataclasses import astuple
 
 import numpy as np
 import pytest
@@ -19,10 +19,10 @@ from chebnorm.hw.report import write_outputs
 from chebnorm.hw.units import (UNIT_KINDS, analyze_unit, design_unit, unit_outputs,
                                unit_vectors)
 from chebnorm.hw.verilog import simulate
+from conftest import requires_tool, run_cli
 
-no_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                 reason="iverilog (Icarus Verilog) is not installed")
-no_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
+no_iverilog = requires_tool("iverilog")
+no_yosys = requires_tool("yosys")
 
 #: small widths keep simulation and synthesis fast; the structure is the same
 SMALL = dict(frac_bits=6, in_bits=8, out_bits=8)
@@ -179,18 +179,11 @@ class TestUnits:
 
 
 class TestCLI:
-    def run(self, argv, capsys):
-        from chebnorm.cli import main
-
-        code = main(argv)
-        out, err = capsys.readouterr()
-        return code, out, err
-
     @no_iverilog
     def test_unit_writes_and_passes(self, tmp_path, capsys):
-        code, out, _ = self.run(["hw", "unit", "quadratic", "--vector-frac-bits", "6", "--in-bits", "8",
-                                 "--out-bits", "8", "--vectors", "200", "-o", str(tmp_path),
-                                 "--simulate"], capsys)
+        code, out, _ = astuple(run_cli(["hw", "unit", "quadratic", "--vector-frac-bits", "6",
+                                        "--in-bits", "8", "--out-bits", "8", "--vectors", "200",
+                                        "-o", str(tmp_path), "--simulate"]))
         assert code == 0 and "PASS:" in out and " 0 mismatches" in out
         names = sorted(p.name for p in tmp_path.iterdir())
         assert names == ["chebnorm_quadratic_unit.hex", "chebnorm_quadratic_unit.v",
@@ -199,10 +192,10 @@ class TestCLI:
     def test_report_with_units(self, tmp_path, capsys):
         t = tmp_path / "t.json"
         fit_target("dichotomy", 2).save(t)
-        code, out, _ = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
-                                 "--coef-frac-bits", "12", "--json", "--no-gappa", "--no-synth",
-                                 "--unit", "dichotomy", "--unit", "classic",
-                                 "--vector-frac-bits", "6"], capsys)
+        code, out, _ = astuple(run_cli(["hw", "report", str(t), "--in-bits", "8",
+                                        "--out-bits", "8", "--coef-frac-bits", "12", "--json",
+                                        "--no-gappa", "--no-synth", "--unit", "dichotomy",
+                                        "--unit", "classic", "--vector-frac-bits", "6"]))
         assert code == 0
         units = json.loads(out)["units"]
         assert [u["unit"] for u in units] == ["dichotomy", "classic"]
@@ -218,15 +211,16 @@ class TestCLI:
     def test_errors_leave_nothing(self, tmp_path, capsys, extra, msg):
         out = tmp_path / "out"
         out.mkdir()
-        code, _, err = self.run(["hw", "unit", *extra, "-o", str(out)], capsys)
+        code, _, err = astuple(run_cli(["hw", "unit", *extra, "-o", str(out)]))
         assert code == 2 and msg in err and err.count("\n") == 1
         assert list(out.iterdir()) == []
 
     def test_report_unknown_unit(self, tmp_path, capsys):
         t = tmp_path / "t.json"
         fit_target("dichotomy", 2).save(t)
-        code, _, err = self.run(["hw", "report", str(t), "--in-bits", "8", "--out-bits", "8",
-                                 "--coef-frac-bits", "12", "--unit", "cordic"], capsys)
+        code, _, err = astuple(run_cli(["hw", "report", str(t), "--in-bits", "8",
+                                        "--out-bits", "8", "--coef-frac-bits", "12",
+                                        "--unit", "cordic"]))
         assert code == 2 and "unit 'cordic' is unknown" in err
 
 

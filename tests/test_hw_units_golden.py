@@ -6,7 +6,6 @@ tests/data/units_golden.json (made before the split)."""
 from __future__ import annotations
 
 import json
-import shutil
 
 import pytest
 
@@ -37,6 +36,6 @@ def test_cli_bytes_unchanged():
         assert got == want, key
 
 
-@pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
+@pytest.mark.requires_tool("yosys")
 def test_yosys_cells_unchanged():
     assert ug.yosys_cells() == GOLDEN["yosys_cells"]

@@ -10,11 +10,12 @@ from pathlib import Path
 import pytest
 
 import chebnorm as cn
-from chebnorm.cli import build_parser, main
+from chebnorm.cli import build_parser
 from chebnorm.cli.common import cli_flags, command_flags
 from chebnorm.hw import design_horner, design_unit, sweep
 from chebnorm.hw.piecewise import design_piecewise
 from chebnorm.hw.piecewise_search import search
+from conftest import run_cli
 
 SRC = Path(__file__).resolve().parent.parent / "src" / "chebnorm"
 
@@ -40,10 +41,11 @@ def _python_message(call) -> str:
     return str(exc.value)
 
 
-def _cli_line(argv, capsys) -> str:
-    capsys.readouterr()
-    assert main([str(a) for a in argv]) == 2
-    err = capsys.readouterr().err
+def _cli_line(argv) -> str:
+    """The one error line of ``chebnorm ARGV`` (exit status 2 required)."""
+    r = run_cli(*map(str, argv))
+    err = r.err
+    assert r.code == 2, err
     assert err.count("\n") == 1 and err.startswith("chebnorm: error: ") and "Traceback" not in err
     return err.strip()
 
@@ -134,7 +136,7 @@ def test_python_names_the_argument(tables, case):
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_cli_names_the_flag(tables, case, capsys, tmp_path):
     _, _, argv, says = CASES[case]
-    line = _cli_line(argv(tables["dir"], tmp_path), capsys)
+    line = _cli_line(argv(tables["dir"], tmp_path))
     assert says in line
     # no Python spelling of a width left over
     assert not re.search(r"(?<![\w.^])[a-z]+(?:_[a-z]+)*_(?:bits|m)\b", line), line

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import shutil
 from fractions import Fraction
 
 import mpmath
@@ -18,6 +17,7 @@ from chebnorm.hw.hdl.tables import table_module
 from chebnorm.hw.multipartite import OffsetTable, design_multipartite
 from chebnorm.hw.plain_table import design_plain_table
 from chebnorm.hw.table_run import simulate_table
+from conftest import requires_tool
 
 SPEC = ("1/sqrt(1+3*x)", ("0", "1"))
 
@@ -128,12 +128,11 @@ def test_banner_states_the_proof(mp12):
     assert "x * / y" in v          # command text inert
 
 
-needs_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog missing")
-needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl missing")
+needs_iverilog = requires_tool("iverilog")
+needs_ghdl = requires_tool("ghdl")
 
 
-@needs_iverilog
-@needs_ghdl
+@requires_tool("iverilog", "ghdl")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("language", ["verilog", "vhdl"])
 def test_hdl_bit_identical_12_bits(mp12, tmp_path, language):
     r = simulate_table(mp12, tmp_path / "mp", language)
@@ -158,8 +157,7 @@ def test_bench_catches_a_wrong_entry(mp12, tmp_path):
     assert not r.passed and r.mismatches == 2 ** (12 - mp12.tiv_bits)
 
 
-@needs_iverilog
-@needs_ghdl
+@requires_tool("iverilog", "ghdl")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("language", ["verilog", "vhdl"])
 def test_spec_16_bits_faithful_and_bit_identical(tmp_path, language):
     d = design_multipartite(*SPEC, 16, 16)

@@ -15,13 +15,10 @@ import threading
 import pytest
 
 from chebnorm.core.files import WriteError, write_all, write_atomic, write_folder
+from conftest import run_process
+from quiet_cli import run_cli_quiet as cli
 
 ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
-
-
-def cli(*args, cwd=None, **kw):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd, timeout=600, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +26,7 @@ def table(tmp_path_factory):
     d = tmp_path_factory.mktemp("table")
     r = cli("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", "--coef-frac-bits", "12",
             "-o", "t.json", cwd=d)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     return d / "t.json"
 
 
@@ -157,13 +154,15 @@ class TestCommands:
         path, reader = _fifo(tmp_path)
         r = cli("export", table, "--format", "c", "-o", path)
         reader.join(60)
-        assert r.returncode == 0, r.stderr
+        assert r.code == 0, r.err
         assert reader.data.startswith(b"/*") and b"#endif" in reader.data
         assert stat.S_ISFIFO(os.lstat(path).st_mode)
 
     def test_export_to_dev_stdout(self, table, system_links):
         before = os.readlink("/dev/stdout")
-        r = cli("export", table, "--format", "json", "-o", "/dev/stdout")
+        # a child process: /dev/stdout is the process's own fd 1, which an
+        # in-process run does not redirect
+        r = run_process("export", table, "--format", "json", "-o", "/dev/stdout")
         assert r.returncode == 0, r.stderr
         assert r.stdout == table.read_text()
         assert os.path.islink("/dev/stdout") and os.readlink("/dev/stdout") == before
@@ -173,7 +172,7 @@ class TestCommands:
         # `chebnorm export ... -o /dev/stdout >> log`: the file is appended to, not truncated
         log = tmp_path / "log.txt"
         log.write_text("earlier line\n")
-        with open(log, "a") as out:
+        with open(log, "a") as out:  # a child process: its fd 1 is the log file
             r = subprocess.run([sys.executable, "-m", "chebnorm", "export", str(table), "--format",
                                 "json", "-o", "/dev/stdout"], stdout=out, stderr=subprocess.PIPE,
                                text=True, check=False)
@@ -183,7 +182,7 @@ class TestCommands:
     def test_export_to_dev_null(self, table, system_links):
         st = os.stat("/dev/null")
         r = cli("export", table, "--format", "c", "-o", "/dev/null")
-        assert r.returncode == 0, r.stderr
+        assert r.code == 0, r.err
         after = os.lstat("/dev/null")
         assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (st.st_ino, st.st_rdev)
 
@@ -191,7 +190,7 @@ class TestCommands:
         (tmp_path / "tables").mkdir()
         (tmp_path / "t.json").symlink_to("tables/real.json")
         r = cli("fit", "x", "--interval", "0", "1", "--degree", "1", "-o", "t.json", cwd=tmp_path)
-        assert r.returncode == 0, r.stderr
+        assert r.code == 0, r.err
         assert (tmp_path / "t.json").is_symlink()
         assert '"degree": 1' in (tmp_path / "tables" / "real.json").read_text()
 
@@ -201,13 +200,13 @@ class TestCommands:
         # a folder where one of the outputs (the bench) goes: that write fails
         (out / "tb_chebnorm_table.v").mkdir()
         r = cli("hw", "verilog", table, "--in-bits", "8", "--out-bits", "8", "-o", out)
-        assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-        assert "tb_chebnorm_table.v" in r.stderr and "it is a directory" in r.stderr
+        assert r.code == 2 and r.err.count("\n") == 1, r.err
+        assert "tb_chebnorm_table.v" in r.err and "it is a directory" in r.err
         assert sorted(p.name for p in out.iterdir()) == ["tb_chebnorm_table.v"]
 
     def test_failed_render_writes_nothing(self, tmp_path):
         r = cli("render", "--mesh", "square", "--tess", "2", "--size", "16", "16",
                 "--out", "a.png", "--error-map", "missing/e.png", cwd=tmp_path)
-        assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-        assert "missing/e.png" in r.stderr
+        assert r.code == 2 and r.err.count("\n") == 1, r.err
+        assert "missing/e.png" in r.err
         assert list(tmp_path.iterdir()) == []

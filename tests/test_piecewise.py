@@ -5,9 +5,7 @@ the C export and the ROM + Horner hardware checked against independent computati
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
-import sys
 from fractions import Fraction
 
 import mpmath
@@ -19,6 +17,8 @@ from chebnorm.approx.piecewise_table import PiecewiseTable, parse_segments
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.export.c_piecewise import piecewise_c_header, piecewise_eval_bound
 from chebnorm.hw.piecewise import design_piecewise, simulate_piecewise
+from conftest import tool_missing
+from quiet_cli import run_cli_quiet
 
 RSQRT = parse_function("1/sqrt(x)")
 
@@ -107,13 +107,12 @@ def test_cli_errors_one_line(tmp_path):
     for extra in (["--segments", "2^13"], ["--segments", "4", "--degree", "-1"],
                   ["--segments", "4", "--interval", "-1", "4"]):
         argv = ["fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", *extra]
-        r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
-                           text=True, cwd=tmp_path, check=False)
-        assert r.returncode == 2, r.stderr
-        assert len(r.stderr.strip().splitlines()) == 1 and "accepted" in r.stderr
+        r = run_cli_quiet(*argv, cwd=tmp_path)
+        assert r.code == 2, r.err
+        assert len(r.err.strip().splitlines()) == 1 and "accepted" in r.err
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.requires_tool("gcc")
 @pytest.mark.parametrize("segment_by", ["uniform", "exponent"])
 def test_c_export_within_eval_bound(tmp_path, segment_by):
     interval = ("1", "4") if segment_by == "uniform" else ("1/4", "4")
@@ -145,7 +144,7 @@ def test_c_export_within_eval_bound(tmp_path, segment_by):
     assert bound < 2 * t.abs_error_bound
 
 
-@pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
+@pytest.mark.requires_tool("iverilog")
 def test_rsqrt_256_segments_hardware_bit_exact(tmp_path):
     """Acceptance: 8-bit index, degree 2, 16-bit in / 16-bit out: iverilog matches the
     model on all 65,536 inputs and the measured error stays within the stated bound."""
@@ -162,7 +161,7 @@ def test_rsqrt_256_segments_hardware_bit_exact(tmp_path):
     print(f"measured max error {m['max_error']:.4e} <= stated bound {b['total']:.4e}")
 
 
-@pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
+@pytest.mark.requires_tool("iverilog")
 @pytest.mark.parametrize("k, degree, centered", [(0, 3, False), (3, 1, True), (5, 2, True)])
 def test_small_designs_bit_exact(tmp_path, k, degree, centered):
     t = piecewise_fit("1/sqrt(x)", ("1", "4"), degree, segments=2 ** k, coef_frac_bits=18,
@@ -201,25 +200,22 @@ def test_design_cli(tmp_path):
     argv = ["design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "10", "--out-bits",
             "10", "--max-error", "2e-3", "--degrees", "1", "2", "--max-segments", "2^6",
             "--no-synth", "-o", str(tmp_path / "out")]
-    r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
-                       text=True, check=False)
-    assert r.returncode == 0, r.stderr
+    r = run_cli_quiet(*argv)
+    assert r.code == 0, r.err
     assert (tmp_path / "out" / "design_design.csv").read_text().startswith("degree,segments")
     assert (tmp_path / "out" / "design_design.png").stat().st_size > 1000
-    assert "winner: degree" in r.stdout
+    assert "winner: degree" in r.out
     bad = argv[:]
     bad[bad.index("2e-3")] = "-1"
-    r = subprocess.run([sys.executable, "-m", "chebnorm", *bad], capture_output=True,
-                       text=True, check=False)
-    assert r.returncode == 2 and "max-error" in r.stderr
-    assert len(r.stderr.strip().splitlines()) == 1
+    r = run_cli_quiet(*bad)
+    assert r.code == 2 and "max-error" in r.err
+    assert len(r.err.strip().splitlines()) == 1
 
 
 def test_cli_fit_export_hw(tmp_path):
     def cli(*argv, code=0):
-        r = subprocess.run([sys.executable, "-m", "chebnorm", *argv], capture_output=True,
-                           text=True, cwd=tmp_path, check=False)
-        assert r.returncode == code, r.stderr
+        r = run_cli_quiet(*argv, cwd=tmp_path)
+        assert r.code == code, r.err
         return r
 
     cli("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^3",
@@ -228,16 +224,16 @@ def test_cli_fit_export_hw(tmp_path):
     assert t.segment_count == 8
     cli("export", "rs.json", "-o", "rs.h", "--in-bits", "12")
     assert "chebnorm_rs_coeffs[8][3]" in (tmp_path / "rs.h").read_text()
-    if shutil.which("iverilog"):
+    if tool_missing("iverilog") is None:
         r = cli("hw", "verilog", "rs.json", "--in-bits", "10", "--out-bits", "10", "-o", "hw",
                 "--simulate")
-        assert "PASS: 1024 vectors, 0 mismatches" in r.stdout
+        assert "PASS: 1024 vectors, 0 mismatches" in r.out
     r = cli("hw", "report", "rs.json", "--in-bits", "10", "--out-bits", "10", "--no-synth",
             "--json")
-    rep = json.loads(r.stdout)
+    rep = json.loads(r.out)
     assert rep["within_budget"] and rep["measured"]["max_error"] <= rep["budget"]["total"]
     r = cli("hw", "verilog", "rs.json", "--in-bits", "3", "--out-bits", "10", "-o", "hw", code=2)
-    assert "--in-bits = 3 is out of range; accepted: 4 <= --in-bits <= 20" in r.stderr
+    assert "--in-bits = 3 is out of range; accepted: 4 <= --in-bits <= 20" in r.err
 
 
 def test_one_width_run_in_int64_only_where_proved_exact():

@@ -3,7 +3,6 @@ Horner steps, pipelining -- certified bound, bit-exact HDL, cycle-accurate pipel
 
 from __future__ import annotations
 
-import shutil
 from fractions import Fraction
 from pathlib import Path
 
@@ -14,6 +13,7 @@ from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.core.files import write_folder
 from chebnorm.hw.hdl import hdl_files
 from chebnorm.hw.piecewise import design_piecewise, shape_cost, sized_bound
+from conftest import tool_missing
 
 SPEC = ("1/sqrt(1+3*x)", ("0", "1"))
 
@@ -142,7 +142,8 @@ def _simulate(d, tmp_path, language):
     return (simulate if language == "verilog" else simulate_vhdl)(out, d)
 
 
-_HAVE = {"verilog": shutil.which("iverilog") is not None, "vhdl": shutil.which("ghdl") is not None}
+#: the simulator each HDL needs
+_SIMULATOR = {"verilog": "iverilog", "vhdl": "ghdl"}
 
 
 @pytest.mark.parametrize("language", ["verilog", "vhdl"])
@@ -158,8 +159,8 @@ _HAVE = {"verilog": shutil.which("iverilog") is not None, "vhdl": shutil.which("
 ])
 def test_hdl_bit_exact_small(tmp_path, language, expr, interval, degree, segments, centered,
                              pipeline, multipliers):
-    if not _HAVE[language]:
-        pytest.skip(f"{language} simulator not installed")
+    if reason := tool_missing(_SIMULATOR[language]):
+        pytest.skip(reason)
     t = _table(expr, interval, degree, segments, centered=centered)
     approx = max(s.abs_error_bound for s in t.segments)
     d = design_piecewise(t, 10, 10, widths="auto", max_error=approx + 2 ** -9,
@@ -178,8 +179,8 @@ def test_spec_16_bit_faithful_pipelined_exhaustive(tmp_path, language, degree, s
     multipliers, fully pipelined (the generic winner in Verilog, the xc7 LUT winner in
     VHDL): every one of the 65,536 codes simulated one per cycle matches the model after
     the latency, and the exact |y - f| stays below the certified bound < 2^-16."""
-    if not _HAVE[language]:
-        pytest.skip(f"{language} simulator not installed")
+    if reason := tool_missing(_SIMULATOR[language]):
+        pytest.skip(reason)
     t = piecewise_fit(*SPEC, degree, segments=segments, coef_frac_bits=26, centered=centered,
                       name="rs")
     d = design_piecewise(t, 16, 16, widths="auto", pipeline="full", multipliers="truncated")
@@ -220,7 +221,7 @@ def test_explicit_widths_edge_shifts(tmp_path, widths, multipliers, pipeline):
     assert max(_datapath_error(d)) <= Fraction(d.budget()["datapath"])
     assert d.measure()["max_error"] <= d.budget()["total"]
     for language in ("verilog", "vhdl"):
-        if _HAVE[language]:
+        if tool_missing(_SIMULATOR[language]) is None:
             sim = _simulate(d, tmp_path, language)
             assert sim.passed and sim.mismatches == 0, sim.line
 

@@ -11,6 +11,7 @@ import pytest
 from chebnorm.raster import (Lighting, Mesh, bump_comparison, compare, error_map_rgb, eta_study,
                              get_mesh, render, setup_spans, split_gouraud_study, write_png, zbuffer)
 from chebnorm.raster import meshes as M
+from conftest import run_cli
 
 SMALL = (64, 64)
 
@@ -223,16 +224,12 @@ class TestMetrics:
 
 # --------------------------------------------------------------------- CLI
 class TestCLI:
-    def run(self, *argv):
-        from chebnorm.cli import main
-        return main(list(argv))
-
     def test_json_and_images(self, tmp_path, capsys):
         out, err = tmp_path / "img.png", tmp_path / "err.png"
-        rc = self.run("render", "--mesh", "sphere", "--tess", "8", "--shading", "gouraud",
-                      "--size", "48", "40", "--out", str(out), "--error-map", str(err), "--json")
-        assert rc == 0
-        d = json.loads(capsys.readouterr().out)
+        r = run_cli("render", "--mesh", "sphere", "--tess", "8", "--shading", "gouraud",
+                    "--size", "48", "40", "--out", str(out), "--error-map", str(err), "--json")
+        assert r.code == 0, r.err
+        d = json.loads(r.out)
         for key in ("max_abs_8bit", "pixels_off_1", "mean_abs_8bit", "psnr", "ssim", "flip",
                     "pixels", "seconds", "vertices_shaded"):
             assert key in d
@@ -240,9 +237,9 @@ class TestCLI:
         assert Image.open(out).size == (48, 40) and Image.open(err).mode == "RGB"
 
     def test_reference_option(self, capsys):
-        rc = self.run("render", "--mesh", "sphere", "--tess", "8", "--shading", "gouraud",
-                      "--size", "32", "32", "--reference", "gouraud", "--json")
-        assert rc == 0 and json.loads(capsys.readouterr().out)["max_abs_8bit"] == 0
+        r = run_cli("render", "--mesh", "sphere", "--tess", "8", "--shading", "gouraud",
+                    "--size", "32", "32", "--reference", "gouraud", "--json")
+        assert r.code == 0 and json.loads(r.out)["max_abs_8bit"] == 0
 
     @pytest.mark.parametrize("argv, message", [
         (["--mesh", "cube"], "unknown mesh"),
@@ -254,8 +251,8 @@ class TestCLI:
     ])
     def test_errors_exit_2_one_line_no_image(self, tmp_path, capsys, argv, message):
         out = tmp_path / "img.png"
-        rc = self.run("render", "--size", "32", "32", "--mesh", "sphere", *argv, "--out", str(out))
-        err = capsys.readouterr().err
+        r = run_cli("render", "--size", "32", "32", "--mesh", "sphere", *argv, "--out", str(out))
+        rc, err = r.code, r.err
         assert rc == 2 and message in err and err.count("\n") == 1
         assert not out.exists()
 

@@ -14,24 +14,22 @@ from __future__ import annotations
 import json
 import math
 import re
-import shutil
 import sys
 from pathlib import Path
 
 import pytest
 
-from chebnorm.cli import main
+from conftest import run_cli, tool_missing
 
 README = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
 
 
-def _run(capsys, *argv) -> str:
-    """``chebnorm ARGV`` in this process; its stdout (exit status 0 required)."""
-    capsys.readouterr()
-    status = main(list(argv))
-    out = capsys.readouterr().out
-    assert status in (0, None), f"chebnorm {' '.join(argv)} exited {status}"
-    return out
+def _run(*argv) -> str:
+    """``chebnorm ARGV`` in this process (:func:`conftest.run_cli`); its stdout
+    (exit status 0 required)."""
+    r = run_cli(*argv)
+    assert r.code == 0, f"chebnorm {' '.join(argv)} exited {r.code}: {r.err}"
+    return r.out
 
 
 def _section(title: str) -> str:
@@ -47,13 +45,13 @@ def test_first_fit_console_block_is_verbatim(capsys):
     assert block, "README's first fit lost its console block"
     command, quoted = block.group(1), block.group(2)
     assert command == 'chebnorm fit "1/sqrt(2+z)" --var z --interval "sqrt(2)" 2 --degree 2'
-    out = _run(capsys, "fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2")
+    out = _run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2")
     assert out == quoted
 
 
 def test_first_fit_minimax_optimum(capsys):
     quoted = re.search(r"`--kind minimax` gives the optimum, ([0-9.e-]+)\.", _section("## A first fit")).group(1)
-    out = _run(capsys, "fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2",
+    out = _run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2",
                "--kind", "minimax")
     located = re.search(r"max \|p - f\|\s+= ([0-9.e+-]+)", out).group(1)
     # quoted to 4 digits: the located maximum (the optimum's value) rounded there
@@ -65,7 +63,7 @@ def test_fixed_point_comparison(capsys):
     m = re.search(r"it now gives `\[([-0-9, ]+)\]`, ([0-9.e-]+), and Sollya", text)
     assert m, "README's fixed-point comparison changed shape"
     integers, bound = m.group(1), m.group(2)
-    out = _run(capsys, "fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2",
+    out = _run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2",
                "--coef-frac-bits", "14")
     assert f"lattice): [{integers}]; certified |p_q - f| <= {bound}" in out
 
@@ -88,10 +86,10 @@ def test_worked_hardware_example(capsys, tmp_path, monkeypatch):
     commands, quoted = _worked_example()
     assert commands[0].startswith('chebnorm fit "1/sqrt(x)" --interval 1 4 --degree 2 --segments 2^8')
     monkeypatch.chdir(tmp_path)
-    _run(capsys, "fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^8",
+    _run("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^8",
          "--kind", "minimax", "--coef-frac-bits", "24", "--name", "rsqrt", "-o", "rsqrt.json")
-    synth = shutil.which("yosys") is not None
-    out = _run(capsys, "hw", "report", "rsqrt.json", "--in-bits", "16", "--out-bits", "16",
+    synth = tool_missing("yosys") is None  # the README's figures with or without synthesis
+    out = _run("hw", "report", "rsqrt.json", "--in-bits", "16", "--out-bits", "16",
                *(() if synth else ("--no-synth",)))
     report = " ".join(out.split())
     text = _joined(quoted)
@@ -105,14 +103,14 @@ def test_worked_hardware_example(capsys, tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not installed")
+@pytest.mark.requires_tool("iverilog")
 def test_worked_hardware_example_simulates(capsys, tmp_path, monkeypatch):
     _commands, quoted = _worked_example()
     passed = next(q for q in quoted if q.startswith("PASS:"))
     monkeypatch.chdir(tmp_path)
-    _run(capsys, "fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^8",
+    _run("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "2", "--segments", "2^8",
          "--kind", "minimax", "--coef-frac-bits", "24", "--name", "rsqrt", "-o", "rsqrt.json")
-    out = _run(capsys, "hw", "verilog", "rsqrt.json", "--in-bits", "16", "--out-bits", "16", "-o", "hw",
+    out = _run("hw", "verilog", "rsqrt.json", "--in-bits", "16", "--out-bits", "16", "-o", "hw",
                "--simulate")
     assert passed in out
 
@@ -182,7 +180,7 @@ def _verify_rows():
     return {tuple(c.strip() for c in r.split("|")[1:3]): r for r in block}
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.requires_tool("gcc")
 def test_verify_table_is_what_verify_measures():
     """Every row of the README's ``chebnorm verify`` table is measured again on
     the committed table: the unfused C evaluators (IEEE arithmetic, the same

@@ -35,6 +35,7 @@ from chebnorm.cli.repro import (
 )
 from chebnorm.methods import detmath
 from paper_repro.style import stable_svg_ids
+from quiet_cli import run_cli_quiet
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -336,23 +337,20 @@ def test_repro_prints_one_line_when_versions_differ(tmp_path):
     out.mkdir()
     rec = dict(installed_versions(), mpmath="0.1")
     (out / "provenance.json").write_text(json.dumps({"versions": rec}))
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", "repro", "coefficients", "-o", str(out)],
-                          capture_output=True, text=True, cwd=tmp_path, check=False)
-    assert proc.returncode == 0, proc.stderr
-    lines = [ln for ln in proc.stderr.splitlines() if "versions differ" in ln]
-    assert len(lines) == 1 and "mpmath" in lines[0] and "numpy" not in lines[0], proc.stderr
+    proc = run_cli_quiet("repro", "coefficients", "-o", out, cwd=tmp_path)
+    assert proc.code == 0, proc.err
+    lines = [ln for ln in proc.err.splitlines() if "versions differ" in ln]
+    assert len(lines) == 1 and "mpmath" in lines[0] and "numpy" not in lines[0], proc.err
     assert json.loads((out / "provenance.json").read_text())["versions"] == installed_versions()
-    again = subprocess.run([sys.executable, "-m", "chebnorm", "repro", "coefficients", "-o", str(out)],
-                           capture_output=True, text=True, cwd=tmp_path, check=False)
-    assert "versions differ" not in again.stderr
+    again = run_cli_quiet("repro", "coefficients", "-o", out, cwd=tmp_path)
+    assert "versions differ" not in again.err
 
 
 def test_repro_refuses_a_missing_bench_results_file(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", "repro", "coefficients", "-o",
-                           str(tmp_path / "o"), "--bench-results", str(tmp_path / "none.json")],
-                          capture_output=True, text=True, cwd=tmp_path, check=False)
-    assert proc.returncode == 2
-    assert len(proc.stderr.strip().splitlines()) == 1 and "--bench-results" in proc.stderr
+    proc = run_cli_quiet("repro", "coefficients", "-o", tmp_path / "o", "--bench-results",
+                         tmp_path / "none.json", cwd=tmp_path)
+    assert proc.code == 2
+    assert len(proc.err.strip().splitlines()) == 1 and "--bench-results" in proc.err
 
 
 def test_ledger_dir_rule(tmp_path, monkeypatch):

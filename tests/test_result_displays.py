@@ -6,7 +6,6 @@ characters of dataclass text."""
 from __future__ import annotations
 
 import dataclasses
-import shutil
 import warnings
 
 import numpy as np
@@ -111,7 +110,7 @@ def test_arrays_show_their_shape_not_their_values(results):
     assert isinstance(mesh.positions, np.ndarray)
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.requires_tool("gcc")
 def test_verify_variants_display_briefly():
     from chebnorm.export.verify import verify
 

@@ -5,13 +5,11 @@ input, and an interrupted sweep keeping its finished rows."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
 from chebnorm.cli import main
+from conftest import run_process
 
 DESIGN = ["design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "8", "--out-bits", "8",
           "--max-error", "1e-2", "--degrees", "1", "2", "--max-segments", "2^4", "--no-synth"]
@@ -20,11 +18,6 @@ PIECEWISE_SWEEP = ["hw", "sweep", "--segments", "2^1", "2^2", "--degrees", "1", 
 RENDER = ["render-sweep", "--meshes", "sphere", "torus", "--shadings", "phong", "gouraud",
           "bump", "--methods", "exact", "none", "dichotomy", "--sizes", "48", "40x32",
           "--bumps", "full", "square"]
-
-
-def _cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *args], cwd=cwd,
-                          capture_output=True, text=True)
 
 
 def _files(folder):
@@ -51,8 +44,10 @@ def cluster():
 ], ids=["design", "hw-sweep-segments"])
 def test_design_same_bytes_for_any_workers(tmp_path, cluster, argv, outputs):
     runs = {"1": ["--workers", "1"], "2": ["--workers", "2"], "dask": ["--scheduler", cluster]}
+    # each run a fresh process, as from a shell: the runs compared for equal bytes share
+    # no caches and no hash seed (in this process they would share both)
     for name, extra in runs.items():
-        r = _cli(*argv, *extra, "-o", str(tmp_path / name), cwd=tmp_path)
+        r = run_process(*argv, *extra, "-o", str(tmp_path / name), cwd=tmp_path)
         assert r.returncode == 0, r.stderr
     serial = _files(tmp_path / "1")
     assert sorted(serial) == sorted(outputs)
@@ -81,8 +76,10 @@ def test_design_search_library_matches_serial():
 @pytest.mark.slow
 def test_render_sweep_same_bytes_for_any_workers(tmp_path, cluster):
     runs = {"1": ["--workers", "1"], "2": ["--workers", "2"], "dask": ["--scheduler", cluster]}
+    # each run a fresh process, as from a shell: the runs compared for equal bytes share
+    # no caches and no hash seed (in this process they would share both)
     for name, extra in runs.items():
-        r = _cli(*RENDER, "--images", *extra, "-o", str(tmp_path / name), cwd=tmp_path)
+        r = run_process(*RENDER, "--images", *extra, "-o", str(tmp_path / name), cwd=tmp_path)
         assert r.returncode == 0, r.stderr
     serial = _files(tmp_path / "1")
     assert _files(tmp_path / "2") == serial and _files(tmp_path / "dask") == serial

@@ -13,9 +13,7 @@ from __future__ import annotations
 import json
 import math
 import re
-import shutil
 import subprocess
-import sys
 from dataclasses import replace
 from decimal import Decimal
 from fractions import Fraction
@@ -31,6 +29,8 @@ from chebnorm.approx.contract import construction
 from chebnorm.export import c_header
 from chebnorm.export.shader import (SHADER_LANGUAGES, float32_eval_bound, float32_literal,
                                     shader_source)
+from conftest import requires_tool, run_cli
+from quiet_cli import run_cli_quiet
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = sorted((ROOT / "figures" / "coefficients").glob("*.json"))
@@ -246,9 +246,7 @@ def test_hostile_names_refused(name):
 
 # -- glslangValidator -----------------------------------------------------------------------
 
-need_glslang = pytest.mark.skipif(shutil.which("glslangValidator") is None,
-                                  reason="glslangValidator not installed (apt-get install "
-                                  "glslang-tools)")
+need_glslang = requires_tool("glslangValidator")
 
 
 @need_glslang
@@ -363,10 +361,8 @@ def test_wgsl_invalid_module_is_rejected(wgpu_device):
 
 # -- VHDL -----------------------------------------------------------------------------------
 
-need_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None,
-                               reason="ghdl not installed (apt-get install ghdl)")
-need_iverilog = pytest.mark.skipif(shutil.which("iverilog") is None,
-                                   reason="iverilog not installed")
+need_ghdl = requires_tool("ghdl")
+need_iverilog = requires_tool("iverilog", "vvp")
 
 
 def _verilog_dump(directory: Path, design) -> Path:
@@ -400,17 +396,14 @@ def _verilog_dump(directory: Path, design) -> Path:
 def _hw(tmp_path, table_path, in_bits, out_bits, *extra):
     out = tmp_path / "hw"
     for lang in ("verilog", "vhdl"):
-        proc = subprocess.run([sys.executable, "-m", "chebnorm", "hw", "verilog", str(table_path),
-                               "--in-bits", str(in_bits), "--out-bits", str(out_bits),
-                               "--lang", lang, "-o", str(out), "--simulate", *extra],
-                              capture_output=True, text=True)
-        assert proc.returncode == 0, proc.stderr
-        assert "FAIL" not in proc.stdout
-    return out, proc.stdout
+        proc = run_cli("hw", "verilog", table_path, "--in-bits", str(in_bits), "--out-bits",
+                       str(out_bits), "--lang", lang, "-o", out, "--simulate", *extra)
+        assert proc.code == 0, proc.err
+        assert "FAIL" not in proc.out
+    return out, proc.out
 
 
-@need_ghdl
-@need_iverilog
+@requires_tool("ghdl", "iverilog", "vvp")  # one marker: the hook reads the closest only
 @pytest.mark.slow
 def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
     """Acceptance: 65,536 codes, 0 mismatches in GHDL, and GHDL's outputs equal
@@ -428,8 +421,7 @@ def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
     assert vhdl == (out / "chebnorm_dichotomy_d2.hex").read_text().split()
 
 
-@need_ghdl
-@need_iverilog
+@requires_tool("ghdl", "iverilog", "vvp")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("table,bits,kw", [
     ("rsqrt_d3.json", 9, {"rounding": "trunc"}),
     ("midpoint_d1.json", 8, {}),
@@ -507,20 +499,15 @@ def test_vhdl_refuses_names_vhdl_cannot_spell(name):
 
 # -- CLI ------------------------------------------------------------------------------------
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *args], capture_output=True,
-                          text=True)
-
-
 @pytest.mark.parametrize("fmt,marker", [("glsl", "float chebnorm_rsqrt_d3(float x)"),
                                         ("wgsl", "fn chebnorm_rsqrt_d3(x: f32) -> f32 {"),
                                         ("hlsl", "mad(acc, x, "), ("c", "#ifndef"),
                                         ("json", '"schema_version"')])
 def test_cli_export_formats(tmp_path, fmt, marker):
     out = tmp_path / f"o.{fmt}"
-    proc = _cli("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format", fmt,
+    proc = run_cli_quiet("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format", fmt,
                 "-o", str(out))
-    assert proc.returncode == 0, proc.stderr
+    assert proc.code == 0, proc.err
     assert marker in out.read_text()
     if fmt != "json":
         assert "Command: " in out.read_text()
@@ -529,9 +516,9 @@ def test_cli_export_formats(tmp_path, fmt, marker):
 @need_ghdl
 def test_cli_export_vhdl(tmp_path):
     out = tmp_path / "e.vhd"
-    proc = _cli("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format", "vhdl",
+    proc = run_cli_quiet("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format", "vhdl",
                 "--in-bits", "10", "--out-bits", "10", "-o", str(out))
-    assert proc.returncode == 0, proc.stderr
+    assert proc.code == 0, proc.err
     text = out.read_text()
     assert "entity chebnorm_rsqrt_d3 is" in text and "entity chebnorm_rsqrt_d3_pipe is" in text
     subprocess.run(["ghdl", "-a", "--std=08", str(out)], cwd=tmp_path, check=True)
@@ -543,22 +530,22 @@ def test_cli_export_vhdl(tmp_path):
     (("--format", "spirv"), "unknown export format 'spirv'"),
 ])
 def test_cli_export_errors(tmp_path, args, message):
-    proc = _cli("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), *args,
+    proc = run_cli_quiet("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), *args,
                 "-o", str(tmp_path / "x"))
-    assert proc.returncode == 2
-    assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert proc.code == 2
+    assert message in proc.err and len(proc.err.strip().splitlines()) == 1
     assert not (tmp_path / "x").exists()
 
 
 def test_cli_hw_lang_choices(tmp_path):
-    proc = _cli("hw", "verilog", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--in-bits",
+    proc = run_cli_quiet("hw", "verilog", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--in-bits",
                 "8", "--out-bits", "8", "--lang", "spice", "-o", str(tmp_path))
-    assert proc.returncode == 2 and "invalid choice: 'spice'" in proc.stderr
+    assert proc.code == 2 and "invalid choice: 'spice'" in proc.err
 
 
 def test_json_export_roundtrips(tmp_path):
     out = tmp_path / "t.json"
-    assert _cli("export", str(TABLES[0]), "--format", "json", "-o", str(out)).returncode == 0
+    assert run_cli_quiet("export", str(TABLES[0]), "--format", "json", "-o", str(out)).code == 0
     assert json.loads(out.read_text()) == json.loads(TABLES[0].read_text())
 
 
@@ -586,9 +573,9 @@ def test_vhdl_matches_the_model_on_fresh_fits(tmp_path, spec):
 @need_iverilog
 def test_cli_export_verilog(tmp_path):
     out = tmp_path / "e.v"
-    proc = _cli("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format",
+    proc = run_cli_quiet("export", str(ROOT / "figures/coefficients/rsqrt_d3.json"), "--format",
                 "verilog", "--in-bits", "10", "--out-bits", "10", "-o", str(out))
-    assert proc.returncode == 0, proc.stderr
+    assert proc.code == 0, proc.err
     text = out.read_text()
     assert "module chebnorm_rsqrt_d3 #(" in text and "module chebnorm_rsqrt_d3_pipe #(" in text
     subprocess.run(["iverilog", "-g2005", "-o", str(tmp_path / "a.out"), str(out)], check=True)

@@ -9,9 +9,6 @@ DSP48E1 (25 x 18 ports); a DSP48E1 weighs 63,400 / 240 LUTs (xc7a100t counts).
 from __future__ import annotations
 
 import json
-import shutil
-import subprocess
-import sys
 
 import pytest
 
@@ -19,10 +16,11 @@ from chebnorm.hw.target_model import (MODEL_SPREAD, DesignFeatures, dsp_count, d
                                       horner_features, model_score, piecewise_features)
 from chebnorm.hw.targets import (cost_from_types, fmax_ice40, get_target, register_wrapper,
                                  synthesize_target, target_names)
+from conftest import requires_tool
+from quiet_cli import run_cli_quiet as cli
 
-no_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
-no_pnr = pytest.mark.skipif(shutil.which("yosys") is None or shutil.which("nextpnr-ice40") is None,
-                            reason="yosys and nextpnr-ice40 are needed (Debian nextpnr-ice40)")
+no_yosys = requires_tool("yosys")
+no_pnr = requires_tool("yosys", "nextpnr-ice40")
 
 LUT6 = """module f6(input wire [5:0] a, output wire y);
     assign y = (a[0] & a[1]) ^ (a[2] | a[3]) ^ (a[4] & ~a[5]);
@@ -187,17 +185,11 @@ def test_model_within_its_measured_spread(target):
         assert max(pred / real, real / pred) <= MODEL_SPREAD[target], (top, real, pred)
 
 
-def cli(*args, cwd, timeout=600):
-    return subprocess.run([sys.executable, "-m", "chebnorm", *map(str, args)], cwd=cwd,
-                          capture_output=True, text=True, timeout=timeout,
-                          stdin=subprocess.DEVNULL)
-
-
 def test_cli_refuses_a_bad_target(tmp_path):
     r = cli("design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "8", "--out-bits", "8",
             "--max-error", "1e-2", "--target", "xc9", "-o", "out", cwd=tmp_path)
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
-    assert "accepted: generic, xc7, xc7-nodsp, ice40" in r.stderr
+    assert r.code == 2 and len(r.err.strip().splitlines()) == 1
+    assert "accepted: generic, xc7, xc7-nodsp, ice40" in r.err
     assert not (tmp_path / "out").exists()
 
 
@@ -206,7 +198,7 @@ def test_cli_design_target_xc7(tmp_path):
     r = cli("design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "10", "--out-bits", "10",
             "--max-error", "2e-3", "--degrees", "1", "2", "--target", "xc7", "--workers", "1",
             "--name", "rs", "-o", "out", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     rows = (tmp_path / "out" / "design_rs.csv").read_text().splitlines()
     head = rows[0].split(",")
     assert head[-8:] == ["target", "target_model", "target_score", "luts", "dsps", "carries",
@@ -220,23 +212,23 @@ def test_cli_design_target_xc7(tmp_path):
             arch = list(csv.DictReader(fh))
         won = [x for x in arch if x["winner"] == "1"]
         assert len(won) == 1 and won[0]["architecture"] != "piecewise" and won[0]["score"], arch
-    assert "winner xc7: " in r.stdout and "Fmax ~" in r.stdout
+    assert "winner xc7: " in r.out and "Fmax ~" in r.out
 
 
 @no_yosys
 def test_cli_hw_report_target_json(tmp_path):
     r = cli("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "1", "--segments", "8",
             "--coef-frac-bits", "12", "-o", "t.json", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     r = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--target",
             "xc7-nodsp", "--json", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
-    t = json.loads(r.stdout)["target"]
+    assert r.code == 0, r.err
+    t = json.loads(r.out)["target"]
     assert t["target"] == "xc7-nodsp" and t["dsps"] == 0 and t["luts"] > 0
     assert t["latency_cycles"] == 0 and "model" in t["fmax_source"]
     r = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--target", "xc7",
             "--no-synth", cwd=tmp_path)
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert r.code == 2 and len(r.err.strip().splitlines()) == 1
 
 
 def test_search_default_target_is_generic_and_other_targets_add_columns():
@@ -261,15 +253,15 @@ def test_cli_hw_report_target_coefficient_table(tmp_path):
     r = cli("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "2", "--coef-frac-bits", "14",
             "-o", "t.json",
             cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
+    assert r.code == 0, r.err
     plain = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--no-gappa",
                 cwd=tmp_path)
     r = cli("hw", "report", "t.json", "--in-bits", "10", "--out-bits", "10", "--no-gappa",
             "--target", "generic", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
-    extra = r.stdout[len(plain.stdout):].splitlines()
-    assert r.stdout.startswith(plain.stdout)        # the report as before, then the target
-    cells = int(plain.stdout.split("yosys: ")[1].split()[0])
+    assert r.code == 0, r.err
+    extra = r.out[len(plain.out):].splitlines()
+    assert r.out.startswith(plain.out)        # the report as before, then the target
+    cells = int(plain.out.split("yosys: ")[1].split()[0])
     assert extra[0] == f"target generic: {cells} cells"
     assert extra[1].startswith("timing: ") and "gate levels" in extra[1]
 

@@ -10,35 +10,31 @@ lists, fixed relative file names in a private folder, and ``TMPDIR=.``."""
 from __future__ import annotations
 
 import os
-import shutil
-import subprocess
-import sys
 
 import pytest
 
 from chebnorm.hw.verilog import synthesize_text
+from conftest import requires_tool, run_cli, run_process
 
-needs = pytest.mark.skipif(not (shutil.which("yosys") and shutil.which("iverilog")),
-                           reason="yosys and iverilog needed")
+needs = requires_tool("yosys", "iverilog")
 
 #: a directory name with a space, both quotes, ``;``, ``!``, ``$`` and a backquote
 NASTY = "sp ace 'q\"uo;te!bang $HOME `id`"
 
 
-def cli(*args, cwd, tmpdir, timeout=300):
-    env = dict(os.environ, TMPDIR=str(tmpdir))
-    return subprocess.run([sys.executable, "-m", "chebnorm", *map(str, args)], cwd=cwd,
-                          env=env, capture_output=True, text=True, timeout=timeout,
-                          stdin=subprocess.DEVNULL)
+def cli(*args, cwd, tmpdir):
+    """``chebnorm ARGS`` as a child process started with ``TMPDIR=tmpdir``: the
+    variable is read when the process starts (tempfile caches it), so the process
+    is the point here."""
+    return run_process(*args, cwd=cwd, env=dict(os.environ, TMPDIR=str(tmpdir)), timeout=300,
+                       input="")  # stdin at end of file, as from /dev/null
 
 
 @pytest.fixture(scope="module")
 def table(tmp_path_factory):
     d = tmp_path_factory.mktemp("tbl")
-    r = subprocess.run([sys.executable, "-m", "chebnorm", "fit", "1/sqrt(x)", "--interval", "1",
-                        "2", "--degree", "1", "-o", "t.json"], cwd=d, capture_output=True,
-                       text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
+    r = run_cli("fit", "1/sqrt(x)", "--interval", "1", "2", "--degree", "1", "-o", "t.json", cwd=d)
+    assert r.code == 0, r.err
     return d / "t.json"
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from dataclasses import astuple
 from pathlib import Path
 
 import mpmath
@@ -25,17 +26,12 @@ from chebnorm.approx import CoefficientTable, fit
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.cli import main
+from conftest import run_cli
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "figures" / "coefficients" / "dichotomy_d2.json"  # 1/sqrt(z + 2) on [sqrt(2), 2]
 PW_ARGS = ["fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "1", "--segments", "2^5",
            "--kind", "minimax", "--coef-frac-bits", "11"]
-
-
-def run_cli(argv, capsys):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def refused(code, err, pattern):
@@ -87,7 +83,7 @@ def test_forged_piecewise_relative_bound_refused_by_every_consumer(piecewise_fil
     forged = tmp_path / "forged.json"
     forged.write_text(json.dumps(d))
     for argv in _consumers(forged, tmp_path):
-        code, _, err = run_cli(argv, capsys)
+        code, _, err = astuple(run_cli(argv))
         refused(code, err, "rel_error_bound: expected null (error_kind is 'abs'")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["forged.json"]
 
@@ -107,7 +103,7 @@ def test_forged_error_kind_and_top_level_bounds_refused(tmp_path, capsys):
     for message, change in cases.items():
         forged = tmp_path / "forged.json"
         forged.write_text(json.dumps({**good, **change}))
-        code, _, err = run_cli(["export", forged, "--format", "c", "-o", tmp_path / "t.h"], capsys)
+        code, _, err = astuple(run_cli(["export", forged, "--format", "c", "-o", tmp_path / "t.h"]))
         refused(code, err, message)
     # the same in memory
     table = PiecewiseTable.load(path)
@@ -185,12 +181,12 @@ def test_piecewise_replace_with_a_forged_segment_is_refused():
 @pytest.mark.parametrize("expr, lo, hi", [("x**1024", "0", "2"), ("sin(x)", "0", "1e300")])
 def test_non_finite_bound_refused_at_fit(expr, lo, hi, tmp_path, capsys):
     out = tmp_path / "I.json"
-    code, stdout, err = run_cli(["fit", expr, "--interval", lo, hi, "--degree", "2", "-o", out],
-                                capsys)
+    code, stdout, err = astuple(run_cli(["fit", expr, "--interval", lo, hi, "--degree", "2",
+                                         "-o", out]))
     refused(code, err, "beyond the float64 range")
     assert not out.exists() and stdout == ""
-    code, stdout, err = run_cli(["fit", expr, "--interval", lo, hi, "--degree", "2", "--json"],
-                                capsys)
+    code, stdout, err = astuple(run_cli(["fit", expr, "--interval", lo, hi, "--degree", "2",
+                                         "--json"]))
     refused(code, err, "beyond the float64 range")
     assert stdout == ""
     with pytest.raises(ValueError, match=r"^abs_error_bound: the certified value is inf"):
@@ -212,8 +208,8 @@ def test_json_is_written_strictly():
 @pytest.mark.parametrize("name", ['a"b', "a\nb", "*/", "été", "", "a b"])
 def test_fit_name_refused_at_the_source(name, tmp_path, capsys):
     out = tmp_path / "N.json"
-    code, _, err = run_cli(["fit", "exp(x)", "--interval", "0", "1", "--degree", "1",
-                            "--name", name, "-o", out], capsys)
+    code, _, err = astuple(run_cli(["fit", "exp(x)", "--interval", "0", "1", "--degree", "1",
+                                    "--name", name, "-o", out]))
     refused(code, err, "--name: ")
     assert "[A-Za-z_][A-Za-z0-9_]*" in err and not out.exists()
     with pytest.raises(ValueError, match=r"^name: .* is not an identifier: expected "
@@ -293,7 +289,7 @@ def test_duplicate_json_keys_refused(piecewise_file, tmp_path, capsys):
     path.write_text(dup)
     with pytest.raises(ValueError, match=r"key 'abs_error_bound' appears twice"):
         CoefficientTable.load(path)
-    code, _, err = run_cli(["export", path, "-o", tmp_path / "t.h"], capsys)
+    code, _, err = astuple(run_cli(["export", path, "-o", tmp_path / "t.h"]))
     refused(code, err, "key 'abs_error_bound' appears twice in one object")
     pw = piecewise_file.read_text().replace('"name": ', '"name": "x", "name": ', 1)
     path.write_text(pw)

@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import astuple
 
 import numpy as np
 import pytest
@@ -17,13 +18,7 @@ import pytest
 import chebnorm as cn
 from chebnorm.approx.expr import parse_function, read_expression
 from chebnorm.cli import main
-
-
-def _run(argv, capsys):
-    """``chebnorm ARGV`` in-process: (status, stdout, stderr)."""
-    status = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return status, out, err
+from conftest import run_cli
 
 
 def _one_line(err: str) -> str:
@@ -60,8 +55,8 @@ def table_file(tmp_path_factory):
 # ------------------------------------------------------------------ item 9
 def test_fit_undefined_at_a_chebyshev_node(capsys):
     # the degree-2 Chebyshev nodes on [-1, 1] include x = 0, where 1/x**2 divides by zero
-    status, _, err = _run(["fit", "exp(-1/x**2)", "--interval", "-1", "1", "--degree", "2"],
-                          capsys)
+    status, _, err = astuple(run_cli(["fit", "exp(-1/x**2)", "--interval", "-1", "1",
+                                      "--degree", "2"]))
     line = _one_line(err)
     assert status == 2 and "undefined at x = 0" in line and "accepted:" in line
     with pytest.raises(ValueError, match="undefined at x = 0"):
@@ -69,8 +64,8 @@ def test_fit_undefined_at_a_chebyshev_node(capsys):
 
 
 def test_frac_bits_2000(capsys, table):
-    status, _, err = _run(["fit", "exp(x)", "--interval", "0", "1", "--degree", "2",
-                           "--coef-frac-bits", "2000"], capsys)
+    status, _, err = astuple(run_cli(["fit", "exp(x)", "--interval", "0", "1", "--degree", "2",
+                                      "--coef-frac-bits", "2000"]))
     assert status == 2 and "accepted: --coef-frac-bits <= 30" in _one_line(err)
     for bits in (2000, 2 ** 70):
         with pytest.raises(ValueError, match="accepted: frac_bits <= 30"):
@@ -79,7 +74,7 @@ def test_frac_bits_2000(capsys, table):
 
 def test_methods_span_too_long_refused_up_front(capsys):
     # 95 GiB asked after a minute before; now refused before anything is computed
-    status, _, err = _run(["methods", "--angle", "0.5", "--span", "100000000"], capsys)
+    status, _, err = astuple(run_cli(["methods", "--angle", "0.5", "--span", "100000000"]))
     assert status == 2 and "m >= 1, at most 65536" in _one_line(err)
     with pytest.raises(ValueError, match="at most 268435456"):
         cn.span_normals("exact", [[0, 0, 1]], [[0, 1, 0]], [8], count=[10 ** 9])
@@ -129,13 +124,13 @@ def test_piecewise_vhdl_written_pipelined_refused_nothing_written(capsys, piecew
     """Piecewise tables print as VHDL (issue 27); the pipelined evaluator, which
     piecewise tables do not have, is refused with nothing written."""
     out = tmp_path / "V"
-    status, stdout, err = _run(["hw", "verilog", piecewise_file, "--in-bits", "10",
-                                "--out-bits", "10", "--lang", "vhdl", "--pipelined", "-o", out],
-                               capsys)
+    status, stdout, err = astuple(run_cli(["hw", "verilog", piecewise_file, "--in-bits", "10",
+                                           "--out-bits", "10", "--lang", "vhdl", "--pipelined",
+                                           "-o", out]))
     assert status == 2 and "--pipelined is not available for a piecewise table" in _one_line(err)
     assert not out.exists() and stdout == ""
-    status, _, err = _run(["hw", "verilog", piecewise_file, "--in-bits", "10",
-                           "--out-bits", "10", "--lang", "vhdl", "-o", out], capsys)
+    status, _, err = astuple(run_cli(["hw", "verilog", piecewise_file, "--in-bits", "10",
+                                      "--out-bits", "10", "--lang", "vhdl", "-o", out]))
     assert status == 0 and err == ""
     assert sorted(p.suffix for p in out.iterdir()) == [".hex", ".vhd", ".vhd"]
     assert "entity chebnorm_table is" in (out / "chebnorm_table.vhd").read_text()
@@ -144,9 +139,9 @@ def test_piecewise_vhdl_written_pipelined_refused_nothing_written(capsys, piecew
 def test_design_narrow_input_default_segments(capsys, tmp_path):
     base = ["design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "8", "--out-bits", "8",
             "--max-error", "1e-2", "--no-synth", "--workers", "1", "-o", tmp_path / "D"]
-    status, out, _ = _run(base, capsys)
+    status, out, _ = astuple(run_cli(base))
     assert status == 0 and "winner:" in out
-    status, _, err = _run(base + ["--max-segments", "2^8"], capsys)
+    status, _, err = astuple(run_cli(base + ["--max-segments", "2^8"]))
     line = _one_line(err)
     assert status == 2 and "--max-segments 2^8" in line and "2^0 .. 2^7" in line
     assert "max-index-bits" not in line
@@ -154,10 +149,10 @@ def test_design_narrow_input_default_segments(capsys, tmp_path):
 
 def test_design_without_winner_exits_2_nothing_written(capsys, tmp_path):
     out = tmp_path / "D"
-    status, stdout, err = _run(["design", "1/sqrt(x)", "--interval", "1", "4", "--in-bits", "8",
-                                "--out-bits", "8", "--max-error", "1e-9", "--degrees", "1",
-                                "--max-segments", "2^3", "--no-synth", "--workers", "1",
-                                "-o", out], capsys)
+    status, stdout, err = astuple(run_cli(["design", "1/sqrt(x)", "--interval", "1", "4",
+                                           "--in-bits", "8", "--out-bits", "8", "--max-error",
+                                           "1e-9", "--degrees", "1", "--max-segments", "2^3",
+                                           "--no-synth", "--workers", "1", "-o", out]))
     line = _one_line(err)
     assert status == 2 and "no design meets --max-error 1e-09" in line
     assert "smallest certified error reached is" in line and not out.exists()
@@ -168,7 +163,8 @@ def test_design_without_winner_exits_2_nothing_written(capsys, tmp_path):
 def test_reader_refuses_non_decimal_numbers_and_bad_log_bases(text, capsys):
     with pytest.raises(ValueError, match="decimal digits|base must be a positive constant"):
         read_expression(text)
-    status, _, err = _run(["fit", f"x + {text}", "--interval", "1", "2", "--degree", "1"], capsys)
+    status, _, err = astuple(run_cli(["fit", f"x + {text}", "--interval", "1", "2",
+                                      "--degree", "1"]))
     assert status == 2 and "accepted" in _one_line(err)
 
 
@@ -215,20 +211,20 @@ def test_reader_still_reads_decimals():
 def test_options_that_do_nothing_are_refused(argv, flag, capsys, tmp_path, table_file,
                                              piecewise_file):
     argv = [a.format(tmp=tmp_path, table=table_file, pw=piecewise_file) for a in argv]
-    status, out, err = _run(argv, capsys)
+    status, out, err = astuple(run_cli(argv))
     line = _one_line(err)
     assert status == 2 and flag in line and ("only" in line or "accepted" in line)
     assert out == "" and list(tmp_path.iterdir()) == []
 
 
 def test_options_still_accepted_where_they_apply(capsys):
-    status, _, _ = _run(["render", "--mesh", "sphere", "--tess", "6", "--shading", "adaptive",
-                         "--eta-threshold", "0.01", "--size", "16", "16", "--engine", "numpy"],
-                        capsys)
+    status, _, _ = astuple(run_cli(["render", "--mesh", "sphere", "--tess", "6", "--shading",
+                                    "adaptive", "--eta-threshold", "0.01", "--size", "16", "16",
+                                    "--engine", "numpy"]))
     assert status == 0
-    status, _, _ = _run(["render", "--mesh", "sphere", "--tess", "6", "--shading",
-                         "split-gouraud", "--q", "0.01", "--size", "16", "16",
-                         "--engine", "numpy"], capsys)
+    status, _, _ = astuple(run_cli(["render", "--mesh", "sphere", "--tess", "6", "--shading",
+                                    "split-gouraud", "--q", "0.01", "--size", "16", "16",
+                                    "--engine", "numpy"]))
     assert status == 0
 
 
@@ -236,6 +232,7 @@ def test_render_sweep_ctrl_c_stops_the_workers(tmp_path):
     """SIGINT to the command: exit 130 at once, the running workers terminated, the
     finished rows kept. (Before: the running cases computed on, ~20-90 s.)"""
     psutil = pytest.importorskip("psutil")
+    # a child process: the signal, the exit status 130 and the workers' end are the point
     out = tmp_path / "o"
     cmd = [sys.executable, "-m", "chebnorm", "render-sweep", "--meshes", "sphere", "teapot",
            "--sizes", "32", "1024", "--workers", "2", "--engine", "numpy", "-o", str(out)]

@@ -11,8 +11,6 @@ from __future__ import annotations
 import ast
 import json
 import re
-import subprocess
-import sys
 import time
 from fractions import Fraction
 from pathlib import Path
@@ -25,6 +23,7 @@ from chebnorm.approx import (CoefficientTable, certify, fit, get_target, read_ex
                              parse_function, parse_number, warnings_of)
 from chebnorm.approx.certify import TOL
 from chebnorm.cli import main
+from conftest import run_cli, run_process
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -381,10 +380,10 @@ HOSTILE = [
 HOSTILE_NUL = HOSTILE + ["x\x00", f"\x00{PAYLOAD}"]
 
 
-def _one_line_exit_2(argv, capsys) -> str:
-    capsys.readouterr()
-    assert main(argv) == 2, argv
-    err = capsys.readouterr().err
+def _one_line_exit_2(argv) -> str:
+    r = run_cli(argv)
+    assert r.code == 2, argv
+    err = r.err
     assert err.endswith("\n") and err.count("\n") == 1 and err.startswith("chebnorm: error: "), err
     return err
 
@@ -414,11 +413,11 @@ def test_hostile_python_api(text, in_tmp):
 
 @pytest.mark.parametrize("text", HOSTILE)
 def test_hostile_cli_fit_and_psi_max(text, in_tmp, capsys):
-    _one_line_exit_2(["fit", text, "--interval", "0", "1", "--degree", "2"], capsys)
-    _one_line_exit_2(["fit", "x", "--interval", text, "1", "--degree", "2"], capsys)
-    _one_line_exit_2(["fit", "x", "--interval", "0", text, "--degree", "2"], capsys)
-    _one_line_exit_2(["hw", "sweep", "--psi-max", text, "--no-synth", "-o", "sweep"], capsys)
-    _one_line_exit_2(["targets", "--psi-max", text], capsys)
+    _one_line_exit_2(["fit", text, "--interval", "0", "1", "--degree", "2"])
+    _one_line_exit_2(["fit", "x", "--interval", text, "1", "--degree", "2"])
+    _one_line_exit_2(["fit", "x", "--interval", "0", text, "--degree", "2"])
+    _one_line_exit_2(["hw", "sweep", "--psi-max", text, "--no-synth", "-o", "sweep"])
+    _one_line_exit_2(["targets", "--psi-max", text])
     assert not (in_tmp / "sweep").exists()
 
 
@@ -437,7 +436,7 @@ def test_hostile_table_fields(text, in_tmp, capsys, table_json):
                      ["hw", "verilog", str(path), "--in-bits", "8", "--out-bits", "8", "-o", "v"],
                      ["hw", "report", str(path), "--in-bits", "8", "--out-bits", "8",
                       "--no-synth", "--no-gappa"]):
-            assert field in _one_line_exit_2(argv, capsys)
+            assert field in _one_line_exit_2(argv)
         assert not (in_tmp / "t.h").exists() and not (in_tmp / "v").exists()
 
 
@@ -451,8 +450,7 @@ def test_hostile_in_a_real_process(tmp_path):
     for argv in (["fit", text, "--interval", "0", "1", "--degree", "2"],
                  ["hw", "sweep", "--psi-max", text, "--no-synth", "-o", "out"],
                  ["export", "t.json", "--format", "c", "-o", "t.h"]):
-        proc = subprocess.run([sys.executable, "-m", "chebnorm", *argv], cwd=tmp_path,
-                              capture_output=True, text=True)
+        proc = run_process(argv, cwd=tmp_path)  # a child process: the docstring says why
         assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
         assert not (tmp_path / MARKER).exists()
 

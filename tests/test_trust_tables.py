@@ -19,10 +19,8 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
-import sys
-from dataclasses import replace
+from dataclasses import astuple, replace
 from pathlib import Path
 
 import mpmath
@@ -32,16 +30,14 @@ from chebnorm.approx import CoefficientTable, fit
 from chebnorm.approx.contract import construction
 from chebnorm.approx.table import MAX_TEXT
 from chebnorm.cli import main
+from conftest import requires_tool, run_cli, run_process, tool_missing
 from chebnorm.export import c_header
 
 ROOT = Path(__file__).resolve().parents[1]
 COEFFS = ROOT / "figures" / "coefficients"
 TABLES = sorted(COEFFS.glob("*.json"))
-GCC = shutil.which("gcc")
-IVERILOG = shutil.which("iverilog")
-needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc is not installed (apt-get install gcc)")
-needs_iverilog = pytest.mark.skipif(IVERILOG is None,
-                                    reason="iverilog is not installed (apt-get install iverilog)")
+needs_gcc = requires_tool("gcc")
+needs_iverilog = requires_tool("iverilog")
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 BASE = COEFFS / "dichotomy_d2.json"  # 1/sqrt(z + 2) on [sqrt(2), 2], fixed point at 24 bits
 
@@ -53,12 +49,6 @@ def base() -> dict:
 #: the committed table's first fixed-point integer and stated bound (the messages name them)
 _INT0 = base()["fixed_point"]["integers"][0]
 _FP_BOUND = f"{base()['fixed_point']['abs_error_bound']:.2e}".replace(".", r"\.").replace("+", r"\+")
-
-
-def run_cli(argv, capsys):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 # -- an independent reference: the true sup of |p - f| from mpmath -------------
@@ -368,7 +358,7 @@ def test_tampered_tables_are_refused_by_every_command(tmp_path, capsys, command,
     table.write_text(json.dumps(d, allow_nan=True))
     out = tmp_path / "out"
     out.mkdir()
-    code, stdout, err = run_cli(COMMANDS[command](table, out), capsys)
+    code, stdout, err = astuple(run_cli(COMMANDS[command](table, out)))
     assert code == 2, (stdout, err)
     assert err.count("\n") == 1 and err.startswith("chebnorm: error: coefficient table "), err
     assert re.search(rf"t\.json': {match}", err), err
@@ -379,7 +369,7 @@ def test_tampered_tables_are_refused_by_every_command(tmp_path, capsys, command,
 def test_untampered_table_passes_every_command(tmp_path, capsys, command):
     out = tmp_path / "out"
     out.mkdir()
-    code, _, err = run_cli(COMMANDS[command](BASE, out), capsys)
+    code, _, err = astuple(run_cli(COMMANDS[command](BASE, out)))
     assert code == 0, err
 
 
@@ -388,8 +378,9 @@ def test_refusal_from_a_spawned_cli_is_one_line(tmp_path):
     d["coefficients"][1] += 1e-3
     table = tmp_path / "t.json"
     table.write_text(json.dumps(d))
-    proc = subprocess.run([sys.executable, "-m", "chebnorm", "export", str(table), "-o",
-                           str(tmp_path / "t.h")], capture_output=True, text=True)
+    # a child process, as the name says: what a shell user sees on stderr, Python
+    # warnings and tracebacks included, is the point
+    proc = run_process("export", table, "-o", tmp_path / "t.h")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "abs_error_bound: stated 2.16e-05 but the coefficients' certified error is" in proc.stderr
@@ -418,14 +409,14 @@ def test_committed_tables_export_byte_identically(tmp_path, capsys, path):
         assert (COEFFS / fname).read_text() == text, fname
     out = tmp_path / "cli" / f"{stem}.h"
     out.parent.mkdir()
-    code, _, err = run_cli(["export", path, "--format", "c", "--proof", "-o", out], capsys)
+    code, _, err = astuple(run_cli(["export", path, "--format", "c", "--proof", "-o", out]))
     assert code == 0, err
     written = out.read_text()
     assert f" * Command: chebnorm export {path} --format c --proof -o {out}\n" in written
     assert re.sub(r"(?m)^ \* Command: .*$", "", written) == \
         re.sub(r"(?m)^ \* Command: .*$", "", committed)
     assert sorted(p.name for p in out.parent.iterdir()) == sorted(lib)
-    code, _, err = run_cli(["export", path, "--format", "json", "-o", tmp_path / "x.json"], capsys)
+    code, _, err = astuple(run_cli(["export", path, "--format", "json", "-o", tmp_path / "x.json"]))
     assert code == 0 and (tmp_path / "x.json").read_text() == path.read_text()
 
 
@@ -473,7 +464,7 @@ TEXT_FIELDS = [
 def strip_c_comments(path: Path) -> str:
     """The header as gcc sees it with comments removed (trigraphs, line splices
     and all), directives kept: the code, and nothing but the code."""
-    proc = subprocess.run([GCC, "-std=c99", "-trigraphs", "-fpreprocessed", "-dD", "-E", "-P",
+    proc = subprocess.run(["gcc", "-std=c99", "-trigraphs", "-fpreprocessed", "-dD", "-E", "-P",
                            "-x", "c", str(path)], capture_output=True, text=True, check=True)
     return "\n".join(line.rstrip() for line in proc.stdout.splitlines() if line.strip())
 
@@ -481,7 +472,7 @@ def strip_c_comments(path: Path) -> str:
 def compile_c(tmp: Path, header: Path) -> None:
     main_c = tmp / "main.c"
     main_c.write_text(f'#include "{header.name}"\nint main(void) {{ return 0; }}\n')
-    proc = subprocess.run([GCC, *CFLAGS, "-c", "-o", str(tmp / "main.o"), str(main_c)],
+    proc = subprocess.run(["gcc", *CFLAGS, "-c", "-o", str(tmp / "main.o"), str(main_c)],
                           cwd=header.parent, capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
 
@@ -518,7 +509,8 @@ def clean(tmp_path_factory):
     assert main(["export", str(BASE), "-o", str(tmp / "chebnorm_dichotomy_d2.h")]) == 0
     assert main(["hw", "verilog", str(BASE), "--in-bits", "8", "--out-bits", "8",
                  "-o", str(tmp)]) == 0
-    c = strip_c_comments(tmp / "chebnorm_dichotomy_d2.h") if GCC else None
+    have_gcc = tool_missing("gcc") is None
+    c = strip_c_comments(tmp / "chebnorm_dichotomy_d2.h") if have_gcc else None
     v = strip_verilog_comments((tmp / "chebnorm_dichotomy_d2.v").read_text())
     tb = strip_verilog_comments((tmp / "tb_chebnorm_dichotomy_d2.v").read_text())
     return c, v, tb
@@ -536,8 +528,7 @@ def _check_outcome(code, err, field, produced):
     return True
 
 
-@needs_gcc
-@needs_iverilog
+@requires_tool("gcc", "iverilog")  # one marker: the hook reads the closest only
 @pytest.mark.parametrize("path,valid,field", TEXT_FIELDS, ids=[f[2] for f in TEXT_FIELDS])
 def test_injection_in_every_text_field(tmp_path, capsys, clean, path, valid, field):
     c_ref, v_ref, tb_ref = clean
@@ -551,15 +542,15 @@ def test_injection_in_every_text_field(tmp_path, capsys, clean, path, valid, fie
             table = case / "t.json"
             table.write_text(json.dumps(d))
             header = case / "chebnorm_dichotomy_d2.h"
-            code, _, err = run_cli(["export", table, "-o", header], capsys)
+            code, _, err = astuple(run_cli(["export", table, "-o", header]))
             if _check_outcome(code, err, field, header.exists()):
                 accepted += 1
                 compile_c(case, header)
                 assert strip_c_comments(header) == c_ref
             vdir = case / "v"
             vdir.mkdir()
-            code, _, err = run_cli(["hw", "verilog", table, "--in-bits", "8", "--out-bits", "8",
-                                    "-o", vdir, "--simulate"], capsys)
+            code, _, err = astuple(run_cli(["hw", "verilog", table, "--in-bits", "8",
+                                            "--out-bits", "8", "-o", vdir, "--simulate"]))
             if _check_outcome(code, err, field, list(vdir.iterdir())):
                 assert strip_verilog_comments((vdir / "chebnorm_dichotomy_d2.v").read_text()) == v_ref
                 assert strip_verilog_comments(
@@ -614,7 +605,7 @@ def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
     assert strip_verilog_comments(text) == clean[1]
     pipe = verilog_pipelined_module(hostile, version=bad, command=bad)
     (tmp_path / "m.v").write_text(text + "\n" + pipe)
-    proc = subprocess.run([IVERILOG, "-g2005", "-Wall", "-o", str(tmp_path / "a.out"),
+    proc = subprocess.run(["iverilog", "-g2005", "-Wall", "-o", str(tmp_path / "a.out"),
                            str(tmp_path / "m.v")], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     with pytest.raises(ValueError, match=r"^name: 'x\\n`define' is not an identifier"):
@@ -623,8 +614,7 @@ def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
         verilog_testbench(d, vectors='a.hex"); $finish; //.hex')
 
 
-@needs_gcc
-@needs_iverilog
+@requires_tool("gcc", "iverilog")  # one marker: the hook reads the closest only
 def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
     """The command line (here the table's own file name) reaches the banners."""
     # the full path holds "*/", line breaks, a trigraph, U+2028 and a backslash
@@ -633,13 +623,13 @@ def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
     table = folder / "* \u2028 \\.json"
     table.write_text(BASE.read_text())
     header = tmp_path / "chebnorm_dichotomy_d2.h"
-    code, _, err = run_cli(["export", table, "-o", header], capsys)
+    code, _, err = astuple(run_cli(["export", table, "-o", header]))
     assert code == 0, err
     compile_c(tmp_path, header)
     assert strip_c_comments(header) == clean[0]
     vdir = tmp_path / "v"
-    code, _, err = run_cli(["hw", "verilog", table, "--in-bits", "8", "--out-bits", "8",
-                            "-o", vdir, "--simulate"], capsys)
+    code, _, err = astuple(run_cli(["hw", "verilog", table, "--in-bits", "8", "--out-bits", "8",
+                                    "-o", vdir, "--simulate"]))
     assert code == 0, err
     assert strip_verilog_comments((vdir / "chebnorm_dichotomy_d2.v").read_text()) == clean[1]
 
@@ -648,9 +638,9 @@ def test_hostile_command_line_is_inert(tmp_path, capsys, clean):
 @needs_iverilog
 def test_unit_banner_keeps_hostile_command_line_inert(tmp_path, capsys):
     def unit_code(table, out):
-        code, _, err = run_cli(["hw", "unit", "dichotomy", "--table", table, "--in-bits", "8",
-                                "--out-bits", "8", "--vector-frac-bits", "6", "--vectors", "50",
-                                "-o", out], capsys)
+        code, _, err = astuple(run_cli(["hw", "unit", "dichotomy", "--table", table,
+                                        "--in-bits", "8", "--out-bits", "8",
+                                        "--vector-frac-bits", "6", "--vectors", "50", "-o", out]))
         assert code == 0, err
         return strip_verilog_comments((out / "chebnorm_dichotomy_unit.v").read_text())
 

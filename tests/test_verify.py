@@ -8,7 +8,7 @@ and ``f`` in mpmath at 40 digits."""
 from __future__ import annotations
 
 import re
-import shutil
+from dataclasses import astuple
 
 import mpmath
 import numpy as np
@@ -16,12 +16,11 @@ import pytest
 
 from chebnorm.approx import fit
 from chebnorm.approx.piecewise_fit import piecewise_fit
-from chebnorm.cli import main
 from chebnorm.export import export_text
 from chebnorm.export.verify import c_evaluate, stated_bounds, verify
+from conftest import requires_tool, run_cli
 
-needs_gcc = pytest.mark.skipif(shutil.which("gcc") is None,
-                               reason="gcc is not installed (apt-get install gcc)")
+needs_gcc = requires_tool("gcc")
 
 
 @pytest.fixture(scope="module")
@@ -127,12 +126,6 @@ def test_reports_every_c_variant_with_its_stated_bound(table):
     assert r.markdown().count("\n") == 2 + 5
 
 
-def _cli(capsys, *args):
-    status = main(["verify", *map(str, args)])
-    out = capsys.readouterr()
-    return status, out.out, out.err
-
-
 @needs_gcc
 def test_tampered_bound_is_reported_as_exceeded(table, table_file, tmp_path, capsys):
     header = export_text(table, "c")
@@ -142,13 +135,13 @@ def test_tampered_bound_is_reported_as_exceeded(table, table_file, tmp_path, cap
     tampered = re.sub(rf"(#define {macro}) \S+", rf"\1 {(stated / 2).hex()}", header)
     path = tmp_path / "tampered.h"
     path.write_text(tampered, encoding="utf-8")
-    status, out, err = _cli(capsys, table_file, "--format", "c", "--source", path,
-                            "--variant", "double", "--variant", "float")
+    status, out, err = astuple(run_cli("verify", table_file, "--format", "c", "--source", path,
+                                         "--variant", "double", "--variant", "float"))
     assert status == 1
     assert err.count("\n") == 1 and "exceeded" in err and macro in err
     assert "EXCEEDS" in out and "float" in out
-    status, _, _ = _cli(capsys, table_file, "--format", "c", "--source", path,
-                        "--variant", "float")
+    status, _, _ = astuple(run_cli("verify", table_file, "--format", "c", "--source", path,
+                                     "--variant", "float"))
     assert status == 0  # the float bound was not touched
 
 
@@ -277,16 +270,16 @@ def test_spread_inputs(table):
     (["--inputs", "1"], "accepted: 'all'"),
 ])
 def test_bad_input_exits_2_with_one_line(table_file, capsys, args, needle):
-    status, out, err = _cli(capsys, table_file, *args)
+    status, out, err = astuple(run_cli("verify", table_file, *args))
     assert status == 2 and out == "" and err.count("\n") == 1 and needle in err
 
 
 def test_bad_files_exit_2(table_file, tmp_path, capsys):
-    status, _, err = _cli(capsys, tmp_path / "missing.json")
+    status, _, err = astuple(run_cli("verify", tmp_path / "missing.json"))
     assert status == 2 and err.count("\n") == 1 and "missing.json" in err
     other = tmp_path / "other.h"
     other.write_text("/* not a chebnorm header */\n", encoding="utf-8")
-    status, _, err = _cli(capsys, table_file, "--source", other)
+    status, _, err = astuple(run_cli("verify", table_file, "--source", other))
     assert status == 2 and err.count("\n") == 1 and "CHEBNORM_RSV_LO" in err
 
 
@@ -295,7 +288,7 @@ def test_source_that_does_not_compile_exits_2(table, table_file, tmp_path, capsy
     broken = tmp_path / "broken.h"
     broken.write_text(export_text(table, "c").replace("return acc;", "return acc +;", 1),
                       encoding="utf-8")
-    status, out, err = _cli(capsys, table_file, "--source", broken)
+    status, out, err = astuple(run_cli("verify", table_file, "--source", broken))
     assert status == 2 and out == "" and err.count("\n") == 1
     assert "does not compile" in err
 

@@ -25,9 +25,7 @@ of the generated Verilog is intended; say so in the commit).
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
-import io
 import json
 import subprocess
 import sys
@@ -154,12 +152,10 @@ def unit_case(case: dict) -> dict:
 
 
 def _cli(argv: list[str], out_dir: str | None = None) -> tuple[int, str, str]:
-    from chebnorm.cli import main
+    from conftest import run_cli
 
-    so, se = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(so), contextlib.redirect_stderr(se):
-        code = main(argv)
-    text, err = so.getvalue(), se.getvalue()
+    r = run_cli(argv)
+    code, text, err = r.code, r.out, r.err
     # the golden lines use flags renamed since (deprecated aliases): same outputs, one warning
     err = "".join(ln for ln in err.splitlines(keepends=True)
                   if not (ln.startswith("chebnorm: warning: --") and " is deprecated" in ln))
