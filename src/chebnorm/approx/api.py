@@ -1085,7 +1085,12 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     the bits: more fractional bits never certify a worse error. A table
     fitted with the same ``monomials`` / ``fix_constant`` (same held
     constant) is quantized from its own coefficients, otherwise the
-    constrained real fit is computed first.
+    constrained real fit is computed first. When ``f`` is proved even or odd
+    on a symmetric interval and the powers asked for (all of them by
+    default) include the other parity, the powers of ``f``'s parity are
+    quantized first (the other coefficients exact zeros, as in the best
+    polynomial); the candidates of every power asked for then compete
+    against that certified bound, so the answer is never worse than either.
 
     In fixed point (``coef_format="fixed"``) the stored polynomial is
 
