@@ -1153,7 +1153,12 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     the bits: more fractional bits never certify a worse error. A table
     fitted with the same ``monomials`` / ``fix_constant`` (same held
     constant) is quantized from its own coefficients, otherwise the
-    constrained real fit is computed first.
+    constrained real fit is computed first. When ``f`` is proved even or odd
+    on a symmetric interval and the powers asked for (all of them by
+    default) include the other parity, the powers of ``f``'s parity are
+    quantized first (the other coefficients exact zeros, as in the best
+    polynomial); the candidates of every power asked for then compete
+    against that certified bound, so the answer is never worse than either.
 
     In fixed point (``coef_format="fixed"``) the stored polynomial is
 
@@ -1230,8 +1235,14 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     if reoptimize and n >= 1 and mons == tuple(range(n + 1)):
         def greedy(quanta):
             return greedy_integers(prob, real, quanta)
-    best = round_coefficients(prob, real, coef_format, fracs if coef_format == "fixed" else None,
-                              greedy, plain=not reoptimize)
+    frac_arg = fracs if coef_format == "fixed" else None
+    # f even or odd on a symmetric interval: the powers of its parity first (the
+    # lattice over the nonzero powers, the others exact zeros), then every
+    # candidate of all the requested powers, certified only where it can beat that
+    incumbent = _parity_rounding(table, fn, iv, mons, fixed, coef_format, frac_arg,
+                                 prob.word_limit) if reoptimize else None
+    best = round_coefficients(prob, real, coef_format, frac_arg, greedy,
+                              plain=not reoptimize, incumbent=incumbent)
     if best is None:
         raise ValueError(_no_rounding(coef_format, real, word_bits, fracs))
     coeffs = best.coefficients
@@ -1241,6 +1252,34 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
                            known={"abs": best.abs_cert, "rel": best.rel_cert})
     return _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits,
                            fix_constant, full_basis)
+
+
+def _parity_rounding(table, fn, iv, mons, fixed: dict, coef_format: str, frac_arg,
+                     word_limit):
+    """The best certified rounding in the powers among ``mons`` of the parity
+    of ``f`` when ``f`` is proved even or odd on the (symmetric) interval and
+    ``mons`` holds powers of the other parity too; None otherwise (or when
+    none certifies). Its real fit is the table's when that is the parity fit,
+    else the minimax fit in those powers."""
+    from .rounding import Problem, round_coefficients
+
+    if not iv.lo_f < 0 < iv.hi_f:
+        return None
+    want = {"even": 0, "odd": 1}.get(_parity(fn, iv))
+    if want is None:
+        return None
+    sub = tuple(k for k in mons if k % 2 == want)
+    # a held constant of the other parity is f(0) = 0 rounded: zero, dropped
+    held = {k: v for k, v in fixed.items() if k % 2 == want or v[0] != 0}
+    if not sub or sub == mons or any(k % 2 != want for k in held):
+        return None
+    n = table.degree
+    real = (list(table.coefficients) if _fitted_alike(table, sub, held)
+            else _constrained_fit(fn, iv, n, sub, held, table.error_kind))
+    prob = Problem(fn=fn, lo=iv.lo, hi=iv.hi, lo_f=iv.lo_f, hi_f=iv.hi_f,
+                   error_kind=table.error_kind, degree=n, powers=sub, fixed=held,
+                   word_limit=word_limit)
+    return round_coefficients(prob, real, coef_format, frac_arg)
 
 
 @functools.lru_cache(maxsize=64)

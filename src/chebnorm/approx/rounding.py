@@ -537,7 +537,10 @@ def greedy(prob: Problem, real, quanta) -> list[int] | None:
     current = list(real)
     ints: dict[int, int] = {}
     for k in range(n, -1, -1):
-        ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        try:
+            ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        except (OverflowError, ValueError):   # no integer at that quantum (a zero
+            return None                       # coefficient's is the format's smallest)
         if k == 0:
             break
         high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
@@ -698,7 +701,8 @@ def _point_errors(prob: Problem, x, coeffs, sampler: _Sampler | None = None) -> 
 
 
 def _certify_ranked(prob: Problem, ranked: list, limit: int | None = None,
-                    slack: float = 0.0, sampler: _Sampler | None = None):
+                    slack: float = 0.0, sampler: _Sampler | None = None,
+                    incumbent: Candidate | None = None):
     """The smallest certified bound among ``ranked`` (from :func:`_rank`):
     candidates are certified in their sampled order, each against the best so
     far (aborted once proven no better); one whose sampled error (a lower bound
@@ -707,8 +711,11 @@ def _certify_ranked(prob: Problem, ranked: list, limit: int | None = None,
     success. ``slack``: nor is one whose sampled error reaches the best bound
     divided by ``1 + slack``: its certified bound is at least that, so the
     answer's bound is within a factor ``1 + slack`` of the smallest certified
-    bound among all the candidates. Returns a Candidate or None (none certified)."""
-    best, tries, peaks = None, 0, []
+    bound among all the candidates. ``incumbent``: a candidate certified
+    before (another problem's answer, same powers 0..degree), the best so far
+    from the start; it is returned when none certifies below its bound.
+    Returns a Candidate or None (none certified)."""
+    best, tries, peaks = incumbent, 0, []
     for low, method, ms, es, coeffs in ranked:
         if best is not None and (low * (1 + slack) >= best.bound
                                  or (limit is not None and tries >= limit)):
@@ -721,7 +728,7 @@ def _certify_ranked(prob: Problem, ranked: list, limit: int | None = None,
             continue
         if slack and cert is not None and not peaks and sampler is not None:
             peaks = _peaks(prob, sampler, coeffs)
-        tries += best is not None
+        tries += best is not None and best is not incumbent
         if cert is not None and (best is None or cert.bound < best.bound):
             best = Candidate(tuple(ms), tuple(es), method, cert.bound,
                              cert if prob.error_kind == "abs" else None,
@@ -851,7 +858,8 @@ def _chain_level(prob: Problem, coarse: _Sampler, real, fracs, level: int, greed
             for method, ms, es in members]
 
 
-def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy) -> Candidate | None:
+def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy,
+                incumbent: Candidate | None = None) -> Candidate | None:
     """The best certified member of the fixed-point pool: at every bit count
     ``b = 0..F`` the members of :func:`_chain_level`. The pool at ``F - 1``
     bits is a subset (same values) of the pool at ``F``, so the certified
@@ -859,7 +867,8 @@ def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy) -> Candid
     bits down; once :func:`_grid_lower_bounds` proves that no polynomial on
     the grid of a bit count (and of every coarser one) reaches the bound
     certified at ``F`` bits, the rest of the pool cannot win and is not built:
-    the minimum is the one over the whole pool."""
+    the minimum is the one over the whole pool (or ``incumbent``, certified
+    before, when nothing certifies below it)."""
     coarse = _Sampler(prob, CHAIN_SAMPLES)
     bound_at = _grid_lower_bounds(prob, fracs)
     pool, best, lower = [], None, 0.0
@@ -877,12 +886,12 @@ def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy) -> Candid
                 break
         pool += members(level)
         if level == 0:
-            best = _certify_ranked(prob, _ranked(sampler, pool))
-    return _certify_ranked(prob, _ranked(sampler, pool))
+            best = _certify_ranked(prob, _ranked(sampler, pool), incumbent=incumbent)
+    return _certify_ranked(prob, _ranked(sampler, pool), incumbent=incumbent)
 
 
 def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=None,
-                       plain: bool = False) -> Candidate:
+                       plain: bool = False, incumbent: Candidate | None = None) -> Candidate:
     """The best certified rounding of ``real`` (coefficients of all powers);
     with ``plain``, each coefficient rounded to nearest and nothing else.
 
@@ -908,6 +917,10 @@ def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=Non
         exponents ``quanta`` of each power, one more candidate; default None.
     plain : bool, optional
         Round each coefficient to nearest and nothing else; default False.
+    incumbent : Candidate, optional
+        A candidate certified before (e.g. the answer of the parity
+        sub-basis): these candidates are certified only while they can beat
+        it, and it is the answer when none does; default None.
 
     Returns
     -------
@@ -920,9 +933,10 @@ def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=Non
         quanta = ([-f for f in frac_bits] if fmt == "fixed" else
                   [float_quantum(real[k], fmt) for k in range(prob.degree + 1)])
         cands = _candidates(prob, sampler, real, quanta, None, fmt, lattice=False)
-        return _certify_ranked(prob, _rank(sampler, [(m, *c) for m, c in cands.items()]))
+        return _certify_ranked(prob, _rank(sampler, [(m, *c) for m, c in cands.items()]),
+                               incumbent=incumbent)
     if fmt == "fixed":
-        return _fixed_pool(prob, sampler, real, list(frac_bits), greedy)
+        return _fixed_pool(prob, sampler, real, list(frac_bits), greedy, incumbent)
     # floating: quanta from the real coefficients, then from the best few
     # candidates' own binades (a lattice answer may leave a binade), a few rounds
     todo = [tuple(float_quantum(real[k], fmt) for k in range(prob.degree + 1))]
@@ -944,4 +958,5 @@ def round_coefficients(prob: Problem, real, fmt: str, frac_bits=None, greedy=Non
                       else quanta[k] for k, (m, e) in enumerate(zip(ms, es)))
             if q not in tried and q not in todo:
                 todo.append(q)
-    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY, FLOAT_SLACK, sampler)
+    return _certify_ranked(prob, _ranked(sampler, pool), FLOAT_CERTIFY, FLOAT_SLACK, sampler,
+                           incumbent)

@@ -513,12 +513,26 @@ def _check_fixed_ranges(table: CoefficientTable, max_abs_x: Fraction) -> None:
     if x_q >= 2 ** 63:
         raise ValueError(f"table {table.name!r}: x * 2^{fp.frac_bits} does not fit int64 on the "
                          f"interval; accepted: fewer fractional bits")
-    acc = Fraction(abs(fp.integers[-1]))
-    for q in reversed(fp.integers[:-1]):
-        if acc * x_q + 2 ** fp.frac_bits >= 2 ** 63:
+    parity = coefficient_parity(fp.integers)
+    ints, var, var_q = list(fp.integers), max_abs_x, x_q
+    if parity is not None:   # t_q = round(x_q^2 / 2^F), then Horner in t_q (times x_q)
+        if x_q * x_q + 2 ** fp.frac_bits >= 2 ** 63:
+            raise ValueError(f"table {table.name!r}: the integer square x_q * x_q overflows "
+                             f"int64 with {fp.frac_bits} fractional bits; accepted: fewer "
+                             f"fractional bits")
+        ints = ints[parity::2]
+        var = max_abs_x ** 2 + Fraction(1, 2 ** fp.frac_bits)
+        var_q = var * 2 ** fp.frac_bits
+    acc = Fraction(abs(ints[-1]))
+    for q in reversed(ints[:-1]) if len(ints) > 1 else ():
+        if acc * var_q + 2 ** fp.frac_bits >= 2 ** 63:
             raise ValueError(f"table {table.name!r}: the integer Horner product overflows int64 "
                              f"with {fp.frac_bits} fractional bits; accepted: fewer fractional bits")
-        acc = acc * max_abs_x + 1 + abs(q)
+        acc = acc * var + 1 + abs(q)
+    if parity == 1 and acc * x_q + 2 ** fp.frac_bits >= 2 ** 63:
+        raise ValueError(f"table {table.name!r}: the final integer product by x_q overflows "
+                         f"int64 with {fp.frac_bits} fractional bits; accepted: fewer fractional "
+                         f"bits")
 
 
 def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
@@ -531,19 +545,35 @@ def _fixed_evaluator(fp, fn: str, macro: str) -> list[str]:
     w("    " + ", ".join(f"INT32_C({q})" for q in fp.integers))
     w("};")
     w("")
-    w(f"/* Integer Horner's rule. x_q = x * 2^{fp.frac_bits} (x in [{macro}_LO, {macro}_HI]);")
-    w(f" * returns p(x) * 2^{fp.frac_bits}, each step rounded to nearest (ties up) by an")
+    parity = coefficient_parity(fp.integers)
+    powers = list(range(len(fp.integers)))
+    var = "x_q"
+    scheme = "" if parity is None else (f" over the {'odd' if parity else 'even'} powers, in "
+                                        f"t_q = x_q * x_q / 2^{fp.frac_bits}")
+    w(f"/* Integer Horner's rule{scheme}. x_q = x * 2^{fp.frac_bits} (x in [{macro}_LO, "
+      f"{macro}_HI]);")
+    w(f" * returns p(x) * 2^{fp.frac_bits}, each {'step' if parity is None else 'product'} "
+      f"rounded to nearest (ties up) by an")
     w(" * arithmetic right shift (implementation-defined for negative values in C99;")
     w(f" * arithmetic on gcc and clang). |result / 2^{fp.frac_bits} - f(x)| <= {macro}_Q_EVAL_ERROR_BOUND. */")
     w(f"static inline int64_t {fn}_q_eval(int64_t x_q)")
     w("{")
-    w(f"    int64_t acc = {fn}_q[{len(fp.integers) - 1}];")
-    for k in range(len(fp.integers) - 2, -1, -1):
-        w(f"    acc = ((acc * x_q + (INT64_C(1) << {max(fp.frac_bits - 1, 0)})) >> {fp.frac_bits})"
-          f" + {fn}_q[{k}];" if fp.frac_bits > 0 else f"    acc = acc * x_q + {fn}_q[{k}];")
-    if len(fp.integers) == 1:
-        w("    (void)x_q;")
-    w("    return acc;")
+
+    def rounded(product: str) -> str:
+        if fp.frac_bits == 0:
+            return product
+        return f"(({product} + (INT64_C(1) << {fp.frac_bits - 1})) >> {fp.frac_bits})"
+
+    if parity is not None:
+        powers = powers[parity::2]
+        var = "t_q"
+        w(f"    int64_t t_q = {rounded('x_q * x_q')};")
+    w(f"    int64_t acc = {fn}_q[{powers[-1]}];")
+    for k in reversed(powers[:-1]):
+        w(f"    acc = {rounded(f'acc * {var}')} + {fn}_q[{k}];")
+    if len(powers) == 1:
+        w(f"    (void){var};")
+    w(f"    return {rounded('acc * x_q')};" if parity == 1 else "    return acc;")
     w("}")
     return out
 
@@ -562,7 +592,12 @@ def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: F
         max_t, _ = _shift_error(table, cs, suffix, u)
     else:
         max_t = max_x
-    problem = range_problem(cs, max_t, suffix, u, where=(*inner_interval(table), table.shift, None))
+    parity = _table_parity(table, coeffs)
+    if parity is None:
+        problem = range_problem(cs, max_t, suffix, u,
+                                where=(*inner_interval(table), table.shift, None))
+    else:
+        problem = evaluator_range_problem(table, cs, parity, suffix, u, max_x)
     if problem is not None:
         return None, problem
     shift = None
@@ -575,7 +610,14 @@ def _eval_bound(table: CoefficientTable, coeffs, suffix: str, u: float, max_x: F
     piece = Piece(tuple(cs), tuple(float(c) for c in coeffs), Fraction(table.abs_error_bound),
                   lo, hi)
     return Evaluator(constant, name, BINARY32 if suffix == "f" else BINARY64, (piece,),
-                     shift=shift, target=(table.expression, table.variable)), None
+                     shift=shift, target=(table.expression, table.variable),
+                     parity=_table_parity(table, coeffs)), None
+
+
+def _table_parity(table: CoefficientTable, coeffs) -> int | None:
+    """The parity of the float evaluators of the real coefficients (not in
+    the shifted basis): :func:`coefficient_parity`."""
+    return None if table.shift is not None else coefficient_parity(coeffs)
 
 
 def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, name: str,
@@ -602,18 +644,74 @@ def _float_evaluator(table: CoefficientTable, coeffs, ctype: str, suffix: str, n
     return out + ["    return acc;", "}"]
 
 
-def _parity(q, degree: int) -> int | None:
-    """1 when only odd powers are used, 0 when only even ones, else None."""
-    powers = set(q.monomials) | ({0} if q.fixed_constant else set())
+def coefficient_parity(coeffs) -> int | None:
+    """The parity of a coefficient list: the evaluators of one whose nonzero
+    coefficients are all of odd (even) powers run ``x*q(x*x)`` (``q(x*x)``):
+    the same polynomial, half the steps.
+
+    Parameters
+    ----------
+    coeffs : sequence of numbers
+        The coefficients in ascending powers (floats or integers).
+
+    Returns
+    -------
+    int or None
+        1 when every nonzero coefficient is of an odd power, 0 when of an
+        even one; None otherwise, below degree 2 (``t = x*x`` saves nothing
+        there) and for the zero polynomial.
+
+    Examples
+    --------
+    >>> coefficient_parity([0.0, 1.0, 0.0, -1 / 6]), coefficient_parity([1.0, 0.0, 0.5])
+    (1, 0)
+    >>> coefficient_parity([1.0, 1.0, 0.0]) is None
+    True
+    """
+    powers = {k for k, c in enumerate(coeffs) if c != 0}
+    if len(coeffs) < 3 or not powers:
+        return None
     for parity in (1, 0):
-        if degree >= 2 and all(k % 2 == parity for k in powers):
+        if all(k % 2 == parity for k in powers):
             return parity
     return None
 
 
-def _quantized_range(table, coeffs, parity, suffix: str, u: float, max_x: Fraction):
-    """:func:`range_problem` of the quantized evaluator (in ``x*x`` and times
-    ``x`` at the end for a parity evaluator)."""
+def _parity(q, degree: int) -> int | None:
+    """1 when only odd powers are used (listed, or the others' coefficients
+    zero), 0 when only even ones, else None."""
+    powers = set(q.monomials) | ({0} if q.fixed_constant else set())
+    for parity in (1, 0):
+        if degree >= 2 and all(k % 2 == parity for k in powers):
+            return parity
+    return coefficient_parity([float(c) for c in q.coefficients])
+
+
+def evaluator_range_problem(table, coeffs, parity, suffix: str, u: float, max_x: Fraction):
+    """:func:`range_problem` of an evaluator of ``coeffs`` on the table's
+    interval: Horner's rule in ``x``, or with ``parity`` in ``t = x*x`` over
+    the coefficients of that parity (times ``x`` at the end when odd).
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table (its inner interval is where the evaluator runs).
+    coeffs : sequence of float
+        The coefficients evaluated, ascending powers, in the type's values.
+    parity : {None, 0, 1}
+        None: Horner's rule in ``x``; 0 / 1: the even / odd scheme.
+    suffix : {"", "f"}
+        The C literal suffix of the type (double, float).
+    u : float
+        The type's unit roundoff.
+    max_x : Fraction
+        A bound of ``|x|`` on the interval.
+
+    Returns
+    -------
+    str or None
+        None when no intermediate can be non-finite, else why.
+    """
     where = (*inner_interval(table), None, parity)
     if parity is None:
         return range_problem(coeffs, max_x, suffix, u, where=where)
@@ -668,7 +766,7 @@ def _quantized_part(table: CoefficientTable, fn: str, macro: str, max_x: Fractio
         ctype, suffix, fsuffix, u = row
         if suffix == "f" and not all(_to_type(c, "f") == c for c in coeffs):
             continue
-        problem = _quantized_range(table, coeffs, parity, suffix, u, max_x)
+        problem = evaluator_range_problem(table, coeffs, parity, suffix, u, max_x)
         if problem is not None and suffix == "":
             raise ValueError(f"table {table.name!r}: the quantized coefficients have no double "
                              f"evaluator on the interval: {problem}; accepted: a table whose "
@@ -865,7 +963,8 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
         w(f"#define {macro}_Q_ABS_ERROR_BOUND {_literal(fp.abs_error_bound, '')}")
         qs = tuple(float(Fraction(q) / 2 ** fp.frac_bits) for q in fp.integers)
         ev = Evaluator(f"{macro}_Q_EVAL_ERROR_BOUND", f"{fn}_q_eval", fixed_arithmetic(fp.frac_bits),
-                       (Piece(qs, qs, Fraction(fp.abs_error_bound), *inner_interval(table)),))
+                       (Piece(qs, qs, Fraction(fp.abs_error_bound), *inner_interval(table)),),
+                       parity=coefficient_parity(fp.integers))
         evaluators.append(ev)
         w(_bound_line(ev, proof))
     w("")
@@ -873,8 +972,11 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
     for k, c in enumerate(coeffs):
         w(f"    {_literal(c, '')}{',' if k < len(coeffs) - 1 else ''}  /* {'t' if shifted else 'x'}^{k} */")
     w("};")
+    parity = _table_parity(table, coeffs)
     for ctype, suffix, fsuffix in emitted:
-        out += _float_evaluator(table, coeffs, ctype, suffix, f"{fn}{fsuffix}", macro)
+        out += (_float_evaluator(table, coeffs, ctype, suffix, f"{fn}{fsuffix}", macro)
+                if parity is None else
+                _parity_evaluator(coeffs, parity, ctype, suffix, f"{fn}{fsuffix}", macro))
     if table.fixed_point is not None:
         out += _fixed_evaluator(table.fixed_point, fn, macro)
     elif table.quantized is not None:

@@ -68,7 +68,8 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from chebnorm.core.numeric import float_up
 
-from .c import inner_interval, interval_max_abs, range_problem, round_inward
+from .c import (coefficient_parity, evaluator_range_problem, inner_interval, interval_max_abs,
+                round_inward)
 from .evalbound import BINARY32_FTZ, Evaluator, Piece
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
@@ -357,8 +358,8 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     m = interval_max_abs(table)
     # no bound for an evaluator that can overflow float32 on the interval (nor
     # for one whose flushed underflows the flush term below does not cover)
-    problem = range_problem(coeffs, m, "f", float(U32),
-                            where=(*inner_interval(table), None, None))
+    problem = evaluator_range_problem(table, [float(np.float32(c)) for c in coeffs],
+                               _parity32(coeffs), "f", float(U32), m)
     if problem is not None:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
@@ -385,10 +386,18 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
                        total32=up32, certificate=cert)
 
 
+def _parity32(coeffs) -> int | None:
+    """The parity of the shader's float32 coefficients (its evaluator is then
+    ``x*q(x*x)`` or ``q(x*x)``): :func:`chebnorm.export.c.coefficient_parity`."""
+    return coefficient_parity([float(np.float32(c)) for c in coeffs])
+
+
 def shader_evaluator(table: CoefficientTable, constant: str = ""):
     """The :class:`~chebnorm.export.evalbound.Evaluator` of the shader
     function: float32 Horner's rule (fused or not, subnormals possibly
-    flushed) on the float32 coefficients, over the float32 interval.
+    flushed) on the float32 coefficients, over the float32 interval; in
+    ``t = x*x`` over the nonzero coefficients when they are all of odd
+    (then times ``x``) or all of even powers.
 
     Parameters
     ----------
@@ -429,7 +438,7 @@ def shader_evaluator(table: CoefficientTable, constant: str = ""):
     name = identifier(table.name, field="table.name")
     return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
                      f"chebnorm_{name}", BINARY32_FTZ, (piece,),
-                     target=(table.expression, table.variable))
+                     target=(table.expression, table.variable), parity=_parity32(coeffs))
 
 
 def interval32(table: CoefficientTable) -> tuple[float, float]:
@@ -559,14 +568,23 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND", value=lit(_up_f32(float_up(certified)))))
     w(lang.const.format(name=f"{big}_EVAL_ERROR_BOUND", value=lit(bound.total32)))
     w("")
-    w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")
+    parity = _parity32(coeffs)
+    if parity is None:
+        w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")
+    else:
+        w(f"// Horner's rule over the {'odd' if parity else 'even'} powers, in t = x*x; x must "
+          f"lie in [{big}_LO, {big}_HI].")
     w(lang.function.format(fn=fn))
-    w(lang.acc.format(P=big, value=lit(coeffs[-1])) + f"  // x^{len(coeffs) - 1}: "
-      f"{float(np.float32(coeffs[-1])).hex()}")
-    for k in range(len(coeffs) - 2, -1, -1):
-        w(f"    acc = {lang.madd.format(P=big)}(acc, x, {lit(coeffs[k])});  // x^{k}: "
+    arg, powers = "x", list(range(len(coeffs)))
+    if parity is not None:
+        arg, powers = "t", powers[parity::2]
+        w(lang.acc.replace(" acc", " t", 1).format(P=big, value="x * x"))
+    w(lang.acc.format(P=big, value=lit(coeffs[powers[-1]])) + f"  // x^{powers[-1]}: "
+      f"{float(np.float32(coeffs[powers[-1]])).hex()}")
+    for k in reversed(powers[:-1]):
+        w(f"    acc = {lang.madd.format(P=big)}(acc, {arg}, {lit(coeffs[k])});  // x^{k}: "
           f"{float(np.float32(coeffs[k])).hex()}")
-    w("    return acc;")
+    w("    return acc * x;" if parity == 1 else "    return acc;")
     w("}")
     for line in lang.postlude:
         w(line.format(P=big))
