@@ -49,7 +49,7 @@ TOOL_PACKAGES = {
     "gcc": "gcc", "clang": "clang", "cc": "gcc", "sollya": "sollya", "gappa": "gappa",
     "iverilog": "iverilog", "vvp": "iverilog", "yosys": "yosys", "ghdl": "ghdl",
     "glslangValidator": "glslang-tools", "nextpnr-ice40": "nextpnr-ice40",
-    "icepack": "fpga-icestorm", "icetime": "fpga-icestorm",
+    "icepack": "fpga-icestorm", "icetime": "fpga-icestorm", "objdump": "binutils",
 }
 
 
@@ -139,11 +139,10 @@ def _measured_slow(items, recorded) -> list:
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        marker = item.get_closest_marker("requires_tool")
-        if marker is not None:
-            reason = tool_missing(*marker.args)
-            if reason is not None:
-                item.add_marker(pytest.mark.skip(reason=reason))
+        tools = [t for marker in item.iter_markers("requires_tool") for t in marker.args]
+        reason = tool_missing(*tools) if tools else None
+        if reason is not None:
+            item.add_marker(pytest.mark.skip(reason=reason))
     for item in _measured_slow(items, _recorded()):
         if item.get_closest_marker("slow") is None:
             item.add_marker(pytest.mark.slow)
@@ -174,6 +173,16 @@ class CliResult:
     out: str
     err: str
 
+    def __iter__(self):
+        """``code, out, err = run_cli(...)``."""
+        return iter((self.code, self.out, self.err))
+
+
+def _args(argv) -> list[str]:
+    """Command-line words: one list, or the words themselves; paths and numbers as text."""
+    words = argv[0] if len(argv) == 1 and isinstance(argv[0], (list, tuple)) else argv
+    return [os.fspath(a) if isinstance(a, (str, os.PathLike)) else str(a) for a in words]
+
 
 def run_cli(*argv, cwd=None) -> CliResult:
     """Run ``chebnorm ARGV`` in this process (``chebnorm.cli.main``), in ``cwd``
@@ -181,8 +190,7 @@ def run_cli(*argv, cwd=None) -> CliResult:
     from chebnorm.cli import main
 
     out, err = io.StringIO(), io.StringIO()
-    args = [os.fspath(a) for a in (argv[0] if len(argv) == 1 and isinstance(argv[0], list)
-                                   else argv)]
+    args = _args(argv)
     with contextlib.ExitStack() as stack:
         if cwd is not None:
             stack.enter_context(contextlib.chdir(cwd))
@@ -190,8 +198,8 @@ def run_cli(*argv, cwd=None) -> CliResult:
         stack.enter_context(contextlib.redirect_stderr(err))
         try:
             code = main(args)
-        except SystemExit as exc:  # argparse's --help and --version
-            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+        except SystemExit as exc:  # argparse's --help and --version; Python's own codes
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
     return CliResult(int(code), out.getvalue(), err.getvalue())
 
 
@@ -204,7 +212,6 @@ def cli():
 def run_process(*argv, cwd=None, env=None, timeout=600, input=None) -> subprocess.CompletedProcess:
     """``python -m chebnorm ARGV`` as a child process (text output), for the tests
     where the process itself is the point."""
-    args = [os.fspath(a) for a in (argv[0] if len(argv) == 1 and isinstance(argv[0], list)
-                                   else argv)]
+    args = _args(argv)
     return subprocess.run([sys.executable, "-m", "chebnorm", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=timeout, input=input)

@@ -43,6 +43,11 @@ def test_shares_the_fixture(costly):
 @pytest.mark.requires_tool("no-such-tool-xyz")
 def test_needs_a_tool():
     pass
+
+@pytest.mark.requires_tool("python3")
+@pytest.mark.requires_tool("no-such-tool-abc")
+def test_needs_two_tools():
+    pass
 """
 
 
@@ -67,9 +72,9 @@ def _ran(result) -> set[str]:
 
 def test_quick_tier_leaves_out_the_measured_and_marked_slow(suite):
     result = suite.inline_run(*_INNER)
-    assert _ran(result) == {"test_fast", "test_needs_a_tool"}
+    assert _ran(result) == {"test_fast", "test_needs_a_tool", "test_needs_two_tools"}
     passed, skipped, failed = result.listoutcomes()
-    assert len(passed) == 1 and len(skipped) == 1 and not failed
+    assert len(passed) == 1 and len(skipped) == 2 and not failed
     deselected = {i.nodeid.split("::")[-1] for r in result.getcalls("pytest_deselected")
                   for i in r.items}
     assert deselected == {"test_recorded_slow", "test_marked_slow", "test_pays_for_the_fixture",
@@ -79,7 +84,7 @@ def test_quick_tier_leaves_out_the_measured_and_marked_slow(suite):
 def test_full_runs_everything(suite):
     result = suite.inline_run(*_INNER, "--full")
     passed, skipped, failed = result.listoutcomes()
-    assert len(passed) == 5 and len(skipped) == 1 and not failed
+    assert len(passed) == 5 and len(skipped) == 2 and not failed
 
 
 def test_marker_expression_replaces_the_tier(suite):
@@ -89,9 +94,12 @@ def test_marker_expression_replaces_the_tier(suite):
 
 
 def test_missing_tool_is_skipped_naming_it_and_its_package(suite):
-    result = suite.runpytest(*_INNER, "-rs", "-k", "needs_a_tool")
+    result = suite.runpytest(*_INNER, "-rs", "-k", "needs_a_tool or needs_two")
     result.stdout.fnmatch_lines(["*no-such-tool-xyz not installed (apt-get install "
                                  "no-such-tool-xyz*"])
+    # stacked markers: every tool named is checked, the missing one is named
+    result.stdout.fnmatch_lines(["*no-such-tool-abc not installed*"])
+    assert "python3 not installed" not in result.stdout.str()
 
 
 def test_store_durations_writes_every_phase(suite, tmp_path):
@@ -101,7 +109,7 @@ def test_store_durations_writes_every_phase(suite, tmp_path):
     recorded = json.loads(out.read_text(encoding="utf-8"))
     assert set(recorded) == {f"test_suite.py::{n}" for n in (
         "test_fast", "test_recorded_slow", "test_marked_slow", "test_pays_for_the_fixture",
-        "test_shares_the_fixture", "test_needs_a_tool")}
+        "test_shares_the_fixture", "test_needs_a_tool", "test_needs_two_tools")}
     assert all(len(v) == 3 and all(x >= 0 for x in v) for v in recorded.values())
 
 
@@ -114,6 +122,8 @@ def test_cli_runner_captures_status_and_both_streams(tmp_path):
     bad = run_cli(["fit", "exp(x)", "--interval", "1", "0", "--degree", "2"])
     assert bad.code == 2 and bad.out == "" and len(bad.err.splitlines()) == 1
     assert run_cli("--version").out.startswith("chebnorm ")
+    code, out, err = run_cli("fit", "exp(x)", "--interval", 0, 1, "--degree", 1)  # numbers as text
+    assert code == 0 and "degree 1" in out and err == ""
 
 
 def test_durations_file_is_well_formed():
