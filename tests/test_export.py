@@ -15,6 +15,8 @@ from chebnorm.export import EXPORT_FORMATS, FORMATS, TABLE_FORMATS, c_header, ex
 from conftest import requires_tool
 
 needs_gcc = requires_tool("gcc")
+#: the compiler the sibling test files run (their tests skip through needs_gcc without it)
+GCC = "gcc"
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 
 DRIVER = r"""
