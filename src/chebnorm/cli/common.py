@@ -249,3 +249,37 @@ def help_when_printed(parser, action, text) -> None:
         return format_help()
 
     parser.format_help = formatted
+
+
+def max_error_value(text, example: str = "1e-5 or 2^-16") -> float:
+    """``--max-error`` as a positive float: a number or an exact expression such
+    as ``2^-20``.
+
+    Parameters
+    ----------
+    text : str
+        The flag's value as typed.
+    example : str, optional
+        Accepted values quoted in the refusal.
+
+    Returns
+    -------
+    float
+        The value, finite and > 0.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--max-error`` and what it accepts.
+    """
+    import math
+
+    from chebnorm.approx import parse_number
+
+    try:
+        value = float(parse_number(str(text).replace("^", "**")))
+    except (ValueError, TypeError, OverflowError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. {example}")
+    return value

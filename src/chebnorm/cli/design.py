@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 
-from .common import command_line, print_json
+from .common import command_line, max_error_value, print_json
 from .parallel_options import add_parallel_args, parallel_kwargs
 
 
@@ -65,20 +65,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _max_error(text) -> float:
-    """``--max-error`` as a float: a number or an exact expression such as ``2^-16``."""
-    from chebnorm.approx import parse_number
-
-    try:
-        value = float(parse_number(str(text).replace("^", "**")))
-    except (ValueError, TypeError, OverflowError):
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. 1e-5 or "
-                         f"2^-16")
-    return value
-
-
 def run(args) -> int:
     """Run ``chebnorm design``: the cheapest certified piecewise evaluator
     (or, by synthesis, another architecture) meeting ``--max-error`` (or
@@ -123,7 +109,7 @@ def run(args) -> int:
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
     accuracy = ("faithful" if args.faithful else "correctly-rounded" if args.correctly_rounded
                 else "max-error")
-    max_error = _max_error(args.max_error) if accuracy == "max-error" else None
+    max_error = max_error_value(args.max_error) if accuracy == "max-error" else None
     frequency = _frequency(args, target)
     if accuracy != "max-error" and args.no_synth:
         raise ValueError(f"--{accuracy} compares architectures by synthesis; accepted: without "

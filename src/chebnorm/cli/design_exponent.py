@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from .common import command_line
+from .common import command_line, max_error_value
 
 
 def run_exponent(args) -> int:
@@ -58,7 +58,7 @@ def run_exponent(args) -> int:
     if args.correctly_rounded:
         raise ValueError("--correctly-rounded: not available with --index exponent (the "
                          "mantissa is faithful at best); accepted: --faithful or --max-error E")
-    max_error = _mantissa_error(args.max_error) if args.max_error is not None else None
+    max_error = max_error_value(args.max_error) if args.max_error is not None else None
     degrees = sorted(set(args.degrees))
     bad = [d for d in degrees if not 1 <= d <= 3]
     if bad:
@@ -111,20 +111,6 @@ def run_exponent(args) -> int:
     for note in notes:
         print(f"  {note}")
     return 0
-
-
-def _mantissa_error(text) -> float:
-    """``--max-error`` as a positive float (a number or e.g. ``2^-16``)."""
-    from chebnorm.approx import parse_number
-
-    try:
-        value = float(parse_number(str(text).replace("^", "**")))
-    except (ValueError, TypeError, OverflowError):
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. 1e-5 or "
-                         f"2^-16")
-    return value
 
 
 def _line(d, cost) -> str:

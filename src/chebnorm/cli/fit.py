@@ -8,7 +8,7 @@ import re
 import sys
 import warnings
 
-from .common import cli_flags, command_line, deprecated_alias, print_json
+from .common import cli_flags, command_line, deprecated_alias, max_error_value, print_json
 from .vocab import COEF_FORMATS as FORMATS, MAX_DEGREE
 
 
@@ -171,27 +171,11 @@ def _fit_cli(args, **kw):
 
     max_error = getattr(args, "max_error", None)
     if max_error is not None:
-        kw["max_error"] = _max_error(max_error)
+        kw["max_error"] = max_error_value(max_error, "1e-6 or 2^-20")
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
                error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
                coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
-
-
-def _max_error(text) -> float:
-    """``--max-error`` as a float: a number or an exact expression such as ``2^-20``."""
-    import math
-
-    from chebnorm.approx import parse_number
-
-    try:
-        value = float(parse_number(str(text).replace("^", "**")))
-    except (ValueError, TypeError, OverflowError):
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. 1e-6 or "
-                         f"2^-20")
-    return value
 
 
 def _run_piecewise(args) -> int:
