@@ -450,6 +450,17 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     return table
 
 
+
+def _function_on(expr, var, interval):
+    """``(Function1D, Interval)`` of a search's expression and interval."""
+    expr_in, var = as_expression(expr, var)
+    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
+    try:
+        lo, hi = interval
+    except (TypeError, ValueError):
+        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
+    return fn, Interval(lo, hi)
+
 def _fit_max_error(expr, interval, degree, max_error, kw):
     """:func:`fit` with ``max_error``: the smallest degree whose certified error
     is at most ``max_error`` (see the parameter), the search recorded in
@@ -487,13 +498,7 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     quantized = kw["frac_bits"] is not None or kw["coef_format"] is not None
     constrained = kw["monomials"] is not None or kw["fix_constant"]
     _check_fit_args(0, kw["kind"], error, kw["basis"], quantized, constrained)
-    expr_in, var = as_expression(expr, kw["var"])
-    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
-    try:
-        lo, hi = interval
-    except (TypeError, ValueError):
-        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
-    iv = Interval(lo, hi)
+    fn, iv = _function_on(expr, kw["var"], interval)
     check_interval(fn, iv)
     lower = degree_lower_bounds(fn, iv, error, MAX_DEGREE)
     mons = kw["monomials"]
@@ -546,13 +551,7 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
     from .piecewise_table import segment_bounds, segment_count
 
     error = kw["error"]
-    expr_in, var = as_expression(expr, kw["var"])
-    fn = expr_in if isinstance(expr_in, Function1D) else parse_function(expr_in, var)
-    try:
-        lo, hi = interval
-    except (TypeError, ValueError):
-        raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
-    iv = Interval(lo, hi)
+    fn, iv = _function_on(expr, kw["var"], interval)
     segment_by = kw["segment_by"] or "uniform"
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) \
             or not 0 <= degree <= MAX_DEGREE:
