@@ -450,7 +450,6 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     return table
 
 
-
 def _function_on(expr, var, interval):
     """``(Function1D, Interval)`` of a search's expression and interval."""
     expr_in, var = as_expression(expr, var)
@@ -460,6 +459,7 @@ def _function_on(expr, var, interval):
     except (TypeError, ValueError):
         raise ValueError(f"interval {interval!r} must be a pair (LO, HI)") from None
     return fn, Interval(lo, hi)
+
 
 def _fit_max_error(expr, interval, degree, max_error, kw):
     """:func:`fit` with ``max_error``: the smallest degree whose certified error
