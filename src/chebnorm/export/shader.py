@@ -358,8 +358,8 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     m = interval_max_abs(table)
     # no bound for an evaluator that can overflow float32 on the interval (nor
     # for one whose flushed underflows the flush term below does not cover)
-    problem = evaluator_range_problem(table, [float(np.float32(c)) for c in coeffs],
-                               _parity32(coeffs), "f", float(U32), m)
+    problem = evaluator_range_problem(table, _float32s(coeffs), _parity32(coeffs), "f",
+                                      float(U32), m)
     if problem is not None:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
@@ -389,7 +389,14 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
 def _parity32(coeffs) -> int | None:
     """The parity of the shader's float32 coefficients (its evaluator is then
     ``x*q(x*x)`` or ``q(x*x)``): :func:`chebnorm.export.c.coefficient_parity`."""
-    return coefficient_parity([float(np.float32(c)) for c in coeffs])
+    return coefficient_parity(_float32s(coeffs))
+
+
+def _float32s(coeffs) -> list[float]:
+    """The coefficients rounded to float32, a coefficient beyond its range as an
+    infinity (which the range check refuses), without numpy's overflow warning."""
+    with np.errstate(over="ignore"):
+        return [float(np.float32(c)) for c in coeffs]
 
 
 def shader_evaluator(table: CoefficientTable, constant: str = ""):
