@@ -297,3 +297,21 @@ def test_the_comment_stripper_shows_code_after_every_line_break():
     assert strip_comments("/* a */ int y; /* b */", "c") == ["int", "y;"]
     assert strip_comments("/* a /* b */ fn f() {} */ fn g() {}", "wgsl") == ["fn", "g()", "{}"]
     assert strip_comments("/* a /* b */ fn f() {} */", "c") == ["fn", "f()", "{}", "*/"]
+
+
+@pytest.mark.parametrize("table", [TABLE, PIECEWISE], ids=["coefficients", "piecewise"])
+def test_hw_verilog_into_the_folder_of_its_input_is_refused(tmp_path, table):
+    """``hw verilog T -o DIR``: a file it would write that is the table itself."""
+    first = tmp_path / "first"
+    code, out, err = astuple(run_cli(["hw", "verilog", table, "--in-bits", "10", "--out-bits",
+                                      "10", "-o", first]))
+    assert code == 0, err
+    names = sorted(p.name for p in first.iterdir())
+    victim = tmp_path / "second" / names[0]
+    victim.parent.mkdir()
+    shutil.copy(table, victim)
+    before = victim.read_bytes()
+    _refused(run_cli(["hw", "verilog", victim, "--in-bits", "10", "--out-bits", "10",
+                      "-o", victim.parent]), "-o")
+    assert victim.read_bytes() == before
+    assert sorted(p.name for p in victim.parent.iterdir()) == [victim.name]
