@@ -293,11 +293,11 @@ def test_committed_proofs_are_the_printed_ones():
     for path in REGISTERED:
         table = load_table(path)
         stem = f"chebnorm_{table.name}"
-        text, evs = c_header_evaluators(table, "chebnorm repro coefficients", proof=stem)
+        text, evs = c_header_evaluators(table, "chebnorm repro coefficients", proof=f"{stem}.h")
         folder = Path(path).parent
         assert (folder / f"{stem}.h").read_text() == text
         for ev in evs:
-            name = f"{stem}.{ev.constant}.gappa"
+            name = f"{stem}.h.{ev.constant}.gappa"
             assert f"proof: {name}" in text
             assert (folder / name).read_text() == gappa_script(ev)
 
@@ -310,7 +310,7 @@ def test_cli_export_proof_writes_the_scripts(tmp_path):
         out = tmp_path / f"t{suffix}"
         assert main(["export", src, "--format", fmt, "-o", str(out), "--proof"]) == 0
         scripts = sorted(p.name for p in tmp_path.glob("t.*.gappa"))
-        assert scripts and all(p.startswith("t.CHEBNORM_") for p in scripts)
+        assert scripts and all(p.startswith(f"t{suffix}.CHEBNORM_") for p in scripts)
         text = out.read_text()
         assert all(name in text for name in scripts if fmt == "c" or "_F_" not in name)
         for p in tmp_path.glob("t.*.gappa"):
@@ -469,7 +469,7 @@ def test_a_certified_constant_names_its_evidence_and_its_proof_holds(fmt, suffix
     assert cert is not None and value < ev.bound().stated
     text = files[out.name]
     assert "exhaustive" in text and repr(ev.bound().stated) in text
-    name = f"e.{ev.constant}.gappa"
+    name = f"e{suffix}.{ev.constant}.gappa"
     assert name in text and files[name] == gappa_script(ev)
     r = _gappa(files[name])
     assert r.returncode == 0 and "not satisfied" not in r.stderr, r.stderr[-2000:]

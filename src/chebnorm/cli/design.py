@@ -501,6 +501,8 @@ def hw_verilog(args, table) -> int:
     files = piecewise_outputs(d, version=__version__, command=command_line(args),
                               language=language)
     out = Path(args.output)
+    from .hw import _refuse_inputs
+    _refuse_inputs(args, files)
     for path in write_folder(out, dict(sorted(files.items()))):
         print(path)
     if args.simulate:

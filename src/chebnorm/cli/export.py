@@ -41,7 +41,7 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", metavar="FILE", required=True)
     p.add_argument("--proof", action="store_true",
                    help="also write a Gappa script per stated evaluation bound beside FILE "
-                   "(FILE's stem.CONSTANT.gappa; formats c, glsl, wgsl, hlsl)")
+                   "(FILE.CONSTANT.gappa; formats c, glsl, wgsl, hlsl)")
     hw = p.add_argument_group("vhdl and verilog (fixed point; see chebnorm hw verilog)")
     hw.add_argument("--in-bits", type=int, default=None,
                     help="input code width, 1..20 (a piecewise table's C export: 1..32, "
@@ -87,11 +87,14 @@ def run(args) -> int:
         library's argument names as the command's flags, and exits with status 2).
     """
     from chebnorm.approx import PiecewiseTable, load_table
+    from chebnorm.core.files import refuse_inputs
     from chebnorm.export import HDL_FORMATS, export_table, export_with_proofs, options_for
 
     if args.format not in EXPORT_FORMATS:
         raise ValueError(f"unknown export format {args.format!r}; accepted: {_all_formats()}")
     given = _given(args)
+    inputs = {"TABLE.json": args.table}
+    refuse_inputs({"-o": args.output}, inputs)
     table = load_table(args.table)
     if isinstance(table, PiecewiseTable):
         takes = options_for(table, args.format) if args.format in ("c", "json", *HDL_FORMATS) \
@@ -111,7 +114,8 @@ def run(args) -> int:
                          f"output code widths){accepted}")
     # the library names its arguments (in_bits): chebnorm.cli.main says them as flags
     if args.proof:
-        export_with_proofs(table, args.format, args.output, command_line(args), **given)
+        export_with_proofs(table, args.format, args.output, command_line(args), inputs=inputs,
+                           **given)
     else:
         export_table(table, args.format, args.output, command_line(args), **given)
     return 0

@@ -79,13 +79,14 @@ def run(args) -> int:
         2).
     """
     from chebnorm.approx import load_table
-    from chebnorm.core.files import write_atomic
+    from chebnorm.core.files import refuse_inputs, write_atomic
     from chebnorm.export.verify import verify
 
     if args.format not in VERIFY_FORMATS:
         raise ValueError(f"unknown format {args.format[:40]!r} for verify; accepted: "
                          f"{', '.join(VERIFY_FORMATS)}")
     inputs = _inputs(args.inputs)
+    refuse_inputs({"--json": args.json}, {"TABLE.json": args.table, "--source": args.source})
     table = load_table(args.table)
     source = None
     if args.source is not None:

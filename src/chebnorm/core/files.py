@@ -37,7 +37,7 @@ import tempfile
 from pathlib import Path
 
 __all__ = ["write_atomic", "write_all", "write_folder", "make_folder", "check_writable",
-           "WriteError"]
+           "refuse_inputs", "WriteError"]
 
 
 class WriteError(OSError, ValueError):
@@ -240,6 +240,57 @@ def write_all(items) -> None:
     finally:
         for tmp, _, _ in staged:
             _unlink_quietly(tmp)
+
+
+def _same_file(a, b) -> bool:
+    """Whether paths ``a`` and ``b`` name one file: the same real path
+    (symbolic links resolved) or, when both exist, the same inode (a hard
+    link)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def refuse_inputs(outputs, inputs) -> None:
+    """Refuse an output that would replace an input of the same command.
+
+    Parameters
+    ----------
+    outputs : dict of str to (str or os.PathLike)
+        What each destination is (``"-o"``, ``"--json"``, ``"proof file"``)
+        -> its path.
+    inputs : dict of str to (str or os.PathLike)
+        What each input is (``"TABLE.json"``) -> its path; ``None`` paths are
+        skipped.
+
+    Raises
+    ------
+    WriteError
+        Naming the output, its path and the input it resolves to (through
+        symbolic links, or a hard link to the same file).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     t = pathlib.Path(tmp) / "t.json"
+    ...     _ = t.write_text("{}")
+    ...     refuse_inputs({"-o": pathlib.Path(tmp) / "t.h"}, {"TABLE.json": t})
+    ...     try:
+    ...         refuse_inputs({"-o": pathlib.Path(tmp) / "." / "t.json"}, {"TABLE.json": t})
+    ...     except WriteError as exc:
+    ...         print(str(exc).split()[0], "is the input" in str(exc))
+    -o True
+    """
+    for what, out in outputs.items():
+        for role, src in inputs.items():
+            if src is not None and out is not None and _same_file(out, src):
+                raise WriteError(f"{what} {str(out)!r:.200} is the input {role} "
+                                 f"{str(src)!r:.200}; an output never replaces an input: "
+                                 f"choose another file name")
 
 
 def check_writable(paths) -> None:

@@ -1,8 +1,9 @@
 """Text that reaches generated code: one validation/escaping function per use.
 
 Every string chebnorm writes into generated C, C++, Verilog, VHDL, GLSL, WGSL,
-HLSL or CSV comes from somewhere a user controls (a table file, a command
-line), so it passes through exactly one of these functions first:
+HLSL, Gappa or CSV comes from somewhere a user controls (a table file, a
+command line, an output file name such as the proof file a header cites), so
+it passes through exactly one of these functions first:
 
 * :func:`identifier` -- a name that becomes part of a symbol (function,
   macro, module, entity, port). It must match ``[A-Za-z_][A-Za-z0-9_]*``;
@@ -12,7 +13,7 @@ line), so it passes through exactly one of these functions first:
   close or open a block comment (``*/``, ``/*``: WGSL's block comments
   nest), cannot continue a line comment onto the next line (a trailing
   backslash, or the C trigraph ``??/``), and contains no line terminator,
-  so it is inert in ``//``, ``/* */`` and ``--`` comments alike.
+  so it is inert in ``//``, ``/* */``, ``--`` and ``#`` comments alike.
 * :func:`csv_cell` -- a text cell of a CSV file (RFC 4180 quoting, and no
   leading ``= + - @`` that a spreadsheet would run as a formula).
 
@@ -74,7 +75,7 @@ def identifier(name, *, field: str = "name") -> str:
 
 
 def comment_text(text, *, max_length: int = 400) -> str:
-    """Make ``text`` inert inside a comment of C, Verilog, VHDL, GLSL, WGSL or HLSL.
+    """Make ``text`` inert inside a comment of C, Verilog, VHDL, GLSL, WGSL, HLSL or Gappa.
 
     Characters outside printable ASCII (line breaks included) become ``_``;
     backslashes become ``_`` (line continuation); ``*/`` and ``/*`` get a space

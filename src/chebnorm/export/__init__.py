@@ -23,7 +23,7 @@ import types
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.piecewise_table import PiecewiseTable
-from chebnorm.core.files import write_atomic
+from chebnorm.core.files import refuse_inputs, write_all, write_atomic
 
 from .c import c_header, horner_rounding_bound
 from .c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
@@ -447,11 +447,13 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     return text
 
 
-def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> dict[str, str]:
+def export_with_proofs(table, fmt: str, path, command: str = "", *, inputs=None,
+                       **options) -> dict[str, str]:
     """Print ``table`` in ``fmt`` naming a Gappa proof beside each stated
     evaluation bound, and write the output and the proofs
-    (:mod:`chebnorm.export.gappa`: ``STEM.CONSTANT.gappa`` next to ``path``,
-    ``STEM`` its name without the suffix). ``fmt``: one of
+    (:mod:`chebnorm.export.gappa`: ``NAME.CONSTANT.gappa`` next to ``path``,
+    ``NAME`` its whole file name, so outputs of other formats or versions
+    never share a proof), all or none. ``fmt``: one of
     :data:`~chebnorm.export.gappa.PROOF_FORMATS` (``c`` of either kind of
     table, ``glsl``, ``wgsl``, ``hlsl``). Returns file name -> text of
     everything written (the output first).
@@ -466,6 +468,9 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
         The output file; the proofs go to its directory.
     command : str, optional
         The command line stated in the banner. Default ``""``.
+    inputs : dict of str to (str or os.PathLike), optional
+        The command's input files (what each is -> path): no file written
+        may resolve to one of them. Default: none.
     **options
         The format's keyword options (:func:`export_text`).
 
@@ -473,7 +478,9 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
     -------
     dict of str to str
         File name (no directory) -> text, the output first, then one
-        ``STEM.CONSTANT.gappa`` per stated evaluation bound.
+        ``NAME.CONSTANT.gappa`` per stated evaluation bound (the comment
+        naming it shows the name through
+        :func:`~chebnorm.core.textsafe.comment_text`).
 
     Raises
     ------
@@ -481,7 +488,8 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
         When ``fmt`` has no proof, or as :func:`export_text` (checked before
         anything is written).
     OSError
-        When a file cannot be written.
+        When a file cannot be written (then none is), or one would replace
+        an input (:func:`~chebnorm.core.files.refuse_inputs`).
 
     Notes
     -----
@@ -505,7 +513,7 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
     >>> t = fit("1/x", ("1", "2"), 1, name="inv")
     >>> with tempfile.TemporaryDirectory() as d:
     ...     sorted(export_with_proofs(t, "glsl", os.path.join(d, "inv.glsl")))
-    ['inv.CHEBNORM_INV_EVAL_ERROR_BOUND.gappa', 'inv.glsl']
+    ['inv.glsl', 'inv.glsl.CHEBNORM_INV_EVAL_ERROR_BOUND.gappa']
     """
     from pathlib import Path
 
@@ -519,7 +527,7 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
                          f"{', '.join(PROOF_FORMATS)}")
     export_text(table, fmt, command, **options)  # every check of the plain export
     path = Path(path)
-    stem = path.name.split(".")[0] or "out"
+    stem = path.name or "out"
     if _kind(table) == "piecewise table":
         text = piecewise_c_header(table, command, proof=stem,
                                   in_bits=options.get("in_bits") or DEFAULT_C_IN_BITS)
@@ -538,9 +546,10 @@ def export_with_proofs(table, fmt: str, path, command: str = "", **options) -> d
         if shader_bound.certificate is None:  # else: the proof is of the a-priori bound
             scripts = {name: gappa_script(ev, shader_bound.total32) for name in scripts}
     files.update(scripts)
-    write_atomic(path, text)
-    for name, script in scripts.items():
-        write_atomic(path.parent / name, script)
+    written = [(path, text)] + [(path.parent / name, script) for name, script in scripts.items()]
+    for i, (p, _) in enumerate(written):
+        refuse_inputs({"path" if i == 0 else "proof file": p}, inputs or {})
+    write_all(written)
     return files
 
 

@@ -988,7 +988,7 @@ def c_header_evaluators(table: CoefficientTable, command: str = "", proof: str =
 
 def _backed(ev, proof: str) -> str:
     """The comment naming the proof file of ``ev``'s constant (when proofs are written)."""
-    return f"  /* proof: {proof}.{ev.constant}.gappa */" if proof else ""
+    return f"  /* proof: {comment_text(f'{proof}.{ev.constant}.gappa')} */" if proof else ""
 
 
 def _bound_line(ev, proof: str) -> str:
@@ -1002,7 +1002,7 @@ def _bound_line(ev, proof: str) -> str:
     if cert is None:
         return line + _backed(ev, proof)
     proved = ev.bound().stated
+    by = f" is proved by {comment_text(f'{proof}.{ev.constant}.gappa')}" if proof else ""
     return (line + f"  /* exhaustive: every float32 input and every fused/unfused mix checked"
             f" (chebnorm.export.certificate; chebnorm verify re-checks); the a-priori bound"
-            f" {proved!r}" + (f" is proved by {proof}.{ev.constant}.gappa" if proof else "")
-            + " */")
+            f" {proved!r}" + by + " */")

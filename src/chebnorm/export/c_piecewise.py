@@ -203,7 +203,8 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
     if table.rel_error_bound is not None:
         w(f"#define {macro}_REL_ERROR_BOUND {table.rel_error_bound!r}")
     w(f"#define {macro}_EVAL_ERROR_BOUND {piecewise_eval_bound(table)!r}"
-      + (f"  /* proof: {proof}.{macro}_EVAL_ERROR_BOUND.gappa */" if proof else ""))
+      + (f"  /* proof: {comment_text(f'{proof}.{macro}_EVAL_ERROR_BOUND.gappa')} */"
+         if proof else ""))
     if uniform:
         w(f"#define {macro}_IN_BITS {in_bits}")
     w("")

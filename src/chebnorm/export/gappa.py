@@ -31,7 +31,8 @@ bound covers every mix; the script proves the two pure sequences).
 
 :func:`gappa_proofs` gives the scripts of an exported file (file name ->
 text); ``chebnorm export --proof`` writes them beside the output, one per
-stated constant, named ``STEM.CONSTANT.gappa``.
+stated constant, named ``NAME.CONSTANT.gappa`` (``NAME`` the output's whole
+file name, so ``t.h`` and ``t.glsl`` never share a proof).
 
 >>> from chebnorm.approx import fit
 >>> from chebnorm.export.c import c_header_evaluators
@@ -216,8 +217,8 @@ def gappa_proofs(evaluators, stem: str) -> dict[str, str]:
         second item of :func:`chebnorm.export.c.c_header_evaluators`, or
         :func:`chebnorm.export.shader.shader_evaluator`'s).
     stem : str
-        The output file's name without its extension; the proofs are named
-        ``STEM.CONSTANT.gappa`` beside it.
+        The prefix of the proof names, ``STEM.CONSTANT.gappa``
+        (``export_with_proofs`` passes the output's whole file name).
 
     Returns
     -------

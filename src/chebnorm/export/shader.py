@@ -554,7 +554,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
           " an ulp of its")
         w(f"//   largest result there, fused or not) + subnormal input flush "
           f"{float(bound.flush):.3e}."
-          + (f" Proof: {proof}.{big}_EVAL_ERROR_BOUND.gappa" if proof else ""))
+          + (f" Proof: {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}" if proof else ""))
     else:
         w(f"//   the certified maximum of |{fn}(x) - f(x)| {float(bound.certificate.maximum):.6e}"
           f" rounded up")
@@ -564,7 +564,8 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
           f"{float(bound.flush):.3e}.")
         w(f"//   The a-priori bound {shader_evaluator(table).bound().stated!r} (interval "
           f"arithmetic) is proved"
-          + (f" by {proof}.{big}_EVAL_ERROR_BOUND.gappa." if proof else " by its Gappa script."))
+          + (f" by {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}." if proof
+             else " by its Gappa script."))
     w("// Assumes float32 (highp) with correctly rounded + and *, and a multiply-add that is fused"
       " or two roundings.")
     w("")
