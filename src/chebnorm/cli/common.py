@@ -283,3 +283,27 @@ def max_error_value(text, example: str = "1e-5 or 2^-16") -> float:
     if not (math.isfinite(value) and value > 0):
         raise ValueError(f"--max-error {text!r}: accepted: a finite number > 0, e.g. {example}")
     return value
+
+
+def refuse_table_overwrite(args, files) -> None:
+    """Refuse (exit 2) a file of ``files`` that ``-o DIR`` would write over the
+    command's input table (``args.table``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: its ``output`` folder and ``table`` (if any).
+    files : iterable of str
+        The names the command writes into the folder.
+
+    Raises
+    ------
+    ValueError
+        Naming ``-o`` and the input it would replace.
+    """
+    from pathlib import Path
+
+    from chebnorm.core.files import refuse_inputs
+
+    for name in files:
+        refuse_inputs({"-o": Path(args.output) / name}, {"TABLE.json": getattr(args, "table", None)})

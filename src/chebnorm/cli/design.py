@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 
-from .common import command_line, max_error_value, print_json
+from .common import command_line, max_error_value, print_json, refuse_table_overwrite
 from .parallel_options import add_parallel_args, parallel_kwargs
 
 
@@ -501,8 +501,7 @@ def hw_verilog(args, table) -> int:
     files = piecewise_outputs(d, version=__version__, command=command_line(args),
                               language=language)
     out = Path(args.output)
-    from .hw import _refuse_inputs
-    _refuse_inputs(args, files)
+    refuse_table_overwrite(args, files)
     for path in write_folder(out, dict(sorted(files.items()))):
         print(path)
     if args.simulate:

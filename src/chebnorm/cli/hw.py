@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import json
 
-from .common import command_line, deprecated_alias, help_when_printed, print_json, refuse_unused
+from .common import (command_line, deprecated_alias, help_when_printed, print_json,
+                     refuse_table_overwrite, refuse_unused)
 from .parallel_options import add_parallel_args
 from .vocab import UNIT_NAMES
 
@@ -215,7 +216,7 @@ def run_verilog(args) -> int:
                         pipelined=args.pipelined)
     files[f"{report.design.module_name}_report.json"] = json.dumps(
         report.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
-    _refuse_inputs(args, files)
+    refuse_table_overwrite(args, files)
     for path in write_outputs(args.output, files):
         print(path)
     if args.simulate:
@@ -409,7 +410,7 @@ def run_unit(args) -> int:
                          command=command_line(args))
     files[f"{unit.module_name}_report.json"] = json.dumps(
         rep.as_dict(), sort_keys=True, indent=2, allow_nan=False) + "\n"
-    _refuse_inputs(args, files)
+    refuse_table_overwrite(args, files)
     for path in write_outputs(args.output, files):
         print(path)
     print("\n".join(rep.lines()))
@@ -484,17 +485,6 @@ def run_sweep(args) -> int:
               f"bits {best.coef_bits}, accumulator bits {best.acc_bits or '-'}: {area}, "
               f"{best.shading_levels:.4f} levels, {best.max_error_lsb:.2f} LSB")
     return 0
-
-
-def _refuse_inputs(args, files) -> None:
-    """Refuse (exit 2) a file of ``files`` that ``-o DIR`` would write over the input table."""
-    from pathlib import Path
-
-    from chebnorm.core.files import refuse_inputs
-
-    for name in files:
-        refuse_inputs({"-o": Path(args.output) / name},
-                      {"TABLE.json": getattr(args, "table", None)})
 
 
 def _check_output(path) -> None:
