@@ -17,7 +17,6 @@ import pytest
 import sympy as sp
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from scipy.optimize import minimize_scalar
 
 import chebnorm.symbolic as S
 from chebnorm.symbolic import bump, highlight, interpolation, symbols
@@ -447,6 +446,8 @@ class TestEdgeHighlight:
             # bounded Brent stops within 2 (sqrt(eps) |x| + xatol/3) of the
             # optimum (scipy's termination test); first-order loss |h'| dx
             # with |h'| <= R theta'(t) <= 2 tan(phi/2)
+            from scipy.optimize import minimize_scalar
+
             res = minimize_scalar(
                 lambda x: -float(self.h_direct(x, hv[i], na[i], nb[i])),
                 bounds=(0.0, 1.0), method="bounded", options={"xatol": self.XATOL},
