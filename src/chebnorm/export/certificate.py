@@ -296,6 +296,11 @@ def _simulate(x, cs, parity, shift, drop, pure=False):
     return lo.astype(np.float64), hi.astype(np.float64), any(_subnormal(v) for v in seen)
 
 
+def _series_coeffs(s):
+    """Coefficients of an Arb series; a constant function yields a plain ball."""
+    return s.coeffs() if hasattr(s, "coeffs") else [s]
+
+
 class _Reference:
     """Taylor pieces of ``f``: per piece the double coefficients and the proved
     bound of ``|q(x) - f(x)|`` (``None`` when Arb cannot enclose ``f``)."""
@@ -316,9 +321,9 @@ class _Reference:
                 m = float(np.float32(0.5 * (a + b)))
                 r = float_up(max(Fraction(m) - Fraction(float(a)), Fraction(float(b)) - Fraction(m)))
                 try:
-                    tc = fn.arb_series(arb_series([arb(m), 1], prec=n + 1)).coeffs()
+                    tc = _series_coeffs(fn.arb_series(arb_series([arb(m), 1], prec=n + 1)))
                     ball = arb(m, r)  # [m - r, m + r] contains the piece
-                    rest = fn.arb_series(arb_series([ball, 1], prec=n + 1)).coeffs()
+                    rest = _series_coeffs(fn.arb_series(arb_series([ball, 1], prec=n + 1)))
                 except (ValueError, ArithmeticError, TypeError):
                     raise _NoReference() from None
                 tc = list(tc) + [arb(0)] * (n + 1 - len(tc))
