@@ -163,6 +163,28 @@ def pytest_report_header(config):
             f"{DURATIONS.name} are deselected; --full runs them")
 
 
+# --- resources one test at a time may use ------------------------------------------------
+
+@contextlib.contextmanager
+def one_at_a_time(resource: str):
+    """Hold the machine-wide lock of ``resource`` (a file lock every xdist worker and
+    every other test run on the machine shares) while the block runs. Jupyter
+    kernels need it: a client picks a kernel's free ports before the kernel binds
+    them, so two kernels started at once (the notebooks test on one worker, the
+    docs build's notebook execution on another) can take the same ports, and the
+    client of one then waits forever on the other's."""
+    import fcntl
+    import tempfile
+
+    path = Path(tempfile.gettempdir()) / f"chebnorm-tests-{resource}.lock"
+    with open(path, "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
 # --- running the command line -------------------------------------------------------------
 
 @dataclass

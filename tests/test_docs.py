@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import one_at_a_time
+
 # found, not imported: importing myst-nb and Sphinx costs the whole suite's collection 0.4 s
 _DOCS_PACKAGES = {"sphinx": "sphinx", "numpydoc": "numpydoc", "myst_nb": "myst-nb", "furo": "furo",
                   "sphinx-mathjax-offline": "sphinx-mathjax-offline"}
@@ -27,6 +29,10 @@ if _MISSING:
                 allow_module_level=True)
 
 REPO = Path(__file__).resolve().parent.parent
+#: seconds a site build may take before it is taken for hung (it takes 100-120 s loaded)
+BUILD_SECONDS = 480
+#: the build may run twice (see ``built``): the module's tests get room for both
+pytestmark = pytest.mark.timeout(2 * BUILD_SECONDS + 300)
 STAGES = ["chebnorm.core", "chebnorm.symbolic", "chebnorm.approx", "chebnorm.export", "chebnorm.methods",
           "chebnorm.hw", "chebnorm.raster"]
 
@@ -36,9 +42,21 @@ def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("docs")
     # offline: no intersphinx fetch (CHEBNORM_DOCS_OFFLINE), as on a machine without network
     env = {**os.environ, "CHEBNORM_DOCS_OFFLINE": "1"}
-    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-n", "--keep-going", "-q", "-b", "html",
-                           "-d", str(out / "doctrees"), str(REPO / "docs"), str(out / "html")],
-                          capture_output=True, text=True, cwd=REPO, env=env)
+    command = [sys.executable, "-m", "sphinx", "-W", "-n", "--keep-going", "-q", "-b", "html",
+               "-d", str(out / "doctrees"), str(REPO / "docs"), str(out / "html")]
+    # The build runs the notebooks in a Jupyter kernel, one kernel on the machine at a time.
+    # A client has been seen waiting forever on an idle kernel (both connected, no message
+    # pending): a build that outlives BUILD_SECONDS (about 4x its time on a loaded 2-core
+    # machine) is stopped and run once more, and fails the test if it hangs again.
+    for attempt in (1, 2):
+        with one_at_a_time("jupyter-kernel"):
+            try:
+                proc = subprocess.run(command, capture_output=True, text=True, cwd=REPO, env=env,
+                                      timeout=BUILD_SECONDS)
+                break
+            except subprocess.TimeoutExpired:
+                if attempt == 2:
+                    pytest.fail(f"sphinx hung twice for {BUILD_SECONDS} s (notebook execution)")
     assert proc.returncode == 0, f"sphinx -W failed:\n{proc.stderr[-4000:]}"
     return out / "html"
 
