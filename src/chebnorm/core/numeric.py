@@ -16,13 +16,16 @@ True
 from __future__ import annotations
 
 import contextlib
+import decimal
 import math
+import numbers
+import re
 from fractions import Fraction
 
 import numpy as np
 
 __all__ = ["float_up", "float_down", "ball_float_up", "ball_float_down", "signed_bits",
-           "unsigned_bits", "check_int", "arb_precision"]
+           "unsigned_bits", "check_int", "arb_precision", "format_up", "format_down"]
 
 
 def float_up(x: Fraction) -> float:
@@ -50,6 +53,102 @@ def float_up(x: Fraction) -> float:
     while Fraction(f) < x:
         f = math.nextafter(f, math.inf)
     return f
+
+
+_SPEC = re.compile(r"([<>^=]?)([-+ ]?)(\d*)\.(\d+)([efgEFG])")
+
+
+def _format_directed(x, spec: str, rounding: str) -> str:
+    if isinstance(x, str) or isinstance(x, bool):
+        raise TypeError(f"a bound must be a number, not {type(x).__name__}")
+    m = _SPEC.fullmatch(spec.lstrip(":"))
+    if m is None:
+        raise ValueError(f"spec must look like '.4e', '.3g' or '.6f', not {spec!r}")
+    digits, kind = int(m.group(4)), m.group(5)
+    if kind in "eE" and digits > 14 or kind in "gG" and digits > 15:
+        raise ValueError(f"spec prints at most 15 significant digits, not {spec!r}")
+    if isinstance(x, numbers.Rational):
+        # the float on the safe side of the rational (an int beyond 2^53 too), then rounded in the same direction
+        x = float_up(x) if rounding == decimal.ROUND_CEILING else float_down(x)
+    x = float(x)
+    if not math.isfinite(x) or x == 0:
+        return format(x, spec.lstrip(":"))
+    d = decimal.Decimal(x)  # exact
+    if kind in "fF":
+        quantum = decimal.Decimal(1).scaleb(-digits)
+    else:
+        keep = digits if kind in "eE" else max(digits, 1) - 1
+        adjusted = d.adjusted() if d else 0
+        quantum = decimal.Decimal(1).scaleb(adjusted - keep)
+    with decimal.localcontext() as ctx:
+        ctx.prec = 400
+        q = d.quantize(quantum, rounding=rounding)
+    if kind in "fF":
+        return format(q, spec.lstrip(":"))  # fixed point prints a decimal as a float
+    # q has at most 15 significant digits, so the float nearest it prints as q
+    # (float's own exponent style), except deep in the subnormals
+    text = format(float(q), spec.lstrip(":"))
+    if decimal.Decimal(text.strip()) != q:
+        text = format(q, spec.lstrip(":"))
+    return text
+
+
+def format_up(x, spec: str = ".4e") -> str:
+    """``x`` printed with ``spec``, rounded upward at the last digit printed.
+
+    An upper bound printed as text must not read smaller than the bound it
+    stands for: ``f"{x:.6e}"`` rounds to nearest and may print a number below
+    ``x``.  Every printer of an upper bound goes through this helper (a lower
+    bound through :func:`format_down`).
+
+    Parameters
+    ----------
+    x : float or int or fractions.Fraction
+        The bound (a rational or an integer is first rounded up to a float).
+    spec : str, optional
+        A format spec ``[align][sign][width].N(e|f|g)`` (upper case allowed).
+
+    Returns
+    -------
+    str
+        The text; the number it reads is ``>= x``.
+
+    Raises
+    ------
+    ValueError
+        When ``spec`` is not of that form (or asks for more than 15 significant digits).
+
+    Examples
+    --------
+    >>> format_up(2.6511904684e-03, ".6e"), f"{2.6511904684e-03:.6e}"
+    ('2.651191e-03', '2.651190e-03')
+    >>> format_up(9.99996e-05, ".4e"), format_up(0.5, ".3g"), format_up(Fraction(1, 3), ".3f")
+    ('1.0000e-04', '0.5', '0.334')
+    """
+    return _format_directed(x, spec, decimal.ROUND_CEILING)
+
+
+def format_down(x, spec: str = ".4e") -> str:
+    """``x`` printed with ``spec``, rounded downward at the last digit printed.
+
+    Parameters
+    ----------
+    x : float or int or fractions.Fraction
+        A lower bound.
+    spec : str, optional
+        As for :func:`format_up`.
+
+    Returns
+    -------
+    str
+        The text; the number it reads is ``<= x``.
+
+    Examples
+    --------
+    >>> format_down(2.6511904684e-03, ".6e"), format_down(Fraction(2, 3), ".2f")
+    ('2.651190e-03', '0.66')
+    """
+    return _format_directed(x, spec, decimal.ROUND_FLOOR)
 
 
 def float_down(x: Fraction) -> float:
