@@ -56,7 +56,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
 # _layer_rule.rst is a fragment, included by contributing.md
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst"]
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli"]
 templates_path = ["_templates"]
 
 # every cross-reference must resolve (python -m sphinx -n); see _resolve_in_defining_module
@@ -192,6 +192,37 @@ def _write_figure_gallery() -> None:
     _write_if_changed(DOCS / "gallery" / "figures.md", "\n".join(lines))
 
 
+def _subparsers(parser):
+    """``(name, parser)`` of each subcommand of ``parser``, in the order they were added."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return list(action.choices.items())
+    return []
+
+
+def _write_cli_help() -> None:
+    """_cli/COMMAND.txt: each command's ``--help`` (``hw_verilog.txt`` for
+    ``hw verilog``), printed 88 columns wide whatever the terminal, so the CLI page
+    shows exactly what the parser accepts."""
+    from chebnorm.cli import build_parser
+
+    saved = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "88"
+    try:
+        for name, sub in _subparsers(build_parser()):
+            nested = _subparsers(sub)
+            for sub_name, leaf in nested or [(None, sub)]:
+                stem = name if sub_name is None else f"{name}_{sub_name}"
+                _write_if_changed(DOCS / "_cli" / f"{stem}.txt", leaf.format_help())
+    finally:
+        if saved is None:
+            os.environ.pop("COLUMNS", None)
+        else:
+            os.environ["COLUMNS"] = saved
+
+
 STAGES = ("core", "symbolic", "approx", "export", "methods", "hw", "raster")
 
 
@@ -285,6 +316,7 @@ def _write_layer_rule() -> None:
 
 _copy_notebooks()
 _write_figure_gallery()
+_write_cli_help()
 _write_layer_rule()
 # autosummary's pages are a build product: a module that moved or was removed must not
 # leave its page behind (a stale page imports a name that no longer exists)

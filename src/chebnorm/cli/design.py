@@ -235,7 +235,7 @@ def _search(args, name, target, max_error, bound=None, synth=None, workers=None)
                  name=name, target=target,
                  bound=bound, **dict(parallel_kwargs(args), **(
                      {} if workers is None else {"workers": workers, "scheduler": None})))
-    if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
+    if res.winner is None:  # one line, exit 2, nothing written (docs/cli.md)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
                          f"certified error reached is {best.total_bound:.4g} (degree {best.degree}, "
