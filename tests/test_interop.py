@@ -206,7 +206,7 @@ def test_quantized_conversions_and_bound():
     assert q.error_bound == q.quantized_error_bound == q.quantized.abs_error_bound
     assert q.error_bound > q.abs_error_bound == t.abs_error_bound  # the JSON field keeps its meaning
     assert t.error_bound == t.abs_error_bound and t.quantized_error_bound is None
-    with pytest.raises(ValueError, match="quantized=True: table 'table' has no quantized part"):
+    with pytest.raises(ValueError, match="quantized=True: table 'rsqrt_z_2_sqrt_2_2_d2' has no quantized part"):
         t.to_sympy(quantized=True)
 
 

@@ -11,6 +11,7 @@ import sympy as sp
 from flint import arb
 
 from chebnorm.core.numeric import ball_float_down, ball_float_up
+from chebnorm.core.textsafe import default_name
 
 from .certify import Certificate, certify
 from .expr import Function1D, compare, enclose, parse_function, parse_number
@@ -233,8 +234,10 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     var : str or sympy.Symbol, optional
         The variable of ``expr`` (default ``"x"``).
     name : str, optional
-        The table's name, an identifier (it names generated code); default
-        ``"table"``.
+        The table's name, an identifier (it names generated code); default: made
+        from the expression, interval and degree (``"rsqrt_1_4_d3"`` for
+        ``fit("1/sqrt(x)", (1, 4), 3)``; :func:`chebnorm.core.textsafe.default_name`),
+        so the exports of different fits coexist in one build.
     frac_bits : int or sequence of int, optional
         Also quantize the coefficients to fixed point with this many
         fractional bits (one, or one per power): see :func:`quantize`. For a
@@ -436,7 +439,8 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         provenance["warnings"] = " | ".join(notes)
     with construction("fitted"):  # certified above: checked, not proved twice
         table = CoefficientTable(
-            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+            name=name or default_name(sp.sstr(fn.expr), iv.strings, degree, fn.var.name),
+            expression=sp.sstr(fn.expr), variable=fn.var.name,
             interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
             error_kind=error, coefficients=tuple(coeffs),
             abs_error_bound=cert_abs.bound, rel_error_bound=None if cert_rel is None else cert_rel.bound,
@@ -1363,12 +1367,13 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
         return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
 
 
-def _table_name(name) -> str:
-    """``name`` checked where it enters: None is ``"table"``, anything else must be
+def _table_name(name) -> str | None:
+    """``name`` checked where it enters: None stays None (the table is named after
+    its expression, interval and degree once they are read), anything else must be
     an identifier (it becomes a C function, a macro, a Verilog module)."""
     from chebnorm.core.textsafe import identifier
 
-    return "table" if name is None else identifier(name, field="name")
+    return None if name is None else identifier(name, field="name")
 
 
 def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:

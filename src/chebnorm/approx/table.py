@@ -298,7 +298,7 @@ class CoefficientTable(Table):
         >>> fit("exp(x)", ("0", "1"), 2, basis="shifted").require_monomial("hw")
         Traceback (most recent call last):
         ...
-        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
+        ValueError: table 'exp_0_1_d2' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
         """
         if self.shift is not None:
             c, s = self.shift

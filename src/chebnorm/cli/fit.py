@@ -68,8 +68,9 @@ def register(sub) -> None:
                    "t = (VAR - c)/s, c the midpoint, s a power of two (well conditioned on "
                    "narrow or offset intervals, where monomials lose accuracy; exported to C, "
                    "not to hw/shaders)")
-    p.add_argument("--name", default="table", help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
-                   "most 63 characters (it names the C function, shader and HDL module)")
+    p.add_argument("--name", default=None, help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
+                   "most 63 characters (it names the C function, shader and HDL module); "
+                   "default: made from EXPR, the interval and the degree, e.g. rsqrt_1_4_d3")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
     # piecewise_fit, under fit --segments, calls --coef-frac-bits coef_frac_bits
@@ -225,7 +226,8 @@ def run(args) -> int:
     from chebnorm.approx import FitWarning, warnings_of
     from chebnorm.core.textsafe import identifier
 
-    identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
+    if args.name is not None:  # before the fit: the name becomes C and HDL symbols
+        identifier(args.name, field="--name")
     if args.degree is None and args.max_error is None:
         raise ValueError(f"the following arguments are required: --degree N (0..{MAX_DEGREE}), "
                          f"or --max-error E instead (the smallest degree whose certified error "
