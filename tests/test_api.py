@@ -63,7 +63,7 @@ def test_export_dispatches_over_every_format():
 
 def test_hw_report_is_callable():
     t = cn.fit_target("dichotomy", 1)
-    r = cn.hw.report(t, 10, 10, coef_bits=12, synth=False, gappa=False)
+    r = cn.hw.report(t, 10, 10, coef_frac_bits=12, synth=False, gappa=False)
     assert isinstance(r, cn.hw.HardwareReport)
     assert r.checks["within_budget"]
 

@@ -230,7 +230,7 @@ class TestPipelined:
     def test_bit_for_bit_with_latency(self, degree, rounding, tmp_path):
         from chebnorm.hw.report import analyze, verilog_outputs
 
-        r = analyze(fit_target("midpoint", degree), 10, 10, coef_bits=16, rounding=rounding,
+        r = analyze(fit_target("midpoint", degree), 10, 10, coef_frac_bits=16, rounding=rounding,
                     synth=False, gappa=False)
         files = verilog_outputs(r, pipelined=True)
         name = f"{r.design.module_name}_pipe"

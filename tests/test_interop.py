@@ -89,7 +89,7 @@ def test_python_errors_name_arguments_and_the_cli_names_flags(capsys):
         cn.fit("exp(y)", (0, 1), 2)
     assert "--" not in str(exc.value)
     t = cn.fit("exp(x)", (0, 1), 3)
-    with pytest.raises(ValueError, match="frac_bits 40 overflows int32.*accepted: frac_bits <= ") \
+    with pytest.raises(ValueError, match="coef_frac_bits 40 overflows int32.*accepted: coef_frac_bits <= ") \
             as exc:
         cn.quantize(t, 40)
     assert "frac-bits" not in str(exc.value)
@@ -260,7 +260,7 @@ def test_result_objects_display_briefly():
     q = cn.quantize(t, 12)
     objects = [t, q, q.fixed_point, cn.quantize(t, coef_format="binary32").quantized,
                cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4), cn.target("dichotomy"),
-               cn.hw.report.analyze(cn.fit_target("dichotomy", 1), 8, 8, coef_bits=12,
+               cn.hw.report.analyze(cn.fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12,
                                     synth=False, gappa=False),
                analyze("newton", 0.5, 8),
                error_sweep(("none", "exact"), [0.2, 0.4], (8,), (np.float64,)),

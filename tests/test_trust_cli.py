@@ -68,7 +68,7 @@ def test_frac_bits_2000(capsys, table):
                                       "--coef-frac-bits", "2000"]))
     assert status == 2 and "accepted: --coef-frac-bits <= 30" in _one_line(err)
     for bits in (2000, 2 ** 70):
-        with pytest.raises(ValueError, match="accepted: frac_bits <= 30"):
+        with pytest.raises(ValueError, match="accepted: coef_frac_bits <= 30"):
             cn.quantize(table, bits)
 
 

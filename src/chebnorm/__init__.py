@@ -129,6 +129,7 @@ _LAZY = {
     "PiecewiseTable": ("chebnorm.approx", "PiecewiseTable"),
     "load_table": ("chebnorm.approx", "load_table"),
     "FitWarning": ("chebnorm.approx", "FitWarning"),
+    "ChebnormDeprecationWarning": ("chebnorm.core.deprecation", "ChebnormDeprecationWarning"),
     "target": ("chebnorm.approx", "get_target"),
     "target_names": ("chebnorm.approx", "target_names"),
     "span_normals": ("chebnorm.methods", "span_normals"),
@@ -141,7 +142,7 @@ _LAZY = {
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
     "PiecewiseTable", "load_table",
-    "FitWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
+    "FitWarning", "ChebnormDeprecationWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
     "core", "symbolic", "approx", "export", "methods", "hw", "raster",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}

@@ -11,6 +11,7 @@ import sympy as sp
 from flint import arb
 
 from chebnorm.core.numeric import ball_float_down, ball_float_up
+from chebnorm.core.deprecation import renamed
 from chebnorm.core.textsafe import default_name
 
 from .certify import Certificate, certify
@@ -202,10 +203,10 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
 
 
 def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", error: str = "abs", *,
-        var: str = "x", name: str | None = None, frac_bits=None,
+        var: str = "x", name: str | None = None, coef_frac_bits=None,
         command: str | None = None, basis: str = "auto", coef_format: str | None = None,
         monomials=None, fix_constant: bool = False, segments=None, segment_by: str | None = None,
-        centered: bool = False, max_error: float | None = None):
+        centered: bool = False, max_error: float | None = None, frac_bits=None):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     Every table carries rigorous bounds of both its absolute and its relative
@@ -238,7 +239,7 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         from the expression, interval and degree (``"rsqrt_1_4_d3"`` for
         ``fit("1/sqrt(x)", (1, 4), 3)``; :func:`chebnorm.core.textsafe.default_name`),
         so the exports of different fits coexist in one build.
-    frac_bits : int or sequence of int, optional
+    coef_frac_bits : int or sequence of int, optional
         Also quantize the coefficients to fixed point with this many
         fractional bits (one, or one per power): see :func:`quantize`. For a
         piecewise table, the one fixed-point format (default 24).
@@ -280,6 +281,9 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         with ``degree``, except with ``segments="auto"``: then the fewest
         segments (``2**k``) whose piecewise table of ``degree`` is certified
         to ``max_error`` (``provenance["segment_search"]``).
+    frac_bits : int or sequence of int, optional
+        The deprecated spelling of ``coef_frac_bits`` (a
+        :class:`~chebnorm.core.deprecation.ChebnormDeprecationWarning`).
 
     Returns
     -------
@@ -387,13 +391,14 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
 
     A piecewise table:
 
-    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
+    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, coef_frac_bits=20)
     >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
     (16, True)
     """
+    frac_bits = renamed(frac_bits, coef_frac_bits, "frac_bits", "coef_frac_bits", "fit")
     if max_error is not None or degree is None or segments == "auto":
         return _fit_max_error(expr, interval, degree, max_error, dict(
-            kind=kind, error=error, var=var, name=name, frac_bits=frac_bits, command=command,
+            kind=kind, error=error, var=var, name=name, coef_frac_bits=frac_bits, command=command,
             basis=basis, coef_format=coef_format, monomials=monomials,
             fix_constant=fix_constant, segments=segments, segment_by=segment_by,
             centered=centered))
@@ -499,7 +504,7 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     max_error = float(max_error)
     error = kw["error"]
     # the arguments are checked once, by a degree-0 check of fit's own
-    quantized = kw["frac_bits"] is not None or kw["coef_format"] is not None
+    quantized = kw["coef_frac_bits"] is not None or kw["coef_format"] is not None
     constrained = kw["monomials"] is not None or kw["fix_constant"]
     _check_fit_args(0, kw["kind"], error, kw["basis"], quantized, constrained)
     fn, iv = _function_on(expr, kw["var"], interval)
@@ -589,7 +594,7 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
     raise ValueError(f"no segment count up to 2^12 reaches max_error {max_error:.6g} at "
                      f"degree {degree} for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: "
                      f"{'; '.join(tried[-3:])}); accepted: a larger max_error, a higher "
-                     f"degree or more coefficient bits (frac_bits)")
+                     f"degree or more coefficient bits (coef_frac_bits)")
 
 
 def _search_text(tried: list[str], what: str) -> str:
@@ -826,13 +831,13 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
     if basis not in ("auto", *BASES):
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(('auto', *BASES))}")
     if basis == "shifted" and (quantized or constrained):
-        raise ValueError("quantized coefficients (frac_bits, coef_format, monomials, "
+        raise ValueError("quantized coefficients (coef_frac_bits, coef_format, monomials, "
                          "fix_constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
     if constrained and not quantized and kind != "minimax":
         raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
                          f"format; accepted: kind 'minimax' (the best real polynomial in those "
-                         f"powers), or a frac_bits or coef_format to quantize")
+                         f"powers), or a coef_frac_bits or coef_format to quantize")
     return degree
 
 
@@ -848,9 +853,9 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
     if coef_format not in (None, "fixed") or monomials is not None or fix_constant:
         raise ValueError("coef_format, monomials and fix_constant apply to one polynomial; "
                          "accepted with segments, segment_by or centered: fixed-point "
-                         "coefficients (frac_bits F, one integer)")
+                         "coefficients (coef_frac_bits F, one integer)")
     if isinstance(frac_bits, (list, tuple)):
-        raise ValueError(f"frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
+        raise ValueError(f"coef_frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
                          f"one format; accepted: one integer")
     return piecewise_fit(expr, tuple(interval), degree, segments=segments or 1,
                          segment_by=segment_by or "uniform",
@@ -1045,28 +1050,28 @@ def _check_table(table, argument: str) -> None:
 
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
-        raise ValueError(f"frac_bits {frac_bits!r} is not a non-negative integer")
+        raise ValueError(f"coef_frac_bits {frac_bits!r} is not a non-negative integer")
     limit = 2 ** (word_bits - 1) - 1
     biggest = max(abs(c) for c in coeffs)
     if biggest == 0:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
     if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
-        raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: the largest "
+        raise ValueError(f"coef_frac_bits {frac_bits} overflows int{word_bits}: the largest "
                          f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
-                         f"accepted: frac_bits <= {max_f}")
+                         f"accepted: coef_frac_bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
-            raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
+            raise ValueError(f"coef_frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
                              f"x^{k} = {c:.6g} becomes {round(math.ldexp(c, frac_bits))}; "
-                             f"accepted: frac_bits <= {max_f}")
+                             f"accepted: coef_frac_bits <= {max_f}")
 
 
 def _frac_list(frac_bits, degree: int, coeffs, word_bits: int) -> list[int]:
     """``frac_bits`` (an integer or one per power 0..degree) as a list, checked."""
     if isinstance(frac_bits, (list, tuple)):
         if len(frac_bits) != degree + 1:
-            raise ValueError(f"frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
+            raise ValueError(f"coef_frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
                              f"accepted: one integer, or degree + 1 = {degree + 1} integers "
                              f"(one per power 0..{degree})")
         for k, f in enumerate(frac_bits):
@@ -1093,9 +1098,9 @@ def _monomials(monomials, degree: int, fix_constant: bool) -> tuple[int, ...]:
     return tuple(mons)
 
 
-def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
+def quantize(table: CoefficientTable, coef_frac_bits=None, *, word_bits: int = 32,
              reoptimize: bool = True, coef_format: str = "fixed", monomials=None,
-             fix_constant: bool = False) -> CoefficientTable:
+             fix_constant: bool = False, frac_bits=None) -> CoefficientTable:
     """Round the coefficients to a fixed or floating format and re-certify.
 
     Parameters
@@ -1104,9 +1109,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         A table in the monomial basis (from :func:`fit` or ``load``); one
         whose shifted basis ``basis="auto"`` chose is first refitted in
         powers of ``x``.
-    frac_bits : int or sequence of int, optional
+    coef_frac_bits : int or sequence of int, optional
         Fixed point (``coef_format="fixed"``, required there): coefficient
-        ``k`` stored with ``frac_bits`` fractional bits (one integer, or one
+        ``k`` stored with ``coef_frac_bits`` fractional bits (one integer, or one
         per power ``0..degree``) as a ``word_bits``-bit integer.
     word_bits : int, optional
         ``2 <= word_bits <= 53``: the signed integer width of fixed point.
@@ -1120,6 +1125,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     fix_constant : bool, optional
         Hold the constant coefficient at ``f(0)`` rounded to its format (so
         ``p(0) = f(0)`` when that is representable).
+    frac_bits : int or sequence of int, optional
+        The deprecated spelling of ``coef_frac_bits`` (a
+        :class:`~chebnorm.core.deprecation.ChebnormDeprecationWarning`).
 
     Returns
     -------
@@ -1139,7 +1147,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
 
     See Also
     --------
-    fit : fit and certify (``frac_bits=`` / ``coef_format=`` quantize at once).
+    fit : fit and certify (``coef_frac_bits=`` / ``coef_format=`` quantize at once).
     chebnorm.hw.design_horner : fixed-point hardware of a quantized table.
     chebnorm.export : C and shader code of the table.
 
@@ -1196,6 +1204,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     >>> s.quantized.mantissas[0::2], s.error_bound < 4e-6
     ((0, 0, 0), True)
     """
+    frac_bits = renamed(frac_bits, coef_frac_bits, "frac_bits", "coef_frac_bits", "quantize")
     _check_table(table, "table")
     if isinstance(word_bits, bool) or not isinstance(word_bits, (int, np.integer)) \
             or not 2 <= word_bits <= 53:
@@ -1216,11 +1225,11 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
-            raise ValueError("coefficient format fixed needs frac_bits (an integer, or one per "
+            raise ValueError("coefficient format fixed needs coef_frac_bits (an integer, or one per "
                              "power); accepted: e.g. 14 or 14,16,18")
         fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
     elif frac_bits is not None:
-        raise ValueError(f"frac_bits applies to coefficient format fixed, not {coef_format}")
+        raise ValueError(f"coef_frac_bits applies to coefficient format fixed, not {coef_format}")
     else:
         fracs = None
     fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \

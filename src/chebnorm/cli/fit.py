@@ -103,7 +103,8 @@ _CLI_WORDS = re.compile(r"(?<![\w.])(coef_frac_bits|frac_bits|coef_format|segmen
 _CLI_PHRASES = (("set it with var=", "set it with --var"),
                 ("interval=('1/4', '4')", "--interval 1/4 4"),
                 ("basis='monomial'", "--basis monomial"),
-                ("quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or chebnorm.quantize)",
+                ("quantized with coef_frac_bits (chebnorm.fit(..., coef_frac_bits=F) or "
+                 "chebnorm.quantize)",
                  "quantized with `chebnorm fit ... --coef-frac-bits F`"))
 
 
@@ -174,7 +175,7 @@ def _fit_cli(args, **kw):
     if max_error is not None:
         kw["max_error"] = max_error_value(max_error, "1e-6 or 2^-20")
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
-               error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
+               error=args.error, var=args.var, name=args.name, coef_frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
                coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
 

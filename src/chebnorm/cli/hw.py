@@ -158,7 +158,7 @@ def _coefficient_table(table, path, command: str):
 def _analyze(args, table, synth: bool, gappa: bool):
     from chebnorm.hw.report import analyze
 
-    return analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
+    return analyze(table, args.in_bits, args.out_bits, coef_frac_bits=args.coef_bits,
                    acc_bits=args.acc_bits, rounding=args.rounding, x_frac_bits=args.x_frac_bits,
                    y_frac_bits=args.y_frac_bits, gappa=gappa, synth=synth)
 

@@ -344,7 +344,7 @@ def _require_fixed_point(table: CoefficientTable, coef_bits):
         return table
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
-                         f"quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or "
+                         f"quantized with coef_frac_bits (chebnorm.fit(..., coef_frac_bits=F) or "
                          f"chebnorm.quantize), or give coef_bits (1 <= coef_bits <= "
                          f"{max_coef_bits(table)}) to quantize it here")
     return table

@@ -7,9 +7,9 @@ is :func:`analyze` (what ``chebnorm hw report`` prints).
 
 >>> from chebnorm.approx import fit_target
 >>> import chebnorm.hw
->>> chebnorm.hw.report(fit_target("dichotomy", 1), 10, 10, coef_bits=12, synth=False, gappa=False).checks["within_budget"]
+>>> chebnorm.hw.report(fit_target("dichotomy", 1), 10, 10, coef_frac_bits=12, synth=False, gappa=False).checks["within_budget"]
 True
->>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_bits=16, synth=False, gappa=False)
+>>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_frac_bits=16, synth=False, gappa=False)
 >>> r.checks["within_budget"], r.checks["budget_within_2x"]
 (True, True)
 """
@@ -23,6 +23,7 @@ from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.display import summary_html, summary_repr
+from chebnorm.core.deprecation import renamed
 from chebnorm.core.files import write_folder
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
@@ -56,7 +57,7 @@ class HardwareReport:
     Examples
     --------
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> all(r.checks.values()), r.as_dict()["module"]
     (True, 'chebnorm_dichotomy_d1')
     """
@@ -167,9 +168,9 @@ def _local(stage, design) -> float:
     return float(rounding_error_bound(stage.out_frac_bits, design.rounding, stage.round_shift))
 
 
-def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=None,
+def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_frac_bits=None,
             acc_bits=None, rounding: str = "rne", x_frac_bits=None, y_frac_bits=None,
-            gappa: bool = True, synth: bool = True) -> HardwareReport:
+            gappa: bool = True, synth: bool = True, coef_bits=None) -> HardwareReport:
     """Design, budget, measure (exhaustively) and optionally synthesize.
 
     Parameters
@@ -178,7 +179,7 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
         A fitted monomial table.
     in_bits, out_bits : int
         Input (1 to 20) and output (1 to 32) code widths.
-    coef_bits : int or None, default None
+    coef_frac_bits : int or None, default None
         Coefficient fractional bits (1 to :func:`~chebnorm.hw.horner.max_coef_bits`);
         None keeps the table's fixed-point part.
     acc_bits : int or None, default None
@@ -192,6 +193,8 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
         Cross-check the rounding bound with gappa when it is installed.
     synth : bool, default True
         Synthesize the Verilog with yosys (when installed) for the cell count.
+    coef_bits : int or None, default None
+        The deprecated spelling of ``coef_frac_bits``.
 
     Returns
     -------
@@ -236,10 +239,11 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     Examples
     --------
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 2), 10, 10, coef_bits=14, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 2), 10, 10, coef_frac_bits=14, synth=False, gappa=False)
     >>> r.measurement.total <= r.budget.total, r.synth is None
     (True, True)
     """
+    coef_bits = renamed(coef_bits, coef_frac_bits, "coef_bits", "coef_frac_bits", "analyze")
     if isinstance(table, CoefficientTable):
         table.verify()  # a comparison, or a re-proof of fields changed since construction
     design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
@@ -262,7 +266,7 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
     (:func:`chebnorm.hw.hdl.hdl_files` of the report's design and budget).
 
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(hdl_outputs(r, "vhdl", pipelined=True))  # doctest: +NORMALIZE_WHITESPACE
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'chebnorm_dichotomy_d1_pipe.hex',
      'chebnorm_dichotomy_d1_pipe.vhd', 'tb_chebnorm_dichotomy_d1.vhd',
@@ -304,7 +308,7 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
     (:func:`hdl_outputs` in Verilog).
 
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(verilog_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v']
 
@@ -353,7 +357,7 @@ def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     --------
     >>> from chebnorm.approx import fit_target
     >>> import tempfile
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     print([p.name for p in write_outputs(tmp, verilog_outputs(r))])
     ['chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v', 'chebnorm_dichotomy_d1.hex']

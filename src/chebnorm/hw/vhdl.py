@@ -80,7 +80,7 @@ def vhdl_outputs(report, *, version: str = "", command: str | None = None,
 
     >>> from chebnorm.approx import fit_target
     >>> from chebnorm.hw.report import analyze
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(vhdl_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'tb_chebnorm_dichotomy_d1.vhd']
 
