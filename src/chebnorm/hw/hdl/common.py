@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text, identifier
 
+from ..trust import verify_design
+
 __all__ = ["LANGUAGES", "COMMENT", "SUFFIX", "check_language", "module_name", "pipelined_name",
            "horner_facts", "piecewise_facts", "comment_lines", "vectors_name", "vector_file"]
 
@@ -337,6 +339,7 @@ def vector_file(design) -> str:
     >>> len(v) == 2 ** 6, [int(w, 16) for w in v[:3]] == d.evaluate()[:3].tolist()
     (True, True)
     """
+    verify_design(design)   # the expected outputs of a design that holds its claims only
     y = design.evaluate()
     digits = (design.out_bits + 3) // 4
     return "".join(f"{int(v):0{digits}x}\n" for v in y)
