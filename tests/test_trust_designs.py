@@ -435,3 +435,27 @@ def test_fuzz_designs(designs):
     seen = _run_fuzz(designs, 60, seed=2026)
     assert seen["refused"] + seen["accepted"] == 360
     assert seen["refused"] > 200
+
+
+def test_every_printer_proves_a_changed_design(designs):
+    """The printers called directly (not through module_text) prove a design
+    changed behind its back: every banner is written from proved facts."""
+    from chebnorm.hw.hdl.verilog import verilog_module
+    from chebnorm.hw.hdl.vhdl import piecewise_vhdl, vhdl_module
+
+    h = copy.copy(designs["horner"])
+    object.__setattr__(h, "integers", tuple(0 for _ in h.integers))
+    for printer in (verilog_module, vhdl_module):
+        with pytest.raises(ValueError, match="^integers: stated"):
+            printer(h)
+    p = copy.copy(designs["piecewise"])
+    object.__setattr__(p, "acc_frac_bits", p.acc_frac_bits + 40)
+    with pytest.raises(ValueError, match="^acc_frac_bits"):
+        piecewise_vhdl(p)
+
+
+def test_design_horner_refuses_a_table_changed_behind_its_back():
+    t = fit_target("dichotomy", 2)
+    object.__setattr__(t, "abs_error_bound", t.abs_error_bound / 1000)
+    with pytest.raises(ValueError, match="^abs_error_bound: stated"):
+        design_horner(t, 8, 8, coef_bits=12)

@@ -552,6 +552,8 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
        polynomial-based hardware architectures for function evaluation",
        IEEE ASAP 2010.
     """
+    _check_table(table)
+    table.verify()   # a table changed behind its back is proved again (or refused)
     with drafting():
         d = _design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
                            rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits,

@@ -169,6 +169,7 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
     'Pipelined: one register stage per Horner step, lat'
     """
     check_language(language)
+    verify_design(design)   # changed since it was proved: proved again (or refused)
     t = design.table
     xf, yf = design.x_format, design.y_format
     lo, hi = design.valid_codes
@@ -240,6 +241,7 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
     chebnorm_rs: piecewise degree-1 evaluator of 1/sqrt(x) on [1, 4),
       2^2 uniform segments (table 'rs'), uncentred local variable.
     """
+    verify_design(design)   # changed since it was proved: proved again (or refused)
     t = design.table
     n, L, K, fc = t.degree, design.local_bits, design.index_bits, t.coef_frac_bits
     yf = design.y_format
