@@ -208,7 +208,7 @@ def test_piecewise_changed_behind_its_back_refused_before_it_prints(designs):
         module_text(d)
 
 
-def test_unchanged_design_proved_once(designs, monkeypatch):
+def test_unchanged_design_proved_once(designs):
     """A design's proof is cached on its content: an unchanged copy is not proved
     again; a change of content is."""
     d = designs["plain"]
@@ -459,3 +459,26 @@ def test_design_horner_refuses_a_table_changed_behind_its_back():
     object.__setattr__(t, "abs_error_bound", t.abs_error_bound / 1000)
     with pytest.raises(ValueError, match="^abs_error_bound: stated"):
         design_horner(t, 8, 8, coef_bits=12)
+
+
+def test_pipelined_table_proves_its_base(designs):
+    from chebnorm.hw.hdl.tables import table_files
+    from chebnorm.hw.pipeline import PipelinedTable
+
+    base = copy.copy(designs["multipartite"])
+    p = PipelinedTable(base, (0, 1))
+    assert "LATENCY = 2" in p.verilog()
+    object.__setattr__(base, "tiv", tuple(0 for _ in base.tiv))
+    with pytest.raises(ValueError, match="^certificate.upper: stated"):
+        table_files(p, "verilog")
+
+
+def test_error_budget_proves_its_design(designs):
+    h = copy.copy(designs["horner"])
+    object.__setattr__(h, "y_format", dataclasses.replace(h.y_format, frac_bits=30))
+    with pytest.raises(ValueError, match="cannot hold the outputs"):
+        error_budget(h)
+    g = copy.copy(designs["horner"])
+    object.__setattr__(g, "acc_frac_bits", g.acc_frac_bits - 3)
+    with pytest.raises(ValueError, match="^acc_frac_bits: stated|^stages: stated"):
+        error_budget(g)

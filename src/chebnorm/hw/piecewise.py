@@ -6,6 +6,10 @@ FloPoCo's ``FixFunctionByPiecewisePoly``). With ``2**K`` segments the top
 ``K`` bits of ``k`` address the ROM, the low ``L = W - K`` bits are the local
 variable ``t = low / 2**L`` in ``[0, 1)`` (``t - 1/2`` when the table is
 centred): exactly the variable each segment's polynomial was certified in.
+An exponent table (``2**m`` segments per binade of ``[lo, hi)``, both powers
+of two) is indexed the same way, so its code stands for ``x = lo * 2**e *
+(1 + u / 2**(L + m))`` with ``e`` the code's top bits and ``u`` the rest
+(:meth:`PiecewiseDesign.x_values`; the banner states it).
 The datapath, for coefficients ``q_j`` (``Fc`` fractional bits) read from
 the ROM::
 
