@@ -545,3 +545,23 @@ def test_exponent_banner_mapping_holds_in_simulation(tmp_path, designs):
             e = abs(v - 1 / mpmath.sqrt(mpmath.mpf(k) / 2 ** W)) / mpmath.mpf(2) ** h
             worst = max(worst, e)
     assert float(worst) <= bound
+
+
+@pytest.mark.requires_tool("iverilog")
+def test_issue_commands_banner_mapping(tmp_path):
+    """The issue's commands: fit an exponent-segmented 1/sqrt, export Verilog; the
+    banner's mapping applied to the simulated module meets the stated bound."""
+    r = run_cli("fit", "1/sqrt(x)", "--interval", "2^-4", "1", "--degree", "2", "--segments",
+                "2^2", "--segment-by", "exponent", "--coef-frac-bits", "20", "-o", "g.json",
+                cwd=tmp_path)
+    assert r.code == 0, r.err
+    r = run_cli("export", "g.json", "--format", "verilog", "--in-bits", "10", "--out-bits", "10",
+                "-o", "g.v", cwd=tmp_path)
+    assert r.code == 0, r.err
+    text = (tmp_path / "g.v").read_text()
+    lines = _banner(text)
+    module = re.search(r"^module (\w+)", text, re.M).group(1)
+    ys = _simulate_outputs(tmp_path, text, module, 10)
+    assert "exponent-indexed" in " ".join(lines)
+    xs = _x_from_banner(lines, range(2 ** 10))
+    assert _banner_error(lines, xs, ys) <= _printed_upper(text)
