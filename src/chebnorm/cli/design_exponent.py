@@ -55,6 +55,10 @@ def run_exponent(args) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
+    if getattr(args, "frequency", None) is not None:   # never silently ignored
+        raise ValueError(f"--frequency {str(args.frequency)[:40]}: not available with --index "
+                         f"exponent (its winner is written combinational); accepted: without "
+                         f"--frequency, or --index uniform")
     if args.correctly_rounded:
         raise ValueError("--correctly-rounded: not available with --index exponent (the "
                          "mantissa is faithful at best); accepted: --faithful or --max-error E")

@@ -39,6 +39,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
+from .trust import verify_design
 
 __all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script",
            "gappa_bound", "SHADING_LEVELS"]
@@ -239,7 +240,8 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     Raises
     ------
     ValueError
-        If gappa is asked for and fails on the datapath (see :func:`gappa_bound`).
+        If gappa is asked for and fails on the datapath (see :func:`gappa_bound`), or
+        the design does not hold its claims (changed since it was built).
 
 
     See Also
@@ -276,6 +278,7 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
        floating-point implementation of an elementary function using
        Gappa", IEEE Transactions on Computers 60(2), 2011.
     """
+    verify_design(design)   # a design changed since it was proved: proved again (or refused)
     t = design.table
     xmax = design.max_abs_x()
     steps = []

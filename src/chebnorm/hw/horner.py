@@ -30,7 +30,7 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from fractions import Fraction
 
 import numpy as np
@@ -40,6 +40,7 @@ from chebnorm.approx import CoefficientTable, parse_number, quantize
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
+from .trust import check, drafting, seal
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
 
@@ -183,6 +184,27 @@ class HornerDesign:
     _display_rows = field_rows
     __repr__ = summary_repr
     _repr_html_ = summary_html
+
+    def __post_init__(self):
+        self.verify()
+
+    def verify(self) -> "HornerDesign":
+        """Re-prove the design; return it unchanged, or raise ValueError: the
+        table re-verified and the datapath sized again from it and the
+        design's own formats (every field must be what :func:`design_horner`
+        gives). Proved once per content (:func:`chebnorm.hw.trust.check`).
+
+        Returns
+        -------
+        HornerDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
 
     @property
     def degree(self) -> int:
@@ -530,6 +552,41 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
        polynomial-based hardware architectures for function evaluation",
        IEEE ASAP 2010.
     """
+    _check_table(table)
+    table.verify()   # a table changed behind its back is proved again (or refused)
+    with drafting():
+        d = _design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
+                           rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits,
+                           guard_bits=guard_bits, name=name)
+    return seal(d)
+
+
+def _prove(d: HornerDesign) -> None:
+    """The table re-verified, the datapath sized again from it and the
+    design's formats: every field must match (ValueError naming the first)."""
+    identifier(d.name, field="name")
+    _check_table(d.table)
+    d.table.verify()
+    xf, yf = d.x_format, d.y_format
+    if not isinstance(xf, QFormat) or not isinstance(yf, QFormat):
+        raise ValueError("x_format, y_format: accepted: QFormat")
+    with drafting():
+        ref = _design_horner(d.table, d.in_bits, d.out_bits, coef_bits=None,
+                             acc_bits=d.acc_frac_bits if d.degree >= 2 else None,
+                             rounding=d.rounding, x_frac_bits=xf.frac_bits,
+                             y_frac_bits=yf.frac_bits, guard_bits=3, name=d.name)
+    for f in fields(d):
+        mine, theirs = getattr(d, f.name), getattr(ref, f.name)
+        if f.name != "table" and (type(mine) is not type(theirs) or mine != theirs):
+            text = repr(mine)
+            raise ValueError(f"{f.name}: stated {text[:60]}, but the table and the design's "
+                             f"formats give {repr(theirs)[:60]}; accepted: the design "
+                             f"design_horner sizes")
+
+
+def _design_horner(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding, x_frac_bits,
+                   y_frac_bits, guard_bits, name) -> HornerDesign:
+    """:func:`design_horner`'s sizing (its drafts unchecked)."""
     _check_table(table)
     in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
     out_bits = check_width(out_bits, "out_bits", 1, MAX_OUT_BITS)

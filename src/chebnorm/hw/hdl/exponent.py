@@ -22,6 +22,7 @@ from __future__ import annotations
 from chebnorm.core.textsafe import comment_text
 
 from . import module_text
+from ..trust import verify_design
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
@@ -34,7 +35,7 @@ def _check(design):
     if getattr(design, "architecture", None) != "exponent":
         raise ValueError(f"design: a {type(design).__name__} is not an exponent-indexed design; "
                          f"accepted: an ExponentDesign (design_exponent)")
-    return design
+    return verify_design(design)   # changed since it was proved: proved again (or refused)
 
 
 def exponent_facts(design, *, version: str = "", command: str | None = None) -> list[str]:

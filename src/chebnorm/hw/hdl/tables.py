@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text
 
+from ..trust import verify_design
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
@@ -34,6 +35,7 @@ def _kind(design) -> str:
     if kind not in ("multipartite", "plain_table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
+    verify_design(design)   # changed since it was proved: proved again (or refused)
     return kind
 
 
