@@ -24,8 +24,8 @@ against ``f(x)`` is bounded by the table's certified bound plus
 ``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
 compares it, code by code and in 40-digit arithmetic, with ``f``.
 
-The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``,
-issue 28) gives every ROM column its own fractional bits ``F_j`` (the
+The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``)
+gives every ROM column its own fractional bits ``F_j`` (the
 coefficients re-rounded from the table's ``Fc``), multiplies step ``j`` by
 the top ``T_j`` bits of ``t`` only, and truncates (floors) products and sums
 to ``G_j`` fractional bits -- with ``multipliers="truncated"`` the

@@ -656,7 +656,7 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
     ``freq_mhz`` is the target nextpnr's timing-driven placement aims at
     (missing it is not an error here: the achieved figure is returned);
     ``seed`` fixes the placer (same seed, same result; seeds 1 and 2 gave 25.2
-    and 23.1 MHz for the 16-bit degree-2 design of issue 28).
+    and 23.1 MHz for a 16-bit degree-2 design of 1/sqrt(1 + 3x)).
 
     Parameters
     ----------

@@ -4,7 +4,7 @@
 self-checking test benches, and the text fragments they (and the
 normalization units of :mod:`chebnorm.hw.units`) share.
 
-The module follows the port contract of issue 5::
+The module follows one port contract::
 
     module chebnorm_NAME #(parameter IN_BITS = W, parameter OUT_BITS = V)
         (input wire [IN_BITS-1:0] x, output wire [OUT_BITS-1:0] y);
