@@ -16,7 +16,6 @@ import ast
 import math
 import re
 import shlex
-import warnings
 from pathlib import Path
 
 import pytest
