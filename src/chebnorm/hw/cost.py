@@ -159,7 +159,7 @@ class Block:
         c = self.cost
         out = [f"{'  ' * indent}{self.name}: {len(c.multipliers)} mul, {len(c.adders)} add, "
                f"{len(c.sqrts)} sqrt, {len(c.dividers)} div, {c.mux_bits} mux bits, "
-               f"{c.rom_bits} ROM bits, latency {c.latency}, area ~{c.area:.0f} FA"]
+               f"{c.rom_bits} ROM bits, {c.latency} operations deep, area ~{c.area:.0f} FA"]
         for ch in self.children:
             out += ch.lines(indent + 1)
         return out
