@@ -54,3 +54,19 @@ def test_fixed_point_drawn_as_before():
     labels = [t.get_text() for t in q.plot(binary32=False).get_legend().get_texts()]
     assert "fixed point, 14 fractional bits" in labels
     assert not any("binary32" in label for label in labels)
+
+
+def test_length_error_map_keeps_rounding_noise_black():
+    import re
+
+    from chebnorm.raster import render
+    from chebnorm.raster.display import LENGTH_SCALE_FLOOR, render_html
+
+    exact = render_html(render("sphere", "phong", "exact", size=(16, 16), tess=6))
+    scale, largest = map(float, re.search(r"black 0, white ([0-9.e+-]+); largest ([0-9.e+-]+)",
+                                          exact).groups())
+    assert largest < 1e-12 and scale == pytest.approx(LENGTH_SCALE_FLOOR, rel=1e-2)
+    newton = render_html(render("sphere", "phong", "newton", size=(16, 16), tess=6))
+    scale, largest = map(float, re.search(r"white ([0-9.e+-]+); largest ([0-9.e+-]+)",
+                                          newton).groups())
+    assert scale == largest > LENGTH_SCALE_FLOOR
