@@ -63,7 +63,7 @@ import numpy as np
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.piecewise_table import PiecewiseTable
-from chebnorm.core.numeric import arb_precision, float_down, float_up
+from chebnorm.core.numeric import arb_precision, float_down, float_up, format_down, format_up
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.tools import run_tool
 from chebnorm.core.display import field_rows, summary_html, summary_repr
@@ -207,8 +207,8 @@ class VariantResult:
         if self.skipped is not None:
             return f"{head} skipped: {self.skipped}"
         verdict = "ok" if self.passed else "EXCEEDS the stated bound"
-        return (f"{head} max {self.measured_max:.4e} at x = {self.argmax!r}  stated "
-                f"{self.stated_bound:.4e}  ratio {self.ratio:.3f}  {self.count} inputs  "
+        return (f"{head} max {format_down(self.measured_max, '.4e')} at x = {self.argmax!r}  stated "
+                f"{format_up(self.stated_bound, '.4e')}  ratio {self.ratio:.3f}  {self.count} inputs  "
                 f"{self.seconds:.2f} s  {verdict}")
 
 
@@ -279,8 +279,8 @@ class VerifyResult:
                     f"NOT CHECKED: {v.unchecked}"
                 out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {why} | | | |")
                 continue
-            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {v.measured_max:.3e} | "
-                       f"{v.stated_bound:.3e} | {v.ratio:.3f} | {v.count} |")
+            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {format_down(v.measured_max, '.3e')} | "
+                       f"{format_up(v.stated_bound, '.3e')} | {v.ratio:.3f} | {v.count} |")
         return "\n".join(out) + "\n"
 
     def __str__(self) -> str:
@@ -297,8 +297,8 @@ class VerifyResult:
                       "", "", "NOT CHECKED"] if v.unchecked is not None else
                      [v.format + " " + v.variant, v.evaluator, "skipped: " + v.skipped, "", "",
                       "", ""] if v.skipped is not None else
-                     [v.format + " " + v.variant, v.evaluator, f"{v.measured_max:.4e}",
-                      f"{v.stated_bound:.4e}", f"{v.ratio:.3f}", str(v.count),
+                     [v.format + " " + v.variant, v.evaluator, f"{format_down(v.measured_max, '.4e')}",
+                      f"{format_up(v.stated_bound, '.4e')}", f"{v.ratio:.3f}", str(v.count),
                       "ok" if v.passed else "EXCEEDS"])
             rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
         head = "".join(f"<th>{h}</th>" for h in ("variant", "evaluator", "measured max",
