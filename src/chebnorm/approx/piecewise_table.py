@@ -489,7 +489,7 @@ def _prove(table: PiecewiseTable) -> None:
         for s in todo:
             bound, maximum = stated[s], getattr(table.segments[s], f"max_{kind}_error")
             if bound < certs[s].bound:
-                raise ValueError(f"segments[{s}].{kind}_error_bound: stated {format_up(bound, '.2e')} but "
+                raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
                                  f"the certified error of segment {s} is "
                                  f"{format_up(certs[s].bound, '.2e')}")
             check_maximum(f"segments[{s}].max_{kind}_error", maximum,
