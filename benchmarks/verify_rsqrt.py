@@ -31,6 +31,8 @@ START, END = "<!-- verify-rsqrt-start -->", "<!-- verify-rsqrt-end -->"
 
 def row_text(fmt: str, v) -> str:
     """One Markdown row of a :class:`~chebnorm.export.verify.VariantResult`."""
+    if v.unchecked is not None:
+        return f"| {fmt} | {v.variant} | `{v.evaluator}` | NOT CHECKED: {v.unchecked} | | | | |"
     if v.skipped is not None:
         return f"| {fmt} | {v.variant} | `{v.evaluator}` | skipped: {v.skipped} | | | | |"
     return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {v.measured_max:.3e} | "
