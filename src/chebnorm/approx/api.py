@@ -1006,7 +1006,8 @@ def _simpler_fit_notes(fn, iv, degree, error, cert_abs, cert_rel) -> list[str]:
     if not cert.maximum > 1.01 * best:
         return []
     what = "|p - f|" if error == "abs" else "|p/f - 1|"
-    return [f"the minimax fit is not minimax: its error {what} = {format_up(cert.maximum, '.3e')} exceeds "
+    return [f"the minimax fit is not minimax: its error {what} = {format_up(cert.maximum, '.3e')} "
+            f"exceeds "
             f"that of {name} (sampled: {best:.3e}); the exchange failed on this problem "
             f"(try a lower degree or a narrower interval); the certified bounds hold"]
 

@@ -407,7 +407,8 @@ class PiecewiseTable(Table):
         label = "p - f" if error == "abs" else "p/f - 1"
         ax.plot(x, g, color="C0", lw=1.0,
                 label=f"{label} ({self.segment_count} segments of degree {self.degree})")
-        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {format_up(bound, '.3e')}")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound "
+                                                             f"{format_up(bound, '.3e')}")
         ax.axhline(-bound, color="C0", ls="--", lw=0.8)
         for s, seg in enumerate(self.segments):
             a, b = (float(v) for v in self.segment_bounds(s))

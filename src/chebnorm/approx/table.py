@@ -591,28 +591,33 @@ class CoefficientTable(Table):
             ("degree, kind", f"{self.degree}, {self.kind} ({self.error_kind} error)"),
             ("coefficients", ", ".join(repr(c) for c in self.coefficients)
              + f" (ascending powers of {self.variable})"),
-            ("max |p - f|", f"{format_down(self.max_abs_error, '.6e')} at {self.variable} = {self.max_abs_at!r}; "
+            ("max |p - f|", f"{format_down(self.max_abs_error, '.6e')} at {self.variable} = "
+                            f"{self.max_abs_at!r}; "
                             f"certified bound {format_up(self.abs_error_bound, '.6e')}"),
         ]
         if self.max_rel_error is not None and self.rel_error_bound is not None:
-            rows.append(("max |p/f - 1|", f"{format_down(self.max_rel_error, '.6e')} at {self.variable} = "
+            rows.append(("max |p/f - 1|", f"{format_down(self.max_rel_error, '.6e')} at "
+                                          f"{self.variable} = "
                                           f"{self.max_rel_at!r}; certified bound "
                                           f"{format_up(self.rel_error_bound, '.6e')}"))
         fp = self.fixed_point
         if fp is not None:
             rows.append(("fixed point", f"{fp.frac_bits} fractional bits, int{fp.word_bits}, "
                                         f"{fp.method}: " + ", ".join(str(q) for q in fp.integers)))
-            rows.append(("fixed max |p - f|", f"{format_down(fp.max_abs_error, '.6e')}; certified bound "
+            rows.append(("fixed max |p - f|", f"{format_down(fp.max_abs_error, '.6e')}; certified "
+                                              f"bound "
                                               f"{format_up(fp.abs_error_bound, '.6e')}"))
             if fp.max_rel_error is not None and fp.rel_error_bound is not None:
-                rows.append(("fixed max |p/f - 1|", f"{format_down(fp.max_rel_error, '.6e')}; certified bound "
+                rows.append(("fixed max |p/f - 1|", f"{format_down(fp.max_rel_error, '.6e')}; "
+                                                    f"certified bound "
                                                     f"{format_up(fp.rel_error_bound, '.6e')}"))
         q = self.quantized
         if q is not None and fp is None:
             rows.append(("quantized", f"{q.format} ({q.method}), powers "
                                       f"{','.join(map(str, q.monomials))}: "
                                       + ", ".join(repr(c) for c in q.coefficients)))
-            rows.append(("quantized max |p - f|", f"{format_down(q.max_abs_error, '.6e')}; certified bound "
+            rows.append(("quantized max |p - f|", f"{format_down(q.max_abs_error, '.6e')}; "
+                                                  f"certified bound "
                                                   f"{format_up(q.abs_error_bound, '.6e')}"))
         if self.provenance:
             rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
@@ -679,7 +684,8 @@ class CoefficientTable(Table):
         bound = self.abs_error_bound if error == "abs" else self.rel_error_bound
         label = "p - f" if error == "abs" else "p/f - 1"
         ax.plot(x, g, color="C0", lw=1.2, label=f"{label} (degree {self.degree}, {self.kind})")
-        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {format_up(bound, '.3e')}")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound "
+                                                             f"{format_up(bound, '.3e')}")
         ax.axhline(-bound, color="C0", ls="--", lw=0.8)
         at = self.max_abs_at if error == "abs" else self.max_rel_at
         if at is not None:
@@ -690,7 +696,8 @@ class CoefficientTable(Table):
         if fixed_bound is not None:
             _, gq = self.error_curve(points, error, fixed=True)
             ax.plot(x, gq, color="C1", lw=1.0, label=f"fixed point, {fp.frac_bits} fractional bits")
-            ax.axhline(fixed_bound, color="C1", ls=":", lw=0.8, label=f"its bound {format_up(fixed_bound, '.3e')}")
+            ax.axhline(fixed_bound, color="C1", ls=":", lw=0.8,
+                       label=f"its bound {format_up(fixed_bound, '.3e')}")
             ax.axhline(-fixed_bound, color="C1", ls=":", lw=0.8)
         ax.axhline(0.0, color="0.6", lw=0.5)
         ax.set_xlabel(self.variable)

@@ -239,7 +239,8 @@ def _search(args, name, target, max_error, bound=None, synth=None, workers=None)
     if res.winner is None:  # one line, exit 2, nothing written (docs/cli.md)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
-                         f"certified error reached is {format_up(best.total_bound, '.4g')} (degree {best.degree}, "
+                         f"certified error reached is {format_up(best.total_bound, '.4g')} "
+                         f"(degree {best.degree}, "
                          f"{best.segments} segments, {best.coef_frac_bits} coefficient bits); "
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
@@ -561,9 +562,12 @@ def hw_report(args, table) -> int:
     print(f"{d.module_name}: {d.table.segment_count} segments x degree {d.degree}, "
           f"{d.in_bits}-bit in / {d.out_bits}-bit out, ROM words {list(d.rom_bits)} bits")
     print(f"error budget |y - f(x)| <= {format_up(b['total'], '.4e')} = approximation "
-          f"{format_up(b['approximation'], '.4e')} + Horner rounding {format_up(b['horner_rounding'], '.4e')} + output "
-          f"rounding {format_up(b['output_rounding'], '.4e')} ({format_up(b['total'] / b['y_lsb'], '.3f')} LSB)")
-    print(f"measured over all {m['codes']} codes: max |y - f(x)| = {format_down(m['max_error'], '.4e')} at code "
+          f"{format_up(b['approximation'], '.4e')} + Horner rounding "
+          f"{format_up(b['horner_rounding'], '.4e')} + output "
+          f"rounding {format_up(b['output_rounding'], '.4e')} "
+          f"({format_up(b['total'] / b['y_lsb'], '.3f')} LSB)")
+    print(f"measured over all {m['codes']} codes: max |y - f(x)| = "
+          f"{format_down(m['max_error'], '.4e')} at code "
           f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
     print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
     if fig is not None:

@@ -284,12 +284,14 @@ def _report(args, table) -> int:
                   f"({table.basis_choice.reason.split('. ')[0]})")
         print("coefficients (ascending powers of {}): {}".format(
             powers_of, ", ".join(f"{c:.17g}" for c in table.coefficients)))
-        print(f"max |p - f|   = {format_down(table.max_abs_error, '.6e')} at {table.variable} = {table.max_abs_at:.17g}; "
+        print(f"max |p - f|   = {format_down(table.max_abs_error, '.6e')} at {table.variable} = "
+              f"{table.max_abs_at:.17g}; "
               f"certified bound {format_up(table.abs_error_bound, '.6e')}")
         if "binary_endpoints" in table.provenance:
             print(f"note: {table.provenance['binary_endpoints']}")
         if table.rel_error_bound is not None:
-            print(f"max |p/f - 1| = {format_down(table.max_rel_error, '.6e')}; certified bound {format_up(table.rel_error_bound, '.6e')}")
+            print(f"max |p/f - 1| = {format_down(table.max_rel_error, '.6e')}; certified bound "
+                  f"{format_up(table.rel_error_bound, '.6e')}")
         if table.fixed_point is not None:
             fp = table.fixed_point
             print(f"fixed point ({fp.frac_bits} fractional bits, {fp.method}): {list(fp.integers)}; "

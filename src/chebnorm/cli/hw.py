@@ -486,7 +486,8 @@ def run_sweep(args) -> int:
             f"~{best.area_fa:.0f} FA (estimate)"
         print(f"cheapest design at or under half a level: degree {best.degree}, coefficient "
               f"bits {best.coef_bits}, accumulator bits {best.acc_bits or '-'}: {area}, "
-              f"{format_down(best.shading_levels, '.4f')} levels, {format_down(best.max_error_lsb, '.2f')} LSB")
+              f"{format_down(best.shading_levels, '.4f')} levels, "
+              f"{format_down(best.max_error_lsb, '.2f')} LSB")
     return 0
 
 

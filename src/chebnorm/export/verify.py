@@ -207,8 +207,10 @@ class VariantResult:
         if self.skipped is not None:
             return f"{head} skipped: {self.skipped}"
         verdict = "ok" if self.passed else "EXCEEDS the stated bound"
-        return (f"{head} max {format_down(self.measured_max, '.4e')} at x = {self.argmax!r}  stated "
-                f"{format_up(self.stated_bound, '.4e')}  ratio {self.ratio:.3f}  {self.count} inputs  "
+        return (f"{head} max {format_down(self.measured_max, '.4e')} at x = {self.argmax!r}  "
+                f"stated "
+                f"{format_up(self.stated_bound, '.4e')}  ratio {self.ratio:.3f}  {self.count} "
+                f"inputs  "
                 f"{self.seconds:.2f} s  {verdict}")
 
 
@@ -279,7 +281,8 @@ class VerifyResult:
                     f"NOT CHECKED: {v.unchecked}"
                 out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {why} | | | |")
                 continue
-            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {format_down(v.measured_max, '.3e')} | "
+            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | "
+                       f"{format_down(v.measured_max, '.3e')} | "
                        f"{format_up(v.stated_bound, '.3e')} | {v.ratio:.3f} | {v.count} |")
         return "\n".join(out) + "\n"
 
@@ -297,7 +300,8 @@ class VerifyResult:
                       "", "", "NOT CHECKED"] if v.unchecked is not None else
                      [v.format + " " + v.variant, v.evaluator, "skipped: " + v.skipped, "", "",
                       "", ""] if v.skipped is not None else
-                     [v.format + " " + v.variant, v.evaluator, f"{format_down(v.measured_max, '.4e')}",
+                     [v.format + " " + v.variant, v.evaluator,
+                      format_down(v.measured_max, '.4e'),
                       f"{format_up(v.stated_bound, '.4e')}", f"{v.ratio:.3f}", str(v.count),
                       "ok" if v.passed else "EXCEEDS"])
             rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
@@ -913,7 +917,8 @@ def _c_piecewise(table: PiecewiseTable, text: str, spread, wanted) -> list[Varia
 #: (the constants as the shader computes them, never their text)
 _PROBE = {"glsl": ("float chebnorm_verify_probe(float i)\n{{\n    if (i < 0.5) return {lo};\n"
                    "    if (i < 1.5) return {hi};\n    return {bound};\n}}\n"),
-          "wgsl": ("fn chebnorm_verify_probe(i: f32) -> f32 {{\n    if (i < 0.5) {{ return {lo}; }}\n"
+          "wgsl": ("fn chebnorm_verify_probe(i: f32) -> f32 {{\n    if (i < 0.5) {{ return {lo}; "
+                   "}}\n"
                    "    if (i < 1.5) {{ return {hi}; }}\n    return {bound};\n}}\n")}
 
 

@@ -353,7 +353,8 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         c = out[i]
         rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
         out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
-                           f"model {c.model:.1f}{rom}: lower bound {format_down(lower(c), '.1f')} >= best "
+                           f"model {c.model:.1f}{rom}: lower bound {format_down(lower(c), '.1f')} "
+                           f">= best "
                            f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
     return out
 

@@ -976,7 +976,8 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     if not ok:
         approx = max(Fraction(seg.abs_error_bound) for seg in t.segments)
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
-                         f"(certified {format_up(float(total), '.6e')}; approximation {format_up(float(approx), '.6e')}); "
+                         f"(certified {format_up(float(total), '.6e')}; approximation "
+                         f"{format_up(float(approx), '.6e')}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
     cur = descend(cur)
     for _ in range(2):  # trades, while one pays

@@ -255,7 +255,8 @@ class SearchResult:
         out.write(",".join(COLUMNS + (TARGET_COLUMNS if extra else ())) + "\n")
         for p in self.points:
             row = [p.degree, p.segments, p.coef_frac_bits, p.acc_frac_bits, p.y_frac_bits,
-                   p.rom_bits, f"{format_up(p.approx_bound, '.6e')}", f"{format_up(p.total_bound, '.6e')}", int(p.meets),
+                   p.rom_bits, format_up(p.approx_bound, '.6e'),
+                   format_up(p.total_bound, '.6e'), int(p.meets),
                    f"{p.model_cost:.1f}", "" if p.yosys_cells is None else p.yosys_cells,
                    int(p.pareto), int(p is self.winner)]
             if extra:

@@ -104,11 +104,13 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
                      f"{g} guard bits.")
         b = design.budget()
         lines.append(f"A priori budget: method {format_up(b['method'], '.6e')} + table rounding "
-                     f"{format_up(b['table_rounding'], '.6e')} + final rounding {format_up(b['final_rounding'], '.6e')} = "
+                     f"{format_up(b['table_rounding'], '.6e')} + final rounding "
+                     f"{format_up(b['final_rounding'], '.6e')} = "
                      f"{format_up(b['a_priori'], '.6e')}; target {b['target']:.6e}"
                      + (" (faithful)" if design.faithful else "") + ".")
     lines.append(f"Proved over all {c.codes} codes (Arb enclosures of f): |y - f(x)| <= "
-                 f"{format_up(c.upper, '.6e')} = {format_up(c.upper * 2.0 ** yf.frac_bits, '.4f')} LSB of y.")
+                 f"{format_up(c.upper, '.6e')} = "
+                 f"{format_up(c.upper * 2.0 ** yf.frac_bits, '.4f')} LSB of y.")
     cuts = table_cuts(design)
     lines.append(f"Pipelined: registers at {', '.join(TABLE_CUTS[c] for c in cuts)}; latency "
                  f"{len(cuts)} cycles (LATENCY), one result per cycle." if cuts else
