@@ -330,6 +330,10 @@ def stated_bounds(text: str) -> dict[str, float]:
     """Every ``#define NAME value`` and shader constant of an exported text
     whose value is a number (hexadecimal or decimal), by name.
 
+    A textual read, for looking at a file: it does not know ``#if 0``,
+    comments or ``#undef``. :func:`verify` never uses it for the bounds it
+    checks; those are read from the compiled object.
+
     Parameters
     ----------
     text : str
