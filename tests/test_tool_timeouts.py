@@ -160,3 +160,14 @@ def test_every_tool_call_in_src_goes_through_run_tool():
             if isinstance(node, ast.ImportFrom) and node.module == "subprocess":
                 found.append(f"{path.relative_to(SRC)}:{node.lineno} from subprocess import")
     assert found == []
+
+
+@pytest.mark.slow
+def test_yosys_in_design_is_one_line_and_exit_2(sleepy_path, capped, tmp_path):
+    status, out, err = astuple(run_cli("design", "1/sqrt(x)", "--interval", "1", "4",
+                                       "--in-bits", "8", "--out-bits", "8", "--faithful",
+                                       "--workers", "1", "-o", str(tmp_path / "d")))
+    assert status == 2 and err.count("\n") == 1 and "Traceback" not in err
+    line = err.split("\r")[-1]  # after the search's progress bar
+    assert line.startswith("chebnorm: error: yosys") and "did not finish within its time limit" in line
+    assert not (tmp_path / "d").exists() or not any((tmp_path / "d").iterdir())
