@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 from chebnorm.approx import load_table
+from chebnorm.core.numeric import format_down, format_up
 from chebnorm.export.verify import verify
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -31,10 +32,13 @@ START, END = "<!-- verify-rsqrt-start -->", "<!-- verify-rsqrt-end -->"
 
 def row_text(fmt: str, v) -> str:
     """One Markdown row of a :class:`~chebnorm.export.verify.VariantResult`."""
+    if v.unchecked is not None:
+        return f"| {fmt} | {v.variant} | `{v.evaluator}` | NOT CHECKED: {v.unchecked} | | | | |"
     if v.skipped is not None:
         return f"| {fmt} | {v.variant} | `{v.evaluator}` | skipped: {v.skipped} | | | | |"
-    return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {v.measured_max:.3e} | "
-            f"{v.argmax!r} | {v.stated_bound:.3e} (`{v.bound_name}`) | "
+    # the measured maximum rounded down, the stated bound up, at the digits shown
+    return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {format_down(v.measured_max, '.3e')} | "
+            f"{v.argmax!r} | {format_up(v.stated_bound, '.3e')} (`{v.bound_name}`) | "
             f"{v.ratio:.3f} | {v.count:,} |")
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import sympy as sp
 from flint import arb
 
-from chebnorm.core.numeric import ball_float_down, ball_float_up
+from chebnorm.core.numeric import ball_float_down, ball_float_up, format_down, format_up
 from chebnorm.core.deprecation import renamed
 from chebnorm.core.textsafe import default_name
 
@@ -522,13 +522,13 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     best = None
     for n in range(first, top + 1):
         if lower[n] > max_error:
-            tried.append(f"{n}: ruled out (>= {lower[n]:.2e})")
+            tried.append(f"{n}: ruled out (>= {format_down(lower[n], '.2e')})")
             continue
         table = fit(expr, interval, n, **{k: v for k, v in kw.items()
                                            if k not in ("segments", "segment_by", "centered")})
         bound = _delivered_bound(table, error)
         ok = bound is not None and bound <= max_error
-        tried.append(f"{n}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        tried.append(f"{n}: certified {format_up(bound, '.3e')}" + (" <= E" if ok else " > E"))
         if ok:
             best = table
             break
@@ -579,12 +579,12 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
             if lower > max_error:
                 break
         if lower > max_error:
-            tried.append(f"{count}: ruled out (>= {lower:.2e})")
+            tried.append(f"{count}: ruled out (>= {format_down(lower, '.2e')})")
             continue
         table = fit(expr, interval, degree, segments=2 ** k, segment_by=segment_by, **fields)
         bound = table.abs_error_bound if error == "abs" else table.rel_error_bound
         ok = bound is not None and bound <= max_error
-        tried.append(f"{count}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        tried.append(f"{count}: certified {format_up(bound, '.3e')}" + (" <= E" if ok else " > E"))
         if ok:
             provenance = dict(table.provenance)
             provenance["max_error"] = repr(max_error)
@@ -1006,7 +1006,8 @@ def _simpler_fit_notes(fn, iv, degree, error, cert_abs, cert_rel) -> list[str]:
     if not cert.maximum > 1.01 * best:
         return []
     what = "|p - f|" if error == "abs" else "|p/f - 1|"
-    return [f"the minimax fit is not minimax: its error {what} = {cert.maximum:.3e} exceeds "
+    return [f"the minimax fit is not minimax: its error {what} = {format_up(cert.maximum, '.3e')} "
+            f"exceeds "
             f"that of {name} (sampled: {best:.3e}); the exchange failed on this problem "
             f"(try a lower degree or a narrower interval); the certified bounds hold"]
 

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from chebnorm.core.display import summary_html, summary_repr
+from chebnorm.core.numeric import format_down, format_up
 
 from .basis_choice import BasisChoice, read_basis_choice
 from .contract import Table
@@ -590,29 +591,34 @@ class CoefficientTable(Table):
             ("degree, kind", f"{self.degree}, {self.kind} ({self.error_kind} error)"),
             ("coefficients", ", ".join(repr(c) for c in self.coefficients)
              + f" (ascending powers of {self.variable})"),
-            ("max |p - f|", f"{self.max_abs_error:.6e} at {self.variable} = {self.max_abs_at!r}; "
-                            f"certified bound {self.abs_error_bound:.6e}"),
+            ("max |p - f|", f"{format_down(self.max_abs_error, '.6e')} at {self.variable} = "
+                            f"{self.max_abs_at!r}; "
+                            f"certified bound {format_up(self.abs_error_bound, '.6e')}"),
         ]
         if self.max_rel_error is not None and self.rel_error_bound is not None:
-            rows.append(("max |p/f - 1|", f"{self.max_rel_error:.6e} at {self.variable} = "
+            rows.append(("max |p/f - 1|", f"{format_down(self.max_rel_error, '.6e')} at "
+                                          f"{self.variable} = "
                                           f"{self.max_rel_at!r}; certified bound "
-                                          f"{self.rel_error_bound:.6e}"))
+                                          f"{format_up(self.rel_error_bound, '.6e')}"))
         fp = self.fixed_point
         if fp is not None:
             rows.append(("fixed point", f"{fp.frac_bits} fractional bits, int{fp.word_bits}, "
                                         f"{fp.method}: " + ", ".join(str(q) for q in fp.integers)))
-            rows.append(("fixed max |p - f|", f"{fp.max_abs_error:.6e}; certified bound "
-                                              f"{fp.abs_error_bound:.6e}"))
+            rows.append(("fixed max |p - f|", f"{format_down(fp.max_abs_error, '.6e')}; certified "
+                                              f"bound "
+                                              f"{format_up(fp.abs_error_bound, '.6e')}"))
             if fp.max_rel_error is not None and fp.rel_error_bound is not None:
-                rows.append(("fixed max |p/f - 1|", f"{fp.max_rel_error:.6e}; certified bound "
-                                                    f"{fp.rel_error_bound:.6e}"))
+                rows.append(("fixed max |p/f - 1|", f"{format_down(fp.max_rel_error, '.6e')}; "
+                                                    f"certified bound "
+                                                    f"{format_up(fp.rel_error_bound, '.6e')}"))
         q = self.quantized
         if q is not None and fp is None:
             rows.append(("quantized", f"{q.format} ({q.method}), powers "
                                       f"{','.join(map(str, q.monomials))}: "
                                       + ", ".join(repr(c) for c in q.coefficients)))
-            rows.append(("quantized max |p - f|", f"{q.max_abs_error:.6e}; certified bound "
-                                                  f"{q.abs_error_bound:.6e}"))
+            rows.append(("quantized max |p - f|", f"{format_down(q.max_abs_error, '.6e')}; "
+                                                  f"certified bound "
+                                                  f"{format_up(q.abs_error_bound, '.6e')}"))
         if self.provenance:
             rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
         return rows
@@ -699,7 +705,6 @@ class CoefficientTable(Table):
         >>> type(ax).__name__
         'Axes'
         """
-        from chebnorm.core.numeric import format_up
 
         if error == "rel" and self.rel_error_bound is None:
             raise ValueError(f"table {self.name!r} has no relative error (f vanishes on the interval)")

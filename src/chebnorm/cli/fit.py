@@ -181,6 +181,7 @@ def _fit_cli(args, **kw):
 
 
 def _run_piecewise(args) -> int:
+    from chebnorm.core.numeric import format_up
     table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
                      segment_by=args.segment_by or "uniform", centered=args.centered)
     if args.output:
@@ -194,9 +195,9 @@ def _run_piecewise(args) -> int:
         if "segment_search" in table.provenance:
             print(f"--max-error {float(table.provenance['max_error']):.6e}, "
                   f"{table.provenance['segment_search']}")
-        print(f"certified max over segments |p_s - f| <= {table.abs_error_bound:.6e}"
+        print(f"certified max over segments |p_s - f| <= {format_up(table.abs_error_bound, '.6e')}"
               + ("" if table.rel_error_bound is None
-                 else f", |p_s/f - 1| <= {table.rel_error_bound:.6e}"))
+                 else f", |p_s/f - 1| <= {format_up(table.rel_error_bound, '.6e')}"))
     return 0
 
 
@@ -265,6 +266,7 @@ def _fit(args, mon):
 
 
 def _report(args, table) -> int:
+    from chebnorm.core.numeric import format_down, format_up
     if args.output:
         table.save(args.output)
     if args.json:
@@ -282,16 +284,18 @@ def _report(args, table) -> int:
                   f"({table.basis_choice.reason.split('. ')[0]})")
         print("coefficients (ascending powers of {}): {}".format(
             powers_of, ", ".join(f"{c:.17g}" for c in table.coefficients)))
-        print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
-              f"certified bound {table.abs_error_bound:.6e}")
+        print(f"max |p - f|   = {format_down(table.max_abs_error, '.6e')} at {table.variable} = "
+              f"{table.max_abs_at:.17g}; "
+              f"certified bound {format_up(table.abs_error_bound, '.6e')}")
         if "binary_endpoints" in table.provenance:
             print(f"note: {table.provenance['binary_endpoints']}")
         if table.rel_error_bound is not None:
-            print(f"max |p/f - 1| = {table.max_rel_error:.6e}; certified bound {table.rel_error_bound:.6e}")
+            print(f"max |p/f - 1| = {format_down(table.max_rel_error, '.6e')}; certified bound "
+                  f"{format_up(table.rel_error_bound, '.6e')}")
         if table.fixed_point is not None:
             fp = table.fixed_point
             print(f"fixed point ({fp.frac_bits} fractional bits, {fp.method}): {list(fp.integers)}; "
-                  f"certified |p_q - f| <= {fp.abs_error_bound:.6e}")
+                  f"certified |p_q - f| <= {format_up(fp.abs_error_bound, '.6e')}")
         elif table.quantized is not None:
             q = table.quantized
             what = (f"fixed point ({','.join(map(str, q.frac_bits))} fractional bits"
@@ -299,7 +303,7 @@ def _report(args, table) -> int:
             print(f"{what}, {q.method}): " + ", ".join(
                 f"{m}*2^{e}" for k, (m, e) in enumerate(zip(q.mantissas, q.exponents))
                 if k in q.monomials or (k == 0 and q.fixed_constant)))
-            print(f"quantized: certified |p_q - f| <= {q.abs_error_bound:.6e}"
+            print(f"quantized: certified |p_q - f| <= {format_up(q.abs_error_bound, '.6e')}"
                   + ("" if q.rel_error_bound is None
-                     else f", |p_q/f - 1| <= {q.rel_error_bound:.6e}"))
+                     else f", |p_q/f - 1| <= {format_up(q.rel_error_bound, '.6e')}"))
     return 0

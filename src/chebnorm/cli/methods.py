@@ -68,6 +68,8 @@ def run(args) -> int:
     """
     import numpy as np
 
+    from chebnorm.core.numeric import format_down
+
     from chebnorm.methods import analyze, angular_drift, method_names
 
     if args.dtype not in ("float32", "float64"):
@@ -99,10 +101,12 @@ def run(args) -> int:
     for r in reports:
         pp = " ".join(f"{r.ops.per_pixel[k]:g}" for k in _KEYS)
         ps = " ".join(f"{r.ops.per_span[k]:g}" for k in _KEYS)
-        print(f"{r.method:10s} {r.max_length_error:12.4e} {r.max_angle_error:10.3e} "
-              f"{r.max_angle_error_slerp:10.3e}  {pp:>22s} | {ps}")
+        print(f"{r.method:10s} {format_down(r.max_length_error, '12.4e')} "
+              f"{format_down(r.max_angle_error, '10.3e')} "
+              f"{format_down(r.max_angle_error_slerp, '10.3e')}  {pp:>22s} | {ps}")
     if drift:
         for dt, d in drift.items():
-            print(f"angular recurrence drift, {dt}: max ||N|-1| = {d.max_length_error:.3e}, "
-                  f"max angle vs slerp = {d.max_angle_error:.3e} rad")
+            print(f"angular recurrence drift, {dt}: max ||N|-1| = "
+                  f"{format_down(d.max_length_error, '.3e')}, "
+                  f"max angle vs slerp = {format_down(d.max_angle_error, '.3e')} rad")
     return 0

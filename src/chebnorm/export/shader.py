@@ -66,7 +66,7 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import comment_text, identifier
 
-from chebnorm.core.numeric import float_up
+from chebnorm.core.numeric import float_up, format_up
 
 from .c import (coefficient_parity, evaluator_range_problem, inner_interval, interval_max_abs,
                 round_inward)
@@ -528,7 +528,8 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     coeffs, certified, source = _coefficients(table)
     bound = float32_eval_bound(table)
     if not np.isfinite(bound.total32):
-        raise ValueError(f"table {table.name!r}: its float32 evaluation bound {bound.total:.3g} "
+        raise ValueError(f"table {table.name!r}: its float32 evaluation bound "
+                         f"{format_up(bound.total, '.3g')} "
                          f"exceeds the float32 range; accepted: a bound below 3.4e38")
     lo32, hi32 = interval32(table)
     var = comment_text(table.variable, max_length=40)
@@ -548,20 +549,22 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
     if bound.certificate is None:
-        w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
-          f" {float(bound.rounding):.6e}")
+        w(f"//   certified {format_up(float(bound.certified), '.6e')} + float32 coefficients and "
+          f"Horner rounding"
+          f" {format_up(float(bound.rounding), '.6e')}")
         w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half"
           " an ulp of its")
         w(f"//   largest result there, fused or not) + subnormal input flush "
-          f"{float(bound.flush):.3e}."
+          f"{format_up(float(bound.flush), '.3e')}."
           + (f" Proof: {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}" if proof else ""))
     else:
-        w(f"//   the certified maximum of |{fn}(x) - f(x)| {float(bound.certificate.maximum):.6e}"
+        w(f"//   the certified maximum of |{fn}(x) - f(x)| "
+          f"{format_up(float(bound.certificate.maximum), '.6e')}"
           f" rounded up")
         w("//   (chebnorm.export.certificate: exhaustive, every float32 input and every fused/"
           "unfused mix run")
         w(f"//   bit-exactly against a proved enclosure of f) + subnormal input flush "
-          f"{float(bound.flush):.3e}.")
+          f"{format_up(float(bound.flush), '.3e')}.")
         w(f"//   The a-priori bound {shader_evaluator(table).bound().stated!r} (interval "
           f"arithmetic) is proved"
           + (f" by {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}." if proof

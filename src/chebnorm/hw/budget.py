@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import re
 import shutil
-import subprocess
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -40,6 +39,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
 from .trust import verify_design
+from chebnorm.core.tools import run_tool
 
 __all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script",
            "gappa_bound", "SHADING_LEVELS"]
@@ -486,14 +486,14 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
     ------
     ValueError
         If gappa fails or gives no bound.
-    subprocess.TimeoutExpired
-        If gappa runs longer than ``timeout``.
+    chebnorm.core.tools.ToolTimeout
+        If gappa runs longer than ``timeout`` (a ``ValueError``
+        and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
     exe = shutil.which("gappa")
     if exe is None:
         return None
-    proc = subprocess.run([exe], input=gappa_script(design), capture_output=True, text=True,
-                          timeout=timeout)
+    proc = run_tool([exe], tool="gappa", timeout=timeout, input=gappa_script(design))
     out = proc.stdout + proc.stderr
     if proc.returncode != 0 or "in [" not in out:
         raise ValueError(f"gappa could not bound the datapath of {design.module_name}: "

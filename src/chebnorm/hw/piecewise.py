@@ -60,7 +60,7 @@ import numpy as np
 
 from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise_table import PiecewiseTable
-from chebnorm.core.numeric import float_up
+from chebnorm.core.numeric import float_up, format_up
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
@@ -976,7 +976,8 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     if not ok:
         approx = max(Fraction(seg.abs_error_bound) for seg in t.segments)
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
-                         f"(certified {float(total):.6e}; approximation {float(approx):.6e}); "
+                         f"(certified {format_up(float(total), '.6e')}; approximation "
+                         f"{format_up(float(approx), '.6e')}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
     cur = descend(cur)
     for _ in range(2):  # trades, while one pays

@@ -44,6 +44,7 @@ from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DE
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.core.textsafe import csv_cell
+from chebnorm.core.numeric import format_up
 
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
@@ -183,7 +184,7 @@ class DesignPoint:
             cells = f"~{self.target_model:.0f} LUT equivalents (model)"
         return (f"degree {self.degree}, {self.segments} segments, {self.coef_frac_bits} "
                 f"coefficient bits (ROM {self.rom_bits} bits): {cells}, certified error "
-                f"<= {self.total_bound:.4e}")
+                f"<= {format_up(self.total_bound, '.4e')}")
 
 
 @dataclass(frozen=True)
@@ -254,7 +255,8 @@ class SearchResult:
         out.write(",".join(COLUMNS + (TARGET_COLUMNS if extra else ())) + "\n")
         for p in self.points:
             row = [p.degree, p.segments, p.coef_frac_bits, p.acc_frac_bits, p.y_frac_bits,
-                   p.rom_bits, f"{p.approx_bound:.6e}", f"{p.total_bound:.6e}", int(p.meets),
+                   p.rom_bits, format_up(p.approx_bound, '.6e'),
+                   format_up(p.total_bound, '.6e'), int(p.meets),
                    f"{p.model_cost:.1f}", "" if p.yosys_cells is None else p.yosys_cells,
                    int(p.pareto), int(p is self.winner)]
             if extra:
@@ -279,7 +281,7 @@ class SearchResult:
                 best = min((p for p in self.points if p.degree == deg),
                            key=lambda p: p.total_bound)
                 lines.append(f"  degree {deg}: no design meets the bound up to {best.segments} "
-                             f"segments (best {best.total_bound:.4e})")
+                             f"segments (best {format_up(best.total_bound, '.4e')})")
                 continue
             b = min(ok, key=lambda p: (p.cost, p.total_bound))
             if b is w:

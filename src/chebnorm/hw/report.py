@@ -25,6 +25,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.deprecation import renamed
 from chebnorm.core.files import write_folder
+from chebnorm.core.numeric import format_down, format_up
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -141,18 +142,24 @@ class HardwareReport:
                f"y_format: code k -> {float(yf.offset)!r} + k / 2^{yf.frac_bits} "
                f"(1 LSB = {b.y_lsb:.6e})",
                "error budget (bound | measured over every valid code):",
-               f"  approximation   {b.approximation:.6e} | {m.approximation:.6e}",
-               f"  quantization    {b.quantization:.6e} | {m.quantization:.6e}  "
-               f"(p_q re-certified {b.quantized:.6e})"]
+               f"  approximation   {format_up(b.approximation, '.6e')} | "
+               f"{format_down(m.approximation, '.6e')}",
+               f"  quantization    {format_up(b.quantization, '.6e')} | "
+               f"{format_down(m.quantization, '.6e')}  "
+               f"(p_q re-certified {format_up(b.quantized, '.6e')})"]
         for st, (bound, meas) in zip(d.stages[:-1], zip(b.rounding_steps, m.step_rounding)):
-            out.append(f"  rounding a{st.power}     {bound:.6e} (local {_local(st, d):.6e}) "
-                       f"| local {meas:.6e}")
-        out += [f"  output rounding {b.output_rounding:.6e}",
-                f"  rounding total  {b.rounding:.6e} | {m.rounding:.6e}"
-                + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
-                f"  total           {b.total:.6e} | {m.total:.6e}  "
-                f"({b.total / b.y_lsb:.3f} | {m.total_lsb:.3f} LSB; ratio {b.total / m.total:.3f})",
-                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output"
+            out.append(f"  rounding a{st.power}     {format_up(bound, '.6e')} (local "
+                       f"{format_up(_local(st, d), '.6e')}) "
+                       f"| local {format_down(meas, '.6e')}")
+        out += [f"  output rounding {format_up(b.output_rounding, '.6e')}",
+                f"  rounding total  {format_up(b.rounding, '.6e')} | "
+                f"{format_down(m.rounding, '.6e')}"
+                + ("" if b.gappa_rounding is None
+                   else f"  (gappa {format_up(b.gappa_rounding, '.6e')})"),
+                f"  total           {format_up(b.total, '.6e')} | {format_down(m.total, '.6e')}  "
+                f"({format_up(b.total / b.y_lsb, '.3f')} | {format_down(m.total_lsb, '.3f')} LSB; "
+                f"ratio {b.total / m.total:.3f})",
+                f"  shading error   {format_down(m.shading_levels, '.4f')} levels of 8-bit output"
                 if m.shading_levels is not None else
                 "  shading error   - (f is zero at a valid code: no relative error)",
                 "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]

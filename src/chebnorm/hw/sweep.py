@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from chebnorm.approx import fit_target, get_target
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.core.display import field_rows, summary_html, summary_repr
+from chebnorm.core.numeric import format_down, format_up
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -124,12 +125,13 @@ class SweepPoint:
 
     def row(self) -> list[str]:
         """The CSV cells of this point, in the order of ``COLUMNS``."""
-        f = lambda v: f"{v:.6e}"
+        # the measured maximum rounded down, the certified budget up (at the digits shown)
         return [str(self.degree), str(self.coef_bits),
                 "" if self.acc_bits is None else str(self.acc_bits), str(self.in_bits),
-                str(self.out_bits), str(self.y_frac_bits), f(self.max_error),
-                f"{self.max_error_lsb:.4f}", f(self.budget), f"{self.budget_lsb:.4f}",
-                f"{self.shading_levels:.6f}",
+                str(self.out_bits), str(self.y_frac_bits), format_down(self.max_error, ".6e"),
+                format_down(self.max_error_lsb, ".4f"), format_up(self.budget, ".6e"),
+                format_up(self.budget_lsb, ".4f"),
+                f"{format_down(self.shading_levels, '.6f')}",
                 "" if self.yosys_cells is None else str(self.yosys_cells),
                 f"{self.area_fa:.1f}", str(int(self.pareto)), str(int(self.meets_half_level))]
 

@@ -19,6 +19,7 @@ attributes.
 from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text, identifier
+from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
 
@@ -197,11 +198,13 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
         f"{design.acc_frac_bits} fractional bits.",
     ]
     if budget is not None:
-        lines.append(f"Error budget (|y - f(x)| on the valid codes): total <= {budget.total:.6e} "
-                     f"= {budget.total / budget.y_lsb:.4g} LSB of y")
-        lines.append(f"  approximation {budget.approximation:.6e}, quantization "
-                     f"{budget.quantization:.6e} (quantized, re-certified {budget.quantized:.6e}), "
-                     f"rounding {budget.rounding:.6e}")
+        lines.append(f"Error budget (|y - f(x)| on the valid codes): total <= "
+                     f"{format_up(budget.total, '.6e')} "
+                     f"= {format_up(budget.total / budget.y_lsb, '.4g')} LSB of y")
+        lines.append(f"  approximation {format_up(budget.approximation, '.6e')}, quantization "
+                     f"{format_up(budget.quantization, '.6e')} (quantized, re-certified "
+                     f"{format_up(budget.quantized, '.6e')}), "
+                     f"rounding {format_up(budget.rounding, '.6e')}")
     if pipelined:
         lines.append(f"Pipelined: one register stage per Horner step, latency {design.degree} "
                      f"cycles (LATENCY); one result per cycle. Constants sized for these widths.")
@@ -282,9 +285,10 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
               f"{design.multipliers} multipliers, products truncated (floor) to P = "
               f"{list(design.prod_frac)} and sums to G = {list(design.acc_frac)} fractional "
               f"bits (a_0 .. a_n); the bias is centred in the ROM.",
-              f"Error budget |y - f(x)| <= {b['total']:.6e} = approximation "
-              f"{b['approximation']:.6e} + Horner rounding {b['horner_rounding']:.6e} + output "
-              f"rounding {b['output_rounding']:.6e}"]
+              f"Error budget |y - f(x)| <= {format_up(b['total'], '.6e')} = approximation "
+              f"{format_up(b['approximation'], '.6e')} + Horner rounding "
+              f"{format_up(b['horner_rounding'], '.6e')} + output "
+              f"rounding {format_up(b['output_rounding'], '.6e')}"]
     if design.latency:
         mult = getattr(design, "mult_cuts", ())
         lines.append(f"Pipelined: registers at cut points {list(design.cuts)} (0 after the ROM, "

@@ -20,6 +20,7 @@ clocked when the core is pipelined).
 from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text
+from chebnorm.core.numeric import format_up
 
 from . import module_text
 from ..trust import verify_design
@@ -86,9 +87,10 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
               f"{d.degree}).",
               f"y = {{h, m}}: h = y[{H + M - 1}:{M}], m = y[{M - 1}:0]; 1/sqrt(x) ~ 2^h * "
               f"({off} + m) / 2^{F}.",
-              f"Certified: |({off} + m) / 2^{F} - g(v)| <= {b['mantissa']:.6e} "
-              f"({b['mantissa'] * 2.0 ** F:.4f} ulp of the mantissa), so |y - 1/sqrt(x)| <= "
-              f"2^h * that and the relative error < {b['relative']:.6e}."]
+              f"Certified: |({off} + m) / 2^{F} - g(v)| <= {format_up(b['mantissa'], '.6e')} "
+              f"({format_up(b['mantissa'] * 2.0 ** F, '.4f')} ulp of the mantissa), so |y - "
+              f"1/sqrt(x)| <= "
+              f"2^h * that and the relative error < {format_up(b['relative'], '.6e')}."]
     if d.latency:
         lines.append(f"Pipelined: the core's registers, latency {d.latency} cycles (LATENCY); "
                      f"h is delayed as many.")
