@@ -163,7 +163,7 @@ class HardwareReport:
                 if m.shading_levels is not None else
                 "  shading error   - (f is zero at a valid code: no relative error)",
                 "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]
-        out += self.block.lines()
+        out += self.block.lines(depth=True)
         if self.synth is not None:
             out.append(f"yosys: {self.synth.cells} cells")
         out += [f"note: {n}" for n in d.notes]
