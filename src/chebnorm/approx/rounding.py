@@ -32,6 +32,7 @@ Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -217,18 +218,21 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool,
     return out
 
 
-def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None):
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None,
+             xp=None):
     """Integer vectors ``n`` (one per free power) near the weighted function values.
 
     ``base`` (integers, one per free power: the real fit rounded) is subtracted
     from the target first and added back to the answers: the lattice then
     resolves the residual, a few quanta, instead of f itself, whose size would
     leave the small columns (high powers at small points) only a few bits once
-    everything is scaled to 62-bit integers.
+    everything is scaled to 62-bit integers. ``xp``: the powers of ``points``
+    (a :class:`_Powers`), kept across calls on the same points.
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    xe = {e: clib.power(x, e) for e in powers}    # libm's pow, not numpy's loop (CPU)
+    xp = _Powers(x) if xp is None else xp         # libm's pow, not numpy's loop (CPU)
+    xe = {e: xp[e] for e in powers}
     vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
     y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
@@ -274,25 +278,59 @@ class Problem:
     reductions: dict = field(default_factory=dict, repr=False)
 
 
+class _Powers:
+    """``x ** k`` (:func:`chebnorm.core.clib.power`, element by element) of the
+    points ``x``, each power computed when first asked for and kept; or, with
+    ``parent`` and ``index``, ``parent[k][index]`` (the same floats: every
+    element is computed on its own)."""
+
+    def __init__(self, x: np.ndarray, parent: "_Powers | None" = None, index=None):
+        self.x, self.parent, self.index = x, parent, index
+        self.cache: dict[int, np.ndarray] = {}
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        v = self.cache.get(k)
+        if v is None:
+            v = (clib.power(self.x, k) if self.parent is None
+                 else self.parent[k][self.index])
+            v.flags.writeable = False
+            self.cache[k] = v
+        return v
+
+
+@functools.lru_cache(maxsize=32)
+def _sample_grid(f_np, lo: float, hi: float, kind: str, samples: int):
+    """The sampler's points inside ``(lo, hi)``, ``f`` there, the weights and
+    the powers of the points (read-only, powers computed as asked for):
+    they depend only on the function, the interval, the error kind and the
+    count, so every quantization of one function on one interval (the parity
+    sub-basis and the whole basis, several formats or bit counts) shares them,
+    as :func:`chebnorm.approx.certify._search_grid` shares its grid."""
+    x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
+    x = np.clip(x, lo, hi)
+    with np.errstate(all="ignore"):
+        fx = np.asarray(f_np(x), dtype=float) * np.ones_like(x)
+    ok = np.isfinite(fx) & (x > lo) & (x < hi)
+    if kind == "rel":
+        ok &= fx != 0
+    x, f = x[ok], fx[ok]
+    w = 1.0 / np.abs(f) if kind == "rel" else np.ones_like(f)
+    for a in (x, f, w):
+        a.flags.writeable = False
+    return x, f, w, _Powers(x)
+
+
 class _Sampler:
     """Sampled weighted error of candidate polynomials (a lower bound of the
     supremum up to the float evaluation error, which is accounted for)."""
 
     def __init__(self, prob: Problem, samples: int = 4097):
-        lo, hi = prob.lo_f, prob.hi_f
-        x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
-        x = np.clip(x, lo, hi)
-        with np.errstate(all="ignore"):
-            fx = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
-        ok = np.isfinite(fx) & (x > lo) & (x < hi)
-        if prob.error_kind == "rel":
-            ok &= fx != 0
-        self.x, self.f = x[ok], fx[ok]
-        self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
-        self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
+        self.x, self.f, self.w, self.xp = _sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f,
+                                                       prob.error_kind, samples)
         self.point_sets: dict = {}            # real coefficients -> _point_sets
         self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
         self._thin = None
+        self._order = None
 
     def thinned(self, step: int = 16) -> "_Sampler":
         """Every ``step``-th of these points: the error of a polynomial there
@@ -301,16 +339,26 @@ class _Sampler:
         if self._thin is None:
             thin = object.__new__(_Sampler)
             thin.x, thin.f, thin.w = self.x[::step], self.f[::step], self.w[::step]
-            thin.xp = {k: v[::step] for k, v in self.xp.items()}
+            thin.xp = _Powers(thin.x, self.xp, slice(None, None, step))
             self._thin = thin
         return self._thin
+
+    def ordered(self) -> "_Sampler":
+        """These points in increasing order (with ``f``, weights and powers)."""
+        if self._order is None:
+            order = np.argsort(self.x)
+            srt = object.__new__(_Sampler)
+            srt.x, srt.f, srt.w = self.x[order], self.f[order], self.w[order]
+            srt.xp = _Powers(srt.x, self.xp, order)
+            self._order = srt
+        return self._order
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
         interpolation points, linearly interpolated between samples)."""
-        order = np.argsort(self.x)
-        x, f = self.x[order], self.f[order]
-        p = sum(c * self.xp[k][order] for k, c in enumerate(coeffs))
+        srt = self.ordered()
+        x, f = srt.x, srt.f
+        p = sum(c * srt.xp[k] for k, c in enumerate(coeffs))
         g = p - f
         idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
         t = g[idx] / (g[idx] - g[idx + 1])
@@ -335,16 +383,27 @@ class _Sampler:
         out: list[float] = []
         if not self.x.size:
             return [0.0] * len(rows)
+        absf = np.abs(self.f)
         for i in range(0, len(rows), chunk):
             c = np.array(rows[i:i + chunk], dtype=float)
             p = np.zeros((len(c), self.x.size))
             mag = np.zeros_like(p)
+            term = np.empty_like(p)
             for k in range(c.shape[1]):
-                term = c[:, k:k + 1] * self.xp[k]
+                if not c[:, k].any():         # a zero column adds zeros: no sum changes
+                    continue
+                np.multiply(c[:, k:k + 1], self.xp[k], out=term)
                 p += term
-                mag += np.abs(term)
-            err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
-            out.extend(float(v) for v in np.max(err, axis=1))
+                np.abs(term, out=term)
+                mag += term
+            # w * (|p - f| - 2^-50 (mag + |f|)), the same operations in place
+            p -= self.f
+            np.abs(p, out=p)
+            mag += absf
+            mag *= 2.0 ** -50
+            p -= mag
+            p *= self.w
+            out.extend(float(v) for v in np.max(p, axis=1))
         return out
 
 
@@ -460,7 +519,8 @@ def _point_sets(prob, sampler, real) -> list:
             fv = np.asarray(prob.fn.numpy(pts), dtype=float) * np.ones_like(pts)
         if not np.all(np.isfinite(fv)) or (prob.error_kind == "rel" and np.any(fv == 0)):
             continue
-        out.append((pts, fv, 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv)))
+        out.append((pts, fv, 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv),
+                    _Powers(pts)))
     sampler.point_sets[key] = out
     return out
 
@@ -472,11 +532,11 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     # each free coefficient rounded to nearest
     cands["rounded"] = _full(prob, {k: (round(math.ldexp(real[k], -quanta[k])), quanta[k])
                                     for k in prob.powers})
-    for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
+    for pts, fv, w, xp in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
                         [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
-                        prob.reductions)
+                        prob.reductions, xp)
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
                 prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
@@ -648,13 +708,10 @@ def _peaks(prob: Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[flo
     """Where the error of ``coeffs`` has its local maxima (every one: a
     near-minimax error has ``n + 2`` of nearly one height), each found on the
     sampler's grid and refined by ``zooms`` denser grids around it."""
-    order = np.argsort(sampler.x)
-    x = sampler.x[order]
+    thin = sampler.ordered()
+    x = thin.x
     if x.size < 3:
         return []
-    thin = object.__new__(_Sampler)
-    thin.x, thin.f, thin.w = x, sampler.f[order], sampler.w[order]
-    thin.xp = {k: v[order] for k, v in sampler.xp.items()}
     err = _point_errors(prob, x, coeffs, thin)
     inner = np.nonzero((err[1:-1] >= err[:-2]) & (err[1:-1] >= err[2:]))[0] + 1
     tops = [i for i in sorted(set(inner.tolist()) | {0, x.size - 1})
