@@ -317,7 +317,27 @@ def _sample_grid(f_np, lo: float, hi: float, kind: str, samples: int):
     w = 1.0 / np.abs(f) if kind == "rel" else np.ones_like(f)
     for a in (x, f, w):
         a.flags.writeable = False
-    return x, f, w, _Powers(x)
+    return _Grid(x, f, w, _Powers(x))
+
+
+class _Grid:
+    """Points, ``f`` there, weights and powers (read-only), with the views
+    of them the sampler takes (every ``step``-th point, the points sorted),
+    each built once."""
+
+    def __init__(self, x, f, w, xp):
+        self.x, self.f, self.w, self.xp = x, f, w, xp
+        self.views: dict = {}
+
+    def view(self, key, index) -> "_Grid":
+        """The grid at ``x[index]`` (``key`` names the view)."""
+        got = self.views.get(key)
+        if got is None:
+            x, f, w = self.x[index], self.f[index], self.w[index]
+            for a in (x, f, w):
+                a.flags.writeable = False
+            got = self.views[key] = _Grid(x, f, w, _Powers(x, self.xp, index))
+        return got
 
 
 class _Sampler:
@@ -325,12 +345,14 @@ class _Sampler:
     supremum up to the float evaluation error, which is accounted for)."""
 
     def __init__(self, prob: Problem, samples: int = 4097):
-        self.x, self.f, self.w, self.xp = _sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f,
-                                                       prob.error_kind, samples)
+        self._use(_sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f, prob.error_kind, samples))
         self.point_sets: dict = {}            # real coefficients -> _point_sets
         self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
         self._thin = None
-        self._order = None
+
+    def _use(self, grid: "_Grid") -> None:
+        self.grid = grid
+        self.x, self.f, self.w, self.xp = grid.x, grid.f, grid.w, grid.xp
 
     def thinned(self, step: int = 16) -> "_Sampler":
         """Every ``step``-th of these points: the error of a polynomial there
@@ -338,20 +360,16 @@ class _Sampler:
         its error on all the points (a cheaper lower bound of that)."""
         if self._thin is None:
             thin = object.__new__(_Sampler)
-            thin.x, thin.f, thin.w = self.x[::step], self.f[::step], self.w[::step]
-            thin.xp = _Powers(thin.x, self.xp, slice(None, None, step))
+            thin._use(self.grid.view(("thin", step), slice(None, None, step)))
             self._thin = thin
         return self._thin
 
     def ordered(self) -> "_Sampler":
         """These points in increasing order (with ``f``, weights and powers)."""
-        if self._order is None:
-            order = np.argsort(self.x)
-            srt = object.__new__(_Sampler)
-            srt.x, srt.f, srt.w = self.x[order], self.f[order], self.w[order]
-            srt.xp = _Powers(srt.x, self.xp, order)
-            self._order = srt
-        return self._order
+        srt = object.__new__(_Sampler)
+        grid = self.grid.views.get("sorted") or self.grid.view("sorted", np.argsort(self.x))
+        srt._use(grid)
+        return srt
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
@@ -587,6 +605,24 @@ def _to_monomial(prob: Problem, cheb) -> list[float]:
     return out
 
 
+@functools.lru_cache(maxsize=128)
+def _greedy_nodes(f_np, lo: float, hi: float, n: int, k: int):
+    """:func:`greedy`'s step ``k`` (degree ``n``): the ``k`` Chebyshev nodes of
+    ``[lo, hi]``, their powers ``k..n``, ``f`` there and the transposed
+    Chebyshev-Vandermonde matrix (read-only; shared by every quantization
+    of one function on one interval)."""
+    cheb_deg = k - 1
+    t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
+    x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+    with np.errstate(all="ignore"):
+        fx = np.array(f_np(x))
+    xj = {j: clib.power(x, j) for j in range(k, n + 1)}
+    vander_t = np.polynomial.chebyshev.chebvander(t, cheb_deg).T
+    for a in (fx, vander_t, *xj.values()):
+        a.flags.writeable = False
+    return xj, fx, vander_t
+
+
 def greedy(prob: Problem, real, quanta) -> list[int] | None:
     """Greedy rounding (all powers free): coefficient ``k`` rounded to its quantum
     ``2**quanta[k]`` from the highest power down, the lower ones refitted after
@@ -606,14 +642,7 @@ def greedy(prob: Problem, real, quanta) -> list[int] | None:
         high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
         nodes = prob.greedy_nodes.get(k)
         if nodes is None:                     # the same at every set of quanta
-            cheb_deg = k - 1
-            t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
-            x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
-            with np.errstate(all="ignore"):
-                fx = f_np(x)
-            nodes = prob.greedy_nodes[k] = (
-                {j: clib.power(x, j) for j in range(k, n + 1)}, fx,
-                np.polynomial.chebyshev.chebvander(t, cheb_deg).T)
+            nodes = prob.greedy_nodes[k] = _greedy_nodes(f_np, lo, hi, n, k)
         xj, fx, vander_t = nodes
         # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
         # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
