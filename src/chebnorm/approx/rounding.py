@@ -582,27 +582,32 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
 def _to_monomial(prob: Problem, cheb) -> list[float]:
     """:func:`chebnorm.approx.fitting.cheb_to_monomial` on the problem's
     interval, the same exact rationals rounded once (so the same floats): the
-    monomial coefficients of each ``T_k(u(x))`` are kept, and each answer is
-    an exact sum of their multiples."""
-    from flint import fmpq_poly
+    monomial coefficients of each ``T_k(u(x))`` are kept (:func:`_cheb_rows`),
+    and each answer is an exact sum of their multiples (one exact
+    matrix-vector product)."""
+    from flint import fmpq_mat
+
+    from .fitting import exact_rational
+
+    n = len(cheb)
+    rows = _cheb_rows(float(prob.lo_f), float(prob.hi_f), n)
+    total = rows * fmpq_mat(n, 1, [exact_rational(c) for c in cheb])
+    return [int(t.p) / int(t.q) for t in total.entries()]
+
+
+@functools.lru_cache(maxsize=256)
+def _cheb_rows(lo: float, hi: float, n: int):
+    """The exact ``n x n`` matrix (fmpq_mat) whose column ``k`` holds the
+    monomial coefficients (powers ``0..n-1`` of ``x``) of ``T_k(u(x))``, ``u``
+    mapping ``[lo, hi]`` onto ``[-1, 1]``; read only."""
+    from flint import fmpq_mat, fmpq_poly
 
     from .fitting import chebyshev_t, exact_rational
 
-    n = len(cheb)
-    key = ("mono", n)
-    rows = prob.greedy_nodes.get(key)
-    if rows is None:
-        lo_q, hi_q = exact_rational(float(prob.lo_f)), exact_rational(float(prob.hi_f))
-        sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
-        rows = prob.greedy_nodes[key] = [
-            (chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
-    exact = [exact_rational(c) for c in cheb]
-    out = []
-    for j in range(n):
-        total = sum((exact[k] * rows[k][j] for k in range(j, n) if rows[k][j] != 0),
-                    exact_rational(0.0))
-        out.append(int(total.p) / int(total.q))
-    return out
+    lo_q, hi_q = exact_rational(lo), exact_rational(hi)
+    sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
+    cols = [(chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
+    return fmpq_mat(n, n, [cols[k][j] for j in range(n) for k in range(n)])
 
 
 @functools.lru_cache(maxsize=128)
