@@ -237,12 +237,18 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
     base = [0] * len(powers) if base is None else list(base)
     y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
              - sum(math.ldexp(b, s) * xe[e] for b, e, s in zip(base, powers, quanta)))
-    big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
+    vecs = np.array(vecs)
+    big = max(float(np.max(np.abs(vecs))), float(np.max(np.abs(y))), 1e-300)
     shift = 62 - math.frexp(big)[1]
     def ints(v):
-        return [int(round(math.ldexp(float(a), shift))) for a in v]
-    basis = [ints(v) for v in vecs]
-    if any(all(a == 0 for a in row) for row in basis):
+        v = np.asarray(v, dtype=float)
+        if np.all(np.isfinite(v)):            # |v| 2^shift < 2^62: exact in int64
+            return np.rint(np.ldexp(v, shift)).astype(np.int64).tolist()
+        if v.ndim == 2:
+            return [ints(row) for row in v]
+        return [int(round(math.ldexp(float(a), shift))) for a in v]   # raises as before
+    basis = ints(vecs)
+    if any(not any(row) for row in basis):
         return []
     try:
         vecs = _babai(basis, ints(y), spread=True, cache=cache)
