@@ -131,10 +131,8 @@ def normal_pair(m: int, s: int) -> tuple[int, int]:
     """
     if m == 0:
         return 0, 0
-    while m % 2 == 0:
-        m //= 2
-        s += 1
-    return m, s
+    zeros = (m & -m).bit_length() - 1     # trailing zero bits (two's complement)
+    return m >> zeros, s + zeros
 
 
 def representable(m: int, s: int, fmt: str) -> bool:
