@@ -302,7 +302,8 @@ class _Powers:
         return v
 
 
-@functools.lru_cache(maxsize=32)
+# at most 8 grids kept, each up to ~1 MB (6000 points, f, weights, powers, views)
+@functools.lru_cache(maxsize=8)
 def _sample_grid(f_np, lo: float, hi: float, kind: str, samples: int):
     """The sampler's points inside ``(lo, hi)``, ``f`` there, the weights and
     the powers of the points (read-only, powers computed as asked for):
