@@ -126,6 +126,14 @@ def _nearest_float(ball: arb) -> float:
     return best
 
 
+@functools.lru_cache(maxsize=256)
+def _complex_evaluator(var: sp.Symbol, expr: sp.Expr):
+    """``expr`` as a numpy function of ``var`` in complex arithmetic (sympy's
+    ``lambdify``), generated once per expression: a quantization that refits,
+    or several fits of one function, reuse it."""
+    return sp.lambdify(var, expr, ["scipy", "numpy"])
+
+
 def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndarray:
     """Sample ``f`` on the interval and reject it where it is not finite and real.
 
@@ -157,7 +165,7 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     x[0], x[-1] = iv.lo_in, iv.hi_in
     with np.errstate(all="ignore"):
         try:
-            y = np.asarray(sp.lambdify(fn.var, fn.expr, ["scipy", "numpy"])(x.astype(complex)), dtype=complex)
+            y = np.asarray(_complex_evaluator(fn.var, fn.expr)(x.astype(complex)), dtype=complex)
         except (ZeroDivisionError, OverflowError):
             y = np.full(x.shape, np.nan, dtype=complex)
         y = y * np.ones_like(x)
