@@ -43,7 +43,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
 
-__all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
+__all__ = ["HornerDesign", "Stage", "SCHEMES", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
            "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
 
 #: widest input code of a Horner design (its model and test bench run all ``2**in_bits`` codes)
@@ -86,6 +86,10 @@ class Stage:
         Fractional bits of ``a_j`` (the accumulator's, or the output's at ``j = 0``).
     round_shift : int
         Bits dropped by the rounding: ``sum_frac_bits - out_frac_bits`` (``>= 0``).
+    operand : {"v", "x"}, default "v"
+        What ``a_{j+1}`` is multiplied by: the Horner variable ``v`` (``x``
+        itself for plain powers, ``x*x`` rounded for a one-parity design),
+        or ``x`` in the last step of an odd design (``y = x * q(x*x)``).
 
     Examples
     --------
@@ -105,6 +109,12 @@ class Stage:
     out_bits: int
     out_frac_bits: int
     round_shift: int
+    operand: str = "v"
+
+
+#: the evaluation schemes of a Horner design: Horner's rule in ``x``; in ``v = R(x*x)`` over
+#: the even powers; ``x`` times Horner's rule in ``v = R(x*x)`` over the odd powers
+SCHEMES = ("monomial", "even", "odd")
 
 
 @dataclass(frozen=True)
@@ -145,6 +155,21 @@ class HornerDesign:
         First and last input code whose value lies in the table's interval.
     notes : tuple of str, default ()
         Remarks on the sizing, for the report.
+    scheme : {"monomial", "even", "odd"}, default "monomial"
+        :data:`SCHEMES`: Horner's rule in ``x``, or, when every nonzero
+        coefficient is of one parity (degree >= 2), Horner's rule over those
+        coefficients in the variable ``v = R(x*x)`` (times ``x`` once at
+        the end when odd).
+    v_frac_bits : int or None, default None
+        Fractional bits of the Horner variable ``v`` (``x_format.frac_bits``
+        for ``"monomial"``).
+    v_bits : int, default 0
+        Signed width of ``v`` (``xs_bits`` for ``"monomial"``).
+    v_round_shift : int, default 0
+        Bits dropped from the exact square ``xs * xs`` (``2 Fx`` fractional
+        bits) to make ``v``; 0 when the square is kept exact.
+    v_error : Fraction, default 0
+        The exact ``max |v - x*x|`` over the valid codes (0 for ``"monomial"``).
 
     Examples
     --------
@@ -173,6 +198,11 @@ class HornerDesign:
     #: ``(lo, hi)``: the input codes whose values lie in the table's interval (the error budget holds on them)
     valid_codes: tuple[int, int]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    scheme: str = "monomial"
+    v_frac_bits: int | None = None
+    v_bits: int = 0
+    v_round_shift: int = 0
+    v_error: Fraction = Fraction(0)
 
     def _summary(self) -> list[tuple[str, object]]:
         return [("name", self.name), ("degree", self.degree), ("in_bits", self.in_bits),
@@ -191,6 +221,44 @@ class HornerDesign:
     @property
     def module_name(self) -> str:
         return f"chebnorm_{self.name}"
+
+    @property
+    def parity(self) -> int | None:
+        """1 for an odd design, 0 for an even one, None for plain Horner in ``x``."""
+        return {"odd": 1, "even": 0}.get(self.scheme)
+
+    @property
+    def horner_integers(self) -> tuple[int, ...]:
+        """The integers Horner's rule runs over, lowest first: ``integers``
+        for ``"monomial"``; the even-power ones for ``"even"``; for ``"odd"``
+        a 0 then the odd-power ones (the last step multiplies by ``x`` and
+        adds nothing)."""
+        if self.scheme == "even":
+            return self.integers[0::2]
+        if self.scheme == "odd":
+            return (0,) + self.integers[1::2]
+        return self.integers
+
+    @property
+    def steps(self) -> int:
+        """Number of Horner steps (multiply-adds): the pipeline's latency."""
+        return len(self.stages)
+
+    @property
+    def multipliers(self) -> int:
+        """Number of multipliers of the datapath: one per step, plus the
+        squarer ``x*x`` of a one-parity design."""
+        return len(self.stages) + (self.scheme != "monomial")
+
+    @property
+    def variable_frac_bits(self) -> int:
+        """Fractional bits of the Horner variable ``v``."""
+        return self.x_format.frac_bits if self.v_frac_bits is None else self.v_frac_bits
+
+    @property
+    def variable_bits(self) -> int:
+        """Signed width of the Horner variable ``v``."""
+        return self.xs_bits if self.scheme == "monomial" else self.v_bits
 
     # -- bit-accurate model --------------------------------------------------
     def evaluate(self, codes=None, *, intermediates: bool = False):
@@ -220,21 +288,32 @@ class HornerDesign:
         return max(abs(self.x_format.value(lo)), abs(self.x_format.value(hi)))
 
 
+def _variable(scheme: str, xs, round_shift: int, rounding: str):
+    """The Horner variable's integers: ``xs`` itself, or ``R(xs * xs)``."""
+    if scheme == "monomial":
+        return xs
+    sq = xs * xs
+    return shift_round(sq, round_shift, rounding) if round_shift else sq
+
+
 def _run(d: HornerDesign, k: np.ndarray) -> dict:
     xs = k + d.x_format.offset_code
-    wires = {"xs": xs}
-    n = d.degree
+    v = _variable(d.scheme, xs, d.v_round_shift, d.rounding)
+    wires = {"xs": xs, "v": v}
+    ints = d.horner_integers
+    n = len(ints) - 1
     if n == 0:
-        top = np.full(k.shape, d.integers[0], dtype=np.int64)
+        top = np.full(k.shape, ints[0], dtype=np.int64)
         top_frac = d.coef_frac_bits
     else:
-        acc = np.full(k.shape, d.integers[n], dtype=np.int64)
+        acc = np.full(k.shape, ints[n], dtype=np.int64)
         for st in d.stages[:-1]:
-            t = ((acc * xs) << st.product_shift) + st.coef_shifted
+            t = ((acc * (xs if st.operand == "x" else v)) << st.product_shift) + st.coef_shifted
             acc = shift_round(t, st.round_shift, d.rounding)
             wires[f"a{st.power}"] = acc
         last = d.stages[-1]
-        top = ((acc * xs) << last.product_shift) + last.coef_shifted
+        top = ((acc * (xs if last.operand == "x" else v)) << last.product_shift) \
+            + last.coef_shifted
         top_frac = last.sum_frac_bits
     wires["top"] = top
     shift = top_frac - d.y_format.frac_bits
@@ -392,8 +471,10 @@ def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
     return fmt, (k_lo, k_hi)
 
 
-def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
-    """Size the Horner steps exactly by running them over all codes."""
+def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding, variable=None, odd=False):
+    """Size the Horner steps exactly by running them over all codes
+    (``variable``: ``(v, fv, v_bits)`` of the Horner variable when it is not
+    ``x``; ``odd``: the last step multiplies by ``x``)."""
     n = len(integers) - 1
     stages = []
     acc = np.full(k_all_xs.shape, integers[n], dtype=np.int64)
@@ -401,9 +482,11 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
     acc_bits = signed_bits(integers[n], integers[n])
     xs_bits = signed_bits(xs_lo, xs_hi)
     for j in range(n - 1, -1, -1):
-        check_int64(acc_bits + xs_bits, f"the product a_{j + 1} * x")
-        prod = acc * k_all_xs
-        prod_frac = acc_frac + fx
+        by_x = variable is None or (odd and j == 0)
+        op, fop, op_bits = (k_all_xs, fx, xs_bits) if by_x else variable
+        check_int64(acc_bits + op_bits, f"the product a_{j + 1} * {'x' if by_x else 'v'}")
+        prod = acc * op
+        prod_frac = acc_frac + fop
         s = max(prod_frac, fc)
         check_int64(signed_bits(int(prod.min()), int(prod.max())) + s - prod_frac + 1,
                     f"the sum of step {j}")
@@ -427,7 +510,8 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
                             product_bits=signed_bits(int(prod.min()), int(prod.max())),
                             product_shift=pshift, coef_shifted=int(coef), sum_bits=sum_bits,
                             sum_frac_bits=s, out_bits=out_bits, out_frac_bits=out_frac,
-                            round_shift=rshift))
+                            round_shift=rshift,
+                            operand="x" if by_x and variable is not None else "v"))
         acc_bits, acc_frac = out_bits, out_frac
     return tuple(stages), acc
 
@@ -436,7 +520,7 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                   coef_bits: int | None = None, acc_bits: int | None = None,
                   rounding: str = "rne", x_frac_bits: int | None = None,
                   y_frac_bits: int | None = None, guard_bits: int = 3,
-                  name: str | None = None) -> HornerDesign:
+                  name: str | None = None, parity: bool = True) -> HornerDesign:
     """Size a fixed-point Horner evaluator of ``table`` (see module docstring).
 
     ``in_bits``/``out_bits``: widths of the unsigned codes ``x`` and ``y``;
@@ -484,6 +568,10 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         Extra accumulator bits beyond the output's, 0 to 32 (used when ``acc_bits`` is None).
     name : str or None, default None
         The design's name; None uses the table's.
+    parity : bool, default True
+        When every nonzero coefficient is of one parity (degree >= 2),
+        evaluate ``q(v)`` or ``x * q(v)`` with ``v = R(x*x)`` (scheme
+        ``"even"``/``"odd"``: half the Horner steps); False: plain Horner in ``x``.
 
     Returns
     -------
@@ -566,10 +654,24 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         candidates = range(fy, -MAX_FRAC_BITS - 1, -1)
     else:
         candidates = [y_frac_bits]
+    scheme = "monomial"
+    if parity is not True and parity is not False:
+        raise ValueError(f"parity = {parity!r} is not accepted; accepted: True or False")
+    if parity and _integer_parity(integers) is not None:
+        scheme = ("even", "odd")[_integer_parity(integers)]
+        check_int64(2 * signed_bits(xs_lo, xs_hi), "the square x * x")
+    horner = (integers if scheme == "monomial" else
+              integers[0::2] if scheme == "even" else (0,) + integers[1::2])
+    v_info = (None, 0, 0, Fraction(0))
     for fy in candidates:
         fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
-        if len(integers) > 1:
-            stages, top = _stages(integers, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding)
+        variable = None
+        if scheme != "monomial":
+            v_info = _square(xs_all, fx, fa, rounding, valid)
+            variable = v_info[0]
+        if len(horner) > 1:
+            stages, top = _stages(horner, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding,
+                                  variable=variable, odd=scheme == "odd")
             top_frac = stages[-1].sum_frac_bits
         else:
             stages, top, top_frac = (), np.full(all_k.shape, integers[0], dtype=np.int64), fc
@@ -599,7 +701,38 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         notes.append(f"{n_sat} input codes outside the valid range saturate the output")
     return HornerDesign(name=name, table=table, in_bits=in_bits, out_bits=out_bits,
                         rounding=rounding, x_format=x_fmt, y_format=y_fmt, coef_frac_bits=fc,
-                        integers=integers, acc_frac_bits=fa if len(integers) > 2 else fy,
+                        integers=integers, acc_frac_bits=fa if len(horner) > 2 else fy,
                         xs_bits=signed_bits(xs_lo, xs_hi), stages=stages,
                         top_bits=signed_bits(int(top.min()), int(top.max())), raw_bits=raw_bits,
-                        valid_codes=valid, notes=tuple(notes))
+                        valid_codes=valid, notes=tuple(notes), scheme=scheme,
+                        v_frac_bits=None if variable is None else variable[1],
+                        v_bits=0 if variable is None else variable[2],
+                        v_round_shift=v_info[1], v_error=v_info[3])
+
+
+def _integer_parity(integers) -> int | None:
+    """1 (0) when every nonzero integer is of an odd (even) power and the
+    degree is at least 2; else None (as the C and shader evaluators decide)."""
+    powers = {k for k, q in enumerate(integers) if q}
+    if len(integers) < 3 or not powers:
+        return None
+    for parity in (1, 0):
+        if all(k % 2 == parity for k in powers):
+            return parity
+    return None
+
+
+def _square(xs_all, fx: int, fa: int, rounding: str, valid):
+    """The Horner variable ``v = R(xs * xs)`` of a one-parity design:
+    ``((v, fv, v_bits), round_shift, None, v_error)``. The square has
+    ``2 Fx`` fractional bits; it keeps at most ``Fa + 2`` of them (two more
+    than the accumulators), and ``v_error`` is the exact largest
+    ``|v - x*x|`` over the valid codes."""
+    sq = xs_all * xs_all
+    fv = min(2 * fx, fa + 2)
+    rs = 2 * fx - fv
+    v = shift_round(sq, rs, rounding) if rs else sq
+    lo, hi = valid
+    err = np.abs((v[lo:hi + 1] << rs) - sq[lo:hi + 1]) if rs else np.zeros(1, dtype=np.int64)
+    return ((v, fv, signed_bits(int(v.min()), int(v.max()))), rs, None,
+            Fraction(int(err.max()), 2 ** (2 * fx)))

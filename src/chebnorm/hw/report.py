@@ -123,6 +123,7 @@ class HardwareReport:
                          "offset_code": d.y_format.offset_code, "q": d.y_format.q_name()},
             "coef_frac_bits": d.coef_frac_bits, "coefficients_q": list(d.integers),
             "acc_frac_bits": d.acc_frac_bits, "valid_codes": list(d.valid_codes),
+            "scheme": d.scheme, "multipliers": d.multipliers,
             "total_error_bound": b.total, "budget": b.as_dict(),
             "measured": self.measurement.as_dict(), "checks": self.checks,
             "cost": self.block.as_dict(),
@@ -146,6 +147,10 @@ class HardwareReport:
         for st, (bound, meas) in zip(d.stages[:-1], zip(b.rounding_steps, m.step_rounding)):
             out.append(f"  rounding a{st.power}     {bound:.6e} (local {_local(st, d):.6e}) "
                        f"| local {meas:.6e}")
+        if d.scheme != "monomial":
+            out.append(f"  square rounding {b.variable_rounding:.6e} (v = x*x with "
+                       f"{d.variable_frac_bits} fractional bits; {d.scheme} powers, "
+                       f"{d.multipliers} multipliers)")
         out += [f"  output rounding {b.output_rounding:.6e}",
                 f"  rounding total  {b.rounding:.6e} | {m.rounding:.6e}"
                 + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
