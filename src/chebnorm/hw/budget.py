@@ -14,7 +14,12 @@ Budget (all in the units of ``y``, i.e. absolute errors of the value)::
 * ``rounding_steps[j]``: the rounding of ``a_j`` (``rho_j`` = one ulp of the
   accumulator for truncation, half of one for ``rne``) carried to the output
   through ``j`` multiplications by ``x``;
-* ``output_rounding``: rounding to the output's ``Fy`` fractional bits.
+* ``output_rounding``: rounding to the output's ``Fy`` fractional bits;
+* ``variable_rounding``: for a design whose Horner variable ``v`` is not
+  ``x`` (``x*x`` rounded, or ``(x - c')/s`` with ``c`` rounded to ``c'``),
+  ``max |v - v_exact| * max |q'|`` (mean value theorem), times ``max |x|``
+  for an odd design; each ``rho_j`` then reaches the output times
+  ``max|v|^j`` (``max|v|^(j-1) max|x|`` when odd).
 
 Every bound is a float rounded upward.
 """
@@ -203,8 +208,12 @@ class Measurement:
 
 
 def _poly_function(table):
-    """``p`` itself as an exact sympy function (its floats as rationals)."""
+    """``p`` itself as an exact sympy function of ``x`` (its floats as
+    rationals; of ``(x - c)/s`` for a shifted table)."""
     v = sp.Symbol(table.variable)
+    if table.shift is not None:
+        c, s = (sp.Rational(*float(w).as_integer_ratio()) for w in table.shift)
+        v = (v - c) / s
     expr = sum(sp.Rational(c) * v ** k for k, c in enumerate(table.coefficients))
     return parse_function(expr, table.variable)
 
@@ -214,7 +223,7 @@ def quantization_bound(design: HornerDesign) -> float:
     t = design.table
     coeffs = [math.ldexp(q, -design.coef_frac_bits) for q in design.integers]
     lo, hi = (parse_number(v) for v in t.interval)
-    return certify(_poly_function(t), coeffs, lo, hi, "abs").bound
+    return certify(_poly_function(t), coeffs, lo, hi, "abs", shift=t.shift).bound
 
 
 def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
@@ -407,7 +416,7 @@ def measure(design: HornerDesign) -> Measurement:
     yv = design.y_format.values(y)
     fn = parse_function(design.table.expression, design.table.variable)
     f = np.asarray(fn.numpy(xf), dtype=np.float64) * np.ones_like(xf)
-    p = np.polynomial.polynomial.polyval(xf, design.table.coefficients)
+    p = design.table(xf)   # in t = (x - c) * (1/s) for a shifted table
     num, den = design.exact_numerators(k)
     pq = _to_float(num, den)
     # exact rounding error: y - p_q, both over the common denominator 2**D
@@ -452,6 +461,11 @@ def _dyadic(q: int, frac: int) -> str:
     return f"{q}b{-frac}" if q else "0"
 
 
+def _fraction_literal(v: Fraction) -> str:
+    """A dyadic rational (a float's value) as a gappa literal ``Nb-E``."""
+    return _dyadic(v.numerator, v.denominator.bit_length() - 1)
+
+
 def gappa_script(design: HornerDesign) -> str:
     """A gappa script bounding ``|y - p_q(x)|`` of the datapath (rounding only).
 
@@ -484,7 +498,14 @@ def gappa_script(design: HornerDesign) -> str:
     if len(design.horner_integers) >= 3:
         lines.append(f"@ra = fixed<{-design.acc_frac_bits},{mode}>;")
     var, exact_var = "x", "x"
-    if design.scheme != "monomial":   # the Horner variable v = R(x*x), exact Mv = x*x
+    if design.scheme == "shifted":   # v = (x - c') * 2^-e exactly, Mv = (x - c) * 2^-e
+        c, s = (Fraction(w) for w in design.table.shift)
+        e = s.numerator.bit_length() - s.denominator.bit_length()
+        g = design.v_shift + xf.frac_bits
+        lines.append(f"Mv = (x - {_fraction_literal(c)}) * 1b{-e};")
+        lines.append(f"v = (x - {_dyadic(design.v_offset, g)}) * 1b{-e};")
+        var, exact_var = "v", "Mv"
+    elif design.scheme != "monomial":   # the Horner variable v = R(x*x), exact Mv = x*x
         q, n = design.horner_integers, len(design.horner_integers) - 1
         lines.append("Mv = x * x;")
         if design.v_round_shift:

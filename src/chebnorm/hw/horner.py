@@ -7,6 +7,14 @@ The datapath (``n`` = degree, ``q_j`` the table's fixed-point integers with
     a_j     = R_Fa(a_{j+1} * x + q_j / 2**Fc),   j = n-1 .. 1
     y_raw   = R_Fy(a_1 * x + q_0 / 2**Fc) - Oy,  y = saturate(y_raw)
 
+Two variants keep that datapath with another Horner variable ``v`` (the
+design's ``scheme``): when every nonzero coefficient is of one parity,
+``v = R(x*x)`` (squared once, exact or rounded two bits past the
+accumulators) and Horner's rule runs over the nonzero coefficients only,
+times ``x`` once at the end when odd; for a table in the shifted basis
+``t = (x - c)/s`` (``s`` a power of two), ``v = (x - c')/s`` (one
+subtraction; ``c' = c`` when ``c`` has few enough fractional bits).
+
 Each step is a multiply-add done exactly, then one rounding (``R_F``: to
 ``F`` fractional bits, ``"trunc"`` or ``"rne"``); the output offset ``Oy``
 is subtracted after rounding (exactly, it is a multiple of ``2**-Fy``).
@@ -113,8 +121,9 @@ class Stage:
 
 
 #: the evaluation schemes of a Horner design: Horner's rule in ``x``; in ``v = R(x*x)`` over
-#: the even powers; ``x`` times Horner's rule in ``v = R(x*x)`` over the odd powers
-SCHEMES = ("monomial", "even", "odd")
+#: the even powers; ``x`` times Horner's rule in ``v = R(x*x)`` over the odd powers; in
+#: ``v = (x - c')/s`` for a table in the shifted basis (``c'``: ``c`` to the datapath's bits)
+SCHEMES = ("monomial", "even", "odd", "shifted")
 
 
 @dataclass(frozen=True)
@@ -155,11 +164,13 @@ class HornerDesign:
         First and last input code whose value lies in the table's interval.
     notes : tuple of str, default ()
         Remarks on the sizing, for the report.
-    scheme : {"monomial", "even", "odd"}, default "monomial"
+    scheme : {"monomial", "even", "odd", "shifted"}, default "monomial"
         :data:`SCHEMES`: Horner's rule in ``x``, or, when every nonzero
         coefficient is of one parity (degree >= 2), Horner's rule over those
         coefficients in the variable ``v = R(x*x)`` (times ``x`` once at
-        the end when odd).
+        the end when odd), or, for a table in the shifted basis
+        ``t = (x - c)/s``, Horner's rule in ``v = (x - c')/s`` (``c'``:
+        ``c`` to the datapath's fractional bits, ``c`` itself when short).
     v_frac_bits : int or None, default None
         Fractional bits of the Horner variable ``v`` (``x_format.frac_bits``
         for ``"monomial"``).
@@ -169,7 +180,12 @@ class HornerDesign:
         Bits dropped from the exact square ``xs * xs`` (``2 Fx`` fractional
         bits) to make ``v``; 0 when the square is kept exact.
     v_error : Fraction, default 0
-        The exact ``max |v - x*x|`` over the valid codes (0 for ``"monomial"``).
+        The exact ``max |v - x*x|`` (``|c - c'|/s`` when shifted) over the valid
+        codes (0 for ``"monomial"``).
+    v_shift : int, default 0
+        Shifted scheme: ``v``'s integer is ``(xs << v_shift) - v_offset``.
+    v_offset : int, default 0
+        Shifted scheme: ``c' * 2**(Fx + v_shift)``.
 
     Examples
     --------
@@ -203,6 +219,8 @@ class HornerDesign:
     v_bits: int = 0
     v_round_shift: int = 0
     v_error: Fraction = Fraction(0)
+    v_shift: int = 0
+    v_offset: int = 0
 
     def _summary(self) -> list[tuple[str, object]]:
         return [("name", self.name), ("degree", self.degree), ("in_bits", self.in_bits),
@@ -248,7 +266,7 @@ class HornerDesign:
     def multipliers(self) -> int:
         """Number of multipliers of the datapath: one per step, plus the
         squarer ``x*x`` of a one-parity design."""
-        return len(self.stages) + (self.scheme != "monomial")
+        return len(self.stages) + (self.scheme in ("even", "odd"))
 
     @property
     def variable_frac_bits(self) -> int:
@@ -274,10 +292,13 @@ class HornerDesign:
         return wires if intermediates else wires["y"]
 
     def exact_numerators(self, codes) -> tuple[np.ndarray, int]:
-        """``p_q(x_k)`` exactly as ``(N_k, D)``: value ``N_k / 2**D`` (object ints)."""
+        """``p_q(x_k)`` exactly as ``(N_k, D)``: value ``N_k / 2**D`` (object ints);
+        for a shifted table ``p_q`` at the exact ``t = (x_k - c)/s``."""
         n = self.degree
         fx, fc = self.x_format.frac_bits, self.coef_frac_bits
         xs = np.asarray(codes, dtype=np.int64).astype(object) + self.x_format.offset_code
+        if self.table.shift is not None:
+            xs, fx = _exact_shifted(xs, fx, self.table.shift)
         acc = np.full(xs.shape, self.integers[n], dtype=object)
         for j in range(n - 1, -1, -1):
             acc = acc * xs + self.integers[j] * 2 ** ((n - j) * fx)
@@ -288,17 +309,33 @@ class HornerDesign:
         return max(abs(self.x_format.value(lo)), abs(self.x_format.value(hi)))
 
 
-def _variable(scheme: str, xs, round_shift: int, rounding: str):
-    """The Horner variable's integers: ``xs`` itself, or ``R(xs * xs)``."""
+def _exact_shifted(xs, fx: int, shift):
+    """``(T, F)``: the exact ``t = (x - c)/s`` as ``T / 2**F`` for ``x = xs / 2**fx``."""
+    c, s = Fraction(shift[0]), Fraction(shift[1])
+    e = s.numerator.bit_length() - s.denominator.bit_length()   # s = 2**e
+    fc0 = c.denominator.bit_length() - 1
+    g = max(fx, fc0)
+    t = xs * 2 ** (g - fx) - int(c * 2 ** g)
+    f = g + e
+    if f < 0:
+        return t * 2 ** -f, 0
+    return t, f
+
+
+def _variable(scheme: str, xs, round_shift: int, rounding: str, shift: int = 0, offset: int = 0):
+    """The Horner variable's integers: ``xs`` itself, ``R(xs * xs)``, or
+    ``(xs << shift) - offset``."""
     if scheme == "monomial":
         return xs
+    if scheme == "shifted":
+        return (xs << shift) - offset
     sq = xs * xs
     return shift_round(sq, round_shift, rounding) if round_shift else sq
 
 
 def _run(d: HornerDesign, k: np.ndarray) -> dict:
     xs = k + d.x_format.offset_code
-    v = _variable(d.scheme, xs, d.v_round_shift, d.rounding)
+    v = _variable(d.scheme, xs, d.v_round_shift, d.rounding, d.v_shift, d.v_offset)
     wires = {"xs": xs, "v": v}
     ints = d.horner_integers
     n = len(ints) - 1
@@ -332,11 +369,19 @@ COEF_WORD_BITS = 32
 
 
 def _check_table(table) -> None:
-    """Refuse anything but a monomial :class:`CoefficientTable` (ValueError)."""
+    """Refuse anything but a :class:`CoefficientTable` in powers of ``x`` or of
+    ``t = (x - c)/s`` with ``s`` a power of two (ValueError)."""
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
                          f"CoefficientTable (chebnorm.fit, or CoefficientTable.load)")
-    table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
+    if table.shift is not None:
+        s = Fraction(table.shift[1])
+        if s.numerator & (s.numerator - 1) or s.denominator & (s.denominator - 1):
+            raise ValueError(f"table {table.name!r} is stored in t = ({table.variable} - "
+                             f"{table.shift[0]!r})/{table.shift[1]!r}; the hardware Horner "
+                             f"evaluator divides by a power of two only; accepted: a table "
+                             f"fitted with basis='shifted' (s a power of two) or "
+                             f"basis='monomial'")
 
 
 def max_coef_bits(table: CoefficientTable) -> int:
@@ -415,12 +460,41 @@ def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
     return int(coef_bits)
 
 
+def _quantize_shifted(table: CoefficientTable, coef_bits: int) -> CoefficientTable:
+    """A shifted table with a fixed-point part: each coefficient (of ``t``)
+    rounded to nearest at ``coef_bits``, ``sup |p_q - f|`` certified
+    (:func:`chebnorm.approx.quantize` takes plain powers of ``x`` only)."""
+    import dataclasses
+
+    from chebnorm.approx import FixedPoint, parse_function
+    from chebnorm.approx.certify import certify
+
+    ints = tuple(round(Fraction(c) * 2 ** coef_bits) for c in table.coefficients)
+    fn = parse_function(table.expression, table.variable)
+    lo, hi = (parse_number(v) for v in table.interval)
+    cert = certify(fn, [math.ldexp(q, -coef_bits) for q in ints], lo, hi, "abs",
+                   shift=table.shift)
+    fp = FixedPoint(frac_bits=coef_bits, integers=ints, word_bits=COEF_WORD_BITS,
+                    method="rounded", abs_error_bound=cert.bound, rel_error_bound=None,
+                    max_abs_error=cert.maximum, max_rel_error=None)
+    return dataclasses.replace(table, fixed_point=fp)
+
+
 def _require_fixed_point(table: CoefficientTable, coef_bits):
+    if coef_bits is not None and table.shift is not None:
+        coef_bits = check_coef_bits(table, coef_bits)
+        if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
+            table = _quantize_shifted(table, coef_bits)
+        return table
     if coef_bits is not None:
         coef_bits = check_coef_bits(table, coef_bits)
         if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
             table = quantize(table, coef_bits)
         return table
+    if table.fixed_point is None and table.shift is not None:
+        raise ValueError(f"table {table.name!r} (shifted basis) has no fixed-point part; "
+                         f"accepted: coef_bits (1 <= coef_bits <= {max_coef_bits(table)}) to "
+                         f"round its coefficients of t = (x - c)/s here")
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
                          f"quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or "
@@ -657,16 +731,21 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     scheme = "monomial"
     if parity is not True and parity is not False:
         raise ValueError(f"parity = {parity!r} is not accepted; accepted: True or False")
-    if parity and _integer_parity(integers) is not None:
+    if table.shift is not None:
+        scheme = "shifted"
+    elif parity and _integer_parity(integers) is not None:
         scheme = ("even", "odd")[_integer_parity(integers)]
         check_int64(2 * signed_bits(xs_lo, xs_hi), "the square x * x")
-    horner = (integers if scheme == "monomial" else
-              integers[0::2] if scheme == "even" else (0,) + integers[1::2])
+    horner = (integers[0::2] if scheme == "even" else (0,) + integers[1::2]
+              if scheme == "odd" else integers)
     v_info = (None, 0, 0, Fraction(0))
     for fy in candidates:
         fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
         variable = None
-        if scheme != "monomial":
+        if scheme == "shifted":
+            v_info = _shifted(xs_all, fx, fa, table.shift, xs_lo, xs_hi)
+            variable = v_info[0]
+        elif scheme != "monomial":
             v_info = _square(xs_all, fx, fa, rounding, valid)
             variable = v_info[0]
         if len(horner) > 1:
@@ -707,7 +786,10 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                         valid_codes=valid, notes=tuple(notes), scheme=scheme,
                         v_frac_bits=None if variable is None else variable[1],
                         v_bits=0 if variable is None else variable[2],
-                        v_round_shift=v_info[1], v_error=v_info[3])
+                        v_round_shift=v_info[1] if scheme != "shifted" else 0,
+                        v_error=v_info[3],
+                        v_shift=v_info[1] if scheme == "shifted" else 0,
+                        v_offset=v_info[2] if scheme == "shifted" else 0)
 
 
 def _integer_parity(integers) -> int | None:
@@ -720,6 +802,27 @@ def _integer_parity(integers) -> int | None:
         if all(k % 2 == parity for k in powers):
             return parity
     return None
+
+
+def _shifted(xs_all, fx: int, fa: int, shift, xs_lo: int, xs_hi: int):
+    """The Horner variable ``v = (x - c')/s`` of a shifted table:
+    ``((v, fv, v_bits), m, C, v_error)`` with ``v``'s integers
+    ``(xs << m) - C``. ``c' = C / 2**G`` is ``c`` itself when it has at
+    most ``max(Fx, Fa + 2 - e)`` fractional bits (``s = 2**e``), else ``c``
+    rounded to them (``v`` then two bits finer than the accumulators), and
+    ``v_error = |c - c'| / s`` exactly."""
+    c, s = Fraction(shift[0]), Fraction(shift[1])
+    e = s.numerator.bit_length() - s.denominator.bit_length()
+    fc0 = c.denominator.bit_length() - 1
+    g = max(fx, min(fc0, fa + 2 - e))
+    m = g - fx
+    offset = round(c * 2 ** g)
+    check_int64(signed_bits(xs_lo, xs_hi) + m + 1, "the shifted input x - c")
+    check_int64(signed_bits(min(xs_lo << m, offset), max(xs_hi << m, offset)) + 1,
+                "the shifted input x - c")
+    v = (xs_all << m) - offset
+    return ((v, g + e, signed_bits(int(v.min()), int(v.max()))), m, offset,
+            abs(c - Fraction(offset, 2 ** g)) / s)
 
 
 def _square(xs_all, fx: int, fa: int, rounding: str, valid):

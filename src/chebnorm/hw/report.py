@@ -147,7 +147,10 @@ class HardwareReport:
         for st, (bound, meas) in zip(d.stages[:-1], zip(b.rounding_steps, m.step_rounding)):
             out.append(f"  rounding a{st.power}     {bound:.6e} (local {_local(st, d):.6e}) "
                        f"| local {meas:.6e}")
-        if d.scheme != "monomial":
+        if d.scheme == "shifted":
+            out.append(f"  shift rounding  {b.variable_rounding:.6e} (v = (x - c')/s with "
+                       f"{d.variable_frac_bits} fractional bits)")
+        elif d.scheme != "monomial":
             out.append(f"  square rounding {b.variable_rounding:.6e} (v = x*x with "
                        f"{d.variable_frac_bits} fractional bits; {d.scheme} powers, "
                        f"{d.multipliers} multipliers)")

@@ -22,7 +22,7 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 __all__ = ["LANGUAGES", "COMMENT", "SUFFIX", "check_language", "module_name", "pipelined_name",
            "horner_facts", "piecewise_facts", "comment_lines", "vectors_name", "vector_file",
-           "variable_name", "step_comment"]
+           "variable_name", "step_comment", "shifted_width"]
 
 #: the hardware description languages the printers write
 LANGUAGES = ("verilog", "vhdl")
@@ -194,7 +194,12 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
         f"Rounding: {comment_text(design.rounding)} after each multiply-add; accumulators with "
         f"{design.acc_frac_bits} fractional bits.",
     ]
-    if design.scheme != "monomial":
+    if design.scheme == "shifted":
+        c, s = design.table.shift
+        exact = "c' = c" if design.v_error == 0 else f"c' = c to {design.x_format.frac_bits + design.v_shift} fractional bits"
+        lines.append(f"Shifted basis: y = q(v) with v = (x - c')/s, c = {c!r}, s = {s!r} "
+                     f"({exact}); coefficients q_j of powers of v.")
+    elif design.scheme != "monomial":
         v_how = (f"rounded to {design.variable_frac_bits} fractional bits"
                  if design.v_round_shift else "exact")
         lines.append(f"Only {design.scheme} powers: y = {'x * ' if design.scheme == 'odd' else ''}"
@@ -440,7 +445,39 @@ def step_comment(design, st) -> str:
     fc = design.coef_frac_bits
     if design.scheme == "monomial":
         return f"a{j} = R(a{j + 1} * x + q{j} / 2^{fc})"
+    if design.scheme == "shifted":
+        return f"a{j} = R(a{j + 1} * v + q{j} / 2^{fc})"
     if st.operand == "x":
         return f"a{j} = a{j + 1} * x"
     k = 2 * j if design.scheme == "even" else 2 * j - 1
     return f"a{j} = R(a{j + 1} * v + q{k} / 2^{fc})"
+
+
+def shifted_width(design) -> int:
+    """Signed width of ``(xs << m) - C`` in a shifted design, with its
+    operands (wide enough that the subtraction wraps nowhere).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        A design of scheme ``"shifted"``.
+
+    Returns
+    -------
+    int
+        The width in bits.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit("exp(x)", ("1", "2"), 3, basis="shifted"), 8, 8, coef_bits=16)
+    >>> d.scheme, d.v_offset, shifted_width(d) >= d.variable_bits
+    ('shifted', 192, True)
+    """
+    from chebnorm.core.numeric import signed_bits
+
+    xf, m = design.x_format, design.v_shift
+    lo, hi = xf.offset_code << m, (xf.offset_code + 2 ** design.in_bits - 1) << m
+    c = design.v_offset
+    return signed_bits(min(lo, hi, c, lo - c, hi - c), max(lo, hi, c, lo - c, hi - c)) + 1

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
-from .common import (step_comment, variable_name)
+from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -285,6 +285,8 @@ def _variable_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
     lines for plain Horner in ``x``)."""
     if design.scheme == "monomial":
         return []
+    if design.scheme == "shifted":
+        return _shifted_lines(design, xs, v)
     sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
     out = [f"    // {v}: x*x with {design.variable_frac_bits} fractional bits "
            f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} powers in it",
@@ -292,6 +294,17 @@ def _variable_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
     if rs:
         return out + round_lines(f"{v}_sq", v, sw, rs, vw, design.rounding)
     return out + [f"    wire signed [{vw - 1}:0] {v} = {v}_sq;"]
+
+
+def _shifted_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
+    """``v = (xs << m) - C``: the shifted table's variable ``(x - c')/s``."""
+    sw, m = shifted_width(design), design.v_shift
+    shifted = f"({xs} <<< {m})" if m else xs
+    return [f"    // {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
+            f"{design.v_offset} / 2^{design.x_format.frac_bits + m}",
+            f"    localparam signed [{sw - 1}:0] {v}_C = {signed_literal(design.v_offset, sw)};",
+            f"    wire signed [{sw - 1}:0] {v}_d = {shifted} - {v}_C;",
+            f"    wire signed [{design.variable_bits - 1}:0] {v} = {v}_d;"]
 
 
 def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
@@ -377,7 +390,7 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
             f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
     out += _variable_lines(design, "xs0", "v0")
-    vw, square = design.variable_bits, design.scheme != "monomial"
+    vw, square = design.variable_bits, design.scheme != "monomial"   # v travels beside x
     n = len(design.horner_integers) - 1
     aw = max(design.stages[0].acc_bits, 2)
     out.append(f"    localparam signed [{aw - 1}:0] A{n} = "

@@ -34,7 +34,7 @@ from __future__ import annotations
 from chebnorm.core.textsafe import identifier
 
 from ..horner import HornerDesign
-from .common import (step_comment, variable_name)
+from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -107,6 +107,15 @@ def _variable(b: _Body, design: HornerDesign, xs: str, v: str) -> None:
     """The Horner variable ``v = R(xs * xs)`` of a one-parity design
     (nothing for plain Horner in ``x``), as the Verilog printer's."""
     if design.scheme == "monomial":
+        return
+    if design.scheme == "shifted":   # v = (xs << m) - C: (x - c')/s
+        sw, m = shifted_width(design), design.v_shift
+        b.stmt.append(f"    -- {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
+                      f"{design.v_offset} / 2^{design.x_format.frac_bits + m}")
+        b.decl.append(_const(f"{v}_C", design.v_offset, sw))
+        wide = f"wrap({xs}, {sw})"
+        b.wire(f"{v}_d", sw, (f"shift_left({wide}, {m})" if m else wide) + f" - {v}_C")
+        b.wire(v, design.variable_bits, f"wrap({v}_d, {design.variable_bits})")
         return
     sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
     b.stmt.append(f"    -- {v}: x*x with {design.variable_frac_bits} fractional bits "

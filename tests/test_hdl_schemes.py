@@ -1,8 +1,10 @@
 """Issue 41, hardware: a one-parity table becomes a Verilog/VHDL evaluator of
 ``x*q(x*x)`` or ``q(x*x)`` (the square once, Horner's rule over the nonzero
-coefficients, one final multiply by ``x`` when odd), and the error budget
-stated for that datapath holds on every input code of the simulated HDL
-against ``f`` in 50-digit mpmath and against the exact quantized polynomial.
+coefficients, one final multiply by ``x`` when odd), a table in the shifted
+basis one of ``q((x - c)/s)`` (the subtraction in the datapath, exact when
+``c`` is short), and the error budget stated for each datapath holds on every
+input code of the simulated HDL against ``f`` in 50-digit mpmath and against
+the exact quantized polynomial.
 """
 
 from __future__ import annotations
@@ -32,25 +34,38 @@ CASES = {
     "atan9": ("atan(x)", ("-1/2", "1/2"), 9, 9, 12, 24, "rne"),
     "cosh6": ("cosh(x)", ("-1/2", "1/2"), 6, 11, 14, 24, "rne"),
 }
+#: shifted tables: c = 2.5 and 1.5 (exact in the datapath), c = 0.4 (rounded to it)
+SHIFTED = {
+    "rsqrt11": ("1/sqrt(x)", (1, 4), 11, 12, 16, 28, "rne"),
+    "exp5": ("exp(x)", ("1/10", "7/10"), 5, 10, 12, 20, "trunc"),
+    "log6": ("log(x)", ("1", "2"), 6, 11, 14, 24, "rne"),
+}
+MP = {"sin(x)": mpmath.sin, "cos(x)": mpmath.cos, "atan(x)": mpmath.atan,
+      "cosh(x)": mpmath.cosh, "1/sqrt(x)": lambda x: 1 / mpmath.sqrt(x), "exp(x)": mpmath.exp,
+      "log(x)": mpmath.log}
 
 
 @pytest.fixture(scope="module")
 def reports():
     out = {}
-    for key, (expr, iv, deg, ib, ob, cb, rnd) in CASES.items():
-        t = cn.fit(expr, iv, deg, name=key)
+    for key, (expr, iv, deg, ib, ob, cb, rnd) in {**CASES, **SHIFTED}.items():
+        t = cn.fit(expr, iv, deg, name=key, kind="minimax",
+                   **({"basis": "shifted"} if key in SHIFTED else {}))
         out[key] = analyze(t, ib, ob, coef_bits=cb, rounding=rnd, gappa=False, synth=False)
     return out
 
 
 def _mp(expr: str):
-    return {"sin(x)": mpmath.sin, "cos(x)": mpmath.cos, "atan(x)": mpmath.atan,
-            "cosh(x)": mpmath.cosh}[expr]
+    return MP[expr]
 
 
 def _exact_pq(design, k: int) -> Fraction:
-    """The quantized polynomial at code ``k`` from the table's integers alone."""
+    """The quantized polynomial at code ``k`` from the table's integers alone
+    (in ``(x - c)/s`` for a shifted table)."""
     x = design.x_format.value(k)
+    if design.table.shift is not None:
+        c, s = (Fraction(v) for v in design.table.shift)
+        x = (x - c) / s
     return sum(Fraction(q, 2 ** design.coef_frac_bits) * x ** j
                for j, q in enumerate(design.integers))
 
@@ -70,7 +85,7 @@ def test_scheme_and_multipliers(reports, key):
     assert reports[key].checks == dict.fromkeys(reports[key].checks, True)
 
 
-@pytest.mark.parametrize("key", list(CASES))
+@pytest.mark.parametrize("key", [*CASES, *SHIFTED])
 def test_budget_holds_on_every_code_against_mpmath(reports, key):
     """``|y - f(x)|`` with ``f`` in 50 digits, and ``|y - p_q(x)|`` exact, on
     every valid code, below the stated total and rounding bounds."""
@@ -78,7 +93,7 @@ def test_budget_holds_on_every_code_against_mpmath(reports, key):
     d, b = r.design, r.budget
     lo, hi = d.valid_codes
     y = d.evaluate()
-    f = _mp(CASES[key][0])
+    f = _mp({**CASES, **SHIFTED}[key][0])
     worst_total, worst_rounding = mpmath.mpf(0), Fraction(0)
     with mpmath.workdps(50):
         for k in range(lo, hi + 1):
@@ -103,7 +118,7 @@ def test_rounded_square_is_in_the_budget(reports):
 
 
 @needs_gappa
-@pytest.mark.parametrize("key", ["sin7", "cos8"])
+@pytest.mark.parametrize("key", ["sin7", "cos8", "exp5", "log6"])
 def test_gappa_bounds_the_parity_datapath(reports, key):
     d = reports[key].design
     g = gappa_bound(d)
@@ -123,19 +138,22 @@ def _simulate(tmp_path, report, language: str):
 
 
 @needs_iverilog
-@pytest.mark.parametrize("key", ["sin7", "cos8", "atan9"])
+@pytest.mark.parametrize("key", ["sin7", "cos8", "atan9", "rsqrt11", "exp5"])
 def test_verilog_is_the_model_on_every_code(reports, tmp_path, key):
     r = reports[key]
     for res in _simulate(tmp_path, r, "verilog"):
         assert res.passed and res.vectors == 2 ** r.design.in_bits and res.mismatches == 0, \
             res.line
     text = (tmp_path / f"{r.design.module_name}.v").read_text()
-    assert f"wire signed [{2 * r.design.xs_bits - 1}:0] v_sq = xs * xs;" in text
+    if key in SHIFTED:
+        assert "v_d = " in text and "v_sq" not in text
+    else:
+        assert f"wire signed [{2 * r.design.xs_bits - 1}:0] v_sq = xs * xs;" in text
     assert text.count(" * v;") == len(r.design.stages) - (r.design.scheme == "odd")
 
 
 @needs_ghdl
-@pytest.mark.parametrize("key", ["sin7", "cos8", "cosh6"])
+@pytest.mark.parametrize("key", ["sin7", "cos8", "cosh6", "exp5", "log6"])
 def test_vhdl_outputs_meet_the_budget_on_every_code(reports, tmp_path, key):
     """GHDL's outputs (read back code by code) are the model's, so the budget
     checked above against mpmath holds for the simulated circuit."""
@@ -146,7 +164,7 @@ def test_vhdl_outputs_meet_the_budget_on_every_code(reports, tmp_path, key):
     seen = [int(w, 16) for w in (tmp_path / f"{d.module_name}_vhdl_y.hex").read_text().split()]
     assert seen == d.evaluate().tolist()
     lo, hi = d.valid_codes
-    f = _mp(CASES[key][0])
+    f = _mp({**CASES, **SHIFTED}[key][0])
     with mpmath.workdps(40):
         worst = max(abs(mpmath.mpf(d.y_format.value(seen[k]).numerator)
                         / d.y_format.value(seen[k]).denominator
@@ -176,3 +194,40 @@ def test_parity_off_is_plain_horner(reports):
     assert "v_sq" not in text and "Only odd powers" not in text
     with pytest.raises(ValueError, match=r"parity = 'yes' is not accepted; accepted: True or False"):
         design_horner(d.table, 8, 8, parity="yes")
+
+
+def test_shifted_scheme(reports):
+    for key in SHIFTED:
+        d = reports[key].design
+        assert d.scheme == "shifted" and d.multipliers == SHIFTED[key][2]
+        assert reports[key].checks == dict.fromkeys(reports[key].checks, True)
+    # c = 2.5 and 1.5 are exact in the datapath; c = 0.4 (a float of 54 bits) is rounded
+    assert reports["rsqrt11"].design.v_error == 0 and reports["log6"].design.v_error == 0
+    d, b = reports["exp5"].design, reports["exp5"].budget
+    assert d.v_error > 0 and b.variable_rounding == pytest.approx(
+        float(variable_error_bound(d)), rel=1e-12)
+
+
+def test_shifted_basis_keeps_the_datapath_accurate(reports):
+    """The issue's 1/sqrt(x) on [1, 4] at degree 11: in powers of x its
+    coefficients cancel and the same datapath is off by units; in the shifted
+    basis the budget is a few LSB of y."""
+    r = reports["rsqrt11"]
+    assert r.budget.total < 3 * r.budget.y_lsb
+    mono = cn.fit("1/sqrt(x)", (1, 4), 11, kind="minimax", basis="monomial")
+    m = analyze(mono, 12, 16, coef_bits=28, gappa=False, synth=False)
+    assert m.measurement.total > 1e4 * r.measurement.total
+
+
+def test_cli_exports_a_default_fit_to_vhdl(tmp_path):
+    t = cn.fit("1/sqrt(x)", (1, 4), 11, kind="minimax", name="rs")
+    assert t.basis == "shifted"
+    t.save(tmp_path / "rs.json")
+    res = run_cli("export", str(tmp_path / "rs.json"), "--format", "vhdl", "--in-bits", "10",
+                  "--out-bits", "12", "--coef-frac-bits", "24", "-o", str(tmp_path / "rs.vhd"))
+    assert res.code == 0, res.err
+    text = (tmp_path / "rs.vhd").read_text()
+    assert "Shifted basis: y = q(v) with v = (x - c')/s, c = 2.5, s = 2.0 (c' = c)" in text
+    res = run_cli("export", str(tmp_path / "rs.json"), "--format", "verilog", "--in-bits", "10",
+                  "--out-bits", "12", "-o", str(tmp_path / "rs.v"))
+    assert res.code == 2 and res.err.count("\n") == 1 and "coef" in res.err
