@@ -231,3 +231,39 @@ def test_cli_exports_a_default_fit_to_vhdl(tmp_path):
     res = run_cli("export", str(tmp_path / "rs.json"), "--format", "verilog", "--in-bits", "10",
                   "--out-bits", "12", "-o", str(tmp_path / "rs.v"))
     assert res.code == 2 and res.err.count("\n") == 1 and "coef" in res.err
+
+
+@pytest.mark.parametrize("key", ["cos8", "sin7", "exp5"])
+def test_variable_rounding_bound_against_exact_enumeration(reports, key):
+    """What rounding the Horner variable costs, computed exactly on every valid
+    code (``q_q`` at the datapath's ``v`` and at the exact ``x*x`` or
+    ``(x - c)/s``, times ``x`` when odd), is within the stated term, and the
+    term is not vacuous (within 64x of what is reached)."""
+    d, b = reports[key].design, reports[key].budget
+    fc, fv = d.coef_frac_bits, d.variable_frac_bits
+    ints = d.horner_integers[1:] if d.scheme == "odd" else d.horner_integers
+    q = lambda v: sum(Fraction(c, 2 ** fc) * v ** i for i, c in enumerate(ints))  # noqa: E731
+    lo, hi = d.valid_codes
+    v_int = d.evaluate(intermediates=True)["v"]
+    worst = Fraction(0)
+    for k in range(lo, hi + 1):
+        x = d.x_format.value(k)
+        if d.scheme == "shifted":
+            c, s = (Fraction(w) for w in d.table.shift)
+            exact = (x - c) / s
+        else:
+            exact = x * x
+        diff = abs(q(Fraction(int(v_int[k]), 2 ** fv)) - q(exact))
+        worst = max(worst, diff * abs(x) if d.scheme == "odd" else diff)
+    assert worst <= Fraction(b.variable_rounding)
+    assert Fraction(b.variable_rounding) <= 64 * worst
+
+
+def test_fpga_features_count_the_squarer(reports):
+    from chebnorm.hw.target_model import horner_features
+
+    d = reports["sin7"].design
+    f = horner_features(d)
+    # the squarer and the steps after the first are variable multipliers; the first is by a constant
+    assert len(f.multipliers) + len(f.const_multipliers) == d.multipliers == 5
+    assert f.multipliers[0] == (d.xs_bits, d.xs_bits)
