@@ -130,3 +130,14 @@ def test_cli_exports_a_default_fit_to_glsl(rsqrt, tmp_path):
     res = run_cli("export", str(path), "--format", "glsl", "-o", str(tmp_path / "rs.glsl"))
     assert res.code == 0, res.err
     assert "(x - 2.5e+00) * 5.0e-01" in (tmp_path / "rs.glsl").read_text()
+
+
+@pytest.mark.requires_tool("gappa")
+def test_gappa_proves_the_shifted_shader_bound(rsqrt):
+    from chebnorm.export.gappa import gappa_script
+
+    ev = shader_evaluator(rsqrt)
+    script = gappa_script(ev, float32_eval_bound(rsqrt).total)
+    assert "t = rnd(rnd(x - 0x1.4000000000000p+1) * 0x1.0000000000000p-1);" in script
+    r = subprocess.run(["gappa"], input=script, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0 and "not satisfied" not in r.stderr, r.stderr[-2000:]
