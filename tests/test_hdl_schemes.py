@@ -267,3 +267,18 @@ def test_fpga_features_count_the_squarer(reports):
     # the squarer and the steps after the first are variable multipliers; the first is by a constant
     assert len(f.multipliers) + len(f.const_multipliers) == d.multipliers == 5
     assert f.multipliers[0] == (d.xs_bits, d.xs_bits)
+
+
+def test_too_wide_for_the_square_falls_back_to_plain_horner():
+    """At 20-bit x and 24-bit y the products by v = x*x exceed the 62-bit model;
+    the design is then Horner's rule in x, and says so."""
+    t = cn.fit("cos(x)", ("-1/2", "1/2"), 10, kind="minimax")
+    d = design_horner(t, 20, 24, coef_bits=24)
+    assert d.scheme == "monomial"
+    assert any("not over one parity in v = x*x" in n and "62 bits" in n for n in d.notes)
+    assert design_horner(t, 12, 12, coef_bits=24).scheme == "even"
+
+
+def test_odd_with_one_coefficient_stays_plain():
+    t = cn.fit("x", ("-1", "1"), 2, name="ident")   # only x^1: no step in v = x*x
+    assert design_horner(t, 8, 8, coef_bits=12).scheme == "monomial"

@@ -37,6 +37,7 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -590,7 +591,7 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding, variable=Non
     return tuple(stages), acc
 
 
-def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
+def _design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                   coef_bits: int | None = None, acc_bits: int | None = None,
                   rounding: str = "rne", x_frac_bits: int | None = None,
                   y_frac_bits: int | None = None, guard_bits: int = 3,
@@ -643,9 +644,10 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     name : str or None, default None
         The design's name; None uses the table's.
     parity : bool, default True
-        When every nonzero coefficient is of one parity (degree >= 2),
-        evaluate ``q(v)`` or ``x * q(v)`` with ``v = R(x*x)`` (scheme
-        ``"even"``/``"odd"``: half the Horner steps); False: plain Horner in ``x``.
+        When every nonzero coefficient is of one parity (degree >= 2; odd:
+        at least two of them), evaluate ``q(v)`` or ``x * q(v)`` with
+        ``v = R(x*x)`` (scheme ``"even"``/``"odd"``: half the Horner steps);
+        False: plain Horner in ``x``.
 
     Returns
     -------
@@ -733,7 +735,8 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         raise ValueError(f"parity = {parity!r} is not accepted; accepted: True or False")
     if table.shift is not None:
         scheme = "shifted"
-    elif parity and _integer_parity(integers) is not None:
+    elif parity and _integer_parity(integers) is not None and \
+            (_integer_parity(integers) == 0 or len(integers[1::2]) >= 2):
         scheme = ("even", "odd")[_integer_parity(integers)]
         check_int64(2 * signed_bits(xs_lo, xs_hi), "the square x * x")
     horner = (integers[0::2] if scheme == "even" else (0,) + integers[1::2]
@@ -790,6 +793,29 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                         v_error=v_info[3],
                         v_shift=v_info[1] if scheme == "shifted" else 0,
                         v_offset=v_info[2] if scheme == "shifted" else 0)
+
+
+@functools.wraps(_design_horner)
+def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
+                  coef_bits: int | None = None, acc_bits: int | None = None,
+                  rounding: str = "rne", x_frac_bits: int | None = None,
+                  y_frac_bits: int | None = None, guard_bits: int = 3,
+                  name: str | None = None, parity: bool = True) -> HornerDesign:
+    options = dict(coef_bits=coef_bits, acc_bits=acc_bits, rounding=rounding,
+                   x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits, guard_bits=guard_bits,
+                   name=name)
+    try:
+        return _design_horner(table, in_bits, out_bits, parity=parity, **options)
+    except ValueError as exc:
+        # the square's datapath is wider than Horner's rule in x (its products are by a
+        # v of about twice x's bits): where it exceeds the 62-bit model, plain Horner
+        if parity is not True or "bit-accurate model" not in str(exc):
+            raise
+        d = _design_horner(table, in_bits, out_bits, parity=False, **options)
+        import dataclasses
+
+        return dataclasses.replace(d, notes=d.notes + (
+            f"Horner's rule in x, not over one parity in v = x*x: {exc}",))
 
 
 def _integer_parity(integers) -> int | None:
