@@ -282,5 +282,5 @@ def test_too_wide_for_the_square_falls_back_to_plain_horner():
 
 
 def test_odd_with_one_coefficient_stays_plain():
-    t = cn.fit("x", ("-1", "1"), 2, name="ident")   # only x^1: no step in v = x*x
+    t = cn.fit("sin(x)", ("-1", "1"), 2, name="s2")   # only x^1: no step in v = x*x
     assert design_horner(t, 8, 8, coef_bits=12).scheme == "monomial"
