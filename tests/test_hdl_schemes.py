@@ -153,7 +153,6 @@ def test_verilog_is_the_model_on_every_code(reports, tmp_path, key):
 
 
 @needs_ghdl
-@pytest.mark.slow
 @pytest.mark.parametrize("key", ["sin7", "cos8", "cosh6", "exp5", "log6"])
 def test_vhdl_outputs_meet_the_budget_on_every_code(reports, tmp_path, key):
     """GHDL's outputs (read back code by code) are the model's, so the budget
@@ -270,7 +269,6 @@ def test_fpga_features_count_the_squarer(reports):
     assert f.multipliers[0] == (d.xs_bits, d.xs_bits)
 
 
-@pytest.mark.slow
 def test_too_wide_for_the_square_falls_back_to_plain_horner():
     """At 20-bit x and 24-bit y the products by v = x*x exceed the 62-bit model;
     the design is then Horner's rule in x, and says so."""
