@@ -95,8 +95,8 @@ def test_python_errors_name_arguments_and_the_cli_names_flags(capsys):
     assert "frac-bits" not in str(exc.value)
     with pytest.raises(ValueError, match="segment_by exponent needs.*interval=\\('1/4', '4'\\)"):
         cn.fit("1/sqrt(x)", ("1", "3"), 1, segment_by="exponent")
-    with pytest.raises(ValueError, match="basis='monomial'"):
-        cn.export(cn.fit("exp(x)", (0, 1), 2, basis="shifted"), "glsl")
+    with pytest.raises(ValueError, match="basis='monomial'"):   # the shaders now take it
+        cn.quantize(cn.fit("exp(x)", (0, 1), 2, basis="shifted"), 12)
     # the command line keeps its flags
     assert main(["fit", "exp(y)", "--interval", "0", "1", "--degree", "2"]) == 2
     assert "set it with --var)" in capsys.readouterr().err

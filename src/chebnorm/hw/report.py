@@ -125,6 +125,7 @@ class HardwareReport:
                          "offset_code": d.y_format.offset_code, "q": d.y_format.q_name()},
             "coef_frac_bits": d.coef_frac_bits, "coefficients_q": list(d.integers),
             "acc_frac_bits": d.acc_frac_bits, "valid_codes": list(d.valid_codes),
+            "scheme": d.scheme, "multipliers": d.multipliers,
             "total_error_bound": b.total, "budget": b.as_dict(),
             "measured": self.measurement.as_dict(), "checks": self.checks,
             "cost": self.block.as_dict(),
@@ -151,6 +152,13 @@ class HardwareReport:
             out.append(f"  rounding a{st.power}     {format_up(bound, '.6e')} (local "
                        f"{format_up(_local(st, d), '.6e')}) "
                        f"| local {format_down(meas, '.6e')}")
+        if d.scheme == "shifted":
+            out.append(f"  shift rounding  {format_up(b.variable_rounding, '.6e')} (v = (x - c')/s "
+                       f"with {d.variable_frac_bits} fractional bits)")
+        elif d.scheme != "monomial":
+            out.append(f"  square rounding {format_up(b.variable_rounding, '.6e')} (v = x*x with "
+                       f"{d.variable_frac_bits} fractional bits; {d.scheme} powers, "
+                       f"{d.multipliers} multipliers)")
         out += [f"  output rounding {format_up(b.output_rounding, '.6e')}",
                 f"  rounding total  {format_up(b.rounding, '.6e')} | "
                 f"{format_down(m.rounding, '.6e')}"

@@ -24,7 +24,8 @@ from chebnorm.core.numeric import format_up
 from ..trust import verify_design
 
 __all__ = ["LANGUAGES", "COMMENT", "SUFFIX", "check_language", "module_name", "pipelined_name",
-           "horner_facts", "piecewise_facts", "comment_lines", "vectors_name", "vector_file"]
+           "horner_facts", "piecewise_facts", "comment_lines", "vectors_name", "vector_file",
+           "variable_name", "step_comment", "shifted_width"]
 
 #: the hardware description languages the printers write
 LANGUAGES = ("verilog", "vhdl")
@@ -197,6 +198,18 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
         f"Rounding: {comment_text(design.rounding)} after each multiply-add; accumulators with "
         f"{design.acc_frac_bits} fractional bits.",
     ]
+    if design.scheme == "shifted":
+        c, s = design.table.shift
+        exact = "c' = c" if design.v_error == 0 else f"c' = c to {design.x_format.frac_bits + design.v_shift} fractional bits"
+        lines.append(f"Shifted basis: y = q(v) with v = (x - c')/s, c = {c!r}, s = {s!r} "
+                     f"({exact}); coefficients q_j of powers of v.")
+    elif design.scheme != "monomial":
+        v_how = (f"rounded to {design.variable_frac_bits} fractional bits"
+                 if design.v_round_shift else "exact")
+        lines.append(f"Only {design.scheme} powers: y = {'x * ' if design.scheme == 'odd' else ''}"
+                     f"q(v) with v = x*x ({v_how}), Horner's rule over the nonzero "
+                     f"coefficients; {design.multipliers} multipliers (the squarer included), "
+                     f"{design.degree} for Horner's rule in x.")
     if budget is not None:
         lines.append(f"Error budget (|y - f(x)| on the valid codes): total <= "
                      f"{format_up(budget.total, '.6e')} "
@@ -206,7 +219,7 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
                      f"{format_up(budget.quantized, '.6e')}), "
                      f"rounding {format_up(budget.rounding, '.6e')}")
     if pipelined:
-        lines.append(f"Pipelined: one register stage per Horner step, latency {design.degree} "
+        lines.append(f"Pipelined: one register stage per Horner step, latency {design.steps} "
                      f"cycles (LATENCY); one result per cycle. Constants sized for these widths.")
     else:
         lines.append(f"Combinational. The widths are {_WIDTH_WORD[language]} for readability; "
@@ -392,3 +405,98 @@ def vectors_name(name: str, vectors: str | None) -> str:
     stem = vectors[:-4] if isinstance(vectors, str) and vectors.endswith(".hex") else vectors
     identifier(stem, field="vectors (without .hex)")
     return vectors
+
+
+def variable_name(design, stage=None) -> str:
+    """The wire a Horner step multiplies by: ``xs`` (the input value) in a
+    plain design and in an odd design's last step, ``v`` (``x*x``) otherwise.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator.
+    stage : Stage or None, default None
+        The step; None: the design's Horner variable.
+
+    Returns
+    -------
+    str
+        ``"xs"`` or ``"v"``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit("sin(x)", ("-1", "1"), 5), 8, 8, coef_bits=16)
+    >>> d.scheme, [variable_name(d, st) for st in d.stages]
+    ('odd', ['v', 'v', 'xs'])
+    """
+    if design.scheme == "monomial" or (stage is not None and stage.operand == "x"):
+        return "xs"
+    return "v"
+
+
+def step_comment(design, st) -> str:
+    """What one Horner step computes, for the HDL comment (``q_k``: the
+    coefficient of ``x^k``).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator.
+    st : Stage
+        The step.
+
+    Returns
+    -------
+    str
+        E.g. ``"a2 = R(a3 * v + q4 / 2^16)"``.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit("sin(x)", ("-1", "1"), 5), 8, 8, coef_bits=16)
+    >>> [step_comment(d, st) for st in d.stages]
+    ['a2 = R(a3 * v + q3 / 2^16)', 'a1 = R(a2 * v + q1 / 2^16)', 'a0 = a1 * x']
+    """
+    j = st.power
+    fc = design.coef_frac_bits
+    if design.scheme == "monomial":
+        return f"a{j} = R(a{j + 1} * x + q{j} / 2^{fc})"
+    if design.scheme == "shifted":
+        return f"a{j} = R(a{j + 1} * v + q{j} / 2^{fc})"
+    if st.operand == "x":
+        return f"a{j} = a{j + 1} * x"
+    k = 2 * j if design.scheme == "even" else 2 * j - 1
+    return f"a{j} = R(a{j + 1} * v + q{k} / 2^{fc})"
+
+
+def shifted_width(design) -> int:
+    """Signed width of ``(xs << m) - C`` in a shifted design, with its
+    operands (wide enough that the subtraction wraps nowhere).
+
+    Parameters
+    ----------
+    design : HornerDesign
+        A design of scheme ``"shifted"``.
+
+    Returns
+    -------
+    int
+        The width in bits.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.hw.horner import design_horner
+    >>> d = design_horner(fit("exp(x)", ("1", "2"), 3, basis="shifted"), 8, 8, coef_bits=16)
+    >>> d.scheme, d.v_offset, shifted_width(d) >= d.variable_bits
+    ('shifted', 192, True)
+    """
+    from chebnorm.core.numeric import signed_bits
+
+    xf, m = design.x_format, design.v_shift
+    lo, hi = xf.offset_code << m, (xf.offset_code + 2 ** design.in_bits - 1) << m
+    c = design.v_offset
+    return signed_bits(min(lo, hi, c, lo - c, hi - c), max(lo, hi, c, lo - c, hi - c)) + 1
