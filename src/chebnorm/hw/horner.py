@@ -37,7 +37,6 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, fields
 from fractions import Fraction
@@ -613,7 +612,7 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding, variable=Non
     return tuple(stages), acc
 
 
-def _design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
+def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                   coef_bits: int | None = None, acc_bits: int | None = None,
                   rounding: str = "rne", x_frac_bits: int | None = None,
                   y_frac_bits: int | None = None, guard_bits: int = 3,
@@ -719,9 +718,10 @@ def _design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     _check_table(table)
     table.verify()   # a table changed behind its back is proved again (or refused)
     with drafting():
-        d = _design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
-                           rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits,
-                           guard_bits=guard_bits, name=name)
+        d = _design_horner_or_plain(table, in_bits, out_bits, coef_bits=coef_bits,
+                                    acc_bits=acc_bits, rounding=rounding,
+                                    x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits,
+                                    guard_bits=guard_bits, name=name, parity=parity)
     return seal(d)
 
 
@@ -734,11 +734,15 @@ def _prove(d: HornerDesign) -> None:
     xf, yf = d.x_format, d.y_format
     if not isinstance(xf, QFormat) or not isinstance(yf, QFormat):
         raise ValueError("x_format, y_format: accepted: QFormat")
+    # the parity scheme as it was asked: one parity in v = x*x, or plain Horner because
+    # it was asked (parity=False) or because the square did not fit (a note says so)
+    parity = d.scheme in ("even", "odd") or any(_NO_PARITY in n for n in d.notes)
     with drafting():
-        ref = _design_horner(d.table, d.in_bits, d.out_bits, coef_bits=None,
-                             acc_bits=d.acc_frac_bits if d.degree >= 2 else None,
-                             rounding=d.rounding, x_frac_bits=xf.frac_bits,
-                             y_frac_bits=yf.frac_bits, guard_bits=3, name=d.name)
+        ref = _design_horner_or_plain(d.table, d.in_bits, d.out_bits, coef_bits=None,
+                                      acc_bits=d.acc_frac_bits if d.degree >= 2 else None,
+                                      rounding=d.rounding, x_frac_bits=xf.frac_bits,
+                                      y_frac_bits=yf.frac_bits, guard_bits=3, name=d.name,
+                                      parity=parity)
     for f in fields(d):
         mine, theirs = getattr(d, f.name), getattr(ref, f.name)
         if f.name != "table" and (type(mine) is not type(theirs) or mine != theirs):
@@ -749,7 +753,7 @@ def _prove(d: HornerDesign) -> None:
 
 
 def _design_horner(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding, x_frac_bits,
-                   y_frac_bits, guard_bits, name) -> HornerDesign:
+                   y_frac_bits, guard_bits, name, parity=True) -> HornerDesign:
     """:func:`design_horner`'s sizing (its drafts unchecked)."""
     _check_table(table)
     in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
@@ -852,12 +856,14 @@ def _design_horner(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding, x
                         v_offset=v_info[2] if scheme == "shifted" else 0)
 
 
-@functools.wraps(_design_horner)
-def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
-                  coef_bits: int | None = None, acc_bits: int | None = None,
-                  rounding: str = "rne", x_frac_bits: int | None = None,
-                  y_frac_bits: int | None = None, guard_bits: int = 3,
-                  name: str | None = None, parity: bool = True) -> HornerDesign:
+#: the note of a design that evaluates Horner's rule in x although its table has one parity
+_NO_PARITY = "Horner's rule in x, not over one parity in v = x*x"
+
+
+def _design_horner_or_plain(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding,
+                            x_frac_bits, y_frac_bits, guard_bits, name, parity) -> HornerDesign:
+    """:func:`_design_horner`, falling back to plain Horner in ``x`` (with a note)
+    where the one-parity datapath would exceed the 62-bit model."""
     options = dict(coef_bits=coef_bits, acc_bits=acc_bits, rounding=rounding,
                    x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits, guard_bits=guard_bits,
                    name=name)
@@ -872,7 +878,7 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         import dataclasses
 
         return dataclasses.replace(d, notes=d.notes + (
-            f"Horner's rule in x, not over one parity in v = x*x: {exc}",))
+            f"{_NO_PARITY}: {exc}",))
 
 
 def _integer_parity(integers) -> int | None:
