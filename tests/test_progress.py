@@ -64,3 +64,12 @@ def test_exhaustive_float32_certificate_shows_progress():
             "t = cn.fit('exp(x)', (1, 2), 6, kind='minimax', basis='monomial')\n"
             "assert 'exhaustive' in cn.export(t, 'c')\n")
     assert "float32 certificate" in _on_a_terminal(code)
+
+
+@pytest.mark.slow
+def test_verify_shows_progress_per_variant(tmp_path):
+    code = ("import chebnorm as cn\n"
+            "from chebnorm.export.verify import verify\n"
+            "t = cn.fit('1/sqrt(x)', (1, 4), 3, basis='monomial', name='rs')\n"
+            "assert verify(t, 'c', variant='float').passed\n")
+    assert "chebnorm verify: chebnorm_rs_f (float)" in _on_a_terminal(code)

@@ -65,6 +65,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import arb_precision, float_down, float_up, format_down, format_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.progress import progress_bar
 from chebnorm.core.tools import run_tool
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
@@ -552,18 +553,21 @@ def _finish(tracker: _Tracker, fn, exact_x) -> tuple[float, float, float, float]
 # ---------------------------------------------------------------- running a variant
 
 
-def _run(fn, evaluate, inputs: _Inputs, to_x64, to_y64, exact_x):
-    """Evaluate every chunk, track the errors; (measured, argmax, upper, ref, seconds)."""
+def _run(fn, evaluate, inputs: _Inputs, to_x64, to_y64, exact_x, what: str = "evaluator"):
+    """Evaluate every chunk, track the errors; (measured, argmax, upper, ref, seconds).
+    A progress bar names ``what`` on a terminal."""
     fn.numpy, fn.arb  # compiled before the clock starts (cached)
     t0 = time.perf_counter()
     tracker = _Tracker()
-    for vals in inputs.chunks():
-        y = evaluate(vals)
-        x64 = to_x64(vals)
-        with np.errstate(all="ignore"):
-            f64 = fn.numpy(x64)
-        tracker.add(vals.view(np.int32).astype(np.int64) if inputs.kind == "f32" else vals,
-                    x64, to_y64(y), f64)
+    with progress_bar(inputs.count, f"chebnorm verify: {what}", unit="input") as bar:
+        for vals in inputs.chunks():
+            y = evaluate(vals)
+            x64 = to_x64(vals)
+            with np.errstate(all="ignore"):
+                f64 = fn.numpy(x64)
+            tracker.add(vals.view(np.int32).astype(np.int64) if inputs.kind == "f32" else vals,
+                        x64, to_y64(y), f64)
+            bar.update(len(vals))
     measured, argmax, upper, ref = _finish(tracker, fn, exact_x)
     return measured, argmax, upper, ref, time.perf_counter() - t0
 
@@ -861,7 +865,7 @@ def _run_c(plan, text, fn, macros, inputs_of) -> list[VariantResult]:
                 t0 = time.perf_counter()
                 inputs, to_x, to_y, exact, note = inputs_of(p, values)
                 m, at, up, ref, _ = _run(fn, lib.evaluator(ret, name, arg), inputs, to_x,
-                                         to_y, exact)
+                                         to_y, exact, what=f"{name} ({variant})")
                 sec = time.perf_counter() - t0  # inputs, evaluation and reference
             except _Skip as exc:
                 results.append(VariantResult("c", variant, name, bound_name, stated, None, None,
@@ -970,7 +974,8 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
         t0 = time.perf_counter()
         inputs = _float32_set(lo, hi, spread)
         m, at, up, ref, _ = _run(fn, run, inputs, lambda v: v.astype(np.float64),
-                                 lambda y: y.astype(np.float64), _f32_exact)
+                                 lambda y: y.astype(np.float64), _f32_exact,
+                                 what=f"{fmt} {variant}")
         sec = time.perf_counter() - t0
     except ToolMissing as exc:
         return skipped(str(exc))
