@@ -64,7 +64,7 @@ nitpicky = True
 nitpick_ignore_regex = [
     # Names of other projects. They link through intersphinx when the inventories are
     # reachable; offline they have no target in this site and render as code.
-    ("py:.*", r"(math|abc|typing|collections|enum|dataclasses|pathlib|concurrent|io|os)(\..*)?"),
+    ("py:.*", r"(math|abc|typing|collections|enum|dataclasses|pathlib|concurrent|io|os|subprocess)(\..*)?"),
     ("py:.*", r"(numpy|np|sympy|sp|mpmath|scipy|flint|matplotlib|PIL|numba|trimesh)(\..*)?"),
     ("py:.*", r"(ABC|Enum|IntEnum|NamedTuple|Path|Axes|Figure|ndarray|Symbol|Expr|Rational|Basic)"),
     ("py:.*", r"(mpf|mpc|arb|arb_poly|fmpq|fmpz|Future|Executor|Callable|Iterable|Iterator|Sequence|Mapping)"),
@@ -423,19 +423,29 @@ def _attr_docs(modname: str) -> dict:
 def _constant_doc(app, what, name, obj, options, lines):
     """A constant a stage re-exports (``chebnorm.approx.COEF_FORMATS``) has its ``#:``
     description where it is assigned, not in the stage: autodoc then falls back to the
-    docstring of the value's type (tuple's, int's). Use the description of the module
-    that assigns it, or nothing."""
+    docstring of the value's type (tuple's, int's), or to nothing. Use the description
+    of the module that assigns it (under any name: ``COEF_FORMATS`` is ``FORMATS`` of
+    ``chebnorm.approx.rounding``), or nothing."""
     if what not in ("data", "attribute") or "." not in name:
         return
     typedoc = inspect.getdoc(type(obj)) or ""
-    if not lines or not typedoc or lines[0].strip() != typedoc.splitlines()[0].strip():
+    # numpydoc has already reshaped the lines: look for the type's first line near the top
+    head = " ".join(line.strip() for line in lines[:6])
+    builtin_value = type(obj).__module__ == "builtins"   # its docstring is never the constant's
+    if lines and not builtin_value and not (typedoc and typedoc.splitlines()[0].strip() in head):
         return
     modname, short = name.rsplit(".", 1)
-    for cand in sorted(m for m in sys.modules if m == modname or m.startswith(modname + ".")):
+    cands = sorted(m for m in sys.modules if m == modname or m.startswith(modname + "."))
+    for cand in cands:
+        docs = _attr_docs(cand)
         mod = sys.modules[cand]
-        if getattr(mod, short, None) is obj and short in _attr_docs(cand):
-            lines[:] = [line for line in _attr_docs(cand)[short] if line.strip()]
-            return
+        names = [short] + sorted(n for n in docs if n != short)
+        for attr in names:
+            if attr in docs and getattr(mod, attr, None) is obj and \
+                    (attr == short or not isinstance(obj, (int, float, bool))):
+                lines[:] = [line for line in docs[attr] if line.strip()]
+                _escape_bars(app, what, name, obj, options, lines)
+                return
     lines[:] = []
 
 

@@ -97,6 +97,7 @@ from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _version
 
 try:
+    #: the installed version of chebnorm (PEP 440 text, from the package metadata)
     __version__ = _version("chebnorm")
 except PackageNotFoundError:  # pragma: no cover - running from a bare checkout
     __version__ = "0.0.0+unknown"
