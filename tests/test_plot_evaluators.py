@@ -70,3 +70,30 @@ def test_length_error_map_keeps_rounding_noise_black():
     scale, largest = map(float, re.search(r"white ([0-9.e+-]+); largest ([0-9.e+-]+)",
                                           newton).groups())
     assert scale == largest > LENGTH_SCALE_FLOOR
+
+
+@pytest.mark.slow
+@pytest.mark.requires_tool("yosys")
+def test_design_plot_names_the_architecture_that_won(tmp_path, monkeypatch):
+    """When another architecture beats the one-width search, the search's plot says
+    so and circles its own best point under another name; synthesized points are
+    drawn at the cost yosys measured."""
+    import chebnorm.hw.piecewise_search as ps
+    from conftest import run_cli
+
+    seen = {}
+    real = ps.pareto_png
+
+    def spy(points, x, y, **kw):
+        seen.update(kw, points=points, x=x)
+        return real(points, x, y, **kw)
+
+    monkeypatch.setattr(ps, "pareto_png", spy)
+    r = run_cli("design", "log2(1+x)", "--interval", "0", "1", "--in-bits", "8", "--out-bits",
+                "8", "--faithful", "-o", tmp_path / "d")
+    assert r.code == 0, r.err
+    winner = [line for line in r.out.splitlines() if "multipartite" in line]
+    assert winner, r.out
+    assert "winner: multipartite" in seen["title"] and seen["best"][1] == "best one-width piecewise"
+    synthesized = [p for p in seen["points"] if p.yosys_cells is not None]
+    assert synthesized and all(seen["measured"](p) == float(p.yosys_cells) for p in synthesized)

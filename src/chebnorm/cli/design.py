@@ -125,6 +125,10 @@ def run(args) -> int:
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
     best = _best_other(others)
     if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
+        # the plot shows the one-width search: say that another architecture won
+        files[f"design_{name}.png"] = res.plot_png(
+            winner="best one-width piecewise",
+            note=f"winner: {best.architecture}, score {best.cost.score:.1f} (not on this plot)")
         return _write_architectures(args, out, name, others, res, files)
     # the winner's place and route may fail (too large for the device): before writing
     figures = winner_figures(res) if res.winner.target_cost is not None and \

@@ -301,17 +301,37 @@ class SearchResult:
                          f"{b.degree} vs {w.degree} multiply-adds")
         return lines
 
-    def plot_png(self) -> bytes:
-        """The Pareto plot of the search (cost against certified error), as PNG bytes."""
+    def plot_png(self, winner: str = "winner", note: str | None = None) -> bytes:
+        """The Pareto plot of the search (cost against certified error), as PNG bytes:
+        the model's cost of every point, and what synthesis measured where it ran.
+
+        Parameters
+        ----------
+        winner : str, optional
+            The label of the circled point (``"best one-width design"`` when
+            another architecture won).
+        note : str, optional
+            A second title line (which design won, when it is not on this plot).
+
+        Returns
+        -------
+        bytes
+            The PNG file.
+        """
         generic = self.target == "generic"
+        if generic:
+            measured = lambda p: None if p.yosys_cells is None else float(p.yosys_cells)  # noqa: E731
+        else:
+            measured = lambda p: None if p.target_cost is None else p.target_cost.score  # noqa: E731
+        title = f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out"
         return pareto_png(
             self.points, (lambda p: p.model_cost) if generic else (lambda p: p.target_model),
             lambda p: p.total_bound,
-            hline=(self.max_error, "max error"), best=(self.winner, "winner"),
-            xlabel="model cost (Yosys-cell units)" if generic else
-            f"{self.target} model score (LUT equivalents)", ylabel="certified max |y - f(x)|",
-            title=f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out",
-            xlog=True)
+            hline=(self.max_error, "max error"), best=(self.winner, winner),
+            xlabel="cost: model (dots), Yosys cells (crosses)" if generic else
+            f"{self.target} score, LUT equivalents: model (dots), synthesized (crosses)",
+            ylabel="certified max |y - f(x)|",
+            title=title if note is None else f"{title}\n{note}", xlog=True, measured=measured)
 
 
 def _point(d: PiecewiseDesign) -> DesignPoint:

@@ -197,7 +197,7 @@ class SweepResult:
 
 
 def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: str,
-               xlog: bool = False) -> bytes:
+               xlog: bool = False, measured=None) -> bytes:
     """A design sweep's Pareto plot as PNG bytes (matplotlib, Agg, no
     timestamp): ``points`` (each with ``degree`` and ``pareto``) scattered by
     degree at ``(x(p), y(p))`` on a log ``y`` axis (and ``x`` with ``xlog``),
@@ -225,6 +225,10 @@ def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: st
         Axis labels and the plot title.
     xlog : bool, default False
         Log scale on the ``x`` axis too.
+    measured : callable, optional
+        Point -> the cost a tool measured in ``x``'s unit (None where not
+        synthesized): drawn as crosses beside the model's dots, each joined to
+        its point.
 
     Returns
     -------
@@ -243,6 +247,13 @@ def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: st
     ax.step([x(p) for p in front], [y(p) for p in front], where="post",
             color="k", lw=1, label="Pareto front")
     ax.axhline(hline[0], color="r", ls="--", lw=1, label=hline[1])
+    if measured is not None:
+        got = [(x(p), measured(p), y(p)) for p in points if measured(p) is not None]
+        if got:
+            for xm, xs, yv in got:
+                ax.plot([xm, xs], [yv, yv], color="0.6", lw=0.6)
+            ax.scatter([g[1] for g in got], [g[2] for g in got], marker="x", s=30, color="k",
+                       label="synthesized (measured)")
     if best[0] is not None:
         ax.scatter([x(best[0])], [y(best[0])], s=90, facecolors="none", edgecolors="r",
                    label=best[1])
