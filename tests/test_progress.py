@@ -73,3 +73,13 @@ def test_verify_shows_progress_per_variant(tmp_path):
             "t = cn.fit('1/sqrt(x)', (1, 4), 3, basis='monomial', name='rs')\n"
             "assert verify(t, 'c', variant='float').passed\n")
     assert "chebnorm verify: chebnorm_rs_f (float)" in _on_a_terminal(code)
+
+
+def test_parallel_map_bar_only_on_a_terminal(capsys):
+    from chebnorm.core.parallel import map_ordered
+
+    assert map_ordered(abs, [-1, -2], workers=1, progress=True, desc="mapping") == [1, 2]
+    assert capsys.readouterr() == ("", "")
+    code = ("from chebnorm.core.parallel import map_ordered\n"
+            "map_ordered(abs, [-1, -2], workers=1, progress=True, desc='mapping things')\n")
+    assert "mapping things" in _on_a_terminal(code)
