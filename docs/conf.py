@@ -136,6 +136,7 @@ intersphinx_timeout = 5
 html_theme = "furo"
 html_title = f"chebnorm {release}"
 html_static_path = ["_static"]
+html_search_scorer = str(DOCS / "_static" / "scorer.js")  # attributes after functions and pages
 html_css_files = ["wide.css"]
 
 
