@@ -399,8 +399,18 @@ _BARS = re.compile(r"(?<![\\\w])\|([^|\n]*?[^|\s\\])\|(?!\w)")
 def _escape_bars(app, what, name, obj, options, lines):
     """Docstrings write ``|p - f|`` for an absolute value: in reStructuredText that
     is a substitution reference. Escape such bars outside code, roles and tables."""
+    math_indent = None   # inside a ``.. math::`` block: LaTeX, where \| is a norm bar
     for i, line in enumerate(lines):
-        if "|" not in line or line.lstrip().startswith(("|", "+")):
+        stripped = line.lstrip()
+        indent = len(line) - len(stripped)
+        if math_indent is not None:
+            if not stripped or indent > math_indent:
+                continue
+            math_indent = None
+        if stripped.startswith(".. math::"):
+            math_indent = indent
+            continue
+        if "|" not in line or stripped.startswith(("|", "+")):
             continue
         parts = _CODE_OR_ROLE.split(line)
         lines[i] = "".join(p if k % 2 else _BARS.sub(r"\\|\1\\|", p) for k, p in enumerate(parts))

@@ -147,3 +147,14 @@ def test_constants_show_their_own_description(built):
     approx = re.sub(r"<[^>]+>", "", (built / "generated" / "chebnorm.approx.html").read_text(
         encoding="utf-8"))
     assert "the highest polynomial degree" in approx and "the registered approximation" in approx
+
+
+@pytest.mark.slow
+def test_absolute_values_in_displayed_math_stay_bars(built):
+    """Docstrings' ``|x|`` is escaped for reStructuredText outside math only: inside a
+    ``.. math::`` block an escaped bar would render as a norm."""
+    pages = list((built / "generated").glob("*.html")) + list((built / "modules").glob("*.html"))
+    blocks = [m for p in pages for m in re.findall(r'<div class="math[^"]*">(.*?)</div>',
+                                                  p.read_text(encoding="utf-8"), re.S)]
+    assert blocks and not [b for b in blocks if "\\|" in b]
+    assert any("|\\mathrm{fl}(p(x)) - p(x)|" in b for b in blocks)
