@@ -83,3 +83,11 @@ def test_parallel_map_bar_only_on_a_terminal(capsys):
     code = ("from chebnorm.core.parallel import map_ordered\n"
             "map_ordered(abs, [-1, -2], workers=1, progress=True, desc='mapping things')\n")
     assert "mapping things" in _on_a_terminal(code)
+
+
+def test_a_running_tool_is_named_on_a_terminal():
+    code = ("import sys\n"
+            "from chebnorm.core.tools import run_tool\n"
+            "run_tool([sys.executable, '-c', 'import time; time.sleep(0.3)'], tool='sleeper',"
+            " timeout=60)\n")
+    assert "chebnorm: running sleeper" in _on_a_terminal(code)

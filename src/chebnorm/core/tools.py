@@ -19,7 +19,11 @@ chebnorm.core.tools.ToolTimeout: python did not finish within its time limit of 
 
 from __future__ import annotations
 
+import contextlib
+import multiprocessing
 import subprocess
+
+from .progress import progress_bar
 
 __all__ = ["run_tool", "ToolTimeout"]
 
@@ -93,8 +97,16 @@ def run_tool(argv, *, tool: str, timeout: float, **kwargs) -> subprocess.Complet
         raise ValueError("argv must be a list of arguments (no shell); accepted: a list of str")
     if "input" not in kwargs:
         kwargs.setdefault("stdin", subprocess.DEVNULL)
-    try:
-        return subprocess.run(list(argv), capture_output=True, text=True, timeout=timeout,
-                              **kwargs)
-    except subprocess.TimeoutExpired as exc:
-        raise ToolTimeout(tool, exc.cmd, timeout) from None
+    # on a terminal, say which tool runs (synthesis and place and route take a minute);
+    # a worker process stays quiet: the parent's bar is on the same terminal
+    quiet = multiprocessing.parent_process() is not None
+    with progress_bar(1, f"chebnorm: running {tool}", unit="run") if not quiet \
+            else contextlib.nullcontext() as bar:
+        try:
+            done = subprocess.run(list(argv), capture_output=True, text=True, timeout=timeout,
+                                  **kwargs)
+        except subprocess.TimeoutExpired as exc:
+            raise ToolTimeout(tool, exc.cmd, timeout) from None
+        if bar is not None:
+            bar.update(1)
+    return done
