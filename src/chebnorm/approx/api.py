@@ -1084,6 +1084,11 @@ def _monomials(monomials, degree: int, fix_constant: bool) -> tuple[int, ...]:
         raise ValueError(f"monomials {monomials!r} are not powers of the variable in "
                          f"0..{degree}; accepted: a non-empty list such as 1,3,5 (at most the "
                          f"degree {degree})")
+    repeated = sorted({int(k) for k in monomials if list(monomials).count(k) > 1})
+    if repeated:
+        raise ValueError(f"monomials {list(monomials)!r} repeat the power "
+                         f"{', '.join(map(str, repeated))}; accepted: each power once, "
+                         f"e.g. 1,3,5")
     if fix_constant and 0 in mons:
         mons.remove(0)
     return tuple(mons)

@@ -260,7 +260,9 @@ class _Reader:
             if base.is_Rational:
                 if base == 0 and ex < 0:
                     raise _Refusal(f"{self.token(node)!r} divides by zero")
-                if _bits(base) * abs(int(ex.p)) > MAX_NUMBER_BITS:
+                # a lower bound of the power's bits (2**1000 has 1001); number() checks
+                # the exact value
+                if (_bits(base) - 1) * abs(int(ex.p)) + 1 > MAX_NUMBER_BITS:
                     raise _Refusal(f"the power {self.token(node)!r} has more than "
                                    f"{MAX_NUMBER_BITS} bits")
                 if int(ex.q) > MAX_EXPONENT:

@@ -15,7 +15,7 @@ import importlib
 import os
 import sys
 
-from .common import command_flags
+from .common import ascii_float, ascii_int, command_flags
 
 __all__ = ["main", "build_parser", "UsageError"]
 
@@ -29,6 +29,13 @@ class UsageError(ValueError):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # every ``type=int`` / ``type=float`` reads ASCII digits only (Python's own
+        # readers take other scripts' digits: int("\u0663") == 3)
+        self.register("type", int, ascii_int)
+        self.register("type", float, ascii_float)
+
     def error(self, message):  # argparse's own errors: one line, status 2
         raise UsageError(f"{self.prog}: {message}")
 
