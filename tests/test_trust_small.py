@@ -234,3 +234,119 @@ def test_render_output_over_the_mesh_file_is_refused(tmp_path):
     refused(run_cli_quiet("render", "--mesh", "m.obj", "--size", "16", "16", "--error-map",
                           "m.png", cwd=tmp_path), "is the input --mesh")
     assert mesh.read_text().startswith("v 0 0 0")
+
+
+# -- false "vanishes" / "not finite" refusals ---------------------------------------
+
+def _dense_worst(poly, f, lo, hi, kind, points=4001, extra=()):
+    """max |p - f| (or |p/f - 1|) on a dense grid at 200 bits: a lower bound of the sup."""
+    import mpmath
+
+    xs = sorted({float(x) for x in np.linspace(lo, hi, points)} | set(extra))
+    with mpmath.workprec(200):
+        worst = mpmath.mpf(0)
+        for x in xs:
+            if not lo <= x <= hi:
+                continue
+            xm = mpmath.mpf(x)
+            fx, px = f(xm), poly(xm)
+            e = px - fx if kind == "abs" else px / fx - 1
+            worst = max(worst, abs(e))
+    return float(worst)
+
+
+def _mono(coeffs):
+    import mpmath
+
+    return lambda x: sum(mpmath.mpf(c) * x ** k for k, c in enumerate(coeffs))
+
+
+ONE_MINUS_COS = (lambda x: 2 * __import__("mpmath").sin(x / 2) ** 2)   # no cancellation
+
+
+@pytest.mark.parametrize("kind", ["chebyshev", "minimax"])
+def test_one_minus_cos_relative_error_near_zero_is_certified(kind):
+    """float64 reads 1 - cos(1e-8) as 0; the function has no zero on [1e-8, 1e-4]."""
+    import warnings
+
+    import chebnorm as cn
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)    # no numpy warning leaks
+        warnings.simplefilter("ignore", cn.approx.FitWarning)
+        t = cn.fit("1 - cos(x)", ("1e-8", "1e-4"), 3, kind=kind, error="rel")
+    worst = _dense_worst(_mono(t.coefficients), ONE_MINUS_COS, 1e-8, 1e-4, "rel",
+                         extra=np.geomspace(1e-8, 1e-4, 400))
+    assert worst <= t.rel_error_bound <= 1.01 * worst
+    if kind == "minimax":   # the fit sees the true values: a useful relative error
+        assert t.rel_error_bound < 1e-6
+
+
+def test_one_minus_cos_relative_error_cli_and_piecewise():
+    code, out, err = run_cli("fit", "1 - cos(x)", "--interval", "1e-8", "1e-4", "--degree",
+                             "3", "--error", "rel")
+    assert code == 0 and "max |p/f - 1|" in out, err
+    import chebnorm as cn
+
+    t = cn.fit("1 - cos(x)", ("1e-8", "1e-4"), 3, error="rel", segments=4, frac_bits=48)
+    assert t.rel_error_bound is not None and t.rel_error_bound <= 1.0 + 1e-9
+    # a true zero is still refused, with the true reason
+    refused(run_cli("fit", "1 - cos(x)", "--interval", "0", "1e-4", "--degree", "3",
+                    "--error", "rel"), "vanishes")
+
+
+def test_sqrt_abs_across_zero_is_certified():
+    """sqrt(|x|) is finite and real on [-1, 1]; Arb's abs of a ball around 0 was not."""
+    import mpmath
+
+    import chebnorm as cn
+
+    for kind in ("chebyshev", "minimax"):
+        t = cn.fit("sqrt(Abs(x))", ("-1", "1"), 4, kind=kind)
+        worst = _dense_worst(_mono(t.coefficients), lambda x: mpmath.sqrt(abs(x)), -1.0, 1.0,
+                             "abs", extra=(0.0, 1e-12, -1e-12))
+        assert worst <= t.abs_error_bound <= 1.01 * worst
+    code, out, err = run_cli("fit", "sqrt(abs(x))", "--interval", "-1", "1", "--degree", "4")
+    assert code == 0, err
+
+
+def _piecewise_worst(t, f, points=401):
+    import mpmath
+
+    worst = 0.0
+    for s in range(t.segment_count):
+        a, b = (float(v) for v in t.segment_bounds(s))
+        cs = [math_ldexp(q, -t.coef_frac_bits) for q in t.segments[s].integers]
+        with mpmath.workprec(200):
+            for k in range(points):
+                tt = mpmath.mpf(k) / (points - 1)
+                x = mpmath.mpf(a) + (mpmath.mpf(b) - mpmath.mpf(a)) * tt
+                u = tt - mpmath.mpf(1) / 2 if t.centered else tt   # the local variable
+                worst = max(worst, float(abs(mpmath.polyval(cs[::-1], u) - f(x))))
+    return worst
+
+
+def math_ldexp(q, e):
+    import math
+
+    return math.ldexp(q, e)
+
+
+@pytest.mark.parametrize("expr, f", [
+    ("sqrt(x)", lambda x: __import__("mpmath").sqrt(x)),
+    ("sqrt(1 - x)", lambda x: __import__("mpmath").sqrt(1 - x)),
+])
+def test_piecewise_sqrt_with_a_singular_end_is_certified(expr, f):
+    """The single fit of sqrt(x) on [0, 1] is certified; so is the piecewise one."""
+    import chebnorm as cn
+
+    for centered in (False, True):
+        t = cn.fit(expr, ("0", "1"), 3, segments=4, centered=centered)
+        worst = _piecewise_worst(t, f)
+        assert worst <= t.abs_error_bound <= 1.01 * worst
+    code, out, err = run_cli("fit", expr, "--interval", "0", "1", "--degree", "3",
+                             "--segments", "4")
+    assert code == 0 and "certified max over segments" in out, err
+    # the relative error of sqrt(x) at 0 has no value: refused with that reason
+    refused(run_cli("fit", "sqrt(x)", "--interval", "0", "1", "--degree", "3", "--segments",
+                    "4", "--error", "rel"), "nonzero")
