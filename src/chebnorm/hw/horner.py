@@ -569,7 +569,12 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     for fy in candidates:
         fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
         if len(integers) > 1:
-            stages, top = _stages(integers, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding)
+            try:
+                stages, top = _stages(integers, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding)
+            except ValueError:
+                if acc_bits is not None or fy == candidates[-1]:
+                    raise
+                continue  # a constant's output has no span: fewer bits than the exact sum's
             top_frac = stages[-1].sum_frac_bits
         else:
             stages, top, top_frac = (), np.full(all_k.shape, integers[0], dtype=np.int64), fc
