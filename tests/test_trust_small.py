@@ -118,6 +118,10 @@ ARABIC_16 = "\u0661\u0666"
     (["render-sweep", "--sizes", ARABIC_16, "-o", "OUT"], "size"),
     (["hw", "verilog", "T.json", "--in-bits", ARABIC_16, "--out-bits", "8", "-o", "D"],
      "--in-bits"),
+    (["design", "exp(x)", "--interval", "0", "1", "--in-bits", "8", "--out-bits", "8",
+      "--max-error", "1e-2", "--target", "ice40", "--frequency", "\u0661\u0660\u0660", "-o",
+      "D"], "--frequency"),
+    (["verify", "T.json", "--inputs", ARABIC_16], "--inputs"),
 ])
 def test_digits_of_other_scripts_are_refused(tmp_path, argv, pattern):
     result = run_cli(*argv, cwd=tmp_path)

@@ -154,6 +154,9 @@ def _frequency(args, target):
         return None
     from chebnorm.hw.pipeline import check_frequency
 
+    if not str(args.frequency).isascii():   # float() reads other scripts' digits
+        raise ValueError(f"--frequency {str(args.frequency)[:40]!r}: accepted: a finite number "
+                         f"of MHz > 0 in ASCII digits, e.g. 100")
     freq = check_frequency(args.frequency, "--frequency")
     if target == "generic" or args.no_synth:
         raise ValueError(f"--frequency {args.frequency} needs a device's timing; accepted: "
