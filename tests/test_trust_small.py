@@ -370,8 +370,11 @@ def _table(tmp_path, expr, quant):
 
 
 def _ok(result):
+    """Exit 0; stderr holds at most chebnorm's one-line warnings (a re-quantized linear
+    table's FitWarning reached stderr as Python prints it, over two lines)."""
     code, out, err = result
     assert code == 0 and "Traceback" not in err, err
+    assert all(line.startswith("chebnorm: warning: ") for line in err.splitlines()), err
     return out
 
 
@@ -431,3 +434,17 @@ def test_constant_and_linear_circuits_simulate_as_their_model(tmp_path, expr):
                               "--coef-frac-bits", "16", "--rounding", rounding, "--lang", lang,
                               "-o", f"{lang}-{rounding}", "--simulate", cwd=tmp_path))
             assert "PASS: 256 vectors, 0 mismatches" in out, out
+
+
+def test_library_warnings_reach_the_cli_as_one_line(tmp_path):
+    """A FitWarning raised while ``export`` re-quantizes a linear table was printed by
+    Python (file, line, category, the source line); the command line prints it as
+    one ``chebnorm: warning:`` line. A child process: in-process, pytest takes the
+    warnings."""
+    _table(tmp_path, "2*x+1", "fixed")
+    child = run_process("export", "t.json", "--format", "verilog", "-o", "e.v", "--in-bits", "8",
+                        "--out-bits", "8", "--coef-frac-bits", "16", cwd=tmp_path, timeout=300)
+    assert child.returncode == 0, child.stderr
+    lines = child.stderr.splitlines()
+    assert lines and all(s.startswith("chebnorm: warning: ") for s in lines), child.stderr
+    assert len(lines) == len(set(lines))

@@ -14,6 +14,7 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
 from .common import ascii_float, ascii_int, command_flags
 
@@ -91,6 +92,29 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    with warnings.catch_warnings():   # restores the caller's showwarning and filters
+        warnings.showwarning = _one_line_warnings(warnings.showwarning)
+        return _main(argv)
+
+
+def _one_line_warnings(previous):
+    """A ``warnings.showwarning`` that prints chebnorm's own warnings (FitWarning,
+    FrequencyWarning, ...) as one ``chebnorm: warning:`` line each, once per command,
+    and hands every other warning to ``previous``."""
+    seen: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not category.__module__.startswith("chebnorm"):
+            return previous(message, category, filename, lineno, file, line)
+        text = " ".join(str(message).split())
+        if text not in seen:
+            seen.add(text)
+            print(f"chebnorm: warning: {text}", file=sys.stderr)
+        return None
+    return show
+
+
+def _main(argv: list[str]) -> int:
     flags = None   # the command's flags by Python name, once it is parsed
     try:
         parser = build_parser()
