@@ -75,6 +75,14 @@ def test_mesh_out_of_float64_range_is_one_line_and_no_warning(tmp_path, text, pa
     refused(run_cli_quiet("render", "--mesh", mesh, "--size", "16", "16"), pattern)
 
 
+def test_mesh_below_the_near_plane_is_refused_with_that_reason(tmp_path):
+    """1e-10 across: the default camera's near distance (1e-9) is the true reason."""
+    mesh = tmp_path / "m.obj"
+    mesh.write_text(TETRA.format(s="1e-10"))
+    refused(run_cli_quiet("render", "--mesh", mesh, "--size", "16", "16", "--engine", "numpy"),
+            "scale the mesh up")
+
+
 def test_mesh_scale_limits_hold_in_the_python_api():
     from chebnorm.raster.meshes import MAX_COORDINATE, Mesh
 
@@ -86,7 +94,7 @@ def test_mesh_scale_limits_hold_in_the_python_api():
 
 
 def test_mesh_at_the_limits_renders(tmp_path):
-    """2^200 and 2^-200 (the accepted extremes' neighbours, 1e60 and 1e-8) render without a warning."""
+    """1e60 (just under 2^200) and 1e-8 (the smallest the default camera frames) render."""
     for s in ("1e60", "1e-8"):
         mesh = tmp_path / f"m{s}.obj"
         mesh.write_text(TETRA.format(s=s))
