@@ -292,6 +292,10 @@ def test_one_minus_cos_relative_error_near_zero_is_certified(kind):
     assert worst <= t.rel_error_bound <= 1.01 * worst
     if kind == "minimax":   # the fit sees the true values: a useful relative error
         assert t.rel_error_bound < 1e-6
+    from chebnorm.approx.load import table_from_json
+    from chebnorm.export import export_text
+
+    assert table_from_json(export_text(t, "json")) == t     # every bound re-proved on load
 
 
 def test_one_minus_cos_relative_error_cli_and_piecewise():
@@ -356,6 +360,10 @@ def test_piecewise_sqrt_with_a_singular_end_is_certified(expr, f):
         t = cn.fit(expr, ("0", "1"), 3, segments=4, centered=centered)
         worst = _piecewise_worst(t, f)
         assert worst <= t.abs_error_bound <= 1.01 * worst
+        from chebnorm.approx.load import table_from_json
+        from chebnorm.export import export_text
+
+        assert table_from_json(export_text(t, "json")) == t
     code, out, err = run_cli("fit", expr, "--interval", "0", "1", "--degree", "3",
                              "--segments", "4")
     assert code == 0 and "certified max over segments" in out, err
