@@ -14,8 +14,8 @@ all to the JSON file (sorted keys).
 
     python benchmarks/bench_design_targets.py --markdown [--json FILE]
 
-prints the README's table of the issue-28 spec from the JSON file (no run):
-``tests/test_readme_figures.py`` checks that the README shows these rows.
+prints the manual's table of the spec per target (docs/hardware.md) from the JSON file (no run):
+``tests/test_readme_figures.py`` checks that docs/hardware.md shows these rows.
 
     python benchmarks/bench_design_targets.py --calibrate [--bits 16 12] [--targets ...]
 
@@ -102,7 +102,7 @@ CELL_NAMES = {"xc7": ("LUT", "DSP48E1", "CARRY4", "MUXF"),
 
 
 def winner_text(line: str, target: str) -> str:
-    """The README's words for the winner of ``design``'s first ``winner:`` line."""
+    """The manual's words for the winner of ``design``'s first ``winner:`` line."""
     arch = line.split("winner: ", 1)[1].split(f": {target}:", 1)[0]
     arch = re.sub(r",? \(?ROM \d+ bits\)?", "", arch)
     if arch.startswith("piecewise-sized: "):
@@ -135,7 +135,7 @@ def timing_text(lines: list[str]) -> str:
 
 
 def markdown(doc: dict) -> str:
-    """The README's table of the spec, one row per target of ``doc`` (the JSON file).
+    """The manual's table of the spec, one row per target of ``doc`` (the JSON file).
 
     >>> doc = {"results": [{"target": "generic", "wall_s": 56.83, "cpu_s": 33.56, "lines": [
     ...     "winner: piecewise-sized: degree 2, 128 centred segments, ROM 4608 bits, "
@@ -159,7 +159,7 @@ def main(argv=None) -> int:
     ap.add_argument("--json", default=os.path.join(HERE, "design_targets_results.json"),
                     help="where to write the results ('' for nowhere)")
     ap.add_argument("--markdown", action="store_true",
-                    help="print the README table from the --json file (no run)")
+                    help="print the manual's table from the --json file (no run)")
     ap.add_argument("--calibrate", action="store_true",
                     help="model against yosys for every candidate (no timing)")
     ap.add_argument("--bits", nargs="+", type=int, default=[16, 12],

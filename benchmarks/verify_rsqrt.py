@@ -1,17 +1,17 @@
-"""The README's "Verify an exported evaluator" table: ``chebnorm verify`` on
+"""The manual's "Verify an exported evaluator" table (docs/formats.md): ``chebnorm verify`` on
 the committed ``rsqrt_d3`` table, every float32 of its interval.
 
     python benchmarks/verify_rsqrt.py            # print the Markdown table
-    python benchmarks/verify_rsqrt.py --readme   # and rewrite it in README.md
+    python benchmarks/verify_rsqrt.py --write    # and rewrite it in docs/formats.md
 
 Runs :func:`chebnorm.export.verify.verify` for ``c`` (every variant the
 header defines: double and float, unfused and fused, the fixed-point
 evaluator), ``glsl`` (llvmpipe) and ``wgsl`` (lavapipe), and prints one row per
 evaluator: measured maximum and where, the stated bound read from the
 exported text, their ratio and the input count (no times: the table is
-deterministic; ``chebnorm verify`` prints the seconds). ``--readme`` replaces the text
+deterministic; ``chebnorm verify`` prints the seconds). ``--write`` replaces the text
 between ``<!-- verify-rsqrt-start -->`` and ``<!-- verify-rsqrt-end -->`` in
-README.md (the stated column follows whatever the exporters state today).
+docs/formats.md (the stated column follows whatever the exporters state today).
 Exit status 1 when a stated bound is exceeded.
 """
 
@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 from chebnorm.approx import load_table
+from chebnorm.core.numeric import format_down, format_up
 from chebnorm.export.verify import verify
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -31,10 +32,13 @@ START, END = "<!-- verify-rsqrt-start -->", "<!-- verify-rsqrt-end -->"
 
 def row_text(fmt: str, v) -> str:
     """One Markdown row of a :class:`~chebnorm.export.verify.VariantResult`."""
+    if v.unchecked is not None:
+        return f"| {fmt} | {v.variant} | `{v.evaluator}` | NOT CHECKED: {v.unchecked} | | | | |"
     if v.skipped is not None:
         return f"| {fmt} | {v.variant} | `{v.evaluator}` | skipped: {v.skipped} | | | | |"
-    return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {v.measured_max:.3e} | "
-            f"{v.argmax!r} | {v.stated_bound:.3e} (`{v.bound_name}`) | "
+    # the measured maximum rounded down, the stated bound up, at the digits shown
+    return (f"| {fmt} | {v.variant} | `{v.evaluator}` | {format_down(v.measured_max, '.3e')} | "
+            f"{v.argmax!r} | {format_up(v.stated_bound, '.3e')} (`{v.bound_name}`) | "
             f"{v.ratio:.3f} | {v.count:,} |")
 
 
@@ -53,15 +57,15 @@ def table_text() -> tuple[str, bool]:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--readme", action="store_true", help="rewrite the table in README.md")
+    p.add_argument("--write", action="store_true", help="rewrite the table in docs/formats.md")
     args = p.parse_args(argv)
     text, ok = table_text()
     print(text, end="")
-    if args.readme:
-        readme = ROOT / "README.md"
+    if args.write:
+        readme = ROOT / "docs" / "formats.md"
         old = readme.read_text(encoding="utf-8")
         if START not in old or END not in old:
-            print(f"README.md has no {START} ... {END} block", file=sys.stderr)
+            print(f"docs/formats.md has no {START} ... {END} block", file=sys.stderr)
             return 2
         head, rest = old.split(START, 1)
         _, tail = rest.split(END, 1)

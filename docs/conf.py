@@ -56,7 +56,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
 # _layer_rule.rst is a fragment, included by contributing.md
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst"]
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli"]
 templates_path = ["_templates"]
 
 # every cross-reference must resolve (python -m sphinx -n); see _resolve_in_defining_module
@@ -64,7 +64,7 @@ nitpicky = True
 nitpick_ignore_regex = [
     # Names of other projects. They link through intersphinx when the inventories are
     # reachable; offline they have no target in this site and render as code.
-    ("py:.*", r"(math|abc|typing|collections|enum|dataclasses|pathlib|concurrent|io|os)(\..*)?"),
+    ("py:.*", r"(math|abc|typing|collections|enum|dataclasses|pathlib|concurrent|io|os|subprocess)(\..*)?"),
     ("py:.*", r"(numpy|np|sympy|sp|mpmath|scipy|flint|matplotlib|PIL|numba|trimesh)(\..*)?"),
     ("py:.*", r"(ABC|Enum|IntEnum|NamedTuple|Path|Axes|Figure|ndarray|Symbol|Expr|Rational|Basic)"),
     ("py:.*", r"(mpf|mpc|arb|arb_poly|fmpq|fmpz|Future|Executor|Callable|Iterable|Iterator|Sequence|Mapping)"),
@@ -192,6 +192,37 @@ def _write_figure_gallery() -> None:
     _write_if_changed(DOCS / "gallery" / "figures.md", "\n".join(lines))
 
 
+def _subparsers(parser):
+    """``(name, parser)`` of each subcommand of ``parser``, in the order they were added."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return list(action.choices.items())
+    return []
+
+
+def _write_cli_help() -> None:
+    """_cli/COMMAND.txt: each command's ``--help`` (``hw_verilog.txt`` for
+    ``hw verilog``), printed 88 columns wide whatever the terminal, so the CLI page
+    shows exactly what the parser accepts."""
+    from chebnorm.cli import build_parser
+
+    saved = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "88"
+    try:
+        for name, sub in _subparsers(build_parser()):
+            nested = _subparsers(sub)
+            for sub_name, leaf in nested or [(None, sub)]:
+                stem = name if sub_name is None else f"{name}_{sub_name}"
+                _write_if_changed(DOCS / "_cli" / f"{stem}.txt", leaf.format_help())
+    finally:
+        if saved is None:
+            os.environ.pop("COLUMNS", None)
+        else:
+            os.environ["COLUMNS"] = saved
+
+
 STAGES = ("core", "symbolic", "approx", "export", "methods", "hw", "raster")
 
 
@@ -285,6 +316,7 @@ def _write_layer_rule() -> None:
 
 _copy_notebooks()
 _write_figure_gallery()
+_write_cli_help()
 _write_layer_rule()
 # autosummary's pages are a build product: a module that moved or was removed must not
 # leave its page behind (a stale page imports a name that no longer exists)
@@ -391,19 +423,29 @@ def _attr_docs(modname: str) -> dict:
 def _constant_doc(app, what, name, obj, options, lines):
     """A constant a stage re-exports (``chebnorm.approx.COEF_FORMATS``) has its ``#:``
     description where it is assigned, not in the stage: autodoc then falls back to the
-    docstring of the value's type (tuple's, int's). Use the description of the module
-    that assigns it, or nothing."""
+    docstring of the value's type (tuple's, int's), or to nothing. Use the description
+    of the module that assigns it (under any name: ``COEF_FORMATS`` is ``FORMATS`` of
+    ``chebnorm.approx.rounding``), or nothing."""
     if what not in ("data", "attribute") or "." not in name:
         return
     typedoc = inspect.getdoc(type(obj)) or ""
-    if not lines or not typedoc or lines[0].strip() != typedoc.splitlines()[0].strip():
+    # numpydoc has already reshaped the lines: look for the type's first line near the top
+    head = " ".join(line.strip() for line in lines[:6])
+    builtin_value = type(obj).__module__ == "builtins"   # its docstring is never the constant's
+    if lines and not builtin_value and not (typedoc and typedoc.splitlines()[0].strip() in head):
         return
     modname, short = name.rsplit(".", 1)
-    for cand in sorted(m for m in sys.modules if m == modname or m.startswith(modname + ".")):
+    cands = sorted(m for m in sys.modules if m == modname or m.startswith(modname + "."))
+    for cand in cands:
+        docs = _attr_docs(cand)
         mod = sys.modules[cand]
-        if getattr(mod, short, None) is obj and short in _attr_docs(cand):
-            lines[:] = [line for line in _attr_docs(cand)[short] if line.strip()]
-            return
+        names = [short] + sorted(n for n in docs if n != short)
+        for attr in names:
+            if attr in docs and getattr(mod, attr, None) is obj and \
+                    (attr == short or not isinstance(obj, (int, float, bool))):
+                lines[:] = [line for line in docs[attr] if line.strip()]
+                _escape_bars(app, what, name, obj, options, lines)
+                return
     lines[:] = []
 
 

@@ -1,5 +1,5 @@
 """The coefficient-format comparison with Sollya's fpminimax (shared by
-tests/test_formats.py and the README figure): one Sollya process for all cases.
+tests/test_formats.py and the figure in docs/formats.md): one Sollya process for all cases.
 
 Run ``python tests/formats_cases.py`` for the table of ratios.
 """

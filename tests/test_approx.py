@@ -170,7 +170,7 @@ class TestQuantize:
 
     def test_overflow_is_rejected(self):
         t = fit("exp(x)", ("0", "1"), 3)
-        with pytest.raises(ValueError, match=r"overflows int32.*accepted: frac_bits <= 30"):
+        with pytest.raises(ValueError, match=r"overflows int32.*accepted: coef_frac_bits <= 30"):
             quantize(t, 40)
         with pytest.raises(ValueError, match="non-negative"):
             quantize(t, -1)

@@ -71,3 +71,21 @@ def test_helps_naming_registries_are_filled_in_when_printed():
     assert "|".join(available_methods()) in "".join(out.split())
     out = " ".join(run_cli("hw", "unit", "--help").out.split())
     assert all(t in out for t in UNIT_TARGETS.values())
+
+
+def test_methods_max_angle_is_below_the_antiparallel_limit():
+    import math
+
+    from chebnorm.cli.methods import MAX_ANGLE
+    from chebnorm.methods import ANTIPARALLEL_TOL
+
+    assert 1 + math.cos(MAX_ANGLE) > ANTIPARALLEL_TOL
+    assert math.acos(ANTIPARALLEL_TOL - 1) - MAX_ANGLE < 1e-2   # not needlessly small
+
+
+def test_methods_angle_near_pi_is_refused_naming_the_flag():
+    from quiet_cli import run_cli_quiet
+
+    code, out, err = run_cli_quiet("methods", "--angle", "3.14159265358979", "--span", "8")
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "--angle" in err and "0 <= PSI <= 3.14" in err

@@ -133,3 +133,17 @@ def test_site_pages(built):
     assert "Architecture: the layer rule" not in text("api") and "0. chebnorm.core" not in text("api")
     guide = (built / "guide.html").read_text(encoding="utf-8")
     assert re.findall(r'<img[^>]+src="_images/[^"]+\.png"', guide)
+
+
+@pytest.mark.slow
+def test_constants_show_their_own_description(built):
+    """A constant re-exported by a stage shows the ``#:`` description where it is
+    assigned, never the docstring of its value's type."""
+    builtin = ("Built-in immutable sequence", "int([x]) -&gt; integer", "str(object=",
+               "dict() -&gt; new empty dictionary", "float(x=0, /)")
+    for page in built.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        assert not [b for b in builtin if b in text], page
+    approx = re.sub(r"<[^>]+>", "", (built / "generated" / "chebnorm.approx.html").read_text(
+        encoding="utf-8"))
+    assert "the highest polynomial degree" in approx and "the registered approximation" in approx

@@ -253,7 +253,7 @@ def _banner(text: str, language: str) -> list[str]:
 def test_vhdl_and_verilog_banners_state_the_same_facts(tables):
     """The same lines, in each language's comment syntax; the one word that may
     differ is each language's name for the width constants."""
-    r = analyze(fit_target("dichotomy", 2), 10, 10, coef_bits=14, gappa=False, synth=False)
+    r = analyze(fit_target("dichotomy", 2), 10, 10, coef_frac_bits=14, gappa=False, synth=False)
     kw = dict(version="1.2.3", command="chebnorm hw verilog t.json --in-bits 10 -o o",
               budget=r.budget)
     cases = [(r.design, False), (r.design, True), (design_piecewise(tables["rc"], 10, 10), False)]

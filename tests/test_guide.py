@@ -25,7 +25,7 @@ def test_what_the_fit_sees_for_you_runs():
     block = re.search(r"```python\n(.*?)```", _section("### What the fit sees for you"), re.S).group(1)
     names = {"cn": cn}
     exec(compile(block, str(GUIDE), "exec"), names)   # the guide's own text, nothing else
-    t, s, q, r = names["t"], names["s"], names["q"], names["r"]
+    t, s, q, r = names["t"], names["s"], names["odd"], names["r"]
     assert t.degree == 6 and t.abs_error_bound <= 2 ** -24
     assert fit("exp(x)", (0, 1), 5).abs_error_bound > 2 ** -24   # the degree below fails
     assert "degrees tried" in t.provenance["degree_search"]

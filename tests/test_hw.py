@@ -34,7 +34,7 @@ def d2():
 
 @pytest.fixture(scope="module")
 def acceptance(d2):
-    return analyze(d2, 16, 16, coef_bits=20, synth=False, gappa=False)
+    return analyze(d2, 16, 16, coef_frac_bits=20, synth=False, gappa=False)
 
 
 class TestFixed:
@@ -142,7 +142,7 @@ class TestBudget:
 
     def test_quantization_against_recertification(self, d2):
         for bits in (10, 14, 20):
-            r = analyze(d2, 12, 12, coef_bits=bits, synth=False, gappa=False)
+            r = analyze(d2, 12, 12, coef_frac_bits=bits, synth=False, gappa=False)
             t, b = r.design.table, r.budget
             fp = t.fixed_point
             # triangle inequality in both directions, with rigorous bounds only
@@ -182,7 +182,7 @@ class TestVerilog:
     @no_iverilog
     @pytest.mark.parametrize("degree, rounding", [(1, "trunc"), (3, "rne"), (4, "trunc")])
     def test_other_designs_bit_for_bit(self, degree, rounding, tmp_path):
-        r = analyze(fit_target("midpoint", degree), 10, 10, coef_bits=16, rounding=rounding,
+        r = analyze(fit_target("midpoint", degree), 10, 10, coef_frac_bits=16, rounding=rounding,
                     synth=False, gappa=False)
         write_outputs(tmp_path, verilog_outputs(r))
         assert simulate(tmp_path, r.design).passed

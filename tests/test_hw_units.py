@@ -230,7 +230,7 @@ class TestPipelined:
     def test_bit_for_bit_with_latency(self, degree, rounding, tmp_path):
         from chebnorm.hw.report import analyze, verilog_outputs
 
-        r = analyze(fit_target("midpoint", degree), 10, 10, coef_bits=16, rounding=rounding,
+        r = analyze(fit_target("midpoint", degree), 10, 10, coef_frac_bits=16, rounding=rounding,
                     synth=False, gappa=False)
         files = verilog_outputs(r, pipelined=True)
         name = f"{r.design.module_name}_pipe"
@@ -248,9 +248,14 @@ class TestPipelined:
         from chebnorm.hw.hdl.verilog import verilog_pipelined_module
 
         d = design_horner(fit_target("dichotomy", 1), 8, 8, coef_bits=12)
-        d0 = d.__class__(**{**d.__dict__, "integers": d.integers[:1], "stages": ()})
-        with pytest.raises(ValueError, match="accepted: degree >= 1"):
-            verilog_pipelined_module(d0)
+        from chebnorm.hw.trust import drafting
+
+        with pytest.raises(ValueError, match="integers"):   # not the table's design
+            d.__class__(**{**d.__dict__, "integers": d.integers[:1], "stages": ()})
+        with drafting():   # the printer's own refusal, on a design left unchecked
+            d0 = d.__class__(**{**d.__dict__, "integers": d.integers[:1], "stages": ()})
+            with pytest.raises(ValueError, match="accepted: degree >= 1"):
+                verilog_pipelined_module(d0)
 
     @no_iverilog
     def test_cli_pipelined(self, tmp_path, capsys):

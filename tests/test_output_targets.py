@@ -198,11 +198,11 @@ class TestCommands:
         out = tmp_path / "hdl"
         out.mkdir()
         # a folder where one of the outputs (the bench) goes: that write fails
-        (out / "tb_chebnorm_table.v").mkdir()
+        (out / "tb_chebnorm_rsqrt_1_2_d2.v").mkdir()
         r = cli("hw", "verilog", table, "--in-bits", "8", "--out-bits", "8", "-o", out)
         assert r.code == 2 and r.err.count("\n") == 1, r.err
-        assert "tb_chebnorm_table.v" in r.err and "it is a directory" in r.err
-        assert sorted(p.name for p in out.iterdir()) == ["tb_chebnorm_table.v"]
+        assert "tb_chebnorm_rsqrt_1_2_d2.v" in r.err and "it is a directory" in r.err
+        assert sorted(p.name for p in out.iterdir()) == ["tb_chebnorm_rsqrt_1_2_d2.v"]
 
     def test_failed_render_writes_nothing(self, tmp_path):
         r = cli("render", "--mesh", "square", "--tess", "2", "--size", "16", "16",

@@ -177,3 +177,66 @@ def test_error_at_the_peaks_is_a_tight_lower_bound():
     low = _error_at(prob, _peaks(prob, _Sampler(prob), coeffs), coeffs)
     assert low <= cert.bound
     assert low >= cert.maximum * (1 - 1e-9)
+
+
+def test_shared_sample_grid_is_the_one_computed_afresh():
+    """The sampler's grid (points, f, weights, powers, its sorted and thinned
+    views) is shared by every quantization of one function on one interval:
+    it holds the floats computed afresh here as the sampler computed them
+    before the sharing, the batched errors on it are those floats' errors,
+    and nothing can change it."""
+    import numpy as np
+
+    from chebnorm.approx.rounding import Problem as _Problem, _Sampler, chebyshev_nodes
+    from chebnorm.core import clib
+
+    fn = parse_function("1/sqrt(x)")
+    prob = _Problem(fn=fn, lo=sp.Rational(1, 4), hi=sp.Integer(1), lo_f=0.25, hi_f=1.0,
+                    error_kind="rel", degree=5, powers=(0, 1, 2, 3, 4, 5), fixed={},
+                    word_limit=None)
+    samplers = [_Sampler(prob), _Sampler(prob)]
+    assert samplers[0].grid is samplers[1].grid          # shared, not recomputed
+    x = np.clip(np.concatenate([np.linspace(0.25, 1.0, 4097),
+                                chebyshev_nodes(0.25, 1.0, 2048)]), 0.25, 1.0)
+    f = np.array([1 / math.sqrt(v) for v in x])
+    ok = (x > 0.25) & (x < 1.0)
+    x, f = x[ok], f[ok]
+    w = 1 / np.abs(f)
+    coeffs = [[3.1, -6.2, 8.4, -6.9, 3.0, -0.5], [3.0, -6.0, 8.0, -7.0, 3.0, 0.0]]
+    for s in samplers + [samplers[0].thinned(), samplers[0].ordered()]:
+        assert s.x.tobytes() in (x.tobytes(), x[::16].tobytes(), np.sort(x).tobytes())
+        idx = np.searchsorted(np.sort(x), s.x)
+        order = np.argsort(x)
+        assert s.f.tobytes() == f[order][idx].tobytes()
+        assert s.w.tobytes() == w[order][idx].tobytes()
+        for k in range(6):
+            assert s.xp[k].tobytes() == clib.power(s.x, k).tobytes()
+        for c in coeffs:   # the error as the sampler defines it, term by term
+            p, mag = np.zeros_like(s.x), np.zeros_like(s.x)
+            for k, v in enumerate(c):
+                if v:
+                    p += v * clib.power(s.x, k)
+                    mag += np.abs(v * clib.power(s.x, k))
+            want = float(np.max(s.w * (np.abs(p - s.f) - 2.0 ** -50 * (mag + np.abs(s.f)))))
+            assert s.errors([c]) == [want] == [s.error(c)]
+        for a in (s.x, s.f, s.w, s.xp[3]):
+            with pytest.raises(ValueError):
+                a[0] = 0.0
+
+
+def test_quantize_with_shared_grids_gives_the_same_table():
+    """A quantization with every shared grid computed afresh and one reusing
+    them write the same bytes (fixed point with the greedy refit, a float
+    format with the lattice rounds, the parity sub-basis)."""
+    from chebnorm.approx import rounding
+
+    cases = [("exp(x)", ("0", "1"), 5, dict(frac_bits=20)),
+             ("atan(x)", ("-1", "1"), 7, dict(coef_format="binary32")),
+             ("1/sqrt(x)", ("1/4", "1"), 4, dict(coef_format="binary16"))]
+    for expr, iv, d, kw in cases:
+        base = fit(expr, iv, d, kind="minimax")
+        rounding._sample_grid.cache_clear()
+        rounding._greedy_nodes.cache_clear()
+        cold = quantize(base, **kw)
+        warm = quantize(base, **kw)
+        assert cold.to_json() == warm.to_json(), expr

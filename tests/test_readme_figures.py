@@ -1,8 +1,9 @@
-"""The figures the README quotes are the ones its commands print, so they cannot
-drift: the first fit (its whole console block), the fixed-point comparison of
-the "Coefficient formats" section, and the worked hardware example of
-"Piecewise tables". Each test reads the quoted text from README.md itself and
-runs the command the README shows, through the installed CLI's ``main``. The
+"""The figures the README and the manual quote are the ones their commands print,
+so they cannot drift: the README's first fit (its whole console block) and its
+fit-to-compiled-evaluator example, the fixed-point comparison of "Coefficient
+formats" (docs/formats.md), and the worked hardware example of "Piecewise
+tables" (docs/hardware.md). Each test reads the quoted text from the page itself
+and runs the command it shows, through the installed CLI's ``main``. The
 benchmark tables (architectures per spec, the issue-28 design per target) are
 compared with the committed JSON the benchmarks wrote, printed by the
 benchmark's own formatter (nothing synthesized again); the ``chebnorm verify``
@@ -21,7 +22,11 @@ import pytest
 
 from conftest import run_cli, tool_missing
 
-README = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
+ROOT = Path(__file__).resolve().parent.parent
+#: the README and the manual's pages that quote measured figures, as one text (each
+#: page starts with a level-1 heading, so a section never runs into the next page's)
+PAGES = ("README.md", "docs/formats.md", "docs/hardware.md", "docs/benchmarks.md")
+README = "\n".join((ROOT / page).read_text(encoding="utf-8") for page in PAGES)
 
 
 def _run(*argv) -> str:
@@ -60,7 +65,7 @@ def test_first_fit_minimax_optimum(capsys):
 
 def test_fixed_point_comparison(capsys):
     text = " ".join(_section("## Coefficient formats").split())
-    m = re.search(r"it now gives `\[([-0-9, ]+)\]`, ([0-9.e-]+), and Sollya", text)
+    m = re.search(r"--coef-frac-bits 14` it gives `\[([-0-9, ]+)\]`, ([0-9.e-]+) \(", text)
     assert m, "README's fixed-point comparison changed shape"
     integers, bound = m.group(1), m.group(2)
     out = _run("fit", "1/sqrt(2+z)", "--var", "z", "--interval", "sqrt(2)", "2", "--degree", "2",
@@ -216,3 +221,30 @@ def test_verify_table_is_what_verify_measures():
     stated, measured = f32[6].split()[0], f32[4].strip()
     assert f"the float and shader bound {stated} against a measured {measured}" in \
         " ".join(README.split())
+
+
+@pytest.mark.requires_tool("gcc")
+def test_fit_to_compiled_evaluator_example(tmp_path, monkeypatch):
+    """The README's "From a fit to a compiled evaluator": every command of its
+    ``sh`` block runs as shown (the chebnorm ones in this process, gcc as itself)
+    on the ``main.c`` it shows, and ``verify`` finds the stated float bound held."""
+    import shlex
+    import subprocess
+
+    section = _section("## From a fit to a compiled evaluator")
+    commands = re.search(r"```sh\n(.*?)```", section, re.S).group(1).strip().splitlines()
+    source = re.search(r"```c\n(.*?)```", section, re.S).group(1)
+    assert [c.split()[0] for c in commands] == ["chebnorm", "chebnorm", "chebnorm", "gcc"]
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "main.c").write_text(source, encoding="utf-8")
+    for command in commands:
+        argv = shlex.split(command)
+        if argv[0] == "chebnorm":
+            out = _run(*argv[1:])
+        else:  # the compiler itself: the header must build with -Wall -Werror
+            done = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True)
+            assert done.returncode == 0, done.stderr
+    assert re.search(r"c float .* ok$", out.strip(), re.M), out
+    assert (tmp_path / "main.o").stat().st_size > 0
+    stated = re.search(r"`(CHEBNORM_\w+_F_EVAL_ERROR_BOUND)`", section).group(1)
+    assert f"#define {stated} " in (tmp_path / "rsqrt.h").read_text(encoding="utf-8")

@@ -95,7 +95,12 @@ def test_html_escapes_user_text():
         warnings.simplefilter("ignore")
         t = cn.quantize(cn.fit("1/sqrt(2+x)", ("0", "1"), 1, name="rs"), 12)
         d = hw.design_horner(t, 6, 6)
-    evil = dataclasses.replace(d, notes=("<script>alert(1)</script>",))
+    from chebnorm.hw.trust import drafting
+
+    with pytest.raises(ValueError, match="^notes: stated"):   # not the sizing's own notes
+        dataclasses.replace(d, notes=("<script>alert(1)</script>",))
+    with drafting():   # the display alone, on a design left unchecked
+        evil = dataclasses.replace(d, notes=("<script>alert(1)</script>",))
     html = evil._repr_html_()
     assert "<script>" not in html and "&lt;script&gt;" in html
 

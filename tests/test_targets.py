@@ -474,9 +474,15 @@ def test_vhdl_hostile_expression_stays_in_comments(tmp_path, hostile):
     d = analyze(clean, 6, 6, gappa=False, synth=False).design
     # the design step parses the expression and would refuse most of these: put the
     # hostile text into the designed table, as a hand-edited table file would
+    from chebnorm.hw.trust import drafting
+
     with construction("unchecked"):  # the constructor refuses it: test the printer alone
-        d = replace(d, table=replace(clean, expression=hostile, provenance={"command": hostile}))
-    text = vhdl_module(d, command=hostile)
+        t = replace(clean, expression=hostile, provenance={"command": hostile})
+    with pytest.raises(ValueError):   # and so does a design of it
+        replace(d, table=t)
+    with drafting():   # a design left unchecked: the printer alone
+        d = replace(d, table=t)
+        text = vhdl_module(d, command=hostile)
     head = text.split("library ieee;")[0]
     assert all(ln.startswith("-- ") for ln in head.splitlines())
     assert "evil" not in text.split("library ieee;")[1]

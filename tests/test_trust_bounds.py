@@ -221,8 +221,8 @@ def test_fit_name_refused_at_the_source(name, tmp_path, capsys):
         dataclasses.replace(CoefficientTable.load(BASE), name=name)
 
 
-def test_default_name_is_table():
-    assert fit("exp(x)", ("0", "1"), 1).name == "table"
+def test_default_name_comes_from_the_fit():
+    assert fit("exp(x)", ("0", "1"), 1).name == "exp_0_1_d1"
 
 
 # -- item 10: located maxima checked; duplicate JSON keys refused -------------------

@@ -598,12 +598,17 @@ def test_verilog_printer_alone_keeps_hostile_text_inert(tmp_path, clean):
         verilog_testbench,
     )
 
+    from chebnorm.hw.trust import drafting
+
     t, bad = _hostile_table()
     d = design_horner(CoefficientTable.load(BASE), 8, 8)
-    hostile = replace(d, table=t)
-    text = verilog_module(hostile, version=bad, command=bad)
+    with pytest.raises(ValueError):   # a design refuses the hostile table
+        replace(d, table=t)
+    with drafting():   # the printers alone, on a design left unchecked
+        hostile = replace(d, table=t)
+        text = verilog_module(hostile, version=bad, command=bad)
+        pipe = verilog_pipelined_module(hostile, version=bad, command=bad)
     assert strip_verilog_comments(text) == clean[1]
-    pipe = verilog_pipelined_module(hostile, version=bad, command=bad)
     (tmp_path / "m.v").write_text(text + "\n" + pipe)
     proc = subprocess.run(["iverilog", "-g2005", "-Wall", "-o", str(tmp_path / "a.out"),
                            str(tmp_path / "m.v")], capture_output=True, text=True)

@@ -39,15 +39,15 @@ from pathlib import Path
 import numpy as np
 
 from chebnorm.approx import CoefficientTable
-from chebnorm.approx.files import write_atomic
+from chebnorm.core.files import write_atomic
 from chebnorm.core.textsafe import csv_cell
 from chebnorm.export import glsl_source
 from chebnorm.export.gpu import gl_context
 from chebnorm.methods import span_normals
 from chebnorm.raster import render
 from chebnorm.raster.meshes import get_mesh
-from chebnorm.raster.metrics import write_png
-from chebnorm.raster.render import Lighting, to_8bit
+from chebnorm.raster.metrics import to_8bit, write_png
+from chebnorm.raster.render import Lighting
 from chebnorm.raster.spans import fit_camera, project
 
 HERE = Path(__file__).resolve().parent

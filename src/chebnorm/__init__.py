@@ -97,6 +97,7 @@ from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _version
 
 try:
+    #: the installed version of chebnorm (PEP 440 text, from the package metadata)
     __version__ = _version("chebnorm")
 except PackageNotFoundError:  # pragma: no cover - running from a bare checkout
     __version__ = "0.0.0+unknown"
@@ -129,6 +130,7 @@ _LAZY = {
     "PiecewiseTable": ("chebnorm.approx", "PiecewiseTable"),
     "load_table": ("chebnorm.approx", "load_table"),
     "FitWarning": ("chebnorm.approx", "FitWarning"),
+    "ChebnormDeprecationWarning": ("chebnorm.core.deprecation", "ChebnormDeprecationWarning"),
     "target": ("chebnorm.approx", "get_target"),
     "target_names": ("chebnorm.approx", "target_names"),
     "span_normals": ("chebnorm.methods", "span_normals"),
@@ -141,7 +143,7 @@ _LAZY = {
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
     "PiecewiseTable", "load_table",
-    "FitWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
+    "FitWarning", "ChebnormDeprecationWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
     "core", "symbolic", "approx", "export", "methods", "hw", "raster",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}

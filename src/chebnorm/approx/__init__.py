@@ -35,7 +35,8 @@ __all__ = [
 
 
 def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = None,
-               error: str = "abs", frac_bits: int | None = None) -> CoefficientTable:
+               error: str = "abs", coef_frac_bits: int | None = None,
+               frac_bits: int | None = None) -> CoefficientTable:
     """Fit a registered target: ``fit_target("dichotomy", 2)``.
 
     Parameters
@@ -50,8 +51,10 @@ def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = Non
         ``"chebyshev"`` or ``"minimax"`` (default: the target's).
     error : str, optional
         ``"abs"`` or ``"rel"``.
-    frac_bits : int, optional
+    coef_frac_bits : int, optional
         Also quantize to this many fractional bits.
+    frac_bits : int, optional
+        The deprecated spelling of ``coef_frac_bits``.
 
     Returns
     -------
@@ -69,9 +72,12 @@ def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = Non
     >>> fit_target("dichotomy", 2).name
     'dichotomy_d2'
     """
+    from chebnorm.core.deprecation import renamed
+
+    frac_bits = renamed(frac_bits, coef_frac_bits, "frac_bits", "coef_frac_bits", "fit_target")
     t = get_target(name)
     return fit(t.expression, t.interval(psi_max), degree, kind=kind or t.kind, error=error,
-               var=t.variable, name=f"{name}_d{degree}", frac_bits=frac_bits,
+               var=t.variable, name=f"{name}_d{degree}", coef_frac_bits=frac_bits,
                basis="monomial",  # the papers' polynomials, in powers of the variable
                command=f"chebnorm.approx.fit_target({name!r}, {degree}, psi_max={psi_max!r}, "
                        f"kind={(kind or t.kind)!r}, error={error!r}, frac_bits={frac_bits!r})")

@@ -10,7 +10,9 @@ import numpy as np
 import sympy as sp
 from flint import arb
 
-from chebnorm.core.numeric import ball_float_down, ball_float_up
+from chebnorm.core.numeric import ball_float_down, ball_float_up, format_down, format_up
+from chebnorm.core.deprecation import renamed
+from chebnorm.core.textsafe import default_name
 
 from .certify import Certificate, certify
 from .expr import AccurateFunction1D, Function1D, compare, enclose, parse_function, parse_number
@@ -124,6 +126,14 @@ def _nearest_float(ball: arb) -> float:
     return best
 
 
+@functools.lru_cache(maxsize=256)
+def _complex_evaluator(var: sp.Symbol, expr: sp.Expr):
+    """``expr`` as a numpy function of ``var`` in complex arithmetic (sympy's
+    ``lambdify``), generated once per expression: a quantization that refits,
+    or several fits of one function, reuse it."""
+    return sp.lambdify(var, expr, ["scipy", "numpy"])
+
+
 def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndarray:
     """Sample ``f`` on the interval and reject it where it is not finite and real.
 
@@ -155,7 +165,7 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
     x[0], x[-1] = iv.lo_in, iv.hi_in
     with np.errstate(all="ignore"):
         try:
-            y = np.asarray(sp.lambdify(fn.var, fn.expr, ["scipy", "numpy"])(x.astype(complex)), dtype=complex)
+            y = np.asarray(_complex_evaluator(fn.var, fn.expr)(x.astype(complex)), dtype=complex)
         except (ZeroDivisionError, OverflowError):
             y = np.full(x.shape, np.nan, dtype=complex)
         y = y * np.ones_like(x)
@@ -226,10 +236,10 @@ def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = Fals
 
 
 def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", error: str = "abs", *,
-        var: str = "x", name: str | None = None, frac_bits=None,
+        var: str = "x", name: str | None = None, coef_frac_bits=None,
         command: str | None = None, basis: str = "auto", coef_format: str | None = None,
         monomials=None, fix_constant: bool = False, segments=None, segment_by: str | None = None,
-        centered: bool = False, max_error: float | None = None):
+        centered: bool = False, max_error: float | None = None, frac_bits=None):
     """Fit a polynomial of ``degree`` to ``expr`` on ``interval`` and certify it.
 
     Every table carries rigorous bounds of both its absolute and its relative
@@ -258,9 +268,11 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     var : str or sympy.Symbol, optional
         The variable of ``expr`` (default ``"x"``).
     name : str, optional
-        The table's name, an identifier (it names generated code); default
-        ``"table"``.
-    frac_bits : int or sequence of int, optional
+        The table's name, an identifier (it names generated code); default: made
+        from the expression, interval and degree (``"rsqrt_1_4_d3"`` for
+        ``fit("1/sqrt(x)", (1, 4), 3)``; :func:`chebnorm.core.textsafe.default_name`),
+        so the exports of different fits coexist in one build.
+    coef_frac_bits : int or sequence of int, optional
         Also quantize the coefficients to fixed point with this many
         fractional bits (one, or one per power): see :func:`quantize`. For a
         piecewise table, the one fixed-point format (default 24).
@@ -302,6 +314,9 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         with ``degree``, except with ``segments="auto"``: then the fewest
         segments (``2**k``) whose piecewise table of ``degree`` is certified
         to ``max_error`` (``provenance["segment_search"]``).
+    frac_bits : int or sequence of int, optional
+        The deprecated spelling of ``coef_frac_bits`` (a
+        :class:`~chebnorm.core.deprecation.ChebnormDeprecationWarning`).
 
     Returns
     -------
@@ -409,13 +424,14 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
 
     A piecewise table:
 
-    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, frac_bits=20)
+    >>> pw = fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=16, coef_frac_bits=20)
     >>> pw.segment_count, 4e-5 < pw.abs_error_bound < 5e-5
     (16, True)
     """
+    frac_bits = renamed(frac_bits, coef_frac_bits, "frac_bits", "coef_frac_bits", "fit")
     if max_error is not None or degree is None or segments == "auto":
         return _fit_max_error(expr, interval, degree, max_error, dict(
-            kind=kind, error=error, var=var, name=name, frac_bits=frac_bits, command=command,
+            kind=kind, error=error, var=var, name=name, coef_frac_bits=frac_bits, command=command,
             basis=basis, coef_format=coef_format, monomials=monomials,
             fix_constant=fix_constant, segments=segments, segment_by=segment_by,
             centered=centered))
@@ -465,7 +481,8 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
         provenance["warnings"] = " | ".join(notes)
     with construction("fitted"):  # certified above: checked, not proved twice
         table = CoefficientTable(
-            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+            name=name or default_name(sp.sstr(fn.expr), iv.strings, degree, fn.var.name),
+            expression=sp.sstr(fn.expr), variable=fn.var.name,
             interval=iv.strings, interval_float=(iv.lo_f, iv.hi_f), degree=degree, kind=kind,
             error_kind=error, coefficients=tuple(coeffs),
             abs_error_bound=cert_abs.bound, rel_error_bound=None if cert_rel is None else cert_rel.bound,
@@ -524,7 +541,7 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     max_error = float(max_error)
     error = kw["error"]
     # the arguments are checked once, by a degree-0 check of fit's own
-    quantized = kw["frac_bits"] is not None or kw["coef_format"] is not None
+    quantized = kw["coef_frac_bits"] is not None or kw["coef_format"] is not None
     constrained = kw["monomials"] is not None or kw["fix_constant"]
     _check_fit_args(0, kw["kind"], error, kw["basis"], quantized, constrained)
     fn, iv = _function_on(expr, kw["var"], interval)
@@ -542,13 +559,13 @@ def _fit_max_error(expr, interval, degree, max_error, kw):
     best = None
     for n in range(first, top + 1):
         if lower[n] > max_error:
-            tried.append(f"{n}: ruled out (>= {lower[n]:.2e})")
+            tried.append(f"{n}: ruled out (>= {format_down(lower[n], '.2e')})")
             continue
         table = fit(expr, interval, n, **{k: v for k, v in kw.items()
                                            if k not in ("segments", "segment_by", "centered")})
         bound = _delivered_bound(table, error)
         ok = bound is not None and bound <= max_error
-        tried.append(f"{n}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        tried.append(f"{n}: certified {format_up(bound, '.3e')}" + (" <= E" if ok else " > E"))
         if ok:
             best = table
             break
@@ -599,12 +616,12 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
             if lower > max_error:
                 break
         if lower > max_error:
-            tried.append(f"{count}: ruled out (>= {lower:.2e})")
+            tried.append(f"{count}: ruled out (>= {format_down(lower, '.2e')})")
             continue
         table = fit(expr, interval, degree, segments=2 ** k, segment_by=segment_by, **fields)
         bound = table.abs_error_bound if error == "abs" else table.rel_error_bound
         ok = bound is not None and bound <= max_error
-        tried.append(f"{count}: certified {bound:.3e}" + (" <= E" if ok else " > E"))
+        tried.append(f"{count}: certified {format_up(bound, '.3e')}" + (" <= E" if ok else " > E"))
         if ok:
             provenance = dict(table.provenance)
             provenance["max_error"] = repr(max_error)
@@ -614,7 +631,7 @@ def _fit_segments_auto(expr, interval, degree, max_error: float, kw):
     raise ValueError(f"no segment count up to 2^12 reaches max_error {max_error:.6g} at "
                      f"degree {degree} for {fn.expr} on [{iv.lo}, {iv.hi}] (tried: "
                      f"{'; '.join(tried[-3:])}); accepted: a larger max_error, a higher "
-                     f"degree or more coefficient bits (frac_bits)")
+                     f"degree or more coefficient bits (coef_frac_bits)")
 
 
 def _search_text(tried: list[str], what: str) -> str:
@@ -851,13 +868,13 @@ def _check_fit_args(degree, kind: str, error: str, basis: str, quantized: bool,
     if basis not in ("auto", *BASES):
         raise ValueError(f"basis {basis!r} is unknown; accepted: {', '.join(('auto', *BASES))}")
     if basis == "shifted" and (quantized or constrained):
-        raise ValueError("quantized coefficients (frac_bits, coef_format, monomials, "
+        raise ValueError("quantized coefficients (coef_frac_bits, coef_format, monomials, "
                          "fix_constant) with basis shifted are not supported; accepted: "
                          "basis monomial for quantized tables")
     if constrained and not quantized and kind != "minimax":
         raise ValueError(f"kind {kind!r} with monomials or fix_constant and no coefficient "
                          f"format; accepted: kind 'minimax' (the best real polynomial in those "
-                         f"powers), or a frac_bits or coef_format to quantize")
+                         f"powers), or a coef_frac_bits or coef_format to quantize")
     return degree
 
 
@@ -873,9 +890,9 @@ def _fit_segments(expr, interval, degree, kind, error, *, var, name, frac_bits, 
     if coef_format not in (None, "fixed") or monomials is not None or fix_constant:
         raise ValueError("coef_format, monomials and fix_constant apply to one polynomial; "
                          "accepted with segments, segment_by or centered: fixed-point "
-                         "coefficients (frac_bits F, one integer)")
+                         "coefficients (coef_frac_bits F, one integer)")
     if isinstance(frac_bits, (list, tuple)):
-        raise ValueError(f"frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
+        raise ValueError(f"coef_frac_bits {','.join(map(str, frac_bits))}: piecewise tables share "
                          f"one format; accepted: one integer")
     return piecewise_fit(expr, tuple(interval), degree, segments=segments or 1,
                          segment_by=segment_by or "uniform",
@@ -1026,7 +1043,8 @@ def _simpler_fit_notes(fn, iv, degree, error, cert_abs, cert_rel) -> list[str]:
     if not cert.maximum > 1.01 * best:
         return []
     what = "|p - f|" if error == "abs" else "|p/f - 1|"
-    return [f"the minimax fit is not minimax: its error {what} = {cert.maximum:.3e} exceeds "
+    return [f"the minimax fit is not minimax: its error {what} = {format_up(cert.maximum, '.3e')} "
+            f"exceeds "
             f"that of {name} (sampled: {best:.3e}); the exchange failed on this problem "
             f"(try a lower degree or a narrower interval); the certified bounds hold"]
 
@@ -1070,28 +1088,28 @@ def _check_table(table, argument: str) -> None:
 
 def _check_frac_bits(frac_bits, coeffs, word_bits) -> None:
     if isinstance(frac_bits, bool) or not isinstance(frac_bits, (int, np.integer)) or frac_bits < 0:
-        raise ValueError(f"frac_bits {frac_bits!r} is not a non-negative integer")
+        raise ValueError(f"coef_frac_bits {frac_bits!r} is not a non-negative integer")
     limit = 2 ** (word_bits - 1) - 1
     biggest = max(abs(c) for c in coeffs)
     if biggest == 0:
         return
     max_f = math.floor(math.log2((limit + 0.5) / biggest))
     if frac_bits > max_f + 1:  # past this, 2**frac_bits overflows a double: refuse exactly here
-        raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: the largest "
+        raise ValueError(f"coef_frac_bits {frac_bits} overflows int{word_bits}: the largest "
                          f"coefficient, {biggest:.6g}, becomes more than 2^{word_bits - 1}; "
-                         f"accepted: frac_bits <= {max_f}")
+                         f"accepted: coef_frac_bits <= {max_f}")
     for k, c in enumerate(coeffs):
         if abs(round(math.ldexp(c, frac_bits))) > limit:
-            raise ValueError(f"frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
+            raise ValueError(f"coef_frac_bits {frac_bits} overflows int{word_bits}: coefficient of "
                              f"x^{k} = {c:.6g} becomes {round(math.ldexp(c, frac_bits))}; "
-                             f"accepted: frac_bits <= {max_f}")
+                             f"accepted: coef_frac_bits <= {max_f}")
 
 
 def _frac_list(frac_bits, degree: int, coeffs, word_bits: int) -> list[int]:
     """``frac_bits`` (an integer or one per power 0..degree) as a list, checked."""
     if isinstance(frac_bits, (list, tuple)):
         if len(frac_bits) != degree + 1:
-            raise ValueError(f"frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
+            raise ValueError(f"coef_frac_bits list {list(frac_bits)} has {len(frac_bits)} entries; "
                              f"accepted: one integer, or degree + 1 = {degree + 1} integers "
                              f"(one per power 0..{degree})")
         for k, f in enumerate(frac_bits):
@@ -1123,9 +1141,9 @@ def _monomials(monomials, degree: int, fix_constant: bool) -> tuple[int, ...]:
     return tuple(mons)
 
 
-def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
+def quantize(table: CoefficientTable, coef_frac_bits=None, *, word_bits: int = 32,
              reoptimize: bool = True, coef_format: str = "fixed", monomials=None,
-             fix_constant: bool = False) -> CoefficientTable:
+             fix_constant: bool = False, frac_bits=None) -> CoefficientTable:
     """Round the coefficients to a fixed or floating format and re-certify.
 
     Parameters
@@ -1134,9 +1152,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
         A table in the monomial basis (from :func:`fit` or ``load``); one
         whose shifted basis ``basis="auto"`` chose is first refitted in
         powers of ``x``.
-    frac_bits : int or sequence of int, optional
+    coef_frac_bits : int or sequence of int, optional
         Fixed point (``coef_format="fixed"``, required there): coefficient
-        ``k`` stored with ``frac_bits`` fractional bits (one integer, or one
+        ``k`` stored with ``coef_frac_bits`` fractional bits (one integer, or one
         per power ``0..degree``) as a ``word_bits``-bit integer.
     word_bits : int, optional
         ``2 <= word_bits <= 53``: the signed integer width of fixed point.
@@ -1150,6 +1168,9 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     fix_constant : bool, optional
         Hold the constant coefficient at ``f(0)`` rounded to its format (so
         ``p(0) = f(0)`` when that is representable).
+    frac_bits : int or sequence of int, optional
+        The deprecated spelling of ``coef_frac_bits`` (a
+        :class:`~chebnorm.core.deprecation.ChebnormDeprecationWarning`).
 
     Returns
     -------
@@ -1169,7 +1190,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
 
     See Also
     --------
-    fit : fit and certify (``frac_bits=`` / ``coef_format=`` quantize at once).
+    fit : fit and certify (``coef_frac_bits=`` / ``coef_format=`` quantize at once).
     chebnorm.hw.design_horner : fixed-point hardware of a quantized table.
     chebnorm.export : C and shader code of the table.
 
@@ -1226,6 +1247,7 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     >>> s.quantized.mantissas[0::2], s.error_bound < 4e-6
     ((0, 0, 0), True)
     """
+    frac_bits = renamed(frac_bits, coef_frac_bits, "frac_bits", "coef_frac_bits", "quantize")
     _check_table(table, "table")
     if isinstance(word_bits, bool) or not isinstance(word_bits, (int, np.integer)) \
             or not 2 <= word_bits <= 53:
@@ -1246,11 +1268,11 @@ def quantize(table: CoefficientTable, frac_bits=None, *, word_bits: int = 32,
     mons = _monomials(monomials, n, fix_constant)
     if coef_format == "fixed":
         if frac_bits is None:
-            raise ValueError("coefficient format fixed needs frac_bits (an integer, or one per "
+            raise ValueError("coefficient format fixed needs coef_frac_bits (an integer, or one per "
                              "power); accepted: e.g. 14 or 14,16,18")
         fracs = _frac_list(frac_bits, n, table.coefficients, word_bits)
     elif frac_bits is not None:
-        raise ValueError(f"frac_bits applies to coefficient format fixed, not {coef_format}")
+        raise ValueError(f"coef_frac_bits applies to coefficient format fixed, not {coef_format}")
     else:
         fracs = None
     fixed = _fixed_constant(fn, coef_format, fracs[0] if coef_format == "fixed" else None) \
@@ -1397,12 +1419,13 @@ def _with_quantized(table, best, ca, cr, coef_format, mons, fracs, word_bits, fi
         return replace(table, fixed_point=fixed_point, quantized=quant, provenance=provenance)
 
 
-def _table_name(name) -> str:
-    """``name`` checked where it enters: None is ``"table"``, anything else must be
+def _table_name(name) -> str | None:
+    """``name`` checked where it enters: None stays None (the table is named after
+    its expression, interval and degree once they are read), anything else must be
     an identifier (it becomes a C function, a macro, a Verilog module)."""
     from chebnorm.core.textsafe import identifier
 
-    return "table" if name is None else identifier(name, field="name")
+    return None if name is None else identifier(name, field="name")
 
 
 def _fixed_constant(fn, coef_format: str, frac0: int | None) -> dict:

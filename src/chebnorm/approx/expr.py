@@ -70,7 +70,9 @@ __all__ = ["Function1D", "AccurateFunction1D", "UndefinedError", "parse_function
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
 
 #: the functions an expression may call, by name (one argument each; ``log``
-#: also accepts a base). Each is certified by the Arb compiler below.
+#: also accepts a base). Each is certified by the Arb compiler below; ``log2``,
+#: ``log10``, ``exp2``, ``expm1``, ``log1p``, ``rsqrt``, ``sinpi`` and ``cospi``
+#: are written with the others (``log(u)/log(2)``, ``2**u``, ``exp(u) - 1``, ...).
 FUNCTIONS: dict[str, Callable] = {
     "sqrt": sp.sqrt, "exp": sp.exp, "log": sp.log,
     "sin": sp.sin, "cos": sp.cos, "tan": sp.tan,
@@ -79,6 +81,11 @@ FUNCTIONS: dict[str, Callable] = {
     "asinh": sp.asinh, "acosh": sp.acosh, "atanh": sp.atanh,
     "erf": sp.erf, "erfc": sp.erfc, "gamma": sp.gamma,
     "Abs": sp.Abs, "abs": sp.Abs,
+    # the names a function designer types, read as the functions they name
+    "log2": lambda u: sp.log(u, 2), "log10": lambda u: sp.log(u, 10),
+    "exp2": lambda u: sp.Pow(2, u), "expm1": lambda u: sp.exp(u) - 1,
+    "log1p": lambda u: sp.log(1 + u), "rsqrt": lambda u: 1 / sp.sqrt(u),
+    "sinpi": lambda u: sp.sin(sp.pi * u), "cospi": lambda u: sp.cos(sp.pi * u),
 }
 #: the named constants an expression may use
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi, "E": sp.E}

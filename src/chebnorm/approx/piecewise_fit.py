@@ -23,6 +23,7 @@ import numpy as np
 import sympy as sp
 
 from chebnorm.core.numeric import check_int
+from chebnorm.core.textsafe import default_name
 
 from .certify import arb_enclose
 from .certify_batch import SegmentError, certify_batch
@@ -162,7 +163,7 @@ def _checked(name, segments, degree, coef_frac_bits, segment_by, fit, error, cen
     frac_bits)``."""
     from chebnorm.core.textsafe import identifier
 
-    name = identifier(name, field="name")
+    name = None if name is None else identifier(name, field="name")
     index_bits = parse_segments(segments)
     degree = check_int(degree, "degree", 0, MAX_PIECEWISE_DEGREE)
     frac_bits = check_int(coef_frac_bits, "coef_frac_bits", 0, MAX_COEF_FRAC_BITS)
@@ -221,7 +222,7 @@ def _fit_all(fn, lo, hi, segment_by, index_bits, degree, frac_bits, centered, fi
 
 def piecewise_fit(expr, interval, degree: int, *, segments=1, segment_by: str = "uniform",
                   coef_frac_bits: int = 24, centered: bool = False, fit: str = "minimax",
-                  error: str = "abs", var: str = "x", name: str = "table",
+                  error: str = "abs", var: str = "x", name: str | None = None,
                   command: str | None = None, progress=None) -> PiecewiseTable:
     """Fit, quantize and certify a piecewise polynomial table.
 
@@ -248,8 +249,10 @@ def piecewise_fit(expr, interval, degree: int, *, segments=1, segment_by: str = 
     error : {"abs", "rel"}
         The error minimized and certified (``"rel"`` certifies both).
     var, name, command : str
-        The variable of ``expr``; the table's name (an identifier); the
-        command recorded in its provenance.
+        The variable of ``expr``; the table's name (an identifier; default: made
+        from the expression, interval, degree and segment count, as
+        :func:`chebnorm.core.textsafe.default_name`); the command recorded in its
+        provenance.
     progress : callable, optional
         Run once per fitted segment (the certification of all segments together follows).
 
@@ -306,7 +309,9 @@ def piecewise_fit(expr, interval, degree: int, *, segments=1, segment_by: str = 
                                   f"coef_frac_bits={frac_bits}, centered={centered})")
     with construction("fitted"):  # certified above: checked, not proved twice
         return PiecewiseTable(
-            name=name, expression=sp.sstr(fn.expr), variable=fn.var.name,
+            name=name or default_name(sp.sstr(fn.expr), (sp.sstr(lo), sp.sstr(hi)), degree,
+                                      fn.var.name, segments=len(out)),
+            expression=sp.sstr(fn.expr), variable=fn.var.name,
             interval=(sp.sstr(lo), sp.sstr(hi)), segment_by=segment_by, index_bits=index_bits,
             degree=degree, centered=centered, fit=fit, error_kind=error,
             coef_frac_bits=frac_bits, segments=tuple(out),

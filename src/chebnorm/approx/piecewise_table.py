@@ -52,7 +52,7 @@ import sympy as sp
 from flint import arb
 
 from chebnorm.core.display import summary_repr
-from chebnorm.core.numeric import arb_precision, signed_bits
+from chebnorm.core.numeric import arb_precision, format_up, signed_bits
 
 from .certify import arb_enclose, certify
 from .certify_batch import certify_batch
@@ -329,7 +329,7 @@ class PiecewiseTable(Table):
         located = [getattr(seg, f"max_{kind}_error") for seg in self.segments]
         s = max(range(len(located)), key=located.__getitem__)
         return (f"{located[s]:.6e} in segment {s}; certified bound "
-                f"{getattr(self, f'{kind}_error_bound'):.6e}")
+                f"{format_up(getattr(self, f'{kind}_error_bound'), '.6e')}")
 
     def error_curve(self, points: int = 801, error: str = "abs"):
         """``(x, g)``: the error ``g = p - f`` (``error="abs"``) or ``p/f - 1``
@@ -407,7 +407,8 @@ class PiecewiseTable(Table):
         label = "p - f" if error == "abs" else "p/f - 1"
         ax.plot(x, g, color="C0", lw=1.0,
                 label=f"{label} ({self.segment_count} segments of degree {self.degree})")
-        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {bound:.3e}")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound "
+                                                             f"{format_up(bound, '.3e')}")
         ax.axhline(-bound, color="C0", ls="--", lw=0.8)
         for s, seg in enumerate(self.segments):
             a, b = (float(v) for v in self.segment_bounds(s))
@@ -491,7 +492,7 @@ def _prove(table: PiecewiseTable) -> None:
             if bound < certs[s].bound:
                 raise ValueError(f"segments[{s}].{kind}_error_bound: stated {bound:.2e} but "
                                  f"the certified error of segment {s} is "
-                                 f"{certs[s].bound:.2e}")
+                                 f"{format_up(certs[s].bound, '.2e')}")
             check_maximum(f"segments[{s}].max_{kind}_error", maximum,
                           f"segments[{s}].{kind}_error_bound", bound, certs[s], "t")
 

@@ -32,6 +32,7 @@ Internal: the public entry point is :func:`chebnorm.approx.quantize`.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -130,10 +131,8 @@ def normal_pair(m: int, s: int) -> tuple[int, int]:
     """
     if m == 0:
         return 0, 0
-    while m % 2 == 0:
-        m //= 2
-        s += 1
-    return m, s
+    zeros = (m & -m).bit_length() - 1     # trailing zero bits (two's complement)
+    return m >> zeros, s + zeros
 
 
 def representable(m: int, s: int, fmt: str) -> bool:
@@ -217,28 +216,37 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool,
     return out
 
 
-def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None):
+def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cache=None,
+             xp=None):
     """Integer vectors ``n`` (one per free power) near the weighted function values.
 
     ``base`` (integers, one per free power: the real fit rounded) is subtracted
     from the target first and added back to the answers: the lattice then
     resolves the residual, a few quanta, instead of f itself, whose size would
     leave the small columns (high powers at small points) only a few bits once
-    everything is scaled to 62-bit integers.
+    everything is scaled to 62-bit integers. ``xp``: the powers of ``points``
+    (a :class:`_Powers`), kept across calls on the same points.
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    xe = {e: clib.power(x, e) for e in powers}    # libm's pow, not numpy's loop (CPU)
+    xp = _Powers(x) if xp is None else xp         # libm's pow, not numpy's loop (CPU)
+    xe = {e: xp[e] for e in powers}
     vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
     y = w * (np.asarray(f_vals, dtype=float) - fixed_poly(x)
              - sum(math.ldexp(b, s) * xe[e] for b, e, s in zip(base, powers, quanta)))
-    big = max(max(float(np.max(np.abs(v))) for v in vecs), float(np.max(np.abs(y))), 1e-300)
+    vecs = np.array(vecs)
+    big = max(float(np.max(np.abs(vecs))), float(np.max(np.abs(y))), 1e-300)
     shift = 62 - math.frexp(big)[1]
     def ints(v):
-        return [int(round(math.ldexp(float(a), shift))) for a in v]
-    basis = [ints(v) for v in vecs]
-    if any(all(a == 0 for a in row) for row in basis):
+        v = np.asarray(v, dtype=float)
+        if np.all(np.isfinite(v)):            # |v| 2^shift < 2^62: exact in int64
+            return np.rint(np.ldexp(v, shift)).astype(np.int64).tolist()
+        if v.ndim == 2:
+            return [ints(row) for row in v]
+        return [int(round(math.ldexp(float(a), shift))) for a in v]   # raises as before
+    basis = ints(vecs)
+    if any(not any(row) for row in basis):
         return []
     try:
         vecs = _babai(basis, ints(y), spread=True, cache=cache)
@@ -274,25 +282,82 @@ class Problem:
     reductions: dict = field(default_factory=dict, repr=False)
 
 
+class _Powers:
+    """``x ** k`` (:func:`chebnorm.core.clib.power`, element by element) of the
+    points ``x``, each power computed when first asked for and kept; or, with
+    ``parent`` and ``index``, ``parent[k][index]`` (the same floats: every
+    element is computed on its own)."""
+
+    def __init__(self, x: np.ndarray, parent: "_Powers | None" = None, index=None):
+        self.x, self.parent, self.index = x, parent, index
+        self.cache: dict[int, np.ndarray] = {}
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        v = self.cache.get(k)
+        if v is None:
+            v = (clib.power(self.x, k) if self.parent is None
+                 else self.parent[k][self.index])
+            v.flags.writeable = False
+            self.cache[k] = v
+        return v
+
+
+# at most 8 grids kept, each up to ~1 MB (6000 points, f, weights, powers, views)
+@functools.lru_cache(maxsize=8)
+def _sample_grid(f_np, lo: float, hi: float, kind: str, samples: int):
+    """The sampler's points inside ``(lo, hi)``, ``f`` there, the weights and
+    the powers of the points (read-only, powers computed as asked for):
+    they depend only on the function, the interval, the error kind and the
+    count, so every quantization of one function on one interval (the parity
+    sub-basis and the whole basis, several formats or bit counts) shares them,
+    as :func:`chebnorm.approx.certify._search_grid` shares its grid."""
+    x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
+    x = np.clip(x, lo, hi)
+    with np.errstate(all="ignore"):
+        fx = np.asarray(f_np(x), dtype=float) * np.ones_like(x)
+    ok = np.isfinite(fx) & (x > lo) & (x < hi)
+    if kind == "rel":
+        ok &= fx != 0
+    x, f = x[ok], fx[ok]
+    w = 1.0 / np.abs(f) if kind == "rel" else np.ones_like(f)
+    for a in (x, f, w):
+        a.flags.writeable = False
+    return _Grid(x, f, w, _Powers(x))
+
+
+class _Grid:
+    """Points, ``f`` there, weights and powers (read-only), with the views
+    of them the sampler takes (every ``step``-th point, the points sorted),
+    each built once."""
+
+    def __init__(self, x, f, w, xp):
+        self.x, self.f, self.w, self.xp = x, f, w, xp
+        self.views: dict = {}
+
+    def view(self, key, index) -> "_Grid":
+        """The grid at ``x[index]`` (``key`` names the view)."""
+        got = self.views.get(key)
+        if got is None:
+            x, f, w = self.x[index], self.f[index], self.w[index]
+            for a in (x, f, w):
+                a.flags.writeable = False
+            got = self.views[key] = _Grid(x, f, w, _Powers(x, self.xp, index))
+        return got
+
+
 class _Sampler:
     """Sampled weighted error of candidate polynomials (a lower bound of the
     supremum up to the float evaluation error, which is accounted for)."""
 
     def __init__(self, prob: Problem, samples: int = 4097):
-        lo, hi = prob.lo_f, prob.hi_f
-        x = np.concatenate([np.linspace(lo, hi, samples), chebyshev_nodes(lo, hi, samples // 2)])
-        x = np.clip(x, lo, hi)
-        with np.errstate(all="ignore"):
-            fx = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
-        ok = np.isfinite(fx) & (x > lo) & (x < hi)
-        if prob.error_kind == "rel":
-            ok &= fx != 0
-        self.x, self.f = x[ok], fx[ok]
-        self.w = 1.0 / np.abs(self.f) if prob.error_kind == "rel" else np.ones_like(self.f)
-        self.xp = {k: clib.power(self.x, k) for k in range(prob.degree + 1)}
+        self._use(_sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f, prob.error_kind, samples))
         self.point_sets: dict = {}            # real coefficients -> _point_sets
         self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
         self._thin = None
+
+    def _use(self, grid: "_Grid") -> None:
+        self.grid = grid
+        self.x, self.f, self.w, self.xp = grid.x, grid.f, grid.w, grid.xp
 
     def thinned(self, step: int = 16) -> "_Sampler":
         """Every ``step``-th of these points: the error of a polynomial there
@@ -300,17 +365,23 @@ class _Sampler:
         its error on all the points (a cheaper lower bound of that)."""
         if self._thin is None:
             thin = object.__new__(_Sampler)
-            thin.x, thin.f, thin.w = self.x[::step], self.f[::step], self.w[::step]
-            thin.xp = {k: v[::step] for k, v in self.xp.items()}
+            thin._use(self.grid.view(("thin", step), slice(None, None, step)))
             self._thin = thin
         return self._thin
+
+    def ordered(self) -> "_Sampler":
+        """These points in increasing order (with ``f``, weights and powers)."""
+        srt = object.__new__(_Sampler)
+        grid = self.grid.views.get("sorted") or self.grid.view("sorted", np.argsort(self.x))
+        srt._use(grid)
+        return srt
 
     def zeros(self, coeffs) -> np.ndarray:
         """Where the error of the real polynomial ``coeffs`` changes sign (its
         interpolation points, linearly interpolated between samples)."""
-        order = np.argsort(self.x)
-        x, f = self.x[order], self.f[order]
-        p = sum(c * self.xp[k][order] for k, c in enumerate(coeffs))
+        srt = self.ordered()
+        x, f = srt.x, srt.f
+        p = sum(c * srt.xp[k] for k, c in enumerate(coeffs))
         g = p - f
         idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]
         t = g[idx] / (g[idx] - g[idx + 1])
@@ -335,16 +406,27 @@ class _Sampler:
         out: list[float] = []
         if not self.x.size:
             return [0.0] * len(rows)
+        absf = np.abs(self.f)
         for i in range(0, len(rows), chunk):
             c = np.array(rows[i:i + chunk], dtype=float)
             p = np.zeros((len(c), self.x.size))
             mag = np.zeros_like(p)
+            term = np.empty_like(p)
             for k in range(c.shape[1]):
-                term = c[:, k:k + 1] * self.xp[k]
+                if not c[:, k].any():         # a zero column adds zeros: no sum changes
+                    continue
+                np.multiply(c[:, k:k + 1], self.xp[k], out=term)
                 p += term
-                mag += np.abs(term)
-            err = self.w * (np.abs(p - self.f) - 2.0 ** -50 * (mag + np.abs(self.f)))
-            out.extend(float(v) for v in np.max(err, axis=1))
+                np.abs(term, out=term)
+                mag += term
+            # w * (|p - f| - 2^-50 (mag + |f|)), the same operations in place
+            p -= self.f
+            np.abs(p, out=p)
+            mag += absf
+            mag *= 2.0 ** -50
+            p -= mag
+            p *= self.w
+            out.extend(float(v) for v in np.max(p, axis=1))
         return out
 
 
@@ -460,7 +542,8 @@ def _point_sets(prob, sampler, real) -> list:
             fv = np.asarray(prob.fn.numpy(pts), dtype=float) * np.ones_like(pts)
         if not np.all(np.isfinite(fv)) or (prob.error_kind == "rel" and np.any(fv == 0)):
             continue
-        out.append((pts, fv, 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv)))
+        out.append((pts, fv, 1.0 / np.abs(fv) if prob.error_kind == "rel" else np.ones_like(fv),
+                    _Powers(pts)))
     sampler.point_sets[key] = out
     return out
 
@@ -472,11 +555,11 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     # each free coefficient rounded to nearest
     cands["rounded"] = _full(prob, {k: (round(math.ldexp(real[k], -quanta[k])), quanta[k])
                                     for k in prob.powers})
-    for pts, fv, w in (_point_sets(prob, sampler, real) if lattice else ()):
+    for pts, fv, w, xp in (_point_sets(prob, sampler, real) if lattice else ()):
         count = len(pts)
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
                         [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
-                        prob.reductions)
+                        prob.reductions, xp)
         for j, ints in enumerate(vecs):
             cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
                 prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
@@ -504,27 +587,50 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
 def _to_monomial(prob: Problem, cheb) -> list[float]:
     """:func:`chebnorm.approx.fitting.cheb_to_monomial` on the problem's
     interval, the same exact rationals rounded once (so the same floats): the
-    monomial coefficients of each ``T_k(u(x))`` are kept, and each answer is
-    an exact sum of their multiples."""
-    from flint import fmpq_poly
+    monomial coefficients of each ``T_k(u(x))`` are kept (:func:`_cheb_rows`),
+    and each answer is an exact sum of their multiples (one exact
+    matrix-vector product)."""
+    from flint import fmpq_mat
+
+    from .fitting import exact_rational
+
+    n = len(cheb)
+    rows = _cheb_rows(float(prob.lo_f), float(prob.hi_f), n)
+    total = rows * fmpq_mat(n, 1, [exact_rational(c) for c in cheb])
+    return [int(t.p) / int(t.q) for t in total.entries()]
+
+
+@functools.lru_cache(maxsize=256)
+def _cheb_rows(lo: float, hi: float, n: int):
+    """The exact ``n x n`` matrix (fmpq_mat) whose column ``k`` holds the
+    monomial coefficients (powers ``0..n-1`` of ``x``) of ``T_k(u(x))``, ``u``
+    mapping ``[lo, hi]`` onto ``[-1, 1]``; read only."""
+    from flint import fmpq_mat, fmpq_poly
 
     from .fitting import chebyshev_t, exact_rational
 
-    n = len(cheb)
-    key = ("mono", n)
-    rows = prob.greedy_nodes.get(key)
-    if rows is None:
-        lo_q, hi_q = exact_rational(float(prob.lo_f)), exact_rational(float(prob.hi_f))
-        sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
-        rows = prob.greedy_nodes[key] = [
-            (chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
-    exact = [exact_rational(c) for c in cheb]
-    out = []
-    for j in range(n):
-        total = sum((exact[k] * rows[k][j] for k in range(j, n) if rows[k][j] != 0),
-                    exact_rational(0.0))
-        out.append(int(total.p) / int(total.q))
-    return out
+    lo_q, hi_q = exact_rational(lo), exact_rational(hi)
+    sub = fmpq_poly([(-lo_q - hi_q) / (hi_q - lo_q), 2 / (hi_q - lo_q)])
+    cols = [(chebyshev_t(k)(sub).coeffs() + [0] * n)[:n] for k in range(n)]
+    return fmpq_mat(n, n, [cols[k][j] for j in range(n) for k in range(n)])
+
+
+@functools.lru_cache(maxsize=128)
+def _greedy_nodes(f_np, lo: float, hi: float, n: int, k: int):
+    """:func:`greedy`'s step ``k`` (degree ``n``): the ``k`` Chebyshev nodes of
+    ``[lo, hi]``, their powers ``k..n``, ``f`` there and the transposed
+    Chebyshev-Vandermonde matrix (read-only; shared by every quantization
+    of one function on one interval)."""
+    cheb_deg = k - 1
+    t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
+    x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+    with np.errstate(all="ignore"):
+        fx = np.array(f_np(x))
+    xj = {j: clib.power(x, j) for j in range(k, n + 1)}
+    vander_t = np.polynomial.chebyshev.chebvander(t, cheb_deg).T
+    for a in (fx, vander_t, *xj.values()):
+        a.flags.writeable = False
+    return xj, fx, vander_t
 
 
 def greedy(prob: Problem, real, quanta) -> list[int] | None:
@@ -546,14 +652,7 @@ def greedy(prob: Problem, real, quanta) -> list[int] | None:
         high = {j: math.ldexp(q, quanta[j]) for j, q in ints.items()}
         nodes = prob.greedy_nodes.get(k)
         if nodes is None:                     # the same at every set of quanta
-            cheb_deg = k - 1
-            t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
-            x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
-            with np.errstate(all="ignore"):
-                fx = f_np(x)
-            nodes = prob.greedy_nodes[k] = (
-                {j: clib.power(x, j) for j in range(k, n + 1)}, fx,
-                np.polynomial.chebyshev.chebvander(t, cheb_deg).T)
+            nodes = prob.greedy_nodes[k] = _greedy_nodes(f_np, lo, hi, n, k)
         xj, fx, vander_t = nodes
         # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
         # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
@@ -648,13 +747,10 @@ def _peaks(prob: Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[flo
     """Where the error of ``coeffs`` has its local maxima (every one: a
     near-minimax error has ``n + 2`` of nearly one height), each found on the
     sampler's grid and refined by ``zooms`` denser grids around it."""
-    order = np.argsort(sampler.x)
-    x = sampler.x[order]
+    thin = sampler.ordered()
+    x = thin.x
     if x.size < 3:
         return []
-    thin = object.__new__(_Sampler)
-    thin.x, thin.f, thin.w = x, sampler.f[order], sampler.w[order]
-    thin.xp = {k: v[order] for k, v in sampler.xp.items()}
     err = _point_errors(prob, x, coeffs, thin)
     inner = np.nonzero((err[1:-1] >= err[:-2]) & (err[1:-1] >= err[2:]))[0] + 1
     tops = [i for i in sorted(set(inner.tolist()) | {0, x.size - 1})

@@ -10,13 +10,13 @@ from __future__ import annotations
 import math
 import re
 import shutil
-import subprocess
 import tempfile
 from dataclasses import dataclass
 
 import sympy as sp
 
 from .expr import parse_function, parse_number
+from chebnorm.core.tools import run_tool
 
 __all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "function_text",
            "interval_text", "FpminimaxCase", "fpminimax"]
@@ -131,8 +131,7 @@ def _run(script: str, timeout: float = 600) -> str:
         fh.write(script + "quit;\n")
         path = fh.name
     try:
-        proc = subprocess.run(["sollya", "--warnonstderr", path], capture_output=True, text=True,
-                              timeout=timeout, stdin=subprocess.DEVNULL)
+        proc = run_tool(["sollya", "--warnonstderr", path], tool="sollya", timeout=timeout)
     finally:
         import os
         os.unlink(path)
@@ -369,8 +368,9 @@ def fpminimax(cases, accuracy: float = 2.0 ** -20, timeout: float = 1200):
     ------
     RuntimeError
         When the Sollya process fails.
-    subprocess.TimeoutExpired
-        When it runs longer than ``timeout``.
+    chebnorm.core.tools.ToolTimeout
+        When it runs longer than ``timeout`` (a ``ValueError``
+        and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
     parts = ["prec=300!;", "display=dyadic!;", "verbosity=0!;"]
     for i, c in enumerate(cases):

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from chebnorm.core.display import summary_html, summary_repr
+from chebnorm.core.numeric import format_down, format_up
 
 from .basis_choice import BasisChoice, read_basis_choice
 from .contract import Table
@@ -298,7 +299,7 @@ class CoefficientTable(Table):
         >>> fit("exp(x)", ("0", "1"), 2, basis="shifted").require_monomial("hw")
         Traceback (most recent call last):
         ...
-        ValueError: table 'table' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
+        ValueError: table 'exp_0_1_d2' is stored in the shifted variable t = (x - 0.5)/0.5; hw: plain powers of x only; accepted: a table fitted with basis='monomial'
         """
         if self.shift is not None:
             c, s = self.shift
@@ -590,39 +591,50 @@ class CoefficientTable(Table):
             ("degree, kind", f"{self.degree}, {self.kind} ({self.error_kind} error)"),
             ("coefficients", ", ".join(repr(c) for c in self.coefficients)
              + f" (ascending powers of {self.variable})"),
-            ("max |p - f|", f"{self.max_abs_error:.6e} at {self.variable} = {self.max_abs_at!r}; "
-                            f"certified bound {self.abs_error_bound:.6e}"),
+            ("max |p - f|", f"{format_down(self.max_abs_error, '.6e')} at {self.variable} = "
+                            f"{self.max_abs_at!r}; "
+                            f"certified bound {format_up(self.abs_error_bound, '.6e')}"),
         ]
         if self.max_rel_error is not None and self.rel_error_bound is not None:
-            rows.append(("max |p/f - 1|", f"{self.max_rel_error:.6e} at {self.variable} = "
+            rows.append(("max |p/f - 1|", f"{format_down(self.max_rel_error, '.6e')} at "
+                                          f"{self.variable} = "
                                           f"{self.max_rel_at!r}; certified bound "
-                                          f"{self.rel_error_bound:.6e}"))
+                                          f"{format_up(self.rel_error_bound, '.6e')}"))
         fp = self.fixed_point
         if fp is not None:
             rows.append(("fixed point", f"{fp.frac_bits} fractional bits, int{fp.word_bits}, "
                                         f"{fp.method}: " + ", ".join(str(q) for q in fp.integers)))
-            rows.append(("fixed max |p - f|", f"{fp.max_abs_error:.6e}; certified bound "
-                                              f"{fp.abs_error_bound:.6e}"))
+            rows.append(("fixed max |p - f|", f"{format_down(fp.max_abs_error, '.6e')}; certified "
+                                              f"bound "
+                                              f"{format_up(fp.abs_error_bound, '.6e')}"))
             if fp.max_rel_error is not None and fp.rel_error_bound is not None:
-                rows.append(("fixed max |p/f - 1|", f"{fp.max_rel_error:.6e}; certified bound "
-                                                    f"{fp.rel_error_bound:.6e}"))
+                rows.append(("fixed max |p/f - 1|", f"{format_down(fp.max_rel_error, '.6e')}; "
+                                                    f"certified bound "
+                                                    f"{format_up(fp.rel_error_bound, '.6e')}"))
         q = self.quantized
         if q is not None and fp is None:
             rows.append(("quantized", f"{q.format} ({q.method}), powers "
                                       f"{','.join(map(str, q.monomials))}: "
                                       + ", ".join(repr(c) for c in q.coefficients)))
-            rows.append(("quantized max |p - f|", f"{q.max_abs_error:.6e}; certified bound "
-                                                  f"{q.abs_error_bound:.6e}"))
+            rows.append(("quantized max |p - f|", f"{format_down(q.max_abs_error, '.6e')}; "
+                                                  f"certified bound "
+                                                  f"{format_up(q.abs_error_bound, '.6e')}"))
         if self.provenance:
             rows.append(("provenance", "; ".join(f"{k}: {v}" for k, v in sorted(self.provenance.items()))))
         return rows
 
-    def error_curve(self, points: int = 801, error: str = "abs", fixed: bool = False):
+    def error_curve(self, points: int = 801, error: str = "abs", fixed: bool = False,
+                    quantized: bool = False, binary32: bool = False):
         """``(x, g)``: the error ``g = p - f`` (``error="abs"``) or
         ``p/f - 1`` (``"rel"``) at ``points`` equally spaced floats of the
         interval, evaluated in mpmath at 40 significant digits (the float
         coefficients exactly, so even an error near zero keeps its digits).
-        ``fixed=True`` uses the fixed-point coefficients.
+        ``fixed=True`` uses the fixed-point coefficients, ``quantized=True`` the
+        quantized ones in any format. ``binary32=True`` measures a binary32
+        Horner evaluation instead (the coefficients, quantized ones if any,
+        rounded to binary32, ``x`` rounded to binary32 and every step in
+        binary32 without fma): a measurement at these points, not a bound (the
+        exported evaluators state their bounds).
 
         >>> from chebnorm.approx import fit
         >>> t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z")
@@ -640,26 +652,51 @@ class CoefficientTable(Table):
             raise ValueError(f"points must be an integer >= 2; got {points!r}")
         if fixed and self.fixed_point is None:
             raise ValueError(f"table {self.name!r} has no fixed-point part")
-        coeffs = self.fixed_point.coefficients if fixed else self.coefficients
+        if quantized and self.quantized is None:
+            raise ValueError(f"table {self.name!r} has no quantized part")
+        coeffs = (self.fixed_point.coefficients if fixed else
+                  self.quantized.coefficients if quantized else self.coefficients)
         fn = parse_function(self.expression, self.variable)
         f_mp = fn.mpmath
         x = np.linspace(self.interval_float[0], self.interval_float[1], points)
-        g = np.empty(points)
+        if binary32:
+            if self.quantized is not None:
+                coeffs = self.quantized.coefficients
+            x = x.astype(np.float32).astype(np.float64)
+            x = x[(x >= self.interval_float[0]) & (x <= self.interval_float[1])]
+            c32 = np.array(coeffs, dtype=np.float64).astype(np.float32)
+            x32 = x.astype(np.float32)
+            if self.shift is not None:
+                t32 = (x32 - np.float32(self.shift[0])) / np.float32(self.shift[1])
+            else:
+                t32 = x32
+            acc = np.full_like(x32, c32[-1])
+            for c in c32[-2::-1]:
+                acc = (acc * t32).astype(np.float32) + c
+            values = acc.astype(np.float64)
+        g = np.empty(len(x))
         with mpmath.workdps(40):
             for i, xi in enumerate(x):
                 xm = mpmath.mpf(float(xi))
-                p = mpmath.mpf(0)
-                tm = _local_mp(self, xm)   # the shifted variable of a shifted table
-                for c in reversed(coeffs):
-                    p = p * tm + mpmath.mpf(c)
+                if binary32:
+                    p = mpmath.mpf(float(values[i]))
+                else:
+                    p = mpmath.mpf(0)
+                    tm = _local_mp(self, xm)   # the shifted variable of a shifted table
+                    for c in reversed(coeffs):
+                        p = p * tm + mpmath.mpf(c)
                 f = f_mp(xm)
                 g[i] = float(p - f) if error == "abs" else float(p / f - 1)
         return x, g
 
-    def plot(self, ax=None, error: str = "abs", points: int = 801):
+    def plot(self, ax=None, error: str = "abs", points: int = 801, binary32: bool = True):
         """Plot the error curve ``p - f`` (``error="rel"``: ``p/f - 1``) over
         the interval with the certified bound ``+-bound`` and the located
-        maximum; a fixed-point part is drawn too. Returns the matplotlib Axes.
+        maximum, and every evaluator the table has: its quantized part (fixed
+        point or a float format) with its own certified bound, and (``binary32``)
+        the error measured of a binary32 Horner evaluation. Bounds are printed
+        rounded up. A new figure is laid out so that every label fits. Returns
+        the matplotlib Axes.
 
         >>> import matplotlib
         >>> matplotlib.use("Agg")
@@ -668,29 +705,38 @@ class CoefficientTable(Table):
         >>> type(ax).__name__
         'Axes'
         """
+
         if error == "rel" and self.rel_error_bound is None:
             raise ValueError(f"table {self.name!r} has no relative error (f vanishes on the interval)")
         if ax is None:
             import matplotlib.pyplot as plt
 
-            _, ax = plt.subplots(figsize=(6.4, 3.6))
+            _, ax = plt.subplots(figsize=(6.4, 3.8), layout="constrained")
         x, g = self.error_curve(points, error)
         bound = self.abs_error_bound if error == "abs" else self.rel_error_bound
         label = "p - f" if error == "abs" else "p/f - 1"
         ax.plot(x, g, color="C0", lw=1.2, label=f"{label} (degree {self.degree}, {self.kind})")
-        ax.axhline(bound, color="C0", ls="--", lw=0.8, label=f"certified bound {bound:.3e}")
+        ax.axhline(bound, color="C0", ls="--", lw=0.8,
+                   label=f"certified bound {format_up(bound, '.3e')}")
         ax.axhline(-bound, color="C0", ls="--", lw=0.8)
         at = self.max_abs_at if error == "abs" else self.max_rel_at
         if at is not None:
             _, g_at = _point_error(self, at, error)
             ax.plot([at], [g_at], "o", color="C0", ms=4, label=f"located maximum at {at:.6g}")
-        fp = self.fixed_point
-        fixed_bound = None if fp is None else (fp.abs_error_bound if error == "abs" else fp.rel_error_bound)
-        if fixed_bound is not None:
-            _, gq = self.error_curve(points, error, fixed=True)
-            ax.plot(x, gq, color="C1", lw=1.0, label=f"fixed point, {fp.frac_bits} fractional bits")
-            ax.axhline(fixed_bound, color="C1", ls=":", lw=0.8, label=f"its bound {fixed_bound:.3e}")
-            ax.axhline(-fixed_bound, color="C1", ls=":", lw=0.8)
+        q = self.quantized
+        q_bound = None if q is None else (q.abs_error_bound if error == "abs" else q.rel_error_bound)
+        if q_bound is not None:
+            _, gq = self.error_curve(points, error, quantized=True)
+            what = (f"fixed point, {','.join(map(str, sorted(set(q.frac_bits))))} fractional bits"
+                    if q.format == "fixed" else f"{q.format} coefficients")
+            ax.plot(x, gq, color="C1", lw=1.0, label=what)
+            ax.axhline(q_bound, color="C1", ls=":", lw=0.8,
+                       label=f"its bound {format_up(q_bound, '.3e')}")
+            ax.axhline(-q_bound, color="C1", ls=":", lw=0.8)
+        if binary32:
+            x32, g32 = self.error_curve(points, error, binary32=True)
+            ax.plot(x32, g32, color="C2", lw=0.6, alpha=0.8,
+                    label="binary32 Horner, measured (the export states its bound)")
         ax.axhline(0.0, color="0.6", lw=0.5)
         ax.set_xlabel(self.variable)
         ax.set_ylabel(label)

@@ -43,7 +43,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``chebnorm`` argument parser, one subcommand per task (see the
-    README's CLI reference).
+    manual's command-line page, docs/cli.md).
 
     Returns
     -------

@@ -124,6 +124,10 @@ def run(args) -> int:
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
     best = _best_other(others)
     if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
+        # the plot shows the one-width search: say that another architecture won
+        files[f"design_{name}.png"] = res.plot_png(
+            winner="best one-width piecewise",
+            note=f"winner: {best.architecture}, score {best.cost.score:.1f} (not on this plot)")
         return _write_architectures(args, out, name, others, res, files)
     # the winner's place and route may fail (too large for the device): before writing
     figures = winner_figures(res) if res.winner.target_cost is not None and \
@@ -231,6 +235,7 @@ def _search(args, name, target, max_error, bound=None, synth=None, workers=None)
     cannot beat it is not synthesized); ``synth``: False for the model only
     (default: unless ``--no-synth``); ``workers``: instead of ``--workers``."""
     from chebnorm.approx.piecewise_table import parse_segments
+    from chebnorm.core.numeric import format_up
     from chebnorm.hw.piecewise_search import search
 
     res = search(args.expr, tuple(args.interval), args.in_bits, args.out_bits, max_error,
@@ -239,10 +244,11 @@ def _search(args, name, target, max_error, bound=None, synth=None, workers=None)
                  name=name, target=target,
                  bound=bound, **dict(parallel_kwargs(args), **(
                      {} if workers is None else {"workers": workers, "scheduler": None})))
-    if res.winner is None:  # one line, exit 2, nothing written (README: CLI reference)
+    if res.winner is None:  # one line, exit 2, nothing written (docs/cli.md)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets --max-error {max_error:.4g}: the smallest "
-                         f"certified error reached is {best.total_bound:.4g} (degree {best.degree}, "
+                         f"certified error reached is {format_up(best.total_bound, '.4g')} "
+                         f"(degree {best.degree}, "
                          f"{best.segments} segments, {best.coef_frac_bits} coefficient bits); "
                          f"accepted: a larger --max-error, or more --max-segments, --degrees "
                          f"or --out-bits")
@@ -317,6 +323,8 @@ def _architectures_csv(others, res, winner) -> str:
     import csv as csvmod
     import io
 
+    from chebnorm.core.numeric import format_up
+
     from chebnorm.core.textsafe import csv_cell
 
     buf = io.StringIO()
@@ -329,7 +337,7 @@ def _architectures_csv(others, res, winner) -> str:
         w.writerow(["piecewise", csv_cell(p.describe()), f"{_score(p):.1f}",
                     "" if c is None else c.cells, "" if c is None else c.luts,
                     "" if c is None else c.dsps, "" if c is None else c.carries,
-                    "" if c is None else c.brams, f"{p.total_bound:.6e}", "",
+                    "" if c is None else c.brams, f"{format_up(p.total_bound, '.6e')}", "",
                     int(winner is None), ""])
     for o in others:
         c = o.cost
@@ -337,7 +345,7 @@ def _architectures_csv(others, res, winner) -> str:
                     "" if c is None else f"{c.score:.1f}", "" if c is None else c.cells,
                     "" if c is None else c.luts, "" if c is None else c.dsps,
                     "" if c is None else c.carries, "" if c is None else c.brams,
-                    "" if o.error is None else f"{o.error:.6e}",
+                    "" if o.error is None else f"{format_up(o.error, '.6e')}",
                     "" if o.ulp is None else f"{o.ulp:.6e}", int(o is winner), csv_cell(o.note)])
     return buf.getvalue()
 
@@ -536,6 +544,7 @@ def hw_report(args, table) -> int:
         When an option does not apply to a piecewise table (the coefficient
     and datapath widths, a ``--rounding`` other than rne).
     """
+    from chebnorm.core.numeric import format_down, format_up
     from chebnorm.hw.piecewise import piecewise_cells
     from chebnorm.hw.piecewise_search import model_cost
 
@@ -560,10 +569,13 @@ def hw_report(args, table) -> int:
         return 0
     print(f"{d.module_name}: {d.table.segment_count} segments x degree {d.degree}, "
           f"{d.in_bits}-bit in / {d.out_bits}-bit out, ROM words {list(d.rom_bits)} bits")
-    print(f"error budget |y - f(x)| <= {b['total']:.4e} = approximation "
-          f"{b['approximation']:.4e} + Horner rounding {b['horner_rounding']:.4e} + output "
-          f"rounding {b['output_rounding']:.4e} ({b['total'] / b['y_lsb']:.3f} LSB)")
-    print(f"measured over all {m['codes']} codes: max |y - f(x)| = {m['max_error']:.4e} at code "
+    print(f"error budget |y - f(x)| <= {format_up(b['total'], '.4e')} = approximation "
+          f"{format_up(b['approximation'], '.4e')} + Horner rounding "
+          f"{format_up(b['horner_rounding'], '.4e')} + output "
+          f"rounding {format_up(b['output_rounding'], '.4e')} "
+          f"({format_up(b['total'] / b['y_lsb'], '.3f')} LSB)")
+    print(f"measured over all {m['codes']} codes: max |y - f(x)| = "
+          f"{format_down(m['max_error'], '.4e')} at code "
           f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
     print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
     if fig is not None:

@@ -55,6 +55,10 @@ def run_exponent(args) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ValueError(f"output {args.output!r} exists and is not a folder; accepted: a folder")
+    if getattr(args, "frequency", None) is not None:   # never silently ignored
+        raise ValueError(f"--frequency {str(args.frequency)[:40]}: not available with --index "
+                         f"exponent (its winner is written combinational); accepted: without "
+                         f"--frequency, or --index uniform")
     if args.correctly_rounded:
         raise ValueError("--correctly-rounded: not available with --index exponent (the "
                          "mantissa is faithful at best); accepted: --faithful or --max-error E")
@@ -114,17 +118,22 @@ def run_exponent(args) -> int:
 
 
 def _line(d, cost) -> str:
+    from chebnorm.core.numeric import format_up
     b = d.budget()
     c = "not synthesized" if cost is None else cost.line()
     return (f"exponent: degree {d.degree}, {d.core.table.segment_count} segments on [1, 4) "
             f"({d.core.table.segment_count // 2} per binade), mantissa {d.mant_bits} bits + "
-            f"shift {d.shift_bits} bits: {c}; certified mantissa error {b['mantissa']:.4e} "
-            f"({b['mantissa'] * 2.0 ** d.frac_bits:.3f} ulp), relative < {b['relative']:.4e}")
+            f"shift {d.shift_bits} bits: {c}; certified mantissa error "
+            f"{format_up(b['mantissa'], '.4e')} "
+            f"({format_up(b['mantissa'] * 2.0 ** d.frac_bits, '.3f')} ulp), relative < "
+            f"{format_up(b['relative'], '.4e')}")
 
 
 def _csv(found, best) -> str:
     import csv as csvmod
     import io
+
+    from chebnorm.core.numeric import format_up
 
     buf = io.StringIO()
     w = csvmod.writer(buf, lineterminator="\n")
@@ -135,6 +144,7 @@ def _csv(found, best) -> str:
                     "" if c is None else f"{c.score:.1f}", "" if c is None else c.cells,
                     "" if c is None else c.luts, "" if c is None else c.dsps,
                     "" if c is None else c.carries, "" if c is None else c.brams,
-                    f"{d.budget()['mantissa']:.6e}", f"{math.ldexp(1.0, -d.frac_bits):.6e}",
+                    format_up(d.budget()['mantissa'], '.6e'),
+                    f"{math.ldexp(1.0, -d.frac_bits):.6e}",
                     int(d is best[0])])
     return buf.getvalue()

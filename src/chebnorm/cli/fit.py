@@ -69,8 +69,9 @@ def register(sub) -> None:
                    "t = (VAR - c)/s, c the midpoint, s a power of two (well conditioned on "
                    "narrow or offset intervals, where monomials lose accuracy; exported to C, "
                    "not to hw/shaders)")
-    p.add_argument("--name", default="table", help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
-                   "most 63 characters (it names the C function, shader and HDL module)")
+    p.add_argument("--name", default=None, help="table name: [A-Za-z_][A-Za-z0-9_]*, at "
+                   "most 63 characters (it names the C function, shader and HDL module); "
+                   "default: made from EXPR, the interval and the degree, e.g. rsqrt_1_4_d3")
     p.add_argument("--json", action="store_true", help="print the table as JSON on stdout")
     p.add_argument("-o", "--output", metavar="TABLE.json", help="write the table as JSON")
     # piecewise_fit, under fit --segments, calls --coef-frac-bits coef_frac_bits
@@ -104,7 +105,8 @@ _CLI_WORDS = re.compile(r"(?<![\w.])(coef_frac_bits|frac_bits|coef_format|segmen
 _CLI_PHRASES = (("set it with var=", "set it with --var"),
                 ("interval=('1/4', '4')", "--interval 1/4 4"),
                 ("basis='monomial'", "--basis monomial"),
-                ("quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or chebnorm.quantize)",
+                ("quantized with coef_frac_bits (chebnorm.fit(..., coef_frac_bits=F) or "
+                 "chebnorm.quantize)",
                  "quantized with `chebnorm fit ... --coef-frac-bits F`"))
 
 
@@ -175,12 +177,13 @@ def _fit_cli(args, **kw):
     if max_error is not None:
         kw["max_error"] = max_error_value(max_error, "1e-6 or 2^-20")
     return fit(args.expr, tuple(args.interval), args.degree, kind=args.kind,
-               error=args.error, var=args.var, name=args.name, frac_bits=args.frac_bits,
+               error=args.error, var=args.var, name=args.name, coef_frac_bits=args.frac_bits,
                command=command_line(args), basis=args.basis,
                coef_format=args.coef_format, fix_constant=args.fix_constant, **kw)
 
 
 def _run_piecewise(args) -> int:
+    from chebnorm.core.numeric import format_up
     table = _fit_cli(args, monomials=args.monomials, segments=args.segments or 1,
                      segment_by=args.segment_by or "uniform", centered=args.centered)
     if args.output:
@@ -194,9 +197,9 @@ def _run_piecewise(args) -> int:
         if "segment_search" in table.provenance:
             print(f"--max-error {float(table.provenance['max_error']):.6e}, "
                   f"{table.provenance['segment_search']}")
-        print(f"certified max over segments |p_s - f| <= {table.abs_error_bound:.6e}"
+        print(f"certified max over segments |p_s - f| <= {format_up(table.abs_error_bound, '.6e')}"
               + ("" if table.rel_error_bound is None
-                 else f", |p_s/f - 1| <= {table.rel_error_bound:.6e}"))
+                 else f", |p_s/f - 1| <= {format_up(table.rel_error_bound, '.6e')}"))
     return 0
 
 
@@ -227,7 +230,8 @@ def run(args) -> int:
     from chebnorm.approx import FitWarning, warnings_of
     from chebnorm.core.textsafe import identifier
 
-    identifier(args.name, field="--name")  # before the fit: the name becomes C and HDL symbols
+    if args.name is not None:  # before the fit: the name becomes C and HDL symbols
+        identifier(args.name, field="--name")
     if args.degree is None and args.max_error is None:
         raise ValueError(f"the following arguments are required: --degree N (0..{MAX_DEGREE}), "
                          f"or --max-error E instead (the smallest degree whose certified error "
@@ -264,6 +268,7 @@ def _fit(args, mon):
 
 
 def _report(args, table) -> int:
+    from chebnorm.core.numeric import format_down, format_up
     if args.output:
         table.save(args.output)
     if args.json:
@@ -281,16 +286,18 @@ def _report(args, table) -> int:
                   f"({table.basis_choice.reason.split('. ')[0]})")
         print("coefficients (ascending powers of {}): {}".format(
             powers_of, ", ".join(f"{c:.17g}" for c in table.coefficients)))
-        print(f"max |p - f|   = {table.max_abs_error:.6e} at {table.variable} = {table.max_abs_at:.17g}; "
-              f"certified bound {table.abs_error_bound:.6e}")
+        print(f"max |p - f|   = {format_down(table.max_abs_error, '.6e')} at {table.variable} = "
+              f"{table.max_abs_at:.17g}; "
+              f"certified bound {format_up(table.abs_error_bound, '.6e')}")
         if "binary_endpoints" in table.provenance:
             print(f"note: {table.provenance['binary_endpoints']}")
         if table.rel_error_bound is not None:
-            print(f"max |p/f - 1| = {table.max_rel_error:.6e}; certified bound {table.rel_error_bound:.6e}")
+            print(f"max |p/f - 1| = {format_down(table.max_rel_error, '.6e')}; certified bound "
+                  f"{format_up(table.rel_error_bound, '.6e')}")
         if table.fixed_point is not None:
             fp = table.fixed_point
             print(f"fixed point ({fp.frac_bits} fractional bits, {fp.method}): {list(fp.integers)}; "
-                  f"certified |p_q - f| <= {fp.abs_error_bound:.6e}")
+                  f"certified |p_q - f| <= {format_up(fp.abs_error_bound, '.6e')}")
         elif table.quantized is not None:
             q = table.quantized
             what = (f"fixed point ({','.join(map(str, q.frac_bits))} fractional bits"
@@ -298,7 +305,7 @@ def _report(args, table) -> int:
             print(f"{what}, {q.method}): " + ", ".join(
                 f"{m}*2^{e}" for k, (m, e) in enumerate(zip(q.mantissas, q.exponents))
                 if k in q.monomials or (k == 0 and q.fixed_constant)))
-            print(f"quantized: certified |p_q - f| <= {q.abs_error_bound:.6e}"
+            print(f"quantized: certified |p_q - f| <= {format_up(q.abs_error_bound, '.6e')}"
                   + ("" if q.rel_error_bound is None
-                     else f", |p_q/f - 1| <= {q.rel_error_bound:.6e}"))
+                     else f", |p_q/f - 1| <= {format_up(q.rel_error_bound, '.6e')}"))
     return 0

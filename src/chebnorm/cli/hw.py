@@ -158,7 +158,7 @@ def _coefficient_table(table, path, command: str):
 def _analyze(args, table, synth: bool, gappa: bool):
     from chebnorm.hw.report import analyze
 
-    return analyze(table, args.in_bits, args.out_bits, coef_bits=args.coef_bits,
+    return analyze(table, args.in_bits, args.out_bits, coef_frac_bits=args.coef_bits,
                    acc_bits=args.acc_bits, rounding=args.rounding, x_frac_bits=args.x_frac_bits,
                    y_frac_bits=args.y_frac_bits, gappa=gappa, synth=synth)
 
@@ -446,6 +446,9 @@ def run_sweep(args) -> int:
         given, or ``--psi-max`` is out of the target's range (:func:`chebnorm.cli.main`
         prints it as one line on stderr and exits with status 2).
     """
+
+    from chebnorm.core.numeric import format_down
+
     from pathlib import Path
 
     from chebnorm.approx import get_target
@@ -483,7 +486,8 @@ def run_sweep(args) -> int:
             f"~{best.area_fa:.0f} FA (estimate)"
         print(f"cheapest design at or under half a level: degree {best.degree}, coefficient "
               f"bits {best.coef_bits}, accumulator bits {best.acc_bits or '-'}: {area}, "
-              f"{best.shading_levels:.4f} levels, {best.max_error_lsb:.2f} LSB")
+              f"{format_down(best.shading_levels, '.4f')} levels, "
+              f"{format_down(best.max_error_lsb, '.2f')} LSB")
     return 0
 
 

@@ -8,6 +8,10 @@ from .common import print_json
 
 _KEYS = ("add", "mul", "div", "sqrt", "trig", "cmp")
 
+#: the largest span angle ``--angle`` takes, radians: every method needs end normals
+#: with ``1 + cos PSI > chebnorm.methods.ANTIPARALLEL_TOL`` (1e-6, so PSI < 3.14018)
+MAX_ANGLE = 3.14
+
 
 def register(sub) -> None:
     """Add the ``chebnorm methods`` subcommand.
@@ -24,7 +28,7 @@ def register(sub) -> None:
                        "angle PSI and length M; print its largest length and angle errors and "
                        "its operation counts (measured by running the kernel on a counting type).")
     p.add_argument("--angle", type=float, required=True, metavar="PSI",
-                   help="angle between the end normals, radians, 0 <= PSI < pi")
+                   help=f"angle between the end normals, radians, 0 <= PSI <= {MAX_ANGLE}")
     p.add_argument("--span", type=int, required=True, metavar="M", help="span length in pixels, 1..65536")
     p.add_argument("--dtype", default="float64", help="float64 (default) or float32")
     p.add_argument("--drift", action="store_true",
@@ -58,18 +62,22 @@ def run(args) -> int:
     Raises
     ------
     ValueError
-        When ``--dtype`` is not float32 or float64, or ``--angle`` is not finite
-        (accepted: 0 <= PSI < pi radians) (:func:`chebnorm.cli.main` prints it as one
+        When ``--dtype`` is not float32 or float64, or ``--angle`` is not in
+        ``[0, MAX_ANGLE]`` radians (:func:`chebnorm.cli.main` prints it as one
         line on stderr and exits with status 2).
     """
     import numpy as np
+
+    from chebnorm.core.numeric import format_down
 
     from chebnorm.methods import analyze, angular_drift, method_names
 
     if args.dtype not in ("float32", "float64"):
         raise ValueError(f"dtype {args.dtype!r} is not supported; accepted: float32, float64")
-    if not math.isfinite(args.angle):
-        raise ValueError(f"angle {args.angle!r} is not finite; accepted: 0 <= PSI < pi (radians)")
+    if not (math.isfinite(args.angle) and 0 <= args.angle <= MAX_ANGLE):
+        raise ValueError(f"--angle {args.angle!r} is out of range; accepted: 0 <= PSI <= "
+                         f"{MAX_ANGLE} radians (end normals further from antiparallel than "
+                         f"1 + cos PSI > 1e-06, which every method needs)")
     dtype = np.dtype(args.dtype).type
     reports = [analyze(m, args.angle, args.span, dtype) for m in method_names()]
     drift = None
@@ -93,10 +101,12 @@ def run(args) -> int:
     for r in reports:
         pp = " ".join(f"{r.ops.per_pixel[k]:g}" for k in _KEYS)
         ps = " ".join(f"{r.ops.per_span[k]:g}" for k in _KEYS)
-        print(f"{r.method:10s} {r.max_length_error:12.4e} {r.max_angle_error:10.3e} "
-              f"{r.max_angle_error_slerp:10.3e}  {pp:>22s} | {ps}")
+        print(f"{r.method:10s} {format_down(r.max_length_error, '12.4e')} "
+              f"{format_down(r.max_angle_error, '10.3e')} "
+              f"{format_down(r.max_angle_error_slerp, '10.3e')}  {pp:>22s} | {ps}")
     if drift:
         for dt, d in drift.items():
-            print(f"angular recurrence drift, {dt}: max ||N|-1| = {d.max_length_error:.3e}, "
-                  f"max angle vs slerp = {d.max_angle_error:.3e} rad")
+            print(f"angular recurrence drift, {dt}: max ||N|-1| = "
+                  f"{format_down(d.max_length_error, '.3e')}, "
+                  f"max angle vs slerp = {format_down(d.max_angle_error, '.3e')} rad")
     return 0

@@ -65,7 +65,7 @@ def export_coefficients(out: Path, **_options) -> list[Path]:
     written = []
     for name in target_names():
         for degree in TARGETS[name].degrees:
-            table = fit_target(name, degree, frac_bits=EXPORT_FRAC_BITS)
+            table = fit_target(name, degree, coef_frac_bits=EXPORT_FRAC_BITS)
             cmd = "chebnorm repro coefficients"
             write_atomic(folder / f"{table.name}.json", json_text(table, cmd))
             written.append(folder / f"{table.name}.json")

@@ -21,6 +21,8 @@ from __future__ import annotations
 import os
 from typing import Callable, Iterable
 
+from .progress import progress_bar
+
 __all__ = ["map_ordered", "default_workers", "check_workers", "check_scheduler"]
 
 
@@ -123,7 +125,8 @@ def map_ordered(fn: Callable, items: Iterable, *, workers: int | None = None, sc
     scheduler : str or distributed.Client, optional
         A Dask distributed scheduler address (``tcp://host:8786``) or a client.
     progress : bool
-        Show a tqdm progress bar (on stderr) labelled ``desc``.
+        Show a tqdm progress bar labelled ``desc`` on stderr when it is a terminal
+        (:func:`chebnorm.core.progress.progress_bar`).
     desc : str, optional
         The progress bar's label.
     on_result : callable, optional
@@ -146,7 +149,9 @@ def map_ordered(fn: Callable, items: Iterable, *, workers: int | None = None, sc
     from tqdm import tqdm
 
     results = [None] * len(items)
-    bar = tqdm(total=len(items), desc=desc, unit="item", disable=not progress, leave=False)
+    # a bar on a terminal only (core.progress): nothing in a pipe, a log or a test's stream
+    bar = progress_bar(len(items), desc or "", unit="item") if progress else \
+        tqdm(total=len(items), disable=True)
 
     def done(i, r):
         results[i] = r

@@ -27,14 +27,76 @@ it passes through exactly one of these functions first:
 
 from __future__ import annotations
 
+import hashlib
 import re
 
-__all__ = ["identifier", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
+__all__ = ["identifier", "default_name", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
 
 #: the identifiers accepted in generated sources (a regular expression; at most 63 characters)
 IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
 _IDENT = re.compile(IDENTIFIER_PATTERN + r"\Z")
 _MAX_IDENT = 63  # C99 guarantees 63 significant characters in an internal identifier
+
+
+def _words(text: str) -> list[str]:
+    """The letters-and-digits runs of ``text``: ``-`` before a run is ``m``, a
+    decimal point ``p``."""
+    text = re.sub(r"(?<=\d)\.(?=\d)", "p", text)
+    text = re.sub(r"-(?=[A-Za-z0-9])", "m", text)
+    return re.findall(r"[A-Za-z0-9]+", text)
+
+
+def default_name(expression: str, interval, degree: int, var: str = "x",
+                 segments: int | None = None) -> str:
+    """The name a table gets when none is given: its expression, interval and
+    degree (and segment count) made an identifier, so the headers and HDL
+    modules of different fits never collide in one build.
+
+    ``1/f(...)`` reads ``rf``; a single call ``f(var)`` drops the variable;
+    ``-`` reads ``m`` and a decimal point ``p``; a name over 63 characters is
+    cut and ends in six hex digits of a hash of the whole text.
+
+    Parameters
+    ----------
+    expression : str
+        The function's text (``sympy.sstr`` of it).
+    interval : (str, str)
+        The endpoints' exact texts.
+    degree : int
+        The polynomial degree.
+    var : str, optional
+        The variable.
+    segments : int, optional
+        A piecewise table's segment count.
+
+    Returns
+    -------
+    str
+        An identifier (:func:`identifier` accepts it).
+
+    Examples
+    --------
+    >>> default_name("1/sqrt(x)", ("1", "4"), 3), default_name("sin(x)", ("-pi/4", "pi/4"), 7)
+    ('rsqrt_1_4_d3', 'sin_mpi_4_pi_4_d7')
+    >>> default_name("exp(-x**2)", ("0", "1/2"), 4, segments=8)
+    'exp_mx_2_0_1_2_d4_s8'
+    """
+    text = str(expression).replace(" ", "")
+    if text.startswith("1/") and re.match(r"[A-Za-z]", text[2:3]):
+        text = "r" + text[2:]
+    head = _words(text)
+    if len(head) == 2 and head[1] == var and text == f"{head[0]}({var})":
+        head = head[:1]
+    parts = head + _words(str(interval[0])) + _words(str(interval[1])) + [f"d{degree}"]
+    if segments is not None:
+        parts.append(f"s{segments}")
+    name = "_".join(parts)
+    if not re.match(r"[A-Za-z_]", name):
+        name = "f" + name
+    if len(name) > _MAX_IDENT:
+        digest = hashlib.sha256(name.encode()).hexdigest()[:6]
+        name = name[:_MAX_IDENT - 7].rstrip("_") + "_" + digest
+    return identifier(name)
 
 
 def identifier(name, *, field: str = "name") -> str:

@@ -254,7 +254,7 @@ def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bit
                         version=__version__, command=command)
     from chebnorm.hw.report import analyze
 
-    report = analyze(table, in_bits, out_bits, coef_bits=coef_frac_bits, acc_bits=acc_bits,
+    report = analyze(table, in_bits, out_bits, coef_frac_bits=coef_frac_bits, acc_bits=acc_bits,
                      rounding="rne" if rounding is None else rounding, gappa=False, synth=False)
     return hdl_text(report.design, language, version=__version__, command=command,
                     budget=report.budget)

@@ -58,6 +58,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from chebnorm.core.progress import progress_bar
+
 __all__ = ["ExhaustiveCertificate", "float32_certificate", "float32_simulation", "fma32",
            "float32_range", "stated_bound",
            "MAX_CERTIFIED_INPUTS"]
@@ -420,29 +422,45 @@ def _certificate(cs, lo, hi, parity, shift, expression, variable, drop):
     except _NoReference:
         return None, False
     best, worst, subnormal, scale = Fraction(-1), x_lo, False, 0.0
-    for start in range(k_lo, k_hi + 1, _CHUNK):
-        x = _from_keys(np.arange(start, min(start + _CHUNK, k_hi + 1), dtype=np.int64))
-        sim = _simulate(x, cs, parity, shift, drop)
-        subnormal = subnormal or sim[2]
-        x64 = x.astype(np.float64)
-        piece = np.clip(np.searchsorted(edges, x64, side="right") - 1, 0, pieces - 1)
-        try:
-            q = ref(x64, piece)
-        except _NoReference:
-            return None, False
-        scale = max(scale, float(np.abs(q).max()))
-        err = np.maximum(np.abs(sim[0] - q), np.abs(sim[1] - q))
-        err = np.nextafter(err, np.inf)  # the subtraction's rounding
-        err = np.nextafter(err + np.array(ref.errors)[piece], np.inf)
-        i = int(np.argmax(err))
-        if Fraction(float(err[i])) > best:
-            best, worst = Fraction(float(err[i])), float(x[i])
+    with progress_bar(count, f"chebnorm: float32 certificate on [{x_lo:.6g}, {x_hi:.6g}]",
+                      unit="input") as bar:
+        for start in range(k_lo, k_hi + 1, _CHUNK):
+            stop = min(start + _CHUNK, k_hi + 1)
+            got = _certify_chunk(start, stop, cs, parity, shift, drop, edges, ref)
+            bar.update(stop - start)
+            if got is None:
+                return None, False
+            chunk_best, chunk_worst, chunk_subnormal, chunk_scale = got
+            subnormal = subnormal or chunk_subnormal
+            scale = max(scale, chunk_scale)
+            if chunk_best > best:
+                best, worst = chunk_best, chunk_worst
     ref_err = Fraction(max(ref.errors))
     # stated: a margin of 2^-48 max|f| over the proved maximum, so that a check
     # with a float64 or long double reference (about 2^-53 |f|) has room
     stated = _up12(best + Fraction(scale) * Fraction(1, 2 ** 48))
     return ExhaustiveCertificate(maximum=best, stated=stated, inputs=count, worst=worst,
                                  reference_error=ref_err), subnormal
+
+
+def _certify_chunk(start, stop, cs, parity, shift, drop, edges, ref):
+    """The float32 inputs with keys ``start..stop-1``: ``(largest error as a
+    Fraction, its input, whether a subnormal value was met, max |f|)``, or None
+    when the reference cannot enclose ``f`` there."""
+    pieces = len(edges) - 1
+    x = _from_keys(np.arange(start, stop, dtype=np.int64))
+    sim = _simulate(x, cs, parity, shift, drop)
+    x64 = x.astype(np.float64)
+    piece = np.clip(np.searchsorted(edges, x64, side="right") - 1, 0, pieces - 1)
+    try:
+        q = ref(x64, piece)
+    except _NoReference:
+        return None
+    err = np.maximum(np.abs(sim[0] - q), np.abs(sim[1] - q))
+    err = np.nextafter(err, np.inf)  # the subtraction's rounding
+    err = np.nextafter(err + np.array(ref.errors)[piece], np.inf)
+    i = int(np.argmax(err))
+    return Fraction(float(err[i])), float(x[i]), sim[2], float(np.abs(q).max())
 
 
 def stated_bound(ev) -> tuple[float, ExhaustiveCertificate | None]:

@@ -21,7 +21,6 @@ interval, or ``2^20`` of them evenly spread when there are more.
 from __future__ import annotations
 
 import shutil
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -31,6 +30,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import identifier
 
 from .shader import interval32, shader_source
+from chebnorm.core.tools import run_tool
 
 __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
            "wgsl_evaluate", "gl_context", "compute_shader_source", "compute_shader_around",
@@ -227,7 +227,8 @@ def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
         GLSL (``shader.comp``) or HLSL (glslang's HLSL front end, ``-D``,
         entry point ``main``, compiled to SPIR-V).
     timeout : float, optional
-        Seconds before the compiler is stopped (``subprocess.TimeoutExpired``).
+        Seconds before the compiler is stopped
+        (:class:`chebnorm.core.tools.ToolTimeout`, a ``ValueError``).
         Default 120.
 
     Returns
@@ -255,7 +256,7 @@ def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
         cmd = [exe, str(path)] if language == "glsl" else \
             [exe, "-D", "-e", "main", "-S", "comp", "-V", "-o", str(Path(tmp) / "cs.spv"),
              str(path)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        proc = run_tool(cmd, tool="glslangValidator", timeout=timeout)
     if proc.returncode != 0:
         raise ValueError(f"glslangValidator rejected the {language} shader: "
                          f"{' '.join((proc.stdout + proc.stderr).split())[:600]}")

@@ -66,10 +66,10 @@ import numpy as np
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import comment_text, identifier
 
-from chebnorm.core.numeric import float_up
+from chebnorm.core.numeric import float_up, format_up
 
 from .c import (coefficient_parity, evaluator_range_problem, inner_interval, interval_max_abs,
-                round_inward)
+                range_problem, round_inward)
 from .evalbound import BINARY32_FTZ, Evaluator, Piece
 
 __all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
@@ -312,7 +312,9 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     Parameters
     ----------
     table : CoefficientTable
-        A table in plain powers of ``x`` (``basis="monomial"``).
+        A table in plain powers of ``x`` (``basis="monomial"``) or of
+        ``t = (x - c)/s`` (``basis="shifted"``, ``s`` a power of two: the
+        shader forms ``t`` as ``(x - c32) * (1/s)``).
 
     Returns
     -------
@@ -322,9 +324,9 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     Raises
     ------
     ValueError
-        When the table is in the shifted basis (the shaders evaluate plain
-        powers of ``x``), its name is not an identifier, or its float32
-        Horner evaluation may overflow on the interval.
+        When the table is in a shifted basis whose scale is not a power of
+        two, its name is not an identifier, or its float32 Horner evaluation
+        may overflow on the interval.
 
     Notes
     -----
@@ -353,13 +355,17 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
     >>> b.certified < b.total <= b.total32 < 2.2e-5
     True
     """
-    table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
+    _check_shift(table)
     coeffs, certified, _ = _coefficients(table)
     m = interval_max_abs(table)
     # no bound for an evaluator that can overflow float32 on the interval (nor
     # for one whose flushed underflows the flush term below does not cover)
-    problem = evaluator_range_problem(table, _float32s(coeffs), _parity32(coeffs), "f",
-                                      float(U32), m)
+    if table.shift is None:
+        problem = evaluator_range_problem(table, _float32s(coeffs), _parity32(table, coeffs), "f",
+                                          float(U32), m)
+    else:
+        problem = range_problem(_float32s(coeffs), _shifted_max(table), "f", float(U32),
+                                where=(*inner_interval(table), table.shift, None))
     if problem is not None:
         raise ValueError(f"table {table.name!r} has no float32 shader evaluator on its "
                          f"interval: {problem}; accepted: a table whose Horner evaluation stays "
@@ -374,8 +380,11 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
         # a subnormal input x may be flushed to x' = 0, which lies in the
         # analysed interval (shader_evaluator): |shader(x') - p(x')| is within
         # the local bound, and |p(x') - p(x)| <= 2^-126 max |p'|
-        flush = _FLUSH * sum((k * abs(Fraction(c)) * m ** (k - 1)
-                              for k, c in enumerate(coeffs) if k), Fraction(0))
+        # (shifted: p is in t = (x - c)/s, so |dt| <= 2^-126 / s and |t| <= its bound)
+        scale, m = ((Fraction(1), m) if table.shift is None else
+                    (1 / Fraction(table.shift[1]), _shifted_max(table)))
+        flush = _FLUSH * scale * sum((k * abs(Fraction(c)) * m ** (k - 1)
+                                      for k, c in enumerate(coeffs) if k), Fraction(0))
     total = Fraction(stated) + flush
     up = float_up(total)
     up32 = float(np.float32(up))
@@ -386,10 +395,46 @@ def float32_eval_bound(table: CoefficientTable) -> ShaderBound:
                        total32=up32, certificate=cert)
 
 
-def _parity32(coeffs) -> int | None:
+def _parity32(table: CoefficientTable, coeffs) -> int | None:
     """The parity of the shader's float32 coefficients (its evaluator is then
-    ``x*q(x*x)`` or ``q(x*x)``): :func:`chebnorm.export.c.coefficient_parity`."""
-    return coefficient_parity(_float32s(coeffs))
+    ``x*q(x*x)`` or ``q(x*x)``): :func:`chebnorm.export.c.coefficient_parity`;
+    None for a shifted table (its coefficients are in ``t``, not ``x``)."""
+    return None if table.shift is not None else coefficient_parity(_float32s(coeffs))
+
+
+def _check_shift(table: CoefficientTable) -> None:
+    """Refuse a shifted table whose scale is not a power of two: the shaders
+    form ``t = (x - c) * (1/s)`` with no division (which the shading
+    languages let be 2.5 ulp) and no rounding of ``1/s``."""
+    if table.shift is not None:
+        s = float(table.shift[1])
+        if not (s > 0 and np.frexp(s)[0] == 0.5):
+            raise ValueError(f"table {table.name!r}: the shaders evaluate the shifted variable "
+                             f"t = (x - c) * (1/s) with s a power of two; its s = {s!r}; "
+                             f"accepted: a table fitted with basis='shifted' (s a power of two) "
+                             f"or basis='monomial'")
+
+
+def _shift_tuple(table: CoefficientTable):
+    """``(c, s, c32, s32, True)``: the shifted variable of the float32
+    evaluator, as :class:`~chebnorm.export.evalbound.Evaluator` takes it
+    (``t = (x - c32) * (1/s)``, the product exact); None for a monomial table."""
+    if table.shift is None:
+        return None
+    c, s = table.shift
+    return (Fraction(c), Fraction(s), Fraction(float(np.float32(c))),
+            Fraction(float(np.float32(s))), True)
+
+
+def _shifted_max(table: CoefficientTable) -> Fraction:
+    """A bound of ``|t|`` and of the float32 ``t`` of a shifted table over its
+    interval: ``max |x - c| / s`` plus the shift's own error (the centre
+    rounded to float32, the subtraction's half ulp, a flushed result)."""
+    c, s = (Fraction(v) for v in table.shift)
+    c32 = Fraction(float(np.float32(table.shift[0])))
+    lo, hi = (Fraction(v) for v in inner_interval(table))
+    reach = max(abs(lo - c32), abs(hi - c32))
+    return (max(abs(lo - c), abs(hi - c)) + abs(c - c32) + reach * U32 + _FLUSH) / s
 
 
 def _float32s(coeffs) -> list[float]:
@@ -443,9 +488,11 @@ def shader_evaluator(table: CoefficientTable, constant: str = ""):
         hi = 0.0
     piece = Piece(c32, tuple(coeffs), certified, lo, hi)
     name = identifier(table.name, field="table.name")
+    _check_shift(table)
     return Evaluator(constant or f"CHEBNORM_{name.upper()}_EVAL_ERROR_BOUND",
                      f"chebnorm_{name}", BINARY32_FTZ, (piece,),
-                     target=(table.expression, table.variable), parity=_parity32(coeffs))
+                     target=(table.expression, table.variable), parity=_parity32(table, coeffs),
+                     shift=_shift_tuple(table))
 
 
 def interval32(table: CoefficientTable) -> tuple[float, float]:
@@ -483,7 +530,8 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     Parameters
     ----------
     table : CoefficientTable
-        A table in plain powers of ``x``; its name must be an identifier.
+        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
+        power of two); its name must be an identifier.
     language : {"glsl", "wgsl", "hlsl"}
         The shading language (a key of :data:`SHADER_LANGUAGES`).
     command : str, optional
@@ -501,9 +549,10 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     Raises
     ------
     ValueError
-        When ``language`` is unknown, the table is in the shifted basis, its
-        name is not an identifier, or its float32 evaluation may overflow
-        (or its bound exceeds the float32 range).
+        When ``language`` is unknown, the table is in a shifted basis whose
+        scale is not a power of two, its name is not an identifier, or its
+        float32 evaluation may overflow (or its bound exceeds the float32
+        range).
 
     Examples
     --------
@@ -514,7 +563,7 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     >>> "fn chebnorm_d1(x: f32) -> f32 {" in shader_source(t, "wgsl")
     True
     """
-    table.require_monomial("the shader exporters (glsl, wgsl, hlsl)")
+    _check_shift(table)
     from chebnorm import __version__
 
     try:
@@ -528,7 +577,8 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     coeffs, certified, source = _coefficients(table)
     bound = float32_eval_bound(table)
     if not np.isfinite(bound.total32):
-        raise ValueError(f"table {table.name!r}: its float32 evaluation bound {bound.total:.3g} "
+        raise ValueError(f"table {table.name!r}: its float32 evaluation bound "
+                         f"{format_up(bound.total, '.3g')} "
                          f"exceeds the float32 range; accepted: a bound below 3.4e38")
     lo32, hi32 = interval32(table)
     var = comment_text(table.variable, max_length=40)
@@ -543,25 +593,28 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
       f"[{comment_text(table.interval[0], max_length=80)}, "
       f"{comment_text(table.interval[1], max_length=80)}]"
       f" = [{table.interval_float[0]!r}, {table.interval_float[1]!r}]")
+    powers_of = var if table.shift is None else f"t = ({var} - c)/s"
     w(f"// {comment_text(table.kind, max_length=40)} fit of degree {table.degree}; coefficients"
-      f" in ascending powers of {var}, rounded to float32 (exact literals).")
+      f" in ascending powers of {powers_of}, rounded to float32 (exact literals).")
     w(f"// Certified |p - f| <= {float(certified)!r} ({source}, exact arithmetic).")
     w(f"// {big}_EVAL_ERROR_BOUND bounds |{fn}(x) - f(x)| for float32 x in [{big}_LO, {big}_HI]:")
     if bound.certificate is None:
-        w(f"//   certified {float(bound.certified):.6e} + float32 coefficients and Horner rounding"
-          f" {float(bound.rounding):.6e}")
+        w(f"//   certified {format_up(float(bound.certified), '.6e')} + float32 coefficients and "
+          f"Horner rounding"
+          f" {format_up(float(bound.rounding), '.6e')}")
         w("//   (chebnorm.export.evalbound: interval arithmetic on 64 pieces, each rounding half"
           " an ulp of its")
         w(f"//   largest result there, fused or not) + subnormal input flush "
-          f"{float(bound.flush):.3e}."
+          f"{format_up(float(bound.flush), '.3e')}."
           + (f" Proof: {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}" if proof else ""))
     else:
-        w(f"//   the certified maximum of |{fn}(x) - f(x)| {float(bound.certificate.maximum):.6e}"
+        w(f"//   the certified maximum of |{fn}(x) - f(x)| "
+          f"{format_up(float(bound.certificate.maximum), '.6e')}"
           f" rounded up")
         w("//   (chebnorm.export.certificate: exhaustive, every float32 input and every fused/"
           "unfused mix run")
         w(f"//   bit-exactly against a proved enclosure of f) + subnormal input flush "
-          f"{float(bound.flush):.3e}.")
+          f"{format_up(float(bound.flush), '.3e')}.")
         w(f"//   The a-priori bound {shader_evaluator(table).bound().stated!r} (interval "
           f"arithmetic) is proved"
           + (f" by {comment_text(f'{proof}.{big}_EVAL_ERROR_BOUND.gappa')}." if proof
@@ -576,21 +629,30 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
     w(lang.const.format(name=f"{big}_ABS_ERROR_BOUND", value=lit(_up_f32(float_up(certified)))))
     w(lang.const.format(name=f"{big}_EVAL_ERROR_BOUND", value=lit(bound.total32)))
     w("")
-    parity = _parity32(coeffs)
-    if parity is None:
+    parity = _parity32(table, coeffs)
+    if table.shift is not None:
+        c, sc = table.shift
+        w(f"// Horner's rule in t = (x - {float(np.float32(c))!r}) * {1 / sc!r} (the product "
+          f"exact); x must lie in [{big}_LO, {big}_HI].")
+    elif parity is None:
         w(f"// Horner's rule; x must lie in [{big}_LO, {big}_HI].")
     else:
         w(f"// Horner's rule over the {'odd' if parity else 'even'} powers, in t = x*x; x must "
           f"lie in [{big}_LO, {big}_HI].")
     w(lang.function.format(fn=fn))
     arg, powers = "x", list(range(len(coeffs)))
+    if table.shift is not None:
+        arg = "t"
+        w(lang.acc.replace(" acc", " t", 1).format(
+            P=big, value=f"(x - {lit(table.shift[0])}) * {lit(1 / table.shift[1])}"))
     if parity is not None:
         arg, powers = "t", powers[parity::2]
         w(lang.acc.replace(" acc", " t", 1).format(P=big, value="x * x"))
-    w(lang.acc.format(P=big, value=lit(coeffs[powers[-1]])) + f"  // x^{powers[-1]}: "
+    label = "x" if table.shift is None else "t"   # the power the coefficient multiplies
+    w(lang.acc.format(P=big, value=lit(coeffs[powers[-1]])) + f"  // {label}^{powers[-1]}: "
       f"{float(np.float32(coeffs[powers[-1]])).hex()}")
     for k in reversed(powers[:-1]):
-        w(f"    acc = {lang.madd.format(P=big)}(acc, {arg}, {lit(coeffs[k])});  // x^{k}: "
+        w(f"    acc = {lang.madd.format(P=big)}(acc, {arg}, {lit(coeffs[k])});  // {label}^{k}: "
           f"{float(np.float32(coeffs[k])).hex()}")
     w("    return acc * x;" if parity == 1 else "    return acc;")
     w("}")
@@ -613,7 +675,8 @@ def glsl_source(table: CoefficientTable, command: str = "") -> str:
     Parameters
     ----------
     table : CoefficientTable
-        A table in plain powers of ``x``; its name must be an identifier.
+        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
+        power of two); its name must be an identifier.
     command : str, optional
         The generating command, stated in the banner. Default ``""``.
 
@@ -625,9 +688,9 @@ def glsl_source(table: CoefficientTable, command: str = "") -> str:
     Raises
     ------
     ValueError
-        When the table is in the shifted basis (the shaders evaluate plain
-        powers of ``x``), its name is not an identifier, or its float32
-        Horner evaluation may overflow on the interval.
+        When the table is in a shifted basis whose scale is not a power of
+        two, its name is not an identifier, or its float32 Horner evaluation
+        may overflow on the interval.
 
     Examples
     --------
@@ -645,7 +708,8 @@ def wgsl_source(table: CoefficientTable, command: str = "") -> str:
     Parameters
     ----------
     table : CoefficientTable
-        A table in plain powers of ``x``; its name must be an identifier.
+        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
+        power of two); its name must be an identifier.
     command : str, optional
         The generating command, stated in the banner. Default ``""``.
 
@@ -657,9 +721,9 @@ def wgsl_source(table: CoefficientTable, command: str = "") -> str:
     Raises
     ------
     ValueError
-        When the table is in the shifted basis (the shaders evaluate plain
-        powers of ``x``), its name is not an identifier, or its float32
-        Horner evaluation may overflow on the interval.
+        When the table is in a shifted basis whose scale is not a power of
+        two, its name is not an identifier, or its float32 Horner evaluation
+        may overflow on the interval.
 
     Examples
     --------
@@ -676,7 +740,8 @@ def hlsl_source(table: CoefficientTable, command: str = "") -> str:
     Parameters
     ----------
     table : CoefficientTable
-        A table in plain powers of ``x``; its name must be an identifier.
+        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
+        power of two); its name must be an identifier.
     command : str, optional
         The generating command, stated in the banner. Default ``""``.
 
@@ -688,9 +753,9 @@ def hlsl_source(table: CoefficientTable, command: str = "") -> str:
     Raises
     ------
     ValueError
-        When the table is in the shifted basis (the shaders evaluate plain
-        powers of ``x``), its name is not an identifier, or its float32
-        Horner evaluation may overflow on the interval.
+        When the table is in a shifted basis whose scale is not a power of
+        two, its name is not an identifier, or its float32 Horner evaluation
+        may overflow on the interval.
 
     Examples
     --------

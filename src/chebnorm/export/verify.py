@@ -2,12 +2,17 @@
 with the bound its text states.
 
 :func:`verify` prints a table in a format (or takes the text as shipped),
-reads the stated bounds *from that text* (the C header's
-``_EVAL_ERROR_BOUND``, ``_F_EVAL_ERROR_BOUND``, ``_Q_EVAL_ERROR_BOUND``,
-``_QUANT..._EVAL_ERROR_BOUND`` macros, the shaders'
-``CHEBNORM_NAME_EVAL_ERROR_BOUND`` constant), runs each evaluator the text
-defines on every input and reports the measured ``max |evaluator(x) - f(x)|``
-beside the stated bound (:class:`VerifyResult`). What runs, per format:
+reads the stated bounds *from what the compiler builds of that text* (the C
+header's ``_EVAL_ERROR_BOUND``, ``_F_EVAL_ERROR_BOUND``, ``_Q_EVAL_ERROR_BOUND``,
+``_QUANT..._EVAL_ERROR_BOUND`` macros, each printed exactly by a probe compiled
+into the same library, ``%La``; the shaders' ``CHEBNORM_NAME_EVAL_ERROR_BOUND``
+constant returned by a probe shader on the driver), never from the last
+textual definition, runs each evaluator the text defines on every input and
+reports the measured ``max |evaluator(x) - f(x)|`` beside the stated bound
+(:class:`VerifyResult`). A variant whose bound or inputs cannot be read from
+the compiled object is ``unchecked`` (a failure). The text is compiled and
+loaded into this process (or run on the GPU driver): code in it runs, so a
+``source`` must be trusted code. What runs, per format:
 
 * ``c`` of a coefficient table: the header compiled by ``gcc`` into a
   shared library (called through ``ctypes``, results straight into numpy
@@ -48,7 +53,6 @@ import html
 import math
 import re
 import shutil
-import subprocess
 import tempfile
 import time
 from dataclasses import asdict, dataclass, field
@@ -59,8 +63,10 @@ import numpy as np
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.approx.piecewise_table import PiecewiseTable
-from chebnorm.core.numeric import arb_precision, float_up
+from chebnorm.core.numeric import arb_precision, float_down, float_up, format_down, format_up
 from chebnorm.core.textsafe import identifier
+from chebnorm.core.progress import progress_bar
+from chebnorm.core.tools import run_tool
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 __all__ = ["verify", "VerifyResult", "VariantResult", "VERIFY_FORMATS", "VARIANTS",
@@ -88,7 +94,10 @@ class VariantResult:
     """One evaluator's exhaustive check (see the module docstring).
 
     ``measured_max``/``argmax``/``upper``/``ref_error`` are None for a
-    skipped variant (``skipped`` then gives the reason).
+    variant that did not run: ``skipped`` gives the reason when this machine
+    lacks what runs it (a tool, a driver, a runtime), ``unchecked`` when the
+    text defines the evaluator but its stated bound or its inputs cannot be
+    read from the compiled object (undefined, not a number): a failure.
 
     Attributes
     ----------
@@ -101,8 +110,9 @@ class VariantResult:
     bound_name : str
         The macro or constant that states its bound.
     stated_bound : float or None
-        That bound as read from the text (:func:`stated_bounds`); None when
-        the text states none.
+        That bound as the compiler sees it (C: the macro's value printed
+        exactly from the compiled object, rounded down to a double; shaders:
+        the constant as the shader computes it); None when it cannot be read.
     measured_max : float or None
         ``max |evaluator(x) - f(x)|`` over the inputs, ``f`` in Arb at 128
         bits at the worst input (so the maximum is attained there).
@@ -123,11 +133,15 @@ class VariantResult:
     seconds : float
         Wall time of the run (compiling included).
     skipped : str or None, default None
-        Why the variant did not run (a missing tool or driver); None when
-        it ran.
+        Why the variant did not run on this machine (a missing tool, driver
+        or runtime); None when it ran.
     notes : tuple of str, default ()
         Remarks on the run (e.g. whether the target has FMA for a fused
         build, the GPU driver used).
+    unchecked : str or None, default None
+        Why the variant, defined by the text, could not be checked (its
+        stated bound or an input macro is undefined or not a number in the
+        compiled object): ``passed`` is then False.
 
     Examples
     --------
@@ -151,8 +165,12 @@ class VariantResult:
     seconds: float
     skipped: str | None = None
     notes: tuple[str, ...] = field(default=())
+    unchecked: str | None = None
 
     def _summary(self) -> list[tuple[str, object]]:
+        if self.unchecked is not None:
+            return [("format", self.format), ("variant", self.variant),
+                    ("unchecked", self.unchecked)]
         if self.skipped is not None:
             return [("format", self.format), ("variant", self.variant),
                     ("skipped", self.skipped)]
@@ -173,7 +191,11 @@ class VariantResult:
 
     @property
     def passed(self) -> bool | None:
-        """True when the bound holds (``upper <= stated_bound``), None when skipped."""
+        """True when the bound holds (``upper <= stated_bound``), False when it
+        is exceeded or the variant could not be checked (``unchecked``), None
+        when skipped."""
+        if self.unchecked is not None:
+            return False
         if self.skipped is not None or self.upper is None or self.stated_bound is None:
             return None
         return bool(self.upper <= self.stated_bound)
@@ -181,11 +203,15 @@ class VariantResult:
     def line(self) -> str:
         """One line of text: variant, measured, stated, ratio, inputs, seconds."""
         head = f"{self.format} {self.variant:<14}"
+        if self.unchecked is not None:
+            return f"{head} NOT CHECKED: {self.unchecked}"
         if self.skipped is not None:
             return f"{head} skipped: {self.skipped}"
         verdict = "ok" if self.passed else "EXCEEDS the stated bound"
-        return (f"{head} max {self.measured_max:.4e} at x = {self.argmax!r}  stated "
-                f"{self.stated_bound:.4e}  ratio {self.ratio:.3f}  {self.count} inputs  "
+        return (f"{head} max {format_down(self.measured_max, '.4e')} at x = {self.argmax!r}  "
+                f"stated "
+                f"{format_up(self.stated_bound, '.4e')}  ratio {self.ratio:.3f}  {self.count} "
+                f"inputs  "
                 f"{self.seconds:.2f} s  {verdict}")
 
 
@@ -214,13 +240,25 @@ class VerifyResult:
 
     @property
     def passed(self) -> bool:
-        """False when some run variant exceeds its stated bound."""
+        """False when some variant exceeds its stated bound or could not be
+        checked (``unchecked``); variants skipped for want of a tool or
+        driver do not count (see :attr:`complete`)."""
         return all(v.passed is not False for v in self.variants)
+
+    @property
+    def complete(self) -> bool:
+        """True when every variant ran (none skipped, none unchecked)."""
+        return all(v.skipped is None and v.unchecked is None for v in self.variants)
+
+    @property
+    def not_run(self) -> tuple[VariantResult, ...]:
+        """The variants that did not run (skipped or unchecked), with their reasons."""
+        return tuple(v for v in self.variants if v.skipped is not None or v.unchecked is not None)
 
     @property
     def exceeded(self) -> tuple[VariantResult, ...]:
         """The variants whose stated bound the measurement exceeds."""
-        return tuple(v for v in self.variants if v.passed is False)
+        return tuple(v for v in self.variants if v.passed is False and v.unchecked is None)
 
     def to_dict(self) -> dict:
         """Plain data (for JSON), variants in order, with ``ratio`` and ``passed``."""
@@ -239,12 +277,14 @@ class VerifyResult:
         out = ["| evaluator | variant | measured max | stated bound | ratio | inputs |",
                "|---|---|---|---|---|---|"]
         for v in self.variants:
-            if v.skipped is not None:
-                out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | skipped: "
-                           f"{v.skipped} | | | |")
+            if v.skipped is not None or v.unchecked is not None:
+                why = f"skipped: {v.skipped}" if v.unchecked is None else \
+                    f"NOT CHECKED: {v.unchecked}"
+                out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {why} | | | |")
                 continue
-            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | {v.measured_max:.3e} | "
-                       f"{v.stated_bound:.3e} | {v.ratio:.3f} | {v.count} |")
+            out.append(f"| `{v.evaluator}` | {v.format} {v.variant} | "
+                       f"{format_down(v.measured_max, '.3e')} | "
+                       f"{format_up(v.stated_bound, '.3e')} | {v.ratio:.3f} | {v.count} |")
         return "\n".join(out) + "\n"
 
     def __str__(self) -> str:
@@ -257,10 +297,13 @@ class VerifyResult:
     def _repr_html_(self) -> str:
         rows = []
         for v in self.variants:
-            cells = ([v.format + " " + v.variant, v.evaluator, "skipped: " + v.skipped, "", "",
+            cells = ([v.format + " " + v.variant, v.evaluator, "NOT CHECKED: " + v.unchecked, "",
+                      "", "", "NOT CHECKED"] if v.unchecked is not None else
+                     [v.format + " " + v.variant, v.evaluator, "skipped: " + v.skipped, "", "",
                       "", ""] if v.skipped is not None else
-                     [v.format + " " + v.variant, v.evaluator, f"{v.measured_max:.4e}",
-                      f"{v.stated_bound:.4e}", f"{v.ratio:.3f}", str(v.count),
+                     [v.format + " " + v.variant, v.evaluator,
+                      format_down(v.measured_max, '.4e'),
+                      f"{format_up(v.stated_bound, '.4e')}", f"{v.ratio:.3f}", str(v.count),
                       "ok" if v.passed else "EXCEEDS"])
             rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
         head = "".join(f"<th>{h}</th>" for h in ("variant", "evaluator", "measured max",
@@ -287,6 +330,10 @@ def _number(text: str) -> float | None:
 def stated_bounds(text: str) -> dict[str, float]:
     """Every ``#define NAME value`` and shader constant of an exported text
     whose value is a number (hexadecimal or decimal), by name.
+
+    A textual read, for looking at a file: it does not know ``#if 0``,
+    comments or ``#undef``. :func:`verify` never uses it for the bounds it
+    checks; those are read from the compiled object.
 
     Parameters
     ----------
@@ -506,18 +553,21 @@ def _finish(tracker: _Tracker, fn, exact_x) -> tuple[float, float, float, float]
 # ---------------------------------------------------------------- running a variant
 
 
-def _run(fn, evaluate, inputs: _Inputs, to_x64, to_y64, exact_x):
-    """Evaluate every chunk, track the errors; (measured, argmax, upper, ref, seconds)."""
+def _run(fn, evaluate, inputs: _Inputs, to_x64, to_y64, exact_x, what: str = "evaluator"):
+    """Evaluate every chunk, track the errors; (measured, argmax, upper, ref, seconds).
+    A progress bar names ``what`` on a terminal."""
     fn.numpy, fn.arb  # compiled before the clock starts (cached)
     t0 = time.perf_counter()
     tracker = _Tracker()
-    for vals in inputs.chunks():
-        y = evaluate(vals)
-        x64 = to_x64(vals)
-        with np.errstate(all="ignore"):
-            f64 = fn.numpy(x64)
-        tracker.add(vals.view(np.int32).astype(np.int64) if inputs.kind == "f32" else vals,
-                    x64, to_y64(y), f64)
+    with progress_bar(inputs.count, f"chebnorm verify: {what}", unit="input") as bar:
+        for vals in inputs.chunks():
+            y = evaluate(vals)
+            x64 = to_x64(vals)
+            with np.errstate(all="ignore"):
+                f64 = fn.numpy(x64)
+            tracker.add(vals.view(np.int32).astype(np.int64) if inputs.kind == "f32" else vals,
+                        x64, to_y64(y), f64)
+            bar.update(len(vals))
     measured, argmax, upper, ref = _finish(tracker, fn, exact_x)
     return measured, argmax, upper, ref, time.perf_counter() - t0
 
@@ -535,25 +585,67 @@ _CTYPES = {"double": (ctypes.c_double, np.float64), "float": (ctypes.c_float, np
 
 
 class _CLibrary:
-    """The header compiled with a wrapper per evaluator: ``NAME_array(x, y, n)``."""
+    """The header compiled with a wrapper per evaluator: ``NAME_array(x, y, n)``,
+    and a probe per macro of ``macros``: ``chebnorm_verify_probe_I(buf, n)``
+    prints the macro's value as the compiler sees it (``%La``, exact), or
+    returns -1 when the macro is not defined at the end of the header."""
 
-    def __init__(self, header: str, evaluators, flags, tmp: Path, tag: str):
+    def __init__(self, header: str, evaluators, flags, tmp: Path, tag: str, macros=()):
         gcc = shutil.which("gcc")
         if gcc is None:
             raise _Skip("gcc is not installed; accepted: apt-get install gcc")
-        lines = [header, "#include <stddef.h>"]
+        base = [header, "#include <stddef.h>", "#include <stdio.h>"]
         for ret, name, arg in evaluators:
-            lines.append(f"void {name}_array(const {arg} *x, {ret} *y, ptrdiff_t n) "
-                         f"{{ for (ptrdiff_t i = 0; i < n; ++i) y[i] = {name}(x[i]); }}")
-        src = tmp / f"verify_{tag}.c"
+            base.append(f"void {name}_array(const {arg} *x, {ret} *y, ptrdiff_t n) "
+                        f"{{ for (ptrdiff_t i = 0; i < n; ++i) y[i] = {name}(x[i]); }}")
+        self.macros = tuple(macros)
+        probes = {m: [f"int chebnorm_verify_probe_{i}(char *buf, int n) {{", f"#ifdef {m}",
+                      f"  return snprintf(buf, (size_t) n, \"%La\", (long double) ({m}));",
+                      "#else", "  return -1;", "#endif", "}"] for i, m in enumerate(self.macros)}
+        self.bad: dict[str, str] = {}
         lib = tmp / f"verify_{tag}.so"
-        src.write_text("\n".join(lines) + "\n", encoding="utf-8")
-        proc = subprocess.run([gcc, *flags, "-std=c99", "-fPIC", "-shared", "-o", str(lib),
-                               str(src), "-lm"], capture_output=True, text=True, timeout=300)
-        if proc.returncode != 0:
-            raise _CompileError(f"gcc {' '.join(flags)} failed: "
-                                f"{' '.join(proc.stderr.split())[:300]}")
+
+        def build(lines, *extra):
+            src = tmp / f"verify_{tag}.c"
+            src.write_text("\n".join(lines) + "\n", encoding="utf-8")
+            out = ["-fsyntax-only"] if extra else ["-fPIC", "-shared", "-o", str(lib)]
+            proc = run_tool([gcc, *flags, "-std=c99", *out, str(src), "-lm"], tool="gcc",
+                            timeout=300)
+            return proc.returncode == 0, " ".join(proc.stderr.replace(str(src), "header.c")
+                                                  .split())[:300]
+
+        ok, err = build(base + [x for m in self.macros for x in probes[m]])
+        if not ok:  # the header itself, or a macro that is no number (a probe)
+            ok, err = build(base)
+            if not ok:
+                raise _CompileError(f"gcc {' '.join(flags)} failed: {err}")
+            for m in self.macros:
+                good, why = build(base + probes[m], "syntax")
+                if not good:
+                    self.bad[m] = f"{m} is not a number in C (gcc: {why[:200]})"
+            ok, err = build(base + [x for m in self.macros if m not in self.bad
+                                    for x in probes[m]])
+            if not ok:
+                raise _CompileError(f"gcc {' '.join(flags)} failed: {err}")
         self.lib = ctypes.CDLL(str(lib))
+
+    def value(self, macro: str) -> Fraction | None:
+        """The value of ``macro`` in the compiled object, exactly (None when
+        the header leaves it undefined); a value that is not a finite number
+        raises :class:`_Unchecked`."""
+        if macro in self.bad:
+            raise _Unchecked(self.bad[macro])
+        f = getattr(self.lib, f"chebnorm_verify_probe_{self.macros.index(macro)}")
+        f.restype = ctypes.c_int
+        f.argtypes = [ctypes.c_char_p, ctypes.c_int]
+        buf = ctypes.create_string_buffer(128)
+        if f(buf, 128) < 0:
+            return None
+        text = buf.value.decode("ascii", "replace")
+        value = _hex_fraction(text)
+        if value is None:
+            raise _Unchecked(f"{macro} is {text} in the compiled header, not a finite number")
+        return value
 
     def evaluator(self, ret: str, name: str, arg: str):
         f = getattr(self.lib, f"{name}_array")
@@ -570,6 +662,24 @@ class _CLibrary:
 
 class _Skip(Exception):
     """A variant that cannot run here (the reason in the message)."""
+
+
+class _Unchecked(Exception):
+    """A variant the text defines but whose stated bound or inputs cannot be
+    read from the compiled object (the reason in the message): a failure."""
+
+
+_HEXFLOAT = re.compile(r"([-+]?)0x([0-9a-f]*)(?:\.([0-9a-f]*))?p([-+]?[0-9]+)", re.I)
+
+
+def _hex_fraction(text: str) -> Fraction | None:
+    """The exact value of a C ``%a``/``%La`` output, None when not finite."""
+    m = _HEXFLOAT.fullmatch(text.strip())
+    if m is None or not (m.group(2) or m.group(3)):
+        return None
+    digits = (m.group(2) or "") + (m.group(3) or "")
+    value = Fraction(int(digits, 16), 16 ** len(m.group(3) or "")) * Fraction(2) ** int(m.group(4))
+    return -value if m.group(1) == "-" else value
 
 
 class _CompileError(_Skip):
@@ -625,8 +735,8 @@ def _fused_note() -> str:
     gcc = shutil.which("gcc")
     if gcc is None:
         return ""
-    proc = subprocess.run([gcc, "-march=native", "-dM", "-E", "-x", "c", "/dev/null"],
-                          capture_output=True, text=True, timeout=60)
+    proc = run_tool([gcc, "-march=native", "-dM", "-E", "-x", "c", "/dev/null"], tool="gcc",
+                    timeout=60)
     return ("the target has FMA (__FMA__)" if "__FMA__" in proc.stdout else
             "no FMA on this target: the fused build cannot contract")
 
@@ -655,24 +765,48 @@ def _c_coefficient(table: CoefficientTable, text: str, spread, wanted) -> list[V
     from chebnorm.approx.expr import parse_function
 
     fn = parse_function(table.expression, table.variable)
-    bounds = stated_bounds(text)
     name = identifier(table.name, field="table.name")
     macro = f"CHEBNORM_{name.upper()}"
-    lo, hi = bounds.get(macro + "_LO"), bounds.get(macro + "_HI")
-    if lo is None or hi is None:
-        raise ValueError(f"the C text defines no {macro}_LO and {macro}_HI; accepted: a header "
-                         f"that chebnorm export printed for table {table.name!r}")
+    _require_defines(text, (macro + "_LO", macro + "_HI"), f"table {table.name!r}")
     plan = [p for p in _c_variants(table, text, spread) if wanted is None or p[0] in wanted]
-    return _run_c(plan, text, fn, bounds, lambda p: _c_inputs(p, lo, hi, bounds, macro, spread))
+    return _run_c(plan, text, fn, (macro + "_LO", macro + "_HI", macro + "_FRAC_BITS"),
+                  lambda p, values: _c_inputs(p, values, macro, spread))
 
 
-def _c_inputs(p, lo, hi, bounds, macro, spread):
+def _require_defines(text: str, names, what: str) -> None:
+    """Refuse a text that does not even mention the macros (not a chebnorm
+    header); their values are read from the compiled object."""
+    defined = {m[0] for m in _DEFINE.findall(text)}
+    if not all(n in defined for n in names):
+        raise ValueError(f"the C text defines no {' and '.join(names)}; accepted: a header "
+                         f"that chebnorm export printed for {what}")
+
+
+def _macro_value(values, macro: str, integer: bool = False):
+    """A macro's value as compiled (a Fraction), or :class:`_Unchecked`."""
+    v = values.get(macro)
+    if isinstance(v, _Unchecked):
+        raise v
+    if v is None:
+        raise _Unchecked(f"{macro} is not defined in the compiled header")
+    if integer and (v.denominator != 1 or not 0 <= v <= 64):
+        raise _Unchecked(f"{macro} is {float(v)!r} in the compiled header; accepted: an "
+                         f"integer 0..64")
+    return int(v) if integer else v
+
+
+def _interval_of(values, macro: str) -> tuple[float, float]:
+    """[LO, HI] as compiled, rounded inward to doubles."""
+    lo, hi = _macro_value(values, macro + "_LO"), _macro_value(values, macro + "_HI")
+    return float_up(lo), float_down(hi)
+
+
+def _c_inputs(p, values, macro, spread):
     """(inputs, to_x64, to_y64, exact_x, note) of one C evaluator."""
     variant, ret, _, arg = p[:4]
+    lo, hi = _interval_of(values, macro)
     if arg == "int64_t":  # the fixed-point evaluator: every code x_q in [LO, HI] * 2^F
-        frac = int(bounds.get(macro + "_FRAC_BITS", -1))
-        if frac < 0:
-            raise _Skip(f"no {macro}_FRAC_BITS in the header")
+        frac = _macro_value(values, macro + "_FRAC_BITS", integer=True)
         a = math.ceil(Fraction(lo) * 2 ** frac)
         b = math.floor(Fraction(hi) * 2 ** frac)
         scale = 2.0 ** -frac
@@ -686,40 +820,60 @@ def _c_inputs(p, lo, hi, bounds, macro, spread):
             lambda y: y.astype(np.float64), _f32_exact, note)
 
 
-def _run_c(plan, text, fn, bounds, inputs_of) -> list[VariantResult]:
+def _probe_all(lib, macros) -> dict:
+    """Macro -> value (Fraction, None when undefined, or the _Unchecked reason)."""
+    out = {}
+    for m in macros:
+        try:
+            out[m] = lib.value(m)
+        except _Unchecked as exc:
+            out[m] = exc
+    return out
+
+
+def _run_c(plan, text, fn, macros, inputs_of) -> list[VariantResult]:
+    """Compile ``text`` (unfused and, for fused variants, fused), read every
+    macro of ``macros`` and every stated bound from each compiled object, and
+    run each variant of ``plan``."""
     results = []
+    macros = tuple(dict.fromkeys([*macros, *(p[4] for p in plan)]))
     with tempfile.TemporaryDirectory(prefix="chebnorm-verify-") as tmp:
         libs = {}
         evaluators = sorted({(p[1], p[2], p[3]) for p in plan})
-        for fused in sorted({p[5] for p in plan}):
+        for fused in sorted({False} | {p[5] for p in plan}):
             try:
                 libs[fused] = _CLibrary(text, evaluators, _FUSED if fused else _UNFUSED,
-                                        Path(tmp), "fused" if fused else "unfused")
+                                        Path(tmp), "fused" if fused else "unfused", macros)
             except _CompileError as exc:
                 if not fused:
                     raise ValueError(f"source: the C text does not compile: {exc}") from None
                 libs[fused] = exc
             except _Skip as exc:
                 libs[fused] = exc
+        base = libs[False]
+        values = {} if isinstance(base, _Skip) else _probe_all(base, macros)
         fma = _fused_note() if any(p[5] for p in plan) else ""
         for p in plan:
             variant, ret, name, arg, bound_name, fused = p
-            stated = bounds.get(bound_name)
             flags = " ".join(_FUSED if fused else _UNFUSED)
+            stated = None
             try:
                 lib = libs[fused]
                 if isinstance(lib, _Skip):
                     raise lib
-                if stated is None:
-                    raise _Skip(f"the header states no {bound_name}")
+                stated = float_down(_macro_value(_probe_all(lib, (bound_name,)), bound_name))
                 t0 = time.perf_counter()
-                inputs, to_x, to_y, exact, note = inputs_of(p)
+                inputs, to_x, to_y, exact, note = inputs_of(p, values)
                 m, at, up, ref, _ = _run(fn, lib.evaluator(ret, name, arg), inputs, to_x,
-                                         to_y, exact)
+                                         to_y, exact, what=f"{name} ({variant})")
                 sec = time.perf_counter() - t0  # inputs, evaluation and reference
             except _Skip as exc:
                 results.append(VariantResult("c", variant, name, bound_name, stated, None, None,
                                              None, None, 0, "", 0.0, skipped=str(exc)))
+                continue
+            except _Unchecked as exc:
+                results.append(VariantResult("c", variant, name, bound_name, stated, None, None,
+                                             None, None, 0, "", 0.0, unchecked=str(exc)))
                 continue
             notes = tuple(n for n in (f"gcc {flags}", fma if fused else "", note) if n)
             results.append(VariantResult("c", variant, name, bound_name, stated, m, at, up, ref,
@@ -731,7 +885,6 @@ def _c_piecewise(table: PiecewiseTable, text: str, spread, wanted) -> list[Varia
     from chebnorm.approx.expr import enclose, parse_function
 
     fn = parse_function(table.expression, table.variable)
-    bounds = stated_bounds(text)
     name = identifier(table.name, field="table.name")
     macro, cname = f"CHEBNORM_{name.upper()}", f"chebnorm_{name}"
     found = {m[1]: (m[0], m[2]) for m in _EVALUATOR.findall(text)}
@@ -743,11 +896,12 @@ def _c_piecewise(table: PiecewiseTable, text: str, spread, wanted) -> list[Varia
             for v in ("double", "double-fused") if wanted is None or v in wanted]
     lo_s, hi_s = float(table.lo), float(table.hi)
 
-    def inputs_of(p):
+    def inputs_of(p, values):
         if arg == "uint32_t":
-            bits = int(bounds.get(macro + "_IN_BITS", -1))
-            if bits < 0:
-                raise _Skip(f"no {macro}_IN_BITS in the header")
+            bits = _macro_value(values, macro + "_IN_BITS", integer=True)
+            if not 1 <= bits <= 32:
+                raise _Unchecked(f"{macro}_IN_BITS is {bits} in the compiled header; accepted: "
+                                 f"1..32")
             scale = (hi_s - lo_s) * 2.0 ** -bits
             with arb_precision(_PREC):
                 lo_a, width = enclose(table.lo, _PREC), enclose(table.hi - table.lo, _PREC)
@@ -761,10 +915,19 @@ def _c_piecewise(table: PiecewiseTable, text: str, spread, wanted) -> list[Varia
         return (_float32_set(lo_s, hi_open, spread, "float32 in [lo, hi)"),
                 lambda v: v.astype(np.float64), lambda y: y, _f32_exact,
                 "a double evaluator run on the float32 inputs only (promoted to double)")
-    return _run_c(plan, text, fn, bounds, inputs_of)
+    return _run_c(plan, text, fn, (macro + "_IN_BITS",), inputs_of)
 
 
 # ---------------------------------------------------------------- shaders
+
+
+#: a function the probe shader maps input 0, 1, 2 through: LO, HI, the bound
+#: (the constants as the shader computes them, never their text)
+_PROBE = {"glsl": ("float chebnorm_verify_probe(float i)\n{{\n    if (i < 0.5) return {lo};\n"
+                   "    if (i < 1.5) return {hi};\n    return {bound};\n}}\n"),
+          "wgsl": ("fn chebnorm_verify_probe(i: f32) -> f32 {{\n    if (i < 0.5) {{ return {lo}; "
+                   "}}\n"
+                   "    if (i < 1.5) {{ return {hi}; }}\n    return {bound};\n}}\n")}
 
 
 def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[VariantResult]:
@@ -776,21 +939,17 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
     cname, macro = f"chebnorm_{name}", f"CHEBNORM_{name.upper()}"
     bounds = stated_bounds(text)
     bound_name = macro + "_EVAL_ERROR_BOUND"
-    # the shader constants are float32: their literals convert exactly to one
-    # (directly and through a double), which is the value the shader uses
-    stated, lo, hi = (None if v is None else float(np.float32(v)) for v in
-                      (bounds.get(bound_name), bounds.get(macro + "_LO"),
-                       bounds.get(macro + "_HI")))
+    # the literals as written (HLSL, which nothing runs here, is reported with them);
+    # the shaders that run report the constants as the driver computes them
+    stated = None if bounds.get(bound_name) is None else float(np.float32(bounds[bound_name]))
     variant = VARIANTS[fmt][0]
-    if lo is None or hi is None:
+    if not re.search(rf"\b{macro}_LO\b", text) or not re.search(rf"\b{macro}_HI\b", text):
         raise ValueError(f"the {fmt} text defines no {macro}_LO and {macro}_HI; accepted: a "
                          f"shader that chebnorm export printed for table {table.name!r}")
 
-    def skipped(reason):
+    def skipped(reason, unchecked=False):
         return [VariantResult(fmt, variant, cname, bound_name, stated, None, None, None, None,
-                              0, "", 0.0, skipped=reason)]
-    if stated is None:
-        return skipped(f"the shader states no {bound_name}")
+                              0, "", 0.0, **{"unchecked" if unchecked else "skipped": reason})]
     source = compute_shader_around(text, cname, fmt)
     if fmt == "hlsl":
         try:
@@ -806,12 +965,17 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
     except Exception as exc:  # the driver's own compile errors
         raise ValueError(f"source: the {fmt} text does not compile on the driver: "
                          f"{' '.join(str(exc).split())[:300]}") from None
-    fn = parse_function(table.expression, table.variable)
-    t0 = time.perf_counter()
-    inputs = _float32_set(lo, hi, spread)
     try:
+        try:
+            lo, hi, stated = _shader_constants(text, fmt, macro)
+        except _Unchecked as exc:
+            return skipped(str(exc), unchecked=True)
+        fn = parse_function(table.expression, table.variable)
+        t0 = time.perf_counter()
+        inputs = _float32_set(lo, hi, spread)
         m, at, up, ref, _ = _run(fn, run, inputs, lambda v: v.astype(np.float64),
-                                 lambda y: y.astype(np.float64), _f32_exact)
+                                 lambda y: y.astype(np.float64), _f32_exact,
+                                 what=f"{fmt} {variant}")
         sec = time.perf_counter() - t0
     except ToolMissing as exc:
         return skipped(str(exc))
@@ -826,6 +990,34 @@ def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[Varian
         "WebGPU compute pipeline, dispatches of 2^20"
     return [VariantResult(fmt, variant, cname, bound_name, stated, m, at, up, ref, inputs.count,
                           inputs.text, sec, notes=(note, _driver(fmt)))]
+
+
+def _shader_constants(text: str, fmt: str, macro: str) -> tuple[float, float, float]:
+    """(LO, HI, EVAL_ERROR_BOUND) as the shader computes them: a probe
+    function returning each is compiled with the text and run on the driver;
+    a constant that is undefined or no float raises :class:`_Unchecked`."""
+    from .gpu import ToolMissing, compute_shader_around
+
+    probe = _PROBE[fmt].format(lo=f"{macro}_LO", hi=f"{macro}_HI",
+                               bound=f"{macro}_EVAL_ERROR_BOUND")
+    source = compute_shader_around(text + "\n" + probe, "chebnorm_verify_probe", fmt)
+    close = lambda: None  # noqa: E731
+    try:
+        run, close = _glsl(source) if fmt == "glsl" else (_wgsl(source), lambda: None)
+        got = np.asarray(run(np.array([0.0, 1.0, 2.0], dtype=np.float32)), dtype=np.float32)
+    except ToolMissing:
+        raise
+    except Exception as exc:  # the driver's own compile errors
+        raise _Unchecked(f"{macro}_LO, {macro}_HI and {macro}_EVAL_ERROR_BOUND cannot be read "
+                         f"as float constants of the compiled shader: "
+                         f"{' '.join(str(exc).split())[:200]}") from None
+    finally:
+        close()
+    lo, hi, bound = (float(v) for v in got)
+    if not all(math.isfinite(v) for v in (lo, hi, bound)):
+        raise _Unchecked(f"the compiled shader's {macro}_LO, _HI, _EVAL_ERROR_BOUND are "
+                         f"{lo!r}, {hi!r}, {bound!r}: not finite")
+    return lo, hi, bound
 
 
 def _glsl(source):

@@ -6,7 +6,8 @@ bit-accurate model); :mod:`.hdl` prints any design in Verilog or VHDL (the
 one HDL printer, with the benches and vector files); :mod:`.verilog` and
 :mod:`.vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
 checks a design against its error budget; :mod:`.units` are the
-normalization units (Verilog).
+normalization units (Verilog). Every design object re-proves its bound and
+claims when it is constructed and before it prints (:mod:`.trust`).
 
 Imports only from :mod:`chebnorm.approx` (and :mod:`chebnorm.symbolic`).
 Fixed-point conventions are those of :mod:`chebnorm.hw.fixed`: a code ``k``

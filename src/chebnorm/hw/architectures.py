@@ -34,6 +34,7 @@ from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS
 
 from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
+from chebnorm.core.numeric import format_down, format_up
 
 from .hdl import module_text
 from .multipartite import design_multipartite
@@ -145,7 +146,7 @@ class Candidate:
         cost = (self.cost.line() if self.cost is not None else
                 f"not synthesized ({self.note})" if self.note else "not synthesized")
         return (f"{self.architecture}: {self.description}: {cost}; certified error "
-                f"{self.error:.4e} ({self.error / self.ulp:.3f} ulp)")
+                f"{format_up(self.error, '.4e')} ({format_up(self.error / self.ulp, '.3f')} ulp)")
 
 
 def _sized_chain(item) -> list:
@@ -352,7 +353,8 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         c = out[i]
         rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
         out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
-                           f"model {c.model:.1f}{rom}: lower bound {lower(c):.1f} >= best "
+                           f"model {c.model:.1f}{rom}: lower bound {format_down(lower(c), '.1f')} "
+                           f">= best "
                            f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
     return out
 

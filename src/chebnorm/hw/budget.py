@@ -14,7 +14,12 @@ Budget (all in the units of ``y``, i.e. absolute errors of the value)::
 * ``rounding_steps[j]``: the rounding of ``a_j`` (``rho_j`` = one ulp of the
   accumulator for truncation, half of one for ``rne``) carried to the output
   through ``j`` multiplications by ``x``;
-* ``output_rounding``: rounding to the output's ``Fy`` fractional bits.
+* ``output_rounding``: rounding to the output's ``Fy`` fractional bits;
+* ``variable_rounding``: for a design whose Horner variable ``v`` is not
+  ``x`` (``x*x`` rounded, or ``(x - c')/s`` with ``c`` rounded to ``c'``),
+  ``max |v - v_exact| * max |q'|`` (mean value theorem), times ``max |x|``
+  for an odd design; each ``rho_j`` then reaches the output times
+  ``max|v|^j`` (``max|v|^(j-1) max|x|`` when odd).
 
 Every bound is a float rounded upward.
 """
@@ -24,7 +29,6 @@ from __future__ import annotations
 import math
 import re
 import shutil
-import subprocess
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -39,8 +43,11 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
+from .trust import verify_design
+from chebnorm.core.tools import run_tool
 
-__all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "gappa_script",
+__all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "variable_error_bound",
+           "gappa_script",
            "gappa_bound", "SHADING_LEVELS"]
 
 #: an 8-bit shading output has 255 steps between black and full intensity
@@ -74,6 +81,9 @@ class ErrorBudget:
     gappa_rounding : float or None, default None
         gappa's independent bound of the rounding part ``|y - p_q(x)|``; None when not
         asked for or gappa is not installed.
+    variable_rounding : float, default 0.0
+        A one-parity design's rounding of the square ``v = R(x*x)`` carried to the
+        output (:func:`variable_error_bound`; included in ``rounding``).
 
     Examples
     --------
@@ -94,6 +104,7 @@ class ErrorBudget:
     total: float
     y_lsb: float
     gappa_rounding: float | None = None
+    variable_rounding: float = 0.0
 
     def _summary(self) -> list[tuple[str, object]]:
         return [("total", self.total), ("approximation", self.approximation),
@@ -108,7 +119,8 @@ class ErrorBudget:
         return {"approximation": self.approximation, "quantization": self.quantization,
                 "quantized_certified": self.quantized,
                 "rounding_steps": list(self.rounding_steps),
-                "output_rounding": self.output_rounding, "rounding": self.rounding,
+                "output_rounding": self.output_rounding,
+                "variable_rounding": self.variable_rounding, "rounding": self.rounding,
                 "total": self.total, "total_lsb": self.total / self.y_lsb,
                 "gappa_rounding": self.gappa_rounding}
 
@@ -197,8 +209,12 @@ class Measurement:
 
 
 def _poly_function(table):
-    """``p`` itself as an exact sympy function (its floats as rationals)."""
+    """``p`` itself as an exact sympy function of ``x`` (its floats as
+    rationals; of ``(x - c)/s`` for a shifted table)."""
     v = sp.Symbol(table.variable)
+    if table.shift is not None:
+        c, s = (sp.Rational(*float(w).as_integer_ratio()) for w in table.shift)
+        v = (v - c) / s
     expr = sum(sp.Rational(c) * v ** k for k, c in enumerate(table.coefficients))
     return parse_function(expr, table.variable)
 
@@ -208,7 +224,7 @@ def quantization_bound(design: HornerDesign) -> float:
     t = design.table
     coeffs = [math.ldexp(q, -design.coef_frac_bits) for q in design.integers]
     lo, hi = (parse_number(v) for v in t.interval)
-    return certify(_poly_function(t), coeffs, lo, hi, "abs").bound
+    return certify(_poly_function(t), coeffs, lo, hi, "abs", shift=t.shift).bound
 
 
 def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
@@ -239,7 +255,8 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     Raises
     ------
     ValueError
-        If gappa is asked for and fails on the datapath (see :func:`gappa_bound`).
+        If gappa is asked for and fails on the datapath (see :func:`gappa_bound`), or
+        the design does not hold its claims (changed since it was built).
 
 
     See Also
@@ -276,16 +293,21 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
        floating-point implementation of an elementary function using
        Gappa", IEEE Transactions on Computers 60(2), 2011.
     """
+    verify_design(design)   # a design changed since it was proved: proved again (or refused)
     t = design.table
     xmax = design.max_abs_x()
+    vmax, x_factor = _variable_max(design), (xmax if design.scheme == "odd" else 1)
     steps = []
     for st in design.stages[:-1]:
         rho = rounding_error_bound(st.out_frac_bits, design.rounding, st.round_shift)
-        steps.append(rho * xmax ** st.power)
+        # a_j reaches the output times v^j; in an odd design times v^(j-1) * x
+        steps.append(rho * (vmax ** (st.power - 1) * xmax if design.scheme == "odd"
+                            else vmax ** st.power))
     top_frac = design.stages[-1].sum_frac_bits if design.stages else design.coef_frac_bits
     fy = design.y_format.frac_bits
     out = rounding_error_bound(fy, design.rounding, top_frac - fy) if top_frac > fy else Fraction(0)
-    rounding = sum(steps, Fraction(0)) + out
+    var = variable_error_bound(design, vmax) * x_factor
+    rounding = sum(steps, Fraction(0)) + out + var
     approx, quant = t.abs_error_bound, quantization_bound(design)
     quantized = t.fixed_point.abs_error_bound
     poly = min(Fraction(approx) + Fraction(quant), Fraction(quantized))
@@ -293,7 +315,64 @@ def error_budget(design: HornerDesign, *, gappa: bool = False) -> ErrorBudget:
     return ErrorBudget(approximation=approx, quantization=quant, quantized=quantized,
                        rounding_steps=tuple(float_up(s) for s in steps), output_rounding=float_up(out),
                        rounding=float_up(rounding), total=float_up(poly + rounding),
-                       y_lsb=float(design.y_format.lsb), gappa_rounding=g)
+                       y_lsb=float(design.y_format.lsb), gappa_rounding=g,
+                       variable_rounding=float_up(var))
+
+
+def _variable_max(design: HornerDesign) -> Fraction:
+    """A bound of ``|v|`` and of the exact variable (``x`` or ``x*x``) over
+    the valid codes: the largest rounded ``|v|`` plus ``v_error``."""
+    lo, hi = design.valid_codes
+    k = np.arange(lo, hi + 1, dtype=np.int64)
+    v = design.evaluate(k, intermediates=True)["v"]
+    biggest = max(abs(int(v.min())), abs(int(v.max())))
+    return Fraction(biggest, 2 ** design.variable_frac_bits) + design.v_error \
+        if design.variable_frac_bits >= 0 else \
+        Fraction(biggest * 2 ** -design.variable_frac_bits) + design.v_error
+
+
+def variable_error_bound(design: HornerDesign, vmax: Fraction | None = None) -> Fraction:
+    """A bound of ``|q(v) - q(x*x)|`` (``q`` the quantized polynomial Horner's
+    rule runs over) from rounding the square to ``v`` in a one-parity design:
+    ``v_error * max |q'|`` by the mean value theorem, with
+    ``|q'| <= sum_i i |d_i| V^(i-1)`` on ``|v| <= V``. An odd design's output
+    is ``x`` times it (the caller multiplies by ``max |x|``); 0 when ``v``
+    is exact or the design is plain Horner in ``x``.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The datapath.
+    vmax : Fraction or None, default None
+        A bound ``V`` of ``|v|`` and ``|x*x|`` on the valid codes; None computes it.
+
+    Returns
+    -------
+    Fraction
+        The bound, exact.
+
+    Examples
+    --------
+    ``cos`` at degree 8 evaluates ``q(v)``, ``v = x*x`` rounded from 24 to
+    16 fractional bits; plain Horner has no such term:
+
+    >>> from chebnorm.approx import fit
+    >>> from chebnorm.hw.horner import design_horner
+    >>> t = fit("cos(x)", ("-1", "1"), 8)
+    >>> d = design_horner(t, 12, 10, coef_bits=22)
+    >>> d.scheme, d.variable_frac_bits, 0 < variable_error_bound(d) < 2 ** -17
+    ('even', 16, True)
+    >>> variable_error_bound(design_horner(t, 12, 10, coef_bits=22, parity=False))
+    Fraction(0, 1)
+    """
+    if design.scheme == "monomial" or design.v_error == 0:
+        return Fraction(0)
+    if vmax is None:
+        vmax = _variable_max(design)
+    ints = design.horner_integers[1:] if design.scheme == "odd" else design.horner_integers
+    slope = sum(i * abs(Fraction(q, 2 ** design.coef_frac_bits)) * vmax ** (i - 1)
+                for i, q in enumerate(ints) if i > 0)
+    return design.v_error * slope
 
 
 def measure(design: HornerDesign) -> Measurement:
@@ -340,7 +419,7 @@ def measure(design: HornerDesign) -> Measurement:
     yv = design.y_format.values(y)
     fn = parse_function(design.table.expression, design.table.variable)
     f = np.asarray(fn.numpy(xf), dtype=np.float64) * np.ones_like(xf)
-    p = np.polynomial.polynomial.polyval(xf, design.table.coefficients)
+    p = design.table(xf)   # in t = (x - c) * (1/s) for a shifted table
     num, den = design.exact_numerators(k)
     pq = _to_float(num, den)
     # exact rounding error: y - p_q, both over the common denominator 2**D
@@ -355,10 +434,10 @@ def measure(design: HornerDesign) -> Measurement:
     worst = max(abs(int(diff.max())), abs(int(diff.min())))
     rounding = float_up(Fraction(worst, 2 ** scale))
     steps = []
-    xs = wires["xs"]
-    acc = np.full(k.shape, design.integers[-1], dtype=np.int64)
+    xs, v = wires["xs"], wires["v"]
+    acc = np.full(k.shape, design.horner_integers[-1], dtype=np.int64)
     for st in design.stages[:-1]:
-        t = ((acc * xs) << st.product_shift) + st.coef_shifted
+        t = ((acc * (xs if st.operand == "x" else v)) << st.product_shift) + st.coef_shifted
         a = wires[f"a{st.power}"]
         err = np.abs((a << st.round_shift) - t)
         steps.append(float(Fraction(int(err.max()), 2 ** st.sum_frac_bits)))
@@ -383,6 +462,11 @@ def _to_float(num, den) -> np.ndarray:
 
 def _dyadic(q: int, frac: int) -> str:
     return f"{q}b{-frac}" if q else "0"
+
+
+def _fraction_literal(v: Fraction) -> str:
+    """A dyadic rational (a float's value) as a gappa literal ``Nb-E``."""
+    return _dyadic(v.numerator, v.denominator.bit_length() - 1)
 
 
 def gappa_script(design: HornerDesign) -> str:
@@ -414,17 +498,37 @@ def gappa_script(design: HornerDesign) -> str:
     lines = [f"# gappa: rounding error of the Horner datapath of {design.module_name}",
              f"# x in the valid codes {lo}..{hi}; coefficients q_j * 2^-{fc}",
              f"@ry = fixed<{-design.y_format.frac_bits},{mode}>;"]
-    if n >= 2:
+    if len(design.horner_integers) >= 3:
         lines.append(f"@ra = fixed<{-design.acc_frac_bits},{mode}>;")
+    var, exact_var = "x", "x"
+    if design.scheme == "shifted":   # v = (x - c') * 2^-e exactly, Mv = (x - c) * 2^-e
+        c, s = (Fraction(w) for w in design.table.shift)
+        e = s.numerator.bit_length() - s.denominator.bit_length()
+        g = design.v_shift + xf.frac_bits
+        lines.append(f"Mv = (x - {_fraction_literal(c)}) * 1b{-e};")
+        lines.append(f"v = (x - {_dyadic(design.v_offset, g)}) * 1b{-e};")
+        var, exact_var = "v", "Mv"
+    elif design.scheme != "monomial":   # the Horner variable v = R(x*x), exact Mv = x*x
+        q, n = design.horner_integers, len(design.horner_integers) - 1
+        lines.append("Mv = x * x;")
+        if design.v_round_shift:
+            lines.insert(3, f"@rv = fixed<{-design.variable_frac_bits},{mode}>;")
+            lines.append("v rv= x * x;")
+        else:
+            lines.append("v = x * x;")
+        var, exact_var = "v", "Mv"
     exact = _dyadic(q[n], fc)
     hw = exact
     for j in range(n - 1, -1, -1):
         c = _dyadic(q[j], fc)
-        exact_j = f"M{j} = {'M' + str(j + 1) if j < n - 1 else exact} * x + {c};"
+        last_x = design.scheme == "odd" and j == 0
+        ev, hv = ("x", "x") if last_x else (exact_var, var)
+        tail = "" if last_x else f" + {c}"
+        exact_j = f"M{j} = {'M' + str(j + 1) if j < n - 1 else exact} * {ev}{tail};"
         lines.append(exact_j)
         rnd = "ry" if j == 0 else "ra"
         prev = hw if j == n - 1 else f"a{j + 1}"
-        lines.append(f"a{j} {rnd}= {prev} * x + {c};")
+        lines.append(f"a{j} {rnd}= {prev} * {hv}{tail};")
     if n == 0:
         lines.append(f"M0 = {exact};")
         lines.append(f"a0 ry= {exact};")
@@ -483,14 +587,14 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
     ------
     ValueError
         If gappa fails or gives no bound.
-    subprocess.TimeoutExpired
-        If gappa runs longer than ``timeout``.
+    chebnorm.core.tools.ToolTimeout
+        If gappa runs longer than ``timeout`` (a ``ValueError``
+        and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
     exe = shutil.which("gappa")
     if exe is None:
         return None
-    proc = subprocess.run([exe], input=gappa_script(design), capture_output=True, text=True,
-                          timeout=timeout)
+    proc = run_tool([exe], tool="gappa", timeout=timeout, input=gappa_script(design))
     out = proc.stdout + proc.stderr
     if proc.returncode != 0 or "in [" not in out:
         raise ValueError(f"gappa could not bound the datapath of {design.module_name}: "

@@ -154,12 +154,15 @@ class Block:
             d["children"] = [c.as_dict() for c in self.children]
         return d
 
-    def lines(self, indent: int = 0) -> list[str]:
-        """One text line per block of the tree, indented by depth."""
+    def lines(self, indent: int = 0, depth: bool = False) -> list[str]:
+        """One text line per block of the tree, indented by depth. ``depth=True``
+        says the model's latency as how many operations deep the block is (a
+        report whose design is combinational states its latency once, in cycles)."""
         c = self.cost
+        steps = f"{c.latency} operations deep" if depth else f"latency {c.latency}"
         out = [f"{'  ' * indent}{self.name}: {len(c.multipliers)} mul, {len(c.adders)} add, "
                f"{len(c.sqrts)} sqrt, {len(c.dividers)} div, {c.mux_bits} mux bits, "
-               f"{c.rom_bits} ROM bits, latency {c.latency}, area ~{c.area:.0f} FA"]
+               f"{c.rom_bits} ROM bits, {steps}, area ~{c.area:.0f} FA"]
         for ch in self.children:
-            out += ch.lines(indent + 1)
+            out += ch.lines(indent + 1, depth)
         return out

@@ -38,8 +38,10 @@ __all__ = ["horner_block", "dot_block", "classic_unit", "dichotomy_unit",
 
 
 def horner_block(design: HornerDesign) -> Block:
-    """The polynomial evaluator: one multiplier and adder per degree, the
-    input-offset adder, rounding incrementers, the output offset and clamp.
+    """The polynomial evaluator: one multiplier and adder per Horner step
+    (per degree; per two degrees plus the squarer ``x*x`` in a one-parity
+    design), the input-offset adder, rounding incrementers, the output
+    offset and clamp.
 
     Parameters
     ----------
@@ -61,15 +63,27 @@ def horner_block(design: HornerDesign) -> Block:
     >>> len(c.multipliers) == d.degree, c.latency
     (True, 5)
     """
-    mults = tuple((st.acc_bits, design.xs_bits) for st in design.stages)
+    square = design.scheme in ("even", "odd")
+    mults = tuple((st.acc_bits, design.xs_bits if st.operand == "x" or design.scheme == "monomial"
+                   else design.variable_bits) for st in design.stages)
     adders = [design.xs_bits] + [st.sum_bits for st in design.stages]
     adders += [st.out_bits for st in design.stages[:-1] if st.round_shift]
     adders += [design.raw_bits, design.raw_bits]  # output rounding + offset, clamp compare
-    rom = sum(max(abs(q), 1).bit_length() + 1 for q in design.integers)
+    if design.scheme == "shifted":   # v = (xs << m) - C
+        adders.append(design.variable_bits)
+    if square:   # the squarer x*x and its rounding
+        mults = ((design.xs_bits, design.xs_bits),) + mults
+        if design.v_round_shift:
+            adders.append(design.variable_bits)
+    rom = sum(max(abs(q), 1).bit_length() + 1 for q in design.horner_integers)
+    scheme = ("" if design.scheme == "monomial" else ", in v = (x - c)/s"
+              if design.scheme == "shifted" else f", {design.scheme} powers in v = x*x")
     return Block(f"horner {design.module_name}",
                  Cost(multipliers=mults, adders=tuple(adders), rom_bits=rom,
-                      mux_bits=design.out_bits, latency=1 + 2 * design.degree),
-                 note=f"degree {design.degree}, {design.in_bits}-bit x, {design.out_bits}-bit y")
+                      mux_bits=design.out_bits,
+                      latency=1 + 2 * (design.steps + square)),
+                 note=f"degree {design.degree}{scheme}, {design.in_bits}-bit x, "
+                      f"{design.out_bits}-bit y")
 
 
 def dot_block(w: int) -> Block:

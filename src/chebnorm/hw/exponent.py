@@ -60,6 +60,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .fixed import check_width
 from .hdl.exponent import exponent_files, exponent_module
 from .piecewise import MAX_PW_IN_BITS, PiecewiseDesign, design_piecewise, shape_cost
+from .trust import check
 
 __all__ = ["MIN_EXP_IN_BITS", "ExponentDesign", "design_exponent", "exponent_fields",
            "check_rsqrt", "simulate_exponent"]
@@ -215,6 +216,30 @@ class ExponentDesign:
     architecture = "exponent"
 
     def __post_init__(self):
+        self.verify()
+
+    def verify(self) -> "ExponentDesign":
+        """Re-prove the design; return it unchanged, or raise ValueError.
+
+        The fields are checked as :func:`design_exponent` builds them (the
+        function ``1/sqrt``, the interval, the shift width), and the core is
+        re-verified (:meth:`PiecewiseDesign.verify`: its table, ROM and
+        certified bound re-proved) and must evaluate ``1/sqrt`` on ``[1, 4)``.
+        Proved once per content (:func:`chebnorm.hw.trust.check`).
+
+        Returns
+        -------
+        ExponentDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
+
+    def _check_fields(self):
         # a hand-built design is checked as design_exponent builds it: the printers trust it
         W = check_width(self.in_bits, "in_bits", MIN_EXP_IN_BITS, MAX_PW_IN_BITS)
         identifier(self.name, field="name")
@@ -229,6 +254,13 @@ class ExponentDesign:
         if self.shift_bits != ((W + 2) >> 1).bit_length():
             raise ValueError(f"shift_bits {self.shift_bits!r}: accepted: "
                              f"{((W + 2) >> 1).bit_length()} (the width of (in_bits + 2) >> 1)")
+        check_rsqrt(self.expression, self.variable)
+        c.verify()
+        try:
+            check_rsqrt(t.expression, t.variable)
+        except ValueError:
+            raise ValueError(f"core: its table evaluates {str(t.expression)[:40]!r}; accepted: "
+                             f"a core of 1/sqrt on [1, 4) (design_exponent builds it)") from None
 
     @property
     def module_name(self) -> str:
@@ -327,6 +359,10 @@ class ExponentDesign:
     def vhdl(self, *, version: str = "", command: str | None = None) -> str:
         """The VHDL-2008 entities (core first): :func:`chebnorm.hw.hdl.exponent.exponent_module`."""
         return exponent_module(self, "vhdl", version=version, command=command)
+
+
+def _prove(d: ExponentDesign) -> None:
+    d._check_fields()
 
 
 def _core_shape(d: PiecewiseDesign) -> tuple:

@@ -7,6 +7,14 @@ The datapath (``n`` = degree, ``q_j`` the table's fixed-point integers with
     a_j     = R_Fa(a_{j+1} * x + q_j / 2**Fc),   j = n-1 .. 1
     y_raw   = R_Fy(a_1 * x + q_0 / 2**Fc) - Oy,  y = saturate(y_raw)
 
+Two variants keep that datapath with another Horner variable ``v`` (the
+design's ``scheme``): when every nonzero coefficient is of one parity,
+``v = R(x*x)`` (squared once, exact or rounded two bits past the
+accumulators) and Horner's rule runs over the nonzero coefficients only,
+times ``x`` once at the end when odd; for a table in the shifted basis
+``t = (x - c)/s`` (``s`` a power of two), ``v = (x - c')/s`` (one
+subtraction; ``c' = c`` when ``c`` has few enough fractional bits).
+
 Each step is a multiply-add done exactly, then one rounding (``R_F``: to
 ``F`` fractional bits, ``"trunc"`` or ``"rne"``); the output offset ``Oy``
 is subtracted after rounding (exactly, it is a multiple of ``2**-Fy``).
@@ -30,7 +38,7 @@ whose range :attr:`HornerDesign.valid_codes` reports.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from fractions import Fraction
 
 import numpy as np
@@ -40,10 +48,11 @@ from chebnorm.approx import CoefficientTable, parse_number, quantize
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
+from .trust import check, drafting, seal
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
 
-__all__ = ["HornerDesign", "Stage", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
+__all__ = ["HornerDesign", "Stage", "SCHEMES", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
            "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
 
 #: widest input code of a Horner design (its model and test bench run all ``2**in_bits`` codes)
@@ -86,6 +95,10 @@ class Stage:
         Fractional bits of ``a_j`` (the accumulator's, or the output's at ``j = 0``).
     round_shift : int
         Bits dropped by the rounding: ``sum_frac_bits - out_frac_bits`` (``>= 0``).
+    operand : {"v", "x"}, default "v"
+        What ``a_{j+1}`` is multiplied by: the Horner variable ``v`` (``x``
+        itself for plain powers, ``x*x`` rounded for a one-parity design),
+        or ``x`` in the last step of an odd design (``y = x * q(x*x)``).
 
     Examples
     --------
@@ -105,6 +118,13 @@ class Stage:
     out_bits: int
     out_frac_bits: int
     round_shift: int
+    operand: str = "v"
+
+
+#: the evaluation schemes of a Horner design: Horner's rule in ``x``; in ``v = R(x*x)`` over
+#: the even powers; ``x`` times Horner's rule in ``v = R(x*x)`` over the odd powers; in
+#: ``v = (x - c')/s`` for a table in the shifted basis (``c'``: ``c`` to the datapath's bits)
+SCHEMES = ("monomial", "even", "odd", "shifted")
 
 
 @dataclass(frozen=True)
@@ -145,6 +165,28 @@ class HornerDesign:
         First and last input code whose value lies in the table's interval.
     notes : tuple of str, default ()
         Remarks on the sizing, for the report.
+    scheme : {"monomial", "even", "odd", "shifted"}, default "monomial"
+        :data:`SCHEMES`: Horner's rule in ``x``, or, when every nonzero
+        coefficient is of one parity (degree >= 2), Horner's rule over those
+        coefficients in the variable ``v = R(x*x)`` (times ``x`` once at
+        the end when odd), or, for a table in the shifted basis
+        ``t = (x - c)/s``, Horner's rule in ``v = (x - c')/s`` (``c'``:
+        ``c`` to the datapath's fractional bits, ``c`` itself when short).
+    v_frac_bits : int or None, default None
+        Fractional bits of the Horner variable ``v`` (``x_format.frac_bits``
+        for ``"monomial"``).
+    v_bits : int, default 0
+        Signed width of ``v`` (``xs_bits`` for ``"monomial"``).
+    v_round_shift : int, default 0
+        Bits dropped from the exact square ``xs * xs`` (``2 Fx`` fractional
+        bits) to make ``v``; 0 when the square is kept exact.
+    v_error : Fraction, default 0
+        The exact ``max |v - x*x|`` (``|c - c'|/s`` when shifted) over the valid
+        codes (0 for ``"monomial"``).
+    v_shift : int, default 0
+        Shifted scheme: ``v``'s integer is ``(xs << v_shift) - v_offset``.
+    v_offset : int, default 0
+        Shifted scheme: ``c' * 2**(Fx + v_shift)``.
 
     Examples
     --------
@@ -173,6 +215,13 @@ class HornerDesign:
     #: ``(lo, hi)``: the input codes whose values lie in the table's interval (the error budget holds on them)
     valid_codes: tuple[int, int]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    scheme: str = "monomial"
+    v_frac_bits: int | None = None
+    v_bits: int = 0
+    v_round_shift: int = 0
+    v_error: Fraction = Fraction(0)
+    v_shift: int = 0
+    v_offset: int = 0
 
     def _summary(self) -> list[tuple[str, object]]:
         return [("name", self.name), ("degree", self.degree), ("in_bits", self.in_bits),
@@ -184,6 +233,27 @@ class HornerDesign:
     __repr__ = summary_repr
     _repr_html_ = summary_html
 
+    def __post_init__(self):
+        self.verify()
+
+    def verify(self) -> "HornerDesign":
+        """Re-prove the design; return it unchanged, or raise ValueError: the
+        table re-verified and the datapath sized again from it and the
+        design's own formats (every field must be what :func:`design_horner`
+        gives). Proved once per content (:func:`chebnorm.hw.trust.check`).
+
+        Returns
+        -------
+        HornerDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
+
     @property
     def degree(self) -> int:
         return len(self.integers) - 1
@@ -191,6 +261,44 @@ class HornerDesign:
     @property
     def module_name(self) -> str:
         return f"chebnorm_{self.name}"
+
+    @property
+    def parity(self) -> int | None:
+        """1 for an odd design, 0 for an even one, None for plain Horner in ``x``."""
+        return {"odd": 1, "even": 0}.get(self.scheme)
+
+    @property
+    def horner_integers(self) -> tuple[int, ...]:
+        """The integers Horner's rule runs over, lowest first: ``integers``
+        for ``"monomial"``; the even-power ones for ``"even"``; for ``"odd"``
+        a 0 then the odd-power ones (the last step multiplies by ``x`` and
+        adds nothing)."""
+        if self.scheme == "even":
+            return self.integers[0::2]
+        if self.scheme == "odd":
+            return (0,) + self.integers[1::2]
+        return self.integers
+
+    @property
+    def steps(self) -> int:
+        """Number of Horner steps (multiply-adds): the pipeline's latency."""
+        return len(self.stages)
+
+    @property
+    def multipliers(self) -> int:
+        """Number of multipliers of the datapath: one per step, plus the
+        squarer ``x*x`` of a one-parity design."""
+        return len(self.stages) + (self.scheme in ("even", "odd"))
+
+    @property
+    def variable_frac_bits(self) -> int:
+        """Fractional bits of the Horner variable ``v``."""
+        return self.x_format.frac_bits if self.v_frac_bits is None else self.v_frac_bits
+
+    @property
+    def variable_bits(self) -> int:
+        """Signed width of the Horner variable ``v``."""
+        return self.xs_bits if self.scheme == "monomial" else self.v_bits
 
     # -- bit-accurate model --------------------------------------------------
     def evaluate(self, codes=None, *, intermediates: bool = False):
@@ -206,10 +314,13 @@ class HornerDesign:
         return wires if intermediates else wires["y"]
 
     def exact_numerators(self, codes) -> tuple[np.ndarray, int]:
-        """``p_q(x_k)`` exactly as ``(N_k, D)``: value ``N_k / 2**D`` (object ints)."""
+        """``p_q(x_k)`` exactly as ``(N_k, D)``: value ``N_k / 2**D`` (object ints);
+        for a shifted table ``p_q`` at the exact ``t = (x_k - c)/s``."""
         n = self.degree
         fx, fc = self.x_format.frac_bits, self.coef_frac_bits
         xs = np.asarray(codes, dtype=np.int64).astype(object) + self.x_format.offset_code
+        if self.table.shift is not None:
+            xs, fx = _exact_shifted(xs, fx, self.table.shift)
         acc = np.full(xs.shape, self.integers[n], dtype=object)
         for j in range(n - 1, -1, -1):
             acc = acc * xs + self.integers[j] * 2 ** ((n - j) * fx)
@@ -220,21 +331,48 @@ class HornerDesign:
         return max(abs(self.x_format.value(lo)), abs(self.x_format.value(hi)))
 
 
+def _exact_shifted(xs, fx: int, shift):
+    """``(T, F)``: the exact ``t = (x - c)/s`` as ``T / 2**F`` for ``x = xs / 2**fx``."""
+    c, s = Fraction(shift[0]), Fraction(shift[1])
+    e = s.numerator.bit_length() - s.denominator.bit_length()   # s = 2**e
+    fc0 = c.denominator.bit_length() - 1
+    g = max(fx, fc0)
+    t = xs * 2 ** (g - fx) - int(c * 2 ** g)
+    f = g + e
+    if f < 0:
+        return t * 2 ** -f, 0
+    return t, f
+
+
+def _variable(scheme: str, xs, round_shift: int, rounding: str, shift: int = 0, offset: int = 0):
+    """The Horner variable's integers: ``xs`` itself, ``R(xs * xs)``, or
+    ``(xs << shift) - offset``."""
+    if scheme == "monomial":
+        return xs
+    if scheme == "shifted":
+        return (xs << shift) - offset
+    sq = xs * xs
+    return shift_round(sq, round_shift, rounding) if round_shift else sq
+
+
 def _run(d: HornerDesign, k: np.ndarray) -> dict:
     xs = k + d.x_format.offset_code
-    wires = {"xs": xs}
-    n = d.degree
+    v = _variable(d.scheme, xs, d.v_round_shift, d.rounding, d.v_shift, d.v_offset)
+    wires = {"xs": xs, "v": v}
+    ints = d.horner_integers
+    n = len(ints) - 1
     if n == 0:
-        top = np.full(k.shape, d.integers[0], dtype=np.int64)
+        top = np.full(k.shape, ints[0], dtype=np.int64)
         top_frac = d.coef_frac_bits
     else:
-        acc = np.full(k.shape, d.integers[n], dtype=np.int64)
+        acc = np.full(k.shape, ints[n], dtype=np.int64)
         for st in d.stages[:-1]:
-            t = ((acc * xs) << st.product_shift) + st.coef_shifted
+            t = ((acc * (xs if st.operand == "x" else v)) << st.product_shift) + st.coef_shifted
             acc = shift_round(t, st.round_shift, d.rounding)
             wires[f"a{st.power}"] = acc
         last = d.stages[-1]
-        top = ((acc * xs) << last.product_shift) + last.coef_shifted
+        top = ((acc * (xs if last.operand == "x" else v)) << last.product_shift) \
+            + last.coef_shifted
         top_frac = last.sum_frac_bits
     wires["top"] = top
     shift = top_frac - d.y_format.frac_bits
@@ -253,11 +391,19 @@ COEF_WORD_BITS = 32
 
 
 def _check_table(table) -> None:
-    """Refuse anything but a monomial :class:`CoefficientTable` (ValueError)."""
+    """Refuse anything but a :class:`CoefficientTable` in powers of ``x`` or of
+    ``t = (x - c)/s`` with ``s`` a power of two (ValueError)."""
     if not isinstance(table, CoefficientTable):
         raise ValueError(f"table of type {type(table).__name__} is not accepted; accepted: a "
                          f"CoefficientTable (chebnorm.fit, or CoefficientTable.load)")
-    table.require_monomial("the hardware Horner evaluator (hw, Verilog, VHDL)")
+    if table.shift is not None:
+        s = Fraction(table.shift[1])
+        if s.numerator & (s.numerator - 1) or s.denominator & (s.denominator - 1):
+            raise ValueError(f"table {table.name!r} is stored in t = ({table.variable} - "
+                             f"{table.shift[0]!r})/{table.shift[1]!r}; the hardware Horner "
+                             f"evaluator divides by a power of two only; accepted: a table "
+                             f"fitted with basis='shifted' (s a power of two) or "
+                             f"basis='monomial'")
 
 
 def max_coef_bits(table: CoefficientTable) -> int:
@@ -336,15 +482,44 @@ def check_coef_bits(table: CoefficientTable, coef_bits) -> int:
     return int(coef_bits)
 
 
+def _quantize_shifted(table: CoefficientTable, coef_bits: int) -> CoefficientTable:
+    """A shifted table with a fixed-point part: each coefficient (of ``t``)
+    rounded to nearest at ``coef_bits``, ``sup |p_q - f|`` certified
+    (:func:`chebnorm.approx.quantize` takes plain powers of ``x`` only)."""
+    import dataclasses
+
+    from chebnorm.approx import FixedPoint, parse_function
+    from chebnorm.approx.certify import certify
+
+    ints = tuple(round(Fraction(c) * 2 ** coef_bits) for c in table.coefficients)
+    fn = parse_function(table.expression, table.variable)
+    lo, hi = (parse_number(v) for v in table.interval)
+    cert = certify(fn, [math.ldexp(q, -coef_bits) for q in ints], lo, hi, "abs",
+                   shift=table.shift)
+    fp = FixedPoint(frac_bits=coef_bits, integers=ints, word_bits=COEF_WORD_BITS,
+                    method="rounded", abs_error_bound=cert.bound, rel_error_bound=None,
+                    max_abs_error=cert.maximum, max_rel_error=None)
+    return dataclasses.replace(table, fixed_point=fp)
+
+
 def _require_fixed_point(table: CoefficientTable, coef_bits):
+    if coef_bits is not None and table.shift is not None:
+        coef_bits = check_coef_bits(table, coef_bits)
+        if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
+            table = _quantize_shifted(table, coef_bits)
+        return table
     if coef_bits is not None:
         coef_bits = check_coef_bits(table, coef_bits)
         if table.fixed_point is None or table.fixed_point.frac_bits != coef_bits:
             table = quantize(table, coef_bits)
         return table
+    if table.fixed_point is None and table.shift is not None:
+        raise ValueError(f"table {table.name!r} (shifted basis) has no fixed-point part; "
+                         f"accepted: coef_bits (1 <= coef_bits <= {max_coef_bits(table)}) to "
+                         f"round its coefficients of t = (x - c)/s here")
     if table.fixed_point is None:
         raise ValueError(f"table {table.name!r} has no fixed-point part; accepted: a table "
-                         f"quantized with frac_bits (chebnorm.fit(..., frac_bits=F) or "
+                         f"quantized with coef_frac_bits (chebnorm.fit(..., coef_frac_bits=F) or "
                          f"chebnorm.quantize), or give coef_bits (1 <= coef_bits <= "
                          f"{max_coef_bits(table)}) to quantize it here")
     return table
@@ -392,8 +567,14 @@ def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
     return fmt, (k_lo, k_hi)
 
 
-def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
-    """Size the Horner steps exactly by running them over all codes."""
+#: the words of :func:`_stages`' refusal of more datapath bits than the exact sum has
+_PAST_EXACT = "exceed the exact sum's"
+
+
+def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding, variable=None, odd=False):
+    """Size the Horner steps exactly by running them over all codes
+    (``variable``: ``(v, fv, v_bits)`` of the Horner variable when it is not
+    ``x``; ``odd``: the last step multiplies by ``x``)."""
     n = len(integers) - 1
     stages = []
     acc = np.full(k_all_xs.shape, integers[n], dtype=np.int64)
@@ -401,9 +582,11 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
     acc_bits = signed_bits(integers[n], integers[n])
     xs_bits = signed_bits(xs_lo, xs_hi)
     for j in range(n - 1, -1, -1):
-        check_int64(acc_bits + xs_bits, f"the product a_{j + 1} * x")
-        prod = acc * k_all_xs
-        prod_frac = acc_frac + fx
+        by_x = variable is None or (odd and j == 0)
+        op, fop, op_bits = (k_all_xs, fx, xs_bits) if by_x else variable
+        check_int64(acc_bits + op_bits, f"the product a_{j + 1} * {'x' if by_x else 'v'}")
+        prod = acc * op
+        prod_frac = acc_frac + fop
         s = max(prod_frac, fc)
         check_int64(signed_bits(int(prod.min()), int(prod.max())) + s - prod_frac + 1,
                     f"the sum of step {j}")
@@ -427,7 +610,8 @@ def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding):
                             product_bits=signed_bits(int(prod.min()), int(prod.max())),
                             product_shift=pshift, coef_shifted=int(coef), sum_bits=sum_bits,
                             sum_frac_bits=s, out_bits=out_bits, out_frac_bits=out_frac,
-                            round_shift=rshift))
+                            round_shift=rshift,
+                            operand="x" if by_x and variable is not None else "v"))
         acc_bits, acc_frac = out_bits, out_frac
     return tuple(stages), acc
 
@@ -436,7 +620,7 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
                   coef_bits: int | None = None, acc_bits: int | None = None,
                   rounding: str = "rne", x_frac_bits: int | None = None,
                   y_frac_bits: int | None = None, guard_bits: int = 3,
-                  name: str | None = None) -> HornerDesign:
+                  name: str | None = None, parity: bool = True) -> HornerDesign:
     """Size a fixed-point Horner evaluator of ``table`` (see module docstring).
 
     ``in_bits``/``out_bits``: widths of the unsigned codes ``x`` and ``y``;
@@ -484,6 +668,11 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         Extra accumulator bits beyond the output's, 0 to 32 (used when ``acc_bits`` is None).
     name : str or None, default None
         The design's name; None uses the table's.
+    parity : bool, default True
+        When every nonzero coefficient is of one parity (degree >= 2; odd:
+        at least two of them), evaluate ``q(v)`` or ``x * q(v)`` with
+        ``v = R(x*x)`` (scheme ``"even"``/``"odd"``: half the Horner steps);
+        False: plain Horner in ``x``.
 
     Returns
     -------
@@ -531,6 +720,46 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
        IEEE ASAP 2010.
     """
     _check_table(table)
+    table.verify()   # a table changed behind its back is proved again (or refused)
+    with drafting():
+        d = _design_horner_or_plain(table, in_bits, out_bits, coef_bits=coef_bits,
+                                    acc_bits=acc_bits, rounding=rounding,
+                                    x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits,
+                                    guard_bits=guard_bits, name=name, parity=parity)
+    return seal(d)
+
+
+def _prove(d: HornerDesign) -> None:
+    """The table re-verified, the datapath sized again from it and the
+    design's formats: every field must match (ValueError naming the first)."""
+    identifier(d.name, field="name")
+    _check_table(d.table)
+    d.table.verify()
+    xf, yf = d.x_format, d.y_format
+    if not isinstance(xf, QFormat) or not isinstance(yf, QFormat):
+        raise ValueError("x_format, y_format: accepted: QFormat")
+    # the parity scheme as it was asked: one parity in v = x*x, or plain Horner because
+    # it was asked (parity=False) or because the square did not fit (a note says so)
+    parity = d.scheme in ("even", "odd") or any(_NO_PARITY in n for n in d.notes)
+    with drafting():
+        ref = _design_horner_or_plain(d.table, d.in_bits, d.out_bits, coef_bits=None,
+                                      acc_bits=d.acc_frac_bits if d.degree >= 2 else None,
+                                      rounding=d.rounding, x_frac_bits=xf.frac_bits,
+                                      y_frac_bits=yf.frac_bits, guard_bits=3, name=d.name,
+                                      parity=parity)
+    for f in fields(d):
+        mine, theirs = getattr(d, f.name), getattr(ref, f.name)
+        if f.name != "table" and (type(mine) is not type(theirs) or mine != theirs):
+            text = repr(mine)
+            raise ValueError(f"{f.name}: stated {text[:60]}, but the table and the design's "
+                             f"formats give {repr(theirs)[:60]}; accepted: the design "
+                             f"design_horner sizes")
+
+
+def _design_horner(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding, x_frac_bits,
+                   y_frac_bits, guard_bits, name, parity=True) -> HornerDesign:
+    """:func:`design_horner`'s sizing (its drafts unchecked)."""
+    _check_table(table)
     in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
     out_bits = check_width(out_bits, "out_bits", 1, MAX_OUT_BITS)
     if rounding not in ROUNDINGS:
@@ -566,15 +795,39 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         candidates = range(fy, -MAX_FRAC_BITS - 1, -1)
     else:
         candidates = [y_frac_bits]
+    scheme = "monomial"
+    if parity is not True and parity is not False:
+        raise ValueError(f"parity = {parity!r} is not accepted; accepted: True or False")
+    if table.shift is not None:
+        scheme = "shifted"
+    elif parity and _integer_parity(integers) is not None and \
+            (_integer_parity(integers) == 0 or len(integers[1::2]) >= 2):
+        scheme = ("even", "odd")[_integer_parity(integers)]
+        check_int64(2 * signed_bits(xs_lo, xs_hi), "the square x * x")
+    horner = (integers[0::2] if scheme == "even" else (0,) + integers[1::2]
+              if scheme == "odd" else integers)
+    v_info = (None, 0, 0, Fraction(0))
     for fy in candidates:
         fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
-        if len(integers) > 1:
-            try:
-                stages, top = _stages(integers, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding)
-            except ValueError:
-                if acc_bits is not None or fy == candidates[-1]:
-                    raise
-                continue  # a constant's output has no span: fewer bits than the exact sum's
+        try:
+            variable = None
+            if scheme == "shifted":
+                v_info = _shifted(xs_all, fx, fa, table.shift, xs_lo, xs_hi)
+                variable = v_info[0]
+            elif scheme != "monomial":
+                v_info = _square(xs_all, fx, fa, rounding, valid)
+                variable = v_info[0]
+            if len(horner) > 1:
+                stages, top = _stages(horner, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding,
+                                      variable=variable, odd=scheme == "odd")
+        except ValueError as exc:
+            # an output of (almost) no span -- a constant -- starts fy at the most
+            # fractional bits, past the exact sum's (the message of _stages): try fewer
+            if acc_bits is not None or fy == candidates[-1] or \
+                    _PAST_EXACT not in str(exc):
+                raise
+            continue
+        if len(horner) > 1:
             top_frac = stages[-1].sum_frac_bits
         else:
             stages, top, top_frac = (), np.full(all_k.shape, integers[0], dtype=np.int64), fc
@@ -604,7 +857,87 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
         notes.append(f"{n_sat} input codes outside the valid range saturate the output")
     return HornerDesign(name=name, table=table, in_bits=in_bits, out_bits=out_bits,
                         rounding=rounding, x_format=x_fmt, y_format=y_fmt, coef_frac_bits=fc,
-                        integers=integers, acc_frac_bits=fa if len(integers) > 2 else fy,
+                        integers=integers, acc_frac_bits=fa if len(horner) > 2 else fy,
                         xs_bits=signed_bits(xs_lo, xs_hi), stages=stages,
                         top_bits=signed_bits(int(top.min()), int(top.max())), raw_bits=raw_bits,
-                        valid_codes=valid, notes=tuple(notes))
+                        valid_codes=valid, notes=tuple(notes), scheme=scheme,
+                        v_frac_bits=None if variable is None else variable[1],
+                        v_bits=0 if variable is None else variable[2],
+                        v_round_shift=v_info[1] if scheme != "shifted" else 0,
+                        v_error=v_info[3],
+                        v_shift=v_info[1] if scheme == "shifted" else 0,
+                        v_offset=v_info[2] if scheme == "shifted" else 0)
+
+
+#: the note of a design that evaluates Horner's rule in x although its table has one parity
+_NO_PARITY = "Horner's rule in x, not over one parity in v = x*x"
+
+
+def _design_horner_or_plain(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding,
+                            x_frac_bits, y_frac_bits, guard_bits, name, parity) -> HornerDesign:
+    """:func:`_design_horner`, falling back to plain Horner in ``x`` (with a note)
+    where the one-parity datapath would exceed the 62-bit model."""
+    options = dict(coef_bits=coef_bits, acc_bits=acc_bits, rounding=rounding,
+                   x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits, guard_bits=guard_bits,
+                   name=name)
+    try:
+        return _design_horner(table, in_bits, out_bits, parity=parity, **options)
+    except ValueError as exc:
+        # the square's datapath is wider than Horner's rule in x (its products are by a
+        # v of about twice x's bits): where it exceeds the 62-bit model, plain Horner
+        if parity is not True or "bit-accurate model" not in str(exc):
+            raise
+        d = _design_horner(table, in_bits, out_bits, parity=False, **options)
+        import dataclasses
+
+        return dataclasses.replace(d, notes=d.notes + (
+            f"{_NO_PARITY}: {exc}",))
+
+
+def _integer_parity(integers) -> int | None:
+    """1 (0) when every nonzero integer is of an odd (even) power and the
+    degree is at least 2; else None (as the C and shader evaluators decide)."""
+    powers = {k for k, q in enumerate(integers) if q}
+    if len(integers) < 3 or not powers:
+        return None
+    for parity in (1, 0):
+        if all(k % 2 == parity for k in powers):
+            return parity
+    return None
+
+
+def _shifted(xs_all, fx: int, fa: int, shift, xs_lo: int, xs_hi: int):
+    """The Horner variable ``v = (x - c')/s`` of a shifted table:
+    ``((v, fv, v_bits), m, C, v_error)`` with ``v``'s integers
+    ``(xs << m) - C``. ``c' = C / 2**G`` is ``c`` itself when it has at
+    most ``max(Fx, Fa + 2 - e)`` fractional bits (``s = 2**e``), else ``c``
+    rounded to them (``v`` then two bits finer than the accumulators), and
+    ``v_error = |c - c'| / s`` exactly."""
+    c, s = Fraction(shift[0]), Fraction(shift[1])
+    e = s.numerator.bit_length() - s.denominator.bit_length()
+    fc0 = c.denominator.bit_length() - 1
+    g = max(fx, min(fc0, fa + 2 - e))
+    m = g - fx
+    offset = round(c * 2 ** g)
+    check_int64(signed_bits(xs_lo, xs_hi) + m + 1, "the shifted input x - c")
+    check_int64(signed_bits(min(xs_lo << m, offset), max(xs_hi << m, offset)) + 1,
+                "the shifted input x - c")
+    v = (xs_all << m) - offset
+    return ((v, g + e, signed_bits(int(v.min()), int(v.max()))), m, offset,
+            abs(c - Fraction(offset, 2 ** g)) / s)
+
+
+def _square(xs_all, fx: int, fa: int, rounding: str, valid):
+    """The Horner variable ``v = R(xs * xs)`` of a one-parity design:
+    ``((v, fv, v_bits), round_shift, None, v_error)``. The square has
+    ``2 Fx`` fractional bits; it keeps at most ``Fa + 2`` of them (two more
+    than the accumulators), and ``v_error`` is the exact largest
+    ``|v - x*x|`` over the valid codes."""
+    sq = xs_all * xs_all
+    fv = min(2 * fx, fa + 2)
+    rs = 2 * fx - fv
+    v = shift_round(sq, rs, rounding) if rs else sq
+    lo, hi = valid
+    err = np.abs((v[lo:hi + 1] << rs) - sq[lo:hi + 1]) if rs else np.zeros(1, dtype=np.int64)
+    return ((v, fv, signed_bits(int(v.min()), int(v.max()))), rs, None,
+            Fraction(int(err.max()), 2 ** (2 * fx)))

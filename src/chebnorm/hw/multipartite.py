@@ -64,6 +64,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .exhaustive import ExhaustiveCheck, reference
 from .fixed import QFormat
+from .trust import check, check_certificate, drafting, seal
 
 __all__ = ["MAX_MP_IN_BITS", "MAX_MP_OUT_BITS", "OffsetTable", "MultipartiteDesign",
            "design_multipartite", "multipartite_candidates", "output_format", "lut_cost", "table_luts"]
@@ -236,6 +237,28 @@ class MultipartiteDesign:
 
     def __post_init__(self):
         _check_design(self)
+        self.verify()
+
+    def verify(self) -> "MultipartiteDesign":
+        """Re-prove the design; return it unchanged, or raise ValueError.
+
+        The exhaustive proof is recomputed from the design's own tables: the
+        certificate's bound must be at least the recomputed one, the target
+        ``max_error`` (and, when ``faithful``, one unit of y's last place,
+        strictly) met, and the a priori budget not below the proved error.
+        Proved once per content (:func:`chebnorm.hw.trust.check`).
+
+        Returns
+        -------
+        MultipartiteDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
 
     architecture = "multipartite"
     degree = 1   # first-order offsets (the VHDL bench reads it for a latency of 1)
@@ -344,6 +367,50 @@ def _check_design(d: MultipartiteDesign) -> None:
                          f"{w - d.tiv_bits} bits exactly")
     if d.out_bits < d.sum_bits - d.guard_bits:
         raise ValueError("sum_bits: accepted: sum_bits - guard_bits <= out_bits")
+
+
+def _prove(d: MultipartiteDesign) -> None:
+    """The certificate and the claims re-proved from the tables (ValueError)."""
+    from chebnorm.core.numeric import format_up
+
+    _check_design(d)
+    yf = d.y_format
+    if not isinstance(yf, QFormat) or yf.bits != d.out_bits or yf.signed:
+        raise ValueError(f"y_format: accepted: an unsigned QFormat of out_bits = {d.out_bits} bits")
+    check_int(yf.frac_bits, "y_format.frac_bits", -60, 60)
+    if not isinstance(d.faithful, bool):
+        raise ValueError(f"faithful {d.faithful!r}: accepted: True or False")
+    ref = reference(d.expression, d.interval, d.in_bits, d.variable)
+    proved = ref.error_bounds(d.evaluate() + yf.offset_code, yf.frac_bits)
+    check_certificate(d.certificate, proved, 2 ** d.in_bits,
+                      f"the multipartite design of {str(d.expression)[:60]}")
+    up, lsb = d.certificate.upper, 2.0 ** -yf.frac_bits
+    m = d.max_error
+    if isinstance(m, bool) or not isinstance(m, (int, float)) or not math.isfinite(m) or m <= 0:
+        raise ValueError(f"max_error {m!r}: accepted: a positive finite number")
+    if d.faithful and not (up < lsb and m <= lsb):
+        raise ValueError(f"faithful: claimed, but the proved error {format_up(up, '.6e')} is not "
+                         f"below one unit of y's last place 2^-{yf.frac_bits} (or max_error "
+                         f"{m!r} exceeds it); accepted: faithful=False")
+    if not up <= m:
+        raise ValueError(f"max_error: stated target {m!r}, but the proved error is "
+                         f"{format_up(up, '.6e')}; accepted: a target the design meets")
+    if not isinstance(d.parts, dict):
+        raise ValueError("parts: accepted: a dict of the a priori budget")
+    if d.parts:
+        keys = ("method", "table_rounding", "final_rounding", "a_priori")
+        vals = {k: d.parts.get(k) for k in keys}
+        for k, v in vals.items():
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+                    or v < 0:
+                raise ValueError(f"parts[{k!r}] {v!r}: accepted: a finite number >= 0")
+        if set(d.parts) != set(keys):
+            raise ValueError(f"parts: keys {sorted(d.parts)}; accepted: {list(keys)}")
+        if vals["a_priori"] < proved["lower"] or any(
+                vals[k] > vals["a_priori"] for k in keys[:3]):
+            raise ValueError(f"parts['a_priori'] {vals['a_priori']!r}: below a part or the proved "
+                             f"error {proved['lower']!r}; accepted: a budget the design's error "
+                             f"stays within")
 
 
 # -- output format ---------------------------------------------------------------------
@@ -934,14 +1001,17 @@ def _assemble(ref, p, name, expr, var, interval, out_bits, alpha, guard, built, 
     yf = QFormat(out_bits, F, offset_code=ymin)
     lsb = 2.0 ** -F
     target = float(limit * lsb)
-    proto = MultipartiteDesign(name, expr, var, (str(interval[0]), str(interval[1])), p.w,
-                               out_bits, yf, guard, alpha, sum_bits,
-                               tuple(int(v) for v in tiv), offsets, target, faithful,
-                               ExhaustiveCheck(math.inf, 0.0, 0, 0))
+    with drafting():
+        proto = MultipartiteDesign(name, expr, var, (str(interval[0]), str(interval[1])), p.w,
+                                   out_bits, yf, guard, alpha, sum_bits,
+                                   tuple(int(v) for v in tiv), offsets, target, faithful,
+                                   ExhaustiveCheck(math.inf, 0.0, 0, 0))
     proof = ExhaustiveCheck.of(ref.error_bounds(proto.evaluate() + ymin, F))
     if proof.upper > target or (strict and proof.upper >= target):
         return None
     total = {k: float_up(v * lsb) for k, v in parts.items()}
     total["a_priori"] = float_up(sum(v * lsb for v in parts.values()))
-    return MultipartiteDesign(name, expr, var, proto.interval, p.w, out_bits, yf, guard, alpha,
-                              sum_bits, proto.tiv, offsets, target, faithful, proof, total)
+    with drafting():
+        d = MultipartiteDesign(name, expr, var, proto.interval, p.w, out_bits, yf, guard, alpha,
+                               sum_bits, proto.tiv, offsets, target, faithful, proof, total)
+    return seal(d)

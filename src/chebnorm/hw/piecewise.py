@@ -6,6 +6,10 @@ FloPoCo's ``FixFunctionByPiecewisePoly``). With ``2**K`` segments the top
 ``K`` bits of ``k`` address the ROM, the low ``L = W - K`` bits are the local
 variable ``t = low / 2**L`` in ``[0, 1)`` (``t - 1/2`` when the table is
 centred): exactly the variable each segment's polynomial was certified in.
+An exponent table (``2**m`` segments per binade of ``[lo, hi)``, both powers
+of two) is indexed the same way, so its code stands for ``x = lo * 2**e *
+(1 + u / 2**(L + m))`` with ``e`` the code's top bits and ``u`` the rest
+(:meth:`PiecewiseDesign.x_values`; the banner states it).
 The datapath, for coefficients ``q_j`` (``Fc`` fractional bits) read from
 the ROM::
 
@@ -20,8 +24,8 @@ against ``f(x)`` is bounded by the table's certified bound plus
 ``a_j`` reaches the output multiplied by ``t^j``); :meth:`PiecewiseDesign.measure`
 compares it, code by code and in 40-digit arithmetic, with ``f``.
 
-The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``,
-issue 28) gives every ROM column its own fractional bits ``F_j`` (the
+The *sized* architecture (``design_piecewise(..., widths="auto" | {...})``)
+gives every ROM column its own fractional bits ``F_j`` (the
 coefficients re-rounded from the table's ``Fc``), multiplies step ``j`` by
 the top ``T_j`` bits of ``t`` only, and truncates (floors) products and sums
 to ``G_j`` fractional bits -- with ``multipliers="truncated"`` the
@@ -45,6 +49,7 @@ one-width design and its outputs unchanged.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, replace
 from fractions import Fraction
@@ -55,7 +60,7 @@ import numpy as np
 
 from chebnorm.approx.expr import parse_function, parse_number
 from chebnorm.approx.piecewise_table import PiecewiseTable
-from chebnorm.core.numeric import float_up
+from chebnorm.core.numeric import float_up, format_up
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
@@ -68,6 +73,7 @@ from .fixed import (
     signed_bits,
 )
 from .hdl import hdl_files, module_text, testbench_text
+from .trust import check, drafting, seal
 from .verilog import simulate, synthesize_text
 
 __all__ = [
@@ -207,6 +213,33 @@ class PiecewiseDesign:
     __repr__ = summary_repr
     _repr_html_ = summary_html
 
+    def __post_init__(self):
+        self.verify()
+
+    def verify(self) -> "PiecewiseDesign":
+        """Re-prove the design; return it unchanged, or raise ValueError.
+
+        The table is re-verified, then the datapath is sized again from the
+        table and the design's own widths (:func:`design_piecewise`'s rules;
+        the sized architecture's ROM and certified bound by
+        :func:`sized_bound`): every field must be what that gives (a ROM
+        coefficient, a wire width, the output format or the bound changed
+        alone is refused). Proved once per content
+        (:func:`chebnorm.hw.trust.check`): called again after a change behind
+        the frozen dataclass's back, it proves again.
+
+        Returns
+        -------
+        PiecewiseDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
+
     @property
     def module_name(self) -> str:
         return f"chebnorm_{self.name}"
@@ -294,12 +327,12 @@ class PiecewiseDesign:
         """
         if self.sized:
             approx, path, total = self.bound
-            out = Fraction(1, 2 ** (self.y_format.frac_bits + 1))
+            out = Fraction(2) ** -(self.y_format.frac_bits + 1)
             return {"approximation": float_up(approx),
                     "horner_rounding": float_up(max(path - out, Fraction(0))),
                     "output_rounding": float_up(out), "datapath": float_up(path),
                     "total": float_up(total),
-                    "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
+                    "y_lsb": float(Fraction(2) ** -self.y_format.frac_bits)}
         tmax = Fraction(1, 2) if self.table.centered else Fraction(1)
         fa = self.acc_frac_bits
         steps = [rounding_error_bound(fa, self.rounding) * tmax ** j
@@ -309,7 +342,7 @@ class PiecewiseDesign:
         total = approx + sum(steps, Fraction(0)) + out
         return {"approximation": self.table.abs_error_bound,
                 "horner_rounding": float_up(sum(steps, Fraction(0))), "output_rounding": float_up(out),
-                "total": float_up(total), "y_lsb": float(Fraction(1, 2 ** self.y_format.frac_bits))}
+                "total": float_up(total), "y_lsb": float(Fraction(2) ** -self.y_format.frac_bits)}
 
     def measure(self, codes=None) -> dict:
         """Exact ``max |y - f(x)|`` over ``codes`` (default all), f at 40 digits."""
@@ -943,7 +976,8 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     if not ok:
         approx = max(Fraction(seg.abs_error_bound) for seg in t.segments)
         raise ValueError(f"max_error {float(max_error):.6e} is not met even with generous widths "
-                         f"(certified {float(total):.6e}; approximation {float(approx):.6e}); "
+                         f"(certified {format_up(float(total), '.6e')}; approximation "
+                         f"{format_up(float(approx), '.6e')}); "
                          f"accepted: a table whose approximation bound leaves room for rounding")
     cur = descend(cur)
     for _ in range(2):  # trades, while one pays
@@ -1089,6 +1123,16 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     """
     if not isinstance(table, PiecewiseTable):
         raise ValueError("design_piecewise needs a PiecewiseTable")
+    table.verify()   # a table changed behind its back is proved again (or refused)
+    with drafting():
+        d = _design_piecewise(table, in_bits, out_bits, guard_bits, name, widths, max_error,
+                              pipeline, multipliers, rom_weight)
+    return seal(d)
+
+
+def _design_piecewise(table, in_bits, out_bits, guard_bits, name, widths, max_error, pipeline,
+                      multipliers, rom_weight) -> PiecewiseDesign:
+    """:func:`design_piecewise`'s sizing (its drafts unchecked)."""
     nseg = table.segment_count
     if table.segment_by != "uniform" and nseg & (nseg - 1):
         raise ValueError(f"table {table.name!r} is segmented by {table.segment_by} into {nseg} "
@@ -1130,6 +1174,71 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     return _uniform_design(proto, w, fa, fy, y_off)
 
 
+def _short(v) -> str:
+    text = repr(v)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _prove(d: PiecewiseDesign) -> None:
+    """The table re-verified and the design sized again from it and its own
+    widths: every field must match (ValueError naming the first that does not)."""
+    t = d.table
+    if not isinstance(t, PiecewiseTable):
+        raise ValueError(f"table: a {type(t).__name__}; accepted: a PiecewiseTable")
+    t.verify()
+    identifier(d.name, field="name")
+    n = t.degree
+    K = (t.segment_count - 1).bit_length()
+    W = check_width(d.in_bits, "in_bits", K + 1, MAX_PW_IN_BITS)
+    check_width(d.out_bits, "out_bits", 1, MAX_PW_OUT_BITS)
+    if not isinstance(d.y_format, QFormat):
+        raise ValueError(f"y_format: a {type(d.y_format).__name__}; accepted: a QFormat")
+    with drafting():
+        if d.sized:
+            L = W - K
+            if d.multipliers not in ("full", "truncated"):
+                raise ValueError(f"multipliers {d.multipliers!r}; accepted: 'full', 'truncated'")
+            if not isinstance(d.acc_frac, tuple) or len(d.acc_frac) != n + 1:
+                raise ValueError(f"acc_frac {_short(d.acc_frac)}: accepted: {n + 1} widths "
+                                 f"G_0 .. G_{n}")
+            fy = check_width(d.acc_frac[0], "acc_frac G_0 (y's fractional bits)", -60, 62)
+            shape = _check_sized_widths({"coef_frac": d.coef_frac, "t_keep": d.t_keep,
+                                         "acc_frac": d.acc_frac[1:n],
+                                         "prod_frac": d.prod_frac}, n, L, t.centered, fy,
+                                        d.multipliers == "truncated")
+            cuts = _check_cuts(d.cuts, n)
+            mult = d.mult_cuts
+            if not isinstance(mult, tuple) or any(
+                    isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= n
+                    for c in mult) or list(mult) != sorted(set(mult)):
+                raise ValueError(f"mult_cuts {_short(mult)}: accepted: sorted distinct steps "
+                                 f"1..{n}")
+            proto = PiecewiseDesign(d.name, t, W, d.out_bits, L, 0, QFormat(d.out_bits, 0),
+                                    t.coefficient_word_bits(), L + 2, (), 0)
+            ref = _sized_design(proto, shape, cuts)
+            if ref is None:
+                raise ValueError(f"out_bits = {d.out_bits}: y's range at {fy} fractional bits "
+                                 f"does not fit; accepted: the widths design_piecewise sized")
+            ref = replace(ref, mult_cuts=mult)
+        else:
+            guard = d.acc_frac_bits - d.y_format.frac_bits \
+                if isinstance(d.acc_frac_bits, int) and isinstance(d.y_format.frac_bits, int) \
+                else None
+            if guard is None or not 0 <= guard <= 16:
+                raise ValueError(f"acc_frac_bits {_short(d.acc_frac_bits)}: accepted: y's "
+                                 f"fractional bits plus 0 .. 16 guard bits")
+            ref = _design_piecewise(t, W, d.out_bits, guard, d.name, None, None, None, "full",
+                                    ROM_WEIGHT)
+    for f in dataclasses.fields(d):
+        if f.name == "table":
+            continue
+        mine, theirs = getattr(d, f.name), getattr(ref, f.name)
+        if type(mine) is not type(theirs) or mine != theirs:
+            raise ValueError(f"{f.name}: stated {_short(mine)}, but the table and the design's "
+                             f"widths give {_short(theirs)}; accepted: the design "
+                             f"design_piecewise sizes")
+
+
 def _uniform_design(proto: PiecewiseDesign, w: dict, fa: int, fy: int,
                     y_off: int) -> PiecewiseDesign:
     """The one-width design from the wires ``w`` of its datapath at ``fa``
@@ -1168,14 +1277,14 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
         limit, strict = _error_limit(max_error), False
     failed = None
     for f in range(fy, fy - 8, -1):
-        lim = Fraction(1, 2 ** f) if limit is None else limit
+        lim = Fraction(2) ** -f if limit is None else limit
         if widths == "auto":
             try:  # faithful at fewer fractional bits of y may still be reachable
                 shape = _auto_shape(proto, f, lim, strict, truncated, rom_weight)
             except ValueError as exc:
                 # only where y's range is tight at f bits is f given up for fewer bits
                 # (else max_error is out of reach and y keeps its last place)
-                if span * 2 ** f + 2 <= 2 ** proto.out_bits - 1:
+                if span * Fraction(2) ** f + 2 <= 2 ** proto.out_bits - 1:
                     if limit is None:
                         raise ValueError(f"max_error None (faithful: error < 2^-{f}, y's last "
                                          f"place): {exc}") from None

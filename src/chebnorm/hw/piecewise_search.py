@@ -44,6 +44,7 @@ from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS, MAX_PIECEWISE_DE
 from chebnorm.approx.piecewise_fit import piecewise_fit
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.core.textsafe import csv_cell
+from chebnorm.core.numeric import format_up
 
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
@@ -183,7 +184,7 @@ class DesignPoint:
             cells = f"~{self.target_model:.0f} LUT equivalents (model)"
         return (f"degree {self.degree}, {self.segments} segments, {self.coef_frac_bits} "
                 f"coefficient bits (ROM {self.rom_bits} bits): {cells}, certified error "
-                f"<= {self.total_bound:.4e}")
+                f"<= {format_up(self.total_bound, '.4e')}")
 
 
 @dataclass(frozen=True)
@@ -254,7 +255,8 @@ class SearchResult:
         out.write(",".join(COLUMNS + (TARGET_COLUMNS if extra else ())) + "\n")
         for p in self.points:
             row = [p.degree, p.segments, p.coef_frac_bits, p.acc_frac_bits, p.y_frac_bits,
-                   p.rom_bits, f"{p.approx_bound:.6e}", f"{p.total_bound:.6e}", int(p.meets),
+                   p.rom_bits, format_up(p.approx_bound, '.6e'),
+                   format_up(p.total_bound, '.6e'), int(p.meets),
                    f"{p.model_cost:.1f}", "" if p.yosys_cells is None else p.yosys_cells,
                    int(p.pareto), int(p is self.winner)]
             if extra:
@@ -279,7 +281,7 @@ class SearchResult:
                 best = min((p for p in self.points if p.degree == deg),
                            key=lambda p: p.total_bound)
                 lines.append(f"  degree {deg}: no design meets the bound up to {best.segments} "
-                             f"segments (best {best.total_bound:.4e})")
+                             f"segments (best {format_up(best.total_bound, '.4e')})")
                 continue
             b = min(ok, key=lambda p: (p.cost, p.total_bound))
             if b is w:
@@ -299,17 +301,37 @@ class SearchResult:
                          f"{b.degree} vs {w.degree} multiply-adds")
         return lines
 
-    def plot_png(self) -> bytes:
-        """The Pareto plot of the search (cost against certified error), as PNG bytes."""
+    def plot_png(self, winner: str = "winner", note: str | None = None) -> bytes:
+        """The Pareto plot of the search (cost against certified error), as PNG bytes:
+        the model's cost of every point, and what synthesis measured where it ran.
+
+        Parameters
+        ----------
+        winner : str, optional
+            The label of the circled point (``"best one-width design"`` when
+            another architecture won).
+        note : str, optional
+            A second title line (which design won, when it is not on this plot).
+
+        Returns
+        -------
+        bytes
+            The PNG file.
+        """
         generic = self.target == "generic"
+        if generic:
+            measured = lambda p: None if p.yosys_cells is None else float(p.yosys_cells)  # noqa: E731
+        else:
+            measured = lambda p: None if p.target_cost is None else p.target_cost.score  # noqa: E731
+        title = f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out"
         return pareto_png(
             self.points, (lambda p: p.model_cost) if generic else (lambda p: p.target_model),
             lambda p: p.total_bound,
-            hline=(self.max_error, "max error"), best=(self.winner, "winner"),
-            xlabel="model cost (Yosys-cell units)" if generic else
-            f"{self.target} model score (LUT equivalents)", ylabel="certified max |y - f(x)|",
-            title=f"piecewise designs, {self.in_bits}-bit in / {self.out_bits}-bit out",
-            xlog=True)
+            hline=(self.max_error, "max error"), best=(self.winner, winner),
+            xlabel="cost: model (dots), Yosys cells (crosses)" if generic else
+            f"{self.target} score, LUT equivalents: model (dots), synthesized (crosses)",
+            ylabel="certified max |y - f(x)|",
+            title=title if note is None else f"{title}\n{note}", xlog=True, measured=measured)
 
 
 def _point(d: PiecewiseDesign) -> DesignPoint:

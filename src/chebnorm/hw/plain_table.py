@@ -26,6 +26,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .exhaustive import ExhaustiveCheck, reference, round_to_nearest
 from .fixed import QFormat
 from .multipartite import output_format
+from .trust import check, check_certificate, drafting, seal
 
 __all__ = ["MAX_TABLE_IN_BITS", "PlainTableDesign", "design_plain_table"]
 
@@ -102,6 +103,28 @@ class PlainTableDesign:
                 not 0 <= int(v) < 2 ** self.out_bits for v in self.values):
             raise ValueError(f"values: accepted: {2 ** self.in_bits} codes in 0 .. "
                              f"2**{self.out_bits} - 1")
+        self.verify()
+
+    def verify(self) -> "PlainTableDesign":
+        """Re-prove the table; return it unchanged, or raise ValueError.
+
+        Every entry must be the nearest code of ``f`` (ties to even),
+        ``unproved`` the count of roundings that cannot be proved, and the
+        certificate's bound at least the recomputed exhaustive bound. Proved
+        once per content (:func:`chebnorm.hw.trust.check`): called again after
+        a change behind the frozen dataclass's back, it proves again.
+
+        Returns
+        -------
+        PlainTableDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the field that does not hold.
+        """
+        return check(self, _prove)
 
     @property
     def module_name(self) -> str:
@@ -200,6 +223,37 @@ def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str 
         raise ValueError(f"out_bits = {out_bits}: the rounded values span {int(y.max()) + 1} "
                          f"codes; accepted: more out_bits or fewer out_frac_bits")
     proof = ExhaustiveCheck.of(ref.error_bounds(n, F))
-    return PlainTableDesign(name, str(expr), var, (str(interval[0]), str(interval[1])), in_bits,
-                            out_bits, QFormat(out_bits, F, offset_code=off),
-                            tuple(int(v) for v in y), int((~proved).sum()), proof)
+    with drafting():
+        d = PlainTableDesign(name, str(expr), var, (str(interval[0]), str(interval[1])), in_bits,
+                             out_bits, QFormat(out_bits, F, offset_code=off),
+                             tuple(int(v) for v in y), int((~proved).sum()), proof)
+    return seal(d)
+
+
+def _prove(d: PlainTableDesign) -> None:
+    """Every entry the nearest code of ``f``, the count of unproved roundings
+    and the certificate re-proved (ValueError naming the field)."""
+    check_int(d.in_bits, "in_bits", 1, MAX_TABLE_IN_BITS)
+    check_int(d.out_bits, "out_bits", 1, 32)
+    identifier(d.name, field="name")
+    yf = d.y_format
+    if not isinstance(yf, QFormat) or yf.bits != d.out_bits or yf.signed:
+        raise ValueError(f"y_format: accepted: an unsigned QFormat of out_bits = {d.out_bits} bits")
+    check_int(yf.frac_bits, "y_format.frac_bits", -60, 60)
+    ref = reference(d.expression, d.interval, d.in_bits, d.variable)
+    F = yf.frac_bits
+    n, proved = round_to_nearest(ref, F)
+    vals = np.asarray(d.values, dtype=np.int64) + int(yf.offset_code)
+    bad = np.flatnonzero(vals != n)
+    lo, hi = d.interval
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(f"values: the entries of a plain table of {d.expression} on [{lo}, {hi}) "
+                         f"are the nearest codes of f; {bad.size} of {vals.size} entries differ "
+                         f"(first: code {k} holds {int(vals[k])}, nearest {int(n[k])})")
+    count = int((~proved).sum())
+    if isinstance(d.unproved, bool) or not isinstance(d.unproved, int) or d.unproved != count:
+        raise ValueError(f"unproved: stated {d.unproved!r}; accepted: {count} (the roundings "
+                         f"that cannot be proved)")
+    check_certificate(d.certificate, ref.error_bounds(vals, F), 2 ** d.in_bits,
+                      f"the plain table of {d.expression}")

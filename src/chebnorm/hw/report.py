@@ -7,9 +7,9 @@ is :func:`analyze` (what ``chebnorm hw report`` prints).
 
 >>> from chebnorm.approx import fit_target
 >>> import chebnorm.hw
->>> chebnorm.hw.report(fit_target("dichotomy", 1), 10, 10, coef_bits=12, synth=False, gappa=False).checks["within_budget"]
+>>> chebnorm.hw.report(fit_target("dichotomy", 1), 10, 10, coef_frac_bits=12, synth=False, gappa=False).checks["within_budget"]
 True
->>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_bits=16, synth=False, gappa=False)
+>>> r = analyze(fit_target("dichotomy", 2), 12, 12, coef_frac_bits=16, synth=False, gappa=False)
 >>> r.checks["within_budget"], r.checks["budget_within_2x"]
 (True, True)
 """
@@ -23,7 +23,9 @@ from pathlib import Path
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.display import summary_html, summary_repr
+from chebnorm.core.deprecation import renamed
 from chebnorm.core.files import write_folder
+from chebnorm.core.numeric import format_down, format_up
 
 from .budget import ErrorBudget, Measurement, error_budget, measure
 from .cost import Block
@@ -56,7 +58,7 @@ class HardwareReport:
     Examples
     --------
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> all(r.checks.values()), r.as_dict()["module"]
     (True, 'chebnorm_dichotomy_d1')
     """
@@ -123,6 +125,7 @@ class HardwareReport:
                          "offset_code": d.y_format.offset_code, "q": d.y_format.q_name()},
             "coef_frac_bits": d.coef_frac_bits, "coefficients_q": list(d.integers),
             "acc_frac_bits": d.acc_frac_bits, "valid_codes": list(d.valid_codes),
+            "scheme": d.scheme, "multipliers": d.multipliers,
             "total_error_bound": b.total, "budget": b.as_dict(),
             "measured": self.measurement.as_dict(), "checks": self.checks,
             "cost": self.block.as_dict(),
@@ -140,22 +143,35 @@ class HardwareReport:
                f"y_format: code k -> {float(yf.offset)!r} + k / 2^{yf.frac_bits} "
                f"(1 LSB = {b.y_lsb:.6e})",
                "error budget (bound | measured over every valid code):",
-               f"  approximation   {b.approximation:.6e} | {m.approximation:.6e}",
-               f"  quantization    {b.quantization:.6e} | {m.quantization:.6e}  "
-               f"(p_q re-certified {b.quantized:.6e})"]
+               f"  approximation   {format_up(b.approximation, '.6e')} | "
+               f"{format_down(m.approximation, '.6e')}",
+               f"  quantization    {format_up(b.quantization, '.6e')} | "
+               f"{format_down(m.quantization, '.6e')}  "
+               f"(p_q re-certified {format_up(b.quantized, '.6e')})"]
         for st, (bound, meas) in zip(d.stages[:-1], zip(b.rounding_steps, m.step_rounding)):
-            out.append(f"  rounding a{st.power}     {bound:.6e} (local {_local(st, d):.6e}) "
-                       f"| local {meas:.6e}")
-        out += [f"  output rounding {b.output_rounding:.6e}",
-                f"  rounding total  {b.rounding:.6e} | {m.rounding:.6e}"
-                + ("" if b.gappa_rounding is None else f"  (gappa {b.gappa_rounding:.6e})"),
-                f"  total           {b.total:.6e} | {m.total:.6e}  "
-                f"({b.total / b.y_lsb:.3f} | {m.total_lsb:.3f} LSB; ratio {b.total / m.total:.3f})",
-                f"  shading error   {m.shading_levels:.4f} levels of 8-bit output"
+            out.append(f"  rounding a{st.power}     {format_up(bound, '.6e')} (local "
+                       f"{format_up(_local(st, d), '.6e')}) "
+                       f"| local {format_down(meas, '.6e')}")
+        if d.scheme == "shifted":
+            out.append(f"  shift rounding  {format_up(b.variable_rounding, '.6e')} (v = (x - c')/s "
+                       f"with {d.variable_frac_bits} fractional bits)")
+        elif d.scheme != "monomial":
+            out.append(f"  square rounding {format_up(b.variable_rounding, '.6e')} (v = x*x with "
+                       f"{d.variable_frac_bits} fractional bits; {d.scheme} powers, "
+                       f"{d.multipliers} multipliers)")
+        out += [f"  output rounding {format_up(b.output_rounding, '.6e')}",
+                f"  rounding total  {format_up(b.rounding, '.6e')} | "
+                f"{format_down(m.rounding, '.6e')}"
+                + ("" if b.gappa_rounding is None
+                   else f"  (gappa {format_up(b.gappa_rounding, '.6e')})"),
+                f"  total           {format_up(b.total, '.6e')} | {format_down(m.total, '.6e')}  "
+                f"({format_up(b.total / b.y_lsb, '.3f')} | {format_down(m.total_lsb, '.3f')} LSB; "
+                f"ratio {b.total / m.total:.3f})",
+                f"  shading error   {format_down(m.shading_levels, '.4f')} levels of 8-bit output"
                 if m.shading_levels is not None else
                 "  shading error   - (f is zero at a valid code: no relative error)",
                 "checks: " + ", ".join(f"{k}={v}" for k, v in self.checks.items())]
-        out += self.block.lines()
+        out += self.block.lines(depth=True)
         if self.synth is not None:
             out.append(f"yosys: {self.synth.cells} cells")
         out += [f"note: {n}" for n in d.notes]
@@ -167,9 +183,9 @@ def _local(stage, design) -> float:
     return float(rounding_error_bound(stage.out_frac_bits, design.rounding, stage.round_shift))
 
 
-def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=None,
+def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_frac_bits=None,
             acc_bits=None, rounding: str = "rne", x_frac_bits=None, y_frac_bits=None,
-            gappa: bool = True, synth: bool = True) -> HardwareReport:
+            gappa: bool = True, synth: bool = True, coef_bits=None) -> HardwareReport:
     """Design, budget, measure (exhaustively) and optionally synthesize.
 
     Parameters
@@ -178,7 +194,7 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
         A fitted monomial table.
     in_bits, out_bits : int
         Input (1 to 20) and output (1 to 32) code widths.
-    coef_bits : int or None, default None
+    coef_frac_bits : int or None, default None
         Coefficient fractional bits (1 to :func:`~chebnorm.hw.horner.max_coef_bits`);
         None keeps the table's fixed-point part.
     acc_bits : int or None, default None
@@ -192,6 +208,8 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
         Cross-check the rounding bound with gappa when it is installed.
     synth : bool, default True
         Synthesize the Verilog with yosys (when installed) for the cell count.
+    coef_bits : int or None, default None
+        The deprecated spelling of ``coef_frac_bits``.
 
     Returns
     -------
@@ -236,10 +254,11 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_bits=N
     Examples
     --------
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 2), 10, 10, coef_bits=14, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 2), 10, 10, coef_frac_bits=14, synth=False, gappa=False)
     >>> r.measurement.total <= r.budget.total, r.synth is None
     (True, True)
     """
+    coef_bits = renamed(coef_bits, coef_frac_bits, "coef_bits", "coef_frac_bits", "analyze")
     if isinstance(table, CoefficientTable):
         table.verify()  # a comparison, or a re-proof of fields changed since construction
     design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
@@ -262,7 +281,7 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
     (:func:`chebnorm.hw.hdl.hdl_files` of the report's design and budget).
 
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(hdl_outputs(r, "vhdl", pipelined=True))  # doctest: +NORMALIZE_WHITESPACE
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'chebnorm_dichotomy_d1_pipe.hex',
      'chebnorm_dichotomy_d1_pipe.vhd', 'tb_chebnorm_dichotomy_d1.vhd',
@@ -304,7 +323,7 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
     (:func:`hdl_outputs` in Verilog).
 
     >>> from chebnorm.approx import fit_target
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(verilog_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v']
 
@@ -353,7 +372,7 @@ def write_outputs(directory, files: dict[str, str]) -> list[Path]:
     --------
     >>> from chebnorm.approx import fit_target
     >>> import tempfile
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     print([p.name for p in write_outputs(tmp, verilog_outputs(r))])
     ['chebnorm_dichotomy_d1.v', 'tb_chebnorm_dichotomy_d1.v', 'chebnorm_dichotomy_d1.hex']

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from chebnorm.approx import fit_target, get_target
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.core.display import field_rows, summary_html, summary_repr
+from chebnorm.core.numeric import format_down, format_up
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -124,12 +125,13 @@ class SweepPoint:
 
     def row(self) -> list[str]:
         """The CSV cells of this point, in the order of ``COLUMNS``."""
-        f = lambda v: f"{v:.6e}"
+        # the measured maximum rounded down, the certified budget up (at the digits shown)
         return [str(self.degree), str(self.coef_bits),
                 "" if self.acc_bits is None else str(self.acc_bits), str(self.in_bits),
-                str(self.out_bits), str(self.y_frac_bits), f(self.max_error),
-                f"{self.max_error_lsb:.4f}", f(self.budget), f"{self.budget_lsb:.4f}",
-                f"{self.shading_levels:.6f}",
+                str(self.out_bits), str(self.y_frac_bits), format_down(self.max_error, ".6e"),
+                format_down(self.max_error_lsb, ".4f"), format_up(self.budget, ".6e"),
+                format_up(self.budget_lsb, ".4f"),
+                f"{format_down(self.shading_levels, '.6f')}",
                 "" if self.yosys_cells is None else str(self.yosys_cells),
                 f"{self.area_fa:.1f}", str(int(self.pareto)), str(int(self.meets_half_level))]
 
@@ -195,7 +197,7 @@ class SweepResult:
 
 
 def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: str,
-               xlog: bool = False) -> bytes:
+               xlog: bool = False, measured=None) -> bytes:
     """A design sweep's Pareto plot as PNG bytes (matplotlib, Agg, no
     timestamp): ``points`` (each with ``degree`` and ``pareto``) scattered by
     degree at ``(x(p), y(p))`` on a log ``y`` axis (and ``x`` with ``xlog``),
@@ -223,6 +225,10 @@ def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: st
         Axis labels and the plot title.
     xlog : bool, default False
         Log scale on the ``x`` axis too.
+    measured : callable, optional
+        Point -> the cost a tool measured in ``x``'s unit (None where not
+        synthesized): drawn as crosses beside the model's dots, each joined to
+        its point.
 
     Returns
     -------
@@ -241,6 +247,13 @@ def pareto_png(points, x, y, *, hline, best, xlabel: str, ylabel: str, title: st
     ax.step([x(p) for p in front], [y(p) for p in front], where="post",
             color="k", lw=1, label="Pareto front")
     ax.axhline(hline[0], color="r", ls="--", lw=1, label=hline[1])
+    if measured is not None:
+        got = [(x(p), measured(p), y(p)) for p in points if measured(p) is not None]
+        if got:
+            for xm, xs, yv in got:
+                ax.plot([xm, xs], [yv, yv], color="0.6", lw=0.6)
+            ax.scatter([g[1] for g in got], [g[2] for g in got], marker="x", s=30, color="k",
+                       label="synthesized (measured)")
     if best[0] is not None:
         ax.scatter([x(best[0])], [y(best[0])], s=90, facecolors="none", edgecolors="r",
                    label=best[1])

@@ -391,9 +391,10 @@ def horner_features(d) -> DesignFeatures:
     Returns
     -------
     DesignFeatures
-        No ROM; one variable multiplier per step after the first, one
-        constant multiplier (the first step), and the adders of the input
-        shift, the steps, their roundings and the output.
+        No ROM; one variable multiplier per step after the first (and the
+        squarer ``x*x`` of a one-parity design), one constant multiplier
+        (the first step), and the adders of the input shift (and of a
+        shifted table's ``x - c``), the steps, their roundings and the output.
 
     Examples
     --------
@@ -403,13 +404,23 @@ def horner_features(d) -> DesignFeatures:
     >>> f.roms, len(f.multipliers), len(f.const_multipliers)
     ((), 1, 1)
     """
+    scheme = getattr(d, "scheme", "monomial")
+
+    def operand(st) -> int:   # x, or the Horner variable v (x*x, (x - c)/s)
+        return int(d.xs_bits if scheme == "monomial" or st.operand == "x" else d.variable_bits)
+
     st0 = d.stages[0]
-    mults = tuple((int(st.acc_bits), int(d.xs_bits)) for st in d.stages[1:])
-    top = int(d.integers[-1])
-    const = ((int(st0.acc_bits), int(d.xs_bits), naf_weight(top)),)
+    mults = tuple((int(st.acc_bits), operand(st)) for st in d.stages[1:])
+    top = int(d.horner_integers[-1]) if scheme != "monomial" else int(d.integers[-1])
+    const = ((int(st0.acc_bits), operand(st0), naf_weight(top)),)
     adds = [int(d.xs_bits)] + [int(st.sum_bits) for st in d.stages]
     adds += [int(st.out_bits) for st in d.stages[:-1] if st.round_shift]
     adds += [int(d.raw_bits), int(d.raw_bits)]
+    if scheme in ("even", "odd"):   # the squarer x*x (and its rounding)
+        mults = ((int(d.xs_bits), int(d.xs_bits)),) + mults
+        adds += [int(d.variable_bits)] if d.v_round_shift else []
+    elif scheme == "shifted":       # v = (xs << m) - C
+        adds.append(int(d.variable_bits))
     return DesignFeatures(multipliers=mults, adders=tuple(adds), const_multipliers=const)
 
 

@@ -49,7 +49,6 @@ from __future__ import annotations
 import json
 import re
 import shutil
-import subprocess
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,6 +56,7 @@ from pathlib import Path
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .verilog import tool_env
+from chebnorm.core.tools import run_tool
 
 __all__ = ["Target", "TargetCost", "TARGETS", "target_names", "get_target", "synthesize_target",
            "target_figures", "cost_from_types",
@@ -369,8 +369,7 @@ def _tool(name: str, package: str) -> str:
 
 
 def _run(argv: list[str], cwd: str, what: str, timeout: float) -> str:
-    proc = subprocess.run(argv, cwd=cwd, env=tool_env(), capture_output=True, text=True,
-                          timeout=timeout, stdin=subprocess.DEVNULL)
+    proc = run_tool(argv, tool=what, timeout=timeout, cwd=cwd, env=tool_env())
     if proc.returncode != 0:
         reason = " ".join((proc.stdout[-300:] + " " + proc.stderr[-300:]).split())
         raise ValueError(f"{what} failed: {reason or f'exit status {proc.returncode}'}")
@@ -656,7 +655,7 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
     ``freq_mhz`` is the target nextpnr's timing-driven placement aims at
     (missing it is not an error here: the achieved figure is returned);
     ``seed`` fixes the placer (same seed, same result; seeds 1 and 2 gave 25.2
-    and 23.1 MHz for the 16-bit degree-2 design of issue 28).
+    and 23.1 MHz for a 16-bit degree-2 design of 1/sqrt(1 + 3x)).
 
     Parameters
     ----------

@@ -10,10 +10,10 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import subprocess
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from chebnorm.core.tools import run_tool
 
 
 __all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_text", "tool_env"]
@@ -116,8 +116,9 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
     ValueError
         If iverilog or vvp is not installed, a file cannot be read, iverilog fails, or
         the bench prints no PASS/FAIL line.
-    subprocess.TimeoutExpired
-        If a step runs longer than ``timeout``.
+    chebnorm.core.tools.ToolTimeout
+        If a step runs longer than ``timeout`` (a ``ValueError``
+        and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
     iverilog, vvp = _need("iverilog"), _need("vvp")
     d = Path(directory)
@@ -128,13 +129,12 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
                 (Path(tmp) / dst).write_bytes((d / src).read_bytes())
             except OSError as exc:
                 raise ValueError(f"cannot read {str(d / src)!r}: {exc.strerror}") from None
-        comp = subprocess.run([iverilog, "-g2005", "-Wall", "-o", "sim.vvp", "tb.v", "dut.v"],
-                              cwd=tmp, env=tool_env(), capture_output=True, text=True,
-                              timeout=timeout, stdin=subprocess.DEVNULL)
+        comp = run_tool([iverilog, "-g2005", "-Wall", "-o", "sim.vvp", "tb.v", "dut.v"],
+                        tool="iverilog", timeout=timeout, cwd=tmp, env=tool_env())
         if comp.returncode != 0:
             raise ValueError(f"iverilog failed on {name}: {' '.join(comp.stderr.split())[:300]}")
-        run = subprocess.run([vvp, "-n", str(Path(tmp) / "sim.vvp")], cwd=d, capture_output=True,
-                             text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+        run = run_tool([vvp, "-n", str(Path(tmp) / "sim.vvp")], tool="vvp", timeout=timeout,
+                       cwd=d)
     m = re.search(r"^(PASS|FAIL): (\d+) vectors, (\d+) mismatches.*$", run.stdout, re.M)
     if not m:
         raise ValueError(f"the test bench of {name} printed no PASS/FAIL line: "
@@ -182,9 +182,8 @@ def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
     yosys = _need("yosys")
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "design.v").write_bytes(Path(path).read_bytes())
-        proc = subprocess.run([yosys, "-p", f"read_verilog design.v; synth -top {top}; stat"],
-                              cwd=tmp, env=tool_env(), capture_output=True, text=True,
-                              timeout=timeout, stdin=subprocess.DEVNULL)
+        proc = run_tool([yosys, "-p", f"read_verilog design.v; synth -top {top}; stat"],
+                        tool="yosys", timeout=timeout, cwd=tmp, env=tool_env())
     if proc.returncode != 0:
         reason = " ".join((proc.stdout[-300:] + " " + proc.stderr[-300:]).split())
         raise ValueError(f"yosys failed on {top}: {reason or f'exit status {proc.returncode}'}")

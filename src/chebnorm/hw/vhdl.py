@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
 from pathlib import Path
 
 from .hdl import hdl_files
 from .hdl.vhdl import VHDL_STD
 from .verilog import SimResult
+from chebnorm.core.tools import run_tool
 
 __all__ = ["simulate_vhdl", "vhdl_outputs"]
 
@@ -44,8 +44,9 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     ValueError
         If ghdl is not installed, a GHDL step fails, or the bench prints no PASS/FAIL
         line.
-    subprocess.TimeoutExpired
-        If a step runs longer than ``timeout``.
+    chebnorm.core.tools.ToolTimeout
+        If a step runs longer than ``timeout`` (a ``ValueError``
+        and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
     ghdl = shutil.which("ghdl")
     if ghdl is None:
@@ -56,12 +57,12 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     std = f"--std={VHDL_STD}"
     for cmd in ([ghdl, "-a", std, f"{name}.vhd"], [ghdl, "-a", std, f"tb_{name}.vhd"],
                 [ghdl, "-e", std, f"tb_{name}"]):
-        proc = subprocess.run(cmd, cwd=d, capture_output=True, text=True, timeout=timeout)
+        proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=d)
         if proc.returncode != 0:
             raise ValueError(f"ghdl {cmd[1]} failed on {name}: "
                              f"{' '.join((proc.stdout + proc.stderr).split())[:400]}")
-    run = subprocess.run([ghdl, "-r", std, f"tb_{name}", "--ieee-asserts=disable-at-0"], cwd=d, capture_output=True, text=True,
-                         timeout=timeout)
+    run = run_tool([ghdl, "-r", std, f"tb_{name}", "--ieee-asserts=disable-at-0"],
+                   tool="ghdl -r", timeout=timeout, cwd=d)
     text = run.stdout + run.stderr
     m = re.search(r"(PASS|FAIL): (\d+) vectors, (\d+) mismatches[^\n]*", text)
     if not m:
@@ -80,7 +81,7 @@ def vhdl_outputs(report, *, version: str = "", command: str | None = None,
 
     >>> from chebnorm.approx import fit_target
     >>> from chebnorm.hw.report import analyze
-    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_bits=12, synth=False, gappa=False)
+    >>> r = analyze(fit_target("dichotomy", 1), 8, 8, coef_frac_bits=12, synth=False, gappa=False)
     >>> sorted(vhdl_outputs(r))
     ['chebnorm_dichotomy_d1.hex', 'chebnorm_dichotomy_d1.vhd', 'tb_chebnorm_dichotomy_d1.vhd']
 

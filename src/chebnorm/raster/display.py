@@ -84,6 +84,11 @@ def _describe(r: ImageFrame) -> str:
     return f"{r.mesh}, {r.shading}" + (f" ({r.method})" if r.method else "")
 
 
+#: the smallest error the length-error map's white stands for: 2^-20, far below what
+#: changes an 8-bit shading level (1/255), so pure rounding noise maps to black
+LENGTH_SCALE_FLOOR = 2.0 ** -20
+
+
 def render_html(result: ImageFrame) -> str:
     """The HTML shown for a :class:`RenderResult`: image, length-error map
     (when the mode has pixel normals) and the render's numbers.
@@ -109,9 +114,11 @@ def render_html(result: ImageFrame) -> str:
     if nl is not None and np.isfinite(nl).any():
         err = np.where(np.isfinite(nl), np.abs(nl - 1.0), 0.0)
         worst = float(err.max())
-        scale = worst if worst > 0 else 1.0
+        # white is the largest error, but never below LENGTH_SCALE_FLOOR: rounding noise
+        # (2e-16 for an exact normalization) stays black instead of filling the scale
+        scale = max(worst, LENGTH_SCALE_FLOOR)
         parts.append(_figure("| |N| - 1 | (length error)", error_map_rgb(err / scale * 255.0, 255.0),
-                             f"white = {worst:.3g}"))
+                             f"black 0, white {scale:.3g}; largest {worst:.3g}"))
     rows = [("mesh", result.mesh), ("shading", result.shading), ("method", result.method),
             ("triangles", result.triangles), ("fragments", result.fragments),
             ("covered pixels", result.pixels), ("seconds", result.seconds)]

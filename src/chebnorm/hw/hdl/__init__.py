@@ -32,6 +32,7 @@ from __future__ import annotations
 from chebnorm.approx.piecewise_table import PiecewiseTable
 
 from ..horner import HornerDesign
+from ..trust import verify_design
 from .common import (LANGUAGES, SUFFIX, check_language, comment_lines, horner_facts,
                      module_name, piecewise_facts, pipelined_name, vector_file)
 from .verilog import (piecewise_clocked_testbench, piecewise_verilog, verilog_module,
@@ -88,6 +89,7 @@ def is_piecewise(design) -> bool:
 
 def _printers(design, language: str, pipelined: bool):
     piecewise = is_piecewise(design)
+    verify_design(design)   # changed since it was proved: proved again (or refused)
     check_language(language)
     if pipelined and piecewise:
         raise ValueError("pipelined: not available for a piecewise design; accepted: "

@@ -20,8 +20,10 @@ clocked when the core is pipelined).
 from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text
+from chebnorm.core.numeric import format_up
 
 from . import module_text
+from ..trust import verify_design
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
@@ -34,7 +36,7 @@ def _check(design):
     if getattr(design, "architecture", None) != "exponent":
         raise ValueError(f"design: a {type(design).__name__} is not an exponent-indexed design; "
                          f"accepted: an ExponentDesign (design_exponent)")
-    return design
+    return verify_design(design)   # changed since it was proved: proved again (or refused)
 
 
 def exponent_facts(design, *, version: str = "", command: str | None = None) -> list[str]:
@@ -85,9 +87,10 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
               f"{d.degree}).",
               f"y = {{h, m}}: h = y[{H + M - 1}:{M}], m = y[{M - 1}:0]; 1/sqrt(x) ~ 2^h * "
               f"({off} + m) / 2^{F}.",
-              f"Certified: |({off} + m) / 2^{F} - g(v)| <= {b['mantissa']:.6e} "
-              f"({b['mantissa'] * 2.0 ** F:.4f} ulp of the mantissa), so |y - 1/sqrt(x)| <= "
-              f"2^h * that and the relative error < {b['relative']:.6e}."]
+              f"Certified: |({off} + m) / 2^{F} - g(v)| <= {format_up(b['mantissa'], '.6e')} "
+              f"({format_up(b['mantissa'] * 2.0 ** F, '.4f')} ulp of the mantissa), so |y - "
+              f"1/sqrt(x)| <= "
+              f"2^h * that and the relative error < {format_up(b['relative'], '.6e')}."]
     if d.latency:
         lines.append(f"Pipelined: the core's registers, latency {d.latency} cycles (LATENCY); "
                      f"h is delayed as many.")

@@ -20,7 +20,9 @@ model's vector file). The banner states the same facts in both languages
 from __future__ import annotations
 
 from chebnorm.core.textsafe import comment_text
+from chebnorm.core.numeric import format_up
 
+from ..trust import verify_design
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
@@ -34,6 +36,7 @@ def _kind(design) -> str:
     if kind not in ("multipartite", "plain_table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
+    verify_design(design)   # changed since it was proved: proved again (or refused)
     return kind
 
 
@@ -100,12 +103,14 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
         lines.append(f"y = (TIV + TO0 + ... ) mod 2^{design.sum_bits} >> {g}: one truncation, "
                      f"{g} guard bits.")
         b = design.budget()
-        lines.append(f"A priori budget: method {b['method']:.6e} + table rounding "
-                     f"{b['table_rounding']:.6e} + final rounding {b['final_rounding']:.6e} = "
-                     f"{b['a_priori']:.6e}; target {b['target']:.6e}"
+        lines.append(f"A priori budget: method {format_up(b['method'], '.6e')} + table rounding "
+                     f"{format_up(b['table_rounding'], '.6e')} + final rounding "
+                     f"{format_up(b['final_rounding'], '.6e')} = "
+                     f"{format_up(b['a_priori'], '.6e')}; target {b['target']:.6e}"
                      + (" (faithful)" if design.faithful else "") + ".")
     lines.append(f"Proved over all {c.codes} codes (Arb enclosures of f): |y - f(x)| <= "
-                 f"{c.upper:.6e} = {c.upper * 2.0 ** yf.frac_bits:.4f} LSB of y.")
+                 f"{format_up(c.upper, '.6e')} = "
+                 f"{format_up(c.upper * 2.0 ** yf.frac_bits, '.4f')} LSB of y.")
     cuts = table_cuts(design)
     lines.append(f"Pipelined: registers at {', '.join(TABLE_CUTS[c] for c in cuts)}; latency "
                  f"{len(cuts)} cycles (LATENCY), one result per cycle." if cuts else

@@ -4,7 +4,7 @@
 self-checking test benches, and the text fragments they (and the
 normalization units of :mod:`chebnorm.hw.units`) share.
 
-The module follows the port contract of issue 5::
+The module follows one port contract::
 
     module chebnorm_NAME #(parameter IN_BITS = W, parameter OUT_BITS = V)
         (input wire [IN_BITS-1:0] x, output wire [OUT_BITS-1:0] y);
@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
+from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -258,19 +259,22 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
     out += [f"    // x value times 2^{xf.frac_bits}",
             f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
             f"    wire signed [{xw - 1}:0] xs = $signed({{1'b0, x}}) + K0;"]
+    out += _variable_lines(design, "xs", "v")
+    n = len(design.horner_integers) - 1
     if n == 0:
         top_bits = max(design.top_bits, 2)
         out.append(f"    wire signed [{top_bits - 1}:0] top = {signed_literal(design.integers[0], top_bits)};")
         top_frac = design.coef_frac_bits
     else:
         aw = max(design.stages[0].acc_bits, 2)
-        out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
+        out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
+                   f"{signed_literal(design.horner_integers[n], aw)};")
         prev = f"A{n}"
         for st in design.stages:
             j = st.power
-            out.append(f"    // step {j}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})"
+            out.append(f"    // step {j}: {step_comment(design, st)}"
                        f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
-            out += _horner_step(design, st, prev, "xs")
+            out += _horner_step(design, st, prev, variable_name(design, st))
             if j > 0:
                 prev = f"a{j}"
         top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
@@ -278,6 +282,33 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
     out += _output_stage(design, yf, top_bits, top_frac)
     return "\n".join(out)
 
+
+
+def _variable_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
+    """The Horner variable ``v = R(xs * xs)`` of a one-parity design (no
+    lines for plain Horner in ``x``)."""
+    if design.scheme == "monomial":
+        return []
+    if design.scheme == "shifted":
+        return _shifted_lines(design, xs, v)
+    sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
+    out = [f"    // {v}: x*x with {design.variable_frac_bits} fractional bits "
+           f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} powers in it",
+           f"    wire signed [{sw - 1}:0] {v}_sq = {xs} * {xs};"]
+    if rs:
+        return out + round_lines(f"{v}_sq", v, sw, rs, vw, design.rounding)
+    return out + [f"    wire signed [{vw - 1}:0] {v} = {v}_sq;"]
+
+
+def _shifted_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
+    """``v = (xs << m) - C``: the shifted table's variable ``(x - c')/s``."""
+    sw, m = shifted_width(design), design.v_shift
+    shifted = f"({xs} <<< {m})" if m else xs
+    return [f"    // {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
+            f"{design.v_offset} / 2^{design.x_format.frac_bits + m}",
+            f"    localparam signed [{sw - 1}:0] {v}_C = {signed_literal(design.v_offset, sw)};",
+            f"    wire signed [{sw - 1}:0] {v}_d = {shifted} - {v}_C;",
+            f"    wire signed [{design.variable_bits - 1}:0] {v} = {v}_d;"]
 
 
 def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
@@ -353,7 +384,7 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     out += [f"module {name} #(",
             f"    parameter IN_BITS = {design.in_bits},",
             f"    parameter OUT_BITS = {design.out_bits},",
-            f"    parameter LATENCY = {n}",
+            f"    parameter LATENCY = {design.steps}",
             ") (",
             "    input  wire                clk,",
             "    input  wire [IN_BITS-1:0]  x,",
@@ -362,20 +393,26 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     xw = design.xs_bits
     out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
             f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
+    out += _variable_lines(design, "xs0", "v0")
+    vw, square = design.variable_bits, design.scheme != "monomial"   # v travels beside x
+    n = len(design.horner_integers) - 1
     aw = max(design.stages[0].acc_bits, 2)
-    out.append(f"    localparam signed [{aw - 1}:0] A{n} = {signed_literal(design.integers[n], aw)};")
+    out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
+               f"{signed_literal(design.horner_integers[n], aw)};")
     prev = f"A{n}"
     for s, st in enumerate(design.stages):
         j = st.power
-        out.append(f"    // stage {s + 1}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})")
-        out += _horner_step(design, st, prev, f"xs{s}")
+        out.append(f"    // stage {s + 1}: {step_comment(design, st)}")
+        out += _horner_step(design, st, prev, f"{variable_name(design, st)}{s}")
         if j > 0:
             out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
-                    f"    reg signed [{xw - 1}:0] xs{s + 1};",
-                    "    always @(posedge clk) begin",
+                    f"    reg signed [{xw - 1}:0] xs{s + 1};"]
+            out += [f"    reg signed [{vw - 1}:0] v{s + 1};"] if square else []
+            out += ["    always @(posedge clk) begin",
                     f"        a{j}_r <= a{j};",
-                    f"        xs{s + 1} <= xs{s};",
-                    "    end"]
+                    f"        xs{s + 1} <= xs{s};"]
+            out += [f"        v{s + 1} <= v{s};"] if square else []
+            out += ["    end"]
             prev = f"a{j}_r"
     top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
     out += [f"    reg signed [{top_bits - 1}:0] top;",
@@ -418,7 +455,7 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     >>> verilog_pipelined_testbench(d).splitlines()[0]
     '// tb_chebnorm_dichotomy_d1_pipe: exhaustive self-checking test bench of chebnorm_dichotomy_d1_pipe, latency 1.'
     """
-    return _clocked_bench(design, pipelined_name(design), design.degree, vectors)
+    return _clocked_bench(design, pipelined_name(design), design.steps, vectors)
 
 
 def _clocked_bench(design, name: str, n: int, vectors: str | None) -> str:

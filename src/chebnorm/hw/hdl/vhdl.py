@@ -34,6 +34,7 @@ from __future__ import annotations
 from chebnorm.core.textsafe import identifier
 
 from ..horner import HornerDesign
+from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -105,10 +106,35 @@ def _round(b: _Body, src: str, dst: str, src_bits: int, shift: int, dst_bits: in
     b.wire(dst, dst_bits, f"wrap(wrap({dst}_q, {w}) + signed'(\"0\" & {dst}_inc), {dst_bits})")
 
 
+def _variable(b: _Body, design: HornerDesign, xs: str, v: str) -> None:
+    """The Horner variable ``v = R(xs * xs)`` of a one-parity design
+    (nothing for plain Horner in ``x``), as the Verilog printer's."""
+    if design.scheme == "monomial":
+        return
+    if design.scheme == "shifted":   # v = (xs << m) - C: (x - c')/s
+        sw, m = shifted_width(design), design.v_shift
+        b.stmt.append(f"    -- {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
+                      f"{design.v_offset} / 2^{design.x_format.frac_bits + m}")
+        b.decl.append(_const(f"{v}_C", design.v_offset, sw))
+        wide = f"wrap({xs}, {sw})"
+        b.wire(f"{v}_d", sw, (f"shift_left({wide}, {m})" if m else wide) + f" - {v}_C")
+        b.wire(v, design.variable_bits, f"wrap({v}_d, {design.variable_bits})")
+        return
+    sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
+    b.stmt.append(f"    -- {v}: x*x with {design.variable_frac_bits} fractional bits "
+                  f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} "
+                  f"powers in it")
+    b.wire(f"{v}_sq", sw, f"{xs} * {xs}")
+    if rs:
+        _round(b, f"{v}_sq", v, sw, rs, vw, design.rounding)
+    else:
+        b.wire(v, vw, f"wrap({v}_sq, {vw})")
+
+
 def _step(b: _Body, design: HornerDesign, st, prev: str, xs: str) -> None:
     j = st.power
     pw = st.product_bits
-    b.stmt.append(f"    -- step {j}: a{j} = R(a{j + 1} * x + q{j} / 2^{design.coef_frac_bits})"
+    b.stmt.append(f"    -- step {j}: {step_comment(design, st)}"
                   f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
     # Verilog extends both operands to pw bits and keeps the product mod 2^pw; the exact
     # product of the narrower operands, wrapped to pw bits, is the same bits for less work
@@ -156,7 +182,8 @@ def _vhdl_name(name: str) -> str:
 
 
 def _entity(name: str, design, clocked: bool) -> list[str]:
-    latency = design.latency if getattr(design, "latency", 0) else design.degree
+    latency = design.latency if getattr(design, "latency", 0) else \
+        getattr(design, "steps", design.degree)
     _vhdl_name(name)
     generics = [f"        IN_BITS  : natural := {design.in_bits};",
                 f"        OUT_BITS : natural := {design.out_bits}" + (";" if clocked else "")]
@@ -214,6 +241,8 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
     b.decl.append(_const("K0", xf.offset_code, xw))
     b.stmt.append(f"    -- x value times 2^{xf.frac_bits}")
     b.wire("xs", xw, f"wrap(signed('0' & x), {xw}) + K0")
+    _variable(b, design, "xs", "v")
+    n = len(design.horner_integers) - 1
     if n == 0:
         top_bits = max(design.top_bits, 2)
         b.decl.append(_const("TOPC", design.integers[0], top_bits))
@@ -221,10 +250,10 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
         top_frac = design.coef_frac_bits
     else:
         aw = max(design.stages[0].acc_bits, 2)
-        b.decl.append(_const(f"A{n}", design.integers[n], aw))
+        b.decl.append(_const(f"A{n}", design.horner_integers[n], aw))
         prev = f"A{n}"
         for st in design.stages:
-            _step(b, design, st, prev, "xs")
+            _step(b, design, st, prev, variable_name(design, st))
             if st.power > 0:
                 prev = f"a{st.power}"
         top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
@@ -289,17 +318,23 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
     xw = design.xs_bits
     b.decl.append(_const("K0", xf.offset_code, xw))
     b.wire("xs0", xw, f"wrap(signed('0' & x), {xw}) + K0")
+    _variable(b, design, "xs0", "v0")
+    square = design.scheme != "monomial"
+    n = len(design.horner_integers) - 1
     aw = max(design.stages[0].acc_bits, 2)
-    b.decl.append(_const(f"A{n}", design.integers[n], aw))
+    b.decl.append(_const(f"A{n}", design.horner_integers[n], aw))
     prev = f"A{n}"
     regs = []
     for s, st in enumerate(design.stages):
         j = st.power
-        _step(b, design, st, prev, f"xs{s}")
+        _step(b, design, st, prev, f"{variable_name(design, st)}{s}")
         if j > 0:
             b.decl.append(_sig(f"a{j}_r", st.out_bits))
             b.decl.append(_sig(f"xs{s + 1}", xw))
             regs += [f"            a{j}_r <= a{j};", f"            xs{s + 1} <= xs{s};"]
+            if square:
+                b.decl.append(_sig(f"v{s + 1}", design.variable_bits))
+                regs.append(f"            v{s + 1} <= v{s};")
             prev = f"a{j}_r"
     top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
     b.decl.append(_sig("top", top_bits))
@@ -337,7 +372,7 @@ def _bench(design, name: str, vectors: str | None, clocked: bool,
            latency: int | None = None) -> str:
     vectors = vectors_name(name, vectors)
     count = 2 ** design.in_bits
-    n = design.degree if latency is None else latency
+    n = getattr(design, "steps", design.degree) if latency is None else latency
     digits = (design.out_bits + 3) // 4
     latency = n if clocked else 1
     dut_generics = "IN_BITS => IN_BITS, OUT_BITS => OUT_BITS" + \
