@@ -304,7 +304,7 @@ def test_one_minus_cos_relative_error_cli_and_piecewise():
     assert code == 0 and "max |p/f - 1|" in out, err
     import chebnorm as cn
 
-    t = cn.fit("1 - cos(x)", ("1e-8", "1e-4"), 3, error="rel", segments=4, frac_bits=48)
+    t = cn.fit("1 - cos(x)", ("1e-8", "1e-4"), 3, error="rel", segments=4, coef_frac_bits=48)
     assert t.rel_error_bound is not None and t.rel_error_bound <= 1.0 + 1e-9
     # a true zero is still refused, with the true reason
     refused(run_cli("fit", "1 - cos(x)", "--interval", "0", "1e-4", "--degree", "3",
