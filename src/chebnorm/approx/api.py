@@ -15,7 +15,7 @@ from chebnorm.core.deprecation import renamed
 from chebnorm.core.textsafe import default_name
 
 from .certify import Certificate, certify
-from .expr import Function1D, compare, enclose, parse_function, parse_number
+from .expr import AccurateFunction1D, Function1D, compare, enclose, parse_function, parse_number
 from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, polish, remez,
                       shift_for)
 from .contract import construction
@@ -182,6 +182,31 @@ def check_interval(fn: Function1D, iv: Interval, samples: int = 2001) -> np.ndar
                          f"(for example at {fn.var} = {where:.6g}); accepted: an interval "
                          f"where the function is defined, finite and real")
     return y.real
+
+
+def _one_sign(fn, iv, samples: int) -> bool:
+    """Whether ``f`` is proven nonzero and of one sign at the float samples of
+    :func:`check_interval` in ball arithmetic (128 bits): float64 reads a zero or a
+    sign change where ``f`` is a cancellation (``1 - cos(x)`` at ``x = 1e-8``)."""
+    from flint import arb
+
+    from chebnorm.core.numeric import arb_precision
+
+    x = np.linspace(iv.lo_in, iv.hi_in, samples)
+    x[0], x[-1] = iv.lo_in, iv.hi_in
+    signs = set()
+    with arb_precision(128):
+        for v in x:
+            try:
+                y = fn.arb(arb(float(v)))
+            except (ValueError, ZeroDivisionError):
+                return False
+            if not y.is_finite() or y.contains(0):
+                return False
+            signs.add(y > 0)
+            if len(signs) > 1:
+                return False
+    return True
 
 
 def _certify_both(fn, coeffs, iv, need_rel: bool, shift=None, tight: bool = False,
@@ -429,8 +454,12 @@ def fit(expr, interval, degree: int | None = None, kind: str = "chebyshev", erro
     iv = Interval(lo, hi)
     samples = check_interval(fn, iv)
     if error == "rel" and (np.any(samples == 0) or np.ptp(np.sign(samples)) > 0):
-        raise ValueError(f"relative error is undefined: {fn.expr} vanishes on [{iv.lo}, {iv.hi}]; "
-                         f"accepted for error='rel': an interval where the function has no zero")
+        if not _one_sign(fn, iv, samples.size):
+            raise ValueError(f"relative error is undefined: {fn.expr} vanishes on "
+                             f"[{iv.lo}, {iv.hi}]; accepted for error='rel': an interval where "
+                             f"the function has no zero")
+        # float64 reads zeros that are not there: fit from the function's true values
+        fn = AccurateFunction1D(fn.expr, fn.var)
 
     mons, fixc = monomials if constrained and not quantized else None, fix_constant and not quantized
     fitted, choice = None, None
@@ -1102,6 +1131,11 @@ def _monomials(monomials, degree: int, fix_constant: bool) -> tuple[int, ...]:
         raise ValueError(f"monomials {monomials!r} are not powers of the variable in "
                          f"0..{degree}; accepted: a non-empty list such as 1,3,5 (at most the "
                          f"degree {degree})")
+    repeated = sorted({int(k) for k in monomials if list(monomials).count(k) > 1})
+    if repeated:
+        raise ValueError(f"monomials {list(monomials)!r} repeat the power "
+                         f"{', '.join(map(str, repeated))}; accepted: each power once, "
+                         f"e.g. 1,3,5")
     if fix_constant and 0 in mons:
         mons.remove(0)
     return tuple(mons)

@@ -248,7 +248,12 @@ def _error_taylor(f_series, p: PolyTaylor, kind: str):
 
     def f_at(x0: arb, n: int) -> arb_series:
         fs = f_series(arb_series([x0, 1], prec=n))
-        return fs if isinstance(fs, arb_series) else arb_series([fs], prec=n)  # f constant
+        fs = fs if isinstance(fs, arb_series) else arb_series([fs], prec=n)  # f constant
+        if kind == "rel" and x0.rad() > 0:
+            c = fs.coeffs()
+            if not c or not c[0].is_finite() or c[0].contains(0):
+                return _recentred(f_series, x0, n, fs)
+        return fs
 
     def taylor(x0: arb, n: int) -> list[arb]:
         try:
@@ -274,6 +279,39 @@ def _error_taylor(f_series, p: PolyTaylor, kind: str):
 
     taylor.over = over
     return taylor
+
+
+def _recentred(f_series, x0: arb, n: int, naive: arb_series) -> arb_series:
+    """The first ``n`` Taylor coefficients of ``f`` over the ball ``x0 = m + H``
+    (``H = [-r, r]``) by a second-order expansion from the exact midpoint ``m``:
+    ``f_k(x0) in f_k(m) + (k + 1) f_{k+1}(m) H + C(k + 2, 2) f_{k+2}(x0) H^2``,
+    each intersected with the direct enclosure ``naive``. Where ``f`` is a
+    cancellation (``1 - cos(x)`` near 0: ``x^2/2`` out of two numbers near 1) the
+    direct enclosure of ``f(x0)`` is wider than ``f`` itself and holds 0 on every
+    piece Arb can afford; the expansion's width is ``|f'(m)| r``, so the ratio
+    ``p/f`` is enclosed once ``r`` is a fraction of the distance to the zero."""
+    m = arb(x0.mid())
+    h = arb(0, x0.rad())
+    try:
+        at_m = f_series(arb_series([m, 1], prec=n + 1))
+        over = f_series(arb_series([x0, 1], prec=n + 2))
+    except (ValueError, ZeroDivisionError):
+        return naive
+    cm = _coeffs(at_m if isinstance(at_m, arb_series) else arb_series([at_m], prec=n + 1),
+                 n + 1)
+    cx = _coeffs(over if isinstance(over, arb_series) else arb_series([over], prec=n + 2),
+                 n + 2)
+    direct = _coeffs(naive, n)
+    h2 = h * h
+    out = []
+    for k in range(n):
+        e = cm[k] + (k + 1) * cm[k + 1] * h + ((k + 2) * (k + 1) // 2) * cx[k + 2] * h2
+        if not e.is_finite():
+            e = direct[k]
+        elif direct[k].is_finite():
+            e = e.intersection(direct[k])
+        out.append(e)
+    return arb_series(out, prec=n)
 
 
 def _quadratic_max(c0: arb, c1: arb, c2: arb, r: arb) -> arb:

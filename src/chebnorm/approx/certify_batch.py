@@ -116,16 +116,42 @@ def _ball(value) -> arb:
 
 
 class _Affine:
-    """``t -> f(o + w t)`` with ``o`` and ``w`` balls, for the fallback certifier."""
+    """``t -> f(o + w t)`` with ``o`` and ``w`` balls, for the fallback certifier.
 
-    def __init__(self, fn: Function1D, o: arb, w: arb):
+    A ball ``t`` that starts exactly at the local range's start ``l0`` (or ends
+    exactly at its end ``l1``) -- the certifier's piece at a singular endpoint,
+    ``[0, r]`` for ``sqrt`` at ``x = 0`` -- maps to a ball that starts exactly at
+    ``o + w l0`` (ends at ``o + w l1``) when ``o`` and ``w`` are exact (``w > 0``):
+    ``o + w t`` in ball arithmetic would widen it past that end, where ``sqrt`` is
+    not real."""
+
+    def __init__(self, fn: Function1D, o: arb, w: arb, l0: float = 0.0, l1: float = 1.0):
         self.expr = fn.expr
         f_series, f_point = fn.arb_series, fn.arb
         self.arb_series = lambda s: f_series(o + w * s)
-        self.arb = lambda x: f_point(o + w * x)
+        exact = o.is_exact() and w.is_exact() and w > 0
+        ends = (arb(l0), arb(l1))
+        self.arb = lambda x: f_point(_affine_image(o, w, x, ends) if exact else o + w * x)
 
     def __str__(self) -> str:
         return f"{self.expr} on a segment"
+
+
+def _affine_image(o: arb, w: arb, x: arb, ends: tuple[arb, arb]) -> arb:
+    """A ball containing ``o + w x`` for ``x`` in the ball ``x`` (``o``, ``w`` exact,
+    ``w > 0``) whose lower end is exactly ``o + w l0`` when ``x`` starts exactly at
+    ``l0`` (whose upper end is exactly ``o + w l1`` when ``x`` ends exactly at
+    ``l1``), as :func:`chebnorm.approx.certify._ball` builds its pieces."""
+    if x.is_exact() or not x.is_finite():
+        return o + w * x
+    lo_t, hi_t = arb(x.lower()), arb(x.upper())
+    lo, hi = o + w * lo_t, o + w * hi_t
+    span = arb(0).union((hi - lo).upper()).nonnegative_part()  # [0, >= hi - lo]
+    if (lo_t - ends[0]).is_zero() and lo.is_exact():
+        return lo + span
+    if (hi_t - ends[1]).is_zero() and hi.is_exact():
+        return hi - span
+    return o + w * x
 
 
 def _exact_half(lo: float, hi: float) -> tuple[float, float]:
@@ -245,7 +271,7 @@ def _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, tol) -> list[Certificate]:
         todo = model.coarse
     for s in sorted(alone + todo):
         try:
-            out[s] = certify(_Affine(fn, o[s], w[s]), coeffs[s], sp.Rational(l0),
+            out[s] = certify(_Affine(fn, o[s], w[s], l0, l1), coeffs[s], sp.Rational(l0),
                              sp.Rational(l1), kind, tol=tol)
         except ValueError as exc:
             raise SegmentError(s, str(exc)) from None

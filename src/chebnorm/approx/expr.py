@@ -65,7 +65,8 @@ from sympy.printing.numpy import SciPyPrinter
 from chebnorm.core import clib
 from chebnorm.core.numeric import arb_precision
 
-__all__ = ["Function1D", "UndefinedError", "parse_function", "parse_number", "read_expression", "FUNCTIONS",
+__all__ = ["Function1D", "AccurateFunction1D", "UndefinedError", "parse_function",
+           "parse_number", "read_expression", "FUNCTIONS",
            "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
 
 #: the functions an expression may call, by name (one argument each; ``log``
@@ -267,7 +268,9 @@ class _Reader:
             if base.is_Rational:
                 if base == 0 and ex < 0:
                     raise _Refusal(f"{self.token(node)!r} divides by zero")
-                if _bits(base) * abs(int(ex.p)) > MAX_NUMBER_BITS:
+                # a lower bound of the power's bits (2**1000 has 1001); number() checks
+                # the exact value
+                if (_bits(base) - 1) * abs(int(ex.p)) + 1 > MAX_NUMBER_BITS:
                     raise _Refusal(f"the power {self.token(node)!r} has more than "
                                    f"{MAX_NUMBER_BITS} bits")
                 if int(ex.q) > MAX_EXPONENT:
@@ -544,10 +547,13 @@ def _nan_like(s):
 
 
 def _abs(s):
-    """``|s|``: for a series, the series of ``s`` or ``-s`` when its value has
-    one sign on the whole ball, else nan (not differentiable there)."""
+    """``|s|``: for a ball, a ball of nonnegative numbers (Arb's ``abs`` keeps the
+    radius of a ball around 0, whose lower end is then negative, and ``sqrt`` of it
+    not real); for a series, the series of ``s`` or ``-s`` when its value has one
+    sign on the whole ball, else nan (not differentiable there)."""
     if not isinstance(s, arb_series):
-        return abs(s)
+        a = abs(s)
+        return a.nonnegative_part() if a.is_finite() and a.lower() < 0 else a
     c = s.coeffs()
     c0 = c[0] if c else arb(0)
     if c0 > 0:
@@ -785,6 +791,45 @@ class Function1D:
 
     def __str__(self) -> str:
         return str(self.expr)
+
+
+class AccurateFunction1D(Function1D):
+    """A :class:`Function1D` whose float evaluator rounds Arb's 128-bit value to
+    float64 instead of evaluating the expression in float64: for a function that
+    float64 evaluates by cancellation (``1 - cos(x)`` near 0, where it reads 0),
+    so that fits weighted by ``1/|f|`` see its true values. Slower (one ball
+    evaluation per point); the certified bounds never depend on it.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+        The expression, in the single variable ``var``.
+    var : sympy.Symbol
+        Its variable (a real Symbol).
+
+    Examples
+    --------
+    >>> g = parse_function("1 - cos(x)")
+    >>> AccurateFunction1D(g.expr, g.var).numpy([1e-8]).tolist(), g.numpy([1e-8]).tolist()
+    ([5e-17], [0.0])
+    """
+
+    @functools.cached_property
+    def numpy(self) -> Callable[[np.ndarray], np.ndarray]:
+        f_arb = self.arb
+
+        def value(x) -> np.ndarray:
+            xs = np.asarray(x, dtype=float)
+            out = np.empty(xs.shape)
+            with arb_precision(128):
+                for i, v in np.ndenumerate(xs):
+                    try:
+                        y = f_arb(arb(float(v)))
+                    except (ValueError, ZeroDivisionError):
+                        y = None
+                    out[i] = float(y.mid()) if y is not None and y.is_finite() else np.nan
+            return out
+        return value
 
 
 def parse_function(text: str | sp.Expr, var: str = "x") -> Function1D:

@@ -28,7 +28,7 @@ from chebnorm.core.textsafe import default_name
 from .certify import arb_enclose
 from .certify_batch import SegmentError, certify_batch
 from .contract import construction
-from .expr import Function1D, parse_function, parse_number
+from .expr import AccurateFunction1D, Function1D, parse_function, parse_number
 from .fitting import cheb_to_monomial, remez
 from .piecewise_table import (PiecewiseSegment, PiecewiseTable, exact_log2, parse_segments,
                               segment_balls, segment_bounds, segment_count)
@@ -194,6 +194,15 @@ def _fit_all(fn, lo, hi, segment_by, index_bits, degree, frac_bits, centered, fi
                 probe = g.numpy(np.linspace(*loc, 65))
             except (ZeroDivisionError, OverflowError, TypeError):
                 probe = np.array([np.nan])
+        if error == "rel" and np.all(np.isfinite(probe)) and np.any(probe == 0):
+            # float64 may read a zero that is a cancellation (1 - cos(x) near 0): fit
+            # from the function's true values where they have no zero
+            exact = _local_function(AccurateFunction1D(fn.expr, fn.var), a, b,
+                                    centered=centered)
+            with np.errstate(all="ignore"):
+                again = exact.numpy(np.linspace(*loc, 65))
+            if np.all(np.isfinite(again)) and np.all(again != 0):
+                g, probe = exact, again
         if not np.all(np.isfinite(probe)) or (error == "rel" and np.any(probe == 0)):
             return ints_all, s
         with np.errstate(all="ignore"):

@@ -640,6 +640,8 @@ def parse_segments(text) -> int:
     """
     s = str(text).strip().replace("**", "^")
     try:
+        if not s.isascii() or "_" in s:  # int() reads other scripts' digits and 1_0
+            raise ValueError
         if s.startswith("2^"):
             k = int(s[2:])
         else:

@@ -14,8 +14,9 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
-from .common import command_flags
+from .common import ascii_float, ascii_int, command_flags
 
 __all__ = ["main", "build_parser", "UsageError"]
 
@@ -29,6 +30,13 @@ class UsageError(ValueError):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # every ``type=int`` / ``type=float`` reads ASCII digits only (Python's own
+        # readers take other scripts' digits: int("\u0663") == 3)
+        self.register("type", int, ascii_int)
+        self.register("type", float, ascii_float)
+
     def error(self, message):  # argparse's own errors: one line, status 2
         raise UsageError(f"{self.prog}: {message}")
 
@@ -84,6 +92,29 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    with warnings.catch_warnings():   # restores the caller's showwarning and filters
+        warnings.showwarning = _one_line_warnings(warnings.showwarning)
+        return _main(argv)
+
+
+def _one_line_warnings(previous):
+    """A ``warnings.showwarning`` that prints chebnorm's own warnings (FitWarning,
+    FrequencyWarning, ...) as one ``chebnorm: warning:`` line each, once per command,
+    and hands every other warning to ``previous``."""
+    seen: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not category.__module__.startswith("chebnorm"):
+            return previous(message, category, filename, lineno, file, line)
+        text = " ".join(str(message).split())
+        if text not in seen:
+            seen.add(text)
+            print(f"chebnorm: warning: {text}", file=sys.stderr)
+        return None
+    return show
+
+
+def _main(argv: list[str]) -> int:
     flags = None   # the command's flags by Python name, once it is parsed
     try:
         parser = build_parser()

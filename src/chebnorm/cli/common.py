@@ -27,6 +27,99 @@ def command_line(args) -> str:
     return " ".join(shlex.quote(a) for a in getattr(args, "argv", ["chebnorm"]))
 
 
+#: an integer as the command line accepts it: ASCII digits, an optional sign
+_ASCII_INT = re.compile(r"[+-]?[0-9]+")
+
+
+def ascii_int(text) -> int:
+    """An integer of the command line, in ASCII digits only (argparse type).
+
+    Python's ``int`` also reads other scripts' digits (``int("\u0663") == 3``)
+    and underscores (``int("1_0") == 10``); a number on the command line is
+    taken only as it is printed back.
+
+    Parameters
+    ----------
+    text : str
+        The value as typed.
+
+    Returns
+    -------
+    int
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        When ``text`` holds a character outside ASCII (its message says so).
+    ValueError
+        When ``text`` is not an optional sign followed by ASCII digits (argparse
+        reports it as ``invalid int value``).
+
+    >>> ascii_int("-12")
+    -12
+    """
+    if isinstance(text, str) and not text.isascii():
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}; accepted: ASCII "
+                                         f"digits 0-9")
+    if not isinstance(text, str) or not _ASCII_INT.fullmatch(text.strip()):
+        raise ValueError(f"{text!r} is not an integer in ASCII digits")
+    return int(text)
+
+
+def ascii_float(text) -> float:
+    """A float of the command line, in ASCII characters only (argparse type).
+
+    Parameters
+    ----------
+    text : str
+        The value as typed.
+
+    Returns
+    -------
+    float
+        Its value (``float(text)``).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        When ``text`` holds a character outside ASCII (another script's digits,
+        which ``float`` would read).
+    ValueError
+        When ``text`` holds an underscore or is not a number (argparse reports it
+        as ``invalid float value``).
+
+    >>> ascii_float("1e-3")
+    0.001
+    """
+    if isinstance(text, str) and not text.isascii():
+        raise argparse.ArgumentTypeError(f"invalid float value: {text!r}; accepted: ASCII "
+                                         f"digits 0-9")
+    if not isinstance(text, str) or "_" in text:
+        raise ValueError(f"{text!r} is not a number in ASCII digits")
+    return float(text)
+
+
+def shell_words(words) -> str:
+    """A command for a POSIX shell: each word ``shlex.quote``-d, joined by spaces
+    (``shlex.split`` gives the words back, as text).
+
+    Parameters
+    ----------
+    words : iterable
+        The command's words (numbers are written with ``str``).
+
+    Returns
+    -------
+    str
+        The quoted command line.
+
+    >>> shell_words(["chebnorm", "fit", "1/sqrt(x)", "--interval", "(1)", 4])
+    "chebnorm fit '1/sqrt(x)' --interval '(1)' 4"
+    """
+    return " ".join(shlex.quote(str(w)) for w in words)
+
+
 def print_json(obj) -> None:
     """Deterministic JSON on stdout: sorted keys, shortest float repr.
 

@@ -3,10 +3,9 @@ also the piecewise-table paths of ``chebnorm hw verilog`` and ``hw report``."""
 
 from __future__ import annotations
 
-import json
 import math
 
-from .common import command_line, max_error_value, print_json, refuse_table_overwrite
+from .common import command_line, max_error_value, print_json, refuse_table_overwrite, shell_words
 from .parallel_options import add_parallel_args, parallel_kwargs
 
 
@@ -144,10 +143,12 @@ def run(args) -> int:
         print("\n".join(figures))
     for c in others:
         print(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None else ""))
-    print(f"reproduce: chebnorm fit {json.dumps(args.expr)} --var {args.var} --interval "
-          f"{args.interval[0]} {args.interval[1]} --degree {w.degree} --segments {w.segments} "
-          f"--kind minimax --coef-frac-bits {w.coef_frac_bits} -o T.json && chebnorm hw verilog "
-          f"T.json --in-bits {args.in_bits} --out-bits {args.out_bits} -o DIR --simulate")
+    fit = ["chebnorm", "fit", args.expr, "--var", args.var, "--interval", *args.interval,
+           "--degree", w.degree, "--segments", w.segments, "--kind", "minimax",
+           "--coef-frac-bits", w.coef_frac_bits, "-o", "T.json"]
+    verilog = ["chebnorm", "hw", "verilog", "T.json", "--in-bits", args.in_bits, "--out-bits",
+               args.out_bits, "-o", "DIR", "--simulate"]
+    print(f"reproduce: {shell_words(fit)} && {shell_words(verilog)}")
     return 0
 
 
@@ -157,6 +158,9 @@ def _frequency(args, target):
         return None
     from chebnorm.hw.pipeline import check_frequency
 
+    if not str(args.frequency).isascii():   # float() reads other scripts' digits
+        raise ValueError(f"--frequency {str(args.frequency)[:40]!r}: accepted: a finite number "
+                         f"of MHz > 0 in ASCII digits, e.g. 100")
     freq = check_frequency(args.frequency, "--frequency")
     if target == "generic" or args.no_synth:
         raise ValueError(f"--frequency {args.frequency} needs a device's timing; accepted: "

@@ -8,7 +8,8 @@ import re
 import sys
 import warnings
 
-from .common import cli_flags, command_line, deprecated_alias, max_error_value, print_json
+from .common import (ascii_int, cli_flags, command_line, deprecated_alias, max_error_value,
+                     print_json)
 from .vocab import COEF_FORMATS as FORMATS, MAX_DEGREE
 
 
@@ -89,10 +90,11 @@ _NOT_AN_OPTION = re.compile(r"^-(?![-ho]|$)")
 def _int_list(text: str):
     """``14`` -> 14; ``1,3,5`` -> [1, 3, 5] (argparse type)."""
     try:
-        parts = [int(p) for p in text.split(",")]
-    except ValueError:
+        parts = [ascii_int(p) for p in text.split(",")]
+    except (ValueError, argparse.ArgumentTypeError):
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer or a comma-separated "
-                                         f"list of integers, e.g. 14 or 1,3,5") from None
+                                         f"list of integers in ASCII digits, e.g. 14 or "
+                                         f"1,3,5") from None
     return parts[0] if len(parts) == 1 and "," not in text else parts
 
 

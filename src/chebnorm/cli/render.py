@@ -3,6 +3,7 @@ error against a reference render (default: Phong, ``exact``, float64)."""
 
 from __future__ import annotations
 
+import os
 import time
 
 from .common import (ETA_THRESHOLD, Q_THRESHOLD, add_lighting_options, help_when_printed,
@@ -116,8 +117,6 @@ def parse_reference(text, shading):
 
 def _refuse_unused(args) -> None:
     """Options that do nothing with this --shading (or mesh) are refused, not ignored."""
-    import os
-
     from chebnorm.raster import MESH_NAMES
 
     if args.shading in ("gouraud", "split-gouraud"):
@@ -130,6 +129,29 @@ def _refuse_unused(args) -> None:
         refuse_unused(args, "with --shading split-gouraud", **{"--q": "q"})
     if os.fspath(args.mesh) not in MESH_NAMES:
         refuse_unused(args, f"to a generated mesh ({', '.join(MESH_NAMES)})", **{"--tess": "tess"})
+
+
+def _refuse_clobber(args) -> None:
+    """Refuse ``--out`` and ``--error-map`` naming one file (also through a symbolic
+    link or another spelling), and an output that is the ``--mesh`` file."""
+    from chebnorm.core.files import WriteError, refuse_inputs
+
+    if args.out and args.error_map and (
+            os.path.realpath(args.out) == os.path.realpath(args.error_map)
+            or _samefile(args.out, args.error_map)):
+        raise WriteError(f"--out {str(args.out)!r:.200} and --error-map "
+                         f"{str(args.error_map)!r:.200} are the same file; accepted: two "
+                         f"different files")
+    mesh_file = None if os.fspath(args.mesh) in MESH_NAMES else args.mesh
+    refuse_inputs({"--out": args.out or None, "--error-map": args.error_map or None},
+                  {"--mesh": mesh_file})
+
+
+def _samefile(a, b) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
 
 
 def run(args) -> int:
@@ -172,6 +194,7 @@ def run(args) -> int:
                 image_format(path)
             except ValueError as exc:
                 raise ValueError(f"{option}: {exc}") from None
+    _refuse_clobber(args)
     check_writable(p for p in (args.out, args.error_map) if p)  # before the renders, not after
     lighting = Lighting(shininess=args.shininess, half_vector=args.half_vector)
     mesh = get_mesh(args.mesh, args.tess, _crease_radians(args.crease_angle))

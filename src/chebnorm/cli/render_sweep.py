@@ -83,7 +83,7 @@ def parse_size(text: str) -> tuple[int, int]:
     """
     from chebnorm.raster.studies import MAX_SIZE
 
-    m = re.fullmatch(r"\s*(\d{1,6})\s*(?:[xX]\s*(\d{1,6})\s*)?", text)
+    m = re.fullmatch(r"\s*([0-9]{1,6})\s*(?:[xX]\s*([0-9]{1,6})\s*)?", text)
     w, h = (0, 0) if m is None else (int(m.group(1)), int(m.group(m.lastindex)))
     if not (1 <= w <= MAX_SIZE and 1 <= h <= MAX_SIZE):
         raise ValueError(f"size {text!r}: expected W or WxH, integers in [1, {MAX_SIZE}]")

@@ -53,6 +53,8 @@ def _inputs(text: str):
     if text == "all":
         return "all"
     try:
+        if not text.isascii():
+            raise ValueError
         return int(text)
     except ValueError:
         raise ValueError(f"--inputs {text[:40]!r} is not accepted; accepted: all, or a count "

@@ -567,6 +567,10 @@ def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
     return fmt, (k_lo, k_hi)
 
 
+#: the words of :func:`_stages`' refusal of more datapath bits than the exact sum has
+_PAST_EXACT = "exceed the exact sum's"
+
+
 def _stages(integers, fc, fa, fx, xs_lo, xs_hi, k_all_xs, rounding, variable=None, odd=False):
     """Size the Horner steps exactly by running them over all codes
     (``variable``: ``(v, fv, v_bits)`` of the Horner variable when it is not
@@ -805,16 +809,25 @@ def _design_horner(table, in_bits, out_bits, *, coef_bits, acc_bits, rounding, x
     v_info = (None, 0, 0, Fraction(0))
     for fy in candidates:
         fa = acc_bits if acc_bits is not None else max(fy + guard_bits, 1)
-        variable = None
-        if scheme == "shifted":
-            v_info = _shifted(xs_all, fx, fa, table.shift, xs_lo, xs_hi)
-            variable = v_info[0]
-        elif scheme != "monomial":
-            v_info = _square(xs_all, fx, fa, rounding, valid)
-            variable = v_info[0]
+        try:
+            variable = None
+            if scheme == "shifted":
+                v_info = _shifted(xs_all, fx, fa, table.shift, xs_lo, xs_hi)
+                variable = v_info[0]
+            elif scheme != "monomial":
+                v_info = _square(xs_all, fx, fa, rounding, valid)
+                variable = v_info[0]
+            if len(horner) > 1:
+                stages, top = _stages(horner, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding,
+                                      variable=variable, odd=scheme == "odd")
+        except ValueError as exc:
+            # an output of (almost) no span -- a constant -- starts fy at the most
+            # fractional bits, past the exact sum's (the message of _stages): try fewer
+            if acc_bits is not None or fy == candidates[-1] or \
+                    _PAST_EXACT not in str(exc):
+                raise
+            continue
         if len(horner) > 1:
-            stages, top = _stages(horner, fc, fa, fx, xs_lo, xs_hi, xs_all, rounding,
-                                  variable=variable, odd=scheme == "odd")
             top_frac = stages[-1].sum_frac_bits
         else:
             stages, top, top_frac = (), np.full(all_k.shape, integers[0], dtype=np.int64), fc

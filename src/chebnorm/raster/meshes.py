@@ -31,7 +31,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.methods import detmath
 
 __all__ = [
-    "Mesh", "MESH_NAMES", "MAX_FACES", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
+    "Mesh", "MESH_NAMES", "MAX_FACES", "MAX_COORDINATE", "MIN_EXTENT", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
     "teapot", "load_mesh", "crease_normals", "unit",
 ]
 
@@ -42,6 +42,14 @@ MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")
 AREA_RTOL = 1e-14
 #: vertex normals must have |n| within this of 1
 UNIT_ATOL = 1e-6
+#: the largest vertex coordinate accepted, in magnitude: normals and areas square
+#: lengths twice (``|(b - a) x (c - a)|**2`` is a fourth power of the coordinates),
+#: which stays finite in float64 below 2**255; 2**200 (about 1.6e60) leaves the
+#: renderer's camera and lighting room
+MAX_COORDINATE = 2.0 ** 200
+#: the smallest bounding-box extent accepted: the same fourth powers stay above
+#: float64's underflow (2**-1022) with the area tolerance's 1e-14 to spare
+MIN_EXTENT = 2.0 ** -200
 #: the most faces a mesh may have: a frame's triangle map is int32 (a GPU's primitive
 #: id is 32 bits too)
 MAX_FACES = 2**31 - 1
@@ -122,6 +130,7 @@ class Mesh:
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(f"mesh {name!r}: position {i} is not finite: {pos[i].tolist()}")
+        _check_scale(pos, f"mesh {name!r}")
         bad = ~np.isfinite(nrm).all(axis=1)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
@@ -166,6 +175,22 @@ class Mesh:
         """Centre of the bounding box and the radius of its bounding sphere."""
         lo, hi = self.positions.min(axis=0), self.positions.max(axis=0)
         return (lo + hi) / 2, float(np.linalg.norm(hi - lo) / 2)
+
+
+def _check_scale(pos: np.ndarray, what: str) -> None:
+    """Refuse finite positions whose squared areas would overflow or underflow
+    (:data:`MAX_COORDINATE`, :data:`MIN_EXTENT`), before any arithmetic on them."""
+    big = float(np.max(np.abs(pos)))
+    if big > MAX_COORDINATE:
+        i = int(np.flatnonzero(np.abs(pos).max(axis=1) == big)[0])
+        raise ValueError(f"{what}: vertex {i} has a coordinate of magnitude {big:.6g}; normals "
+                         f"and areas square lengths twice, which overflows float64; accepted: "
+                         f"coordinates up to 2^200 (about 1.6e60) in magnitude (scale the mesh)")
+    extent = float(np.max(pos.max(axis=0) - pos.min(axis=0)))
+    if len(pos) > 1 and extent < MIN_EXTENT:
+        raise ValueError(f"{what}: the vertices span only {extent:.6g}; normals and areas square "
+                         f"lengths twice, which underflows float64; accepted: a bounding box at "
+                         f"least 2^-200 (about 6.2e-61) across (scale the mesh)")
 
 
 def _degenerate_faces(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -719,6 +744,7 @@ def load_mesh(path, crease_angle: float | None = None) -> Mesh:
         raise ValueError(f"cannot read mesh file {path!r}: {exc}") from None
     if faces is None or len(faces) == 0:
         raise ValueError(f"mesh file {path!r} holds no triangles")
+    _check_scale(pos, f"mesh file {path!r}")
     bad = _degenerate_faces(pos, faces)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])

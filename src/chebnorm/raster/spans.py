@@ -211,7 +211,9 @@ def project(camera: Camera, points, width: int, height: int):
     pc = (np.asarray(points, float) - np.asarray(camera.eye, float)) @ frame.T
     w = -pc[..., 2]
     if (w <= 1e-9).any():
-        raise ValueError("the mesh reaches behind the camera; move the camera back")
+        raise ValueError("the mesh reaches behind the camera, or within 1e-9 of the plane "
+                         "through the eye (a mesh under about 1e-8 across, seen by the default "
+                         "camera); move the camera back, or scale the mesh up")
     f = 1.0 / math.tan(camera.fov_y / 2)
     aspect = width / height
     x_ndc = f / aspect * pc[..., 0] / w

@@ -94,7 +94,7 @@ def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
     src_bits : int
         Width of ``src``.
     shift : int
-        Bits to drop, ``>= 1``.
+        Bits to drop, ``>= 0``.
     dst_bits : int
         Width of ``dst`` (wide enough for the rounded value plus the increment).
     mode : {"trunc", "rne"}
@@ -105,8 +105,12 @@ def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
     list of str
         Verilog declaration lines, indented by four spaces.
     """
-    lines = [f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};"]
-    if mode == "trunc":
+    lines = []
+    if mode != "trunc" and shift + 1 > src_bits:   # the round bit lies above src: extend it
+        lines.append(f"    wire signed [{shift}:0] {dst}_x = {src};")
+        src, src_bits = f"{dst}_x", shift + 1
+    lines.append(f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};")
+    if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
         lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q;")
         return lines
     sticky = f"(|{src}[{shift - 2}:0]) | " if shift >= 2 else ""

@@ -92,8 +92,11 @@ class _Body:
 def _round(b: _Body, src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
            mode: str) -> None:
     """``dst = round(src / 2^shift)`` as in the Verilog :func:`~chebnorm.hw.hdl.verilog.round_lines`."""
+    if mode != "trunc" and shift + 1 > src_bits:   # the round bit lies above src: extend it
+        b.wire(f"{dst}_x", shift + 1, f"resize({src}, {shift + 1})")
+        src, src_bits = f"{dst}_x", shift + 1
     b.wire(f"{dst}_q", src_bits, f"shift_right({src}, {shift})")
-    if mode == "trunc":
+    if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
         b.wire(dst, dst_bits, f"wrap({dst}_q, {dst_bits})")
         return
     sticky = f"(or {src}({shift - 2} downto 0)) or " if shift >= 2 else ""

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from .base import Engine, FrameUnsupported
 from .numba import HAVE_NUMBA, NumbaEngine
+from .numba.jit import JIT_DISABLED
 from .numpy import NumpyEngine
 
 __all__ = ["ENGINES", "HAVE_NUMBA", "Engine", "FrameUnsupported", "resolve_engine",
@@ -20,7 +21,8 @@ _ENGINES = {"numpy": NumpyEngine(), "numba": NumbaEngine()}
 
 def resolve_engine(engine) -> str:
     """``"numpy"`` or ``"numba"``: what ``engine`` (``"auto"``, None, ``"numpy"``,
-    ``"numba"``) means here; ``"numba"`` without numba installed is an error.
+    ``"numba"``) means here; ``"numba"`` without numba installed (or with
+    ``NUMBA_DISABLE_JIT=1``) is an error.
 
     Parameters
     ----------
@@ -35,7 +37,8 @@ def resolve_engine(engine) -> str:
     Raises
     ------
     ValueError
-        For another name, or ``"numba"`` without numba installed.
+        For another name, or ``"numba"`` without numba installed or with its compiler
+        turned off (``NUMBA_DISABLE_JIT=1``).
 
     Examples
     --------
@@ -48,6 +51,9 @@ def resolve_engine(engine) -> str:
         raise ValueError(f"unknown engine {engine!r}; accepted: {', '.join(ENGINES)}")
     if engine == "auto":
         return "numba" if HAVE_NUMBA else "numpy"
+    if engine == "numba" and JIT_DISABLED:
+        raise ValueError("engine 'numba' needs numba's compiler, which NUMBA_DISABLE_JIT turns "
+                         "off; accepted with it: auto, numpy")
     if engine == "numba" and not HAVE_NUMBA:
         raise ValueError("engine 'numba' needs the numba package (pip install numba); "
                          "accepted without it: auto, numpy")

@@ -7,8 +7,9 @@ thread pool of the process.
 Every compiled function of :mod:`chebnorm.raster.engines.numba` is made by :func:`njit`:
 cached, ``nogil``, no ``fastmath`` (every float operation is the numpy reference's, in
 its order and dtype; LLVM does not contract a multiply-add into an FMA without
-fast-math flags).  Without numba (:data:`HAVE_NUMBA` False) :func:`njit` returns the
-Python function and the engine is not offered (:func:`chebnorm.raster.engines.get_engine`).
+fast-math flags).  Without numba, or with its compiler turned off (``NUMBA_DISABLE_JIT=1``:
+:data:`HAVE_NUMBA` False), :func:`njit` returns the Python function and the engine is not
+offered (:func:`chebnorm.raster.engines.get_engine`).
 """
 
 from __future__ import annotations
@@ -23,16 +24,21 @@ try:  # pragma: no cover - exercised by whichever environment runs the tests
     from llvmlite import ir as _ir
     from numba.core import types as _types
     from numba.core.extending import intrinsic as _intrinsic
-    #: whether numba is installed (else every function here runs as plain Python)
-    HAVE_NUMBA = True
+    #: whether numba's compiler is off (``NUMBA_DISABLE_JIT=1``): its intrinsics cannot
+    #: run as Python, so the engine is then not offered, as without numba
+    JIT_DISABLED = bool(numba.config.DISABLE_JIT)
+    #: whether numba is installed and compiles (else every function here runs as plain
+    #: Python and ``render`` uses the numpy engine)
+    HAVE_NUMBA = not JIT_DISABLED
     #: numba's ``objmode`` (a block of compiled code run by the interpreter, under the GIL)
     objmode = numba.objmode
 except ImportError:  # pragma: no cover
     numba = None
+    JIT_DISABLED = False
     HAVE_NUMBA = False
     objmode = None
 
-__all__ = ["HAVE_NUMBA", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "prefetch",
+__all__ = ["HAVE_NUMBA", "JIT_DISABLED", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "prefetch",
            "stream16",
            "store_fence", "threads", "pool",
            "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
