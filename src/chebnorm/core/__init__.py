@@ -17,6 +17,7 @@
 This stage imports no other stage of chebnorm.
 """
 
-from . import clib, detlinalg, files, numeric, parallel, textsafe
+from . import clib, deprecation, detlinalg, files, numeric, parallel, progress, textsafe, tools
 
-__all__ = ["clib", "detlinalg", "files", "numeric", "parallel", "textsafe"]
+__all__ = ["clib", "deprecation", "detlinalg", "files", "numeric", "parallel", "progress", "textsafe",
+           "tools"]
