@@ -89,3 +89,12 @@ def test_methods_angle_near_pi_is_refused_naming_the_flag():
     code, out, err = run_cli_quiet("methods", "--angle", "3.14159265358979", "--span", "8")
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and "--angle" in err and "0 <= PSI <= 3.14" in err
+
+
+def test_a_top_level_usage_error_names_the_program_once():
+    from quiet_cli import run_cli_quiet
+
+    code, out, err = run_cli_quiet("targets", "--bogus")   # an unknown option, top level
+    assert code == 2 and err.count("chebnorm:") == 1 and "--bogus" in err, err
+    code, out, err = run_cli_quiet("fit", "x", "--interval", "0", "1", "--degree", "1", "--bogus")
+    assert code == 2 and err.startswith("chebnorm: error:") and "--bogus" in err

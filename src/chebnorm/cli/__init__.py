@@ -38,7 +38,8 @@ class _Parser(argparse.ArgumentParser):
         self.register("type", float, ascii_float)
 
     def error(self, message):  # argparse's own errors: one line, status 2
-        raise UsageError(f"{self.prog}: {message}")
+        # "chebnorm: error: " already starts the line: name a subcommand, not the program
+        raise UsageError(message if self.prog == "chebnorm" else f"{self.prog}: {message}")
 
 
 def build_parser() -> argparse.ArgumentParser:
