@@ -55,6 +55,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from dataclasses import dataclass
@@ -357,6 +358,14 @@ def choose(fn_np, lo: float, hi: float, candidates) -> tuple[BasisChoice, str]:
     return BasisChoice(basis, reason, floor, estimates), note
 
 
+@functools.lru_cache(maxsize=256)
+def _stored_estimate(coefficients: tuple, shift, interval_float: tuple) -> float:
+    """:func:`rounding_estimate` of stored coefficients at the interval's
+    sample points (kept: every table built from another by
+    ``dataclasses.replace`` checks the same choice again)."""
+    return rounding_estimate(coefficients, sample_points(*interval_float), shift)
+
+
 def read_basis_choice(value, basis: str, coefficients, shift, interval_float):
     """The ``basis_choice`` field of a table file, checked: its numbers, the
     rule's verdict on them, the table's basis, and the chosen basis's
@@ -414,8 +423,8 @@ def read_basis_choice(value, basis: str, coefficients, shift, interval_float):
     if chosen not in estimates or out.expected() != chosen:
         raise ValueError(f"basis_choice.basis: {chosen!r} is not what the rule picks from "
                          f"basis_choice.estimates and basis_choice.floor")
-    x = sample_points(*interval_float)
-    again = rounding_estimate(coefficients, x, shift)
+    again = _stored_estimate(tuple(coefficients), None if shift is None else tuple(shift),
+                             tuple(interval_float))
     if abs(again - estimates[chosen]["rounding"]) > _AGREE * max(again, 1e-300):
         raise ValueError(f"basis_choice.estimates.{chosen}.rounding: stated "
                          f"{estimates[chosen]['rounding']!r}, but the stored coefficients give "
