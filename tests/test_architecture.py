@@ -201,7 +201,9 @@ def layer_violations(repo) -> list[str]:
         parts = ["chebnorm", *rel.parent.parts]
         where = f"chebnorm/{rel.as_posix()}"
         if len(rel.parts) == 1:
-            stage = {"__init__.py": "<root>", "__main__.py": "<main>"}.get(rel.name)
+            # a module at the root is a stage when LAYERS names it (chebnorm/exceptions.py)
+            stage = {"__init__.py": "<root>", "__main__.py": "<main>"}.get(
+                rel.name, rel.stem if rel.stem in layers else None)
             if stage is None:
                 bad.append(f"{where}: a module at the package root outside LAYERS")
                 continue
@@ -258,8 +260,10 @@ def layer_violations(repo) -> list[str]:
 
 def test_layers_is_the_package_constant():
     assert read_layers(PACKAGE) == chebnorm.LAYERS
-    stages = sorted(p.name for p in PACKAGE.iterdir()
-                    if p.is_dir() and (p / "__init__.py").exists())
+    stages = sorted([p.name for p in PACKAGE.iterdir()
+                     if p.is_dir() and (p / "__init__.py").exists()]
+                    + [p.stem for p in PACKAGE.glob("*.py")
+                       if p.name not in ("__init__.py", "__main__.py")])
     assert stages == sorted(chebnorm.LAYERS)
     for stage, allowed in chebnorm.LAYERS.items():  # a DAG: no stage allows itself or a cycle
         assert stage not in allowed
@@ -270,9 +274,17 @@ def test_layers_is_the_package_constant():
 def test_docstring_names_the_allowed_imports():
     doc = chebnorm.__doc__
     assert "imports core, symbolic, approx and methods (not hw, not export)" in doc
-    assert chebnorm.LAYERS["raster"] == ("core", "symbolic", "approx", "methods")
+    assert chebnorm.LAYERS["raster"] == ("exceptions", "core", "symbolic", "approx", "methods")
     assert "imports core, symbolic, approx, hw" in doc
-    assert chebnorm.LAYERS["export"] == ("core", "symbolic", "approx", "hw")
+    assert chebnorm.LAYERS["export"] == ("exceptions", "core", "symbolic", "approx", "hw")
+    assert "the floor every stage" in doc and "imports nothing of chebnorm" in doc
+
+
+def test_exceptions_is_the_floor():
+    """chebnorm.exceptions may be imported by every stage and imports no stage."""
+    assert chebnorm.LAYERS["exceptions"] == ()
+    for stage, allowed in chebnorm.LAYERS.items():
+        assert stage == "exceptions" or "exceptions" in allowed, stage
 
 
 def test_tree_obeys_the_layer_rule():
@@ -348,6 +360,10 @@ INJECTIONS = [
     ("benchmarks/bench_fit.py", "import importlib\nm = importlib.import_module('chebnorm.hw._x')",
      "chebnorm.hw._x"),
     ("src/chebnorm/newstage/__init__.py", "x = 1", "stage 'newstage' is not declared"),
+    ("src/chebnorm/exceptions.py", "from chebnorm.core import tools", "chebnorm.core.tools"),
+    ("src/chebnorm/exceptions.py", "def f():\n    from .core.files import write_atomic\n",
+     "stage 'exceptions' may import only no stage"),
+    ("src/chebnorm/helpers.py", "x = 1", "a module at the package root outside LAYERS"),
 ]
 
 
@@ -405,8 +421,8 @@ def __getattr__(name):
         assert layer_violations(tree) != []
         init = "src/chebnorm/__init__.py"
         text = tree.read(init)
-        old = '"raster": ("core", "symbolic", "approx", "methods"),'
+        old = '"raster": ("exceptions", "core", "symbolic", "approx", "methods"),'
         assert old in text
         widened = Tree(pristine, {**tree.overlay, init: text.replace(
-            old, '"raster": ("core", "symbolic", "approx", "methods", "hw"),')})
+            old, '"raster": ("exceptions", "core", "symbolic", "approx", "methods", "hw"),')})
         assert layer_violations(widened) == []

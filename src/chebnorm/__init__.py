@@ -20,10 +20,13 @@ The package is split by pipeline stage, and a stage imports only the stages
 ``importlib.import_module``/``__import__`` with a literal name, and attribute
 access such as ``chebnorm.raster.render`` after ``import chebnorm``):
 
-0. ``chebnorm.core``     -- the floor every stage may import: atomic
-   files, the ordered parallel map, safe text for generated sources, the
-   C-library math and fixed-order linear algebra that keep outputs
-   byte-identical, small numeric helpers written once.
+0. ``chebnorm.exceptions`` and ``chebnorm.core`` -- the floor every stage
+   may import. ``exceptions`` (a module) holds every public exception and
+   warning class and imports nothing of chebnorm; ``core`` imports only it:
+   atomic files, the ordered parallel map, safe text for generated sources,
+   the C-library math and fixed-order linear algebra that keep outputs
+   byte-identical, finding and running external tools, small numeric
+   helpers written once.
 1. ``chebnorm.symbolic`` -- sympy closed forms of the papers; imports core.
 2. ``chebnorm.approx``   -- targets, fitting (Chebyshev, Remez), certified
    error bounds, fixed-point quantization, the table contract.
@@ -41,7 +44,9 @@ contract both kinds of table share in ``approx/contract.py`` (read either
 with :func:`chebnorm.approx.load_table`); an output format in ``export/``
 (HDL text in ``hw/hdl/``); the Phong frame in ``raster/shading.py`` over
 the engines of ``raster/engines/`` (numpy, the reference; numba, compiled);
-a helper two stages need in ``core/``. Within the package the module graph
+a helper two stages need in ``core/``; a public exception or warning class
+in ``exceptions.py``; a run of an external tool through ``core/tools.py``
+(the only module that looks tools up or starts processes). Within the package the module graph
 has no import cycle and a ``_name`` never leaves its module
 (``tests/test_import_graph.py``).
 
@@ -82,7 +87,8 @@ from its stage (nothing is moved) and imported only when first used
 * ``cn.hw.report(table, in_bits, out_bits)``: the bit-accurate hardware
   report of a table (:mod:`chebnorm.hw`).
 * ``cn.symbolic``, ``cn.approx``, ``cn.export``, ``cn.methods``, ``cn.hw``,
-  ``cn.raster``: the stage subpackages themselves.
+  ``cn.raster``: the stage subpackages themselves; ``cn.exceptions``: every
+  exception and warning class (:mod:`chebnorm.exceptions`).
 
 >>> import chebnorm as cn
 >>> t = cn.fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z")
@@ -102,22 +108,24 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a bare checkout
     __version__ = "0.0.0+unknown"
 
-#: The layer rule: each stage of the package and the stages it may import
-#: (besides itself). Read by ``tests/test_architecture.py``; keep it a literal.
+#: The layer rule: each stage of the package (a subpackage, or a module at the
+#: root such as ``exceptions``) and the stages it may import (besides itself).
+#: Read by ``tests/test_architecture.py``; keep it a literal.
 LAYERS = {
-    "core": (),
-    "symbolic": ("core",),
-    "approx": ("core", "symbolic"),
-    "methods": ("core", "symbolic", "approx"),
-    "hw": ("core", "symbolic", "approx"),
-    "export": ("core", "symbolic", "approx", "hw"),
-    "raster": ("core", "symbolic", "approx", "methods"),
-    "cli": ("core", "symbolic", "approx", "methods", "hw", "export", "raster"),
+    "exceptions": (),
+    "core": ("exceptions",),
+    "symbolic": ("exceptions", "core"),
+    "approx": ("exceptions", "core", "symbolic"),
+    "methods": ("exceptions", "core", "symbolic", "approx"),
+    "hw": ("exceptions", "core", "symbolic", "approx"),
+    "export": ("exceptions", "core", "symbolic", "approx", "hw"),
+    "raster": ("exceptions", "core", "symbolic", "approx", "methods"),
+    "cli": ("exceptions", "core", "symbolic", "approx", "methods", "hw", "export", "raster"),
 }
 
 
 #: the stage subpackages, imported on first attribute access
-_SUBPACKAGES = ("core", "symbolic", "approx", "export", "methods", "hw", "raster")
+_SUBPACKAGES = ("exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster")
 
 #: facade name -> (module, attribute); imported on first use
 _LAZY = {
@@ -129,8 +137,8 @@ _LAZY = {
     "FixedPoint": ("chebnorm.approx", "FixedPoint"),
     "PiecewiseTable": ("chebnorm.approx", "PiecewiseTable"),
     "load_table": ("chebnorm.approx", "load_table"),
-    "FitWarning": ("chebnorm.approx", "FitWarning"),
-    "ChebnormDeprecationWarning": ("chebnorm.core.deprecation", "ChebnormDeprecationWarning"),
+    "FitWarning": ("chebnorm.exceptions", "FitWarning"),
+    "ChebnormDeprecationWarning": ("chebnorm.exceptions", "ChebnormDeprecationWarning"),
     "target": ("chebnorm.approx", "get_target"),
     "target_names": ("chebnorm.approx", "target_names"),
     "span_normals": ("chebnorm.methods", "span_normals"),
@@ -144,7 +152,7 @@ __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
     "PiecewiseTable", "load_table",
     "FitWarning", "ChebnormDeprecationWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
-    "core", "symbolic", "approx", "export", "methods", "hw", "raster",
+    "exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}
 

@@ -21,18 +21,10 @@ from .fitting import (chebyshev_interpolant, cheb_to_monomial, minimax_powers, p
 from .contract import construction
 from .schema import BASES, ERROR_KINDS, KINDS, MAX_DEGREE, versions
 from .table import CoefficientTable, FixedPoint, Quantized
+from chebnorm.exceptions import FitWarning
 
 __all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
            "FitWarning", "degree_lower_bounds"]
-
-
-class FitWarning(UserWarning):
-    """A fit or a quantization that is not what it claims to be: the Remez
-    exchange did not converge, a minimax fit's error exceeds that of a
-    simpler polynomial, or a certified bound missed its tightness. The same
-    text is recorded in the table's ``provenance["warnings"]``
-    (:func:`warnings_of`); ``chebnorm fit`` prints it as
-    ``chebnorm: warning: ...``."""
 
 
 def _warn(notes) -> None:

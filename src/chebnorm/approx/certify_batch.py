@@ -77,6 +77,8 @@ import sympy as sp
 from flint import arb, arb_series, ctx
 
 from chebnorm.core import detlinalg
+from chebnorm.core.numeric import arb_precision
+from chebnorm.exceptions import SegmentError
 from .certify import TOL, Certificate, arb_enclose, certify
 from .expr import Function1D
 
@@ -229,24 +231,16 @@ def certify_batch(fn: Function1D, origins: Sequence, widths: Sequence,
     coeffs = [[float(c) for c in cs] or [0.0] for cs in coefficients]
     if any(not math.isfinite(c) for cs in coeffs for c in cs):
         raise ValueError("coefficients: accepted: finite floats")
-    old, old_cap = ctx.prec, ctx.cap
+    old_cap = ctx.cap
     try:
-        ctx.prec = 128
-        # series of the highest order tried (python-flint truncates at ctx.cap terms)
-        ctx.cap = max(old_cap, max(map(len, coeffs), default=1) + EXTRA_ORDERS[-1] + 2)
-        o = [_ball(v) for v in origins]
-        w = [_ball(v) for v in widths]
-        return _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, float(tol))
+        with arb_precision(128):
+            # series of the highest order tried (python-flint truncates at ctx.cap terms)
+            ctx.cap = max(old_cap, max(map(len, coeffs), default=1) + EXTRA_ORDERS[-1] + 2)
+            o = [_ball(v) for v in origins]
+            w = [_ball(v) for v in widths]
+            return _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, float(tol))
     finally:
-        ctx.prec, ctx.cap = old, old_cap
-
-
-class SegmentError(ValueError):
-    """``g_s`` cannot be certified on segment ``segment`` (the message says why)."""
-
-    def __init__(self, segment: int, message: str):
-        super().__init__(message)
-        self.segment = segment
+        ctx.cap = old_cap
 
 
 def _run(fn, o, w, coeffs, t0, rho, l0, l1, kind, tol) -> list[Certificate]:

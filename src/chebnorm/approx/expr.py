@@ -64,6 +64,7 @@ from sympy.printing.numpy import SciPyPrinter
 
 from chebnorm.core import clib
 from chebnorm.core.numeric import arb_precision
+from chebnorm.exceptions import UndefinedError
 
 __all__ = ["Function1D", "AccurateFunction1D", "UndefinedError", "parse_function",
            "parse_number", "read_expression", "FUNCTIONS",
@@ -702,20 +703,6 @@ class _CLibraryPrinter(SciPyPrinter):
 for _name in clib.FUNCTIONS:
     setattr(_CLibraryPrinter, f"_print_{_name}", _CLibraryPrinter._print_clib_function)
 del _name
-
-
-class UndefinedError(ValueError, ZeroDivisionError):
-    """The function has no value at a point (a ValueError for callers, and
-    still a ZeroDivisionError for code that catches that).
-
-    Examples
-    --------
-    >>> import mpmath
-    >>> parse_function("exp(-1/x**2)").mpmath(mpmath.mpf(0))
-    Traceback (most recent call last):
-    ...
-    chebnorm.approx.expr.UndefinedError: exp(-1/x**2) is undefined at x = 0.0 (a division by zero); accepted: ...
-    """
 
 
 @dataclass(frozen=True)

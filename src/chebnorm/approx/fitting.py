@@ -13,10 +13,11 @@ from typing import Callable
 
 import mpmath
 import numpy as np
-from flint import arb, arb_mat, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
+from flint import arb, arb_mat, arb_poly, fmpq, fmpq_poly, fmpz_poly
 from numpy.polynomial import chebyshev as C
 
 from chebnorm.core import clib, detlinalg
+from chebnorm.core.numeric import arb_precision
 
 __all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
            "polish", "minimax_powers", "PowersFit"]
@@ -517,23 +518,20 @@ def _solve(rows: list, rhs: list, dps: int) -> list:
     exactly as mpmath numbers (mpmath's pure-Python ``lu_solve`` where Arb
     finds the system singular). Like mpmath's, not a rigorous enclosure:
     the coefficients are certified afterwards."""
-    old = ctx.prec
-    try:
-        ctx.prec = math.ceil(dps * math.log2(10)) + 16
-        a = arb_mat([[_to_arb(v) for v in row] for row in rows])
-        b = arb_mat([[_to_arb(v)] for v in rhs])
-        x = a.solve(b, algorithm="approx")
-        out = []
-        for k in range(len(rhs)):
-            man, exp = x[k, 0].mid().man_exp()
-            out.append(mpmath.mpf((int(man), int(exp))))
-        return out
-    except ZeroDivisionError:
-        with mpmath.workdps(dps):
-            sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
-            return [sol[k] for k in range(len(rhs))]
-    finally:
-        ctx.prec = old
+    with arb_precision(math.ceil(dps * math.log2(10)) + 16):
+        try:
+            a = arb_mat([[_to_arb(v) for v in row] for row in rows])
+            b = arb_mat([[_to_arb(v)] for v in rhs])
+            x = a.solve(b, algorithm="approx")
+            out = []
+            for k in range(len(rhs)):
+                man, exp = x[k, 0].mid().man_exp()
+                out.append(mpmath.mpf((int(man), int(exp))))
+            return out
+        except ZeroDivisionError:
+            with mpmath.workdps(dps):
+                sol = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
+                return [sol[k] for k in range(len(rhs))]
 
 
 def _to_arb(v) -> arb:
@@ -682,9 +680,7 @@ class _Residual:
         return w, g
 
     def _exact(self, x: np.ndarray) -> np.ndarray:
-        old = ctx.prec
-        try:
-            ctx.prec = 200
+        with arb_precision(200):
             total = self.poly
             for k, c in self.fixed.items():
                 total += exact_rational(c) * fmpq_poly([0] * k + [1])
@@ -698,8 +694,6 @@ class _Residual:
                 except (ValueError, ZeroDivisionError):
                     out[i] = math.nan
             return out
-        finally:
-            ctx.prec = old
 
 
 def minimax_powers(fn, lo: float, hi: float, degree: int, powers, fixed: dict | None = None,

@@ -723,15 +723,13 @@ def _error_at(prob: Problem, points, coeffs) -> float:
     interval): its largest value at ``points`` (inside the interval), in ball
     arithmetic at 128 bits (no float evaluation allowance, which at a
     near-minimax binary64 error is larger than the candidates' differences)."""
-    from flint import arb, ctx
+    from flint import arb
 
-    from chebnorm.core.numeric import ball_float_down
+    from chebnorm.core.numeric import arb_precision, ball_float_down
 
     from .certify import error_function
 
-    old = ctx.prec
-    try:
-        ctx.prec = 128
+    with arb_precision(128):
         g = error_function(prob.fn.arb, [arb(c) for c in coeffs], prob.error_kind)
         best = arb(0)
         for x in points:
@@ -739,8 +737,6 @@ def _error_at(prob: Problem, points, coeffs) -> float:
             if v.is_finite():
                 best = best.max(v.lower())
         return max(ball_float_down(best), 0.0)
-    finally:
-        ctx.prec = old
 
 
 def _peaks(prob: Problem, sampler: _Sampler, coeffs, zooms: int = 2) -> list[float]:
@@ -858,7 +854,9 @@ def _grid_lower_bounds(prob: Problem, fracs):
     dist(u_k . g, q Z) / sum_i |u_ki| / w_i`` -- in ball arithmetic. The
     grids are nested (fewer bits: a subset), so a bound at a level also holds
     at every coarser one (the caller keeps the largest)."""
-    from flint import arb, arb_mat, ctx
+    from flint import arb, arb_mat
+
+    from chebnorm.core.numeric import arb_precision
 
     def nothing(level):
         return 0.0
@@ -868,56 +866,51 @@ def _grid_lower_bounds(prob: Problem, fracs):
     pts = [float(v) for v in chebyshev_nodes(lo, prob.hi_f, n)]
     if n == 0 or not all(prob.lo_f < v < prob.hi_f for v in pts) or len(set(pts)) < n:
         return nothing
-    old = ctx.prec
     try:
-        ctx.prec = 128
-        xs = [arb(v) for v in pts]
-        fx = [prob.fn.arb(x) for x in xs]
-        g = [f - sum((arb(m) * arb(2) ** e * x ** k for k, (m, e) in prob.fixed.items()),
-                     arb(0)) for f, x in zip(fx, xs)]
-        inv = arb_mat([[x ** e for e in prob.powers] for x in xs]).inv()
-        scale = [abs(f) if prob.error_kind == "rel" else arb(1) for f in fx]
-        if not all(v.is_finite() for v in g + scale) or (
-                prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
-            return nothing
-        # dual rows D_k = 2^f_k u_k: at level l the integers are 2^-l D_k . (g - e/w);
-        # any integer combination a of them is an integer too, so every row of
-        # LLL's transform of D (short combinations: small norms) gives a bound
-        dual = [[inv[k, i] * arb(2) ** fracs[power] for i in range(n)]
-                for k, power in enumerate(prob.powers)]
-        combos = [[int(j == k) for j in range(n)] for k in range(n)]
-        combos += _short_combinations([[float((d * sc).mid()) for d, sc in zip(row, scale)]
-                                       for row in dual])
-        rows = []
-        for a in combos:
-            u = [sum((a[k] * dual[k][i] for k in range(n) if a[k]), arb(0)) for i in range(n)]
-            v = sum((u[i] * g[i] for i in range(n)), arb(0))
-            norm = sum((abs(u[i]) * scale[i] for i in range(n)), arb(0)).upper()
-            if v.is_finite() and norm.is_finite() and norm > 0:
-                rows.append((v, norm))
+        with arb_precision(128):
+            xs = [arb(v) for v in pts]
+            fx = [prob.fn.arb(x) for x in xs]
+            g = [f - sum((arb(m) * arb(2) ** e * x ** k for k, (m, e) in prob.fixed.items()),
+                         arb(0)) for f, x in zip(fx, xs)]
+            inv = arb_mat([[x ** e for e in prob.powers] for x in xs]).inv()
+            scale = [abs(f) if prob.error_kind == "rel" else arb(1) for f in fx]
+            if not all(v.is_finite() for v in g + scale) or (
+                    prob.error_kind == "rel" and any(f.contains(0) for f in fx)):
+                return nothing
+            # dual rows D_k = 2^f_k u_k: at level l the integers are 2^-l D_k . (g - e/w);
+            # any integer combination a of them is an integer too, so every row of
+            # LLL's transform of D (short combinations: small norms) gives a bound
+            dual = [[inv[k, i] * arb(2) ** fracs[power] for i in range(n)]
+                    for k, power in enumerate(prob.powers)]
+            combos = [[int(j == k) for j in range(n)] for k in range(n)]
+            combos += _short_combinations([[float((d * sc).mid()) for d, sc in zip(row, scale)]
+                                           for row in dual])
+            rows = []
+            for a in combos:
+                u = [sum((a[k] * dual[k][i] for k in range(n) if a[k]), arb(0)) for i in range(n)]
+                v = sum((u[i] * g[i] for i in range(n)), arb(0))
+                norm = sum((abs(u[i]) * scale[i] for i in range(n)), arb(0)).upper()
+                if v.is_finite() and norm.is_finite() and norm > 0:
+                    rows.append((v, norm))
     except (ValueError, ZeroDivisionError, ArithmeticError):
         return nothing
-    finally:
-        ctx.prec = old
 
     def at(level: int) -> float:
-        old = ctx.prec
+        # a closure called later: it sets the precision itself
         try:
-            ctx.prec = 128
-            best = 0.0
-            step = arb(2) ** level
-            for v, norm in rows:
-                t = v / step
-                z = math.floor(float(t.mid()))
-                dist = min((abs(t - (z + d))).lower() for d in (-1, 0, 1, 2))
-                bound = step * dist / norm
-                if bound.is_finite() and bound > 0:
-                    best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
-            return best
+            with arb_precision(128):
+                best = 0.0
+                step = arb(2) ** level
+                for v, norm in rows:
+                    t = v / step
+                    z = math.floor(float(t.mid()))
+                    dist = min((abs(t - (z + d))).lower() for d in (-1, 0, 1, 2))
+                    bound = step * dist / norm
+                    if bound.is_finite() and bound > 0:
+                        best = max(best, float(bound.lower()) * (1 - 2.0 ** -40))
+                return best
         except (ValueError, ZeroDivisionError, ArithmeticError, OverflowError):
             return 0.0
-        finally:
-            ctx.prec = old
     return at
 
 

@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
 import tempfile
 from dataclasses import dataclass
 
 import sympy as sp
 
 from .expr import parse_function, parse_number
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool, which
 
 __all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "function_text",
            "interval_text", "FpminimaxCase", "fpminimax"]
@@ -28,9 +27,9 @@ def available() -> bool:
     Returns
     -------
     bool
-        Whether ``shutil.which`` finds ``sollya``.
+        Whether :func:`chebnorm.core.tools.which` finds ``sollya``.
     """
-    return shutil.which("sollya") is not None
+    return which("sollya") is not None
 
 
 @dataclass(frozen=True)
@@ -127,16 +126,15 @@ def interval_text(lo: str, hi: str) -> str:
 
 
 def _run(script: str, timeout: float = 600) -> str:
+    exe = require("sollya", "the cross-check with Sollya")
     with tempfile.NamedTemporaryFile("w", suffix=".sollya", delete=False) as fh:
         fh.write(script + "quit;\n")
         path = fh.name
     try:
-        proc = run_tool(["sollya", "--warnonstderr", path], tool="sollya", timeout=timeout)
+        proc = run_tool([exe, "--warnonstderr", path], tool="sollya", timeout=timeout, check=True)
     finally:
         import os
         os.unlink(path)
-    if proc.returncode != 0:
-        raise RuntimeError(f"sollya failed: {proc.stderr.strip()[:500]}")
     return proc.stdout
 
 
@@ -368,7 +366,7 @@ def fpminimax(cases, accuracy: float = 2.0 ** -20, timeout: float = 1200):
     ------
     RuntimeError
         When the Sollya process fails.
-    chebnorm.core.tools.ToolTimeout
+    chebnorm.exceptions.ToolTimeout
         When it runs longer than ``timeout`` (a ``ValueError``
         and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """

@@ -1090,13 +1090,13 @@ def check_maximum(field: str, stated: float, bound_field: str, bound: float, cer
 def _check_at(kind: str, stated: float, at: float, fn, t) -> None:
     """Refuse ``max_{kind}_error`` unless it is ``|g(max_{kind}_at)|`` (one ulp, and the
     enclosure's own width, allowed)."""
-    from flint import arb, ctx
+    from flint import arb
+
+    from chebnorm.core.numeric import arb_precision
 
     from .certify import PolyTaylor, error_function
 
-    old = ctx.prec
-    try:
-        ctx.prec = 128
+    with arb_precision(128):
         g = error_function(fn.arb, PolyTaylor([arb(c) for c in t.coefficients], t.shift), kind)
         v = abs(g(arb(at)))
         if not v.is_finite():
@@ -1108,8 +1108,6 @@ def _check_at(kind: str, stated: float, at: float, fn, t) -> None:
             s, u = _fmt2(stated, float(v.mid()))
             raise ValueError(f"max_{kind}_error: stated {s} but {g_text} at max_{kind}_at = "
                              f"{at!r} is {u}; accepted: the error at the stated point")
-    finally:
-        ctx.prec = old
 
 
 def _point_error(table: CoefficientTable, at: float, error: str) -> tuple[float, float]:

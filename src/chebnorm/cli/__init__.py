@@ -16,6 +16,8 @@ import os
 import sys
 import warnings
 
+from chebnorm.exceptions import UsageError
+
 from .common import ascii_float, ascii_int, command_flags
 
 __all__ = ["main", "build_parser", "UsageError"]
@@ -23,10 +25,6 @@ __all__ = ["main", "build_parser", "UsageError"]
 #: subcommand modules, in the order ``chebnorm --help`` lists them
 SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "render_sweep", "hw", "design",
                "repro", "verify")
-
-
-class UsageError(ValueError):
-    """A user error detected by the CLI itself."""
 
 
 class _Parser(argparse.ArgumentParser):

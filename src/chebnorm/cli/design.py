@@ -203,10 +203,11 @@ def _pipelined(args, design, frequency):
 
 def _verify_vhdl(d):
     """GHDL's verdict on the pipelined VHDL over every code (None without GHDL)."""
-    import shutil
     import tempfile
 
-    if shutil.which("ghdl") is None:
+    from chebnorm.core.tools import which
+
+    if which("ghdl") is None:
         return None
     from pathlib import Path
 
@@ -261,13 +262,13 @@ def _synth_both(args, name, target, accuracy, max_error):
     once it cannot beat the best score so far
     (:func:`chebnorm.hw.architectures.synthesize_with_search`).
     Returns ``(others, result)`` (``result`` None for a correctly rounded spec)."""
-    import shutil
     from concurrent.futures import ThreadPoolExecutor
 
+    from chebnorm.core.tools import which
     from chebnorm.hw.architectures import cheapest_candidates, synthesize_with_search
 
     built = _architectures(args, name, target, accuracy, max_error)
-    if accuracy == "correctly-rounded" or shutil.which("yosys") is None:
+    if accuracy == "correctly-rounded" or which("yosys") is None:
         others = _synth_others(args, built, target)   # yosys missing: its error, one line
         if accuracy == "correctly-rounded":
             return others, None

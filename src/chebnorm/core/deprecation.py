@@ -10,12 +10,9 @@ from __future__ import annotations
 
 import warnings
 
+from chebnorm.exceptions import ChebnormDeprecationWarning
+
 __all__ = ["ChebnormDeprecationWarning", "renamed"]
-
-
-class ChebnormDeprecationWarning(DeprecationWarning):
-    """An old spelling that still works in this release and goes in the next: the
-    message names the new one (``fit(frac_bits=)`` is ``fit(coef_frac_bits=)``)."""
 
 
 def renamed(old_value, new_value, old: str, new: str, func: str, *, stacklevel: int = 3):

@@ -24,7 +24,7 @@
 >>> write_atomic(folder, "x")
 Traceback (most recent call last):
 ...
-chebnorm.core.files.WriteError: cannot write '...': it is a directory
+chebnorm.exceptions.WriteError: cannot write '...': it is a directory
 """
 
 from __future__ import annotations
@@ -36,26 +36,10 @@ import stat
 import tempfile
 from pathlib import Path
 
+from chebnorm.exceptions import WriteError
+
 __all__ = ["write_atomic", "write_all", "write_folder", "make_folder", "check_writable",
            "refuse_inputs", "WriteError"]
-
-
-class WriteError(OSError, ValueError):
-    """A destination chebnorm cannot write: the message names the path the
-    caller gave (never a temporary file) and the reason. It is an ``OSError``
-    and a ``ValueError``, so the command line reports it as a user error
-    (exit status 2, one line).
-
-    Examples
-    --------
-    >>> import pathlib, tempfile
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     try:
-    ...         write_atomic(pathlib.Path(tmp) / "missing" / "t.txt", "x")
-    ...     except WriteError as exc:
-    ...         print(isinstance(exc, ValueError), isinstance(exc, OSError))
-    True True
-    """
 
 
 _REASONS = {
@@ -315,7 +299,7 @@ def check_writable(paths) -> None:
     >>> check_writable(["/proc/x.png"])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    chebnorm.core.files.WriteError: cannot write '/proc/x.png': cannot create a file in folder '/proc' ...
+    chebnorm.exceptions.WriteError: cannot write '/proc/x.png': cannot create a file in folder '/proc' ...
     """
     for path in paths:
         how, given, target = _plan(path)

@@ -1,12 +1,20 @@
-"""Running an external tool (gcc, sollya, gappa, iverilog, vvp, ghdl, yosys,
-nextpnr, glslangValidator) with a time limit.
+"""Finding and running an external tool (gcc, sollya, gappa, iverilog, vvp,
+ghdl, yosys, nextpnr, glslangValidator) with a time limit: the one module that
+looks tools up on ``PATH`` and starts processes.
+
+:func:`which` finds a tool (None when it is not installed); :func:`require`
+finds it or raises one :class:`~chebnorm.exceptions.ToolMissing` naming the
+tool and the Debian package that installs it.
 
 :func:`run_tool` is :func:`subprocess.run` with an argument list (never a
 shell), output captured as text, and a time limit; a tool that runs longer
-is stopped and reported as one :class:`ToolTimeout` naming the tool and the
-limit. ``ToolTimeout`` is a ``ValueError`` (the command line prints it as one
-line and exits with status 2, as for a tool that fails) and a
-``subprocess.TimeoutExpired`` (code that caught the latter still does).
+is stopped and reported as one :class:`~chebnorm.exceptions.ToolTimeout`
+naming the tool and the limit; with ``check=True`` a non-zero exit status is
+raised as one :class:`~chebnorm.exceptions.ToolFailed` (the tool, the status,
+the end of its standard error). ``ToolTimeout`` is a ``ValueError`` (the
+command line prints it as one line and exits with status 2, as for a tool
+that fails) and a ``subprocess.TimeoutExpired`` (code that caught the latter
+still does). The three classes live in :mod:`chebnorm.exceptions`.
 
 >>> import sys
 >>> run_tool([sys.executable, "-c", "print(6 * 7)"], tool="python", timeout=60).stdout
@@ -14,55 +22,101 @@ line and exits with status 2, as for a tool that fails) and a
 >>> run_tool([sys.executable, "-c", "import time; time.sleep(5)"], tool="python", timeout=0.2)
 Traceback (most recent call last):
 ...
-chebnorm.core.tools.ToolTimeout: python did not finish within its time limit of 0.2 s; ...
+chebnorm.exceptions.ToolTimeout: python did not finish within its time limit of 0.2 s; ...
 """
 
 from __future__ import annotations
 
 import contextlib
 import multiprocessing
+import shutil
 import subprocess
+
+from chebnorm.exceptions import ToolFailed, ToolMissing, ToolTimeout
 
 from .progress import progress_bar
 
-__all__ = ["run_tool", "ToolTimeout"]
+__all__ = ["run_tool", "which", "require", "ToolTimeout", "ToolMissing", "ToolFailed",
+           "DEBIAN_PACKAGES"]
+
+#: the Debian package that installs each tool chebnorm runs (:func:`require`'s message)
+DEBIAN_PACKAGES = {
+    "gcc": "gcc", "clang": "clang", "sollya": "sollya", "gappa": "gappa",
+    "iverilog": "iverilog", "vvp": "iverilog", "ghdl": "ghdl", "yosys": "yosys",
+    "nextpnr-ice40": "nextpnr-ice40", "icepack": "fpga-icestorm",
+    "glslangValidator": "glslang-tools",
+}
 
 
-class ToolTimeout(subprocess.TimeoutExpired, ValueError):
-    """An external tool stopped at its time limit: the message names the tool
-    and the limit (one line).
+def which(name: str) -> str | None:
+    """The path of the executable ``name`` on ``PATH``, or None when it is not
+    installed (the one look-up of a tool in chebnorm).
 
     Parameters
     ----------
-    tool : str
-        The tool's name as the user knows it (``"gappa"``, ``"ghdl -r"``).
-    cmd : list of str
-        The argument list that ran.
-    timeout : float
-        The limit, in seconds.
+    name : str
+        The executable's name (``"gcc"``, ``"yosys"``).
+
+    Returns
+    -------
+    str or None
+        Its full path, or None.
 
     Examples
     --------
-    >>> str(ToolTimeout("gappa", ["gappa"], 60))[:52]
-    'gappa did not finish within its time limit of 60 s; '
-    >>> isinstance(ToolTimeout("gappa", ["gappa"], 60), ValueError)
+    >>> which("no-such-tool-chebnorm") is None
     True
     """
-
-    def __init__(self, tool: str, cmd, timeout: float):
-        super().__init__(cmd, timeout)
-        self.tool = tool
-
-    def __str__(self) -> str:
-        return (f"{self.tool} did not finish within its time limit of {self.timeout:g} s; "
-                f"accepted: a smaller problem, or a larger timeout where the function "
-                f"takes one")
+    if not isinstance(name, str) or not name or "/" in name or "\\" in name:
+        raise ValueError(f"name = {str(name)[:60]!r} is not a tool name; accepted: an executable's "
+                         f"name without a folder (gcc, yosys)")
+    return shutil.which(name)
 
 
-def run_tool(argv, *, tool: str, timeout: float, **kwargs) -> subprocess.CompletedProcess:
+def require(name: str, why: str = "") -> str:
+    """The path of the executable ``name``, or :class:`~chebnorm.exceptions.ToolMissing`
+    (one line naming the tool, what needs it and the Debian package to install).
+
+    Parameters
+    ----------
+    name : str
+        The executable's name.
+    why : str, optional
+        What needs it (``"the VHDL simulation"``), put in the message.
+
+    Returns
+    -------
+    str
+        Its full path.
+
+    Raises
+    ------
+    chebnorm.exceptions.ToolMissing
+        When ``name`` is not on ``PATH``.
+
+    Examples
+    --------
+    >>> require("no-such-tool-chebnorm", "a doctest")
+    Traceback (most recent call last):
+    ...
+    chebnorm.exceptions.ToolMissing: no-such-tool-chebnorm is not installed (needed for a doctest); accepted: install it (apt-get install no-such-tool-chebnorm)
+    """
+    exe = which(name)
+    if exe is None:
+        package = DEBIAN_PACKAGES.get(name, name)
+        need = f" (needed for {' '.join(str(why).split())})" if why else ""
+        raise ToolMissing(f"{name} is not installed{need}; accepted: install it "
+                          f"(apt-get install {package})")
+    return exe
+
+
+
+
+def run_tool(argv, *, tool: str, timeout: float, check: bool = False,
+             **kwargs) -> subprocess.CompletedProcess:
     """Run ``argv`` (a list: no shell) with output captured as text and stdin
     closed unless ``input`` is given; a run longer than ``timeout`` seconds is
-    stopped and raised as :class:`ToolTimeout`.
+    stopped and raised as :class:`~chebnorm.exceptions.ToolTimeout`.
 
     Parameters
     ----------
@@ -72,6 +126,9 @@ def run_tool(argv, *, tool: str, timeout: float, **kwargs) -> subprocess.Complet
         The tool's name for the message (``"gcc"``, ``"ghdl -a"``).
     timeout : float
         Seconds allowed (> 0).
+    check : bool, default False
+        Raise :class:`~chebnorm.exceptions.ToolFailed` when the exit status is
+        not 0 (else the caller judges it).
     **kwargs
         Further :func:`subprocess.run` arguments (``cwd``, ``env``, ``input``).
 
@@ -79,12 +136,14 @@ def run_tool(argv, *, tool: str, timeout: float, **kwargs) -> subprocess.Complet
     -------
     subprocess.CompletedProcess
         With ``stdout`` and ``stderr`` as text; the exit status is the
-        caller's to judge.
+        caller's to judge unless ``check``.
 
     Raises
     ------
-    ToolTimeout
+    chebnorm.exceptions.ToolTimeout
         When the tool runs longer than ``timeout``.
+    chebnorm.exceptions.ToolFailed
+        With ``check``, when the exit status is not 0.
 
     Examples
     --------
@@ -109,4 +168,6 @@ def run_tool(argv, *, tool: str, timeout: float, **kwargs) -> subprocess.Complet
             raise ToolTimeout(tool, exc.cmd, timeout) from None
         if bar is not None:
             bar.update(1)
+    if check and done.returncode != 0:
+        raise ToolFailed(tool, done.returncode, done.stderr)
     return done

@@ -20,7 +20,6 @@ interval, or ``2^20`` of them evenly spread when there are more.
 
 from __future__ import annotations
 
-import shutil
 import tempfile
 from pathlib import Path
 
@@ -28,9 +27,10 @@ import numpy as np
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import identifier
+from chebnorm.exceptions import ToolMissing
 
 from .shader import interval32, shader_source
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool
 
 __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
            "wgsl_evaluate", "gl_context", "compute_shader_source", "compute_shader_around",
@@ -40,16 +40,6 @@ __all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
 #: of :func:`glsl_runner`): ``2**20``.
 MAX_SAMPLES = 2 ** 20
 _GROUP = 64
-
-
-class ToolMissing(RuntimeError):
-    """An optional tool or driver is not available.
-
-    Examples
-    --------
-    >>> issubclass(ToolMissing, RuntimeError)
-    True
-    """
 
 
 def float32_inputs(table: CoefficientTable, max_samples: int = MAX_SAMPLES) -> np.ndarray:
@@ -228,7 +218,7 @@ def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
         entry point ``main``, compiled to SPIR-V).
     timeout : float, optional
         Seconds before the compiler is stopped
-        (:class:`chebnorm.core.tools.ToolTimeout`, a ``ValueError``).
+        (:class:`chebnorm.exceptions.ToolTimeout`, a ``ValueError``).
         Default 120.
 
     Returns
@@ -244,10 +234,7 @@ def glslang_validate(source: str, language: str, timeout: float = 120) -> str:
         When ``language`` is neither glsl nor hlsl, or the shader does not
         compile (the messages, up to 600 characters).
     """
-    exe = shutil.which("glslangValidator")
-    if exe is None:
-        raise ToolMissing("glslangValidator is not installed; accepted: apt-get install "
-                          "glslang-tools")
+    exe = require("glslangValidator", "the shader check")
     if language not in ("glsl", "hlsl"):
         raise ValueError(f"glslangValidator checks glsl or hlsl, not {language!r}")
     with tempfile.TemporaryDirectory() as tmp:

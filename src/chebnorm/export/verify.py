@@ -52,7 +52,6 @@ import ctypes
 import html
 import math
 import re
-import shutil
 import tempfile
 import time
 from dataclasses import asdict, dataclass, field
@@ -66,7 +65,8 @@ from chebnorm.approx.piecewise_table import PiecewiseTable
 from chebnorm.core.numeric import arb_precision, float_down, float_up, format_down, format_up
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.progress import progress_bar
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool, which
+from chebnorm.exceptions import ToolMissing
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 __all__ = ["verify", "VerifyResult", "VariantResult", "VERIFY_FORMATS", "VARIANTS",
@@ -591,9 +591,7 @@ class _CLibrary:
     returns -1 when the macro is not defined at the end of the header."""
 
     def __init__(self, header: str, evaluators, flags, tmp: Path, tag: str, macros=()):
-        gcc = shutil.which("gcc")
-        if gcc is None:
-            raise _Skip("gcc is not installed; accepted: apt-get install gcc")
+        gcc = require("gcc", "the C check")  # ToolMissing: the C variants are skipped
         base = [header, "#include <stddef.h>", "#include <stdio.h>"]
         for ret, name, arg in evaluators:
             base.append(f"void {name}_array(const {arg} *x, {ret} *y, ptrdiff_t n) "
@@ -664,6 +662,10 @@ class _Skip(Exception):
     """A variant that cannot run here (the reason in the message)."""
 
 
+#: a variant that cannot run here: the compiler refused it, or the compiler is missing
+_SKIPPED = (_Skip, ToolMissing)
+
+
 class _Unchecked(Exception):
     """A variant the text defines but whose stated bound or inputs cannot be
     read from the compiled object (the reason in the message): a failure."""
@@ -732,7 +734,7 @@ def c_evaluate(text: str, name: str, xs, *, fused: bool = False) -> np.ndarray:
 
 
 def _fused_note() -> str:
-    gcc = shutil.which("gcc")
+    gcc = which("gcc")
     if gcc is None:
         return ""
     proc = run_tool([gcc, "-march=native", "-dM", "-E", "-x", "c", "/dev/null"], tool="gcc",
@@ -848,10 +850,10 @@ def _run_c(plan, text, fn, macros, inputs_of) -> list[VariantResult]:
                 if not fused:
                     raise ValueError(f"source: the C text does not compile: {exc}") from None
                 libs[fused] = exc
-            except _Skip as exc:
+            except _SKIPPED as exc:
                 libs[fused] = exc
         base = libs[False]
-        values = {} if isinstance(base, _Skip) else _probe_all(base, macros)
+        values = {} if isinstance(base, _SKIPPED) else _probe_all(base, macros)
         fma = _fused_note() if any(p[5] for p in plan) else ""
         for p in plan:
             variant, ret, name, arg, bound_name, fused = p
@@ -859,7 +861,7 @@ def _run_c(plan, text, fn, macros, inputs_of) -> list[VariantResult]:
             stated = None
             try:
                 lib = libs[fused]
-                if isinstance(lib, _Skip):
+                if isinstance(lib, _SKIPPED):
                     raise lib
                 stated = float_down(_macro_value(_probe_all(lib, (bound_name,)), bound_name))
                 t0 = time.perf_counter()
@@ -867,7 +869,7 @@ def _run_c(plan, text, fn, macros, inputs_of) -> list[VariantResult]:
                 m, at, up, ref, _ = _run(fn, lib.evaluator(ret, name, arg), inputs, to_x,
                                          to_y, exact, what=f"{name} ({variant})")
                 sec = time.perf_counter() - t0  # inputs, evaluation and reference
-            except _Skip as exc:
+            except _SKIPPED as exc:
                 results.append(VariantResult("c", variant, name, bound_name, stated, None, None,
                                              None, None, 0, "", 0.0, skipped=str(exc)))
                 continue
@@ -933,7 +935,7 @@ _PROBE = {"glsl": ("float chebnorm_verify_probe(float i)\n{{\n    if (i < 0.5) r
 def _shader(table: CoefficientTable, fmt: str, text: str, spread) -> list[VariantResult]:
     from chebnorm.approx.expr import parse_function
 
-    from .gpu import ToolMissing, compute_shader_around, glslang_validate
+    from .gpu import compute_shader_around, glslang_validate
 
     name = identifier(table.name, field="table.name")
     cname, macro = f"chebnorm_{name}", f"CHEBNORM_{name.upper()}"
@@ -996,7 +998,7 @@ def _shader_constants(text: str, fmt: str, macro: str) -> tuple[float, float, fl
     """(LO, HI, EVAL_ERROR_BOUND) as the shader computes them: a probe
     function returning each is compiled with the text and run on the driver;
     a constant that is undefined or no float raises :class:`_Unchecked`."""
-    from .gpu import ToolMissing, compute_shader_around
+    from .gpu import compute_shader_around
 
     probe = _PROBE[fmt].format(lo=f"{macro}_LO", hi=f"{macro}_HI",
                                bound=f"{macro}_EVAL_ERROR_BOUND")
@@ -1028,7 +1030,7 @@ def _glsl(source):
 
 
 def _wgsl(source):
-    from .gpu import MAX_SAMPLES, ToolMissing
+    from .gpu import MAX_SAMPLES
 
     try:
         import wgpu

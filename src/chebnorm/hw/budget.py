@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -44,7 +43,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .fixed import rounding_error_bound
 from .horner import HornerDesign
 from .trust import verify_design
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import run_tool, which
 
 __all__ = ["ErrorBudget", "Measurement", "error_budget", "measure", "variable_error_bound",
            "gappa_script",
@@ -587,11 +586,11 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
     ------
     ValueError
         If gappa fails or gives no bound.
-    chebnorm.core.tools.ToolTimeout
+    chebnorm.exceptions.ToolTimeout
         If gappa runs longer than ``timeout`` (a ``ValueError``
         and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
-    exe = shutil.which("gappa")
+    exe = which("gappa")
     if exe is None:
         return None
     proc = run_tool([exe], tool="gappa", timeout=timeout, input=gappa_script(design))

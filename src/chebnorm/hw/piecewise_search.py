@@ -518,9 +518,9 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
                        max_error, tuple(points[k] for k in keys), winner, "model estimate",
                        {k: designs[k] for k in keys}, target)
     if synth and meeting:
-        import shutil
+        from chebnorm.core.tools import which
 
-        if shutil.which("yosys") is not None:
+        if which("yosys") is not None:
             res = synthesize_search(res, bound=bound, workers=workers, scheduler=scheduler,
                                     progress=progress)
     return res

@@ -39,6 +39,7 @@ from itertools import combinations
 from pathlib import Path
 
 from chebnorm.core.display import field_rows, summary_html, summary_repr
+from chebnorm.exceptions import FrequencyWarning
 
 from .hdl import hdl_files, module_text
 from .hdl.tables import table_cuts, table_files, table_module
@@ -52,14 +53,6 @@ __all__ = ["FrequencyWarning", "PipelineStep", "PipelineResult", "PipelinedTable
 STAGE_WEIGHTS = {"rom": 1.0, "mul": 2.0, "add": 1.0, "output": 0.5}
 #: nextpnr's timing-driven placement aims at most at this frequency (its range)
 MAX_PNR_MHZ = 1000.0
-
-
-class FrequencyWarning(UserWarning):
-    """The asked clock frequency was not reached (the highest reached is named).
-
-    >>> issubclass(FrequencyWarning, UserWarning)
-    True
-    """
 
 
 def check_frequency(value, name: str = "frequency") -> float:
@@ -535,10 +528,10 @@ def verify_pipelined(design, *, bench_design=None):
 
     Examples
     --------
-    >>> import shutil
+    >>> from chebnorm.core.tools import which
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> d = with_cuts(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
-    >>> if shutil.which("iverilog"):
+    >>> if which("iverilog"):
     ...     print(verify_pipelined(d).line)
     ...     print(verify_pipelined(d, bench_design=with_cuts(d, (0,))).passed)
     ... else:

@@ -263,11 +263,11 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_frac_b
         table.verify()  # a comparison, or a re-proof of fields changed since construction
     design = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, acc_bits=acc_bits,
                            rounding=rounding, x_frac_bits=x_frac_bits, y_frac_bits=y_frac_bits)
-    import shutil
-    budget = error_budget(design, gappa=gappa and shutil.which("gappa") is not None)
+    from chebnorm.core.tools import which
+    budget = error_budget(design, gappa=gappa and which("gappa") is not None)
     meas = measure(design)
     syn = None
-    if synth and shutil.which("yosys") is not None:
+    if synth and which("yosys") is not None:
         syn = synthesize_text(module_text(design), design.module_name)
     return HardwareReport(design, budget, meas, horner_block(design), syn)
 

@@ -10,13 +10,13 @@ intensity ``I <= 1`` whose normal is scaled by ``y`` instead of ``f``.
 from __future__ import annotations
 
 import io
-import shutil
 from dataclasses import dataclass
 
 from chebnorm.approx import fit_target, get_target
 from chebnorm.core.parallel import check_scheduler, check_workers, map_ordered
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.core.numeric import format_down, format_up
+from chebnorm.core.tools import which
 
 from .budget import error_budget, measure
 from .datapaths import horner_block
@@ -377,7 +377,7 @@ def sweep(target: str = "dichotomy", *, degrees=DEFAULT_DEGREES, coef_bits=DEFAU
                                min(max_coef_bits(t) for t in tables.values()))
     grid = [(d, c, a if d >= 2 else None) for d in degrees for c in coef_bits
             for a in (acc_bits if d >= 2 else (None,))]
-    use_yosys = synth and shutil.which("yosys") is not None
+    use_yosys = synth and which("yosys") is not None
     items = [(target, tables[d], d, c, a, in_bits, out_bits, rounding, use_yosys)
              for d, c, a in grid]
     points = map_ordered(_design_point, items, workers=workers, scheduler=scheduler,

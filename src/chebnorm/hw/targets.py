@@ -48,7 +48,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,7 +55,7 @@ from pathlib import Path
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .verilog import tool_env
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool
 
 __all__ = ["Target", "TargetCost", "TARGETS", "target_names", "get_target", "synthesize_target",
            "target_figures", "cost_from_types",
@@ -360,14 +359,6 @@ def _check_top(top) -> str:
     return top
 
 
-def _tool(name: str, package: str) -> str:
-    exe = shutil.which(name)
-    if exe is None:
-        raise ValueError(f"{name} is not installed (needed for this step); accepted: install "
-                         f"it (apt-get install {package})")
-    return exe
-
-
 def _run(argv: list[str], cwd: str, what: str, timeout: float) -> str:
     proc = run_tool(argv, tool=what, timeout=timeout, cwd=cwd, env=tool_env())
     if proc.returncode != 0:
@@ -377,7 +368,7 @@ def _run(argv: list[str], cwd: str, what: str, timeout: float) -> str:
 
 
 def _yosys(tmp: str, script: str, what: str, timeout: float) -> str:
-    return _run([_tool("yosys", "yosys"), "-p", script], tmp, f"yosys ({what})", timeout)
+    return _run([require("yosys", "this step"), "-p", script], tmp, f"yosys ({what})", timeout)
 
 
 def _stat(tmp: str, top: str) -> dict:
@@ -696,7 +687,7 @@ def fmax_ice40(verilog_text: str, top: str, *, clocked: bool = False, freq_mhz: 
     if pins > ICE40_IO:
         raise ValueError(f"module {top} needs {pins} I/O pins; accepted: at most {ICE40_IO} "
                          f"(iCE40 HX8K ct256)")
-    pnr = _tool("nextpnr-ice40", "nextpnr-ice40")
+    pnr = require("nextpnr-ice40", "this step")
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "design.v").write_text(verilog_text + "\n" + wrapper + "\n",
                                             encoding="utf-8")

@@ -9,11 +9,10 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool
 
 
 __all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_text", "tool_env"]
@@ -58,11 +57,7 @@ class SynthResult:
 
 
 def _need(tool: str) -> str:
-    exe = shutil.which(tool)
-    if exe is None:
-        raise ValueError(f"{tool} is not installed (needed for this step); accepted: "
-                         f"install it (apt-get install {'iverilog' if tool == 'iverilog' else tool})")
-    return exe
+    return require(tool, "this step")
 
 
 def tool_env() -> dict[str, str]:
@@ -116,7 +111,7 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
     ValueError
         If iverilog or vvp is not installed, a file cannot be read, iverilog fails, or
         the bench prints no PASS/FAIL line.
-    chebnorm.core.tools.ToolTimeout
+    chebnorm.exceptions.ToolTimeout
         If a step runs longer than ``timeout`` (a ``ValueError``
         and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """

@@ -9,13 +9,12 @@ every design and language, bit-identical to the Verilog).
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 from .hdl import hdl_files
 from .hdl.vhdl import VHDL_STD
 from .verilog import SimResult
-from chebnorm.core.tools import run_tool
+from chebnorm.core.tools import require, run_tool
 
 __all__ = ["simulate_vhdl", "vhdl_outputs"]
 
@@ -44,14 +43,11 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     ValueError
         If ghdl is not installed, a GHDL step fails, or the bench prints no PASS/FAIL
         line.
-    chebnorm.core.tools.ToolTimeout
+    chebnorm.exceptions.ToolTimeout
         If a step runs longer than ``timeout`` (a ``ValueError``
         and a ``subprocess.TimeoutExpired``; one line naming the tool and the limit).
     """
-    ghdl = shutil.which("ghdl")
-    if ghdl is None:
-        raise ValueError("ghdl is not installed (needed for this step); accepted: install it "
-                         "(apt-get install ghdl)")
+    ghdl = require("ghdl", "this step")
     d = Path(directory)
     name = design if isinstance(design, str) else design.module_name
     std = f"--std={VHDL_STD}"

@@ -3,11 +3,11 @@ files, report its cost."""
 
 from __future__ import annotations
 
-import shutil
 from dataclasses import dataclass
 
 from chebnorm.approx import CoefficientTable
 from chebnorm.core.display import field_rows, summary_html, summary_repr
+from chebnorm.core.tools import which
 
 from ..cost import Block
 from ..fixed import check_width
@@ -257,6 +257,6 @@ def analyze_unit(unit: UnitDesign, *, synth: bool = True) -> UnitReport:
     (6, 0)
     """
     syn = None
-    if synth and shutil.which("yosys") is not None:
+    if synth and which("yosys") is not None:
         syn = synthesize_text(unit_verilog(unit), unit.module_name)
     return UnitReport(unit, unit.block, syn)

@@ -22,6 +22,7 @@ from functools import lru_cache
 import numpy as np
 
 from chebnorm.approx import parse_number
+from chebnorm.exceptions import FrameUnsupported
 from chebnorm.methods import default_tables
 
 from ..meshes import Mesh, unit
@@ -29,11 +30,6 @@ from ..spans import Camera
 
 __all__ = ["Engine", "Setup", "ModeResult", "FrameUnsupported", "dot", "half_vectors",
            "triangle_half_vectors", "auto_tables"]
-
-
-class FrameUnsupported(Exception):
-    """Raised by :meth:`Engine.phong_frame` when the frame it was asked for is one whose
-    reference bytes it cannot promise; the caller draws the frame step by step."""
 
 
 @dataclass

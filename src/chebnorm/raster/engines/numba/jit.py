@@ -19,6 +19,8 @@ import threading
 import warnings
 from concurrent.futures import ThreadPoolExecutor
 
+from chebnorm.exceptions import NumbaCompileWarning
+
 try:  # pragma: no cover - exercised by whichever environment runs the tests
     import numba
     from llvmlite import ir as _ir
@@ -42,14 +44,6 @@ __all__ = ["HAVE_NUMBA", "JIT_DISABLED", "njit", "objmode", "fma", "f2i", "i2f",
            "stream16",
            "store_fence", "threads", "pool",
            "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
-
-
-class NumbaCompileWarning(UserWarning):
-    """numba is compiling the raster engine's kernels (the first render of a kind
-    on this machine; numba caches them on disk for later processes). Issued once
-    per process, and only when the compile takes a while (:data:`ANNOUNCE_AFTER`);
-    ``render`` compiles before starting its clock, so its ``seconds`` do not
-    count it (``RenderResult.compile_seconds`` does)."""
 
 
 #: seconds a warm-up (compile or cache load) may take before it is announced
