@@ -35,8 +35,8 @@ BUILD_SECONDS = 300
 ATTEMPTS = 4
 #: the module's tests get room for every attempt
 pytestmark = pytest.mark.timeout(ATTEMPTS * BUILD_SECONDS + 300)
-STAGES = ["chebnorm.core", "chebnorm.symbolic", "chebnorm.approx", "chebnorm.export", "chebnorm.methods",
-          "chebnorm.hw", "chebnorm.raster"]
+STAGES = ["chebnorm.exceptions", "chebnorm.core", "chebnorm.symbolic", "chebnorm.approx",
+          "chebnorm.export", "chebnorm.methods", "chebnorm.hw", "chebnorm.raster"]
 
 
 @pytest.fixture(scope="module")

@@ -12,9 +12,13 @@
   order (BLAS and LAPACK kernels differ per CPU).
 * :mod:`chebnorm.core.numeric`   -- small exact helpers written once: floats
   rounded up or down from a rational or a ball, two's-complement widths,
-  integer argument checks, a scoped Arb working precision.
+  integer argument checks, a scoped Arb working precision
+  (``arb_precision``, the one way the package sets it).
+* :mod:`chebnorm.core.tools`     -- the one place that finds external tools
+  (``which``, ``require``) and runs them (``run_tool``, with a time limit).
 
-This stage imports no other stage of chebnorm.
+This stage imports no other stage of chebnorm, only :mod:`chebnorm.exceptions`
+(the classes it raises and warns with).
 """
 
 from . import clib, deprecation, detlinalg, files, numeric, parallel, progress, textsafe, tools
