@@ -283,9 +283,28 @@ def test_tool_failed_is_one_line_with_the_tail_of_stderr(bin_dir):
     assert isinstance(info.value, ValueError) and isinstance(info.value, RuntimeError)
 
 
+def test_a_failing_hardware_tool_is_one_tool_failed(bin_dir, tmp_path):
+    """yosys exiting with an error (a fake one on PATH): one ToolFailed line naming the
+    tool, the module, the status and the end of what it printed."""
+    from chebnorm.hw.verilog import synthesize
+
+    bin_dir("yosys", "import sys\nprint('-- Parsing --')\n"
+            "sys.stderr.write('ERROR: syntax error, unexpected end of file\\n')\nsys.exit(1)")
+    v = tmp_path / "m.v"
+    v.write_text("module m(\n", encoding="utf-8")
+    with pytest.raises(exceptions.ToolFailed) as info:
+        synthesize(v, "m")
+    text = str(info.value)
+    assert "\n" not in text and isinstance(info.value, ValueError)
+    assert text == ("yosys failed on m (exit status 1): -- Parsing -- "
+                    "ERROR: syntax error, unexpected end of file")
+
+
 def test_tool_failed_without_stderr():
     assert str(exceptions.ToolFailed("yosys", 1, "")) == "yosys failed (exit status 1)"
     assert str(exceptions.ToolFailed("yosys", -9, None)) == "yosys failed (exit status -9)"
+    assert str(exceptions.ToolFailed("ghdl -a", 1, " \n", subject="e")) == \
+        "ghdl -a failed on e (exit status 1)"
 
 
 def test_a_missing_tool_is_one_tool_missing_at_every_call_site(bin_dir):

@@ -156,13 +156,18 @@ class ToolFailed(RuntimeError, ValueError):
     returncode : int
         Its exit status.
     stderr : str, optional
-        What it printed on standard error; the last lines (at most 300
-        characters, joined into one line) are quoted.
+        What it printed on standard error (or its messages, where the tool
+        prints them on standard output); the last lines (at most
+        :attr:`TAIL` characters, joined into one line) are quoted.
+    subject : str, optional
+        What it was run on (a module, an entity), named in the message.
 
     Examples
     --------
     >>> str(ToolFailed("sollya", 3, "line 1\\nerror: bad\\n"))
     'sollya failed (exit status 3): line 1 error: bad'
+    >>> str(ToolFailed("yosys", 1, "ERROR: syntax error", subject="top"))
+    'yosys failed on top (exit status 1): ERROR: syntax error'
     >>> ToolFailed("gappa", 1).returncode
     1
     """
@@ -170,12 +175,15 @@ class ToolFailed(RuntimeError, ValueError):
     #: characters of the tool's standard error quoted at most
     TAIL = 300
 
-    def __init__(self, tool: str, returncode: int, stderr: str = ""):
+    def __init__(self, tool: str, returncode: int, stderr: str = "", *, subject: str = ""):
         tail = " ".join(str(stderr or "")[-self.TAIL:].split())
-        super().__init__(f"{tool} failed (exit status {returncode})" + (f": {tail}" if tail else ""))
+        on = f" on {subject}" if subject else ""
+        super().__init__(f"{tool} failed{on} (exit status {returncode})"
+                         + (f": {tail}" if tail else ""))
         self.tool = tool
         self.returncode = returncode
         self.stderr = stderr
+        self.subject = subject
 
 
 class ToolTimeout(subprocess.TimeoutExpired, ValueError):

@@ -56,6 +56,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .verilog import tool_env
 from chebnorm.core.tools import require, run_tool
+from chebnorm.exceptions import ToolFailed
 
 __all__ = ["Target", "TargetCost", "TARGETS", "target_names", "get_target", "synthesize_target",
            "target_figures", "cost_from_types",
@@ -361,9 +362,8 @@ def _check_top(top) -> str:
 
 def _run(argv: list[str], cwd: str, what: str, timeout: float) -> str:
     proc = run_tool(argv, tool=what, timeout=timeout, cwd=cwd, env=tool_env())
-    if proc.returncode != 0:
-        reason = " ".join((proc.stdout[-300:] + " " + proc.stderr[-300:]).split())
-        raise ValueError(f"{what} failed: {reason or f'exit status {proc.returncode}'}")
+    if proc.returncode != 0:  # yosys and nextpnr print their errors on both streams
+        raise ToolFailed(what, proc.returncode, proc.stdout[-300:] + "\n" + proc.stderr)
     return proc.stdout
 
 

@@ -13,6 +13,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from chebnorm.core.tools import require, run_tool
+from chebnorm.exceptions import ToolFailed
 
 
 __all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_text", "tool_env"]
@@ -127,7 +128,7 @@ def simulate(directory, design, timeout: float = 600) -> SimResult:
         comp = run_tool([iverilog, "-g2005", "-Wall", "-o", "sim.vvp", "tb.v", "dut.v"],
                         tool="iverilog", timeout=timeout, cwd=tmp, env=tool_env())
         if comp.returncode != 0:
-            raise ValueError(f"iverilog failed on {name}: {' '.join(comp.stderr.split())[:300]}")
+            raise ToolFailed("iverilog", comp.returncode, comp.stderr, subject=name)
         run = run_tool([vvp, "-n", str(Path(tmp) / "sim.vvp")], tool="vvp", timeout=timeout,
                        cwd=d)
     m = re.search(r"^(PASS|FAIL): (\d+) vectors, (\d+) mismatches.*$", run.stdout, re.M)
@@ -179,9 +180,9 @@ def synthesize(path, top: str, timeout: float = 600) -> SynthResult:
         (Path(tmp) / "design.v").write_bytes(Path(path).read_bytes())
         proc = run_tool([yosys, "-p", f"read_verilog design.v; synth -top {top}; stat"],
                         tool="yosys", timeout=timeout, cwd=tmp, env=tool_env())
-    if proc.returncode != 0:
-        reason = " ".join((proc.stdout[-300:] + " " + proc.stderr[-300:]).split())
-        raise ValueError(f"yosys failed on {top}: {reason or f'exit status {proc.returncode}'}")
+    if proc.returncode != 0:  # yosys prints its errors on both streams
+        raise ToolFailed("yosys", proc.returncode, proc.stdout[-300:] + "\n" + proc.stderr,
+                         subject=top)
     text = proc.stdout
     start = text.rfind("Number of cells:")
     if start < 0:

@@ -15,6 +15,7 @@ from .hdl import hdl_files
 from .hdl.vhdl import VHDL_STD
 from .verilog import SimResult
 from chebnorm.core.tools import require, run_tool
+from chebnorm.exceptions import ToolFailed
 
 __all__ = ["simulate_vhdl", "vhdl_outputs"]
 
@@ -55,8 +56,8 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
                 [ghdl, "-e", std, f"tb_{name}"]):
         proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=d)
         if proc.returncode != 0:
-            raise ValueError(f"ghdl {cmd[1]} failed on {name}: "
-                             f"{' '.join((proc.stdout + proc.stderr).split())[:400]}")
+            raise ToolFailed(f"ghdl {cmd[1]}", proc.returncode, proc.stdout + "\n" + proc.stderr,
+                             subject=name)
     run = run_tool([ghdl, "-r", std, f"tb_{name}", "--ieee-asserts=disable-at-0"],
                    tool="ghdl -r", timeout=timeout, cwd=d)
     text = run.stdout + run.stderr
