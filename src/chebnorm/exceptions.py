@@ -7,7 +7,7 @@ chebnorm.exceptions.FitWarning``), so either import works.
 
 Errors a user can fix derive from ``ValueError`` (the command line prints them
 as one line and exits with status 2); warnings derive from ``UserWarning`` or
-``DeprecationWarning`` and are issued with :func:`warnings.warn`.
+``DeprecationWarning`` and are issued with ``warnings.warn``.
 
 * :class:`FitWarning` -- a fit or quantization that is not what it claims.
 * :class:`ChebnormDeprecationWarning` -- an old spelling that still works.
