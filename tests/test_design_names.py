@@ -88,13 +88,20 @@ def test_design_default_name_from_the_max_error_value(tmp_path):
     assert code == 2 and "--max-error" in err and len(err.strip().splitlines()) == 1
 
 
-def test_hw_verilog_and_report_default_module_is_the_tables_default_name(tmp_path):
+@pytest.mark.parametrize("shape, expected", [
+    (["--degree", "1", "--segments", "4"], "rsqrt_1_4_d1_s4"),   # piecewise
+    (["--degree", "2"], "rsqrt_1_4_d2"),                          # one polynomial (Horner)
+])
+def test_hw_verilog_and_report_default_module_is_the_tables_default_name(tmp_path, shape,
+                                                                         expected):
     table = tmp_path / "t.json"
-    r = run_cli_quiet("fit", "1/sqrt(x)", "--interval", "1", "4", "--degree", "1", "--segments",
-                      "4", "--kind", "minimax", "--coef-frac-bits", "10", "-o", table)
+    r = run_cli_quiet("fit", "1/sqrt(x)", "--interval", "1", "4", *shape, "--kind", "minimax",
+                      "--coef-frac-bits", "10", "-o", table)
     assert r.code == 0, r.err
     name = json.loads(table.read_text())["name"]
-    assert name == default_name("1/sqrt(x)", ("1", "4"), 1, segments=4) == "rsqrt_1_4_d1_s4"
+    segments = int(shape[3]) if len(shape) > 2 else None
+    assert name == default_name("1/sqrt(x)", ("1", "4"), int(shape[1]), segments=segments)
+    assert name == expected and VHDL_IDENT.match(name)
     r = run_cli_quiet("hw", "verilog", table, "--in-bits", "6", "--out-bits", "6", "-o",
                       tmp_path / "v")
     assert r.code == 0, r.err
@@ -103,3 +110,14 @@ def test_hw_verilog_and_report_default_module_is_the_tables_default_name(tmp_pat
                       "--json")
     assert r.code == 0, r.err
     assert json.loads(r.out)["module"] == f"chebnorm_{name}"
+
+
+def test_exponent_design_default_name_says_its_index(tmp_path):
+    out = tmp_path / "x"
+    r = run_cli_quiet("design", "1/sqrt(x)", "--index", "exponent", "--interval", "2^-8", "1",
+                      "--in-bits", "8", "--out-bits", "8", "--faithful", "--degrees", "1",
+                      "--no-synth", "-o", out)
+    assert r.code == 0, r.err
+    name = "rsqrt_2_m8_1_i8_o8_faithful_lz"   # lz: the leading-zero (exponent) index
+    assert {f"chebnorm_{name}.v", f"chebnorm_{name}.vhd",
+            f"design_{name}_architectures.csv"} <= {p.name for p in out.iterdir()}
