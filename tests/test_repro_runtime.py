@@ -104,9 +104,11 @@ def test_repro_ctrl_c_exits_130_and_keeps_what_finished(tmp_path):
                              "--ledger-dir", str(out / "claims"), "--workers", "2"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             cwd=tmp_path, env=_env(tmp_path), start_new_session=True)
+    committed = sorted(p.name for p in (ROOT / "figures" / "coefficients").iterdir())
     try:
         deadline = time.monotonic() + 300
-        while len(list((out / "coefficients").glob("*.h"))) < 8:   # the first job done
+        # the first job done: every file it writes is there (each written atomically)
+        while not all((out / "coefficients" / name).exists() for name in committed):
             assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
             time.sleep(0.05)
         time.sleep(0.5)   # the two render jobs are running (each takes many seconds)
@@ -119,9 +121,9 @@ def test_repro_ctrl_c_exits_130_and_keeps_what_finished(tmp_path):
     assert proc.returncode == 130, stderr
     assert stderr == "chebnorm: interrupted\n"   # no "leaked semaphore", no traceback
     assert stdout == ""
-    committed = ROOT / "figures" / "coefficients"
-    for p in committed.iterdir():   # the finished job's files, whole
-        assert (out / "coefficients" / p.name).read_bytes() == p.read_bytes(), p.name
+    for name in committed:   # the finished job's files, whole
+        assert (out / "coefficients" / name).read_bytes() == \
+            (ROOT / "figures" / "coefficients" / name).read_bytes(), name
     assert not (out / "provenance.json").exists()   # the run did not finish
     # nothing of the run is left running: workers and resource tracker gone (a zombie
     # is dead, waiting for a reaper that a container's init may not be)
