@@ -249,3 +249,28 @@ def test_draws_finds_the_figures_of_a_cell():
     assert _draws("f()", drawers) and _draws("t.plot()\nplt.show()", drawers)
     assert not _draws("if widgets:\n    widgets.interact(f, n=3)", drawers)
     assert not _draws("%matplotlib inline\nprint(1)", drawers)
+
+
+@pytest.mark.slow
+def test_facade_is_documented_under_the_names_users_type(built):
+    """``chebnorm.fit`` (not ``chebnorm.approx.fit``) carries the documentation; the stage
+    page lists ``chebnorm.approx.fit`` with a link to it; ``cn.export(...)`` and
+    ``cn.hw.report(...)`` are documented as calls, and their module pages link there."""
+    import chebnorm
+
+    api = (built / "api.html").read_text(encoding="utf-8")
+    for name, (module, attr) in chebnorm._LAZY.items():
+        page = (built / "facade" / f"chebnorm.{name}.html").read_text(encoding="utf-8")
+        assert f'id="chebnorm.{name}"' in page, name
+        assert f'href="facade/chebnorm.{name}.html#chebnorm.{name}"' in api, name
+        stage = (built / "generated" / f"{module}.html").read_text(encoding="utf-8")
+        entry = stage.split(f'id="{module}.{attr}"', 1)[1].split("</dd>", 1)[0]
+        assert f"#chebnorm.{name}" in entry, f"{module}.{attr} does not link to chebnorm.{name}"
+        assert "Parameters" not in entry, f"{module}.{attr} is documented twice"
+    fit = (built / "facade" / "chebnorm.fit.html").read_text(encoding="utf-8")
+    assert "Parameters" in fit
+    for call, module_page in (("export", "generated/chebnorm.export.html"),
+                              ("hw.report", "modules/chebnorm.hw.report.html")):
+        page = re.sub(r"<[^>]+>", "", (built / "facade" / f"chebnorm.{call}.html").read_text(encoding="utf-8"))
+        assert f"{call}(table" in page and "Parameters" in page, call
+        assert f'facade/chebnorm.{call}.html#facade-' in (built / module_page).read_text(encoding="utf-8")
