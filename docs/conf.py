@@ -55,9 +55,9 @@ extensions = [
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
-# fragments included by a page: _layer_rule.rst (contributing.md), _cli (cli.md),
-# facade/_table.rst (api.rst)
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli",
+# fragments included by a page: _layer_rule.rst (contributing.md), _cli (cli.md), _bench
+# (benchmarks.md), facade/_table.rst (api.rst)
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli", "_bench",
                     "facade/_table.rst"]
 templates_path = ["_templates"]
 
@@ -424,8 +424,21 @@ def _write_facade_pages() -> None:
     _write_if_changed(out / "_table.rst", "\n".join(table) + "\n")
 
 
+def _write_bench_tables() -> None:
+    """_bench/NAME.md: the tables of the benchmarks page, printed from the committed
+    result files of ``benchmarks/`` by ``_benchtables.py`` (build products, git-ignored)."""
+    sys.path.insert(0, str(DOCS))
+    try:
+        import _benchtables
+    finally:
+        sys.path.remove(str(DOCS))
+    for name, printer in _benchtables.TABLES.items():
+        _write_if_changed(DOCS / "_bench" / f"{name}.md", printer())
+
+
 _copy_notebooks()
 _write_figure_gallery()
+_write_bench_tables()
 _write_cli_help()
 _write_layer_rule()
 _write_facade_pages()
