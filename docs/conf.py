@@ -406,7 +406,7 @@ def _write_facade_pages() -> None:
         short = modname.removeprefix("chebnorm.")
         pages[modname] = "\n".join([
             f".. _{label}:", "", modname, "=" * len(modname), "", ".. currentmodule:: chebnorm", "",
-            f"The module :mod:`{modname}` is callable: ``cn.{short}(...)`` below.", "",
+            f"The module :mod:`{modname}` is callable, ``cn.{short}(...)``: {summary[0].lower()}{summary[1:]}", "",
             f".. facade-call:: {modname}", ""])
         rows.append((f":ref:`{short}(...) <{label}>`", f"{summary} (calling :mod:`{modname}`)"))
     wanted = {f"{p}.rst" for p in pages} | {"_table.rst"}
@@ -718,11 +718,8 @@ def _facade_links(app, doctree, docname):
     and a link) goes to the facade's entry (``chebnorm.fit``), where it is documented."""
     from docutils import nodes
 
-    targets = getattr(app.env, "_chebnorm_facade_targets", None)
-    if targets is None:
-        targets = {f"{mod}.{stub['name']}": stub["facade"]
-                   for mod, stubs in autosummary_context["facade_stubs"].items() for stub in stubs}
-        app.env._chebnorm_facade_targets = targets
+    targets = {f"{mod}.{stub['name']}": stub["facade"]
+               for mod, stubs in autosummary_context["facade_stubs"].items() for stub in stubs}
     for ref in doctree.findall(nodes.reference):
         uri = ref.get("refuri") or ""
         anchor = uri.rsplit("#", 1)[-1] if "#" in uri else ref.get("refid")   # refid: on the same page
