@@ -225,8 +225,8 @@ def _page_cells(page: str) -> list[dict]:
 @pytest.mark.slow
 def test_every_notebook_figure_is_on_its_page(built):
     """Each code cell of a notebook that draws a figure shows an image on its page, and
-    a slider cell's note ("the static figure above shows the same") follows a figure of
-    its own section: the static figure is drawn whether ipywidgets is installed or not."""
+    a slider cell's note ("the static figure above shows the same") follows the cell that
+    draws that figure: the static figure is drawn whether ipywidgets is installed or not."""
     import json
 
     for nb in sorted((REPO / "notebooks").glob("*.ipynb")):
@@ -238,9 +238,10 @@ def test_every_notebook_figure_is_on_its_page(built):
         for i, (source, cell) in enumerate(zip(code, cells)):
             if _draws(source, drawers):
                 assert cell["images"], f"{nb.name}, code cell {i}: draws a figure, none on the page"
-            if cell["widget_note"]:
-                before = [c for c in cells[:i] if c["section"] == cell["section"] and c["images"]]
-                assert before, f"{nb.name}, code cell {i}: 'the static figure above' but none above"
+            if cell["widget_note"]:   # the static figure is the previous cell's, in the same section
+                above = cells[i - 1] if i else None
+                assert above and above["section"] == cell["section"] and above["images"], \
+                    f"{nb.name}, code cell {i}: 'the static figure above' but no figure just above"
 
 
 def test_draws_finds_the_figures_of_a_cell():
