@@ -52,7 +52,7 @@ def reports():
     for key, (expr, iv, deg, ib, ob, cb, rnd) in {**CASES, **SHIFTED}.items():
         t = cn.fit(expr, iv, deg, name=key, kind="minimax",
                    **({"basis": "shifted"} if key in SHIFTED else {}))
-        out[key] = analyze(t, ib, ob, coef_bits=cb, rounding=rnd, gappa=False, synth=False)
+        out[key] = analyze(t, ib, ob, coef_frac_bits=cb, rounding=rnd, gappa=False, synth=False)
     return out
 
 
@@ -217,7 +217,7 @@ def test_shifted_basis_keeps_the_datapath_accurate(reports):
     r = reports["rsqrt11"]
     assert r.budget.total < 3 * r.budget.y_lsb
     mono = cn.fit("1/sqrt(x)", (1, 4), 11, kind="minimax", basis="monomial")
-    m = analyze(mono, 12, 16, coef_bits=28, gappa=False, synth=False)
+    m = analyze(mono, 12, 16, coef_frac_bits=28, gappa=False, synth=False)
     assert m.measurement.total > 1e4 * r.measurement.total
 
 
