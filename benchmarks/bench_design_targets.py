@@ -1,4 +1,4 @@
-"""Wall time of ``chebnorm design`` on the issue-28 spec for every FPGA target
+"""Wall time of ``chebnorm design`` on the FloPoCo comparison spec (``1/sqrt(1+3x)`` on [0, 1), 16 bits) for every FPGA target
 (search, synthesis on the target, and the winner's timing run).
 
     python benchmarks/bench_design_targets.py [--targets generic xc7 ...] [--repeat 3]

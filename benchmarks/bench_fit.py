@@ -11,14 +11,14 @@ Runs, in one process and one sitting:
   on the same cases, in one sollya process, each part timed by Sollya's own
   ``time()``; so each ratio compares like with like.
 
-Piecewise workload (issue 13): certify every segment of the 256-segment
+Piecewise workload: certify every segment of the 256-segment
 degree-2 table of ``1/sqrt(x)`` on [1, 4) (24-bit fixed-point coefficients)
 with the batched certifier (``certify_segments``), against one Sollya process
 running ``supnorm`` on each segment's composed function ``f(a_s + h t)``, t in
 [0, 1], same coefficients, same tightness; and, for reference, chebnorm's
 ``certify`` run on one segment after another (one run).
 
-Quantization workload (issue 25; printed last by the plain text run, ``--quantize`` runs it alone): 48 cases (fixed point
+Quantization workload (printed last by the plain text run, ``--quantize`` runs it alone): 48 cases (fixed point
 8..28 bits, binary16/bfloat16/binary32/binary64, degrees 2..10, odd and even
 powers, a fixed constant; 1/sqrt, exp, sin, cos, atan, log(1+x), 2^x, erf, tan;
 absolute and relative error). chebnorm: ``quantize`` of a table fitted before
@@ -29,7 +29,7 @@ the case's format) is not the fit's (f(0) in binary64), quantize refits,
 and that refit is timed with it. Sollya's fpminimax runs its own real fit (timed);
 Sollya: in one process, per case ``fpminimax`` then ``supnorm`` at 2^-20 of its
 result, each timed by Sollya's ``time()``. Prints per case the seconds, the
-ratio, both certified bounds and chebnorm's bound before issue 25's speed work
+ratio, both certified bounds and chebnorm's reference bound
 (benchmarks/quantize_bounds_before.json); exit status 1 if the bound of the
 case's error kind got worse than that by more than 0.1 %.
 
@@ -77,7 +77,7 @@ WORKLOAD = (
     + [("sqrt(2*(1+x))/2", ("0", "1"), d) for d in range(1, 5)]
     + [("1/sqrt(x)", ("1/2", "2"), d) for d in range(1, 7)]
 )
-#: issue 13's high-degree cases (``--high-degree``)
+#: the high-degree cases (``--high-degree``)
 HIGH_DEGREE = tuple((expr, ("0", "1"), d) for expr in ("exp(x)", "atan(x)") for d in (20, 25, 30))
 
 
@@ -234,7 +234,7 @@ def piecewise_rows(tights, repeat: int) -> list[dict]:
     return rows
 
 
-# ------------------------------------------------------------ quantization (issue 25)
+# ------------------------------------------------------------ quantization
 ODD5, ODD7, ODD9 = (1, 3, 5), (1, 3, 5, 7), (1, 3, 5, 7, 9)
 EV4, EV6, EV8 = (0, 2, 4), (0, 2, 4, 6), (0, 2, 4, 6, 8)
 PI4 = ("-pi/4", "pi/4")
@@ -289,12 +289,12 @@ QUANT_WORKLOAD = [
  ("tan(x)", ("-1/4","1/4"), 7, "abs", "binary64", None, ODD7, False),
  ("exp(x)", ("0","1"), 2, "rel", "bfloat16", None, None, False),
 ]
-#: quantize's bounds on QUANT_WORKLOAD before issue 25's speed work (none may get worse)
+#: quantize's reference bounds on QUANT_WORKLOAD (none may get worse)
 QUANT_BEFORE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                             "quantize_bounds_before.json")
 
 
-#: relative tolerance of that check (issue 25: candidates are ranked by sampled
+#: relative tolerance of that check (candidates are ranked by sampled
 #: error and only the best few certified, no longer all of them)
 QUANT_TOLERANCE = 1e-3
 
@@ -469,9 +469,9 @@ def print_quantize(q: dict) -> None:
     else:
         line += f"; {q['sollya']}"
     print(line)
-    print("bounds: " + ("none worse than before issue 25's speed work by more than "
+    print("bounds: " + ("none worse than the reference bounds by more than "
                         f"{QUANT_TOLERANCE:.1%}" if not
-                        q["worse_than_before"] else "WORSE than before: "
+                        q["worse_than_before"] else "WORSE than the reference: "
                         + "; ".join(q["worse_than_before"])))
 
 
@@ -485,7 +485,7 @@ def main(argv=None) -> int:
     ap.add_argument("--high-degree", action="store_true",
                     help="the workload exp(x), atan(x) on [0, 1] at degree 20, 25, 30 instead")
     ap.add_argument("--quantize", action="store_true",
-                    help="run only the quantization workload (issue 25): quantize against "
+                    help="run only the quantization workload: quantize against "
                          "Sollya's fpminimax + supnorm; exit status 1 if a bound got worse")
     args = ap.parse_args(argv)
     if args.quantize:
@@ -562,7 +562,7 @@ def main(argv=None) -> int:
             else:
                 print(f"  {r['sollya']}")
     if not (args.json or args.piecewise_only or args.high_degree):
-        # the whole text run prints issue 25's quantization workload last
+        # the whole text run prints the quantization workload last
         q = quantize_rows(args.repeat)
         print_quantize(q)
         return 1 if q["worse_than_before"] else 0

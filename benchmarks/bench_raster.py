@@ -12,7 +12,7 @@ visibility and background, the method's normals, half vectors, shading with ``po
 and the output maps), every method; with ``--image-only`` the frame of
 ``render(..., extra_maps=False)``.
 
-``--peer llvmpipe`` (issue 30): the ``phong`` frame of every method against Mesa's
+``--peer llvmpipe``: the ``phong`` frame of every method against Mesa's
 llvmpipe drawing the same frame (the shader demo's fragment shader with
 ``normalize``; see :class:`LlvmpipePeer`), every case once per round, 7 rounds
 (``--repeat``) after a warm-up round, best round per case, all in one process;

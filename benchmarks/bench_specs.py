@@ -1,4 +1,4 @@
-"""Architectures per spec on every FPGA target (issue 28): faithful designs,
+"""Architectures per spec on every FPGA target: faithful designs,
 checked exhaustively, synthesized by yosys, timed by nextpnr-ice40.
 
     python benchmarks/bench_specs.py [--quick] [--json PATH] [--no-sim] [--spec I ...]
@@ -72,7 +72,7 @@ from chebnorm.hw.table_run import simulate_table
 from chebnorm.hw.targets import fmax_ice40, synthesize_target, target_names
 from chebnorm.hw.vhdl import simulate_vhdl
 
-#: (label, expression, interval, in_bits, out_bits); the first is issue 28's
+#: (label, expression, interval, in_bits, out_bits); the first is the FloPoCo comparison spec's
 SPECS = (
     ("1/sqrt(1+3x) [0,1) 16b", "1/sqrt(1+3*x)", ("0", "1"), 16, 16),
     ("2^x [0,1) 12b", "2**x", ("0", "1"), 12, 12),
@@ -438,7 +438,7 @@ def _versions() -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="only the issue-28 spec")
+    ap.add_argument("--quick", action="store_true", help="only the first spec (1/sqrt(1+3x) on [0, 1), 16 bits)")
     ap.add_argument("--json", help="keep the rows here (and reuse those already there)")
     ap.add_argument("--no-sim", action="store_true",
                     help="skip the winners' Icarus and GHDL simulations")

@@ -1,4 +1,4 @@
-"""Table-based designs on the FloPoCo comparison spec (issue 28), priced by yosys.
+"""Table-based designs on the FloPoCo comparison spec, priced by yosys.
 
 Usage: python benchmarks/bench_tables.py [mp|plain]
 

@@ -634,7 +634,7 @@ def fit_vs_sollya(quick):
 
 
 def raster_throughput(size, quick):
-    """bench_raster.py's summary; a full run times exactly issue 16's acceptance command
+    """bench_raster.py's summary; a full run times exactly the rasterizer's reference command
     (``bench_raster.py --size W H``: its default repeats, best of 5 frames)."""
     import bench_raster
 
@@ -674,7 +674,7 @@ def _raster_line(ra) -> str:
     load = ra.get("load_average_before")
     head = (f"- rasterizer ({ra['mesh']}, {ra['size'][0]}x{ra['size'][1]}, "
             f"{' and '.join(engines)}" + ("" if load is None else f", load average {load[0]:.1f}")
-            + "; issue 16's goal: phong >= 20 Mfrag/s): ")
+            + "; goal: phong >= 20 Mfrag/s): ")
     return head + "; ".join(parts)
 
 
@@ -819,7 +819,7 @@ def markdown(res):
     fs = res["fit_vs_sollya"]
     if "rows" in fs:
         for r in fs["rows"]:
-            if "workload" in r:  # the piecewise table (issue 13)
+            if "workload" in r:  # the piecewise table
                 L.append(_piecewise_line(r))
                 continue
             line = (f"- fit and certify, {r['cases']} cases, tightness {r['tightness']:.3g}: chebnorm "

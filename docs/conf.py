@@ -55,8 +55,10 @@ extensions = [
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
-# _layer_rule.rst is a fragment, included by contributing.md
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli"]
+# fragments included by a page: _layer_rule.rst (contributing.md), _cli (cli.md), _bench
+# (benchmarks.md), facade/_table.rst (api.rst)
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_layer_rule.rst", "_cli", "_bench",
+                    "facade/_table.rst"]
 templates_path = ["_templates"]
 
 # every cross-reference must resolve (python -m sphinx -n); see _resolve_in_defining_module
@@ -251,6 +253,10 @@ def _module_page(modname: str) -> str:
     shown = [n for n in own if n in pkg.__all__ and getattr(mod, n, None) is getattr(pkg, n)
              and (inspect.isfunction(getattr(pkg, n)) or inspect.isclass(getattr(pkg, n)))]
     lines = [modname, "=" * len(modname), ""]
+    if modname in FACADE_CALLS:
+        label = "facade-" + modname.removeprefix("chebnorm.").replace(".", "-")
+        lines += [f"The module is callable: :ref:`cn.{modname.removeprefix('chebnorm.')}(...) <{label}>` "
+                  "on the API page.", ""]
     if hasattr(pkg, modname.split(".")[2]) and not inspect.ismodule(getattr(pkg, modname.split(".")[2])) \
             and len(modname.split(".")) == 3:
         # the stage exports a function of the module's name (chebnorm.approx.certify):
@@ -273,7 +279,8 @@ def _module_page(modname: str) -> str:
         lines.append("")
     if shown:
         lines += [f"Defined here and documented with :mod:`{stage}`:", ""]
-        lines += [f"* :obj:`{stage}.{n}`" for n in shown]
+        facade = {id(obj): f"chebnorm.{name}" for name, obj, _path in _facade()}
+        lines += [f"* :obj:`{facade.get(id(getattr(pkg, n)), f'{stage}.{n}')}`" for n in shown]
         lines.append("")
     del mod
     return "\n".join(lines)
@@ -315,14 +322,135 @@ def _write_layer_rule() -> None:
     _write_if_changed(DOCS / "_layer_rule.rst", body.strip() + "\n")
 
 
+# -- The facade: documented under the names users type ------------------------------
+
+#: the callable stages of the facade: module -> (the object whose docstring the call
+#: shows, the call's summary on the API page)
+FACADE_CALLS = {
+    "chebnorm.export": ("chebnorm.export.__call__",
+                        "The text of a table in a format (:func:`chebnorm.export.export_text`)."),
+    "chebnorm.hw.report": ("chebnorm.hw.analyze",
+                           "The bit-accurate hardware report of a table (:func:`chebnorm.hw.analyze`)."),
+}
+
+
+def _facade() -> list[tuple[str, object, str]]:
+    """``(name, object, stage path)`` of each facade name, in ``chebnorm.__all__``'s
+    order (``("target", get_target, "chebnorm.approx.get_target")``)."""
+    return [(name, getattr(chebnorm, name), ".".join(chebnorm._LAZY[name]))
+            for name in chebnorm.__all__ if name in chebnorm._LAZY]
+
+
+def _kind(obj) -> str:
+    """The Python domain's directive for ``obj``: function, exception or class."""
+    if inspect.isclass(obj):
+        return "exception" if issubclass(obj, BaseException) else "class"
+    return "function"
+
+
+def _summary(obj) -> str:
+    """The first sentence of ``obj``'s docstring, on one line."""
+    first = (inspect.getdoc(obj) or "").split("\n\n")[0]
+    text = " ".join(first.split())
+    end = re.search(r"\.(\s|$)", text)
+    return text[:end.start() + 1] if end else text
+
+
+def _facade_stubs() -> dict[str, list[dict]]:
+    """For each module whose ``__all__`` exports a facade object: the entries its page
+    shows in place of the object's documentation (a signature and a link to the
+    facade's entry), passed to the autosummary module template."""
+    stubs: dict[str, list[dict]] = {}
+    facade = _facade()
+    for modname in sorted(m for m in sys.modules if m == "chebnorm" or m.startswith("chebnorm.")):
+        mod = sys.modules[modname]
+        if modname == "chebnorm" or not isinstance(getattr(mod, "__all__", None), (list, tuple)):
+            continue
+        for name in mod.__all__:
+            value = getattr(mod, name, None)
+            for facade_name, obj, _path in facade:
+                if value is obj:
+                    kind = _kind(obj)
+                    sig = ""
+                    if kind == "function":
+                        try:   # without annotations, as autodoc shows signatures here
+                            plain = inspect.signature(obj)
+                            sig = str(plain.replace(
+                                parameters=[p.replace(annotation=p.empty) for p in plain.parameters.values()],
+                                return_annotation=plain.empty))
+                        except (TypeError, ValueError):
+                            sig = "(...)"
+                    role = {"function": "func", "class": "class", "exception": "exc"}[kind]
+                    stubs.setdefault(modname, []).append(
+                        {"name": name, "kind": kind, "sig": sig, "role": role,
+                         "facade": f"chebnorm.{facade_name}", "short": facade_name})
+    return stubs
+
+
+def _write_facade_pages() -> None:
+    """facade/*.rst: a page per facade name (``chebnorm.fit``, ``chebnorm.export``,
+    ``chebnorm.hw.report``) and facade/_table.rst, the table of the API page (build
+    products, git-ignored)."""
+    out = DOCS / "facade"
+    pages = {}
+    rows = []
+    for name, obj, path in _facade():
+        full = f"chebnorm.{name}"
+        kind = _kind(obj)
+        pages[full] = "\n".join([full, "=" * len(full), "", ".. currentmodule:: chebnorm", "",
+                                 f".. auto{kind}:: {name}", ""])
+        role = {"function": "func", "class": "class", "exception": "exc"}[kind]
+        rows.append((f":{role}:`{name} <{full}>`", f"{_summary(obj)} (``{path}``)"))
+    for modname, (_doc, summary) in FACADE_CALLS.items():
+        label = "facade-" + modname.removeprefix("chebnorm.").replace(".", "-")
+        short = modname.removeprefix("chebnorm.")
+        pages[modname] = "\n".join([
+            f".. _{label}:", "", modname, "=" * len(modname), "", ".. currentmodule:: chebnorm", "",
+            f"The module :mod:`{modname}` is callable, ``cn.{short}(...)``: {summary[0].lower()}{summary[1:]}", "",
+            f".. facade-call:: {modname}", ""])
+        rows.append((f":ref:`{short}(...) <{label}>`", f"{summary} (calling :mod:`{modname}`)"))
+    wanted = {f"{p}.rst" for p in pages} | {"_table.rst"}
+    if out.is_dir():
+        for old in out.glob("*.rst"):
+            if old.name not in wanted:
+                old.unlink()
+    for full, text in pages.items():
+        _write_if_changed(out / f"{full}.rst", text)
+    table = [".. list-table::", "   :header-rows: 1", "   :widths: 25 75", "",
+             "   * - ``cn.``", "     - what it is (the same object's name in its stage)"]
+    for name_cell, summary in rows:
+        table += [f"   * - {name_cell}", f"     - {summary}"]
+    table += ["", ".. toctree::", "   :hidden:", ""] + [f"   facade/{full}" for full in pages]
+    _write_if_changed(out / "_table.rst", "\n".join(table) + "\n")
+
+
+def _write_bench_tables() -> None:
+    """_bench/NAME.md: the tables of the benchmarks page, printed from the committed
+    result files of ``benchmarks/`` by ``_benchtables.py`` (build products, git-ignored)."""
+    sys.path.insert(0, str(DOCS))
+    try:
+        import _benchtables
+    finally:
+        sys.path.remove(str(DOCS))
+    for name, printer in _benchtables.TABLES.items():
+        _write_if_changed(DOCS / "_bench" / f"{name}.md", printer())
+
+
 _copy_notebooks()
 _write_figure_gallery()
+_write_bench_tables()
 _write_cli_help()
 _write_layer_rule()
+_write_facade_pages()
 # autosummary's pages are a build product: a module that moved or was removed must not
 # leave its page behind (a stale page imports a name that no longer exists)
 shutil.rmtree(DOCS / "generated", ignore_errors=True)
 _write_module_pages()
+# the stage pages list a facade object with a link to its entry (docs/_templates/autosummary)
+autosummary_context = {
+    "facade_stubs": _facade_stubs(),
+    "facade_calls": {m: "facade-" + m.removeprefix("chebnorm.").replace(".", "-") for m in FACADE_CALLS},
+}
 
 
 # -- cross-references resolved where the docstring's module would resolve them ------
@@ -344,6 +472,8 @@ def _documented_names(env) -> dict[int, tuple[str, str]]:
         if isinstance(obj, (int, float, str, bytes, bool, tuple, frozenset)):
             # values that may be shared by identity: keyed by (last name, id)
             cache.setdefault((name.rsplit(".", 1)[-1], id(obj)), (objtype, name))
+        elif objtype != "module" and name.count(".") == 1:
+            cache[id(obj)] = (objtype, name)   # the facade's entry (chebnorm.fit) before its stage's
         else:
             cache.setdefault(id(obj), (objtype, name))
     env._chebnorm_documented = cache
@@ -535,8 +665,75 @@ def _widget_fallback(app, doctree):
             block.replace_self(note)
 
 
+def _facade_call_directive():
+    """The ``facade-call`` directive: ``.. facade-call:: chebnorm.export`` shows the call of
+    a callable module under the name users type (``export(table, fmt=None, ...)``), with
+    the docstring of :data:`FACADE_CALLS`' object, processed as autodoc would (numpydoc).
+    Not indexed: the module keeps its name in the Python domain."""
+    from docutils.statemachine import StringList
+    from sphinx.util.docutils import SphinxDirective
+    from sphinx.util.parsing import nested_parse_to_nodes
+
+    class FacadeCall(SphinxDirective):
+        required_arguments = 1
+
+        def run(self):
+            modname = self.arguments[0]
+            call = type(importlib.import_module(modname)).__call__
+            documented = _lookup(FACADE_CALLS[modname][0])
+            documented = getattr(documented, "__func__", documented)
+            lines = (inspect.getdoc(documented) or "").splitlines()
+            self.env.app.emit("autodoc-process-docstring", "function", modname, documented, {}, lines)
+            sig = inspect.signature(call)
+            sig = sig.replace(parameters=[p.replace(annotation=p.empty) for p in list(sig.parameters.values())[1:]],
+                              return_annotation=sig.empty)
+            params = str(sig).replace("'", '"')
+            text = [f".. py:function:: {modname.removeprefix('chebnorm.')}{params}", "   :no-index:", ""]
+            text += [f"   {line}" if line.strip() else "" for line in lines]
+            source = f"docstring of {documented.__module__}.{documented.__qualname__}"
+            return nested_parse_to_nodes(self.state, StringList(text, source=source))
+
+    return FacadeCall
+
+
+def _facade_context(app, doctree):
+    """A facade page (``facade/chebnorm.fit``) shows a docstring written in its stage
+    (``:mod:`.kernels``` in ``chebnorm.methods``): its references are resolved in the
+    stage, as on the stage's page, not in ``chebnorm``."""
+    from sphinx import addnodes
+
+    docname = app.env.docname
+    if not docname.startswith("facade/"):
+        return
+    full = docname.split("/", 1)[1]
+    name = full.removeprefix("chebnorm.")
+    context = chebnorm._LAZY[name][0] if name in chebnorm._LAZY else FACADE_CALLS[full][0].rsplit(".", 1)[0]
+    for node in doctree.findall(addnodes.pending_xref):
+        if node.get("refdomain") == "py" and node.get("py:module") in (None, "chebnorm"):
+            node["py:module"] = context
+
+
+def _facade_links(app, doctree, docname):
+    """A link to a stage's entry of a facade object (``chebnorm.approx.fit``, a signature
+    and a link) goes to the facade's entry (``chebnorm.fit``), where it is documented."""
+    from docutils import nodes
+
+    targets = {f"{mod}.{stub['name']}": stub["facade"]
+               for mod, stubs in autosummary_context["facade_stubs"].items() for stub in stubs}
+    for ref in doctree.findall(nodes.reference):
+        uri = ref.get("refuri") or ""
+        anchor = uri.rsplit("#", 1)[-1] if "#" in uri else ref.get("refid")   # refid: on the same page
+        if anchor in targets:
+            ref.attributes.pop("refid", None)
+            full = targets[anchor]
+            ref["refuri"] = app.builder.get_relative_uri(docname, f"facade/{full}") + f"#{full}"
+
+
 def setup(app):
-    """Register the reference resolver."""
+    """Register the reference resolver and the ``facade-call`` directive."""
+    app.add_directive("facade-call", _facade_call_directive())
+    app.connect("doctree-read", _facade_context)
+    app.connect("doctree-resolved", _facade_links)
     app.connect("doctree-read", _widget_fallback)
     app.connect("env-updated", _forget_documented)
     app.connect("missing-reference", _resolve_in_defining_module, priority=900)

@@ -1,5 +1,5 @@
 """The speed claims' numbers: ``benchmarks/results.json`` (written by
-``python benchmarks/run.py``, issue 6). Which file is read is set per run by
+``python benchmarks/run.py``). Which file is read is set per run by
 :func:`use_results` (``chebnorm repro --bench-results``; default
 :func:`~.paths.bench_results`: ``./benchmarks/results.json`` when it exists);
 no file -> ``None``, so a later run picks the numbers up without code changes."""

@@ -29,7 +29,7 @@ __all__ = ["PAPERS", "DEFAULT_OUTPUT", "LEDGER_HOME", "DEFAULT_BENCH_RESULTS", "
 DEFAULT_OUTPUT = Path("figures")
 #: the ledger's home in a checkout, relative to the current directory
 LEDGER_HOME = Path("paper_repro")
-#: the speed measurements written by ``python benchmarks/run.py`` (issue 6), relative to the cwd
+#: the speed measurements written by ``python benchmarks/run.py``, relative to the cwd
 DEFAULT_BENCH_RESULTS = Path("benchmarks") / "results.json"
 #: the ledger's two files
 LEDGER_FILES = ("claims.json", "CLAIMS.md")

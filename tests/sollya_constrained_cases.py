@@ -152,7 +152,7 @@ def run():
     for case in CASES:
         expr, lo, hi, n, mons, fix, (fmt, bits), kind = case
         common = dict(kind="minimax", error=kind, monomials=mons, fix_constant=fix)
-        q = fit(expr, (lo, hi), n, coef_format=fmt, frac_bits=bits, **common)
+        q = fit(expr, (lo, hi), n, coef_format=fmt, coef_frac_bits=bits, **common)
         real = fit(expr, (lo, hi), n, **common) if (mons or fix) else fit(
             expr, (lo, hi), n, kind="minimax", error=kind)
         tables.append((case, q, real))

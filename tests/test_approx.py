@@ -178,8 +178,8 @@ class TestQuantize:
 
 class TestTable:
     def test_json_round_trip_and_determinism(self):
-        a = fit_target("midpoint", 2, frac_bits=20)
-        b = fit_target("midpoint", 2, frac_bits=20)
+        a = fit_target("midpoint", 2, coef_frac_bits=20)
+        b = fit_target("midpoint", 2, coef_frac_bits=20)
         assert a.to_json() == b.to_json()
         assert CoefficientTable.from_json(a.to_json()) == a
 

@@ -16,6 +16,7 @@ from conftest import requires_tool
 needs_yosys = requires_tool("yosys")
 needs_iverilog = requires_tool("iverilog")
 SPEC = ["1/sqrt(1+3*x)", "--interval", "0", "1", "--in-bits", "8", "--out-bits", "8"]
+NAME = "rsqrt_1_3_x_0_1_i8_o8"   # the default name's start (chebnorm.core.textsafe.design_name)
 
 
 @needs_yosys
@@ -24,7 +25,7 @@ def test_faithful_design_compares_every_architecture(tmp_path, capsys):
     assert main(["design", *SPEC, "--faithful", "--target", "xc7-nodsp", "--workers", "1",
                  "-o", str(out)]) == 0
     text = capsys.readouterr().out
-    rows = list(csv.DictReader((out / "design_design_architectures.csv").open()))
+    rows = list(csv.DictReader((out / f"design_{NAME}_faithful_architectures.csv").open()))
     archs = {r["architecture"] for r in rows}
     assert {"piecewise", "piecewise-sized", "multipartite", "table"} <= archs
     assert sum(int(r["winner"]) for r in rows) == 1
@@ -60,12 +61,12 @@ def test_each_architecture_winner_simulates_over_every_code(tmp_path):
 def test_correctly_rounded_builds_the_proved_table(tmp_path, capsys):
     out = tmp_path / "D"
     assert main(["design", *SPEC, "--correctly-rounded", "-o", str(out)]) == 0
-    rows = list(csv.DictReader((out / "design_design_architectures.csv").open()))
+    rows = list(csv.DictReader((out / f"design_{NAME}_cr_architectures.csv").open()))
     winner = next(r for r in rows if r["winner"] == "1")
     assert winner["architecture"] == "table" and "correctly rounded (proved)" in \
         winner["description"]
     assert float(winner["error"]) <= float(winner["ulp"]) / 2
-    assert (out / "chebnorm_design_table.v").exists()
+    assert (out / f"chebnorm_{NAME}_cr_table.v").exists()
 
 
 @pytest.mark.parametrize("bad", ["0", "-2^-16", "nan", "2^^3", "x"])
@@ -82,7 +83,9 @@ def test_max_error_takes_an_exact_power_of_two(tmp_path, capsys):
                  "-o", str(a)]) == 0
     assert main(["design", *SPEC, "--max-error", "0.015625", "--no-synth", "--workers", "1",
                  "-o", str(b)]) == 0
-    assert (a / "design_design.csv").read_bytes() == (b / "design_design.csv").read_bytes()
+    # the default name comes from the value: both runs name their design alike
+    assert (a / f"design_{NAME}_e_2_m6.csv").read_bytes() == \
+        (b / f"design_{NAME}_e_2_m6.csv").read_bytes()
 
 
 def _fake_candidates(models):

@@ -158,3 +158,120 @@ def test_absolute_values_in_displayed_math_stay_bars(built):
                                                   p.read_text(encoding="utf-8"), re.S)]
     assert blocks and not [b for b in blocks if "\\|" in b]
     assert any("|\\mathrm{fl}(p(x)) - p(x)|" in b for b in blocks)
+
+
+def _draws(source: str, drawers: set[str]) -> bool:
+    """Whether a code cell draws a matplotlib figure when it runs: a call, outside a
+    function body, of ``plt.show``, of a ``.plot`` method or of a function of the
+    notebook that draws (``drawers``, updated with the functions this cell defines)."""
+    import ast
+
+    tree = ast.parse("\n".join(line for line in source.splitlines() if not line.lstrip().startswith(("%", "!"))))
+
+    def calls(nodes):
+        for node in nodes:
+            for sub in ast.walk(node):
+                if isinstance(sub, ast.Call):
+                    f = sub.func
+                    if isinstance(f, ast.Attribute) and (f.attr == "plot" or (
+                            f.attr == "show" and isinstance(f.value, ast.Name) and f.value.id == "plt")):
+                        yield True
+                    elif isinstance(f, ast.Name) and f.id in drawers:
+                        yield True
+
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and any(calls(node.body)):
+            drawers.add(node.name)
+    top = [n for n in tree.body if not isinstance(n, (ast.FunctionDef, ast.ClassDef))]
+    return any(calls(top))
+
+
+def _page_cells(page: str) -> list[dict]:
+    """The code cells of a notebook's page in order: the section (heading) each is in,
+    the images its output shows and whether it holds the widget note."""
+    from html.parser import HTMLParser
+
+    class Cells(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.cells, self.depth, self.cell_depth, self.section = [], 0, None, 0
+
+        def handle_starttag(self, tag, attrs):
+            classes = (dict(attrs).get("class") or "").split()
+            if tag == "section":
+                self.section += 1
+            if tag == "div":
+                self.depth += 1
+                if self.cell_depth is None and "cell" in classes and "docutils" in classes:
+                    self.cell_depth = self.depth
+                    self.cells.append({"section": self.section, "images": 0, "widget_note": False})
+            if self.cell_depth is not None:
+                if tag == "img":
+                    self.cells[-1]["images"] += 1
+                if "widget-fallback" in classes:
+                    self.cells[-1]["widget_note"] = True
+
+        def handle_endtag(self, tag):
+            if tag == "div":
+                if self.cell_depth == self.depth:
+                    self.cell_depth = None
+                self.depth -= 1
+
+    parser = Cells()
+    parser.feed(page)
+    return parser.cells
+
+
+@pytest.mark.slow
+def test_every_notebook_figure_is_on_its_page(built):
+    """Each code cell of a notebook that draws a figure shows an image on its page, and
+    a slider cell's note ("the static figure above shows the same") follows the cell that
+    draws that figure: the static figure is drawn whether ipywidgets is installed or not."""
+    import json
+
+    for nb in sorted((REPO / "notebooks").glob("*.ipynb")):
+        code = ["".join(c["source"]) for c in json.loads(nb.read_text(encoding="utf-8"))["cells"]
+                if c["cell_type"] == "code"]
+        cells = _page_cells((built / "gallery" / "notebooks" / f"{nb.stem}.html").read_text(encoding="utf-8"))
+        assert len(cells) == len(code), f"{nb.name}: {len(cells)} cells on the page, {len(code)} in the notebook"
+        drawers: set[str] = set()
+        for i, (source, cell) in enumerate(zip(code, cells)):
+            if _draws(source, drawers):
+                assert cell["images"], f"{nb.name}, code cell {i}: draws a figure, none on the page"
+            if cell["widget_note"]:   # the static figure is the previous cell's, in the same section
+                above = cells[i - 1] if i else None
+                assert above and above["section"] == cell["section"] and above["images"], \
+                    f"{nb.name}, code cell {i}: 'the static figure above' but no figure just above"
+
+
+def test_draws_finds_the_figures_of_a_cell():
+    drawers: set[str] = set()
+    assert not _draws("def f(n=1):\n    plt.plot([n])\n    plt.show()\n", drawers) and drawers == {"f"}
+    assert _draws("f()", drawers) and _draws("t.plot()\nplt.show()", drawers)
+    assert not _draws("if widgets:\n    widgets.interact(f, n=3)", drawers)
+    assert not _draws("%matplotlib inline\nprint(1)", drawers)
+
+
+@pytest.mark.slow
+def test_facade_is_documented_under_the_names_users_type(built):
+    """``chebnorm.fit`` (not ``chebnorm.approx.fit``) carries the documentation; the stage
+    page lists ``chebnorm.approx.fit`` with a link to it; ``cn.export(...)`` and
+    ``cn.hw.report(...)`` are documented as calls, and their module pages link there."""
+    import chebnorm
+
+    api = (built / "api.html").read_text(encoding="utf-8")
+    for name, (module, attr) in chebnorm._LAZY.items():
+        page = (built / "facade" / f"chebnorm.{name}.html").read_text(encoding="utf-8")
+        assert f'id="chebnorm.{name}"' in page, name
+        assert f'href="facade/chebnorm.{name}.html#chebnorm.{name}"' in api, name
+        stage = (built / "generated" / f"{module}.html").read_text(encoding="utf-8")
+        entry = stage.split(f'id="{module}.{attr}"', 1)[1].split("</dd>", 1)[0]
+        assert f"#chebnorm.{name}" in entry, f"{module}.{attr} does not link to chebnorm.{name}"
+        assert "Parameters" not in entry, f"{module}.{attr} is documented twice"
+    fit = (built / "facade" / "chebnorm.fit.html").read_text(encoding="utf-8")
+    assert "Parameters" in fit
+    for call, module_page in (("export", "generated/chebnorm.export.html"),
+                              ("hw.report", "modules/chebnorm.hw.report.html")):
+        page = re.sub(r"<[^>]+>", "", (built / "facade" / f"chebnorm.{call}.html").read_text(encoding="utf-8"))
+        assert f"{call}(table" in page and "Parameters" in page, call
+        assert f'facade/chebnorm.{call}.html#facade-' in (built / module_page).read_text(encoding="utf-8")

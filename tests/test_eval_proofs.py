@@ -60,7 +60,7 @@ def _own(key):
         # plain powers: the shader evaluators take no shifted table
         return fit("exp(x)", ("1", "2"), 6, kind="minimax", name="own_exp_d6", basis="monomial")  # 2^23 float32s (on [0, 1]: 2^30, minutes in long double)
     if key == "rsqrt_d3_fixed":
-        return fit("1/sqrt(x)", ("1/2", "1"), 3, kind="minimax", frac_bits=16,
+        return fit("1/sqrt(x)", ("1/2", "1"), 3, kind="minimax", coef_frac_bits=16,
                    name="own_rsqrt_fixed")
     if key == "sin_odd":
         return fit("sin(x)", ("1/4", "1"), 7, monomials=[1, 3, 5, 7], coef_format="binary32",

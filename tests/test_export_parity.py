@@ -178,7 +178,7 @@ def test_glsl_parity_shader_runs_within_its_bound(case):
 def test_c_fixed_point_parity_evaluator_within_its_bound(tmp_path, expr, iv, n, frac, f, parity):
     from test_export import compile_and_run
 
-    t = fit(expr, iv, n, kind="minimax", frac_bits=frac, name="fx")
+    t = fit(expr, iv, n, kind="minimax", coef_frac_bits=frac, name="fx")
     fp = t.fixed_point
     assert fp is not None and all(q == 0 for k, q in enumerate(fp.integers) if k % 2 != parity)
     h = c_header(t)
@@ -221,7 +221,7 @@ def test_gappa_proves_the_integer_parity_bound(expr, iv, n, frac):
     script, and half of it is not."""
     from chebnorm.export.c import c_header_evaluators
 
-    t = fit(expr, iv, n, kind="minimax", frac_bits=frac, name="fx")
+    t = fit(expr, iv, n, kind="minimax", coef_frac_bits=frac, name="fx")
     ev = {e.constant: e for e in c_header_evaluators(t)[1]}["CHEBNORM_FX_Q_EVAL_ERROR_BOUND"]
     assert ev.parity == n % 2
     r = _gappa(ev)

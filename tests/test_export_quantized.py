@@ -47,7 +47,7 @@ CASES = {
                                               monomials=(0, 2, 4, 6), fix_constant=True),
                                          mpmath.cos, True, "even"),
     "exp_per_power_fixed": (dict(expr="exp(x)", interval=("0", "1"), degree=3, kind="minimax",
-                                 frac_bits=(10, 12, 14, 16)),
+                                 coef_frac_bits=(10, 12, 14, 16)),
                             mpmath.exp, True, None),
     "atan_binary64": (dict(expr="atan(x)", interval=("0", "1"), degree=9, kind="minimax",
                            coef_format="binary64"),
@@ -108,7 +108,7 @@ def test_quantized_evaluators_within_their_bounds(tmp_path, case):
 
 def test_plain_fixed_point_tables_keep_their_header():
     # a uniform fixed-point quantization is the table's fixed_point part: no second copy
-    t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z", name="d2", frac_bits=24)
+    t = fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z", name="d2", coef_frac_bits=24)
     assert t.fixed_point is not None and t.quantized is not None
     assert "_QUANT_" not in c_header(t)
 
@@ -124,5 +124,5 @@ def test_shader_uses_float32_exact_quantized_coefficients():
     # the lattice-chosen binary32 coefficients beat rounding the real ones to float32
     assert b.certified + b.coefficients <= b_plain.certified + b_plain.coefficients
     # a fixed-point quantization is not what a shader evaluates: the double coefficients stay
-    fixed = fit("exp(x)", ("0", "1"), 4, kind="minimax", frac_bits=20, name="t")
+    fixed = fit("exp(x)", ("0", "1"), 4, kind="minimax", coef_frac_bits=20, name="t")
     assert shader_source(fixed, "glsl") == shader_source(plain, "glsl")

@@ -79,7 +79,7 @@ def test_consumers_without_shifted_evaluation_refuse(tmp_path):
     # the shaders and the Verilog/VHDL evaluators take the shifted variable
     # (tests/test_export_shifted_shaders.py, tests/test_hdl_schemes.py)
     with pytest.raises(ValueError, match="basis shifted"):
-        fit("exp(x)", ("0", "1"), 2, basis="shifted", frac_bits=12)
+        fit("exp(x)", ("0", "1"), 2, basis="shifted", coef_frac_bits=12)
 
 
 @pytest.mark.requires_tool("gcc")

@@ -108,10 +108,10 @@ def test_relative_error_and_removable_singularity():
 def test_segments_auto_fewest_segments():
     E = 1e-5
     t = cn.fit("1/sqrt(x)", (1, 4), 2, kind="minimax", segments="auto", max_error=E,
-               frac_bits=24)
+               coef_frac_bits=24)
     assert t.abs_error_bound <= E
     half = cn.fit("1/sqrt(x)", (1, 4), 2, kind="minimax", segments=t.segment_count // 2,
-                  frac_bits=24)
+                  coef_frac_bits=24)
     assert half.abs_error_bound > E
     search = t.provenance["segment_search"].removeprefix("segment counts tried: ").split("; ")
     assert int(search[-1].split(":")[0]) == t.segment_count and "certified" in search[-1]

@@ -153,7 +153,7 @@ def test_exported_to_c_shaders_and_hdl():
     t = cn.fit("sin(x)/x", (-1, 1), 8, kind="minimax")
     for fmt in ("c", "glsl", "wgsl", "hlsl"):
         assert "ABS_ERROR_BOUND" in export_text(t, fmt)
-    q = cn.fit("(exp(x)-1)/x", (-1, 1), 6, kind="minimax", frac_bits=24)
+    q = cn.fit("(exp(x)-1)/x", (-1, 1), 6, kind="minimax", coef_frac_bits=24)
     assert q.fixed_point.abs_error_bound < 1e-6
     assert "module" in export_text(q, "verilog", in_bits=16, out_bits=16)
 
@@ -255,7 +255,7 @@ def test_piecewise_segments_around_the_point():
     """Segments meeting at 0 and one containing it (batch certification composes the
     Taylor enclosure with each segment's affine map): the bound holds against mpmath
     on every segment and is within 1% of the largest error seen."""
-    t = cn.fit("sin(x)/x", ("-1", "3/2"), 3, kind="minimax", segments=8, frac_bits=30)
+    t = cn.fit("sin(x)/x", ("-1", "3/2"), 3, kind="minimax", segments=8, coef_frac_bits=30)
     worst = 0
     with mpmath.workprec(120):
         for s in range(t.segment_count):

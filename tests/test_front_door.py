@@ -15,6 +15,7 @@ NARRATION = [
     r"\bruns? \d+ (to|and) \d+\b", r"\bsession\b", r"\bbefore (this|the) (change|work)",
     r"\bat the start of this work\b", r"\bmeasured on 20\d\d-\d\d-\d\d", r"\bissue[- ]\d+\b",
     r"\bearlier releases?\b", r"\btried and not kept\b", r"\bno longer\b",
+    r"\b\d{4}-\d\d-\d\d \((morning|afternoon|evening|later)\)", r"\bin \w+ of \w+ runs\b",
 ]
 
 
@@ -27,7 +28,7 @@ def test_readme_is_short_and_starts_with_the_quickstart():
 
 
 @pytest.mark.parametrize("page", ["README.md"] + sorted(
-    str(p.relative_to(ROOT)) for p in (ROOT / "docs").glob("*.md") if p.name != "changelog.md"))
+    str(p.relative_to(ROOT)) for p in (ROOT / "docs").glob("*.md")))
 def test_no_development_narration(page):
     text = " ".join((ROOT / page).read_text(encoding="utf-8").split())
     found = [m.group(0) for pattern in NARRATION for m in re.finditer(pattern, text, re.I)]

@@ -329,7 +329,7 @@ class TestHostileText:
 
         from chebnorm.cli import main
 
-        table = fit_target("dichotomy", 2, frac_bits=18).to_dict()
+        table = fit_target("dichotomy", 2, coef_frac_bits=18).to_dict()
         folder = tmp_path / self.EVIL
         folder.mkdir()
         # an expression carrying a comment-closer is refused when the table is read
@@ -358,7 +358,7 @@ class TestHostileText:
     def test_hostile_table_name_refused(self, tmp_path, capsys, name):
         from chebnorm.cli import main
 
-        table = fit_target("dichotomy", 2, frac_bits=18).to_dict()
+        table = fit_target("dichotomy", 2, coef_frac_bits=18).to_dict()
         table["name"] = name
         (tmp_path / "t.json").write_text(json.dumps(table))
         out = tmp_path / "out"

@@ -78,8 +78,8 @@ def test_var_must_be_a_string_or_symbol():
 
 
 def test_piecewise_fit_from_a_callable():
-    a = cn.fit(lambda x: 1 / np.sqrt(x), ("1", "4"), 1, segments=4, frac_bits=16)
-    b = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16)
+    a = cn.fit(lambda x: 1 / np.sqrt(x), ("1", "4"), 1, segments=4, coef_frac_bits=16)
+    b = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
     assert a.segments == b.segments and a.abs_error_bound == b.abs_error_bound
 
 
@@ -215,7 +215,7 @@ def test_asarray_gives_the_coefficients_not_an_object():
     a = np.asarray(t)
     assert a.dtype == np.float64 and a.shape == (5,) and tuple(a) == t.coefficients
     assert np.asarray(t, dtype=np.float32).dtype == np.float32
-    pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, segments=8, frac_bits=20)
+    pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, segments=8, coef_frac_bits=20)
     b = np.asarray(pw)
     assert b.dtype == np.float64 and b.shape == (8, 3)
     assert [tuple(r) for r in b] == [pw.coefficients(s) for s in range(8)]
@@ -224,7 +224,7 @@ def test_asarray_gives_the_coefficients_not_an_object():
 @pytest.mark.parametrize("segment_by,centered", [("uniform", False), ("uniform", True),
                                                  ("exponent", False)])
 def test_piecewise_to_sympy_evaluates_as_the_table(segment_by, centered):
-    pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, segments=4, frac_bits=20, segment_by=segment_by,
+    pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, segments=4, coef_frac_bits=20, segment_by=segment_by,
                 centered=centered)
     expr = pw.to_sympy()
     assert isinstance(expr, sp.Piecewise) and len(expr.args) == pw.segment_count
@@ -334,7 +334,7 @@ def test_error_curve_of_a_shifted_table_is_within_its_bound():
 
 
 def test_piecewise_c_in_bits_named_as_argument_and_as_flag(tmp_path, capsys):
-    pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16)
+    pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16)
     with pytest.raises(ValueError, match=r"^in_bits = 1 is out of range; accepted: 2 <= in_bits"):
         cn.export(pw, "c", in_bits=1)
     pw.save(tmp_path / "pw.json")

@@ -28,7 +28,7 @@ def tables(tmp_path_factory):
     d = tmp_path_factory.mktemp("tables")
     plain = cn.fit("1/sqrt(2+x)", ("0", "1"), 2, name="rs")
     q = cn.quantize(plain, 16)
-    pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16, name="pw")
+    pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="pw")
     q.save(d / "q.json")
     plain.save(d / "plain.json")
     pw.save(d / "pw.json")
@@ -111,7 +111,7 @@ CASES = {
                    "--max-error", "1e-2", "--no-synth", "-o", d / "D"],
         "--in-bits = 1 is out of range; accepted: 2 <= --in-bits <= 20"),
     "piecewise fit coef_frac_bits": (
-        lambda t: cn.fit("1/sqrt(x)", ("1", "4"), 3, segments=4, frac_bits=62),
+        lambda t: cn.fit("1/sqrt(x)", ("1", "4"), 3, segments=4, coef_frac_bits=62),
         "coef_frac_bits = 62 is out of range; accepted: 0 <= coef_frac_bits <= 48",
         lambda t, d: ["fit", "1/sqrt(x)", "--interval", 1, 4, "--degree", 3, "--segments", 4,
                    "--coef-frac-bits", 62],

@@ -202,8 +202,8 @@ def test_design_cli(tmp_path):
             "--no-synth", "-o", str(tmp_path / "out")]
     r = run_cli_quiet(*argv)
     assert r.code == 0, r.err
-    assert (tmp_path / "out" / "design_design.csv").read_text().startswith("degree,segments")
-    assert (tmp_path / "out" / "design_design.png").stat().st_size > 1000
+    assert (tmp_path / "out" / "design_rsqrt_1_4_i10_o10_e_0p002.csv").read_text().startswith("degree,segments")
+    assert (tmp_path / "out" / "design_rsqrt_1_4_i10_o10_e_0p002.png").stat().st_size > 1000
     assert "winner: degree" in r.out
     bad = argv[:]
     bad[bad.index("2e-3")] = "-1"

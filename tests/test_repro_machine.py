@@ -375,7 +375,7 @@ res = {"blas_own": h(np.linalg.solve(a, b).tobytes() + (a @ b).tobytes())}
 import chebnorm as cn
 from chebnorm.approx import fit_target
 for name, d in (("rsqrt", 3), ("dichotomy", 2)):
-    res[f"target {name}"] = h(fit_target(name, d, frac_bits=24).to_json().encode())
+    res[f"target {name}"] = h(fit_target(name, d, coef_frac_bits=24).to_json().encode())
 for expr, iv, d, err in (("exp(x)", ("0", "1"), 9, "abs"), ("acos(x)", ("-0.9", "0.9"), 12, "rel"),
                          ("1/sqrt(x)", ("1", "4"), 6, "rel")):
     res[f"fit {expr}"] = h(cn.fit(expr, iv, d, "minimax", err).to_json().encode())
@@ -383,7 +383,7 @@ for expr, iv, d, mons in (("sin(x)", ("-1/8", "1/8"), 7, (1, 3, 5, 7)),
                           ("atan(x)", ("0", "1"), 7, (1, 3, 5, 7)),
                           ("cos(x)", ("-pi/4", "pi/4"), 6, None)):
     res[f"powers {expr}"] = h(cn.fit(expr, iv, d, "minimax", monomials=mons).to_json().encode())
-pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=32, frac_bits=20)
+pw = cn.fit("1/sqrt(x)", ("1", "4"), 2, kind="minimax", segments=32, coef_frac_bits=20)
 res["piecewise"] = h(pw.to_json().encode())
 from paper_repro.criterion import interior_min_norm
 v = rng.normal(size=(3, 500, 3))

@@ -33,7 +33,7 @@ def results():
         warnings.simplefilter("ignore")
         t = cn.quantize(cn.fit("1/sqrt(2+x)", ("0", "1"), 2, name="rs"), 16)
         d = hw.design_horner(t, 10, 10)
-        pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, frac_bits=16, name="pw")
+        pw = cn.fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="pw")
         unit = hw.design_unit("classic", frac_bits=6)
         mp = hw.design_multipartite("1/sqrt(x)", ("1", "4"), 8, 8)
         search = hw_search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1, 2),

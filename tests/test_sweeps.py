@@ -39,7 +39,7 @@ def cluster():
 # ------------------------------------------------------------------ design
 @pytest.mark.slow
 @pytest.mark.parametrize("argv, outputs", [
-    (DESIGN, ("design_design.csv", "design_design.png")),
+    (DESIGN, ("design_rsqrt_1_4_i8_o8_e_0p01.csv", "design_rsqrt_1_4_i8_o8_e_0p01.png")),
     (PIECEWISE_SWEEP, ("sweep_piecewise.csv", "sweep_piecewise.png")),
 ], ids=["design", "hw-sweep-segments"])
 def test_design_same_bytes_for_any_workers(tmp_path, cluster, argv, outputs):

@@ -425,7 +425,7 @@ def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
 @pytest.mark.parametrize("table,bits,kw", [
     ("rsqrt_d3.json", 9, {"rounding": "trunc"}),
     ("midpoint_d1.json", 8, {}),
-    ("eta_term_d2.json", 8, {"coef_bits": 12, "acc_bits": 6}),
+    ("eta_term_d2.json", 8, {"coef_frac_bits": 12, "acc_bits": 6}),
 ])
 def test_vhdl_pipelined_and_combinational_agree_with_verilog(tmp_path, table, bits, kw):
     from chebnorm.hw.report import analyze, verilog_outputs
@@ -565,7 +565,7 @@ def test_vhdl_matches_the_model_on_fresh_fits(tmp_path, spec):
     from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
 
     expr, iv, deg, wi, wo, rounding = spec
-    t = fit(expr, iv, deg, name=f"f{deg}", frac_bits=20)
+    t = fit(expr, iv, deg, name=f"f{deg}", coef_frac_bits=20)
     r = analyze(t, wi, wo, rounding=rounding, gappa=False, synth=False)
     files = vhdl_outputs(r, pipelined=deg >= 1)
     for k, v in files.items():

@@ -341,7 +341,7 @@ def test_registered_targets_fit_as_committed():
     from chebnorm.approx import fit_target
     for name, degree in (("dichotomy", 2), ("rsqrt", 3)):
         committed = json.loads((root / f"{name}_d{degree}.json").read_text())
-        t = fit_target(name, degree, frac_bits=24)
+        t = fit_target(name, degree, coef_frac_bits=24)
         assert list(t.coefficients) == committed["coefficients"]
         assert t.abs_error_bound == committed["abs_error_bound"]
         assert t.rel_error_bound == committed["rel_error_bound"]
@@ -398,7 +398,7 @@ def in_tmp(tmp_path, monkeypatch):
 @pytest.fixture(scope="module")
 def table_json():
     return json.loads(fit("1/sqrt(2+z)", ("sqrt(2)", "2"), 2, var="z", name="t",
-                          frac_bits=16).to_json())
+                          coef_frac_bits=16).to_json())
 
 
 @pytest.mark.parametrize("text", HOSTILE_NUL)

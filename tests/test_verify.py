@@ -26,7 +26,7 @@ needs_gcc = requires_tool("gcc")
 @pytest.fixture(scope="module")
 def table():
     # 8193 float32 in [1, 1 + 2^-10]; a fixed-point part (16385 codes)
-    return fit("1/sqrt(x)", ("1", "1 + 2**-10"), 2, name="rsv", frac_bits=24)
+    return fit("1/sqrt(x)", ("1", "1 + 2**-10"), 2, name="rsv", coef_frac_bits=24)
 
 
 @pytest.fixture(scope="module")

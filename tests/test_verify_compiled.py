@@ -25,7 +25,7 @@ BOUND = "CHEBNORM_RSC_F_EVAL_ERROR_BOUND"
 
 @pytest.fixture(scope="module")
 def table():
-    return fit("1/sqrt(x)", ("1", "1 + 2**-10"), 2, name="rsc", frac_bits=24)
+    return fit("1/sqrt(x)", ("1", "1 + 2**-10"), 2, name="rsc", coef_frac_bits=24)
 
 
 @pytest.fixture(scope="module")

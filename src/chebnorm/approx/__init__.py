@@ -80,4 +80,4 @@ def fit_target(name: str, degree: int, *, psi_max="pi/4", kind: str | None = Non
                var=t.variable, name=f"{name}_d{degree}", coef_frac_bits=frac_bits,
                basis="monomial",  # the papers' polynomials, in powers of the variable
                command=f"chebnorm.approx.fit_target({name!r}, {degree}, psi_max={psi_max!r}, "
-                       f"kind={(kind or t.kind)!r}, error={error!r}, frac_bits={frac_bits!r})")
+                       f"kind={(kind or t.kind)!r}, error={error!r}, coef_frac_bits={frac_bits!r})")

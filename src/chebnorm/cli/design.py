@@ -57,7 +57,10 @@ def register(sub) -> None:
                    "the segment; exponent: 1/sqrt(x) only, x = code / 2^in-bits with --interval "
                    "2^-m 1, a leading-zero count picks the binade pair, the output is a "
                    "mantissa (--out-bits) and a shift (chebnorm.hw.exponent)")
-    p.add_argument("--name", default="design", help="module name (an identifier)")
+    p.add_argument("--name", default=None,
+                   help="module name (an identifier; default: from EXPR, the interval, the "
+                   "widths and the accuracy, e.g. rsqrt_1_4_i8_o8_faithful, so different "
+                   "designs' modules coexist in one build)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
                    help="folder for design_NAME.csv/.png (created if missing)")
     add_parallel_args(p)
@@ -97,6 +100,8 @@ def run(args) -> int:
     from chebnorm.core.textsafe import identifier
     from chebnorm.hw.targets import get_target
 
+    if getattr(args, "name", None) is None:
+        args = _with_default_name(args)
     if getattr(args, "index", "uniform") == "exponent":
         from .design_exponent import run_exponent
 
@@ -150,6 +155,32 @@ def run(args) -> int:
                args.out_bits, "-o", "DIR", "--simulate"]
     print(f"reproduce: {shell_words(fit)} && {shell_words(verilog)}")
     return 0
+
+
+def _with_default_name(args):
+    """A copy of ``args`` whose ``name`` is the spec's default
+    (:func:`chebnorm.core.textsafe.design_name`): the expression, interval,
+    widths, accuracy and index, so two designs' modules never collide."""
+    import argparse
+
+    from chebnorm.core.textsafe import design_name
+
+    if getattr(args, "faithful", False):
+        tags = ["faithful"]
+    elif getattr(args, "correctly_rounded", False):
+        tags = ["cr"]
+    else:  # by value: 2^-6 and 0.015625 name the same design
+        try:
+            e = max_error_value(args.max_error)
+        except ValueError:   # refused with its message by run()
+            e = None
+        m, k = math.frexp(e) if e is not None else (None, None)
+        tags = ["e", str(args.max_error) if e is None else f"2^{k - 1}" if m == 0.5 else repr(e)]
+    if getattr(args, "index", "uniform") == "exponent":
+        tags.append("lz")
+    name = design_name(args.expr, tuple(args.interval), args.in_bits, args.out_bits,
+                       var=args.var, tags=tags)
+    return argparse.Namespace(**dict(vars(args), name=name))
 
 
 def _frequency(args, target):

@@ -12,7 +12,10 @@ from .vocab import UNIT_NAMES
 
 def _design_args(p) -> None:
     p.add_argument("table", metavar="TABLE.json")
-    p.add_argument("--in-bits", type=int, required=True, help="input code width, 1..20")
+    p.add_argument("--in-bits", type=int, required=True,
+                   help="input code width W, 1..20: code k is x = LO + (HI - LO) k / 2^W on the "
+                   "table's [LO, HI) as in chebnorm design, when HI - LO is a power of two "
+                   "(see --x-frac-bits; docs/hardware.md, Input codes)")
     p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
     p.add_argument("--coef-frac-bits", dest="coef_bits", type=int, default=None, metavar="B",
                    help="coefficient fractional bits, 1..31 or fewer: the table's coefficients "
@@ -21,7 +24,11 @@ def _design_args(p) -> None:
     p.add_argument("--acc-bits", type=int, default=None,
                    help="accumulator fractional bits (default: output's + 3)")
     p.add_argument("--rounding", default="rne", help="rne (default) or trunc")
-    p.add_argument("--x-frac-bits", type=int, default=None, help="default: the largest that fits")
+    p.add_argument("--x-frac-bits", type=int, default=None, metavar="F",
+                   help="input fractional bits; default W - log2(HI - LO) (every code valid) "
+                   "when HI - LO is a power of two and LO a multiple of the step, else the "
+                   "largest whose codes cover [LO, HI] (the report names the valid codes); "
+                   "another F: the covering mapping x = (floor(LO 2^F) + k) / 2^F")
     p.add_argument("--y-frac-bits", type=int, default=None, help="default: the largest that fits")
 
 

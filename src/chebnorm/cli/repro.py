@@ -180,9 +180,22 @@ def register(sub) -> None:
 
 
 def _run_job(item) -> int:
-    """Run the repro job ``name`` into ``out`` (on a worker); the number of files written."""
+    """Run the repro job ``name`` into ``out`` (on a worker); the number of files written.
+
+    A render's first compile on an empty numba cache is announced by a
+    :class:`~chebnorm.raster.engines.numba.jit.NumbaCompileWarning` (for one
+    ``render`` call that takes seconds for no visible reason); repro's progress
+    bar and its closing line already show the time, and each worker process would
+    print the note again inside the bar, so it is not issued here. Every other
+    warning (chebnorm's own among them) passes."""
+    import warnings
+
+    from chebnorm.raster.engines.numba.jit import NumbaCompileWarning
+
     name, out, bench, ledger_dir = item
-    return len(jobs()[name](Path(out), bench_results=bench, ledger_dir=ledger_dir) or [])
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=NumbaCompileWarning)
+        return len(jobs()[name](Path(out), bench_results=bench, ledger_dir=ledger_dir) or [])
 
 
 def run(args) -> int:

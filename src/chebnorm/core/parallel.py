@@ -176,24 +176,58 @@ def _run_processes(fn, items, workers, done):
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_ignores_ctrl_c)
+    finished_all = False
     try:
         pending = {pool.submit(fn, x): i for i, x in enumerate(items)}
         while pending:
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
             for fut in sorted(finished, key=pending.get):
                 done(pending.pop(fut), fut.result())
-    except BaseException:
-        # Ctrl-C or an error: drop the queued items and stop the running ones now
-        # (shutdown alone lets them compute on, and the exit waits for them)
+        finished_all = True
+    finally:
+        if finished_all:
+            pool.shutdown(wait=True)
+        else:
+            _stop(pool)
+
+
+def _worker_ignores_ctrl_c() -> None:
+    """A worker's SIGINT does nothing: Ctrl-C in a terminal reaches the whole
+    process group, and the parent stops the workers itself (:func:`_stop`); an
+    idle worker would otherwise print a ``KeyboardInterrupt`` traceback. A
+    Python handler, not ``SIG_IGN``: the programs a worker runs (yosys, a C
+    compiler) get the default action back at ``exec`` and stop at Ctrl-C."""
+    import signal
+
+    signal.signal(signal.SIGINT, lambda signum, frame: None)
+
+
+def _stop(pool) -> None:
+    """Ctrl-C or an error: drop the queued items and stop the running ones now
+    (``shutdown`` alone lets them compute on, and the exit waits for them), then
+    reap the workers, so the process exits at once with nothing left running and
+    every queue and semaphore released (no resource-tracker warning). A second
+    Ctrl-C meanwhile does not cut this short."""
+    import signal
+    import threading
+
+    # signals are handled in the main thread only; None: a handler not set from Python
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main else None
+    if previous is not None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
         processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         for proc in processes:
             proc.terminate()
         for proc in processes:
             proc.join(timeout=5)
-        raise
-    pool.shutdown(wait=True)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 def _run_dask(fn, items, scheduler, done):

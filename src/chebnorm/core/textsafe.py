@@ -30,7 +30,7 @@ from __future__ import annotations
 import hashlib
 import re
 
-__all__ = ["identifier", "default_name", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
+__all__ = ["identifier", "default_name", "design_name", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
 
 #: the identifiers accepted in generated sources (a regular expression; at most 63 characters)
 IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
@@ -81,21 +81,83 @@ def default_name(expression: str, interval, degree: int, var: str = "x",
     >>> default_name("exp(-x**2)", ("0", "1/2"), 4, segments=8)
     'exp_mx_2_0_1_2_d4_s8'
     """
+    parts = _spec_words(expression, interval, var) + [f"d{degree}"]
+    if segments is not None:
+        parts.append(f"s{segments}")
+    return _join(parts, _MAX_IDENT)
+
+
+#: the longest default design name: its modules append ``_table``, ``_mp``, ``_core``
+#: or ``_sized_dN`` (and a pipeline stage suffix) and must stay within 63 characters
+_MAX_DESIGN = 44
+
+
+def design_name(expression: str, interval, in_bits: int, out_bits: int, var: str = "x",
+                tags=()) -> str:
+    """The name a hardware design gets when none is given: its expression,
+    interval, input and output widths (and ``tags``, e.g. the accuracy asked)
+    made an identifier by the rule of :func:`default_name`, so the modules of
+    different designs never collide in one synthesis run.
+
+    The name is at most 44 characters (cut and ended by six hex digits of a
+    hash of the whole text when longer), so the modules derived from it
+    (``NAME_table``, ``NAME_sized_d3``, ...) are identifiers too. It never
+    holds two underscores in a row nor starts or ends with one: a VHDL
+    basic identifier as well as a Verilog and C one.
+
+    Parameters
+    ----------
+    expression : str
+        The function's text, as given.
+    interval : (str, str)
+        The endpoints' texts, as given.
+    in_bits, out_bits : int
+        The input and output code widths.
+    var : str, optional
+        The variable.
+    tags : sequence of str, optional
+        Further texts appended in order (their letters-and-digits runs).
+
+    Returns
+    -------
+    str
+        An identifier (:func:`identifier` accepts it).
+
+    Examples
+    --------
+    >>> design_name("1/sqrt(x)", ("1", "4"), 8, 8, tags=("faithful",))
+    'rsqrt_1_4_i8_o8_faithful'
+    >>> design_name("log2(1+x)", ("0", "1"), 10, 12, tags=("e", "2^-10"))
+    'log2_1_x_0_1_i10_o12_e_2_m10'
+    """
+    parts = _spec_words(expression, interval, var)
+    parts += [f"i{in_bits}".replace("-", "m"), f"o{out_bits}".replace("-", "m")]
+    for tag in tags:
+        parts += _words(str(tag))
+    return _join(parts, _MAX_DESIGN)
+
+
+def _spec_words(expression, interval, var) -> list[str]:
+    """The words naming a function on an interval: ``1/f(...)`` reads ``rf``,
+    a single call ``f(var)`` drops the variable, then both endpoints."""
     text = str(expression).replace(" ", "")
     if text.startswith("1/") and re.match(r"[A-Za-z]", text[2:3]):
         text = "r" + text[2:]
     head = _words(text)
     if len(head) == 2 and head[1] == var and text == f"{head[0]}({var})":
         head = head[:1]
-    parts = head + _words(str(interval[0])) + _words(str(interval[1])) + [f"d{degree}"]
-    if segments is not None:
-        parts.append(f"s{segments}")
+    return head + _words(str(interval[0])) + _words(str(interval[1]))
+
+
+def _join(parts, limit: int) -> str:
+    """``parts`` joined by ``_``, led by ``f`` unless a letter starts it, at most
+    ``limit`` characters (a longer one cut, ending in a hash of the whole)."""
     name = "_".join(parts)
     if not re.match(r"[A-Za-z_]", name):
         name = "f" + name
-    if len(name) > _MAX_IDENT:
+    if len(name) > limit:
         digest = hashlib.sha256(name.encode()).hexdigest()[:6]
-        name = name[:_MAX_IDENT - 7].rstrip("_") + "_" + digest
+        name = name[:limit - 7].rstrip("_") + "_" + digest
     return identifier(name)
 
 

@@ -550,7 +550,11 @@ def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarra
     na, nb, nc : array_like of int
         The three vertex normals, codes of shape ``(..., 3)``.
     design : HornerDesign
-        The polynomial evaluator ``g`` of ``sqrt(2(1 + x))/2``.
+        The polynomial evaluator ``g`` of ``sqrt(2(1 + x))/2``; the dot products
+        reach 1, so its input format should cover ``[0, 1]`` (``x_frac_bits=``
+        :func:`~chebnorm.hw.horner.cover_frac_bits`, as the eta unit's evaluator):
+        under the input-code mapping onto ``[0, 1)`` ``x = 1`` saturates to
+        ``1 - 2**-in_bits``.
     frac_bits : int
         ``F``: fractional bits of the vector components, ``>= 0``.
 
@@ -562,8 +566,9 @@ def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarra
     Examples
     --------
     >>> from chebnorm.approx import fit_target
-    >>> from chebnorm.hw.horner import design_horner
-    >>> d = design_horner(fit_target("eta_term", 2), 10, 10, coef_bits=14)
+    >>> from chebnorm.hw.horner import cover_frac_bits, design_horner
+    >>> t = fit_target("eta_term", 2)
+    >>> d = design_horner(t, 10, 10, coef_bits=14, x_frac_bits=cover_frac_bits(t, 10))
     >>> n = np.array([[1 << 8, 0, 0]])
     >>> eta = eta_criterion(n, n, n, d, 8)   # three equal normals: eta = 3 - 3 g(1) = 0
     >>> from chebnorm.hw.budget import error_budget

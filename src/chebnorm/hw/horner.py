@@ -20,11 +20,19 @@ Each step is a multiply-add done exactly, then one rounding (``R_F``: to
 is subtracted after rounding (exactly, it is a multiple of ``2**-Fy``).
 Every intermediate wire is sized from its exact range over *all*
 ``2**in_bits`` input codes, so nothing but the output ever overflows, and
-the output saturates. The input format maps the table's interval onto the
-codes (``Fx`` as large as the interval allows); codes whose value lies
-outside the table's interval are *invalid*: the circuit still answers (and
-the test bench checks it), but the error budget holds on the valid codes,
-whose range :attr:`HornerDesign.valid_codes` reports.
+the output saturates.
+
+Input codes (docs/hardware.md, "Input codes"): the ``W``-bit code ``k``
+stands for ``x_k = lo + (hi - lo) k / 2**W`` on ``[lo, hi)``, as in
+``chebnorm design`` and :mod:`chebnorm.hw.exhaustive`, whenever that is a
+fixed-point format (``hi - lo`` a power of two, ``lo`` a multiple of the
+step: ``Fx = W - log2(hi - lo)``, :func:`code_frac_bits`); every code is
+then valid. Otherwise the format *covers* ``[lo, hi]`` with the largest
+``Fx`` (:func:`cover_frac_bits`) and codes whose value lies outside the
+table's interval are *invalid*: the circuit still answers (and the test
+bench checks it), but the error budget holds on the valid codes, whose range
+:attr:`HornerDesign.valid_codes` reports. An explicit ``x_frac_bits`` other
+than the input-code one asks for the covering mapping.
 
 >>> from chebnorm.approx import fit_target
 >>> d = design_horner(fit_target("dichotomy", 2), 16, 16, coef_bits=20)
@@ -53,7 +61,8 @@ from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, s
                     unsigned_bits)
 
 __all__ = ["HornerDesign", "Stage", "SCHEMES", "design_horner", "MAX_IN_BITS", "MAX_OUT_BITS",
-           "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits"]
+           "MAX_FRAC_BITS", "max_coef_bits", "check_coef_bits", "code_frac_bits",
+           "cover_frac_bits"]
 
 #: widest input code of a Horner design (its model and test bench run all ``2**in_bits`` codes)
 MAX_IN_BITS = 20
@@ -144,7 +153,8 @@ class HornerDesign:
     rounding : {"rne", "trunc"}
         Rounding of every step (:data:`~chebnorm.hw.fixed.ROUNDINGS`).
     x_format : QFormat
-        The input format: code ``k`` stands for ``(offset_code + k) / 2**Fx``.
+        The input format: code ``k`` stands for ``(offset_code + k) / 2**Fx``
+        (``lo + (hi - lo) k / 2**in_bits`` when the interval allows; module docstring).
     y_format : QFormat
         The output format.
     coef_frac_bits : int
@@ -162,7 +172,8 @@ class HornerDesign:
     raw_bits : int
         Signed width of ``y_raw`` (after subtracting the output offset).
     valid_codes : tuple of (int, int)
-        First and last input code whose value lies in the table's interval.
+        First and last input code whose value lies in the table's interval
+        (every code, ``(0, 2**in_bits - 1)``, under the input-code mapping).
     notes : tuple of str, default ()
         Remarks on the sizing, for the report.
     scheme : {"monomial", "even", "odd", "shifted"}, default "monomial"
@@ -525,37 +536,152 @@ def _require_fixed_point(table: CoefficientTable, coef_bits):
     return table
 
 
+def _interval_rationals(table: CoefficientTable):
+    """The table's endpoints as exact Fractions, or None when one is irrational."""
+    lo, hi = (parse_number(v) for v in table.interval)
+    if not (lo.is_Rational and hi.is_Rational):
+        return None
+    return Fraction(int(lo.p), int(lo.q)), Fraction(int(hi.p), int(hi.q))
+
+
+def code_frac_bits(table: CoefficientTable, in_bits: int) -> int | None:
+    """The ``x_frac_bits`` of the input-code convention on the table's interval,
+    or None when that convention is not a fixed-point format there.
+
+    A ``W``-bit input code ``k`` stands for ``x_k = lo + (hi - lo) k / 2**W``
+    on ``[lo, hi)`` (as ``chebnorm design`` and :mod:`chebnorm.hw.exhaustive`
+    map it). That is the format ``x = (K0 + k) / 2**F`` exactly when
+    ``hi - lo = 2**(W - F)`` and ``lo`` is a multiple of ``2**-F``: then
+    ``F = W - log2(hi - lo)`` is returned (``|F| <=`` :data:`MAX_FRAC_BITS`),
+    and every code ``0 .. 2**W - 1`` lies in the interval.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table whose interval the codes map onto.
+    in_bits : int
+        The width ``W`` of the input code, 1 to :data:`MAX_IN_BITS`.
+
+    Returns
+    -------
+    int or None
+        ``F``, or None when ``hi - lo`` is not a power of two, ``lo`` is not a
+        multiple of ``2**-F``, an endpoint is irrational, or ``|F|`` exceeds
+        :data:`MAX_FRAC_BITS`.
+
+    Raises
+    ------
+    ValueError
+        If ``in_bits`` is out of range.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> code_frac_bits(fit("exp(x)", ("0", "1"), 2), 12)       # x_k = k / 2^12
+    12
+    >>> code_frac_bits(fit("exp(x)", ("1", "3"), 2), 12)       # x_k = 1 + 2 k / 2^12
+    11
+    >>> code_frac_bits(fit("exp(x)", ("0", "3"), 2), 12) is None   # width 3: not a power of two
+    True
+    """
+    in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
+    ends = _interval_rationals(table)
+    if ends is None:
+        return None
+    lo, hi = ends
+    width = hi - lo
+    if width <= 0 or width.numerator & (width.numerator - 1) or \
+            width.denominator & (width.denominator - 1):
+        return None
+    e = width.numerator.bit_length() - width.denominator.bit_length()   # width = 2**e
+    f = in_bits - e
+    if abs(f) > MAX_FRAC_BITS or (lo * Fraction(2) ** f).denominator != 1:
+        return None
+    return f
+
+
+def cover_frac_bits(table: CoefficientTable, in_bits: int) -> int:
+    """The largest ``x_frac_bits`` whose ``2**in_bits`` codes cover the closed
+    interval ``[lo, hi]`` with the offset ``floor(lo * 2**F)`` (the covering
+    mapping: ``hi`` itself is a code, some codes may lie outside).
+
+    Passed as ``x_frac_bits`` to :func:`design_horner` it gives the covering
+    mapping, for an input that reaches ``hi`` (a dot product of unit vectors
+    reaching 1, in the normalization units); see "Input codes" in
+    docs/hardware.md.
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        The table whose interval the codes must cover.
+    in_bits : int
+        The width of the input code, 1 to :data:`MAX_IN_BITS`.
+
+    Returns
+    -------
+    int
+        The fractional bits, ``-MAX_FRAC_BITS`` to :data:`MAX_FRAC_BITS`.
+
+    Raises
+    ------
+    ValueError
+        If ``in_bits`` is out of range, or no such format exists.
+
+    Examples
+    --------
+    >>> from chebnorm.approx import fit
+    >>> cover_frac_bits(fit("exp(x)", ("0", "1"), 2), 12)   # codes 0..2048 of 4096 in [0, 1]
+    11
+    """
+    in_bits = check_width(in_bits, "in_bits", 1, MAX_IN_BITS)
+    lo, hi = (parse_number(v) for v in table.interval)
+    width = float(sp.N(hi - lo, 20))
+    f = min(MAX_FRAC_BITS, in_bits - math.floor(math.log2(width)) + 1)
+    while f >= -MAX_FRAC_BITS:
+        if _covers(lo, hi, in_bits, f)[1]:
+            return f
+        f -= 1
+    raise ValueError(f"table {table.name!r}: no input format of {in_bits} bits covers "
+                     f"[{table.interval[0]}, {table.interval[1]}]; accepted: more input bits")
+
+
+def _covers(lo, hi, in_bits: int, f: int):
+    """``(K0, ok)``: the covering offset ``floor(lo * 2**f)`` and whether codes
+    ``0 .. 2**in_bits - 1`` from it reach ``hi``."""
+    k0 = int(sp.floor(lo * sp.Integer(2) ** f))
+    return k0, (sp.Integer(k0 + 2 ** in_bits - 1) / sp.Integer(2) ** f) >= hi
+
+
 def _x_format(table: CoefficientTable, in_bits: int, x_frac_bits):
+    """The input format and the valid codes (module docstring, "Input codes" in
+    docs/hardware.md): the input-code mapping onto ``[lo, hi)`` when it is a
+    fixed-point format (:func:`code_frac_bits`) and ``x_frac_bits`` is None or
+    its ``F``; else the covering mapping (:func:`cover_frac_bits`, or the
+    ``x_frac_bits`` given, refused when its codes do not reach ``hi``)."""
     lo, hi = (parse_number(v) for v in table.interval)
     span_codes = 2 ** in_bits - 1
-
-    def fits(f):
-        k0 = int(sp.floor(lo * sp.Integer(2) ** f))
-        return k0, (sp.Integer(k0 + span_codes) / sp.Integer(2) ** f) >= hi
-
+    fc = code_frac_bits(table, in_bits)
+    if x_frac_bits is not None:
+        x_frac_bits = check_width(x_frac_bits, "x_frac_bits", -MAX_FRAC_BITS, MAX_FRAC_BITS)
+    if fc is not None and x_frac_bits in (None, fc):
+        k0 = int(_interval_rationals(table)[0] * Fraction(2) ** fc)
+        return QFormat(bits=in_bits, frac_bits=fc, offset_code=k0, signed=False), (0, span_codes)
     if x_frac_bits is None:
-        width = float(sp.N(hi - lo, 20))
-        f = min(MAX_FRAC_BITS, in_bits - math.floor(math.log2(width)) + 1)
-        while f >= -MAX_FRAC_BITS:
-            k0, ok = fits(f)
-            if ok:
-                break
-            f -= 1
+        f = cover_frac_bits(table, in_bits)
+        k0 = _covers(lo, hi, in_bits, f)[0]
     else:
-        f = check_width(x_frac_bits, "x_frac_bits", -MAX_FRAC_BITS, MAX_FRAC_BITS)
-        k0, ok = fits(f)
+        f = x_frac_bits
+        k0, ok = _covers(lo, hi, in_bits, f)
         if not ok:
-            best = None
-            g = in_bits - math.floor(math.log2(float(sp.N(hi - lo, 20)))) + 1
-            while g > -MAX_FRAC_BITS and not fits(g)[1]:
-                g -= 1
-            best = g
+            best = cover_frac_bits(table, in_bits)
             cover_hi = float((k0 + span_codes) / sp.Integer(2) ** f)
+            codes = "" if fc is None else (f"x_frac_bits = {fc} (the codes map onto "
+                                           f"[{table.interval[0]}, {table.interval[1]})), ")
             raise ValueError(f"table {table.name!r}: interval [{table.interval[0]}, "
                              f"{table.interval[1]}] does not fit the input format of {in_bits} "
                              f"bits with {f} fractional bits (codes cover "
                              f"[{float(k0 / sp.Integer(2) ** f):.9g}, {cover_hi:.9g}]); accepted: "
-                             f"x_frac_bits <= {best}, or more input bits")
+                             f"{codes}x_frac_bits <= {best}, or more input bits")
     fmt = QFormat(bits=in_bits, frac_bits=f, offset_code=k0, signed=False)
     scale = sp.Integer(2) ** f
     k_lo = max(0, int(sp.ceiling(lo * scale)) - k0)
@@ -627,9 +753,12 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     ``coef_bits``: fractional bits of the coefficients (re-quantizes the
     table with :func:`chebnorm.approx.quantize`; default: the table's own
     fixed-point part); ``acc_bits``: fractional bits of the intermediate
-    accumulators (default ``y_frac_bits + guard_bits``); ``x_frac_bits`` and
-    ``y_frac_bits`` default to the largest the interval and the output range
-    allow. Raises ValueError naming the problem and the accepted range.
+    accumulators (default ``y_frac_bits + guard_bits``); ``x_frac_bits``
+    defaults to the input-code mapping ``x_k = lo + (hi - lo) k / 2**in_bits``
+    when the interval allows it, else to the largest covering the interval
+    ("Input codes" in docs/hardware.md); ``y_frac_bits`` to the largest the
+    output range allows. Raises ValueError naming the problem and the
+    accepted range.
 
     The bit-accurate model stays within the certified budget on every code:
 
@@ -659,8 +788,15 @@ def design_horner(table: CoefficientTable, in_bits: int, out_bits: int, *,
     rounding : {"rne", "trunc"}, default "rne"
         Rounding of every step: to nearest, ties to even, or toward minus infinity.
     x_frac_bits : int or None, default None
-        Fractional bits of the input, ``-MAX_FRAC_BITS`` to :data:`MAX_FRAC_BITS`;
-        None takes the largest the interval allows.
+        Fractional bits of the input, ``-MAX_FRAC_BITS`` to :data:`MAX_FRAC_BITS`.
+        None: the input-code mapping ``x_k = lo + (hi - lo) k / 2**in_bits`` on
+        ``[lo, hi)`` (every code valid) when ``hi - lo`` is a power of two and
+        ``lo`` a multiple of the step (:func:`code_frac_bits`), else the largest
+        whose codes cover ``[lo, hi]`` (:func:`cover_frac_bits`; codes outside
+        the interval are invalid). Given: :func:`code_frac_bits` is that same
+        input-code mapping, any other value the covering mapping with it
+        (refused when its codes do not reach ``hi``). See "Input codes" in
+        docs/hardware.md.
     y_frac_bits : int or None, default None
         Fractional bits of the output, ``-MAX_FRAC_BITS`` to ``MAX_FRAC_BITS + 20``;
         None takes the largest for which ``out_bits`` holds the output range.

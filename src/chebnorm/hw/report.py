@@ -202,8 +202,14 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_frac_b
     rounding : {"rne", "trunc"}, default "rne"
         Rounding of every datapath step.
     x_frac_bits, y_frac_bits : int or None, default None
-        Fractional bits of the input and output formats; None takes the largest that fit
-        (see :func:`~chebnorm.hw.horner.design_horner`).
+        Fractional bits of the input and output formats. ``x_frac_bits`` None: the
+        input code ``k`` stands for ``lo + (hi - lo) k / 2**in_bits`` on ``[lo, hi)``,
+        every code valid, as in ``chebnorm design``, when ``hi - lo`` is a power of
+        two and ``lo`` a multiple of the step; else the largest format covering
+        ``[lo, hi]`` (the report names the valid codes). Any other ``x_frac_bits``
+        asks for the covering mapping with it ("Input codes" in docs/hardware.md;
+        :func:`~chebnorm.hw.horner.design_horner`). ``y_frac_bits`` None: the
+        largest for which ``out_bits`` holds the output range.
     gappa : bool, default True
         Cross-check the rounding bound with gappa when it is installed.
     synth : bool, default True

@@ -491,8 +491,8 @@ def shifted_width(design) -> int:
     >>> from chebnorm.approx import fit
     >>> from chebnorm.hw.horner import design_horner
     >>> d = design_horner(fit("exp(x)", ("1", "2"), 3, basis="shifted"), 8, 8, coef_bits=16)
-    >>> d.scheme, d.v_offset, shifted_width(d) >= d.variable_bits
-    ('shifted', 192, True)
+    >>> d.scheme, d.v_offset, shifted_width(d) >= d.variable_bits   # c = 3/2 times 2^8
+    ('shifted', 384, True)
     """
     from chebnorm.core.numeric import signed_bits
 

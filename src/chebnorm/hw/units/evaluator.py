@@ -14,7 +14,7 @@ from chebnorm.approx import CoefficientTable, fit_target
 from chebnorm.core.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
-from ..horner import HornerDesign, design_horner
+from ..horner import HornerDesign, cover_frac_bits, design_horner
 from ..hdl.verilog import round_lines, signed_literal
 from ..hdl.verilog import verilog_module
 from .base import UnitDesign, UnitKind, get_unit
@@ -74,8 +74,10 @@ def _unit_horner(kind: str, table, in_bits, out_bits, coef_bits, rounding) -> Ho
                          f"needs {target.expression} (target {target.name!r}); accepted: a table "
                          f"of that function")
     try:
+        # the unit's input (a dot product, 2 cos(theta)) reaches the interval's top: the
+        # covering mapping, whose codes include hi ("Input codes" in docs/hardware.md)
         d = design_horner(table, in_bits, out_bits, coef_bits=coef_bits, rounding=rounding,
-                          name=table.name)
+                          name=table.name, x_frac_bits=cover_frac_bits(table, in_bits))
         identifier(d.name, field="table name")  # it names the evaluator module
     except ValueError as e:
         raise ValueError(f"the evaluator of unit {kind!r}: {e}") from None

@@ -25,6 +25,7 @@ try:  # pragma: no cover - exercised by whichever environment runs the tests
     import numba
     from llvmlite import ir as _ir
     from numba.core import types as _types
+    from numba.core.errors import NumbaWarning as _NumbaWarning
     from numba.core.extending import intrinsic as _intrinsic
     #: whether numba's compiler is off (``NUMBA_DISABLE_JIT=1``): its intrinsics cannot
     #: run as Python, so the engine is then not offered, as without numba
@@ -36,6 +37,7 @@ try:  # pragma: no cover - exercised by whichever environment runs the tests
     objmode = numba.objmode
 except ImportError:  # pragma: no cover
     numba = None
+    _NumbaWarning = None
     JIT_DISABLED = False
     HAVE_NUMBA = False
     objmode = None
@@ -55,6 +57,9 @@ _ANNOUNCED = threading.Event()
 def announce_slow(work, what: str = "the raster engine"):
     """Run ``work()``; if it takes longer than :data:`ANNOUNCE_AFTER` seconds,
     issue one :class:`NumbaCompileWarning` while it runs (once per process).
+
+    numba's own warnings while it compiles (``NumbaWarning`` and its kinds: about
+    chebnorm's kernels, nothing a caller can act on) are caught here.
 
     Parameters
     ----------
@@ -82,7 +87,10 @@ def announce_slow(work, what: str = "the raster engine"):
     watcher = threading.Thread(target=note, name="chebnorm-compile-note", daemon=True)
     watcher.start()
     try:
-        return work()
+        with warnings.catch_warnings():
+            if _NumbaWarning is not None:
+                warnings.simplefilter("ignore", _NumbaWarning)
+            return work()
     finally:
         done.set()
         watcher.join()
