@@ -280,8 +280,8 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
         The module name (an identifier); default: made from the spec
         (:func:`chebnorm.core.textsafe.design_name`).
     synth : bool, default True
-        Synthesize with yosys; False prices by the model only (``max_error``
-        only, no ``frequency``).
+        Synthesize with yosys; False prices by the model only (with
+        ``index="uniform"``: ``max_error`` only, no ``frequency``).
     workers : int, optional
         Local worker processes (default: the core count; 1 in this process).
     scheduler : str, optional
@@ -369,9 +369,13 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
             raise ValueError(f"max_segments {str(max_segments)[:40]}: with in_bits {in_bits} "
                              f"accepted: 2^0 .. 2^{top} (at most half the input codes, and "
                              f"2^12)")
+    if frequency is not None and index == "exponent":   # never silently ignored
+        raise ValueError(f"frequency {str(frequency)[:40]}: not available with "
+                         f"index='exponent' (its winner is written combinational); accepted: "
+                         f"frequency=None, or index='uniform'")
     if frequency is not None:
         frequency = _frequency(frequency, device, synth)
-    if accuracy != "max-error" and not synth:
+    if accuracy != "max-error" and not synth and index == "uniform":
         raise ValueError(f"{_python(accuracy)} compares architectures by synthesis; accepted: "
                          f"synth=True (or max_error=E with synth=False)")
     workers = None if workers is None else check_workers(workers)
@@ -687,10 +691,6 @@ def _design_exponent(spec: _Spec) -> DesignResult:
     from .exponent import design_exponent
     from .targets import synthesize_target, target_figures
 
-    if spec.frequency is not None:   # never silently ignored
-        raise ValueError(f"frequency {spec.frequency:g}: not available with index='exponent' "
-                         f"(its winner is written combinational); accepted: frequency=None, "
-                         f"or index='uniform'")
     if spec.accuracy == "correctly-rounded":
         raise ValueError("correctly_rounded=True: not available with index='exponent' (the "
                          "mantissa is faithful at best); accepted: faithful=True or "
