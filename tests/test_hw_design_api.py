@@ -122,7 +122,7 @@ SPEC = dict(expr="1/sqrt(x)", interval=("1", "4"), in_bits=8, out_bits=8, max_er
     ({"max_segments": "2^8"}, "max_segments"), ({"max_segments": 3}, "max_segments"),
     ({"index": "log"}, "index"), ({"var": "1x"}, "var"), ({"name": "1bad"}, "name"),
     ({"synth": "no"}, "synth"), ({"faithful": True, "max_error": None}, "synth"),
-    ({"workers": 0}, "workers"), ({"interval": ("1",)}, "interval"), ({"expr": ""}, "expr"),
+    ({"workers": 0}, "workers"), ({"interval": ("1",)}, "interval"), ({"interval": 4}, "interval"), ({"expr": ""}, "expr"),
 ])
 def test_refusal_names_the_argument(change, named):
     kw = dict(SPEC, **change)
@@ -132,11 +132,15 @@ def test_refusal_names_the_argument(change, named):
     assert "--" not in str(exc.value)
 
 
-def test_exponent_refusals_name_the_argument():
-    kw = dict(SPEC, interval=("2^-8", "1"), index="exponent", max_error=None,
-              correctly_rounded=True, synth=True)
-    with pytest.raises(ValueError, match="correctly_rounded=True: not available with "
-                                         "index='exponent'"):
+@pytest.mark.parametrize("change, says", [
+    ({"max_error": None, "correctly_rounded": True},
+     "correctly_rounded=True: not available with index='exponent'"),
+    ({"frequency": 100, "device": "ice40"}, "frequency 100: not available with index='exponent'"),
+    ({"degrees": (4,)}, "degrees 4: accepted with index='exponent': 1, 2 or 3"),
+])
+def test_exponent_refusals_name_the_argument(change, says):
+    kw = dict(SPEC, interval=("2^-8", "1"), index="exponent", synth=True, **change)
+    with pytest.raises(ValueError, match=re.escape(says)):
         design(kw.pop("expr"), kw.pop("interval"), **kw)
 
 

@@ -21,6 +21,7 @@ import shlex
 import warnings
 from dataclasses import dataclass, field
 
+from chebnorm.approx.piecewise_table import MAX_PIECEWISE_DEGREE
 from chebnorm.core.numeric import check_int, format_up
 from chebnorm.core.textsafe import csv_cell, design_name, identifier
 
@@ -326,7 +327,8 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
     if not isinstance(expr, str) or not expr.strip():
         raise ValueError(f"expr {str(expr)[:40]!r}: accepted: a function of {var!r} as text, "
                          f"e.g. '1/sqrt(x)'")
-    if isinstance(interval, (str, bytes)) or len(tuple(interval)) != 2:
+    if isinstance(interval, (str, bytes)) or not hasattr(interval, "__iter__") or \
+            len(tuple(interval)) != 2:
         raise ValueError(f"interval {str(interval)[:40]!r}: accepted: two endpoints (lo, hi)")
     interval = tuple(str(v) for v in interval)
     if not isinstance(var, str) or not var.isidentifier():
@@ -354,7 +356,7 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
             not list(degrees):
         raise ValueError(f"degrees {str(degrees)[:40]!r}: accepted: a non-empty sequence of "
                          f"int, e.g. (1, 2, 3)")
-    degrees = tuple(check_int(d, "degrees", 0, 8) for d in degrees)
+    degrees = tuple(check_int(d, "degrees", 0, MAX_PIECEWISE_DEGREE) for d in degrees)
     top = min(12, in_bits - 1)
     if max_segments is None:
         max_index_bits = min(8, top)
