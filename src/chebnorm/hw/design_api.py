@@ -2,11 +2,11 @@
 Python (``chebnorm design`` is its command-line front).
 
 The decisions of a design live here: the one-width piecewise Pareto search
-(:mod:`.piecewise_search`), the other architectures (sized piecewise,
-multipartite, plain table; :mod:`.architectures`) synthesized in one pruned
-queue with it, the winner by its score on the device (:mod:`.targets`), its
-pipelining to a clock (:mod:`.pipeline`), or, with ``index="exponent"``, the
-exponent-indexed ``1/sqrt`` of :mod:`.exponent`. The result holds every
+(:mod:`chebnorm.hw.piecewise_search`), the other architectures (sized piecewise,
+multipartite, plain table; :mod:`chebnorm.hw.architectures`) synthesized in one pruned
+queue with it, the winner by its score on the device (:mod:`chebnorm.hw.targets`), its
+pipelining to a clock (:mod:`chebnorm.hw.pipeline`), or, with ``index="exponent"``, the
+exponent-indexed ``1/sqrt`` of :mod:`chebnorm.hw.exponent`. The result holds every
 candidate, the text the command prints (:meth:`DesignResult.lines`) and the
 files it writes (:meth:`DesignResult.files`).
 
