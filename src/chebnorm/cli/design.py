@@ -14,7 +14,8 @@ _PHRASES = (("with synth=True", "without --no-synth"), ("synth=True", "without -
             ("faithful=True", "--faithful"), ("max_error=E", "--max-error E"),
             ("index='exponent'", "--index exponent"), ("index='uniform'", "--index uniform"),
             ("frequency=None", "without --frequency"), ("device ice40", "--target ice40"),
-            ("device '", "--target '"))
+            ("device '", "--target '"), ("max_segments, degrees", "max_segments, --degrees"),
+            ("<= degrees <=", "<= --degrees <="))
 #: one-word arguments named at the start of a refusal
 _LEADING = re.compile(r"^(frequency|degrees|max_segments|interval|var|name) ")
 
@@ -25,9 +26,8 @@ def register(sub) -> None:
     Parameters
     ----------
     sub : argparse._SubParsersAction
-        The subparsers of the ``chebnorm`` parser (from
-        ``argparse.ArgumentParser.add_subparsers``); the new parser's ``func``
-        default is :func:`run`.
+        The subparsers of the ``chebnorm`` parser (``add_subparsers``); the
+        new parser's ``func`` default is :func:`run`.
     """
     p = sub.add_parser("design", help="cheapest certified piecewise evaluator meeting --max-error",
                        description="Search segments x degree x coefficient bits for the "

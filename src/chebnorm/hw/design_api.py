@@ -16,6 +16,7 @@ already holds the units' ``design`` module.
 
 from __future__ import annotations
 
+import keyword
 import math
 import shlex
 import warnings
@@ -331,8 +332,11 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
             len(tuple(interval)) != 2:
         raise ValueError(f"interval {str(interval)[:40]!r}: accepted: two endpoints (lo, hi)")
     interval = tuple(str(v) for v in interval)
-    if not isinstance(var, str) or not var.isidentifier():
-        raise ValueError(f"var {str(var)[:40]!r}: accepted: an identifier, e.g. 'x'")
+    if not isinstance(var, str) or not var.isascii() or not var.isidentifier() or \
+            keyword.iskeyword(var) or var.startswith("_"):
+        raise ValueError(f"var {str(var)[:40]!r} is not accepted; accepted: an ASCII "
+                         f"identifier such as x or z, not a keyword, function or constant "
+                         f"name and not starting with '_'")
     in_bits = check_int(in_bits, "in_bits", 2, 20)
     out_bits = check_int(out_bits, "out_bits", 1, 32)
     for flag, value in (("faithful", faithful), ("correctly_rounded", correctly_rounded),
@@ -488,7 +492,7 @@ def _other_wins(spec: _Spec, others, res, files) -> DesignResult:
     best = _best_other(others)
     if best is None:
         raise ValueError("no architecture meets the accuracy asked (" + "; ".join(
-            c.line() for c in others) + "); accepted: larger out_bits, or faithful=True / "
+            c.line() for c in others) + "); accepted: more out_bits, or faithful=True / "
             "max_error=E instead of correctly_rounded=True")
     files = dict(files)
     files[f"design_{spec.name}_architectures.csv"] = _architectures_csv(others, res, best)
