@@ -56,6 +56,14 @@ class Winner:
         generic, the model's estimate without synthesis); None when not priced.
     error : float or None
         Its certified bound on ``|y - f(x)|`` (the mantissa's for ``exponent``).
+
+    Examples
+    --------
+    >>> from chebnorm.hw import design
+    >>> w = design("1/sqrt(x)", ("1", "4"), in_bits=6, out_bits=6, max_error="2^-4",
+    ...            synth=False, workers=1).winner
+    >>> w.architecture, w.error <= 2 ** -4, w.design.module_name == "chebnorm_" + w.design.name
+    ('piecewise', True, True)
     """
 
     architecture: str
@@ -98,6 +106,16 @@ class DesignResult:
     _hdl : str
         Internal: the winner's HDL files to print in :meth:`files` (``""``: none,
         ``"architecture"``, ``"exponent"``).
+
+    Examples
+    --------
+    >>> from chebnorm.hw import design
+    >>> r = design("1/sqrt(x)", ("1", "4"), in_bits=6, out_bits=6, max_error="2^-4",
+    ...            synth=False, workers=1)
+    >>> r.accuracy, r.device, r.search is not None, r.pipeline is None
+    ('max-error', 'generic', True, True)
+    >>> r.lines()[-1].startswith("reproduce: chebnorm fit '1/sqrt(x)'")
+    True
     """
 
     name: str
