@@ -52,13 +52,13 @@ ALLOWED = {
         "an estimate in a warning, as above",
     ("approx/rounding.py", "math.ldexp(2 - 2.0 ** (1 - p), emax)"):
         "a format's largest finite value in a refusal",
-    ("cli/design.py", "max_error"):
-        "the user's --max-error echoed in a refusal, not a bound",
+    ("hw/design_api.py", "max_error"):
+        "the user's max_error echoed in a refusal, not a bound",
     ("hw/piecewise.py", "float(max_error)"): "the user's max_error echoed in a refusal",
     ("hw/piecewise_search.py", "self.max_error"): "the user's max error target echoed",
     ("methods/spans.py", "float(np.max(psi))"): "a span angle in a refusal",
     ("raster/display.py", "worst"): "a colour scale's white point in a plot title",
-    ("cli/design.py", "o.ulp"): "the output's unit in the last place (a unit, not a bound)",
+    ("hw/design_api.py", "o.ulp"): "the output's unit in the last place (a unit, not a bound)",
     ("hw/report.py", "b.y_lsb"): "the output's LSB (a unit, not a bound)",
     ("hw/report.py", "b.total / m.total"): "the ratio of the bound to the measurement (no claim)",
     ("cli/fit.py", "table.max_abs_at"): "an abscissa (where the maximum is located)",

@@ -6,7 +6,7 @@ import json
 
 from .common import (command_line, deprecated_alias, help_when_printed, print_json,
                      refuse_table_overwrite, refuse_unused)
-from .parallel_options import add_parallel_args
+from .parallel_options import add_parallel_args, parallel_kwargs
 from .vocab import UNIT_NAMES
 
 
@@ -183,7 +183,7 @@ def run_verilog(args) -> int:
     """Run ``chebnorm hw verilog``: write the Verilog (or with
     ``--lang vhdl`` VHDL) module of a table, its test bench, vectors and report
     into the folder ``-o``; a piecewise table goes to
-    :func:`chebnorm.cli.design.hw_verilog`.
+    :func:`hw_verilog`.
 
     Parameters
     ----------
@@ -212,7 +212,6 @@ def run_verilog(args) -> int:
     _check_output(args.output)
     table = load_table(args.table)
     if isinstance(table, PiecewiseTable):
-        from .design import hw_verilog
         return hw_verilog(args, table)
     report = _analyze(args, table, synth=False, gappa=False)
     if args.pipelined and report.design.degree < 1:
@@ -239,13 +238,15 @@ def run_verilog(args) -> int:
     return 0
 
 
-def _unit(args, kind, table=None):
+def _unit(args, kind, table=None, rounding=...):
+    """The unit ``kind`` of the command's widths (``rounding``: instead of ``--rounding``)."""
     from chebnorm.hw.units import design_unit
 
+    rounding = args.rounding if rounding is ... else rounding
     return design_unit(kind, frac_bits=14 if args.frac_bits is None else args.frac_bits,
                        comp_bits=args.comp_bits, table=table,
                        in_bits=args.in_bits, out_bits=args.out_bits, coef_bits=args.coef_bits,
-                       rounding=args.rounding, log_m=4 if args.log_m is None else args.log_m,
+                       rounding=rounding, log_m=4 if args.log_m is None else args.log_m,
                        guard=args.guard)
 
 
@@ -263,7 +264,7 @@ def _refuse_unit_options(args, kinds) -> None:
 def run_report(args) -> int:
     """Run ``chebnorm hw report``: the error budget by part, the measured
     error, the cost and the Q formats of a table's hardware evaluator (a
-    piecewise table goes to :func:`chebnorm.cli.design.hw_report`).
+    piecewise table goes to :func:`hw_report`).
 
     Parameters
     ----------
@@ -293,7 +294,6 @@ def run_report(args) -> int:
     check_report_target(args)
     table = load_table(args.table)
     if isinstance(table, PiecewiseTable) and not args.unit:
-        from .design import hw_report
         return hw_report(args, table)
     table = _coefficient_table(table, args.table, "hw report --unit")
     report = _analyze(args, table, synth=not args.no_synth, gappa=not args.no_gappa)
@@ -313,7 +313,7 @@ def run_report(args) -> int:
         table = report.design.table
         if has_evaluator and not table_matches(kind, table):
             table = None
-        unit = _unit(argparse_ns(args, rounding=rounding), kind, table=table)
+        unit = _unit(args, kind, table=table, rounding=rounding)
         units.append(analyze_unit(unit, synth=not args.no_synth))
     if args.json:
         d = report.as_dict()
@@ -355,26 +355,6 @@ def check_report_target(args) -> None:
     if args.no_synth:
         raise ValueError(f"--target {args.target} maps the design with yosys; accepted: "
                          f"--target without --no-synth")
-
-
-def argparse_ns(args, **changes):
-    """A copy of ``args`` with some attributes changed.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        The namespace to copy (left unchanged).
-    **changes
-        Attribute name -> new value.
-
-    Returns
-    -------
-    argparse.Namespace
-        A new namespace with the attributes of ``args`` updated by ``changes``.
-    """
-    import argparse
-
-    return argparse.Namespace(**{**vars(args), **changes})
 
 
 def run_unit(args) -> int:
@@ -431,7 +411,7 @@ def run_unit(args) -> int:
 def run_sweep(args) -> int:
     """Run ``chebnorm hw sweep``: the grid of degree x coefficient bits x
     datapath bits of a target against area (or, with ``--segments``, the
-    piecewise grid of :func:`chebnorm.cli.design.hw_sweep_piecewise`), its CSV
+    piecewise grid of :func:`hw_sweep_piecewise`), its CSV
     and Pareto plot written into the folder ``-o``.
 
     Parameters
@@ -468,7 +448,6 @@ def run_sweep(args) -> int:
         refuse_unused(args, "to the target sweep (without --segments)", **{
             "--target": "target", "--psi-max": "psi_max", "--acc-bits": "acc_bits",
             "--rounding": "rounding"})
-        from .design import hw_sweep_piecewise
         return hw_sweep_piecewise(args)
     refuse_unused(args, "to the piecewise sweep (with --segments)",
                   **{"--expr": "expr", "--interval": "interval"})
@@ -506,3 +485,167 @@ def _check_output(path) -> None:
     if p.exists() and not p.is_dir():
         raise ValueError(f"output {str(path)!r} exists and is not a folder; accepted: a folder "
                          f"(created if missing)")
+
+
+def _piecewise_design(args, table):
+    """The hardware design of the piecewise ``table`` (read from ``args.table``)."""
+    from chebnorm.hw.piecewise import design_piecewise
+
+    for opt in ("coef_bits", "acc_bits", "x_frac_bits", "y_frac_bits"):
+        if getattr(args, opt, None) is not None:
+            raise ValueError(f"--{opt.replace('_', '-')} is not available for a piecewise table "
+                             f"(its coefficient format is the table's; the widths are sized "
+                             f"exactly); accepted: --in-bits and --out-bits")
+    if getattr(args, "rounding", "rne") != "rne":
+        raise ValueError(f"rounding {args.rounding!r}: a piecewise evaluator rounds to nearest "
+                         f"even; accepted: rne")
+    return design_piecewise(table, args.in_bits, args.out_bits)
+
+
+def hw_verilog(args, table) -> int:
+    """``chebnorm hw verilog`` of a piecewise table (called by :mod:`chebnorm.cli.hw`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw verilog`` command line.
+    table : chebnorm.approx.PiecewiseTable
+        The table read from ``args.table``.
+
+    Returns
+    -------
+    int
+        The exit status: 0, or 1 when ``--simulate`` finds a mismatch.
+
+    Raises
+    ------
+    ValueError
+        When an option does not apply to a piecewise table (``--pipelined``,
+        ``--coef-bits``-style widths, a rounding other than to nearest).
+    """
+    from pathlib import Path
+
+    from chebnorm import __version__
+    from chebnorm.core.files import write_folder
+    from chebnorm.hw.piecewise import piecewise_outputs
+
+    if getattr(args, "pipelined", False):
+        raise ValueError("--pipelined is not available for a piecewise table; accepted: the "
+                         "combinational evaluator")
+    language = getattr(args, "lang", "verilog")  # VHDL: the same design, simulated by GHDL
+    if language == "vhdl":
+        from chebnorm.hw.vhdl import simulate_vhdl as simulate
+    else:
+        from chebnorm.hw.verilog import simulate
+    d = _piecewise_design(args, table)
+    files = piecewise_outputs(d, version=__version__, command=command_line(args),
+                              language=language)
+    out = Path(args.output)
+    refuse_table_overwrite(args, files)
+    for path in write_folder(out, dict(sorted(files.items()))):
+        print(path)
+    if args.simulate:
+        res = simulate(out, d)
+        print(res.line)
+        return 0 if res.passed else 1
+    return 0
+
+
+def hw_report(args, table) -> int:
+    """``chebnorm hw report`` of a piecewise table: error budget by part, measured error, cells.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw report`` command line.
+    table : chebnorm.approx.PiecewiseTable
+        The table read from ``args.table``.
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    ValueError
+        When an option does not apply to a piecewise table (the coefficient
+    and datapath widths, a ``--rounding`` other than rne).
+    """
+    from chebnorm.core.numeric import format_down, format_up
+    from chebnorm.hw.piecewise import piecewise_cells
+    from chebnorm.hw.piecewise_search import model_cost
+
+    d = _piecewise_design(args, table)
+    b, m = d.budget(), d.measure()
+    cells = None if args.no_synth else piecewise_cells(d).cells
+    rep = {"module": d.module_name, "segments": d.table.segment_count, "degree": d.degree,
+           "in_bits": d.in_bits, "out_bits": d.out_bits,
+           "coef_frac_bits": d.table.coef_frac_bits, "rom_word_bits": list(d.rom_bits),
+           "acc_frac_bits": d.acc_frac_bits, "y_format": d.y_format.as_dict(), "budget": b,
+           "measured": m, "within_budget": m["max_error"] <= b["total"],
+           "model_cost": model_cost(d), "yosys_cells": cells}
+    fig = None
+    if getattr(args, "target", None) is not None:
+        from chebnorm.hw.targets import target_figures
+
+        from chebnorm.hw.hdl import module_text
+
+        fig = target_figures(module_text(d, "verilog"), d.module_name, args.target)
+        rep["target"] = {k: v for k, v in fig.items() if k not in ("line", "timing")}
+    if args.json:
+        rep["y_format"]["offset"] = float(rep["y_format"]["offset"])
+        print_json(rep)
+        return 0
+    print(f"{d.module_name}: {d.table.segment_count} segments x degree {d.degree}, "
+          f"{d.in_bits}-bit in / {d.out_bits}-bit out, ROM words {list(d.rom_bits)} bits")
+    print(f"error budget |y - f(x)| <= {format_up(b['total'], '.4e')} = approximation "
+          f"{format_up(b['approximation'], '.4e')} + Horner rounding "
+          f"{format_up(b['horner_rounding'], '.4e')} + output "
+          f"rounding {format_up(b['output_rounding'], '.4e')} "
+          f"({format_up(b['total'] / b['y_lsb'], '.3f')} LSB)")
+    print(f"measured over all {m['codes']} codes: max |y - f(x)| = "
+          f"{format_down(m['max_error'], '.4e')} at code "
+          f"{m['at_code']} ({'within' if rep['within_budget'] else 'OVER'} the budget)")
+    print(f"cost: {'-' if cells is None else cells} yosys cells, model {rep['model_cost']:.0f}")
+    if fig is not None:
+        print(f"target {fig['line']}")
+        print(f"timing: {fig['timing']}")
+    return 0
+
+
+def hw_sweep_piecewise(args) -> int:
+    """``chebnorm hw sweep --segments ...``: the piecewise grid, CSV and Pareto plot.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``hw sweep`` command line (with ``--segments``).
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    ValueError
+        When a ``--segments`` value is not a power of two in range, or the grid's
+    expression (``--expr``, default ``1/sqrt(x)``), interval (default 1 to 4)
+    or widths are refused by :func:`chebnorm.hw.piecewise_search.grid`.
+    """
+    from pathlib import Path
+
+    from chebnorm.core.files import write_folder
+    from chebnorm.approx.piecewise_table import parse_segments
+    from chebnorm.hw.piecewise_search import grid
+
+    res = grid(args.expr or "1/sqrt(x)", tuple(args.interval or ("1", "4")), args.in_bits,
+               args.out_bits, index_bits=[parse_segments(v) for v in args.segments],
+               degrees=args.degrees or (1, 2, 3), coef_frac_bits=args.coef_bits or (12, 16, 20),
+               synth=not args.no_synth, **parallel_kwargs(args))
+    out = Path(args.output)
+    write_folder(out, {"sweep_piecewise.csv": res.csv(), "sweep_piecewise.png": res.plot_png()})
+    print(out / "sweep_piecewise.csv")
+    print(out / "sweep_piecewise.png")
+    return 0

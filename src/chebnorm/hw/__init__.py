@@ -6,7 +6,8 @@ bit-accurate model); :mod:`.hdl` prints any design in Verilog or VHDL (the
 one HDL printer, with the benches and vector files); :mod:`.verilog` and
 :mod:`.vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
 checks a design against its error budget; :mod:`.units` are the
-normalization units (Verilog). Every design object re-proves its bound and
+normalization units (Verilog); :func:`design` (:mod:`.design_api`) picks the
+cheapest certified evaluator of a function on a device (``chebnorm design``). Every design object re-proves its bound and
 claims when it is constructed and before it prints (:mod:`.trust`).
 
 Imports only from :mod:`chebnorm.approx` (and :mod:`chebnorm.symbolic`).
@@ -40,6 +41,7 @@ from .hdl.tables import table_files, table_module
 from .table_run import simulate_table
 from .pipeline import FrequencyWarning, PipelineResult, pipeline_to_frequency
 from .exponent import ExponentDesign, design_exponent, simulate_exponent
+from .design_api import DesignResult, Winner, design
 
 __all__ = [
     "QFormat", "shift_round", "fit_bits",
@@ -62,4 +64,5 @@ __all__ = [
     "TargetCost", "synthesize_target", "fmax_ice40", "Candidate", "architecture_candidates",
     "FrequencyWarning", "PipelineResult", "pipeline_to_frequency",
     "ExponentDesign", "design_exponent", "simulate_exponent",
+    "design", "DesignResult", "Winner",
 ]
