@@ -230,7 +230,7 @@ def test_quantize_with_shared_grids_gives_the_same_table():
     format with the lattice rounds, the parity sub-basis)."""
     from chebnorm.approx import rounding
 
-    cases = [("exp(x)", ("0", "1"), 5, dict(frac_bits=20)),
+    cases = [("exp(x)", ("0", "1"), 5, dict(coef_frac_bits=20)),
              ("atan(x)", ("-1", "1"), 7, dict(coef_format="binary32")),
              ("1/sqrt(x)", ("1/4", "1"), 4, dict(coef_format="binary16"))]
     for expr, iv, d, kw in cases:

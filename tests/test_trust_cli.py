@@ -85,7 +85,7 @@ def _api_calls(table):
     return {
         "fit expr [[1]]": lambda: cn.fit([[1]], ("0", "1"), 2),
         "fit var {}": lambda: cn.fit("exp(x)", ("0", "1"), 2, var={}),
-        "fit frac_bits 2**70": lambda: cn.fit("exp(x)", ("0", "1"), 2, frac_bits=2 ** 70),
+        "fit coef_frac_bits 2**70": lambda: cn.fit("exp(x)", ("0", "1"), 2, coef_frac_bits=2 ** 70),
         "quantize word_bits None": lambda: cn.quantize(table, 14, word_bits=None),
         "quantize word_bits inf": lambda: cn.quantize(table, 14, word_bits=math.inf),
         "quantize table None": lambda: cn.quantize(None, 14),
@@ -106,7 +106,7 @@ def _api_calls(table):
 
 
 def test_api_wrong_types_raise_value_error_naming_the_argument(table):
-    names = {"fit expr": "expression", "fit var": "var", "fit frac": "frac_bits",
+    names = {"fit expr": "expression", "fit var": "var", "fit coef_frac": "coef_frac_bits",
              "quantize word": "word_bits", "quantize table": "table", "target": "target",
              "fit_target": "target", "export": "table", "hw.report": "table",
              "certify fn": "fn", "certify coef": "coefficients", "certify lo": "lo",
