@@ -89,10 +89,10 @@ def register(sub) -> None:
     r.add_argument("--json", action="store_true", help="print the report as JSON")
     r.add_argument("--no-synth", action="store_true", help="skip yosys")
     r.add_argument("--no-gappa", action="store_true", help="skip gappa")
-    r.add_argument("--target", default=None, metavar="T",
-                   help="also map the evaluator on an FPGA target: generic, xc7, xc7-nodsp or "
+    r.add_argument("--target", "--device", dest="target", default=None, metavar="T",
+                   help="also map the evaluator on an FPGA device: generic, xc7, xc7-nodsp or "
                    "ice40: LUT/DSP/carry/RAM/FF, Fmax (ice40: nextpnr-ice40; xc7: a model) "
-                   "and latency")
+                   "and latency; --device is the same flag")
     r.add_argument("--unit", action="append", default=[], metavar="KIND",
                    help=f"also cost a normalization unit ({', '.join(UNIT_NAMES)}; "
                    "repeatable): model area beside yosys cells; units with an evaluator "
