@@ -70,7 +70,7 @@ from chebnorm.hw.piecewise import (design_piecewise, piecewise_outputs, shape_co
 from chebnorm.hw.plain_table import design_plain_table
 from chebnorm.hw.table_run import simulate_table
 from chebnorm.hw.targets import fmax_ice40, synthesize_target, target_names
-from chebnorm.hw.vhdl import simulate_vhdl
+from chebnorm.hw.run_vhdl import simulate_vhdl
 
 #: (label, expression, interval, in_bits, out_bits); the first is the FloPoCo comparison spec's
 SPECS = (

@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from chebnorm.hw import design_multipartite, design_plain_table, simulate_table
-from chebnorm.hw.verilog import tool_env
+from chebnorm.hw.run_verilog import tool_env
 
 SPEC = ("1/sqrt(1+3*x)", ("0", "1"), 16, 16)
 SCRIPTS = ("synth -top {top}", "synth_xilinx -family xc7 -nodsp -top {top}",

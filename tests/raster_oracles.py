@@ -1,5 +1,5 @@
 """Test-only oracles of the compiled engine's span set-up: the spans of
-:func:`chebnorm.raster.spans.setup_spans` without fragment arrays, numbered per
+:func:`chebnorm.raster.scanline.setup_spans` without fragment arrays, numbered per
 triangle (:func:`spans`) or per row (:func:`row_spans`), computed pair by pair with the
 engine's :func:`span_geom` and :func:`span_write`.  The engine's own
 :func:`chebnorm.raster.engines.numba.rasterize.row_spans` (geometry kept between its

@@ -341,8 +341,8 @@ INJECTIONS = [
      "chebnorm.methods"),
     ("src/chebnorm/symbolic/symbols.py", "from chebnorm.approx import fit", "chebnorm.approx.fit"),
     ("src/chebnorm/approx/targets.py", "from ..symbolic import _algebra", "chebnorm.symbolic._algebra"),
-    ("src/chebnorm/raster/spans.py", "from chebnorm.hw import fixed", "chebnorm.hw.fixed"),
-    ("src/chebnorm/raster/spans.py", "from chebnorm import fit", "chebnorm.fit"),
+    ("src/chebnorm/raster/scanline.py", "from chebnorm.hw import fixed", "chebnorm.hw.fixed"),
+    ("src/chebnorm/raster/scanline.py", "from chebnorm import fit", "chebnorm.fit"),
     ("src/chebnorm/methods/ops.py", "import paper_repro.style", "paper_repro"),
     ("src/chebnorm/methods/ops.py", "import importlib\nm = importlib.import_module('benchmarks.run')",
      "benchmarks"),
@@ -411,13 +411,13 @@ def __getattr__(name):
 ''')
         assert layer_violations(tree) == []
         # ... but a stage may not reach a later one through a facade name
-        tree = tree.appended("src/chebnorm/raster/spans.py", "import chebnorm\nf = chebnorm.fit")
+        tree = tree.appended("src/chebnorm/raster/scanline.py", "import chebnorm\nf = chebnorm.fit")
         assert any("chebnorm.fit is not a stage" in b for b in layer_violations(tree))
 
     def test_rule_comes_from_layers(self, pristine):
         """Widening LAYERS (raster may import hw) makes that import legal: the
         checker has no rule of its own."""
-        tree = Tree(pristine).appended("src/chebnorm/raster/spans.py", "from chebnorm.hw import fixed")
+        tree = Tree(pristine).appended("src/chebnorm/raster/scanline.py", "from chebnorm.hw import fixed")
         assert layer_violations(tree) != []
         init = "src/chebnorm/__init__.py"
         text = tree.read(init)

@@ -116,7 +116,7 @@ def test_cycle_accurate_simulation_catches_a_wrong_latency(kind, sized, multipar
 @pytest.mark.requires_tool("ghdl")
 @pytest.mark.parametrize("kind", ["sized", "multipartite"])
 def test_pipelined_vhdl_cycle_accurate(tmp_path, kind, sized, multipartite):
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     base = sized if kind == "sized" else multipartite
     for plan in cut_plans(base)[::2]:  # every other latency, the full plan among them

@@ -127,8 +127,8 @@ def test_piecewise_c_compiles_and_agrees_with_the_table(tables, tmp_path, name, 
 def _simulate(tmp_path, d, language: str, module: str):
     """Run ``module`` (the text under test) with its bench and the model's
     vectors; return the simulator's verdict and the outputs it saw (VHDL)."""
-    from chebnorm.hw.verilog import simulate
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_verilog import simulate
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     ext = ".v" if language == "verilog" else ".vhd"
     name = d.module_name
@@ -174,7 +174,7 @@ def test_piecewise_vhdl_bench_sees_a_wrong_vector(tables, tmp_path):
     words[77] = f"{int(words[77], 16) ^ 1:02x}"
     files["chebnorm_rc.hex"] = "\n".join(words)
     write_folder(tmp_path, files)
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     res = simulate_vhdl(tmp_path, d.module_name)
     assert not res.passed and res.mismatches == 1 and res.vectors == 256

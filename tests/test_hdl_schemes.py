@@ -129,8 +129,8 @@ def test_gappa_bounds_the_parity_datapath(reports, key):
 
 
 def _simulate(tmp_path, report, language: str):
-    from chebnorm.hw.verilog import simulate
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_verilog import simulate
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     write_folder(tmp_path, hdl_outputs(report, language, pipelined=True))
     sim = simulate if language == "verilog" else simulate_vhdl

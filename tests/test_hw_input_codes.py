@@ -182,7 +182,7 @@ def test_cli_report_default_and_explicit(tmp_path, unit_table):
 
 @requires_tool("iverilog", "vvp")
 def test_verilog_bench_runs_every_code(tmp_path, unit_table):
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.run_verilog import simulate
 
     r = analyze(unit_table, 9, 10, synth=False, gappa=False)
     assert r.design.valid_codes == (0, 511)
@@ -196,7 +196,7 @@ def test_verilog_bench_runs_every_code(tmp_path, unit_table):
 
 @requires_tool("ghdl")
 def test_vhdl_bench_runs_every_code(tmp_path, unit_table):
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     r = analyze(unit_table, 9, 10, synth=False, gappa=False)
     write_outputs(tmp_path, hdl_outputs(r, "vhdl"))

@@ -18,7 +18,7 @@ from chebnorm.hw.datapaths import (dichotomy_next_z, eta_criterion, forward_diff
 from chebnorm.hw.report import write_outputs
 from chebnorm.hw.units import (UNIT_KINDS, analyze_unit, design_unit, unit_outputs,
                                unit_vectors)
-from chebnorm.hw.verilog import simulate
+from chebnorm.hw.run_verilog import simulate
 from conftest import requires_tool, run_cli
 
 no_iverilog = requires_tool("iverilog")

@@ -149,7 +149,7 @@ def test_bench_catches_a_wrong_entry(mp12, tmp_path):
     from chebnorm.core.files import write_folder
     from chebnorm.hw.hdl.tables import table_files
     from chebnorm.hw.trust import drafting
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.run_verilog import simulate
     with pytest.raises(ValueError, match="certificate"):   # refused as a design
         dataclasses.replace(mp12, tiv=tuple(tiv))
     with drafting():   # the bench's own defense, tested on a design left unchecked

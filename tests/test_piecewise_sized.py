@@ -134,8 +134,8 @@ def test_bad_input(kwargs, match):
 
 
 def _simulate(d, tmp_path, language):
-    from chebnorm.hw.verilog import simulate
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_verilog import simulate
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     out = Path(tmp_path) / language
     write_folder(out, hdl_files(d, language))

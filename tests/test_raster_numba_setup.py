@@ -26,7 +26,7 @@ import raster_oracles  # noqa: E402
 from chebnorm.raster.engines.numba import calibration, frame, kernels, rasterize, setup  # noqa: E402
 from chebnorm.raster.engines.numba import workspace  # noqa: E402
 from chebnorm.raster.meshes import unit as _unit  # noqa: E402
-from chebnorm.raster.spans import fit_camera  # noqa: E402
+from chebnorm.raster.scanline import fit_camera  # noqa: E402
 
 R = importlib.import_module("chebnorm.raster.render")
 SPAN_METHODS = [m for m in method_names() if m != "none"]
@@ -223,7 +223,7 @@ _QUADS = {
 @pytest.mark.parametrize("size", [(16, 16), (5, 5), (9, 9)])
 @pytest.mark.parametrize("quad", sorted(_QUADS))
 def test_bad_meshes_same_errors_through_render(quad, size):
-    from chebnorm.raster.spans import Camera
+    from chebnorm.raster.scanline import Camera
 
     mesh = Mesh("bad", _POS, _QUADS[quad], np.array([[0, 1, 2], [1, 3, 2]]))
     cam = Camera((0.5, 0.5, 3.0), (0.5, 0.5, 0.0), (0.0, 1.0, 0.0))
@@ -267,7 +267,7 @@ def test_default_camera_follows_the_positions():
 
 
 def test_project_identical_and_same_error():
-    from chebnorm.raster.spans import Camera, default_camera, project
+    from chebnorm.raster.scanline import Camera, default_camera, project
 
     mesh = get_mesh("teapot")
     for size in ((1024, 1024), (37, 91)):

@@ -286,7 +286,7 @@ def test_tool_failed_is_one_line_with_the_tail_of_stderr(bin_dir):
 def test_a_failing_hardware_tool_is_one_tool_failed(bin_dir, tmp_path):
     """yosys exiting with an error (a fake one on PATH): one ToolFailed line naming the
     tool, the module, the status and the end of what it printed."""
-    from chebnorm.hw.verilog import synthesize
+    from chebnorm.hw.run_verilog import synthesize
 
     bin_dir("yosys", "import sys\nprint('-- Parsing --')\n"
             "sys.stderr.write('ERROR: syntax error, unexpected end of file\\n')\nsys.exit(1)")
@@ -314,8 +314,8 @@ def test_a_missing_tool_is_one_tool_missing_at_every_call_site(bin_dir):
     from chebnorm.approx import sollya
     from chebnorm.export.gpu import glslang_validate
     from chebnorm.hw.targets import synthesize_target
-    from chebnorm.hw.verilog import simulate, synthesize
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_verilog import simulate, synthesize
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     calls = [
         ("iverilog", lambda: simulate(".", "m")),

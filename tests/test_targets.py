@@ -429,8 +429,8 @@ def test_vhdl_dichotomy_d2_16_bits_all_codes_and_agrees_with_iverilog(tmp_path):
 ])
 def test_vhdl_pipelined_and_combinational_agree_with_verilog(tmp_path, table, bits, kw):
     from chebnorm.hw.report import analyze, verilog_outputs
-    from chebnorm.hw.verilog import simulate
-    from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
+    from chebnorm.hw.run_verilog import simulate
+    from chebnorm.hw.run_vhdl import simulate_vhdl, vhdl_outputs
 
     report = analyze(CoefficientTable.load(ROOT / "figures" / "coefficients" / table), bits,
                      bits, gappa=False, synth=False, **kw)
@@ -451,7 +451,7 @@ def test_vhdl_pipelined_and_combinational_agree_with_verilog(tmp_path, table, bi
 def test_vhdl_bench_detects_a_wrong_vector(tmp_path):
     """The bench can fail: one corrupted expected word is one mismatch."""
     from chebnorm.hw.report import analyze
-    from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
+    from chebnorm.hw.run_vhdl import simulate_vhdl, vhdl_outputs
 
     t = CoefficientTable.load(ROOT / "figures" / "coefficients" / "dichotomy_d1.json")
     files = vhdl_outputs(analyze(t, 6, 6, gappa=False, synth=False))
@@ -562,7 +562,7 @@ def test_json_export_roundtrips(tmp_path):
 ])
 def test_vhdl_matches_the_model_on_fresh_fits(tmp_path, spec):
     from chebnorm.hw.report import analyze
-    from chebnorm.hw.vhdl import simulate_vhdl, vhdl_outputs
+    from chebnorm.hw.run_vhdl import simulate_vhdl, vhdl_outputs
 
     expr, iv, deg, wi, wo, rounding = spec
     t = fit(expr, iv, deg, name=f"f{deg}", coef_frac_bits=20)

@@ -13,7 +13,7 @@ import os
 
 import pytest
 
-from chebnorm.hw.verilog import synthesize_text
+from chebnorm.hw.run_verilog import synthesize_text
 from conftest import requires_tool, run_cli, run_process
 
 needs = requires_tool("yosys", "iverilog")

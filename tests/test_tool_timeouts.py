@@ -90,7 +90,7 @@ def test_sollya(sleepy_path, capped):
 
 
 def test_iverilog_and_vvp(sleepy_path, tmp_path):
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.run_verilog import simulate
 
     (tmp_path / "m.v").write_text("module m; endmodule\n", encoding="utf-8")
     (tmp_path / "tb_m.v").write_text("module tb_m; endmodule\n", encoding="utf-8")
@@ -101,7 +101,7 @@ def test_iverilog_and_vvp(sleepy_path, tmp_path):
 
 def test_yosys(sleepy_path, tmp_path):
     from chebnorm.hw.targets import synthesize_target
-    from chebnorm.hw.verilog import synthesize
+    from chebnorm.hw.run_verilog import synthesize
 
     path = tmp_path / "m.v"
     path.write_text("module m(input a, output y); assign y = a; endmodule\n", encoding="utf-8")
@@ -114,7 +114,7 @@ def test_yosys(sleepy_path, tmp_path):
 
 
 def test_ghdl(sleepy_path, tmp_path):
-    from chebnorm.hw.vhdl import simulate_vhdl
+    from chebnorm.hw.run_vhdl import simulate_vhdl
 
     with pytest.raises(ToolTimeout) as info:
         simulate_vhdl(tmp_path, "m", timeout=LIMIT)

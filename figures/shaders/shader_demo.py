@@ -48,7 +48,7 @@ from chebnorm.raster import render
 from chebnorm.raster.meshes import get_mesh
 from chebnorm.raster.metrics import to_8bit, write_png
 from chebnorm.raster.render import Lighting
-from chebnorm.raster.spans import fit_camera, project
+from chebnorm.raster.scanline import fit_camera, project
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]

@@ -173,9 +173,9 @@ def _analyze(args, table, synth: bool, gappa: bool):
 def _simulator(language: str):
     """The runner of ``language``'s benches: Icarus Verilog or GHDL."""
     if language == "vhdl":
-        from chebnorm.hw.vhdl import simulate_vhdl
+        from chebnorm.hw.run_vhdl import simulate_vhdl
         return simulate_vhdl
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.run_verilog import simulate
     return simulate
 
 
@@ -385,7 +385,7 @@ def run_unit(args) -> int:
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs
     from chebnorm.approx import load_table
-    from chebnorm.hw.verilog import simulate
+    from chebnorm.hw.run_verilog import simulate
 
     _check_output(args.output)
     _refuse_unit_options(args, [args.kind])
@@ -534,9 +534,9 @@ def hw_verilog(args, table) -> int:
                          "combinational evaluator")
     language = getattr(args, "lang", "verilog")  # VHDL: the same design, simulated by GHDL
     if language == "vhdl":
-        from chebnorm.hw.vhdl import simulate_vhdl as simulate
+        from chebnorm.hw.run_vhdl import simulate_vhdl as simulate
     else:
-        from chebnorm.hw.verilog import simulate
+        from chebnorm.hw.run_verilog import simulate
     d = _piecewise_design(args, table)
     files = piecewise_outputs(d, version=__version__, command=command_line(args),
                               language=language)

@@ -3,8 +3,8 @@ Verilog and VHDL checked in Icarus Verilog and GHDL and sized by Yosys.
 
 Where things are: :mod:`.horner` and :mod:`.piecewise` size a design (the
 bit-accurate model); :mod:`.hdl` prints any design in Verilog or VHDL (the
-one HDL printer, with the benches and vector files); :mod:`.verilog` and
-:mod:`.vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
+one HDL printer, with the benches and vector files); :mod:`.run_verilog` and
+:mod:`.run_vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
 checks a design against its error budget; :mod:`.units` are the
 normalization units (Verilog); :func:`design` (:mod:`.design_api`) picks the
 cheapest certified evaluator of a function on a device (``chebnorm design``). Every design object re-proves its bound and
@@ -31,7 +31,7 @@ from .report import HardwareReport, analyze, verilog_outputs, write_outputs
 from .sweep import SweepPoint, SweepResult, sweep
 from .hdl import hdl_files, hdl_text, module_text, testbench_text, vector_file
 from .hdl.verilog import verilog_module, verilog_testbench
-from .verilog import SimResult, SynthResult, simulate, synthesize
+from .run_verilog import SimResult, SynthResult, simulate, synthesize
 from .multipartite import (MultipartiteDesign, OffsetTable, design_multipartite,
                            multipartite_candidates)
 from .plain_table import PlainTableDesign, design_plain_table

@@ -9,7 +9,7 @@ digit-recurrence square root ~ ``w*w/2`` and divider ~ ``w*w``, a 2:1 mux bit
 ~ 1/2, a ROM bit ~ 1/8. Latency assumes one register level per multiply or
 add level and one result bit per cycle for square root and division. These
 are estimates for comparing designs; Yosys's cell count of the exported
-Verilog is the real figure (:func:`chebnorm.hw.verilog.synthesize`).
+Verilog is the real figure (:func:`chebnorm.hw.run_verilog.synthesize`).
 
 >>> a = Cost(multipliers=((16, 16),), adders=(32,), latency=2)
 >>> b = Cost(adders=(16, 16), latency=1)

@@ -579,7 +579,7 @@ def _verify_vhdl(d):
     if which("ghdl") is None:
         return None
     from .pipeline import design_files
-    from .vhdl import simulate_vhdl
+    from .run_vhdl import simulate_vhdl
 
     with tempfile.TemporaryDirectory() as tmp:
         for fname, text in design_files(d, "vhdl").items():

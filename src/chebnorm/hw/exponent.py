@@ -489,8 +489,8 @@ def simulate_exponent(design: ExponentDesign, directory, language: str = "verilo
     -------
     object
         The simulator's verdict (``passed``, ``line``), as
-        :func:`chebnorm.hw.verilog.simulate` and
-        :func:`chebnorm.hw.vhdl.simulate_vhdl` return it.
+        :func:`chebnorm.hw.run_verilog.simulate` and
+        :func:`chebnorm.hw.run_vhdl.simulate_vhdl` return it.
 
     Raises
     ------
@@ -509,8 +509,8 @@ def simulate_exponent(design: ExponentDesign, directory, language: str = "verilo
 
     from chebnorm.core.files import write_folder
 
-    from .verilog import simulate
-    from .vhdl import simulate_vhdl
+    from .run_verilog import simulate
+    from .run_vhdl import simulate_vhdl
 
     write_folder(Path(directory), exponent_files(design, language))
     if language == "verilog":

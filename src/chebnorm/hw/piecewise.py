@@ -74,7 +74,7 @@ from .fixed import (
 )
 from .hdl import hdl_files, module_text, testbench_text
 from .trust import check, drafting, seal
-from .verilog import simulate, synthesize_text
+from .run_verilog import simulate, synthesize_text
 
 __all__ = [
     "MAX_PW_IN_BITS",
@@ -1426,7 +1426,7 @@ def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | N
 
 
 def piecewise_cells(d: PiecewiseDesign):
-    """Yosys ``synth; stat`` of the module (a :class:`~chebnorm.hw.verilog.SynthResult`).
+    """Yosys ``synth; stat`` of the module (a :class:`~chebnorm.hw.run_verilog.SynthResult`).
 
     Parameters
     ----------
@@ -1437,7 +1437,7 @@ def piecewise_cells(d: PiecewiseDesign):
     -------
     SynthResult
         The cell counts of its Verilog module
-        (:func:`chebnorm.hw.verilog.synthesize_text`).
+        (:func:`chebnorm.hw.run_verilog.synthesize_text`).
 
     Raises
     ------
@@ -1461,7 +1461,7 @@ def simulate_piecewise(d: PiecewiseDesign, directory):
     Returns
     -------
     SimResult
-        The bench's verdict (:func:`chebnorm.hw.verilog.simulate`).
+        The bench's verdict (:func:`chebnorm.hw.run_verilog.simulate`).
 
     Raises
     ------

@@ -524,7 +524,7 @@ def verify_pipelined(design, *, bench_design=None):
 
     Returns
     -------
-    chebnorm.hw.verilog.SimResult
+    chebnorm.hw.run_verilog.SimResult
 
     Examples
     --------
@@ -540,7 +540,7 @@ def verify_pipelined(design, *, bench_design=None):
     PASS: 256 vectors, 0 mismatches (chebnorm_multipartite, latency 2)
     False
     """
-    from .verilog import simulate
+    from .run_verilog import simulate
 
     files = design_files(design, "verilog")
     if bench_design is not None:

@@ -32,7 +32,7 @@ from .cost import Block
 from .datapaths import horner_block
 from .horner import HornerDesign, design_horner
 from .hdl import hdl_files, module_text
-from .verilog import SynthResult, synthesize_text
+from .run_verilog import SynthResult, synthesize_text
 
 __all__ = ["HardwareReport", "analyze", "hdl_outputs", "verilog_outputs", "write_outputs"]
 

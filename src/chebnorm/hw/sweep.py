@@ -23,7 +23,7 @@ from .datapaths import horner_block
 from .fixed import check_width
 from .horner import MAX_FRAC_BITS, design_horner, max_coef_bits
 from .hdl.verilog import verilog_module
-from .verilog import synthesize_text
+from .run_verilog import synthesize_text
 
 __all__ = ["SweepPoint", "SweepResult", "sweep", "pareto_png", "DEFAULT_DEGREES", "DEFAULT_COEF_BITS",
            "DEFAULT_ACC_BITS", "HALF_LEVEL"]

@@ -2,7 +2,7 @@
 or GHDL (:func:`simulate_table`), each in a fresh folder.
 
 The text comes from :mod:`chebnorm.hw.hdl.tables`; the simulators are run by
-:mod:`chebnorm.hw.verilog` and :mod:`chebnorm.hw.vhdl`.
+:mod:`chebnorm.hw.run_verilog` and :mod:`chebnorm.hw.run_vhdl`.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from pathlib import Path
 from chebnorm.core.files import write_folder
 
 from .hdl.tables import table_files
-from .verilog import SimResult, simulate
-from .vhdl import simulate_vhdl
+from .run_verilog import SimResult, simulate
+from .run_vhdl import simulate_vhdl
 
 __all__ = ["simulate_table"]
 

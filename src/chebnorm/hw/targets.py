@@ -40,7 +40,7 @@ the model is the depth in gates (``ltp -noff``: the longest topological path,
 flip-flops cut), no time.
 
 Every tool runs in a private temporary folder (``cwd``) with
-:func:`chebnorm.hw.verilog.tool_env`, on argument lists and fixed relative file
+:func:`chebnorm.hw.run_verilog.tool_env`, on argument lists and fixed relative file
 names: no path and no environment variable reaches a command text.
 """
 
@@ -54,7 +54,7 @@ from pathlib import Path
 
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
-from .verilog import tool_env
+from .run_verilog import tool_env
 from chebnorm.core.tools import require, run_tool
 from chebnorm.exceptions import ToolFailed
 

@@ -21,7 +21,7 @@ dispatches the mode); ``shading.py`` holds the shading modes, written once again
 engine interface of ``engines/base.py``; ``engines/numpy.py`` is the reference engine
 and ``engines/numba/`` the compiled one (``jit`` < ``calibration``, ``workspace`` <
 ``rasterize``, ``kernels`` < ``setup`` < ``frame``: the fused ``phong`` frame), which
-must give the reference's bytes; ``spans.py`` the numpy span set-up and camera;
+must give the reference's bytes; ``scanline.py`` the numpy span set-up and camera;
 ``meshes.py``, ``metrics.py``, ``display.py`` and ``studies.py`` what their names say.
 """
 
@@ -30,7 +30,7 @@ from .meshes import (MESH_NAMES, Mesh, crease_normals, get_mesh, icosphere, load
 from .metrics import IMAGE_FORMATS, ImageMetrics, compare, error_map_rgb, write_image, write_png
 from .render import (BUMP_VARIANTS, SHADING_MODES, HeightMap, Lighting, RenderResult,
                      available_methods, get_span_normals, render, to_8bit)
-from .spans import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
+from .scanline import Camera, Spans, default_camera, fit_camera, project, setup_spans, zbuffer
 from .display import RenderComparison, png_data_uri, render_html
 from .studies import (RENDER_SWEEP_COLUMNS, BumpCase, EtaLevel, RenderCase, RenderSweep,
                       RenderSweepRow, SplitGouraudStudy, bump_comparison, eta_study,

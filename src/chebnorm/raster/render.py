@@ -35,7 +35,7 @@ from . import shading as shading_modes
 from .engines import get_engine
 from .meshes import get_mesh, unit
 from .metrics import ImageFrame, to_8bit
-from .spans import Camera
+from .scanline import Camera
 
 __all__ = [
     "SHADING_MODES", "BUMP_VARIANTS", "Lighting", "HeightMap", "RenderResult", "render",

@@ -17,7 +17,7 @@ from .engines.base import (FrameUnsupported, ModeResult, auto_tables, dot, half_
                            triangle_half_vectors)
 from .engines.numpy import to_image
 from .meshes import unit
-from .spans import project
+from .scanline import project
 
 __all__ = ["gouraud", "phong", "split_gouraud", "bump", "interpolated_normals"]
 

@@ -17,8 +17,8 @@ reads the model's expected outputs (:func:`vector_file`). The banner is
 written once (:mod:`.common`). ``chebnorm hw verilog``, ``chebnorm export
 --format verilog|vhdl`` and :func:`chebnorm.hw.report.hdl_outputs` all call
 :func:`module_text` / :func:`hdl_text` / :func:`hdl_files`; the simulators
-are run by :mod:`chebnorm.hw.verilog` (Icarus Verilog, Yosys) and
-:mod:`chebnorm.hw.vhdl` (GHDL).
+are run by :mod:`chebnorm.hw.run_verilog` (Icarus Verilog, Yosys) and
+:mod:`chebnorm.hw.run_vhdl` (GHDL).
 
 >>> from chebnorm.approx import fit_target
 >>> from chebnorm.hw.horner import design_horner

@@ -2,7 +2,7 @@
 :class:`~chebnorm.hw.horner.HornerDesign` and the evaluator of a
 :class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), each
 bit-identical to :mod:`chebnorm.hw.hdl.verilog`'s, and their self-checking
-test benches (:func:`chebnorm.hw.vhdl.simulate_vhdl` runs them in GHDL).
+test benches (:func:`chebnorm.hw.run_vhdl.simulate_vhdl` runs them in GHDL).
 
 The entities follow the Verilog port contract::
 

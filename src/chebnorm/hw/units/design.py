@@ -11,7 +11,7 @@ from chebnorm.core.tools import which
 
 from ..cost import Block
 from ..fixed import check_width
-from ..verilog import SynthResult, synthesize_text
+from ..run_verilog import SynthResult, synthesize_text
 from .base import MAX_COMP_BITS, MAX_UNIT_FRAC_BITS, UnitDesign, get_unit
 from .bench import unit_testbench, unit_vector_file, unit_vectors
 

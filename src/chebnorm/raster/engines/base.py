@@ -26,7 +26,7 @@ from chebnorm.exceptions import FrameUnsupported
 from chebnorm.methods import default_tables
 
 from ..meshes import Mesh, unit
-from ..spans import Camera
+from ..scanline import Camera
 
 __all__ = ["Engine", "Setup", "ModeResult", "FrameUnsupported", "dot", "half_vectors",
            "triangle_half_vectors", "auto_tables"]

@@ -6,14 +6,14 @@ import numpy as np
 
 from chebnorm.methods import span_normals as _span_normals
 
-from ..spans import fit_camera, project, setup_spans, zbuffer
+from ..scanline import fit_camera, project, setup_spans, zbuffer
 from .base import Engine, Setup, dot, half_vectors
 
 __all__ = ["NumpyEngine", "to_image", "pixel_map"]
 
 
 class NumpyEngine(Engine):
-    """The reference engine: numpy arrays, every step in :mod:`chebnorm.raster.spans`'s
+    """The reference engine: numpy arrays, every step in :mod:`chebnorm.raster.scanline`'s
     and :func:`chebnorm.methods.span_normals`'s operation order."""
 
     name = "numpy"

@@ -8,7 +8,7 @@ without the full-frame intermediate arrays of those two paths (fragment lists, a
 frame-sized z-buffer, per-fragment normals, half vectors and dot products):
 
 1. triangle set-up and span set-up, compiled, the spans split over threads
-   (:func:`.rasterize.row_spans`, the arithmetic of :func:`chebnorm.raster.spans.setup_spans`);
+   (:func:`.rasterize.row_spans`, the arithmetic of :func:`chebnorm.raster.scanline.setup_spans`);
 2. the method's checks and per-span set-up, the values and errors of
    :func:`chebnorm.methods.span_normals`'s, compiled and split over threads in
    :mod:`.setup` (the reference functions run where a check fails; sine, cosine
@@ -17,7 +17,7 @@ frame-sized z-buffer, per-fragment normals, half vectors and dot products):
 3. one pass per scan line, rows split across the cores (threads running the compiled
    kernels without the GIL, rows interleaved): a z-test of the
    line's spans in span order into a line buffer (the winning span of every pixel,
-   ties to the earliest fragment as in :func:`chebnorm.raster.spans.zbuffer`), then each
+   ties to the earliest fragment as in :func:`chebnorm.raster.scanline.zbuffer`), then each
    span's pixel normals by the method's kernel (stepping kernels step through every
    pixel of the span, the others are evaluated only where the span won) and, for the
    winners only, half vector, Blinn-Phong intensity, ``|N|`` and the triangle id,

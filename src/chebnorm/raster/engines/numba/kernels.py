@@ -23,7 +23,7 @@ from chebnorm.methods.ops import NumpyOps
 from chebnorm.methods.registry import method_kernel
 from chebnorm.methods.spans import MAX_LEVELS, SpanNormals, check_span_input, span_normals
 
-from ...spans import Spans
+from ...scanline import Spans
 from .jit import HAVE_NUMBA, njit
 
 __all__ = ["supports", "fast_span_normals", "dichotomy_denominators",

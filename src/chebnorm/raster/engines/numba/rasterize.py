@@ -1,7 +1,7 @@
-"""Rasterization of the compiled engine: the spans of :func:`chebnorm.raster.spans.setup_spans`
+"""Rasterization of the compiled engine: the spans of :func:`chebnorm.raster.scanline.setup_spans`
 (fragment lists and z-buffer for every shading mode; the row-ordered spans of the fused
 ``phong`` frame), the front-facing triangle gather, and ``render``'s default camera
-and projection, the same bits as the numpy reference (:mod:`chebnorm.raster.spans`).
+and projection, the same bits as the numpy reference (:mod:`chebnorm.raster.scanline`).
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ...spans import Spans, fit_camera
-from ...spans import project as reference_project
+from ...scanline import Spans, fit_camera
+from ...scanline import project as reference_project
 from .jit import HAVE_NUMBA, fma, njit, prefetch, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
@@ -27,7 +27,7 @@ __all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gathe
 def count_rows(ys, height):
     """``(r0, nrows)``: the first pixel row and the number of rows (clipped to
     ``[0, height]``) of each triangle whose corner ``y`` are ``ys (T, 3)``, pixel centres
-    at ``r + 0.5`` as :func:`chebnorm.raster.spans.setup_spans` counts them."""
+    at ``r + 0.5`` as :func:`chebnorm.raster.scanline.setup_spans` counts them."""
     T = ys.shape[0]
     r0 = np.empty(T, np.int64)
     nrows = np.empty(T, np.int64)
@@ -339,7 +339,7 @@ def gather_setup(mesh, xy, inv_w, cull, corners=True):
 # ------------------------------------------------------------- span set-up
 @njit(inline=True)
 def span_geom(xy, i, r, width):
-    """Row ``r`` of triangle ``i`` as :func:`chebnorm.raster.spans.setup_spans` finds it: ``(c, a, pa,
+    """Row ``r`` of triangle ``i`` as :func:`chebnorm.raster.scanline.setup_spans` finds it: ``(c, a, pa,
     qa, sa, p, q, sb, swap, xl, xr)``, ``c`` the pixel count (0: no span), ``a`` the first
     pixel, ``sa``, ``sb`` the positions along edges ``pa -> qa`` and ``p -> q``."""
     y0, y1, y2 = xy[i, 0, 1], xy[i, 1, 1], xy[i, 2, 1]
@@ -548,7 +548,7 @@ def _row_write_part(xy, width, attrs, first, ids, rlo, rhi, row_start, gc, tri, 
 
 
 def row_spans(xy, attrs, width, height, work=None):
-    """The spans of :func:`chebnorm.raster.spans.setup_spans` without the fragment
+    """The spans of :func:`chebnorm.raster.scanline.setup_spans` without the fragment
     arrays, numbered row by row: ``(namespace of tri, row, x0, count, m, t0, dt, left,
     right, row_start, by_row)``; row ``r``'s spans are ``row_start[r] ..
     row_start[r+1]-1``, in ``setup_spans``' order within the row (so ties of the z-test
@@ -578,7 +578,7 @@ def row_spans(xy, attrs, width, height, work=None):
 
     Examples
     --------
-    >>> from chebnorm.raster.spans import setup_spans
+    >>> from chebnorm.raster.scanline import setup_spans
     >>> xy = np.array([[[0.0, 0.0], [8.0, 0.0], [0.0, 6.0]], [[1.0, 0.5], [7.0, 1.5], [2.0, 5.0]]])
     >>> a, b = row_spans(xy, np.ones((2, 3, 1)), 8, 6), setup_spans(xy, np.ones((2, 3, 1)), 8, 6)
     >>> o = np.lexsort((a.row, a.tri))     # a's spans in setup_spans' order
@@ -627,7 +627,7 @@ def _identity(S):
 # -------------------------------------------------------------- projection
 @njit()
 def _project(pts, eye, frame, fa, f, width, height, xy, inv_w):
-    """:func:`chebnorm.raster.spans.project` of ``pts (V, 3)``: ``(pts - eye) @ frame.T`` summed as
+    """:func:`chebnorm.raster.scanline.project` of ``pts (V, 3)``: ``(pts - eye) @ frame.T`` summed as
     OpenBLAS does (``fma(d2, F2, fma(d1, F1, d0 F0))``, checked by :func:`_gemm_fma`),
     then the reference's divisions; False if a point is not in front of the camera."""
     ok = True
@@ -667,7 +667,7 @@ def _gemm_fma() -> bool:
 
 
 def project(camera, points, width, height):
-    """:func:`chebnorm.raster.spans.project` (the same bits and errors), compiled where
+    """:func:`chebnorm.raster.scanline.project` (the same bits and errors), compiled where
     :func:`_gemm_fma` holds.
 
     Parameters
@@ -693,7 +693,7 @@ def project(camera, points, width, height):
 
     Examples
     --------
-    >>> from chebnorm.raster.spans import default_camera, project as ref
+    >>> from chebnorm.raster.scanline import default_camera, project as ref
     >>> cam = default_camera((0.0, 0.0, 0.0), 1.0)
     >>> p = np.random.default_rng(1).standard_normal((50, 3)) * 0.3
     >>> all(a.tobytes() == b.tobytes() for a, b in zip(project(cam, p, 64, 48),

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .hdl import hdl_files
 from .hdl.vhdl import VHDL_STD
-from .verilog import SimResult
+from .run_verilog import SimResult
 from chebnorm.core.tools import require, run_tool
 from chebnorm.exceptions import ToolFailed
 
