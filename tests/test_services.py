@@ -454,3 +454,38 @@ class TestScansCatch:
 def test_the_facade_names_the_module():
     assert chebnorm.exceptions is exceptions
     assert chebnorm.FitWarning is exceptions.FitWarning
+
+
+def test_arb_precision_scopes_of_two_threads_do_not_mix():
+    """``flint.ctx.prec`` is one process-wide value: a thread that enters and
+    leaves a precision scope while another certifies must neither change the
+    other's bound nor leave its precision behind. (``chebnorm design`` fits
+    the one-width search in a thread while the main thread prepares synthesis.)"""
+    import threading
+    import time
+
+    from chebnorm.approx.piecewise_fit import piecewise_fit
+    from chebnorm.core.numeric import arb_precision
+
+    def bounds():
+        t = piecewise_fit("1/sqrt(1+3*x)", (0, 1), 1, segments=4, coef_frac_bits=22)
+        return [s.abs_error_bound for s in t.segments]
+
+    alone = bounds()
+    before = ctx.prec
+    stop = threading.Event()
+
+    def churn():  # another thread's short scopes at a much lower precision
+        while not stop.is_set():
+            with arb_precision(12):
+                time.sleep(0.0005)
+
+    other = threading.Thread(target=churn)
+    other.start()
+    try:
+        beside = [bounds() for _ in range(3)]
+    finally:
+        stop.set()
+        other.join()
+    assert beside == [alone] * 3
+    assert ctx.prec == before

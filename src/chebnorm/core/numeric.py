@@ -4,7 +4,8 @@ Floats rounded outward from exact values (a bound printed as a float must not
 be below the proved rational or ball it stands for), two's-complement
 widths, the integer argument check every width and degree goes through, and
 a scoped Arb working precision (``flint.ctx.prec`` is process-global, so a
-function that raises it must restore it on every exit).
+function that raises it must restore it on every exit, and two threads' scopes
+must not interleave).
 
 >>> from fractions import Fraction
 >>> float_up(Fraction(1, 3)) >= Fraction(1, 3) >= float_down(Fraction(1, 3))
@@ -20,6 +21,7 @@ import decimal
 import math
 import numbers
 import re
+import threading
 from fractions import Fraction
 
 import numpy as np
@@ -322,10 +324,20 @@ def check_int(value, name: str, lo: int, hi: int) -> int:
     return int(value)
 
 
+#: held for the whole of an :func:`arb_precision` scope: python-flint keeps one
+#: precision per process, so a second thread's scope waits (re-entrant: scopes nest)
+_PRECISION_LOCK = threading.RLock()
+
+
 @contextlib.contextmanager
 def arb_precision(prec: int):
     """Run a block at Arb working precision ``prec`` bits, restoring the
     previous ``flint.ctx.prec`` on every exit (return, exception).
+
+    The scope holds a process-wide re-entrant lock: python-flint's precision
+    is one value for all threads, so another thread's scope waits until this
+    one ends instead of changing the precision under it (a thread's own
+    scopes nest freely).
 
     Parameters
     ----------
@@ -349,9 +361,10 @@ def arb_precision(prec: int):
     """
     from flint import ctx
 
-    old = ctx.prec
-    try:
-        ctx.prec = prec
-        yield
-    finally:
-        ctx.prec = old
+    with _PRECISION_LOCK:
+        old = ctx.prec
+        try:
+            ctx.prec = prec
+            yield
+        finally:
+            ctx.prec = old
