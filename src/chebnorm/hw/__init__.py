@@ -30,6 +30,7 @@ from .units import (UNIT_KINDS, UNITS, UnitDesign, UnitKind, UnitReport, analyze
 from .report import HardwareReport, analyze, verilog_outputs, write_outputs
 from .sweep import SweepPoint, SweepResult, sweep
 from .hdl import hdl_files, hdl_text, module_text, testbench_text, vector_file
+from .design_base import ARCHITECTURES, Design, architecture, provide as _provide
 from .hdl.verilog import verilog_module, verilog_testbench
 from .run_verilog import SimResult, SynthResult, simulate, synthesize
 from .multipartite import (MultipartiteDesign, OffsetTable, design_multipartite,
@@ -42,6 +43,11 @@ from .table_run import simulate_table
 from .pipeline import FrequencyWarning, PipelineResult, pipeline_to_frequency
 from .exponent import ExponentDesign, design_exponent, simulate_exponent
 from .design_api import DesignResult, Winner, design
+
+# the HDL seam (chebnorm.hw.design_base): chebnorm.hw.hdl imports the Horner design,
+# so the Horner design gets its printers from here instead of importing them
+_provide("horner.module_text", module_text)
+_provide("horner.hdl_files", hdl_files)
 
 __all__ = [
     "QFormat", "shift_round", "fit_bits",
@@ -65,4 +71,5 @@ __all__ = [
     "FrequencyWarning", "PipelineResult", "pipeline_to_frequency",
     "ExponentDesign", "design_exponent", "simulate_exponent",
     "design", "DesignResult", "Winner",
+    "Design", "ARCHITECTURES", "architecture",
 ]

@@ -36,12 +36,12 @@ from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
 from chebnorm.core.numeric import format_down, format_up
 
-from .hdl import module_text
+from .design_base import Design
 from .multipartite import design_multipartite
 from .piecewise import design_piecewise
-from .piecewise_search import (SYNTH_ROUND, map_synth, synthesis_queue, synthesize_point,
-                               with_costs)
+from .piecewise_search import SearchResult, synthesis_queue, synthesize_point, with_costs
 from .plain_table import design_plain_table
+from .synth_loop import SynthJob, map_synth, pruned_synthesis
 from .targets import get_target, synthesize_target
 
 __all__ = ["Candidate", "ACCURACIES", "MAX_TABLE_ROM_BITS", "PRUNE_SPREAD",
@@ -88,7 +88,7 @@ class Candidate:
         ``piecewise-sized``, ``multipartite`` or ``table``.
     description : str
         Its parameters in one line.
-    design : object or None
+    design : Design or None
         The design (None when it was not built: see ``note``).
     error : float or None
         Its certified maximum error ``|y - f(x)|``.
@@ -113,7 +113,7 @@ class Candidate:
 
     architecture: str
     description: str
-    design: object = None
+    design: Design | None = None
     error: float | None = None
     ulp: float | None = None
     cost: object = None
@@ -136,8 +136,7 @@ class Candidate:
     @property
     def verilog(self) -> str:
         """The candidate's Verilog module (its top is ``design.module_name``)."""
-        d = self.design
-        return d.verilog() if hasattr(d, "verilog") else module_text(d, "verilog")
+        return self.design.verilog()
 
     def line(self) -> str:
         """One line: the architecture, its parameters, cost and error."""
@@ -158,7 +157,7 @@ def _sized_chain(item) -> list:
     larger ROM no longer pays for itself (the model alone is too rough to stop
     at the first rise: on ``xc7-nodsp`` the cheapest degree-2 design has 256
     segments, after a rise at 128)."""
-    from .target_model import model_parts, piecewise_features
+    from .target_model import model_parts
 
     expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target = item
     mult = "full" if get_target(target).name == "xc7" else "truncated"
@@ -173,7 +172,7 @@ def _sized_chain(item) -> list:
                                  multipliers=mult)
         except ValueError:  # not reachable at this segment count
             continue
-        model, rom = model_parts(piecewise_features(d), target)
+        model, rom = model_parts(d.features(), target)
         if found and prune_lower("piecewise-sized", target, model, rom) > min(
                 m for _, _, m, _ in found):
             break   # even at the model's spread, costlier than a smaller k
@@ -329,34 +328,38 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
 
     workers = check_workers(workers)
     out = list(cands)
-    todo = sorted((i for i, c in enumerate(out) if c.design is not None),
-                  key=lambda i: (out[i].model is None, out[i].model or 0.0, i))
-    best = math.inf if bound is None else float(bound)
 
     def lower(c):
         return -math.inf if c.model is None else prune_lower(c.architecture, target, c.model,
                                                              c.model_rom)
 
-    while todo:
-        run = [i for i in todo if not prune or lower(out[i]) < best][:SYNTH_ROUND]
-        if not run:
-            break
-        costs = map_synth(_synth_item, [(out[i].verilog, out[i].design.module_name, target)
-                                        for i in run], workers=workers, scheduler=scheduler)
-        for i, cost in zip(run, costs):
-            c = out[i]
-            out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, cost,
-                               c.note, c.model, c.model_rom)
-            best = min(best, cost.score)
-        todo = [i for i in todo if i not in run]
-    for i in todo:
-        c = out[i]
-        rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
-        out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
-                           f"model {c.model:.1f}{rom}: lower bound {format_down(lower(c), '.1f')} "
-                           f">= best "
-                           f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
+    jobs = [SynthJob((c.model is None, c.model or 0.0, i), lower(c), i)
+            for i, c in enumerate(out) if c.design is not None]
+    run = pruned_synthesis(
+        jobs, lambda batch: map_synth(_synth_item, [(out[j.key].verilog,
+                                                     out[j.key].design.module_name, target)
+                                                    for j in batch],
+                                      workers=workers, scheduler=scheduler),
+        score=lambda j, cost: cost.score, bound=bound, prune=prune)
+    for i, cost in run.costs.items():
+        out[i] = _with_cost(out[i], cost)
+    for j in run.skipped:
+        c = out[j.key]
+        out[j.key] = _skipped(c, format_down(j.lower, '.1f'), run.best)
     return out
+
+
+def _with_cost(c: Candidate, cost) -> Candidate:
+    return Candidate(c.architecture, c.description, c.design, c.error, c.ulp, cost, c.note,
+                     c.model, c.model_rom)
+
+
+def _skipped(c: Candidate, low: str, best: float) -> Candidate:
+    """``c`` not synthesized: its lower bound ``low`` (formatted) cannot beat ``best``."""
+    rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
+    return Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
+                     f"model {c.model:.1f}{rom}: lower bound {low} >= best "
+                     f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
 
 
 def _synth_job(item):
@@ -421,44 +424,39 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
     t = get_target(target).name
     workers = check_workers(workers)
     out = list(cands)
-    jobs = [(prune_lower(c.architecture, t, c.model, c.model_rom) if c.model is not None
-             else -math.inf, 0, i) for i, c in enumerate(out) if c.design is not None]
-    todo = sorted(jobs, key=lambda j: (j[0], j[1], j[2]))
-    best, costs, merged, rounds = math.inf, {}, False, 0
-    while True:
-        if rounds >= 1 and not merged:   # the search's points join from round two
-            if hasattr(result, "result"):
-                result = result.result()
-            todo = sorted(todo + [(low, 1, key) for key, low in synthesis_queue(result)],
-                          key=lambda j: (j[0], j[1], j[2]))
-            merged = True
-        rounds += 1
-        run = [j for j in todo if j[0] < best][:SYNTH_ROUND]
-        if not run:
-            if merged:
-                break
-            continue
-        items = [("arch", (out[j[2]].verilog, out[j[2]].design.module_name, t)) if j[1] == 0
-                 else ("point", (result.designs[j[2]], t)) for j in run]
-        for j, cost in zip(run, map_synth(_synth_job, items, workers=workers,
-                                          scheduler=scheduler)):
-            if j[1] == 0:
-                c = out[j[2]]
-                out[j[2]] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp,
-                                      cost, c.note, c.model, c.model_rom)
-                best = min(best, cost.score)
-            else:
-                costs[j[2]] = cost
-                best = min(best, float(cost) if t == "generic" else cost.score)
-        todo = [j for j in todo if j not in run]
-    for low, kind, i in todo:
-        if kind == 0:
-            c = out[i]
-            rom = "" if c.model_rom is None else f" (ROM part {c.model_rom:.1f})"
-            out[i] = Candidate(c.architecture, c.description, c.design, c.error, c.ulp, None,
-                               f"model {c.model:.1f}{rom}: lower bound {low:.1f} >= best "
-                               f"synthesized {best:.1f}: cannot win", c.model, c.model_rom)
-    return out, with_costs(result, costs)
+    jobs = []
+    for i, c in enumerate(out):
+        if c.design is not None:
+            low = (prune_lower(c.architecture, t, c.model, c.model_rom) if c.model is not None
+                   else -math.inf)
+            jobs.append(SynthJob((low, 0, i), low, ("arch", i)))
+    searched = [result]
+
+    def later():   # the search's points, from round two (the search may still be running)
+        if not isinstance(searched[0], SearchResult):   # a future of it
+            searched[0] = searched[0].result()
+        return [SynthJob((low, 1, key), low, ("point", key))
+                for key, low in synthesis_queue(searched[0])]
+
+    def synthesize(batch):
+        items = [("arch", (out[j.key[1]].verilog, out[j.key[1]].design.module_name, t))
+                 if j.key[0] == "arch" else ("point", (searched[0].designs[j.key[1]], t))
+                 for j in batch]
+        return map_synth(_synth_job, items, workers=workers, scheduler=scheduler)
+
+    run = pruned_synthesis(jobs, synthesize, later=later,
+                           score=lambda j, cost: (float(cost) if j.key[0] == "point"
+                                                  and t == "generic" else cost.score))
+    costs = {}
+    for (kind, i), cost in run.costs.items():
+        if kind == "arch":
+            out[i] = _with_cost(out[i], cost)
+        else:
+            costs[i] = cost
+    for j in run.skipped:
+        if j.key[0] == "arch":
+            out[j.key[1]] = _skipped(out[j.key[1]], f"{j.lower:.1f}", run.best)
+    return out, with_costs(searched[0], costs)
 
 
 def architecture_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,
@@ -619,7 +617,7 @@ def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: s
 def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees, k_start,
                       var, name, target, workers, scheduler) -> list[Candidate]:
     """Every candidate of :func:`architecture_candidates`, built, not synthesized."""
-    from .target_model import design_features, model_parts, model_score
+    from .target_model import model_parts, model_score
 
     e = max_error if accuracy == "max-error" else None
     out: list[Candidate] = []
@@ -650,7 +648,7 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                                  model_rom=model_rom))
         if items and items[-1][0] == "multipartite":
             m = built[-1]
-            model, model_rom = model_parts(design_features(m), target)
+            model, model_rom = model_parts(m.features(), target)
             out.append(Candidate("multipartite", f"{len(m.offsets)} offset tables, ROM "
                                  f"{m.rom_bits} bits", m, float(m.certificate.upper),
                                  2.0 ** -m.y_format.frac_bits, model=model,
@@ -663,8 +661,8 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                              p if ok else None, float(p.certificate.upper),
                              2.0 ** -p.y_format.frac_bits,
                              note="" if ok else f"{p.unproved} codes' rounding not proved",
-                             model=model_score(design_features(p), target),
-                             model_rom=model_parts(design_features(p), target)[1]))
+                             model=model_score(p.features(), target),
+                             model_rom=model_parts(p.features(), target)[1]))
     else:
         out.append(Candidate("table", f"{2 ** in_bits} entries", note=f"ROM of {rom} bits, over "
                              f"{MAX_TABLE_ROM_BITS}: not built (it cannot win)"))

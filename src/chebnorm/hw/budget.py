@@ -41,6 +41,7 @@ from chebnorm.core.numeric import float_up
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .fixed import rounding_error_bound
+from .design_base import provide
 from .horner import HornerDesign
 from .trust import verify_design
 from chebnorm.core.tools import run_tool, which
@@ -599,3 +600,9 @@ def gappa_bound(design: HornerDesign, timeout: float = 60) -> float | None:
         raise ValueError(f"gappa could not bound the datapath of {design.module_name}: "
                          f"{' '.join(out.split())[:300]}")
     return float_up(parse_gappa_upper(out))
+
+
+# the Horner design's budget and measurement (chebnorm.hw.design_base.Design): this
+# module imports chebnorm.hw.horner, so it hands them over instead of being imported
+provide("horner.error_budget", error_budget)
+provide("horner.measure", measure)

@@ -184,23 +184,14 @@ def _version() -> str:
 
 
 def _hdl_files(kind: str, d, version: str, command: str) -> dict:
-    if kind == "exponent":
-        from .hdl.exponent import exponent_files
-
-        files = {f"{d.module_name}.v": d.verilog(version=version, command=command),
-                 f"{d.module_name}.vhd": d.vhdl(version=version, command=command)}
+    files = {f"{d.module_name}.v": d.verilog(version=version, command=command),
+             f"{d.module_name}.vhd": d.vhdl(version=version, command=command)}
+    if kind == "exponent":   # its benches too (the exponent command's own outputs)
         for lang in ("verilog", "vhdl"):
-            for fname, text in exponent_files(d, lang).items():
+            for fname, text in d.hdl_files(lang).items():
                 if fname.startswith("tb_") or fname.endswith(".hex"):
                     files[fname] = text
-        return files
-    if hasattr(d, "vhdl"):
-        return {f"{d.module_name}.v": d.verilog(version=version, command=command),
-                f"{d.module_name}.vhd": d.vhdl(version=version, command=command)}
-    from .hdl import module_text
-
-    return {f"{d.module_name}.v": module_text(d, "verilog", version=version, command=command),
-            f"{d.module_name}.vhd": module_text(d, "vhdl", version=version, command=command)}
+    return files
 
 
 @dataclass(frozen=True)
@@ -523,7 +514,7 @@ def _other_wins(spec: _Spec, others, res, files) -> DesignResult:
         from .targets import target_figures
 
         fig = target_figures(best.verilog, d.module_name, spec.device, cost=best.cost,
-                             latency=getattr(d, "latency", 0))
+                             latency=d.latency)
         figures = [f"winner {fig['line']}", f"timing: {fig['timing']}"]
     lines = [f"winner: {best.line()}", *figures]
     if res is not None:

@@ -60,6 +60,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .fixed import check_width
 from .hdl.exponent import exponent_files, exponent_module
 from .piecewise import MAX_PW_IN_BITS, PiecewiseDesign, design_piecewise, shape_cost
+from .design_base import Design, register
 from .trust import check
 
 __all__ = ["MIN_EXP_IN_BITS", "ExponentDesign", "design_exponent", "exponent_fields",
@@ -161,8 +162,9 @@ def _check_interval(interval, in_bits: int) -> int:
     return -e
 
 
+@register("exponent")
 @dataclass(frozen=True)
-class ExponentDesign:
+class ExponentDesign(Design):
     """The exponent-indexed ``1/sqrt`` evaluator (module docstring): a
     leading-zero count and shift in front of a sized piecewise ``core``.
 
@@ -245,8 +247,8 @@ class ExponentDesign:
         identifier(self.name, field="name")
         _check_interval(self.interval, W)
         c = self.core
-        t = getattr(c, "table", None)
-        if not isinstance(c, PiecewiseDesign) or not c.sized or c.in_bits != W or \
+        t = c.table if isinstance(c, PiecewiseDesign) else None
+        if t is None or not c.sized or c.in_bits != W or \
                 t.segment_by != "exponent" or tuple(t.interval) != ("1", "4"):
             raise ValueError("core: accepted: a sized PiecewiseDesign of an exponent table of "
                              "1/sqrt on [1, 4) with in_bits equal to the design's "
@@ -359,6 +361,29 @@ class ExponentDesign:
     def vhdl(self, *, version: str = "", command: str | None = None) -> str:
         """The VHDL-2008 entities (core first): :func:`chebnorm.hw.hdl.exponent.exponent_module`."""
         return exponent_module(self, "vhdl", version=version, command=command)
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, bench and vectors (:func:`chebnorm.hw.hdl.exponent.exponent_files`)."""
+        return exponent_files(self, language)
+
+    def features(self):
+        """The cost model's inputs: the core's
+        (:func:`chebnorm.hw.target_model.piecewise_features`) and the
+        normalization in front of it, priced as adder bits: the leading-zero
+        count (``W`` bits), the left shift by ``lz`` (one ``W``-bit level of
+        2:1 multiplexers per bit of ``lz``) and ``h = (lz + 2) >> 1``
+        (``shift_bits``). A structural estimate: the target models were not
+        calibrated on this architecture."""
+        from dataclasses import replace as _replace
+
+        f = self.core.features()
+        W = int(self.in_bits)
+        norm = (W,) + (W,) * W.bit_length() + (int(self.shift_bits),)
+        return _replace(f, adders=tuple(f.adders) + norm)
+
+    def cut_points(self) -> tuple[str, ...]:
+        """None: the core's registers are set by :func:`design_exponent` (``pipeline=``)."""
+        return ()
 
 
 def _prove(d: ExponentDesign) -> None:

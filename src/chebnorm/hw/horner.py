@@ -56,6 +56,7 @@ from chebnorm.approx import CoefficientTable, parse_number, quantize
 from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
+from .design_base import Design, provided, register
 from .trust import check, drafting, seal
 from .fixed import (QFormat, ROUNDINGS, check_int64, check_width, shift_round, signed_bits,
                     unsigned_bits)
@@ -136,8 +137,9 @@ class Stage:
 SCHEMES = ("monomial", "even", "odd", "shifted")
 
 
+@register("horner")
 @dataclass(frozen=True)
-class HornerDesign:
+class HornerDesign(Design):
     """A fully sized fixed-point polynomial evaluator (see module docstring).
 
     Attributes
@@ -269,9 +271,44 @@ class HornerDesign:
     def degree(self) -> int:
         return len(self.integers) - 1
 
+    architecture = "horner"
+
     @property
     def module_name(self) -> str:
         return f"chebnorm_{self.name}"
+
+    # -- the Design interface ----------------------------------------------------
+    # chebnorm.hw.hdl and chebnorm.hw.budget import this module: their functions are
+    # provided to it (chebnorm.hw.design_base.provide) instead of imported
+    def budget(self) -> dict:
+        """The certified budget (:func:`chebnorm.hw.budget.error_budget`) as a dict."""
+        return provided("horner.error_budget")(self).as_dict()
+
+    def measure(self) -> dict:
+        """The errors over every valid code (:func:`chebnorm.hw.budget.measure`) as a dict."""
+        return provided("horner.measure")(self).as_dict()
+
+    def features(self):
+        """The cost model's inputs (:func:`chebnorm.hw.target_model.horner_features`)."""
+        from .target_model import horner_features
+
+        return horner_features(self)
+
+    def cut_points(self) -> tuple[str, ...]:
+        """None: the registered Horner pipeline is the ``pipelined`` variant of the printers."""
+        return ()
+
+    def verilog(self, *, version: str = "", command: str | None = None) -> str:
+        """The Verilog-2005 module (:func:`chebnorm.hw.hdl.module_text`)."""
+        return provided("horner.module_text")(self, "verilog", version=version, command=command)
+
+    def vhdl(self, *, version: str = "", command: str | None = None) -> str:
+        """The VHDL-2008 entity (:func:`chebnorm.hw.hdl.module_text`)."""
+        return provided("horner.module_text")(self, "vhdl", version=version, command=command)
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, bench and vectors (:func:`chebnorm.hw.hdl.hdl_files`)."""
+        return provided("horner.hdl_files")(self, language)
 
     @property
     def parity(self) -> int | None:

@@ -64,6 +64,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .exhaustive import ExhaustiveCheck, reference
 from .fixed import QFormat
+from .design_base import Design, register
 from .trust import check, check_certificate, drafting, seal
 
 __all__ = ["MAX_MP_IN_BITS", "MAX_MP_OUT_BITS", "OffsetTable", "MultipartiteDesign",
@@ -146,8 +147,9 @@ class OffsetTable:
         return np.where(s == 1, v, ((1 << self.width) - 1) ^ v)
 
 
+@register("multipartite")
 @dataclass(frozen=True, eq=False)
-class MultipartiteDesign:
+class MultipartiteDesign(Design):
     """A certified multipartite evaluator (see the module docstring).
 
     ``tiv`` holds ``2**tiv_bits`` entries of ``sum_bits`` bits (the offset and
@@ -322,6 +324,25 @@ class MultipartiteDesign:
         """The VHDL-2008 entity (:func:`chebnorm.hw.hdl.tables.table_module`)."""
         from .hdl.tables import table_module
         return table_module(self, "vhdl", version=version, command=command)
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, bench and vectors (:func:`chebnorm.hw.hdl.tables.table_files`)."""
+        from .hdl.tables import table_files
+        return table_files(self, language)
+
+    def features(self):
+        """The cost model's inputs (:func:`chebnorm.hw.target_model.multipartite_features`)."""
+        from .target_model import multipartite_features
+        return multipartite_features(self)
+
+    def cut_points(self) -> tuple[str, ...]:
+        """``tables`` (after the table reads) and ``offsets`` (after the offsets' sum)."""
+        return ("tables", "offsets")
+
+    def with_cuts(self, cuts):
+        """A :class:`~chebnorm.hw.pipeline.PipelinedTable` with registers at ``cuts``."""
+        from .pipeline import PipelinedTable
+        return PipelinedTable(self, cuts)
 
 
 def _codes(codes, in_bits: int) -> np.ndarray:

@@ -73,6 +73,7 @@ from .fixed import (
     signed_bits,
 )
 from .hdl import hdl_files, module_text, testbench_text
+from .design_base import Design, register
 from .trust import check, drafting, seal
 from .run_verilog import simulate, synthesize_text
 
@@ -100,8 +101,9 @@ MAX_PW_OUT_BITS = 32
 ROUNDING = "rne"
 
 
+@register("piecewise", "piecewise-sized")
 @dataclass(frozen=True)
-class PiecewiseDesign:
+class PiecewiseDesign(Design):
     """A sized ROM + Horner evaluator of a uniform :class:`PiecewiseTable`.
 
     Built by :func:`design_piecewise`; two architectures share the class: the
@@ -247,6 +249,77 @@ class PiecewiseDesign:
     @property
     def degree(self) -> int:
         return self.table.degree
+
+    @property
+    def architecture(self) -> str:
+        """``"piecewise-sized"`` for the sized architecture, else ``"piecewise"``."""
+        return "piecewise-sized" if self.sized else "piecewise"
+
+    # -- the Design interface ----------------------------------------------------
+    def features(self):
+        """The cost model's inputs (:func:`chebnorm.hw.target_model.piecewise_features`)."""
+        from .target_model import piecewise_features
+
+        return piecewise_features(self)
+
+    def cut_points(self) -> tuple[str, ...]:
+        """The sized architecture's: ``rom`` (after the ROM read), then ``mulI``
+        and ``addI`` (after the ``I``-th multiply and add); none for one width."""
+        if not self.sized:
+            return ()
+        return ("rom",) + tuple(f"{op}{i}" for i in range(1, self.degree + 1)
+                                for op in ("mul", "add"))
+
+    def cut_plans(self) -> list[tuple[int, ...]]:
+        """Per latency ``1, 2, ...`` the cut set whose heaviest stage (by
+        :data:`chebnorm.hw.pipeline.STAGE_WEIGHTS`) is the lightest, ties to the
+        earliest cuts (none for one width)."""
+        from itertools import combinations
+
+        from .pipeline import STAGE_WEIGHTS
+
+        if not self.sized:
+            return []
+        n = self.degree
+        # stage k sits before position k: the ROM, a multiply and an add per step, the output
+        weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["mul"], STAGE_WEIGHTS["add"]] * n
+                   + [STAGE_WEIGHTS["output"]])
+
+        def worst(cuts) -> float:
+            edges = [0, *[c + 1 for c in cuts], len(weights)]
+            return max(sum(weights[a:b]) for a, b in zip(edges, edges[1:]))
+
+        return [min(combinations(range(2 * n + 1), m), key=lambda c: (worst(c), c))
+                for m in range(1, 2 * n + 2)]
+
+    def with_cuts(self, cuts) -> "PiecewiseDesign":
+        """Registers at positions ``cuts`` (0 after the ROM, ``2i - 1`` after the
+        ``i``-th multiply, ``2i`` after the ``i``-th add): ``cuts`` and ``mult_cuts``."""
+        if not self.sized:
+            return super().with_cuts(cuts)
+        cuts = tuple(sorted(set(cuts)))
+        top = 2 * self.degree
+        if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= top for c in cuts):
+            raise ValueError(f"cuts {list(cuts)[:8]}: accepted: integers 0..{top} (0 after the "
+                             f"ROM, 2i-1 after the i-th multiply, 2i after the i-th add)")
+        return replace(self, cuts=tuple(c // 2 for c in cuts if c % 2 == 0),
+                       mult_cuts=tuple((c + 1) // 2 for c in cuts if c % 2 == 1))
+
+    def combinational(self) -> "PiecewiseDesign":
+        """The design without its pipeline registers."""
+        return replace(self, cuts=(), mult_cuts=()) if self.sized else self
+
+    def verilog(self, *, version: str = "", command: str | None = None) -> str:
+        """The Verilog-2005 module (:func:`chebnorm.hw.hdl.module_text`)."""
+        return module_text(self, "verilog", version=version, command=command)
+
+    def vhdl(self, *, version: str = "", command: str | None = None) -> str:
+        """The VHDL-2008 entity (:func:`chebnorm.hw.hdl.module_text`)."""
+        return module_text(self, "vhdl", version=version, command=command)
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, bench and vectors (:func:`chebnorm.hw.hdl.hdl_files`)."""
+        return hdl_files(self, language)
 
     @property
     def sized(self) -> bool:

@@ -49,6 +49,7 @@ from chebnorm.core.numeric import format_up
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
 from .sweep import pareto_png
+from .synth_loop import SYNTH_ROUND, SynthJob, map_synth, pruned_synthesis
 from .targets import TargetCost, get_target
 
 __all__ = ["DesignPoint", "SearchResult", "search", "grid", "model_cost", "COLUMNS",
@@ -65,9 +66,6 @@ TARGET_COLUMNS = ("target", "target_model", "target_score", "luts", "dsps", "car
 #: Yosys cells per ROM bit, measured on the 256 x 55-bit ROM of the 1/sqrt example
 ROM_CELLS_PER_BIT = 0.15
 MAX_SYNTH = 6
-#: points synthesized per round of the pruned synthesis (fixed, so the points
-#: synthesized, and the CSV, do not depend on the worker count)
-SYNTH_ROUND = 2
 #: a worker thread fits one table at a time: the certifier sets python-flint's global
 #: precision, which threads of one process (a threaded Dask worker) would share
 _FIT_LOCK = threading.Lock()
@@ -706,92 +704,40 @@ def with_costs(result: SearchResult, costs: dict) -> SearchResult:
     return replace(result, points=ordered, winner=winner, cost_source=cost_source)
 
 
-def map_synth(fn, items, *, workers: int | None = None, scheduler=None, progress=False,
-              desc: str | None = None) -> list:
-    """``[fn(x) for x in items]`` for yosys runs: on a Dask ``scheduler`` through
-    :func:`chebnorm.core.parallel.map_ordered`, else on ``workers`` threads of
-    this process (a yosys run is a child process: threads run them side by
-    side without starting a Python worker per batch).
-
-    Parameters
-    ----------
-    fn : callable
-        A function of one item (thread-safe: it writes only its own files).
-    items : iterable
-    workers : int, optional
-        Threads (default: the core count).
-    scheduler, progress, desc
-        As :func:`~chebnorm.core.parallel.map_ordered` (``progress`` and
-        ``desc`` only with a scheduler).
-
-    Returns
-    -------
-    list
-        The results in the order of ``items``.
-
-    Examples
-    --------
-    >>> map_synth(abs, [-1, 2, -3], workers=2)
-    [1, 2, 3]
-    """
-    items = list(items)
-    if scheduler is not None:
-        return map_ordered(fn, items, scheduler=scheduler, progress=progress, desc=desc)
-    workers = check_workers(workers)
-    if workers == 1 or len(items) <= 1:
-        return [fn(x) for x in items]
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
-        return list(pool.map(fn, items))
-
-
 def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
     """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
     target model first, skipping those whose model lower bound cannot beat
     the best score so far (or ``bound``; the first key always runs); update
     ``points``. Returns the number synthesized."""
-    from .target_model import MODEL_SPREAD, model_score, piecewise_features
+    from .target_model import MODEL_SPREAD, model_score
 
     spread = MODEL_SPREAD[target]
-    model = {k: model_score(piecewise_features(designs[k]), target) for k in chosen}
-    todo = sorted(chosen, key=lambda k: (model[k], k))
-    best = math.inf if bound is None else float(bound)
-    n = 0
-    while todo:
-        run = [k for k in todo if model[k] / spread < best][:SYNTH_ROUND]
-        if n == 0 and not run and bound is None:   # the cheapest by the model always
-            run = todo[:1]
-        if not run:
-            break
+    model = {k: model_score(designs[k].features(), target) for k in chosen}
+    jobs = [SynthJob((model[k], k), model[k] / spread, k) for k in chosen]
+
+    def synthesize(batch):
         if target == "generic":
-            got = map_synth(_cells, [designs[k] for k in run], desc="yosys", **par)
-            for key, c in zip(run, got):
-                points[key] = replace(points[key], yosys_cells=c)
-                best = min(best, float(c))
-        else:
-            got = map_synth(_target_cost, [(designs[k], target) for k in run],
-                            desc=f"yosys {target}", **par)
-            for key, c in zip(run, got):
-                points[key] = replace(points[key], target_cost=c)
-                best = min(best, c.score)
-        n += len(run)
-        todo = [k for k in todo if k not in run]
-    return n
+            return map_synth(_cells, [designs[j.key] for j in batch], desc="yosys", **par)
+        return map_synth(_target_cost, [(designs[j.key], target) for j in batch],
+                         desc=f"yosys {target}", **par)
+
+    run = pruned_synthesis(jobs, synthesize, bound=bound, first=bound is None,
+                           score=lambda j, c: float(c) if target == "generic" else c.score)
+    for key, c in run.costs.items():
+        points[key] = (replace(points[key], yosys_cells=c) if target == "generic" else
+                       replace(points[key], target_cost=c))
+    return len(run.costs)
 
 
 def _target_cost(item) -> TargetCost:
     """Yosys's mapping of one design on a target, with its delay model (run by
     ``map_ordered`` on a worker)."""
-    from .hdl import module_text
     from .targets import synthesize_target
 
     design, target = item
     if get_target(target).timing == "sta":   # the sta model later, on the winner's netlist
-        return synthesize_target(module_text(design, "verilog"), design.module_name, target,
-                                 netlist=True)
-    return synthesize_target(module_text(design, "verilog"), design.module_name, target,
-                             timing=True)
+        return synthesize_target(design.verilog(), design.module_name, target, netlist=True)
+    return synthesize_target(design.verilog(), design.module_name, target, timing=True)
 
 
 def _grid_point(item) -> tuple[DesignPoint, PiecewiseDesign]:

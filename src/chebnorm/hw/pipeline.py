@@ -41,7 +41,7 @@ from pathlib import Path
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.exceptions import FrequencyWarning
 
-from .hdl import hdl_files, module_text
+from .design_base import Design
 from .hdl.tables import table_cuts, table_files, table_module
 from .targets import fmax_ice40, get_target, synthesize_target
 
@@ -96,21 +96,15 @@ def check_frequency(value, name: str = "frequency") -> float:
 
 
 def _pipelinable(design) -> bool:
-    if getattr(design, "architecture", None) == "multipartite":
-        return True
-    return bool(getattr(design, "sized", False)) and hasattr(design, "cuts")
+    return isinstance(design, Design) and bool(design.cut_points())
 
 
 def _base(design):
     """``design`` without pipeline registers."""
-    if isinstance(design, PipelinedTable):
-        return design.base
-    if getattr(design, "sized", False):
-        return replace(design, cuts=(), mult_cuts=())
-    return design
+    return design.combinational()
 
 
-class PipelinedTable:
+class PipelinedTable(Design):
     """A multipartite design with pipeline registers at ``cuts``
     (:data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table reads,
     ``1`` after the offsets' sum); every other attribute is the design's
@@ -137,7 +131,8 @@ class PipelinedTable:
     """
 
     def __init__(self, base, cuts):
-        if getattr(base, "architecture", None) != "multipartite":
+        if not isinstance(base, Design) or base.cut_points() != ("tables", "offsets") \
+                or base.combinational() is not base:
             raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign")
         self.base = base
         self.cuts = tuple(cuts)
@@ -153,6 +148,58 @@ class PipelinedTable:
         """Clock cycles from ``x`` to ``y``."""
         return len(self.cuts)
 
+    # -- the Design interface: the base's, but for the registers -----------------
+    @property
+    def architecture(self) -> str:
+        """The base's architecture."""
+        return self.base.architecture
+
+    @property
+    def module_name(self) -> str:
+        """The base's module name."""
+        return self.base.module_name
+
+    def verify(self) -> "PipelinedTable":
+        """Re-prove the base design; return ``self``."""
+        self.base.verify()
+        return self
+
+    def evaluate(self, codes=None, **kw):
+        """The base's output codes (``latency`` cycles later in the circuit)."""
+        return self.base.evaluate(codes, **kw)
+
+    def budget(self) -> dict:
+        """The base's certified budget (registers change no value)."""
+        return self.base.budget()
+
+    def measure(self) -> dict:
+        """The base's measured error."""
+        return self.base.measure()
+
+    def features(self):
+        """The base's cost model inputs (the registers are not priced)."""
+        return self.base.features()
+
+    def cut_points(self) -> tuple[str, ...]:
+        """The base's cut points."""
+        return self.base.cut_points()
+
+    def with_cuts(self, cuts) -> "PipelinedTable":
+        """The base with registers at ``cuts`` instead."""
+        return PipelinedTable(self.base, cuts)
+
+    def combinational(self):
+        """The base design."""
+        return self.base
+
+    def state(self) -> dict:
+        """The base and the cuts."""
+        return {"base": self.base, "cuts": self.cuts}
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, clocked bench and vectors (:func:`chebnorm.hw.hdl.tables.table_files`)."""
+        return table_files(self, language)
+
     def verilog(self, *, version: str = "", command: str | None = None) -> str:
         """The pipelined Verilog-2005 module (:func:`chebnorm.hw.hdl.tables.table_module`)."""
         return table_module(self, "verilog", version=version, command=command)
@@ -163,7 +210,7 @@ class PipelinedTable:
 
 
 def _verilog(design) -> str:
-    return design.verilog() if hasattr(design, "verilog") else module_text(design, "verilog")
+    return design.verilog()
 
 
 def design_files(design, language: str = "verilog") -> dict:
@@ -192,9 +239,7 @@ def design_files(design, language: str = "verilog") -> dict:
     ValueError
         If ``language`` is not ``"verilog"`` or ``"vhdl"``.
     """
-    if getattr(design, "architecture", None) in ("multipartite", "plain_table"):
-        return table_files(design, language)
-    return hdl_files(design, language)
+    return design.hdl_files(language)
 
 
 def cut_plans(design) -> list[tuple[int, ...]]:
@@ -228,19 +273,7 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     """
     if not _pipelinable(design):
         return []
-    if getattr(design, "architecture", None) == "multipartite":
-        return [(0,), (0, 1)]
-    n = design.degree
-    # stage k sits before position k: the ROM, then a multiply and an add per step, the output
-    weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["mul"], STAGE_WEIGHTS["add"]] * n
-               + [STAGE_WEIGHTS["output"]])
-
-    def worst(cuts) -> float:
-        edges = [0, *[c + 1 for c in cuts], len(weights)]
-        return max(sum(weights[a:b]) for a, b in zip(edges, edges[1:]))
-
-    return [min(combinations(range(2 * n + 1), m), key=lambda c: (worst(c), c))
-            for m in range(1, 2 * n + 2)]
+    return list(design.cut_plans())
 
 
 def cut_names(design, cuts) -> list[str]:
@@ -263,9 +296,8 @@ def cut_names(design, cuts) -> list[str]:
     list of str
         One name per position, in order.
     """
-    if getattr(design, "architecture", None) == "multipartite":
-        return [("tables", "offsets")[c] for c in cuts]
-    return ["rom" if c == 0 else f"{'mul' if c % 2 else 'add'}{(c + 1) // 2}" for c in cuts]
+    points = design.cut_points()
+    return [points[c] for c in cuts]
 
 
 def with_cuts(design, cuts):
@@ -309,14 +341,7 @@ def with_cuts(design, cuts):
     if isinstance(cuts, (str, bytes)) or not hasattr(cuts, "__iter__"):
         raise ValueError(f"cuts {cuts!r}: accepted: an iterable of cut positions")
     cuts = tuple(sorted(set(cuts)))
-    if getattr(design, "architecture", None) == "multipartite":
-        return PipelinedTable(_base(design), cuts)
-    top = 2 * design.degree
-    if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= top for c in cuts):
-        raise ValueError(f"cuts {list(cuts)[:8]}: accepted: integers 0..{top} (0 after the ROM, "
-                         f"2i-1 after the i-th multiply, 2i after the i-th add)")
-    return replace(design, cuts=tuple(c // 2 for c in cuts if c % 2 == 0),
-                   mult_cuts=tuple((c + 1) // 2 for c in cuts if c % 2 == 1))
+    return design.with_cuts(cuts)
 
 
 @dataclass(frozen=True)
@@ -426,7 +451,7 @@ def _timing(design, target: str, frequency: float, seed: int):
     """(Fmax MHz, source, TargetCost or None) of ``design``'s module on ``target``."""
     text = _verilog(design)
     top = design.module_name
-    clocked = getattr(design, "latency", 0) > 0
+    clocked = design.latency > 0
     if target == "ice40":
         f = fmax_ice40(text, top, clocked=clocked, freq_mhz=min(frequency, MAX_PNR_MHZ),
                        seed=seed)

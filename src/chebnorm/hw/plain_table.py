@@ -26,6 +26,7 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from .exhaustive import ExhaustiveCheck, reference, round_to_nearest
 from .fixed import QFormat
 from .multipartite import output_format
+from .design_base import Design, register
 from .trust import check, check_certificate, drafting, seal
 
 __all__ = ["MAX_TABLE_IN_BITS", "PlainTableDesign", "design_plain_table"]
@@ -34,8 +35,9 @@ __all__ = ["MAX_TABLE_IN_BITS", "PlainTableDesign", "design_plain_table"]
 MAX_TABLE_IN_BITS = 20
 
 
+@register("table")
 @dataclass(frozen=True, eq=False)
-class PlainTableDesign:
+class PlainTableDesign(Design):
     """A ROM of the correctly rounded ``f`` at every input code.
 
     ``values[k]`` is the output code of input ``k`` (value ``(offset_code +
@@ -173,6 +175,20 @@ class PlainTableDesign:
         """The VHDL-2008 entity (:func:`chebnorm.hw.hdl.tables.table_module`)."""
         from .hdl.tables import table_module
         return table_module(self, "vhdl", version=version, command=command)
+
+    def hdl_files(self, language: str = "verilog") -> dict:
+        """Module, bench and vectors (:func:`chebnorm.hw.hdl.tables.table_files`)."""
+        from .hdl.tables import table_files
+        return table_files(self, language)
+
+    def features(self):
+        """The cost model's inputs (:func:`chebnorm.hw.target_model.table_features`)."""
+        from .target_model import table_features
+        return table_features(self)
+
+    def cut_points(self) -> tuple[str, ...]:
+        """None: one ROM read."""
+        return ()
 
 
 def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str = "x",

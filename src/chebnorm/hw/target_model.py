@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .design_base import Design
 from .targets import DEVICE_WEIGHTS, get_target
 
 __all__ = ["DesignFeatures", "piecewise_features", "horner_features", "model_score",
@@ -329,7 +330,7 @@ def piecewise_features(d) -> DesignFeatures:
     n = d.degree
     mults, adds, partial = [], [], []
     acc_w = d.rom_bits[n] if n > 0 else 0
-    if getattr(d, "sized", False):
+    if d.sized:
         for st in d.sized_signals():   # each step multiplies by its own T_j bits of t
             a = int(acc_w)
             if st["rows"]:   # truncated: the kept bits of the shifted-multiplicand rows
@@ -404,7 +405,7 @@ def horner_features(d) -> DesignFeatures:
     >>> f.roms, len(f.multipliers), len(f.const_multipliers)
     ((), 1, 1)
     """
-    scheme = getattr(d, "scheme", "monomial")
+    scheme = d.scheme
 
     def operand(st) -> int:   # x, or the Horner variable v (x*x, (x - c)/s)
         return int(d.xs_bits if scheme == "monomial" or st.operand == "x" else d.variable_bits)
@@ -489,19 +490,20 @@ def design_features(d) -> DesignFeatures:
 
     Parameters
     ----------
-    d : PiecewiseDesign, MultipartiteDesign or PlainTableDesign
-        The design.
+    d : Design
+        Any design of :mod:`chebnorm.hw` (:class:`~chebnorm.hw.design_base.Design`).
 
     Returns
     -------
     DesignFeatures
-        As :func:`piecewise_features`, :func:`multipartite_features` or
-        :func:`table_features` give them.
+        Its :meth:`~chebnorm.hw.design_base.Design.features` (e.g.
+        :func:`piecewise_features`, :func:`multipartite_features`,
+        :func:`table_features`).
 
     Raises
     ------
     ValueError
-        ``d`` is none of these designs.
+        ``d`` is not a design.
 
     Examples
     --------
@@ -509,12 +511,7 @@ def design_features(d) -> DesignFeatures:
     >>> design_features(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 6, 6)).roms
     ((6, 6),)
     """
-    arch = getattr(d, "architecture", None)
-    if arch == "multipartite":
-        return multipartite_features(d)
-    if arch == "plain_table":
-        return table_features(d)
-    if hasattr(d, "table") and hasattr(d, "widths"):
-        return piecewise_features(d)
-    raise ValueError(f"design: a {type(d).__name__}; accepted: a piecewise, multipartite or "
-                     f"plain-table design")
+    if isinstance(d, Design):
+        return d.features()
+    raise ValueError(f"design: a {type(d).__name__}; accepted: a design of chebnorm.hw "
+                     f"(chebnorm.hw.design_base.Design)")

@@ -45,6 +45,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from .design_base import Design
+
 __all__ = ["check", "digest", "drafting", "seal", "verify_design", "check_certificate"]
 
 #: digests of the design contents proved (or sealed by their builder), most recent last
@@ -115,8 +117,8 @@ def _canonical(value):
         return (type(value).__name__,) + tuple(_canonical(v) for v in value)
     if isinstance(value, dict):
         return ("d",) + tuple(sorted((repr(k), _canonical(v)) for k, v in value.items()))
-    if hasattr(value, "base") and hasattr(value, "cuts"):   # a PipelinedTable
-        return ("pipelined", _canonical(value.base), _canonical(value.cuts))
+    if isinstance(value, Design):   # a design that is not a dataclass (a PipelinedTable)
+        return (type(value).__name__, _canonical(value.state()))
     return ("opaque", type(value).__name__, id(value))
 
 
@@ -217,7 +219,8 @@ def check(design, prove):
 
 def verify_design(design):
     """Re-prove ``design`` if its fields changed since it was proved (its own
-    ``verify``); anything without a ``verify`` method is returned as it is.
+    :meth:`~chebnorm.hw.design_base.Design.verify`); anything that is not a
+    :class:`~chebnorm.hw.design_base.Design` is returned as it is.
 
     Parameters
     ----------
@@ -244,9 +247,8 @@ def verify_design(design):
     ...
     ValueError: unproved: stated 2; accepted: 0 (the roundings that cannot be proved)
     """
-    verify = getattr(design, "verify", None)
-    if callable(verify):
-        verify()
+    if isinstance(design, Design):
+        design.verify()
     return design
 
 
