@@ -217,25 +217,43 @@ ALLOWED = {
 
 
 def attribute_probes(root: Path) -> set[tuple[str, str]]:
-    """``(file relative to root, call source)`` of every ``hasattr``/``getattr`` call."""
+    """``(file relative to root, call source)`` of every ``hasattr``/``getattr`` call
+    (also when called through another name: ``probe = getattr`` is a call of a name
+    bound to it, and ``builtins.getattr(...)`` an attribute call)."""
     found = set()
     for path in sorted(root.rglob("*.py")):
         text = path.read_text(encoding="utf-8")
+        if "hasattr" not in text and "getattr" not in text:
+            continue
+        lines = text.encode("utf-8").splitlines(keepends=True)
         for node in ast.walk(ast.parse(text, filename=str(path))):
-            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and \
-                    node.func.id in ("hasattr", "getattr"):
-                found.add((path.relative_to(root).as_posix(), ast.get_source_segment(text, node)))
+            if not isinstance(node, ast.Call):
+                continue
+            f = node.func
+            name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) \
+                else ""
+            if name not in ("hasattr", "getattr"):
+                continue
+            first, last = node.lineno - 1, node.end_lineno - 1
+            seg = b"".join(lines[first:last + 1])
+            seg = seg[node.col_offset:len(seg) - len(lines[last]) + node.end_col_offset]
+            found.add((path.relative_to(root).as_posix(), " ".join(seg.decode().split())))
     return found
 
 
-def test_no_attribute_probe_dispatch_in_hw():
-    assert attribute_probes(HW) <= ALLOWED, sorted(attribute_probes(HW) - ALLOWED)
+@pytest.fixture(scope="module")
+def probes():
+    return attribute_probes(HW)
 
 
-def test_no_dispatch_left_in_the_search_pipeline_and_reports():
+def test_no_attribute_probe_dispatch_in_hw(probes):
+    assert probes <= ALLOWED, sorted(probes - ALLOWED)
+
+
+def test_no_dispatch_left_in_the_search_pipeline_and_reports(probes):
     """The modules that choose among designs probe no attribute at all, but
     to check user input's iterability."""
-    for rel, src in attribute_probes(HW):
+    for rel, src in probes:
         if rel in ("architectures.py", "report.py", "target_model.py", "synth_loop.py",
                    "piecewise_search.py", "exponent.py", "multipartite.py", "plain_table.py"):
             pytest.fail(f"{rel}: {src}")
@@ -247,8 +265,91 @@ def test_the_scan_catches_a_dispatch(tmp_path):
 
     copy = tmp_path / "hw"
     shutil.copytree(HW, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    assert attribute_probes(copy) <= ALLOWED
     p = copy / "architectures.py"
     p.write_text(p.read_text(encoding="utf-8") + "\n\ndef _v(d):\n    return d.verilog() "
                  "if hasattr(d, \"verilog\") else None\n", encoding="utf-8")
-    assert attribute_probes(copy) - ALLOWED == {("architectures.py", 'hasattr(d, "verilog")')}
+    q = copy / "pipeline.py"
+    q.write_text(q.read_text(encoding="utf-8") + "\n\ndef _s(d):\n    return builtins.getattr(\n"
+                 "        d, \"sized\", False)\n", encoding="utf-8")
+    assert attribute_probes(copy) - ALLOWED == {("architectures.py", 'hasattr(d, "verilog")'),
+                                                ("pipeline.py", 'builtins.getattr( d, "sized", False)')}
+
+
+# -- the one pruned synthesis loop -----------------------------------------------------
+
+def _queue(lowers):
+    from chebnorm.hw.synth_loop import SynthJob
+
+    return [SynthJob((low, i), low, f"j{i}") for i, low in enumerate(lowers)]
+
+
+def _run(jobs, true, **kw):
+    from chebnorm.hw.synth_loop import pruned_synthesis
+
+    batches = []
+
+    def synthesize(batch):
+        batches.append([j.key for j in batch])
+        return [true[j.key] for j in batch]
+
+    run = pruned_synthesis(jobs, synthesize, score=lambda j, c: c, **kw)
+    return run, batches
+
+
+def test_pruned_synthesis_rounds_prune_and_join():
+    from chebnorm.hw.synth_loop import SYNTH_ROUND, SynthJob
+
+    assert SYNTH_ROUND == 2
+    jobs = _queue([3.0, 1.0, 2.0, 5.0, 4.0])   # queue order j1, j2, j0, j4, j3
+    true = {"j0": 3.5, "j1": 2.5, "j2": 4.0, "j3": 4.5, "j4": 5.5}
+    run, batches = _run(jobs, true)
+    # round one: the two lowest bounds; then nothing left can beat 2.5
+    assert batches == [["j1", "j2"]] and run.best == 2.5
+    assert [j.key for j in run.skipped] == ["j0", "j4", "j3"]
+    assert all(j.lower >= run.best for j in run.skipped)
+    # without pruning: everything, two at a time, in queue order
+    run, batches = _run(jobs, true, prune=False)
+    assert batches == [["j1", "j2"], ["j0", "j4"], ["j3"]] and not run.skipped
+    # a bound from elsewhere prunes everything; `first` still runs the cheapest
+    assert _run(jobs, true, bound=0.5)[1] == []
+    assert _run(jobs, true, bound=0.5, first=True)[1] == [["j1"]]
+    # later jobs join from round two, even when their bound is the lowest
+    late = [SynthJob((0.1, 9), 0.1, "late")]
+    run, batches = _run(jobs, dict(true, late=0.2), later=lambda: late)
+    assert batches == [["j1", "j2"], ["late"]] and run.best == 0.2
+    # no first-round job: the later ones still run
+    assert _run([], {"late": 0.2}, later=lambda: late)[1] == [["late"]]
+
+
+def test_every_synthesis_goes_through_the_one_loop(monkeypatch):
+    """synthesize_candidates, synthesize_search and synthesize_with_search each
+    run their jobs through synth_loop.pruned_synthesis (no copy of the loop)."""
+    from chebnorm.hw import architectures as A
+    from chebnorm.hw import piecewise_search as S
+    from chebnorm.hw.synth_loop import pruned_synthesis
+
+    seen = []
+
+    def spy(jobs, synthesize, **kw):
+        seen.append(kw.get("later") is not None)
+        return pruned_synthesis(jobs, synthesize, **kw)
+
+    monkeypatch.setattr(A, "pruned_synthesis", spy)
+    monkeypatch.setattr(S, "pruned_synthesis", spy)
+    monkeypatch.setattr(A, "_synth_item", lambda item: type("C", (), {"score": 1.0})())
+    monkeypatch.setattr(A, "_synth_job", lambda item: type("C", (), {"score": 1.0})())
+
+    class D:
+        module_name = "m"
+
+        def verilog(self):
+            return "module m; endmodule"
+
+    cands = [A.Candidate("table", "t", D(), 0.0, 1.0, model=5.0, model_rom=5.0)]
+    assert A.synthesize_candidates(cands, "generic")[0].cost.score == 1.0
+    r = S.search("1/sqrt(x)", ("1", "4"), 8, 8, 1e-2, degrees=(1,), max_index_bits=4,
+                 synth=False, progress=False, workers=1, target="xc7")
+    assert S.synthesize_search(r, bound=0.0).winner is not None
+    out, res = A.synthesize_with_search(cands, r, "xc7", workers=1)
+    assert out[0].cost.score == 1.0
+    assert seen == [False, False, True]

@@ -25,6 +25,12 @@ The interface (abstract: a subclass missing one cannot be instantiated):
 * :meth:`Design.verify` -- re-prove the design's claims;
 * :attr:`Design.module_name`.
 
+The normalization units of :mod:`chebnorm.hw.units` are not designs in this
+sense: each is a whole multi-port unit (vectors in, vectors out, some
+clocked) sized per kind, with its own interface
+(:class:`~chebnorm.hw.units.base.UnitKind` and its registry); the polynomial
+evaluator inside some of them is a Horner design.
+
 The HDL seam: the three HDL methods print through :mod:`chebnorm.hw.hdl`
 today. A design module that :mod:`chebnorm.hw.hdl` itself imports (the Horner
 design) cannot import it back (no import cycles), so its printers are handed
@@ -269,6 +275,7 @@ def provide(role: str, fn) -> None:
 
     Examples
     --------
+    >>> import chebnorm.hw
     >>> provided("horner.module_text").__name__   # chebnorm.hw provides it on import
     'module_text'
     """
@@ -292,6 +299,16 @@ def provided(role: str):
     RuntimeError
         Nothing was provided: ``chebnorm.hw`` was not imported whole (it
         provides every role on import, before any design exists).
+
+    Examples
+    --------
+    >>> import chebnorm.hw
+    >>> provided("horner.error_budget").__name__
+    'error_budget'
+    >>> provided("horner.netlist")
+    Traceback (most recent call last):
+    ...
+    RuntimeError: horner.netlist: not provided; import chebnorm.hw (it provides it)
     """
     fn = _PROVIDED.get(role)
     if fn is None:

@@ -34,8 +34,7 @@ from __future__ import annotations
 import math
 import tempfile
 import warnings
-from dataclasses import dataclass, replace
-from itertools import combinations
+from dataclasses import dataclass
 from pathlib import Path
 
 from chebnorm.core.display import field_rows, summary_html, summary_repr
@@ -286,8 +285,10 @@ def cut_names(design, cuts) -> list[str]:
 
     Parameters
     ----------
-    design : object
-        A sized piecewise design or a multipartite design.
+    design : Design
+        A design with cut points
+        (:meth:`~chebnorm.hw.design_base.Design.cut_points`): a sized piecewise
+        design or a multipartite design.
     cuts : iterable of int
         Cut positions, as :func:`cut_plans` gives them.
 
@@ -295,8 +296,21 @@ def cut_names(design, cuts) -> list[str]:
     -------
     list of str
         One name per position, in order.
+
+    Raises
+    ------
+    ValueError
+        A position is not one of the design's cut points.
     """
     points = design.cut_points()
+    cuts = list(cuts)
+    if cuts and not points:
+        raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
+                         f"accepted: a design with cut points")
+    if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c < len(points)
+           for c in cuts):
+        raise ValueError(f"cuts {cuts[:8]}: accepted: positions 0..{len(points) - 1} "
+                         f"({', '.join(points)})")
     return [points[c] for c in cuts]
 
 
