@@ -1,9 +1,10 @@
 """Stage 3 (hardware): bit-accurate fixed-point datapaths, error budgets,
 Verilog and VHDL checked in Icarus Verilog and GHDL and sized by Yosys.
 
-Where things are: :mod:`.horner` and :mod:`.piecewise` size a design (the
-bit-accurate model); :mod:`.hdl` prints any design in Verilog or VHDL (the
-one HDL printer, with the benches and vector files); :mod:`.run_verilog` and
+Where things are: every design is a :class:`~.design_base.Design` (one
+interface, one registry of architectures by name: :mod:`.design_base`);
+:mod:`.horner` and :mod:`.piecewise` size a design (the bit-accurate
+model); :mod:`.hdl` prints any design in Verilog or VHDL (the one HDL printer, with the benches and vector files); :mod:`.run_verilog` and
 :mod:`.run_vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
 checks a design against its error budget; :mod:`.units` are the
 normalization units (Verilog); :func:`design` (:mod:`.design_api`) picks the

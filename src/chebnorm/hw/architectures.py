@@ -454,8 +454,9 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
         else:
             costs[i] = cost
     for j in run.skipped:
-        if j.key[0] == "arch":
-            out[j.key[1]] = _skipped(out[j.key[1]], f"{j.lower:.1f}", run.best)
+        low, (kind, i) = j.lower, j.key
+        if kind == "arch":   # rounded to nearest, as this queue always printed it
+            out[i] = _skipped(out[i], f"{low:.1f}", run.best)
     return out, with_costs(searched[0], costs)
 
 

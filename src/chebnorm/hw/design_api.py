@@ -590,10 +590,9 @@ def _winner_design(res):
 
 def _winner_figures(res, d) -> list[str]:
     """The one-width winner's mapping and timing on the search's device."""
-    from .hdl import module_text
     from .targets import target_figures
 
-    fig = target_figures(module_text(d, "verilog"), d.module_name, res.target,
+    fig = target_figures(d.verilog(), d.module_name, res.target,
                          cost=res.winner.target_cost)
     return [f"winner {fig['line']}", f"timing: {fig['timing']}"]
 
