@@ -353,3 +353,18 @@ def test_every_synthesis_goes_through_the_one_loop(monkeypatch):
     out, res = A.synthesize_with_search(cands, r, "xc7", workers=1)
     assert out[0].cost.score == 1.0
     assert seen == [False, False, True]
+
+
+def test_candidates_name_registered_architectures():
+    """The search's candidates and the pruning's calibration use the registry's
+    names, and each built candidate's design is of its architecture's class."""
+    from chebnorm.hw.architectures import PRUNE_SPREAD, build_candidates
+
+    assert {a for a, _ in PRUNE_SPREAD} <= set(ARCHITECTURES)
+    cs = build_candidates("1/sqrt(1+3*x)", ("0", "1"), 6, 6, accuracy="faithful",
+                          k_start={1: 2})
+    assert {c.architecture for c in cs} == {"piecewise-sized", "multipartite", "table"}
+    for c in cs:
+        if c.design is not None:
+            assert isinstance(c.design, architecture(c.architecture))
+            assert c.verilog == c.design.verilog()
