@@ -20,9 +20,11 @@ with ``sized``): after the ROM read, after each multiply, after each add (the
 values are unchanged; ``latency`` cycles later). The plans balance the stages
 by a weight per stage (:data:`STAGE_WEIGHTS`: a multiply weighs two ROM reads
 or two adds). A multipartite design (:class:`PipelinedTable`)
-has two: after the table reads, after the offsets' sum. A plain table and the
-one-width piecewise design have none here (their plan list is empty: only the
-combinational module is measured).
+has two: after the table reads, after the offsets' sum. A plain table
+(:class:`PipelinedTable` too) has two: its ROM output registered (a synchronous
+read: block RAM in yosys) and its address registered. The one-width piecewise
+design has none here (its plan list is empty: only the combinational module is
+measured).
 
 :func:`verify_pipelined` simulates the pipelined module cycle by cycle over
 every input code in Icarus Verilog (one code per clock; output ``i`` checked
@@ -96,9 +98,13 @@ def check_frequency(value, name: str = "frequency") -> float:
 
 
 def _pipelinable(design) -> bool:
-    if getattr(design, "architecture", None) == "multipartite":
+    if getattr(design, "architecture", None) in _TABLE_KINDS:
         return True
     return bool(getattr(design, "sized", False)) and hasattr(design, "cuts")
+
+
+#: the table designs :class:`PipelinedTable` pipelines, with their cut plans per latency
+_TABLE_KINDS = {"multipartite": [(0,), (0, 1)], "plain_table": [(1,), (0, 1)]}
 
 
 def _base(design):
@@ -111,10 +117,12 @@ def _base(design):
 
 
 class PipelinedTable:
-    """A multipartite design with pipeline registers at ``cuts``
-    (:data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table reads,
-    ``1`` after the offsets' sum); every other attribute is the design's
-    (same values, ``latency`` cycles later).
+    """A multipartite design or a plain table with pipeline registers at ``cuts``
+    (multipartite, :data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table
+    reads, ``1`` after the offsets' sum; plain table,
+    :data:`chebnorm.hw.hdl.tables.PLAIN_TABLE_CUTS`: ``0`` the address register,
+    ``1`` the ROM output register); every other attribute is the design's (same
+    values, ``latency`` cycles later).
 
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> p = PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
@@ -123,22 +131,23 @@ class PipelinedTable:
 
     Parameters
     ----------
-    base : MultipartiteDesign
+    base : MultipartiteDesign or PlainTableDesign
         The combinational design, from
-        :func:`~chebnorm.hw.multipartite.design_multipartite`.
+        :func:`~chebnorm.hw.multipartite.design_multipartite` or
+        :func:`~chebnorm.hw.plain_table.design_plain_table`.
     cuts : iterable of int
-        Sorted register positions among 0 (after the table reads) and 1 (after the
-        offsets' sum); the latency is ``len(cuts)``.
+        Sorted register positions among 0 and 1 (above); the latency is ``len(cuts)``.
 
     Raises
     ------
     ValueError
-        If ``base`` is not a multipartite design or ``cuts`` is not such a set.
+        If ``base`` is not a table design or ``cuts`` is not such a set.
     """
 
     def __init__(self, base, cuts):
-        if getattr(base, "architecture", None) != "multipartite":
-            raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign")
+        if getattr(base, "architecture", None) not in _TABLE_KINDS:
+            raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign "
+                             f"or a PlainTableDesign")
         self.base = base
         self.cuts = tuple(cuts)
         table_cuts(self)  # checked
@@ -204,7 +213,8 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     (:func:`cut_names`); for each count of registers the set whose heaviest
     stage (by :data:`STAGE_WEIGHTS`) is the lightest, ties to the earliest
     cuts. A multipartite design: ``[(0,), (0, 1)]`` (after the table reads,
-    after the offsets' sum). Empty for a design without cut points.
+    after the offsets' sum); a plain table: ``[(1,), (0, 1)]`` (the ROM output
+    registered, then the address too). Empty for a design without cut points.
 
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
@@ -218,8 +228,8 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw`; only a sized piecewise design and a multipartite
-        design have cut points.
+        A design of :mod:`chebnorm.hw`; a sized piecewise design, a multipartite
+        design and a plain table have cut points.
 
     Returns
     -------
@@ -228,8 +238,8 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     """
     if not _pipelinable(design):
         return []
-    if getattr(design, "architecture", None) == "multipartite":
-        return [(0,), (0, 1)]
+    if getattr(design, "architecture", None) in _TABLE_KINDS:
+        return list(_TABLE_KINDS[design.architecture])
     n = design.degree
     # stage k sits before position k: the ROM, then a multiply and an add per step, the output
     weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["mul"], STAGE_WEIGHTS["add"]] * n
@@ -244,8 +254,8 @@ def cut_plans(design) -> list[tuple[int, ...]]:
 
 
 def cut_names(design, cuts) -> list[str]:
-    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise) or
-    ``tables``, ``offsets`` (multipartite).
+    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise),
+    ``tables``, ``offsets`` (multipartite) or ``address``, ``rom`` (plain table).
 
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> cut_names(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
@@ -254,7 +264,7 @@ def cut_names(design, cuts) -> list[str]:
     Parameters
     ----------
     design : object
-        A sized piecewise design or a multipartite design.
+        A sized piecewise design, a multipartite design or a plain table.
     cuts : iterable of int
         Cut positions, as :func:`cut_plans` gives them.
 
@@ -265,6 +275,8 @@ def cut_names(design, cuts) -> list[str]:
     """
     if getattr(design, "architecture", None) == "multipartite":
         return [("tables", "offsets")[c] for c in cuts]
+    if getattr(design, "architecture", None) == "plain_table":
+        return [("address", "rom")[c] for c in cuts]
     return ["rom" if c == 0 else f"{'mul' if c % 2 else 'add'}{(c + 1) // 2}" for c in cuts]
 
 
@@ -283,17 +295,19 @@ def with_cuts(design, cuts):
     Parameters
     ----------
     design : object
-        A sized piecewise design (``design_piecewise(..., widths=...)``) or a
-        multipartite design, combinational or already pipelined (its cuts are replaced).
+        A sized piecewise design (``design_piecewise(..., widths=...)``), a
+        multipartite design or a plain table, combinational or already pipelined (its
+        cuts are replaced).
     cuts : iterable of int
         Register positions, in any order (duplicates count once): 0 to ``2 * degree``
         for a piecewise design (0 after the ROM, ``2i - 1`` after the ``i``-th
-        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite one.
+        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite design
+        or a plain table.
 
     Returns
     -------
     PiecewiseDesign or PipelinedTable
-        A new design with the cuts (a piecewise design stays one; a multipartite one
+        A new design with the cuts (a piecewise design stays one; a table design
         becomes a :class:`PipelinedTable`), ``latency == len(cuts)``.
 
     Raises
@@ -305,11 +319,11 @@ def with_cuts(design, cuts):
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
                          f"accepted: a sized piecewise design (design_piecewise(..., "
-                         f"widths=...)) or a multipartite design")
+                         f"widths=...)), a multipartite design or a plain table")
     if isinstance(cuts, (str, bytes)) or not hasattr(cuts, "__iter__"):
         raise ValueError(f"cuts {cuts!r}: accepted: an iterable of cut positions")
     cuts = tuple(sorted(set(cuts)))
-    if getattr(design, "architecture", None) == "multipartite":
+    if getattr(design, "architecture", None) in _TABLE_KINDS:
         return PipelinedTable(_base(design), cuts)
     top = 2 * design.degree
     if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= top for c in cuts):
@@ -445,9 +459,9 @@ def pipeline_to_frequency(design, target: str, frequency_mhz, *, seed: int = 1,
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw` (combinational). Only a sized
-        piecewise design has cut points (:func:`cut_plans`); any other is
-        measured as it is.
+        A design of :mod:`chebnorm.hw` (combinational). A sized piecewise
+        design, a multipartite design and a plain table have cut points
+        (:func:`cut_plans`); any other is measured as it is.
     target : str
         ``ice40`` (nextpnr-ice40 Fmax), ``xc7`` or ``xc7-nodsp`` (the sta
         model); ``generic`` has no time and is refused.
