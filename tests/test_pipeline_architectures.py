@@ -1,8 +1,8 @@
 """Every architecture pipelined for ``design --frequency`` (issue 45).
 
-The pipelined plain table (address and ROM output registered) and the
-pipelined multipartite design (table reads and offsets' sum registered) are
-simulated over every input code in Icarus Verilog and GHDL, output ``i``
+The pipelined plain table (address and ROM output registered), the pipelined
+multipartite design (table reads and offsets' sum registered) and the one-width
+piecewise design (after the ROM, each multiply, each add) are simulated over every input code in Icarus Verilog and GHDL, output ``i``
 against the bit-accurate model's value of code ``i - latency``; the bench is
 shown to catch a wrong latency. The choice of the winner at a frequency is
 checked on made-up timings (cheapest pipelined design reaching the clock,
@@ -112,6 +112,79 @@ def test_every_plan_simulated_in_ghdl(tmp_path, kind, table, multipartite):
         (folder / name).write_text(short[name] if name.startswith("tb_") else text,
                                    encoding="utf-8")
     assert not simulate_vhdl(folder, full).passed
+
+
+# -- the one-width piecewise design: the sized design's cut points ------------------------
+
+@pytest.fixture(scope="module")
+def one_width():
+    from chebnorm.approx.piecewise_fit import piecewise_fit
+    from chebnorm.hw.piecewise import design_piecewise
+
+    t = piecewise_fit("1/sqrt(1+3*x)", ("0", "1"), 2, segments=8, coef_frac_bits=14,
+                      centered=True, name="ow")
+    return design_piecewise(t, BITS, BITS)
+
+
+def test_one_width_cut_points(one_width):
+    d = one_width
+    assert not d.sized and d.latency == 0
+    # stage weights rom 1, mul 2, add 1, output 0.5 (STAGE_WEIGHTS): one cut after add1
+    # leaves 1+2+1 | 2+1+0.5, two after mul1 and mul2 leave 1+2 | 1+2 | 1+0.5, ...
+    assert cut_plans(d) == [(2,), (1, 3), (0, 1, 3), (0, 1, 2, 3), (0, 1, 2, 3, 4)]
+    p = with_cuts(d, (4, 0, 1))
+    assert (p.cuts, p.mult_cuts, p.latency) == ((0, 2), (1,), 3)
+    assert (p.evaluate() == d.evaluate()).all()
+    assert p.verify() is p                              # re-proved with its registers
+    from chebnorm.hw.hdl import module_text
+
+    v, h = module_text(p, "verilog"), module_text(p, "vhdl")
+    assert "parameter LATENCY = 3" in v and v.count("always @(posedge clk)") == 3
+    assert "LATENCY  : natural := 3" in h and h.count("rising_edge(clk)") == 3
+    assert "Pipelined: registers at cut points [0, 2]" in v
+    assert "clk" not in module_text(d, "verilog")     # without cuts: the combinational module
+    with pytest.raises(ValueError, match=r"accepted: integers 0\.\.4"):
+        with_cuts(d, (5,))
+    from dataclasses import replace
+
+    with pytest.raises(ValueError, match="mult_cuts"):
+        replace(d, mult_cuts=(3,))
+
+
+def _both_simulators(tmp_path, base, plans) -> None:
+    from chebnorm.hw.run_vhdl import simulate_vhdl
+
+    for plan in plans:
+        d = with_cuts(base, plan)
+        res = verify_pipelined(d)
+        assert res.passed and res.vectors == 2 ** BITS, (plan, res.line)
+        folder = tmp_path / "_".join(map(str, plan))
+        folder.mkdir()
+        for name, text in design_files(d, "vhdl").items():
+            (folder / name).write_text(text, encoding="utf-8")
+        res = simulate_vhdl(folder, d)
+        assert res.passed and res.vectors == 2 ** BITS, (plan, res.line)
+
+
+@pytest.mark.requires_tool("iverilog", "ghdl")
+def test_one_width_plans_in_both_simulators(tmp_path, one_width):
+    top = 2 * one_width.degree
+    # every plan design --frequency tries, and each single register alone
+    plans = sorted(set(cut_plans(one_width)) | {(c,) for c in range(top + 1)})
+    _both_simulators(tmp_path, one_width, plans)
+    full = with_cuts(one_width, range(top + 1))
+    bad = verify_pipelined(full, bench_design=with_cuts(one_width, range(top)))
+    assert not bad.passed and bad.mismatches > 0, bad.line
+
+
+@pytest.mark.slow
+@pytest.mark.requires_tool("iverilog", "ghdl")
+def test_one_width_every_cut_set_in_both_simulators(tmp_path, one_width):
+    from itertools import combinations
+
+    top = 2 * one_width.degree
+    _both_simulators(tmp_path, one_width, [plan for m in range(1, top + 2)
+                                           for plan in combinations(range(top + 1), m)])
 
 
 # -- the winner at a frequency: the cheapest pipelined design reaching it -----------------

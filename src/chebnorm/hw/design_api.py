@@ -165,7 +165,8 @@ class DesignResult:
         dict of str to (str or bytes)
             ``design_NAME.csv`` / ``.png`` (the one-width search),
             ``design_NAME_architectures.csv``, and when another architecture
-            wins its ``.v`` and ``.vhd`` (with benches and vectors for
+            wins (or the one-width winner is pipelined for ``frequency``) its ``.v``
+            and ``.vhd`` (with benches and vectors for
             ``index="exponent"``); sorted by name.
         """
         files = dict(self._data.get("static", {}))
@@ -499,7 +500,7 @@ def _design_uniform(spec: _Spec) -> DesignResult:
     if others:
         files[f"design_{spec.name}_architectures.csv"] = _architectures_csv(others, res, None)
     piped = None
-    if spec.frequency is not None:  # the one-width winner has no cut points: timed as it is
+    if spec.frequency is not None:  # pipelined at the ROM, multiply and add boundaries
         figures, piped = _pipelined(spec, d, timed)
     w = res.winner
     lines = [*res.explain(), *figures]
@@ -513,9 +514,11 @@ def _design_uniform(spec: _Spec) -> DesignResult:
     lines.append(f"reproduce: {_words(fit)} && {_words(verilog)}")
     winner = Winner("piecewise", w.describe(), d if piped is None else piped.design,
                     _score(w) if piped is None else piped.cost.score, w.total_bound)
+    # a pipelined one-width winner writes its clocked RTL (the reproduce line is combinational)
+    hdl = "architecture" if piped is not None and piped.latency > 0 else ""
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
                         piped, (), tuple(lines), {"static": files, "command": spec.command()},
-                        timings=() if timed is None else timed.timings)
+                        hdl, () if timed is None else timed.timings)
 
 
 def _words(words) -> str:

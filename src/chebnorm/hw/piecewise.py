@@ -995,6 +995,15 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     return shape(descend(cur))
 
 
+def _check_mult_cuts(mult, n: int) -> tuple[int, ...]:
+    """``mult_cuts`` checked: a sorted tuple of distinct steps ``1..n``."""
+    if not isinstance(mult, tuple) or any(
+            isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= n
+            for c in mult) or list(mult) != sorted(set(mult)):
+        raise ValueError(f"mult_cuts {_short(mult)}: accepted: sorted distinct steps 1..{n}")
+    return mult
+
+
 def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
     if pipeline is None:
         return ()
@@ -1207,12 +1216,7 @@ def _prove(d: PiecewiseDesign) -> None:
                                          "prod_frac": d.prod_frac}, n, L, t.centered, fy,
                                         d.multipliers == "truncated")
             cuts = _check_cuts(d.cuts, n)
-            mult = d.mult_cuts
-            if not isinstance(mult, tuple) or any(
-                    isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= n
-                    for c in mult) or list(mult) != sorted(set(mult)):
-                raise ValueError(f"mult_cuts {_short(mult)}: accepted: sorted distinct steps "
-                                 f"1..{n}")
+            mult = _check_mult_cuts(d.mult_cuts, n)
             proto = PiecewiseDesign(d.name, t, W, d.out_bits, L, 0, QFormat(d.out_bits, 0),
                                     t.coefficient_word_bits(), L + 2, (), 0)
             ref = _sized_design(proto, shape, cuts)
@@ -1229,6 +1233,9 @@ def _prove(d: PiecewiseDesign) -> None:
                                  f"fractional bits plus 0 .. 16 guard bits")
             ref = _design_piecewise(t, W, d.out_bits, guard, d.name, None, None, None, "full",
                                     ROM_WEIGHT)
+            # pipeline registers (chebnorm.hw.pipeline.with_cuts): the same values, later
+            ref = replace(ref, cuts=_check_cuts(d.cuts, n),
+                          mult_cuts=_check_mult_cuts(d.mult_cuts, n))
     for f in dataclasses.fields(d):
         if f.name == "table":
             continue

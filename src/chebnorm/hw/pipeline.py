@@ -15,16 +15,15 @@ Timing, per target (:mod:`chebnorm.hw.targets`):
   delays, no routing (optimistic: it ranks, it does not sign off);
 * ``generic`` has no device and no time: refused.
 
-Cut points of a sized piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`
-with ``sized``): after the ROM read, after each multiply, after each add (the
-values are unchanged; ``latency`` cycles later). The plans balance the stages
+Cut points of a piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`,
+one-width or sized): after the ROM read, after each multiply, after each add
+(with its rounding; the values are unchanged, ``latency`` cycles later). The plans balance the stages
 by a weight per stage (:data:`STAGE_WEIGHTS`: a multiply weighs two ROM reads
 or two adds). A multipartite design (:class:`PipelinedTable`)
 has two: after the table reads, after the offsets' sum. A plain table
 (:class:`PipelinedTable` too) has two: its ROM output registered (a synchronous
-read: block RAM in yosys) and its address registered. The one-width piecewise
-design has none here (its plan list is empty: only the combinational module is
-measured).
+read: block RAM in yosys) and its address registered. Any other design has none
+(its plan list is empty: only the combinational module is measured).
 
 :func:`verify_pipelined` simulates the pipelined module cycle by cycle over
 every input code in Icarus Verilog (one code per clock; output ``i`` checked
@@ -100,7 +99,15 @@ def check_frequency(value, name: str = "frequency") -> float:
 def _pipelinable(design) -> bool:
     if getattr(design, "architecture", None) in _TABLE_KINDS:
         return True
-    return bool(getattr(design, "sized", False)) and hasattr(design, "cuts")
+    return _piecewise(design)
+
+
+def _piecewise(design) -> bool:
+    """A piecewise design (one-width or sized): cut points after the ROM and each
+    multiply and add."""
+    from .piecewise import PiecewiseDesign
+
+    return isinstance(design, PiecewiseDesign)
 
 
 #: the table designs :class:`PipelinedTable` pipelines, with their cut plans per latency
@@ -111,7 +118,7 @@ def _base(design):
     """``design`` without pipeline registers."""
     if isinstance(design, PipelinedTable):
         return design.base
-    if getattr(design, "sized", False):
+    if _piecewise(design):
         return replace(design, cuts=(), mult_cuts=())
     return design
 
@@ -208,7 +215,7 @@ def design_files(design, language: str = "verilog") -> dict:
 
 def cut_plans(design) -> list[tuple[int, ...]]:
     """The cut sets tried, one per latency ``1, 2, ...``, as *positions*: for
-    a sized piecewise design of degree ``n``, ``0`` after the ROM read,
+    a piecewise design of degree ``n`` (one-width or sized), ``0`` after the ROM read,
     ``2i - 1`` after the ``i``-th multiply, ``2i`` after the ``i``-th add
     (:func:`cut_names`); for each count of registers the set whose heaviest
     stage (by :data:`STAGE_WEIGHTS`) is the lightest, ties to the earliest
@@ -222,13 +229,13 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5)
     >>> [cut_names(d, p) for p in cut_plans(d)]
     [['mul1'], ['rom', 'mul1'], ['rom', 'mul1', 'add1']]
-    >>> cut_plans(design_piecewise(t, 8, 8))
-    []
+    >>> cut_plans(design_piecewise(t, 8, 8))     # the one-width design: the same points
+    [(1,), (0, 1), (0, 1, 2)]
 
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw`; a sized piecewise design, a multipartite
+        A design of :mod:`chebnorm.hw`; a piecewise design, a multipartite
         design and a plain table have cut points.
 
     Returns
@@ -254,7 +261,7 @@ def cut_plans(design) -> list[tuple[int, ...]]:
 
 
 def cut_names(design, cuts) -> list[str]:
-    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise),
+    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (piecewise),
     ``tables``, ``offsets`` (multipartite) or ``address``, ``rom`` (plain table).
 
     >>> from chebnorm.hw.multipartite import design_multipartite
@@ -264,7 +271,7 @@ def cut_names(design, cuts) -> list[str]:
     Parameters
     ----------
     design : object
-        A sized piecewise design, a multipartite design or a plain table.
+        A piecewise design, a multipartite design or a plain table.
     cuts : iterable of int
         Cut positions, as :func:`cut_plans` gives them.
 
@@ -295,9 +302,9 @@ def with_cuts(design, cuts):
     Parameters
     ----------
     design : object
-        A sized piecewise design (``design_piecewise(..., widths=...)``), a
-        multipartite design or a plain table, combinational or already pipelined (its
-        cuts are replaced).
+        A piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`, one-width
+        or sized), a multipartite design or a plain table, combinational or already
+        pipelined (its cuts are replaced).
     cuts : iterable of int
         Register positions, in any order (duplicates count once): 0 to ``2 * degree``
         for a piecewise design (0 after the ROM, ``2i - 1`` after the ``i``-th
@@ -318,8 +325,8 @@ def with_cuts(design, cuts):
     """
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
-                         f"accepted: a sized piecewise design (design_piecewise(..., "
-                         f"widths=...)), a multipartite design or a plain table")
+                         f"accepted: a piecewise design (design_piecewise), a multipartite "
+                         f"design or a plain table")
     if isinstance(cuts, (str, bytes)) or not hasattr(cuts, "__iter__"):
         raise ValueError(f"cuts {cuts!r}: accepted: an iterable of cut positions")
     cuts = tuple(sorted(set(cuts)))
@@ -459,8 +466,8 @@ def pipeline_to_frequency(design, target: str, frequency_mhz, *, seed: int = 1,
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw` (combinational). A sized piecewise
-        design, a multipartite design and a plain table have cut points
+        A design of :mod:`chebnorm.hw` (combinational). A piecewise design
+        (one-width or sized), a multipartite design and a plain table have cut points
         (:func:`cut_plans`); any other is measured as it is.
     target : str
         ``ice40`` (nextpnr-ice40 Fmax), ``xc7`` or ``xc7-nodsp`` (the sta
