@@ -252,6 +252,29 @@ def test_none_reaching_names_the_closest(monkeypatch):
                     r"piecewise-sized: 180\.00, multipartite: 230\.00; ", t.shortfall), t.shortfall
 
 
+def test_an_architecture_the_tools_refuse_is_reported_and_left_out(monkeypatch):
+    import chebnorm.hw.pipeline as pipeline
+    from chebnorm.hw.design_api import _time_all
+
+    others = _candidates(("multipartite", 150.0), ("table", 300.0))
+
+    def timing(d, target, f, warn=True):
+        if d == "design-table":
+            raise ValueError("module chebnorm_t needs 300 I/O pins; accepted: at most 206")
+        return _result(230.0, 190.0, 2)
+
+    monkeypatch.setattr(pipeline, "pipeline_to_frequency", timing)
+    t = _time_all(_spec(), others, None)
+    assert t.candidate is others[0] and [a for a, _, _ in t.timings] == ["multipartite"]
+    assert "  table: table design: not timed (module chebnorm_t needs 300 I/O pins; " \
+           "accepted: at most 206)" in t.lines
+    monkeypatch.setattr(pipeline, "pipeline_to_frequency",
+                        lambda *a, **k: timing("design-table", None, None))
+    with pytest.raises(ValueError, match=r"^no architecture could be timed at 200 MHz on ice40 "
+                                         r"\(multipartite: module chebnorm_t needs 300 I/O"):
+        _time_all(_spec(), others, None)
+
+
 # -- the acceptance command on nextpnr-ice40 ---------------------------------------------
 
 SPEC = ["1/sqrt(1+3*x)", "--interval", "0", "1", "--faithful", "--target", "ice40"]

@@ -582,7 +582,9 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
     winner and every built candidate) for the frequency on the device
     (:func:`~chebnorm.hw.pipeline.pipeline_to_frequency`): the winner is the
     cheapest pipelined design (its registers counted) among those reaching the
-    frequency, else the fastest (the closest), lower score on a tie."""
+    frequency, else the fastest (the closest), lower score on a tie. An
+    architecture the tools cannot time (e.g. too large for the device) is reported
+    and left out."""
     from .pipeline import pipeline_to_frequency
 
     entries = [] if res is None else [("piecewise (one width)", res.winner.describe(), None,
@@ -591,33 +593,51 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
         if c.design is not None and (spec.accuracy != "max-error" or c.error is None
                                      or c.error <= spec.max_error):
             entries.append((c.architecture, c.description, c, c.design))
-    if not entries:
-        raise ValueError("no architecture meets the accuracy asked; accepted: more out_bits, "
-                         "or a larger max_error")
-    runs = [pipeline_to_frequency(d, spec.device, spec.frequency, warn=False)
-            for _, _, _, d in entries]
-    met = [i for i, r in enumerate(runs) if r.met]
+    runs, failed = [], {}
+    for i, (arch, desc, _, d) in enumerate(entries):
+        try:
+            runs.append(pipeline_to_frequency(d, spec.device, spec.frequency, warn=False))
+        except ValueError as exc:   # a tool's refusal: one line, the others still compete
+            runs.append(None)
+            failed[i] = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+    timed = [i for i, r in enumerate(runs) if r is not None]
+    if not timed:
+        raise ValueError(f"no architecture could be timed at {spec.frequency:g} MHz on "
+                         f"{spec.device} ("
+                         f"{'; '.join(f'{entries[i][0]}: {m}' for i, m in failed.items())}"
+                         f"{'' if failed else 'none meets the accuracy'}); "
+                         f"accepted: a smaller design (fewer in_bits) or another device")
+    met = [i for i in timed if runs[i].met]
     if met:
         k = min(met, key=lambda i: (runs[i].cost.score, runs[i].latency, i))
     else:
-        k = max(range(len(runs)), key=lambda i: (runs[i].fmax_mhz, -runs[i].cost.score, -i))
+        k = max(timed, key=lambda i: (runs[i].fmax_mhz, -runs[i].cost.score, -i))
+    lines, short = _timing_lines(spec, entries, runs, k, failed), ""
+    if not met:
+        r, arch = runs[k], entries[k][0]
+        best = ", ".join(f"{entries[i][0]}: {runs[i].fmax_mhz:.2f}" for i in timed)
+        short = (f"{spec.frequency:g} MHz not reached: the highest is {r.fmax_mhz:.2f} MHz at "
+                 f"latency {r.latency}, by {arch}, the closest architecture (highest MHz per "
+                 f"architecture: {best}; {r.source})")
+    timings = tuple((entries[i][0], entries[i][1], runs[i]) for i in timed)
+    return _Timed(entries[k][2], runs[k], timings, tuple(lines), short)
+
+
+def _timing_lines(spec: _Spec, entries, runs, k: int, failed: dict) -> list[str]:
+    """The report of every architecture at the frequency (``k``: the winner's index;
+    ``failed``: index -> why the tools could not time it)."""
     f = spec.frequency
     lines = [f"at {f:g} MHz on {spec.device}, every architecture pipelined (the cheapest "
              f"reaching {f:g} MHz wins, its registers counted; else the closest):"]
     for i, ((arch, desc, _, _), r) in enumerate(zip(entries, runs)):
+        if r is None:
+            lines.append(f"  {arch}: {desc}: not timed ({failed[i]})")
+            continue
         verdict = "reaches" if r.met else "does not reach"
         lines.append(f"  {arch}: {desc}: Fmax {r.fmax_mhz:.2f} MHz at latency {r.latency} "
                      f"({verdict} {f:g} MHz), score {r.cost.score:.1f} with {r.extra_ffs} FFs"
                      + (" -- the winner" if i == k else ""))
-    short = ""
-    if not met:
-        r, arch = runs[k], entries[k][0]
-        best = ", ".join(f"{a}: {x.fmax_mhz:.2f}" for (a, _, _, _), x in zip(entries, runs))
-        short = (f"{f:g} MHz not reached: the highest is {r.fmax_mhz:.2f} MHz at latency "
-                 f"{r.latency}, by {arch}, the closest architecture (highest MHz per "
-                 f"architecture: {best}; {r.source})")
-    timings = tuple((a, desc, r) for (a, desc, _, _), r in zip(entries, runs))
-    return _Timed(entries[k][2], runs[k], timings, tuple(lines), short)
+    return lines
 
 
 def _lost(spec: _Spec) -> str:
