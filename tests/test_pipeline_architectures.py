@@ -333,3 +333,22 @@ def test_frequency_changes_the_winner(tmp_path):
     assert win[0] != first and win[3] and win[1] >= 200, (comb.out, fast.out)
     # the combinational winner was timed too, pipelined, and missed 200 MHz (or cost more)
     assert any(a == first and (not met or s > win[4]) for a, _, _, met, s, _ in rows)
+
+
+@pytest.mark.slow
+@requires_tool("nextpnr-ice40", "yosys", "iverilog")
+def test_unreachable_frequency_names_the_closest_architecture(tmp_path):
+    r = run_cli("design", *SPEC, "--in-bits", "6", "--out-bits", "6", "--frequency", "2000",
+                "-o", tmp_path / "o")
+    assert r.code == 0, r.err
+    warn = [ln for ln in r.err.splitlines() if ln.startswith("chebnorm: warning:")]
+    assert len(warn) == 1, r.err
+    m = re.search(r"2000 MHz not reached: the highest is ([\d.]+) MHz at latency (\d+), by "
+                  r"(.+?), the closest architecture", warn[0])
+    assert m, warn[0]
+    rows = _figures(r.out)
+    assert rows and not any(met for _, _, _, met, _, _ in rows)
+    (win,) = [row for row in rows if row[5]]
+    # the winner is the fastest of all, and the warning names it with its figures
+    assert win[1] == max(f for _, f, *_ in rows) == float(m.group(1)), r.out
+    assert win[0] == m.group(3) and win[2] == int(m.group(2)), (win, warn[0])
