@@ -143,6 +143,13 @@ def test_one_width_cut_points(one_width):
     assert "LATENCY  : natural := 3" in h and h.count("rising_edge(clk)") == 3
     assert "Pipelined: registers at cut points [0, 2]" in v
     assert "clk" not in module_text(d, "verilog")     # without cuts: the combinational module
+    # what design --frequency writes for a pipelined one-width winner
+    from chebnorm.hw.design_api import _hdl_files
+
+    files = _hdl_files("architecture", p, "0.0", "chebnorm design ...")
+    assert sorted(files) == ["chebnorm_ow.v", "chebnorm_ow.vhd"]
+    assert "parameter LATENCY = 3" in files["chebnorm_ow.v"]
+    assert "LATENCY  : natural := 3" in files["chebnorm_ow.vhd"]
     with pytest.raises(ValueError, match=r"accepted: integers 0\.\.4"):
         with_cuts(d, (5,))
     from dataclasses import replace
