@@ -218,9 +218,12 @@ def _candidates(*specs):
 
 
 def _time(monkeypatch, spec, others, timings):
+    import chebnorm.hw.design_api as design_api
     import chebnorm.hw.pipeline as pipeline
     from chebnorm.hw.design_api import _time_all
 
+    # the made-up designs have no netlist: priced by their made-up cost
+    monkeypatch.setattr(design_api, "_placed_score", lambda run, device: run.cost.score)
     by_design = dict(timings)
     monkeypatch.setattr(pipeline, "pipeline_to_frequency",
                         lambda d, target, f, warn=True: by_design[d])
@@ -236,10 +239,12 @@ def test_winner_is_the_cheapest_reaching_the_frequency(monkeypatch):
         ("design-multipartite", _result(230.0, 190.0, 2)),
         ("design-table", _result(400.0, 300.0, 0))])
     assert t.candidate is others[1] and t.result.fmax_mhz == 230.0 and t.shortfall == ""
-    assert [a for a, _, _ in t.timings] == ["piecewise-sized", "multipartite", "table"]
+    assert [a for a, _, _, _ in t.timings] == ["piecewise-sized", "multipartite", "table"]
+    assert t.score == 190.0
     winner = [ln for ln in t.lines if ln.endswith("-- the winner")]
     assert len(winner) == 1 and winner[0].startswith("  multipartite:")
-    assert "Fmax 180.00 MHz at latency 3 (does not reach 200 MHz), score 160.0" in t.lines[1]
+    assert "Fmax 180.00 MHz at latency 3 (does not reach 200 MHz), score 160.0, 24 pipeline " \
+           "FFs" in t.lines[1]
     # a tie in score: the shorter latency, then the first listed
     t = _time(monkeypatch, _spec(), others, [
         ("design-piecewise-sized", _result(250.0, 190.0, 3)),
@@ -260,9 +265,11 @@ def test_none_reaching_names_the_closest(monkeypatch):
 
 
 def test_an_architecture_the_tools_refuse_is_reported_and_left_out(monkeypatch):
+    import chebnorm.hw.design_api as design_api
     import chebnorm.hw.pipeline as pipeline
     from chebnorm.hw.design_api import _time_all
 
+    monkeypatch.setattr(design_api, "_placed_score", lambda run, device: run.cost.score)
     others = _candidates(("multipartite", 150.0), ("table", 300.0))
 
     def timing(d, target, f, warn=True):
@@ -272,7 +279,7 @@ def test_an_architecture_the_tools_refuse_is_reported_and_left_out(monkeypatch):
 
     monkeypatch.setattr(pipeline, "pipeline_to_frequency", timing)
     t = _time_all(_spec(), others, None)
-    assert t.candidate is others[0] and [a for a, _, _ in t.timings] == ["multipartite"]
+    assert t.candidate is others[0] and [a for a, *_ in t.timings] == ["multipartite"]
     assert "  table: table design: not timed (module chebnorm_t needs 300 I/O pins; " \
            "accepted: at most 206)" in t.lines
     monkeypatch.setattr(pipeline, "pipeline_to_frequency",
@@ -280,6 +287,24 @@ def test_an_architecture_the_tools_refuse_is_reported_and_left_out(monkeypatch):
     with pytest.raises(ValueError, match=r"^no architecture could be timed at 200 MHz on ice40 "
                                          r"\(multipartite: module chebnorm_t needs 300 I/O"):
         _time_all(_spec(), others, None)
+
+
+@pytest.mark.requires_tool("yosys")
+def test_table_is_priced_as_the_netlist_nextpnr_times():
+    # between the input and output registers the ROM read becomes a block RAM read:
+    # the module alone maps to LUTs, the timed netlist to SB_RAM40_4K (240 LUT each)
+    from chebnorm.hw.design_api import _placed_score
+    from chebnorm.hw.plain_table import design_plain_table
+    from chebnorm.hw.targets import synthesize_target
+
+    d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 10, 10)
+    alone = synthesize_target(d.verilog(), d.module_name, "ice40")
+    run = PipelineResult(d, "ice40", 200.0, True, 0, 469.26, "nextpnr-ice40", alone,
+                         (PipelineStep((), 0, 469.26),))
+    assert alone.brams == 0 and alone.ffs == 0
+    placed = _placed_score(run, "ice40")
+    assert placed >= 240.0 + 10 and placed != alone.score      # a RAM and the out register
+    assert _placed_score(run, "xc7") == alone.score              # sta times the module itself
 
 
 # -- the acceptance command on nextpnr-ice40 ---------------------------------------------
@@ -290,7 +315,8 @@ SPEC = ["1/sqrt(1+3*x)", "--interval", "0", "1", "--faithful", "--target", "ice4
 def _figures(out: str):
     """(architecture, Fmax, latency, met, score, winner) per architecture line."""
     rows = re.findall(r"^  (.+?): .*: Fmax ([\d.]+) MHz at latency (\d+) \((reaches|does not "
-                      r"reach) \d+ MHz\), score ([\d.]+) with \d+ FFs( -- the winner)?$", out,
+                      r"reach) \d+ MHz\), score ([\d.]+), \d+ pipeline FFs( -- the winner)?$",
+                      out,
                       re.M)
     return [(a, float(f), int(lat), m == "reaches", float(s), bool(w))
             for a, f, lat, m, s, w in rows]

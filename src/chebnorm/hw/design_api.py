@@ -54,7 +54,9 @@ class Winner:
     score : float or None
         Its cost on the device (LUT equivalents on xc7/ice40, yosys cells on
         generic, the model's estimate without synthesis; with ``frequency``, the
-        pipelined design's, its registers counted); None when not priced.
+        pipelined design's as it was timed, its registers counted: on ice40 the
+        module between input and output registers, where yosys may fold a
+        register into a ROM's block RAM); None when not priced.
     error : float or None
         Its certified bound on ``|y - f(x)|`` (the mantissa's for ``exponent``).
 
@@ -109,9 +111,10 @@ class DesignResult:
         ``"architecture"``, ``"exponent"``).
     timings : tuple
         With ``frequency``: per architecture that meets the accuracy,
-        ``(architecture, description, PipelineResult)``, each pipelined for the
-        frequency (the winner is the cheapest reaching it, else the fastest);
-        empty without ``frequency``.
+        ``(architecture, description, PipelineResult, score)``, each pipelined for
+        the frequency, ``score`` that of the netlist timed (on ice40 the module
+        between input and output registers); the winner is the cheapest reaching
+        the frequency, else the fastest. Empty without ``frequency``.
 
     Examples
     --------
@@ -488,7 +491,7 @@ def _design_uniform(spec: _Spec) -> DesignResult:
         other_wins = best is not None and (best.cost.score < _score(res.winner) or not synthesized)
     if other_wins:
         # the plot shows the one-width search: say that another architecture won
-        score = best.cost.score if timed is None else timed.result.cost.score
+        score = best.cost.score if timed is None else timed.score
         files[f"design_{spec.name}.png"] = res.plot_png(
             winner="best one-width piecewise",
             note=f"winner: {best.architecture}, score {score:.1f} (not on this plot)")
@@ -513,7 +516,7 @@ def _design_uniform(spec: _Spec) -> DesignResult:
                spec.out_bits, "-o", "DIR", "--simulate"]
     lines.append(f"reproduce: {_words(fit)} && {_words(verilog)}")
     winner = Winner("piecewise", w.describe(), d if piped is None else piped.design,
-                    _score(w) if piped is None else piped.cost.score, w.total_bound)
+                    _score(w) if timed is None else timed.score, w.total_bound)
     # a pipelined one-width winner writes its clocked RTL (the reproduce line is combinational)
     hdl = "architecture" if piped is not None and piped.latency > 0 else ""
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
@@ -561,7 +564,7 @@ def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
         if c is not best:
             lines.append(f"  {c.line()}" + (_lost(spec) if c.cost is not None else ""))
     winner = Winner(best.architecture, best.description, d,
-                    best.cost.score if piped is None else piped.cost.score, best.error)
+                    best.cost.score if timed is None else timed.score, best.error)
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
                         piped, (), tuple(lines), {"static": files, "command": spec.command()},
                         "architecture", () if timed is None else timed.timings)
@@ -575,6 +578,7 @@ class _Timed:
     timings: tuple        # (architecture, description, PipelineResult) per architecture
     lines: tuple          # the report of every architecture at the frequency
     shortfall: str        # the warning when none reaches the frequency ("" else)
+    score: float          # the winner's score at the clock (_placed_score)
 
 
 def _time_all(spec: _Spec, others, res) -> _Timed:
@@ -601,6 +605,7 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
             runs.append(None)
             failed[i] = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
     timed = [i for i, r in enumerate(runs) if r is not None]
+    scores = {i: _placed_score(runs[i], spec.device) for i in timed}
     if not timed:
         raise ValueError(f"no architecture could be timed at {spec.frequency:g} MHz on "
                          f"{spec.device} ("
@@ -609,34 +614,57 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
                          f"accepted: a smaller design (fewer in_bits) or another device")
     met = [i for i in timed if runs[i].met]
     if met:
-        k = min(met, key=lambda i: (runs[i].cost.score, runs[i].latency, i))
+        k = min(met, key=lambda i: (scores[i], runs[i].latency, i))
     else:
-        k = max(timed, key=lambda i: (runs[i].fmax_mhz, -runs[i].cost.score, -i))
-    lines, short = _timing_lines(spec, entries, runs, k, failed), ""
+        k = max(timed, key=lambda i: (runs[i].fmax_mhz, -scores[i], -i))
+    lines, short = _timing_lines(spec, entries, runs, k, failed, scores), ""
     if not met:
         r, arch = runs[k], entries[k][0]
         best = ", ".join(f"{entries[i][0]}: {runs[i].fmax_mhz:.2f}" for i in timed)
         short = (f"{spec.frequency:g} MHz not reached: the highest is {r.fmax_mhz:.2f} MHz at "
                  f"latency {r.latency}, by {arch}, the closest architecture (highest MHz per "
                  f"architecture: {best}; {r.source})")
-    timings = tuple((entries[i][0], entries[i][1], runs[i]) for i in timed)
-    return _Timed(entries[k][2], runs[k], timings, tuple(lines), short)
+    timings = tuple((entries[i][0], entries[i][1], runs[i], scores[i]) for i in timed)
+    return _Timed(entries[k][2], runs[k], timings, tuple(lines), short, scores[k])
 
 
-def _timing_lines(spec: _Spec, entries, runs, k: int, failed: dict) -> list[str]:
+def _placed_score(run, device: str) -> float:
+    """The score of the netlist ``run``'s Fmax was measured on. On ice40 nextpnr
+    times the module between input and output registers (:func:`~.targets.fmax_ice40`),
+    and yosys may fold those into a ROM's block RAM (a synchronous read): the
+    module alone would be priced in LUTs and timed as block RAM, so the wrapped
+    netlist is priced, its I/O registers counted (the same ones for every
+    architecture of a spec). On xc7 the sta model times the module itself."""
+    if device != "ice40":
+        return float(run.cost.score)
+    from .hdl import module_text
+    from .targets import WRAP, module_ports, register_wrapper, synthesize_target
+
+    d = run.design
+    text = d.verilog() if hasattr(d, "verilog") else module_text(d, "verilog")
+    wrapper = register_wrapper(d.module_name, module_ports(text, d.module_name),
+                               clocked=run.latency > 0)
+    return float(synthesize_target(text + "\n" + wrapper + "\n", WRAP, device).score)
+
+
+def _timing_lines(spec: _Spec, entries, runs, k: int, failed: dict, scores: dict) -> list[str]:
     """The report of every architecture at the frequency (``k``: the winner's index;
-    ``failed``: index -> why the tools could not time it)."""
+    ``failed``: index -> why the tools could not time it; ``scores``: index -> the
+    placed netlist's score, :func:`_placed_score`)."""
     f = spec.frequency
+    placed = (" (ice40: the module between its input and output registers, as nextpnr "
+              "placed it)" if spec.device == "ice40" else "")
     lines = [f"at {f:g} MHz on {spec.device}, every architecture pipelined (the cheapest "
-             f"reaching {f:g} MHz wins, its registers counted; else the closest):"]
+             f"reaching {f:g} MHz wins, its registers counted; else the closest); score"
+             f"{placed}:"]
     for i, ((arch, desc, _, _), r) in enumerate(zip(entries, runs)):
         if r is None:
             lines.append(f"  {arch}: {desc}: not timed ({failed[i]})")
             continue
         verdict = "reaches" if r.met else "does not reach"
         lines.append(f"  {arch}: {desc}: Fmax {r.fmax_mhz:.2f} MHz at latency {r.latency} "
-                     f"({verdict} {f:g} MHz), score {r.cost.score:.1f} with {r.extra_ffs} FFs"
-                     + (" -- the winner" if i == k else ""))
+                     f"({verdict} {f:g} MHz), score {scores[i]:.1f}, {r.extra_ffs} pipeline "
+                     f"FFs" + (" -- the winner" if i == k else ""))
     return lines
 
 
@@ -663,6 +691,9 @@ def _pipelined(spec: _Spec, d, timed=None):
              for st in res.steps]
     lines = [f"timing: {res.line()}", f"measured (latency: Fmax MHz): {', '.join(tried)}"]
     if timed is not None:
+        if spec.device == "ice40":
+            lines.append(f"priced as timed (the module between its input and output registers, "
+                         f"as nextpnr placed it): score {timed.score:.1f}")
         lines += timed.lines
     if res.latency > 0:
         sim = verify_pipelined(p)
