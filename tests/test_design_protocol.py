@@ -96,7 +96,7 @@ def test_architecture_implements_the_protocol(designs, name):
     assert isinstance(f, DesignFeatures) and model_score(f, "generic") > 0
     cuts = d.cut_points()
     assert isinstance(cuts, tuple) and all(isinstance(c, str) for c in cuts)
-    assert bool(cuts) == (name in ("piecewise-sized", "multipartite"))
+    assert bool(cuts) == (name in ("piecewise", "piecewise-sized", "multipartite", "table"))
     text = d.verilog()
     assert f"module {d.module_name}" in text
     assert f"entity {d.module_name} is" in d.vhdl()

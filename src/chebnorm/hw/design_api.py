@@ -53,7 +53,10 @@ class Winner:
         ``frequency``, the pipelined design.
     score : float or None
         Its cost on the device (LUT equivalents on xc7/ice40, yosys cells on
-        generic, the model's estimate without synthesis); None when not priced.
+        generic, the model's estimate without synthesis; with ``frequency``, the
+        pipelined design's as it was timed, its registers counted: on ice40 the
+        module between input and output registers, where yosys may fold a
+        register into a ROM's block RAM); None when not priced.
     error : float or None
         Its certified bound on ``|y - f(x)|`` (the mantissa's for ``exponent``).
 
@@ -106,6 +109,12 @@ class DesignResult:
     _hdl : str
         Internal: the winner's HDL files to print in :meth:`files` (``""``: none,
         ``"architecture"``, ``"exponent"``).
+    timings : tuple
+        With ``frequency``: per architecture that meets the accuracy,
+        ``(architecture, description, PipelineResult, score)``, each pipelined for
+        the frequency, ``score`` that of the netlist timed (on ice40 the module
+        between input and output registers); the winner is the cheapest reaching
+        the frequency, else the fastest. Empty without ``frequency``.
 
     Examples
     --------
@@ -129,6 +138,7 @@ class DesignResult:
     _lines: tuple = field(default=(), repr=False)
     _data: dict = field(default_factory=dict, repr=False, compare=False)
     _hdl: str = field(default="", repr=False)
+    timings: tuple = ()
 
     def lines(self) -> list[str]:
         """The text ``chebnorm design`` prints after the paths of its files.
@@ -158,7 +168,8 @@ class DesignResult:
         dict of str to (str or bytes)
             ``design_NAME.csv`` / ``.png`` (the one-width search),
             ``design_NAME_architectures.csv``, and when another architecture
-            wins its ``.v`` and ``.vhd`` (with benches and vectors for
+            wins (or the one-width winner is pipelined for ``frequency``) its ``.v``
+            and ``.vhd`` (with benches and vectors for
             ``index="exponent"``); sorted by name.
         """
         files = dict(self._data.get("static", {}))
@@ -244,8 +255,10 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
     Exactly what ``chebnorm design`` computes (it parses its flags and calls this):
     the one-width piecewise Pareto search and, with synthesis, the sized
     piecewise, multipartite and plain-table architectures, priced on ``device``;
-    the cheapest wins. With ``frequency``, the winner is pipelined to that clock
-    (:func:`~chebnorm.hw.pipeline.pipeline_to_frequency`) and its pipelined RTL
+    the cheapest wins. With ``frequency``, every architecture meeting the accuracy
+    is pipelined to that clock (:func:`~chebnorm.hw.pipeline.pipeline_to_frequency`)
+    and the cheapest pipelined design reaching it wins (registers counted; when none
+    does, the fastest, with a warning naming it); the winner's pipelined RTL is
     simulated cycle by cycle over every input code.
 
     Parameters
@@ -271,8 +284,9 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
         The FPGA priced on: ``generic`` (yosys cells), ``xc7``, ``xc7-nodsp``
         or ``ice40`` (the command's ``--target``).
     frequency : float, optional
-        Clock in MHz (finite, > 0): pipeline the winner until the device's Fmax
-        reaches it (ice40, xc7, xc7-nodsp, with synthesis; ``index="uniform"``).
+        Clock in MHz (finite, > 0): pipeline every architecture until the device's
+        Fmax reaches it and choose the winner by its pipelined cost (ice40, xc7,
+        xc7-nodsp, with synthesis; ``index="uniform"``).
         A shortfall is a :class:`~chebnorm.hw.pipeline.FrequencyWarning`.
     degrees : sequence of int, default (1, 2, 3)
         Polynomial degrees tried, 0..the piecewise maximum (1..3 with
@@ -459,13 +473,20 @@ def _design_uniform(spec: _Spec) -> DesignResult:
             return _other_wins(spec, others, None, {})
     files = {f"design_{spec.name}.csv": res.csv(), f"design_{spec.name}.png": res.plot_png()}
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
-    best = _best_other(others)
-    if best is not None and (best.cost.score < _score(res.winner) or not synthesized):
+    best, timed = _best_other(others), None
+    if spec.frequency is not None:   # every architecture pipelined: the cheapest at the clock
+        timed = _time_all(spec, others, res)
+        best = timed.candidate
+        other_wins = best is not None
+    else:
+        other_wins = best is not None and (best.cost.score < _score(res.winner) or not synthesized)
+    if other_wins:
         # the plot shows the one-width search: say that another architecture won
+        score = best.cost.score if timed is None else timed.score
         files[f"design_{spec.name}.png"] = res.plot_png(
             winner="best one-width piecewise",
-            note=f"winner: {best.architecture}, score {best.cost.score:.1f} (not on this plot)")
-        return _other_wins(spec, others, res, files)
+            note=f"winner: {best.architecture}, score {score:.1f} (not on this plot)")
+        return _other_wins(spec, others, res, files, timed)
     d = _winner_design(res)
     # the winner's place and route may fail (too large for the device): before writing
     figures = _winner_figures(res, d) if res.winner.target_cost is not None and \
@@ -473,13 +494,12 @@ def _design_uniform(spec: _Spec) -> DesignResult:
     if others:
         files[f"design_{spec.name}_architectures.csv"] = _architectures_csv(others, res, None)
     piped = None
-    if spec.frequency is not None:  # the one-width winner has no cut points: timed as it is
-        figures, piped = _pipelined(spec, d)
+    if spec.frequency is not None:  # pipelined at the ROM, multiply and add boundaries
+        figures, piped = _pipelined(spec, d, timed)
     w = res.winner
     lines = [*res.explain(), *figures]
     for c in others:
-        lines.append(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None
-                                        else ""))
+        lines.append(f"  {c.line()}" + (_lost(spec) if c.cost is not None else ""))
     fit = ["chebnorm", "fit", spec.expr, "--var", spec.var, "--interval", *spec.interval,
            "--degree", w.degree, "--segments", w.segments, "--kind", "minimax",
            "--coef-frac-bits", w.coef_frac_bits, "-o", "T.json"]
@@ -487,18 +507,24 @@ def _design_uniform(spec: _Spec) -> DesignResult:
                spec.out_bits, "-o", "DIR", "--simulate"]
     lines.append(f"reproduce: {_words(fit)} && {_words(verilog)}")
     winner = Winner("piecewise", w.describe(), d if piped is None else piped.design,
-                    _score(w), w.total_bound)
+                    _score(w) if timed is None else timed.score, w.total_bound)
+    # a pipelined one-width winner writes its clocked RTL (the reproduce line is combinational)
+    hdl = "architecture" if piped is not None and piped.latency > 0 else ""
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
-                        piped, (), tuple(lines), {"static": files, "command": spec.command()})
+                        piped, (), tuple(lines), {"static": files, "command": spec.command()},
+                        hdl, () if timed is None else timed.timings)
 
 
 def _words(words) -> str:
     return " ".join(shlex.quote(str(w)) for w in words)
 
 
-def _other_wins(spec: _Spec, others, res, files) -> DesignResult:
-    """Another architecture than the one-width search wins: its HDL beside the CSVs."""
-    best = _best_other(others)
+def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
+    """Another architecture than the one-width search wins: its HDL beside the CSVs
+    (``timed``: every architecture pipelined for the frequency, :func:`_time_all`)."""
+    if spec.frequency is not None and timed is None and _best_other(others) is not None:
+        timed = _time_all(spec, others, res)
+    best = _best_other(others) if timed is None else timed.candidate
     if best is None:
         raise ValueError("no architecture meets the accuracy asked (" + "; ".join(
             c.line() for c in others) + "); accepted: more out_bits, or faithful=True / "
@@ -508,7 +534,7 @@ def _other_wins(spec: _Spec, others, res, files) -> DesignResult:
     d = best.design
     figures, piped = [], None
     if spec.frequency is not None:
-        figures, piped = _pipelined(spec, d)
+        figures, piped = _pipelined(spec, d, timed)
         d = piped.design
     if not figures and spec.device != "generic":  # may fail: before writing
         from .targets import target_figures
@@ -522,30 +548,143 @@ def _other_wins(spec: _Spec, others, res, files) -> DesignResult:
         why = (f"score {_score(w):.1f}, costlier than the winner" if w.target_cost is not None
                or w.yosys_cells is not None else "not synthesized: its model cannot beat the "
                "winner")
+        if spec.frequency is not None:
+            why = f"score {_score(w):.1f}" + _lost(spec)
         lines.append(f"  piecewise (one width): {w.describe()} -- {why}")
     for c in others:
         if c is not best:
-            lines.append(f"  {c.line()}" + (" -- costlier than the winner" if c.cost is not None
-                                            else ""))
-    winner = Winner(best.architecture, best.description, d, best.cost.score, best.error)
+            lines.append(f"  {c.line()}" + (_lost(spec) if c.cost is not None else ""))
+    winner = Winner(best.architecture, best.description, d,
+                    best.cost.score if timed is None else timed.score, best.error)
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
                         piped, (), tuple(lines), {"static": files, "command": spec.command()},
-                        "architecture")
+                        "architecture", () if timed is None else timed.timings)
 
 
-def _pipelined(spec: _Spec, d):
-    """Pipeline ``d`` to the frequency (:mod:`.pipeline`) and simulate the pipelined
-    RTL over every code (Icarus Verilog; GHDL too for its VHDL): (figure lines, the
+@dataclass(frozen=True)
+class _Timed:
+    """Every architecture pipelined for the frequency (:func:`_time_all`)."""
+    candidate: object     # the winning Candidate, None when the one-width design wins
+    result: object        # its PipelineResult
+    timings: tuple        # (architecture, description, PipelineResult) per architecture
+    lines: tuple          # the report of every architecture at the frequency
+    shortfall: str        # the warning when none reaches the frequency ("" else)
+    score: float          # the winner's score at the clock (_placed_score)
+
+
+def _time_all(spec: _Spec, others, res) -> _Timed:
+    """Pipeline every architecture that meets the accuracy (the one-width search's
+    winner and every built candidate) for the frequency on the device
+    (:func:`~chebnorm.hw.pipeline.pipeline_to_frequency`): the winner is the
+    cheapest pipelined design (its registers counted) among those reaching the
+    frequency, else the fastest (the closest), lower score on a tie. An
+    architecture the tools cannot time (e.g. too large for the device) is reported
+    and left out."""
+    from .pipeline import pipeline_to_frequency
+
+    entries = [] if res is None else [("piecewise (one width)", res.winner.describe(), None,
+                                       _winner_design(res))]
+    for c in others:
+        if c.design is not None and (spec.accuracy != "max-error" or c.error is None
+                                     or c.error <= spec.max_error):
+            entries.append((c.architecture, c.description, c, c.design))
+    runs, failed = [], {}
+    for i, (arch, desc, _, d) in enumerate(entries):
+        try:
+            runs.append(pipeline_to_frequency(d, spec.device, spec.frequency, warn=False))
+        except ValueError as exc:   # a tool's refusal: one line, the others still compete
+            runs.append(None)
+            failed[i] = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+    timed = [i for i, r in enumerate(runs) if r is not None]
+    scores = {i: _placed_score(runs[i], spec.device) for i in timed}
+    if not timed:
+        raise ValueError(f"no architecture could be timed at {spec.frequency:g} MHz on "
+                         f"{spec.device} ("
+                         f"{'; '.join(f'{entries[i][0]}: {m}' for i, m in failed.items())}"
+                         f"{'' if failed else 'none meets the accuracy'}); "
+                         f"accepted: a smaller design (fewer in_bits) or another device")
+    met = [i for i in timed if runs[i].met]
+    if met:
+        k = min(met, key=lambda i: (scores[i], runs[i].latency, i))
+    else:
+        k = max(timed, key=lambda i: (runs[i].fmax_mhz, -scores[i], -i))
+    lines, short = _timing_lines(spec, entries, runs, k, failed, scores), ""
+    if not met:
+        r, arch = runs[k], entries[k][0]
+        best = ", ".join(f"{entries[i][0]}: {runs[i].fmax_mhz:.2f}" for i in timed)
+        short = (f"{spec.frequency:g} MHz not reached: the highest is {r.fmax_mhz:.2f} MHz at "
+                 f"latency {r.latency}, by {arch}, the closest architecture (highest MHz per "
+                 f"architecture: {best}; {r.source})")
+    timings = tuple((entries[i][0], entries[i][1], runs[i], scores[i]) for i in timed)
+    return _Timed(entries[k][2], runs[k], timings, tuple(lines), short, scores[k])
+
+
+def _placed_score(run, device: str) -> float:
+    """The score of the netlist ``run``'s Fmax was measured on. On ice40 nextpnr
+    times the module between input and output registers (:func:`~.targets.fmax_ice40`),
+    and yosys may fold those into a ROM's block RAM (a synchronous read): the
+    module alone would be priced in LUTs and timed as block RAM, so the wrapped
+    netlist is priced, its I/O registers counted (the same ones for every
+    architecture of a spec). On xc7 the sta model times the module itself."""
+    if device != "ice40":
+        return float(run.cost.score)
+    from .targets import WRAP, module_ports, register_wrapper, synthesize_target
+
+    d = run.design
+    text = d.verilog()
+    wrapper = register_wrapper(d.module_name, module_ports(text, d.module_name),
+                               clocked=run.latency > 0)
+    return float(synthesize_target(text + "\n" + wrapper + "\n", WRAP, device).score)
+
+
+def _timing_lines(spec: _Spec, entries, runs, k: int, failed: dict, scores: dict) -> list[str]:
+    """The report of every architecture at the frequency (``k``: the winner's index;
+    ``failed``: index -> why the tools could not time it; ``scores``: index -> the
+    placed netlist's score, :func:`_placed_score`)."""
+    f = spec.frequency
+    placed = (" (ice40: the module between its input and output registers, as nextpnr "
+              "placed it)" if spec.device == "ice40" else "")
+    lines = [f"at {f:g} MHz on {spec.device}, every architecture pipelined (the cheapest "
+             f"reaching {f:g} MHz wins, its registers counted; else the closest); score"
+             f"{placed}:"]
+    for i, ((arch, desc, _, _), r) in enumerate(zip(entries, runs)):
+        if r is None:
+            lines.append(f"  {arch}: {desc}: not timed ({failed[i]})")
+            continue
+        verdict = "reaches" if r.met else "does not reach"
+        lines.append(f"  {arch}: {desc}: Fmax {r.fmax_mhz:.2f} MHz at latency {r.latency} "
+                     f"({verdict} {f:g} MHz), score {scores[i]:.1f}, {r.extra_ffs} pipeline "
+                     f"FFs" + (" -- the winner" if i == k else ""))
+    return lines
+
+
+def _lost(spec: _Spec) -> str:
+    """Why a synthesized candidate lost, after its combinational line."""
+    if spec.frequency is None:
+        return " -- costlier than the winner"
+    return f" -- combinational figures (pipelined for {spec.frequency:g} MHz: above)"
+
+
+def _pipelined(spec: _Spec, d, timed=None):
+    """Pipeline ``d`` to the frequency (:mod:`.pipeline`; ``timed``: already done for
+    every architecture by :func:`_time_all`) and simulate the pipelined RTL over
+    every code (Icarus Verilog; GHDL too for its VHDL): (figure lines, the
     :class:`~chebnorm.hw.pipeline.PipelineResult`). A shortfall is one
     :class:`~chebnorm.hw.pipeline.FrequencyWarning`."""
     from .pipeline import FrequencyWarning, cut_names, pipeline_to_frequency, verify_pipelined
 
-    res = pipeline_to_frequency(d, spec.device, spec.frequency, warn=False)
+    res = pipeline_to_frequency(d, spec.device, spec.frequency, warn=False) if timed is None \
+        else timed.result
     p = res.design
     tried = [f"{st.latency}: {st.fmax_mhz:.2f}"
              + (f" (after {', '.join(cut_names(d, st.cuts))})" if st.cuts else "")
              for st in res.steps]
     lines = [f"timing: {res.line()}", f"measured (latency: Fmax MHz): {', '.join(tried)}"]
+    if timed is not None:
+        if spec.device == "ice40":
+            lines.append(f"priced as timed (the module between its input and output registers, "
+                         f"as nextpnr placed it): score {timed.score:.1f}")
+        lines += timed.lines
     if res.latency > 0:
         sim = verify_pipelined(p)
         if not sim.passed:
@@ -556,7 +695,8 @@ def _pipelined(spec: _Spec, d):
         if vhdl is not None:
             lines.append(f"cycle-accurate simulation (GHDL, every code): {vhdl}")
     if not res.met:
-        warnings.warn(res.shortfall(), FrequencyWarning, stacklevel=4)
+        warnings.warn(res.shortfall() if timed is None else timed.shortfall, FrequencyWarning,
+                      stacklevel=4)
     return lines, res
 
 

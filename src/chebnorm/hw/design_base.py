@@ -140,8 +140,8 @@ class Design(ABC):
         duplicates; the same values, ``len(cuts)`` cycles later). Here:
         ValueError, the architecture has no cut points."""
         raise ValueError(f"design: a {type(self).__name__} has no pipeline cut points; "
-                         f"accepted: a sized piecewise design (design_piecewise(..., "
-                         f"widths=...)) or a multipartite design")
+                         f"accepted: a piecewise design (design_piecewise), a multipartite "
+                         f"design or a plain table")
 
     def combinational(self) -> "Design":
         """The design without pipeline registers (here: itself)."""

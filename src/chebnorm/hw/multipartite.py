@@ -339,6 +339,10 @@ class MultipartiteDesign(Design):
         """``tables`` (after the table reads) and ``offsets`` (after the offsets' sum)."""
         return ("tables", "offsets")
 
+    def cut_plans(self) -> list[tuple[int, ...]]:
+        """After the table reads, then both."""
+        return [(0,), (0, 1)]
+
     def with_cuts(self, cuts):
         """A :class:`~chebnorm.hw.pipeline.PipelinedTable` with registers at ``cuts``."""
         from .pipeline import PipelinedTable

@@ -263,23 +263,19 @@ class PiecewiseDesign(Design):
         return piecewise_features(self)
 
     def cut_points(self) -> tuple[str, ...]:
-        """The sized architecture's: ``rom`` (after the ROM read), then ``mulI``
-        and ``addI`` (after the ``I``-th multiply and add); none for one width."""
-        if not self.sized:
-            return ()
+        """``rom`` (after the ROM read), then ``mulI`` and ``addI`` (after the
+        ``I``-th multiply and add), for the sized and the one-width datapath."""
         return ("rom",) + tuple(f"{op}{i}" for i in range(1, self.degree + 1)
                                 for op in ("mul", "add"))
 
     def cut_plans(self) -> list[tuple[int, ...]]:
         """Per latency ``1, 2, ...`` the cut set whose heaviest stage (by
         :data:`chebnorm.hw.pipeline.STAGE_WEIGHTS`) is the lightest, ties to the
-        earliest cuts (none for one width)."""
+        earliest cuts."""
         from itertools import combinations
 
         from .pipeline import STAGE_WEIGHTS
 
-        if not self.sized:
-            return []
         n = self.degree
         # stage k sits before position k: the ROM, a multiply and an add per step, the output
         weights = ([STAGE_WEIGHTS["rom"]] + [STAGE_WEIGHTS["mul"], STAGE_WEIGHTS["add"]] * n
@@ -295,8 +291,6 @@ class PiecewiseDesign(Design):
     def with_cuts(self, cuts) -> "PiecewiseDesign":
         """Registers at positions ``cuts`` (0 after the ROM, ``2i - 1`` after the
         ``i``-th multiply, ``2i`` after the ``i``-th add): ``cuts`` and ``mult_cuts``."""
-        if not self.sized:
-            return super().with_cuts(cuts)
         cuts = tuple(sorted(set(cuts)))
         top = 2 * self.degree
         if any(isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= top for c in cuts):
@@ -307,7 +301,7 @@ class PiecewiseDesign(Design):
 
     def combinational(self) -> "PiecewiseDesign":
         """The design without its pipeline registers."""
-        return replace(self, cuts=(), mult_cuts=()) if self.sized else self
+        return replace(self, cuts=(), mult_cuts=())
 
     def verilog(self, *, version: str = "", command: str | None = None) -> str:
         """The Verilog-2005 module (:func:`chebnorm.hw.hdl.module_text`)."""
@@ -1068,6 +1062,15 @@ def _auto_shape(proto: PiecewiseDesign, fy: int, max_error: Fraction, strict: bo
     return shape(descend(cur))
 
 
+def _check_mult_cuts(mult, n: int) -> tuple[int, ...]:
+    """``mult_cuts`` checked: a sorted tuple of distinct steps ``1..n``."""
+    if not isinstance(mult, tuple) or any(
+            isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= n
+            for c in mult) or list(mult) != sorted(set(mult)):
+        raise ValueError(f"mult_cuts {_short(mult)}: accepted: sorted distinct steps 1..{n}")
+    return mult
+
+
 def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
     if pipeline is None:
         return ()
@@ -1280,12 +1283,7 @@ def _prove(d: PiecewiseDesign) -> None:
                                          "prod_frac": d.prod_frac}, n, L, t.centered, fy,
                                         d.multipliers == "truncated")
             cuts = _check_cuts(d.cuts, n)
-            mult = d.mult_cuts
-            if not isinstance(mult, tuple) or any(
-                    isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= n
-                    for c in mult) or list(mult) != sorted(set(mult)):
-                raise ValueError(f"mult_cuts {_short(mult)}: accepted: sorted distinct steps "
-                                 f"1..{n}")
+            mult = _check_mult_cuts(d.mult_cuts, n)
             proto = PiecewiseDesign(d.name, t, W, d.out_bits, L, 0, QFormat(d.out_bits, 0),
                                     t.coefficient_word_bits(), L + 2, (), 0)
             ref = _sized_design(proto, shape, cuts)
@@ -1302,6 +1300,9 @@ def _prove(d: PiecewiseDesign) -> None:
                                  f"fractional bits plus 0 .. 16 guard bits")
             ref = _design_piecewise(t, W, d.out_bits, guard, d.name, None, None, None, "full",
                                     ROM_WEIGHT)
+            # pipeline registers (chebnorm.hw.pipeline.with_cuts): the same values, later
+            ref = replace(ref, cuts=_check_cuts(d.cuts, n),
+                          mult_cuts=_check_mult_cuts(d.mult_cuts, n))
     for f in dataclasses.fields(d):
         if f.name == "table":
             continue

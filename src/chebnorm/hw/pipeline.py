@@ -15,14 +15,15 @@ Timing, per target (:mod:`chebnorm.hw.targets`):
   delays, no routing (optimistic: it ranks, it does not sign off);
 * ``generic`` has no device and no time: refused.
 
-Cut points of a sized piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`
-with ``sized``): after the ROM read, after each multiply, after each add (the
-values are unchanged; ``latency`` cycles later). The plans balance the stages
+Cut points of a piecewise design (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`,
+one-width or sized): after the ROM read, after each multiply, after each add
+(with its rounding; the values are unchanged, ``latency`` cycles later). The plans balance the stages
 by a weight per stage (:data:`STAGE_WEIGHTS`: a multiply weighs two ROM reads
 or two adds). A multipartite design (:class:`PipelinedTable`)
-has two: after the table reads, after the offsets' sum. A plain table and the
-one-width piecewise design have none here (their plan list is empty: only the
-combinational module is measured).
+has two: after the table reads, after the offsets' sum. A plain table
+(:class:`PipelinedTable` too) has two: its ROM output registered (a synchronous
+read: block RAM in yosys) and its address registered. Any other design has none
+(its plan list is empty: only the combinational module is measured).
 
 :func:`verify_pipelined` simulates the pipelined module cycle by cycle over
 every input code in Icarus Verilog (one code per clock; output ``i`` checked
@@ -98,16 +99,22 @@ def _pipelinable(design) -> bool:
     return isinstance(design, Design) and bool(design.cut_points())
 
 
+#: the cut points of the table designs :class:`PipelinedTable` pipelines
+_TABLE_CUT_POINTS = (("tables", "offsets"), ("address", "rom"))
+
+
 def _base(design):
     """``design`` without pipeline registers."""
     return design.combinational()
 
 
 class PipelinedTable(Design):
-    """A multipartite design with pipeline registers at ``cuts``
-    (:data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table reads,
-    ``1`` after the offsets' sum); every other attribute is the design's
-    (same values, ``latency`` cycles later).
+    """A multipartite design or a plain table with pipeline registers at ``cuts``
+    (multipartite, :data:`chebnorm.hw.hdl.tables.TABLE_CUTS`: ``0`` after the table
+    reads, ``1`` after the offsets' sum; plain table,
+    :data:`chebnorm.hw.hdl.tables.PLAIN_TABLE_CUTS`: ``0`` the address register,
+    ``1`` the ROM output register); every other attribute is the design's (same
+    values, ``latency`` cycles later).
 
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> p = PipelinedTable(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
@@ -116,23 +123,24 @@ class PipelinedTable(Design):
 
     Parameters
     ----------
-    base : MultipartiteDesign
+    base : MultipartiteDesign or PlainTableDesign
         The combinational design, from
-        :func:`~chebnorm.hw.multipartite.design_multipartite`.
+        :func:`~chebnorm.hw.multipartite.design_multipartite` or
+        :func:`~chebnorm.hw.plain_table.design_plain_table`.
     cuts : iterable of int
-        Sorted register positions among 0 (after the table reads) and 1 (after the
-        offsets' sum); the latency is ``len(cuts)``.
+        Sorted register positions among 0 and 1 (above); the latency is ``len(cuts)``.
 
     Raises
     ------
     ValueError
-        If ``base`` is not a multipartite design or ``cuts`` is not such a set.
+        If ``base`` is not a table design or ``cuts`` is not such a set.
     """
 
     def __init__(self, base, cuts):
-        if not isinstance(base, Design) or base.cut_points() != ("tables", "offsets") \
+        if not isinstance(base, Design) or base.cut_points() not in _TABLE_CUT_POINTS \
                 or base.combinational() is not base:
-            raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign")
+            raise ValueError(f"base: a {type(base).__name__}; accepted: a MultipartiteDesign "
+                             f"or a PlainTableDesign")
         self.base = base
         self.cuts = tuple(cuts)
         table_cuts(self)  # checked
@@ -182,6 +190,10 @@ class PipelinedTable(Design):
     def cut_points(self) -> tuple[str, ...]:
         """The base's cut points."""
         return self.base.cut_points()
+
+    def cut_plans(self) -> list[tuple[int, ...]]:
+        """The base's cut plans."""
+        return self.base.cut_plans()
 
     def with_cuts(self, cuts) -> "PipelinedTable":
         """The base with registers at ``cuts`` instead."""
@@ -243,12 +255,13 @@ def design_files(design, language: str = "verilog") -> dict:
 
 def cut_plans(design) -> list[tuple[int, ...]]:
     """The cut sets tried, one per latency ``1, 2, ...``, as *positions*: for
-    a sized piecewise design of degree ``n``, ``0`` after the ROM read,
+    a piecewise design of degree ``n`` (one-width or sized), ``0`` after the ROM read,
     ``2i - 1`` after the ``i``-th multiply, ``2i`` after the ``i``-th add
     (:func:`cut_names`); for each count of registers the set whose heaviest
     stage (by :data:`STAGE_WEIGHTS`) is the lightest, ties to the earliest
     cuts. A multipartite design: ``[(0,), (0, 1)]`` (after the table reads,
-    after the offsets' sum). Empty for a design without cut points.
+    after the offsets' sum); a plain table: ``[(1,), (0, 1)]`` (the ROM output
+    registered, then the address too). Empty for a design without cut points.
 
     >>> from chebnorm.approx.piecewise_fit import piecewise_fit
     >>> from chebnorm.hw.piecewise import design_piecewise
@@ -256,14 +269,14 @@ def cut_plans(design) -> list[tuple[int, ...]]:
     >>> d = design_piecewise(t, 8, 8, widths="auto", max_error=2 ** -5)
     >>> [cut_names(d, p) for p in cut_plans(d)]
     [['mul1'], ['rom', 'mul1'], ['rom', 'mul1', 'add1']]
-    >>> cut_plans(design_piecewise(t, 8, 8))
-    []
+    >>> cut_plans(design_piecewise(t, 8, 8))     # the one-width design: the same points
+    [(1,), (0, 1), (0, 1, 2)]
 
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw`; only a sized piecewise design and a multipartite
-        design have cut points.
+        A design of :mod:`chebnorm.hw`; a piecewise design, a multipartite
+        design and a plain table have cut points.
 
     Returns
     -------
@@ -276,8 +289,8 @@ def cut_plans(design) -> list[tuple[int, ...]]:
 
 
 def cut_names(design, cuts) -> list[str]:
-    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (sized piecewise) or
-    ``tables``, ``offsets`` (multipartite).
+    """Names of cut positions: ``rom``, ``mulI``, ``addI`` (piecewise),
+    ``tables``, ``offsets`` (multipartite) or ``address``, ``rom`` (plain table).
 
     >>> from chebnorm.hw.multipartite import design_multipartite
     >>> cut_names(design_multipartite("1/sqrt(1+3*x)", ("0", "1"), 8, 8), (0, 1))
@@ -329,17 +342,19 @@ def with_cuts(design, cuts):
     Parameters
     ----------
     design : object
-        A sized piecewise design (``design_piecewise(..., widths=...)``) or a
-        multipartite design, combinational or already pipelined (its cuts are replaced).
+        A piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`, one-width
+        or sized), a multipartite design or a plain table, combinational or already
+        pipelined (its cuts are replaced).
     cuts : iterable of int
         Register positions, in any order (duplicates count once): 0 to ``2 * degree``
         for a piecewise design (0 after the ROM, ``2i - 1`` after the ``i``-th
-        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite one.
+        multiply, ``2i`` after the ``i``-th add); 0 and 1 for a multipartite design
+        or a plain table.
 
     Returns
     -------
     PiecewiseDesign or PipelinedTable
-        A new design with the cuts (a piecewise design stays one; a multipartite one
+        A new design with the cuts (a piecewise design stays one; a table design
         becomes a :class:`PipelinedTable`), ``latency == len(cuts)``.
 
     Raises
@@ -350,8 +365,8 @@ def with_cuts(design, cuts):
     """
     if not _pipelinable(design):
         raise ValueError(f"design: a {type(design).__name__} has no pipeline cut points; "
-                         f"accepted: a sized piecewise design (design_piecewise(..., "
-                         f"widths=...)) or a multipartite design")
+                         f"accepted: a piecewise design (design_piecewise), a multipartite "
+                         f"design or a plain table")
     if isinstance(cuts, (str, bytes)) or not hasattr(cuts, "__iter__"):
         raise ValueError(f"cuts {cuts!r}: accepted: an iterable of cut positions")
     cuts = tuple(sorted(set(cuts)))
@@ -484,9 +499,9 @@ def pipeline_to_frequency(design, target: str, frequency_mhz, *, seed: int = 1,
     Parameters
     ----------
     design : object
-        A design of :mod:`chebnorm.hw` (combinational). Only a sized
-        piecewise design has cut points (:func:`cut_plans`); any other is
-        measured as it is.
+        A design of :mod:`chebnorm.hw` (combinational). A piecewise design
+        (one-width or sized), a multipartite design and a plain table have cut points
+        (:func:`cut_plans`); any other is measured as it is.
     target : str
         ``ice40`` (nextpnr-ice40 Fmax), ``xc7`` or ``xc7-nodsp`` (the sta
         model); ``generic`` has no time and is refused.

@@ -187,8 +187,18 @@ class PlainTableDesign(Design):
         return table_features(self)
 
     def cut_points(self) -> tuple[str, ...]:
-        """None: one ROM read."""
-        return ()
+        """``address`` (the address registered) and ``rom`` (the ROM's output
+        registered: a synchronous read)."""
+        return ("address", "rom")
+
+    def cut_plans(self) -> list[tuple[int, ...]]:
+        """The ROM output first (a synchronous read maps to block RAM), then both."""
+        return [(1,), (0, 1)]
+
+    def with_cuts(self, cuts):
+        """A :class:`~chebnorm.hw.pipeline.PipelinedTable` with registers at ``cuts``."""
+        from .pipeline import PipelinedTable
+        return PipelinedTable(self, cuts)
 
 
 def design_plain_table(expr, interval, in_bits: int, out_bits: int, *, var: str = "x",

@@ -27,7 +27,7 @@ from .common import SUFFIX, check_language, comment_lines, module_name, vector_f
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
-__all__ = ["TABLE_CUTS", "table_cuts", "table_facts", "table_module", "table_testbench",
+__all__ = ["TABLE_CUTS", "PLAIN_TABLE_CUTS", "cut_labels", "table_cuts", "table_facts", "table_module", "table_testbench",
            "table_files"]
 
 
@@ -112,7 +112,8 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
                  f"{format_up(c.upper, '.6e')} = "
                  f"{format_up(c.upper * 2.0 ** yf.frac_bits, '.4f')} LSB of y.")
     cuts = table_cuts(design)
-    lines.append(f"Pipelined: registers at {', '.join(TABLE_CUTS[c] for c in cuts)}; latency "
+    labels = cut_labels(design)
+    lines.append(f"Pipelined: registers at {', '.join(labels[c] for c in cuts)}; latency "
                  f"{len(cuts)} cycles (LATENCY), one result per cycle." if cuts else
                  "Combinational.")
     return lines
@@ -120,12 +121,46 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
 
 #: a multipartite design's cut points: 0 after the table reads, 1 after the offsets' sum
 TABLE_CUTS = {0: "the table reads", 1: "the offsets' sum"}
+#: a plain table's cut points: 0 the registered address (before the ROM read), 1 the
+#: registered ROM output (after it: a synchronous read, which yosys maps to block RAM)
+PLAIN_TABLE_CUTS = {0: "the address", 1: "the ROM read"}
+
+
+def cut_labels(design) -> dict:
+    """Cut position -> what the register holds, for ``design``'s kind of table:
+    :data:`TABLE_CUTS` (multipartite) or :data:`PLAIN_TABLE_CUTS` (plain table).
+
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> cut_labels(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4))[1]
+    'the ROM read'
+
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design.
+
+    Returns
+    -------
+    dict of int to str
+        The cut positions of this kind of table and their descriptions.
+
+    Raises
+    ------
+    ValueError
+        If ``design`` is not a table design.
+    """
+    kind = getattr(design, "architecture", None)
+    if kind not in ("multipartite", "plain_table"):
+        raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
+                         f"MultipartiteDesign or a PlainTableDesign")
+    return PLAIN_TABLE_CUTS if kind == "plain_table" else TABLE_CUTS
 
 
 def table_cuts(design) -> tuple[int, ...]:
-    """The pipeline cut points of a table design (``design.cuts``; none for a
-    plain table, whose one ROM read has no inner boundary here): ``0`` after
-    the table reads, ``1`` after the sum of the offset tables.
+    """The pipeline cut points of a table design (``design.cuts``): for a
+    multipartite design ``0`` after the table reads, ``1`` after the sum of the
+    offset tables; for a plain table ``0`` the registered address, ``1`` the
+    registered ROM output (:data:`PLAIN_TABLE_CUTS`).
 
     >>> from chebnorm.hw.plain_table import design_plain_table
     >>> table_cuts(design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4))
@@ -146,11 +181,15 @@ def table_cuts(design) -> tuple[int, ...]:
     Raises
     ------
     ValueError
-        If ``design.cuts`` is not a sorted set of 0 and 1 (or is non-empty for a plain table).
+        If ``design.cuts`` is not a sorted set of 0 and 1.
     """
     cuts = tuple(getattr(design, "cuts", ()) or ())
-    if cuts and (_kind(design) != "multipartite" or not set(cuts) <= set(TABLE_CUTS)
-                 or list(cuts) != sorted(set(cuts))):
+    if cuts and (not set(cuts) <= set(cut_labels(design)) or list(cuts) != sorted(set(cuts))
+                 or any(isinstance(c, bool) for c in cuts)):
+        if _kind(design) == "plain_table":
+            raise ValueError(f"cuts {list(cuts)[:8]}: accepted: a plain table's sorted cut "
+                             f"points among 0 (the address register) and 1 (the ROM output "
+                             f"register)")
         raise ValueError(f"cuts {list(cuts)[:8]}: accepted: a multipartite design's sorted "
                          f"cut points among 0 (after the table reads) and 1 (after the "
                          f"offsets' sum)")
@@ -191,6 +230,9 @@ def _verilog(design, facts: list[str]) -> str:
             *(["    input  wire                clk,"] if cuts else []),
             "    input  wire [IN_BITS-1:0]  x,", "    output wire [OUT_BITS-1:0] y", ");"]
     if design.architecture == "plain_table":
+        if cuts:
+            _verilog_plain_pipelined(out, design, cuts)
+            return "\n".join(out)
         _verilog_rom(out, "rom", "x", w, design.out_bits, design.values)
         out += ["    assign y = rom;", "endmodule", ""]
         return "\n".join(out)
@@ -228,6 +270,43 @@ def _verilog(design, facts: list[str]) -> str:
             f"    assign y = {{{{{design.out_bits - (s - g)}{{1'b0}}}}, acc[{s - 1}:{g}]}};",
             "endmodule", ""]
     return "\n".join(out)
+
+
+def _verilog_plain_pipelined(out: list[str], design, cuts) -> None:
+    """The body of a pipelined plain table: the address registered (cut 0), the ROM
+    read, its output registered (cut 1: a synchronous read, block RAM in yosys)."""
+    w, ob = design.in_bits, design.out_bits
+    addr = "x"
+    if 0 in cuts:
+        out += [f"    reg [{w - 1}:0] addr_r0;", "    always @(posedge clk) addr_r0 <= x;"]
+        addr = "addr_r0"
+    _verilog_rom(out, "rom", addr, w, ob, design.values)
+    if 1 in cuts:
+        out += [f"    reg [{ob - 1}:0] rom_r1;", "    always @(posedge clk) rom_r1 <= rom;",
+                "    assign y = rom_r1;"]
+    else:
+        out.append("    assign y = rom;")
+    out += ["endmodule", ""]
+
+
+def _vhdl_plain_pipelined(decl: list[str], stmt: list[str], design, cuts) -> None:
+    """The VHDL of :func:`_verilog_plain_pipelined`: address and ROM output registers."""
+    w, ob = design.in_bits, design.out_bits
+    addr = "x"
+    regs = []
+    if 0 in cuts:
+        decl.append(f"    signal addr_r0 : std_logic_vector({w - 1} downto 0);")
+        regs.append("            addr_r0 <= x;")
+        addr = "addr_r0"
+    _vhdl_rom(decl, stmt, "rom", addr, ob, design.values)
+    if 1 in cuts:
+        decl.append(f"    signal rom_r1 : unsigned({ob - 1} downto 0);")
+        regs.append("            rom_r1 <= rom;")
+        stmt.append("    y <= std_logic_vector(rom_r1);")
+    else:
+        stmt.append("    y <= std_logic_vector(rom);")
+    stmt.extend(["    regs : process (clk)", "    begin", "        if rising_edge(clk) then",
+                 *regs, "        end if;", "    end process regs;"])
 
 
 def _offset_sum_bits(design) -> int:
@@ -278,7 +357,9 @@ def _vhdl(design, facts: list[str]) -> str:
             "        y : out std_logic_vector(OUT_BITS - 1 downto 0)", "    );",
             f"end entity {name};", ""]
     decl, stmt = [], []
-    if design.architecture == "plain_table":
+    if design.architecture == "plain_table" and cuts:
+        _vhdl_plain_pipelined(decl, stmt, design, cuts)
+    elif design.architecture == "plain_table":
         _vhdl_rom(decl, stmt, "rom", "x", design.out_bits, design.values)
         stmt.append("    y <= std_logic_vector(rom);")
     else:

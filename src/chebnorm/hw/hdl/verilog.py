@@ -33,7 +33,7 @@ from .common import (comment_lines, horner_facts, module_name, piecewise_facts, 
 __all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
            "verilog_module", "verilog_pipelined_module", "verilog_testbench",
            "verilog_pipelined_testbench", "piecewise_verilog", "sized_piecewise_verilog",
-           "piecewise_clocked_testbench"]
+           "piecewise_clocked_testbench", "pipelined_piecewise_verilog"]
 
 
 # -- fragments -------------------------------------------------------------------
@@ -606,6 +606,8 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     """
     if d.sized:
         return sized_piecewise_verilog(d, version=version, command=command)
+    if d.latency:
+        return pipelined_piecewise_verilog(d, version=version, command=command)
     t = d.table
     n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
     yf = d.y_format
@@ -851,3 +853,123 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
         If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
     return _clocked_bench(d, module_name(d), d.latency, vectors)
+
+
+# -- one-width piecewise evaluator with pipeline registers ----------------------------------
+# (printed beside the combinational piecewise_verilog: the same wires, registered at the cuts)
+
+def pipelined_piecewise_verilog(d, *, version: str = "", command: str | None = None) -> str:
+    """The Verilog-2005 module of a one-width piecewise design with pipeline
+    registers (``d.latency > 0``, ``d.sized`` False): the wires of
+    :func:`piecewise_verilog`, every live signal registered after the ROM read
+    (cut ``0``), after step ``i``'s multiply (``i`` in ``d.mult_cuts``) and after
+    its add and rounding (``i`` in ``d.cuts``); ``clk`` port, ``LATENCY``
+    parameter, bit for bit :meth:`~chebnorm.hw.piecewise.PiecewiseDesign.evaluate`
+    ``LATENCY`` cycles later.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A one-width piecewise design with cuts (``chebnorm.hw.pipeline.with_cuts``).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The Verilog-2005 text, banner first.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> from chebnorm.hw.pipeline import with_cuts
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> v = pipelined_piecewise_verilog(with_cuts(design_piecewise(t, 8, 8), (0, 1, 2)))
+    >>> v.count("always @(posedge clk)"), "parameter LATENCY = 3" in v
+    (3, True)
+    """
+    t = d.table
+    n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
+    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
+    out += [f"module {module_name(d)} #(",
+            f"    parameter IN_BITS = {d.in_bits},",
+            f"    parameter OUT_BITS = {d.out_bits},",
+            f"    parameter LATENCY = {d.latency}",
+            ") (",
+            "    input  wire                clk,",
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");",
+            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
+    tw = d.t_bits
+    centre = f" - {signed_literal(1 << (L - 1), tw)}" if t.centered else ""
+    out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}){centre};")
+    if K == 0:
+        for j in range(n + 1):
+            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
+                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
+    else:
+        out += [f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};" for j in range(n + 1)]
+        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
+                "    always @(*) begin",
+                "        case (idx)"]
+        for s, seg in enumerate(t.segments):
+            body = " ".join(f"c{j} = {signed_literal(q, d.rom_bits[j])};"
+                            for j, q in enumerate(seg.integers))
+            out.append(f"            {K}'d{s}: begin {body} end")
+        out += ["        endcase", "    end"]
+    # live signals: name -> width (all signed); registered at each cut point
+    live = {"t": tw, **{f"c{j}": d.rom_bits[j] for j in range(n + 1)}}
+    cur = {k: k for k in live}
+
+    def cut(stage) -> None:
+        regs = []
+        for key, w in live.items():
+            r = f"{key}_r{stage}"
+            out.append(f"    reg signed [{w - 1}:0] {r};")
+            regs.append(f"        {r} <= {cur[key]};")
+            cur[key] = r
+        out.extend(["    always @(posedge clk) begin", *regs, "    end"])
+
+    if 0 in d.cuts:
+        cut(0)
+    acc, prev_frac = f"c{n}", fc
+    for i, j in enumerate(range(n - 1, -1, -1), start=1):
+        pw, sw, ow = d.widths[i - 1]
+        pf = prev_frac + L
+        sf = max(pf, fc)
+        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
+        out.append(f"    wire signed [{pw - 1}:0] p{j} = {cur[acc]} * {cur['t']};")
+        p = f"p{j}"
+        del live[acc], cur[acc]
+        if j == 0:
+            del live["t"], cur["t"]
+        if i in d.mult_cuts:  # a register between the multiply and the add
+            live[p], cur[p] = pw, p
+            cut(f"m{i}")
+            p = cur.pop(p)
+            del live[f"p{j}"]
+        sh_p = f" <<< {sf - pf}" if sf > pf else ""
+        sh_c = f" <<< {sf - fc}" if sf > fc else ""
+        out.append(f"    wire signed [{sw - 1}:0] s{j} = ({p}{sh_p}) + ({cur[f'c{j}']}{sh_c});")
+        del live[f"c{j}"], cur[f"c{j}"]
+        if j > 0:
+            f_out = min(d.acc_frac_bits, sf)
+            if sf > f_out:
+                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
+            else:
+                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
+            acc, prev_frac, width = f"a{j}", f_out, ow
+        else:
+            acc, prev_frac, width = f"s{j}", sf, sw
+        live[acc], cur[acc] = width, acc
+        if i in d.cuts:
+            cut(i)
+    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
+    out += saturating_output(cur[acc], top_bits, prev_frac, d.y_format, d.out_bits, d.rounding)
+    return "\n".join(out)
+

@@ -40,7 +40,8 @@ from .common import (comment_lines, horner_facts, module_name, piecewise_facts, 
 
 __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
            "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
-           "sized_piecewise_vhdl", "piecewise_vhdl_clocked_testbench"]
+           "sized_piecewise_vhdl", "piecewise_vhdl_clocked_testbench",
+           "pipelined_piecewise_vhdl"]
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"
@@ -581,6 +582,8 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """
     if d.sized:
         return sized_piecewise_vhdl(d, version=version, command=command)
+    if d.latency:
+        return pipelined_piecewise_vhdl(d, version=version, command=command)
     t = d.table
     n, L, fc = t.degree, d.local_bits, t.coef_frac_bits
     name = module_name(d)
@@ -844,3 +847,106 @@ def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
         If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
     return _bench(d, module_name(d), vectors, clocked=True, latency=d.latency)
+
+
+# -- one-width piecewise evaluator with pipeline registers ----------------------------------
+# (printed beside the combinational piecewise_vhdl: the same signals, registered at the cuts)
+
+def pipelined_piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
+    """The VHDL-2008 entity of a one-width piecewise design with pipeline
+    registers (``d.latency > 0``, ``d.sized`` False), bit for bit the module of
+    :func:`~chebnorm.hw.hdl.verilog.pipelined_piecewise_verilog`: the signals of
+    :func:`piecewise_vhdl` registered at the same cut points.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        A one-width piecewise design with cuts (``chebnorm.hw.pipeline.with_cuts``).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe);
+        None or empty: no such line.
+
+    Returns
+    -------
+    str
+        The VHDL-2008 text, banner first.
+
+    Examples
+    --------
+    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
+    >>> from chebnorm.hw.piecewise import design_piecewise
+    >>> from chebnorm.hw.pipeline import with_cuts
+    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
+    >>> v = pipelined_piecewise_vhdl(with_cuts(design_piecewise(t, 8, 8), (0, 2)))
+    >>> v.count("rising_edge(clk)"), "LATENCY  : natural := 2" in v
+    (2, True)
+    """
+    t = d.table
+    n, L, fc = t.degree, d.local_bits, t.coef_frac_bits
+    name = module_name(d)
+    out = comment_lines(piecewise_facts(d, version=version, command=command), "vhdl")
+    out += _entity(name, d, clocked=True)
+    b = _Body()
+    tw = d.t_bits
+    low = f"signed(\"00\" & x({L - 1} downto 0))"
+    if t.centered:
+        b.decl.append(_const("TC", 1 << (L - 1), tw))
+        b.wire("t", tw, f"{low} - TC")
+    else:
+        b.wire("t", tw, low)
+    _piecewise_rom(b, d)
+    live = {"t": tw, **{f"c{j}": d.rom_bits[j] for j in range(n + 1)}}
+    cur = {k: k for k in live}
+
+    def cut(stage) -> None:
+        regs = []
+        for key, w in live.items():
+            r = f"{key}_r{stage}"
+            b.decl.append(_sig(r, w))
+            regs.append(f"            {r} <= {cur[key]};")
+            cur[key] = r
+        b.stmt.extend(["    process (clk)", "    begin", "        if rising_edge(clk) then", *regs,
+                       "        end if;", "    end process;"])
+
+    if 0 in d.cuts:
+        cut(0)
+    acc, prev_frac = f"c{n}", fc
+    for i, j in enumerate(range(n - 1, -1, -1), start=1):
+        pw, sw, ow = d.widths[i - 1]
+        pf = prev_frac + L
+        sf = max(pf, fc)
+        b.stmt.append(f"    -- step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
+        b.wire(f"p{j}", pw, f"wrap({cur[acc]} * {cur['t']}, {pw})")
+        p = f"p{j}"
+        del live[acc], cur[acc]
+        if j == 0:
+            del live["t"], cur["t"]
+        if i in d.mult_cuts:  # a register between the multiply and the add
+            live[p], cur[p] = pw, p
+            cut(f"m{i}")
+            p = cur.pop(p)
+            del live[f"p{j}"]
+        terms = [f"shift_left(wrap({v}, {sw}), {sh})" if sh else f"wrap({v}, {sw})"
+                 for v, sh in ((p, sf - pf), (cur[f"c{j}"], sf - fc))]
+        b.wire(f"s{j}", sw, " + ".join(terms))
+        del live[f"c{j}"], cur[f"c{j}"]
+        if j > 0:
+            f_out = min(d.acc_frac_bits, sf)
+            if sf > f_out:
+                _round(b, f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
+            else:
+                b.wire(f"a{j}", ow, f"wrap(s{j}, {ow})")
+            acc, prev_frac, width = f"a{j}", f_out, ow
+        else:
+            acc, prev_frac, width = f"s{j}", sf, sw
+        live[acc], cur[acc] = width, acc
+        if i in d.cuts:
+            cut(i)
+    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
+    _output(b, cur[acc], top_bits, prev_frac, d.y_format, d.out_bits, d.rounding)
+    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
+            "end architecture rtl;", ""]
+    return "\n".join(out)
+
