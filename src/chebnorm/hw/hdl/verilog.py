@@ -27,6 +27,8 @@ from __future__ import annotations
 from ..fixed import QFormat
 from ..horner import HornerDesign
 from .common import (shifted_width, step_comment, variable_name)
+from .datapath import sized_piecewise_netlist
+from .netlist import verilog as _verilog
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -700,124 +702,9 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     >>> v.count("always @(posedge clk)"), "parameter LATENCY = 3" in v
     (3, True)
     """
-    t = d.table
-    n, L, K = t.degree, d.local_bits, d.index_bits
-    mod = module_name(d)
-    clocked = d.latency > 0
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
-    out += [f"module {mod} #(",
-            f"    parameter IN_BITS = {d.in_bits},",
-            f"    parameter OUT_BITS = {d.out_bits}" + ("," if clocked else ""),
-            *([f"    parameter LATENCY = {d.latency}"] if clocked else []),
-            ") (",
-            *(["    input  wire                clk,"] if clocked else []),
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");",
-            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
-    if K == 0:
-        for j in range(n + 1):
-            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{signed_literal(d.coefficients[0][j], d.rom_bits[j])};")
-    else:
-        out += [f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};" for j in range(n + 1)]
-        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
-                "    always @(*) begin",
-                "        case (idx)"]
-        for s, row in enumerate(d.coefficients):
-            body = " ".join(f"c{j} = {signed_literal(q, d.rom_bits[j])};"
-                            for j, q in enumerate(row))
-            out.append(f"            {K}'d{s}: begin {body} end")
-        out += ["        endcase", "    end"]
-    # live signals: name -> (width, signed); registered at each cut point
-    live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
-    cur = {k: k for k in live}
-    acc, accw = f"c{n}", d.rom_bits[n]
-
-    def cut(stage) -> None:
-        regs = []
-        for key, (w, sgn) in live.items():
-            r = f"{key}_r{stage}"
-            out.append(f"    reg {'signed ' if sgn else ''}[{w - 1}:0] {r};")
-            regs.append(f"        {r} <= {cur[key]};")
-            cur[key] = r
-        out.extend(["    always @(posedge clk) begin", *regs, "    end"])
-
-    if 0 in d.cuts:
-        cut(0)
-    for i, st in enumerate(d.sized_signals(), start=1):
-        j, T = st["j"], st["T"]
-        lo = cur["low"]
-        out.append(f"    // step {j}: a{j} = (((a{j + 1} * t{j}) >>> {st['pshift']}) <<< {st['qshift']}"
-                   f" + c{j} <<< {st['cshift']}) >>> {st['ashift']}, t{j} = top {T} bits of t"
-                   + (", truncated multiplier" if st["rows"] else ""))
-        if t.centered:
-            bits = f"~{lo}[{L - 1}]" if T == 1 else f"{{~{lo}[{L - 1}], {lo}[{L - 2}:{L - T}]}}"
-            out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = {bits};")
-        else:
-            out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = $signed({{1'b0, {lo}[{L - 1}:{L - T}]}});")
-        if st["rows"]:
-            out += _truncated_rows(st, cur[acc], accw, lo)
-        else:
-            out.append(f"    wire signed [{st['pw'] - 1}:0] p{j} = {cur[acc]} * t{j};")
-            ps = st["pshift"]
-            shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
-            out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
-        q = f"q{j}"
-        if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
-            live.pop(acc, None)
-            cur.pop(acc, None)
-            if j == 0:
-                live.pop("low", None)
-            live[q], cur[q] = (st["qw"], True), q
-            cut(f"m{i}")
-            q = cur.pop(q)
-            del live[f"q{j}"]
-        cs = f" <<< {st['cshift']}" if st["cshift"] else ""
-        qs = f"({q} <<< {st['qshift']})" if st["qshift"] else q
-        out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = {qs} + ({cur[f'c{j}']}{cs});")
-        ash = f" >>> {st['ashift']}" if st["ashift"] else ""
-        out.append(f"    wire signed [{st['aw'] - 1}:0] a{j} = s{j}{ash};")
-        del live[f"c{j}"], cur[f"c{j}"]
-        live.pop(acc, None)
-        cur.pop(acc, None)
-        acc, accw = f"a{j}", st["aw"]
-        live[acc], cur[acc] = (st["aw"], True), acc
-        if j == 0:
-            live.pop("low", None)
-        if i in d.cuts:
-            cut(i)
-    top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]
-    if n == 0:
-        f0, g0 = d.coef_frac[0], d.acc_frac[0]
-        sh = f" >>> {f0 - g0}" if f0 > g0 else (f" <<< {g0 - f0}" if g0 > f0 else "")
-        top_bits = d.rom_bits[0] + max(0, g0 - f0)
-        out.append(f"    wire signed [{top_bits - 1}:0] a0 = {cur['c0']}{sh};")
-        acc = "a0"
-        cur[acc] = acc
-    out += saturating_output(cur[acc], top_bits, d.y_format.frac_bits, d.y_format, d.out_bits,
-                             "trunc")
-    return "\n".join(out)
+    return _verilog(sized_piecewise_netlist(d, version=version, command=command))
 
 
-def _truncated_rows(st: dict, a: str, aw: int, low: str) -> list[str]:
-    """The truncated multiplier ``q_j`` of a sized step: one row per bit of
-    ``t_j``'s code, ``a`` floored at column ``P`` (an arithmetic shift), gated by
-    the bit (the inverted top bit, negated row, when ``t`` is centred), all
-    rows added modulo ``2^qw`` (the exact sum fits ``qw`` bits)."""
-    j, qw = st["j"], st["qw"]
-    out, terms = [], []
-    if any(neg for _, _, neg in st["rows"]):
-        out.append(f"    wire signed [{aw}:0] na{j} = -{a};")
-    for i, sh, neg in st["rows"]:
-        src = f"na{j}" if neg else a
-        expr = f"{src} >>> {sh}" if sh > 0 else (f"{src} <<< {-sh}" if sh < 0 else src)
-        bit = f"{low}[{st['tshift'] + i}]"
-        out += [f"    wire signed [{qw - 1}:0] r{j}_{i} = {expr};",
-                f"    wire [{qw - 1}:0] m{j}_{i} = r{j}_{i} & {{{qw}{{{'~' if neg else ''}{bit}}}}};"]
-        terms.append(f"m{j}_{i}")
-    out.append(f"    wire signed [{qw - 1}:0] q{j} = {' + '.join(terms)};")
-    return out
 
 
 def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:

@@ -35,6 +35,8 @@ from chebnorm.core.textsafe import identifier
 
 from ..horner import HornerDesign
 from .common import (shifted_width, step_comment, variable_name)
+from .datapath import sized_piecewise_netlist
+from .netlist import vhdl as _vhdl
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
@@ -685,132 +687,10 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     >>> v.count("rising_edge(clk)"), "LATENCY  : natural := 2" in v
     (2, True)
     """
-    t = d.table
-    n, L, K = t.degree, d.local_bits, d.index_bits
-    name = module_name(d)
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "vhdl")
-    out += _entity(name, d, clocked=d.latency > 0)
-    b = _Body()
-    b.decl.append(f"    signal low : std_logic_vector({L - 1} downto 0);")
-    b.stmt.append(f"    low <= x({L - 1} downto 0);")
-    if K == 0:
-        for j in range(n + 1):
-            b.wire(f"c{j}", d.rom_bits[j], _bits(d.coefficients[0][j], d.rom_bits[j]))
-    else:
-        b.decl.append(f"    signal idx : unsigned({K - 1} downto 0);")
-        b.stmt.append(f"    idx <= unsigned(x({d.in_bits - 1} downto {L}));")
-        for j in range(n + 1):
-            w = d.rom_bits[j]
-            b.decl.append(f"    type rom{j}_t is array (0 to {2 ** K - 1}) of signed({w - 1} downto 0);")
-            rows = [f"        {_bits(row[j], w)}{',' if s < len(d.coefficients) - 1 else ''}"
-                    f"  -- segment {s}: {row[j]}" for s, row in enumerate(d.coefficients)]
-            b.decl += [f"    constant ROM{j} : rom{j}_t := (", *rows, "    );"]
-            b.wire(f"c{j}", w, f"ROM{j}(to_integer(idx))")
-    live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
-    cur = {k: k for k in live}
-    acc, accw = f"c{n}", d.rom_bits[n]
-
-    def cut(stage) -> None:
-        regs = []
-        for key, (w, sgn) in live.items():
-            r = f"{key}_r{stage}"
-            typ = f"signed({w - 1} downto 0)" if sgn else f"std_logic_vector({w - 1} downto 0)"
-            b.decl.append(f"    signal {r} : {typ};")
-            regs.append(f"            {r} <= {cur[key]};")
-            cur[key] = r
-        b.stmt.extend(["    process (clk)", "    begin", "        if rising_edge(clk) then", *regs,
-                       "        end if;", "    end process;"])
-
-    if 0 in d.cuts:
-        cut(0)
-    for i, st in enumerate(d.sized_signals(), start=1):
-        j, T, tw = st["j"], st["T"], st["tw"]
-        lo = cur["low"]
-        b.stmt.append(f"    -- step {j}: a{j} = (((a{j + 1} * t{j}) >> {st['pshift']}) << {st['qshift']}"
-                      f" + c{j} << {st['cshift']}) >> {st['ashift']}, t{j} = top {T} bits of t"
-                      + (", truncated multiplier" if st["rows"] else ""))
-        if t.centered:
-            rest = f" & {lo}({L - 2} downto {L - T})" if T > 1 else ""
-            b.wire(f"t{j}", tw, f"signed(not {lo}({L - 1} downto {L - 1}){rest})")
-        else:
-            b.wire(f"t{j}", tw, f"signed(\"0\" & {lo}({L - 1} downto {L - T}))")
-        pw, qw, sw, aw = st["pw"], st["qw"], st["sw"], st["aw"]
-        ps = st["pshift"]
-        if not st["rows"]:
-            b.wire(f"p{j}", pw, f"wrap({cur[acc]} * t{j}, {pw})")
-        if st["rows"]:
-            _truncated_rows(b, st, cur[acc], accw, lo)
-        elif ps > 0:
-            b.wire(f"q{j}", qw, f"wrap(shift_right(p{j}, {ps}), {qw})")
-        elif ps < 0:
-            b.wire(f"q{j}", qw, f"shift_left(wrap(p{j}, {qw}), {-ps})")
-        else:
-            b.wire(f"q{j}", qw, f"wrap(p{j}, {qw})")
-        q = f"q{j}"
-        if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
-            live.pop(acc, None)
-            cur.pop(acc, None)
-            if j == 0:
-                live.pop("low", None)
-            live[q], cur[q] = (qw, True), q
-            cut(f"m{i}")
-            q = cur.pop(q)
-            del live[f"q{j}"]
-        ctx = max(qw, sw, d.rom_bits[j])
-        c = f"wrap({cur[f'c{j}']}, {ctx})"
-        c = f"shift_left({c}, {st['cshift']})" if st["cshift"] else c
-        qv = f"wrap({q}, {ctx})"
-        qv = f"shift_left({qv}, {st['qshift']})" if st["qshift"] else qv
-        b.wire(f"s{j}", sw, f"wrap({qv} + {c}, {sw})")
-        a_expr = f"shift_right(s{j}, {st['ashift']})" if st["ashift"] else f"s{j}"
-        b.wire(f"a{j}", aw, f"wrap({a_expr}, {aw})")
-        del live[f"c{j}"], cur[f"c{j}"]
-        live.pop(acc, None)
-        cur.pop(acc, None)
-        acc, accw = f"a{j}", aw
-        live[acc], cur[acc] = (aw, True), acc
-        if j == 0:
-            live.pop("low", None)
-        if i in d.cuts:
-            cut(i)
-    top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]
-    if n == 0:
-        f0, g0 = d.coef_frac[0], d.acc_frac[0]
-        top_bits = d.rom_bits[0] + max(0, g0 - f0)
-        src = f"wrap({cur['c0']}, {top_bits})"
-        expr = (f"shift_right({src}, {f0 - g0})" if f0 > g0 else
-                f"shift_left({src}, {g0 - f0})" if g0 > f0 else src)
-        b.wire("a0", top_bits, expr)
-        cur["a0"] = acc = "a0"
-    _output(b, cur[acc], top_bits, d.y_format.frac_bits, d.y_format, d.out_bits, "trunc")
-    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
-            "end architecture rtl;", ""]
-    return "\n".join(out)
+    _vhdl_name(module_name(d))
+    return _vhdl(sized_piecewise_netlist(d, version=version, command=command))
 
 
-def _truncated_rows(b: _Body, st: dict, a: str, aw: int, low: str) -> None:
-    """The truncated multiplier ``q_j``, as the Verilog printer writes it: one
-    row per bit of ``t_j``'s code, floored at column ``P``, gated, summed
-    modulo ``2^qw``."""
-    j, qw = st["j"], st["qw"]
-    if any(neg for _, _, neg in st["rows"]):
-        b.wire(f"na{j}", aw + 1, f"-wrap({a}, {aw + 1})")
-    terms = []
-    for i, sh, neg in st["rows"]:
-        src = f"na{j}" if neg else a
-        sw = max(aw + 1 if neg else aw, qw)
-        if sh > 0:
-            expr = f"wrap(shift_right(wrap({src}, {sw}), {sh}), {qw})"
-        elif sh < 0:
-            expr = f"shift_left(wrap({src}, {qw}), {-sh})"
-        else:
-            expr = f"wrap({src}, {qw})"
-        b.wire(f"r{j}_{i}", qw, expr)
-        bit = f"{low}({st['tshift'] + i})"
-        on = "'0'" if neg else "'1'"
-        b.wire(f"m{j}_{i}", qw, f"r{j}_{i} when {bit} = {on} else (others => '0')")
-        terms.append(f"m{j}_{i}")
-    b.wire(f"q{j}", qw, " + ".join(terms))
 
 
 def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:

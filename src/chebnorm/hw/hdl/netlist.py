@@ -1,0 +1,1263 @@
+"""One netlist IR of a fixed-point datapath, and its two printers: Verilog-2005
+(:func:`verilog`) and VHDL-2008 (:func:`vhdl`).
+
+A :class:`Module` holds typed :class:`Signal` s and statements
+(:class:`Assign`, :class:`ConstDecl`, :class:`Rom`, :class:`Registers`,
+:class:`Saturate`, :class:`Comment`) over expression nodes (:class:`Const`,
+:class:`Slice`, :class:`Bit`, :class:`Concat`, :class:`Not`, :class:`ZeroExt`,
+:class:`Resize`, :class:`Extend`, :class:`Shl`, :class:`Shr`, :class:`Neg`,
+:class:`Add`, :class:`Sub`, :class:`Mul`, :class:`Gate`, :class:`And`,
+:class:`Or`, :class:`ReduceOr`, :class:`Group`, :class:`Paren`). The logic is
+held once; each language is a table of templates, one per node kind
+(:data:`_VERILOG`, :data:`_VHDL`), as :mod:`chebnorm.export.shader` prints
+GLSL, WGSL and HLSL from one table.
+
+Every width change is explicit in the IR (:class:`Resize`: Verilog's
+assignment semantics, sign-extend or keep the low bits): the Verilog printer
+leaves it to the assignment context, the VHDL printer writes it as the
+``wrap`` function. The nodes check their operands when built -- an
+:class:`Add` of two widths, an :class:`Assign` of a 9-bit value to an 8-bit
+signal, a signed/unsigned mix -- and refuse them naming the node, so a
+printed module never relies on an implicit conversion the other language
+lacks. :func:`evaluate` computes any signal of a combinational module from
+its input code in Python (two's complement, the node semantics above).
+
+>>> x = Signal("x", 4)
+>>> m = Module("chebnorm_neg", 4, 5, facts=["negate"], statements=[
+...     Assign(Signal("n", 5, signed=True), Neg(ZeroExt(x))),
+...     Assign(Signal("y", 5), Resize(Signal("n", 5, signed=True), 5, signed=False))])
+>>> print(verilog(m).splitlines()[-3])
+    wire signed [4:0] n = -$signed({1'b0, x});
+>>> evaluate(m, 3)["n"]
+-3
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .common import comment_lines
+
+__all__ = ["Signal", "Const", "Slice", "Bit", "Concat", "Not", "ZeroExt", "Resize", "Extend",
+           "Shl", "Shr", "Neg", "Add", "Sub", "Mul", "Gate", "And", "Or", "ReduceOr", "Group",
+           "Paren", "BitVec", "Assign", "ConstDecl", "Rom", "Registers", "Saturate", "Output",
+           "Comment", "Module", "vhdl_entity", "VHDL_WRAP",
+           "verilog", "vhdl", "statement_lines", "evaluate", "signed_literal", "vhdl_bits"]
+
+
+def _refuse(what: str, detail: str) -> ValueError:
+    return ValueError(f"{what}: {detail}")
+
+
+def signed_literal(value: int, bits: int) -> str:
+    """A sized signed Verilog decimal literal ``[-]BITS'sdMAGNITUDE``.
+
+    >>> signed_literal(5, 4), signed_literal(-8, 4)
+    ("4'sd5", "-4'sd8")
+
+    Parameters
+    ----------
+    value : int
+        The constant.
+    bits : int
+        The literal's width, ``>= 1``; ``value`` must lie in ``[-2**(bits-1), 2**(bits-1) - 1]``.
+
+    Returns
+    -------
+    str
+        The literal, e.g. ``"4'sd5"`` or ``"-4'sd8"``.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` does not fit a signed ``bits``-bit word.
+    """
+    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
+        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
+    return f"{'-' if value < 0 else ''}{bits}'sd{abs(value)}"
+
+
+def vhdl_bits(value: int, bits: int) -> str:
+    """A VHDL ``signed`` bit-string literal of ``value`` in ``bits`` bits.
+
+    >>> vhdl_bits(-3, 4)
+    'signed\\'("1101")'
+
+    Parameters
+    ----------
+    value : int
+        The constant.
+    bits : int
+        The width, ``>= 1``; ``value`` must fit a signed ``bits``-bit word.
+
+    Returns
+    -------
+    str
+        ``signed'("...")`` with the two's complement bits.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` does not fit a signed ``bits``-bit word.
+    """
+    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
+        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
+    return f'signed\'("{value & ((1 << bits) - 1):0{bits}b}")'
+
+
+# -- signals and expressions -----------------------------------------------------------
+
+@dataclass(frozen=True)
+class Signal:
+    """A named wire (register) of ``width`` bits.
+
+    Parameters
+    ----------
+    name : str
+        The identifier.
+    width : int
+        Bits, ``>= 1``.
+    signed : bool, default False
+        Two's complement (Verilog ``signed``, VHDL ``signed``); else unsigned.
+    logic : bool, default False
+        A plain bit vector (VHDL ``std_logic_vector``, ``std_logic`` when one bit wide);
+        unsigned in arithmetic. Not with ``signed``.
+    """
+
+    name: str
+    width: int
+    signed: bool = False
+    logic: bool = False
+
+    def __post_init__(self):
+        if not isinstance(self.width, int) or self.width < 1:
+            raise _refuse(f"signal {self.name!r}", f"width {self.width!r}; accepted: an integer >= 1")
+        if self.signed and self.logic:
+            raise _refuse(f"signal {self.name!r}", "signed and logic; accepted: one of them")
+
+
+def _check_expr(e, what: str):
+    if not isinstance(e, _EXPR):
+        raise _refuse(what, f"operand {type(e).__name__}; accepted: a Signal or an expression node")
+    return e
+
+
+def _same(what: str, a, b) -> None:
+    if a.width != b.width or a.signed != b.signed:
+        raise _refuse(what, f"operands of {_kind(a)} and {_kind(b)}; accepted: one width and "
+                            f"signedness (make the change explicit with Resize or ZeroExt)")
+
+
+def _same_sign(what: str, a, b) -> None:
+    if a.signed != b.signed:
+        raise _refuse(what, f"operands of {_kind(a)} and {_kind(b)}; accepted: one signedness "
+                            f"(make the change explicit with Resize or ZeroExt)")
+
+
+def _kind(e) -> str:
+    return f"{e.width} {'signed' if e.signed else 'unsigned'} bits"
+
+
+@dataclass(frozen=True)
+class Const:
+    """A signed constant of ``width`` bits.
+
+    Parameters
+    ----------
+    value : int
+        The value; it must fit a signed ``width``-bit word.
+    width : int
+        Bits.
+    """
+
+    value: int
+    width: int
+    signed = True
+
+    def __post_init__(self):
+        if not -(1 << (self.width - 1)) <= self.value < (1 << (self.width - 1)):
+            raise _refuse("Const", f"{self.value} does not fit a signed {self.width}-bit word")
+
+
+@dataclass(frozen=True)
+class Slice:
+    """Bits ``hi`` down to ``lo`` of a signal, unsigned.
+
+    Parameters
+    ----------
+    src : Signal
+        The signal.
+    hi, lo : int
+        The bit range, ``src.width > hi >= lo >= 0``.
+    """
+
+    src: Signal
+    hi: int
+    lo: int
+    signed = False
+
+    def __post_init__(self):
+        if not (isinstance(self.src, Signal) and self.src.width > self.hi >= self.lo >= 0):
+            raise _refuse("Slice", f"bits {self.hi}..{self.lo} of {self.src!r}; accepted: a "
+                                   f"range inside the signal")
+
+    @property
+    def width(self) -> int:
+        """Bits of the slice."""
+        return self.hi - self.lo + 1
+
+
+@dataclass(frozen=True)
+class Bit:
+    """Bit ``index`` of a signal (one unsigned bit).
+
+    Parameters
+    ----------
+    src : Signal
+        The signal.
+    index : int
+        The bit, ``0 <= index < src.width``.
+    """
+
+    src: Signal
+    index: int
+    width = 1
+    signed = False
+
+    def __post_init__(self):
+        if not (isinstance(self.src, Signal) and 0 <= self.index < self.src.width):
+            raise _refuse("Bit", f"bit {self.index} of {self.src!r}; accepted: a bit of the signal")
+
+
+@dataclass(frozen=True)
+class BitVec(Bit):
+    """Bit ``index`` of a signal as a one-bit vector (VHDL ``s(i downto i)``).
+
+    Parameters
+    ----------
+    src : Signal
+        The signal.
+    index : int
+        The bit, ``0 <= index < src.width``.
+    """
+
+
+@dataclass(frozen=True)
+class Concat:
+    """Unsigned concatenation, most significant part first.
+
+    Parameters
+    ----------
+    parts : tuple
+        The unsigned expressions.
+    """
+
+    parts: tuple
+    signed = False
+
+    def __post_init__(self):
+        for p in self.parts:
+            _check_expr(p, "Concat")
+            if p.signed:
+                raise _refuse("Concat", f"a part of {_kind(p)}; accepted: unsigned parts")
+
+    @property
+    def width(self) -> int:
+        """Sum of the parts' widths."""
+        return sum(p.width for p in self.parts)
+
+
+@dataclass(frozen=True)
+class Not:
+    """Bitwise complement of an unsigned expression.
+
+    Parameters
+    ----------
+    a : expression
+        The operand (unsigned).
+    """
+
+    a: object
+    signed = False
+
+    def __post_init__(self):
+        if _check_expr(self.a, "Not").signed:
+            raise _refuse("Not", f"operand of {_kind(self.a)}; accepted: unsigned")
+
+    @property
+    def width(self) -> int:
+        """The operand's width."""
+        return self.a.width
+
+
+@dataclass(frozen=True)
+class ZeroExt:
+    """An unsigned expression made signed by a zero bit on top (one bit wider).
+
+    Parameters
+    ----------
+    a : expression
+        The unsigned operand.
+    qualified : bool, default False
+        VHDL spelling ``signed'(...)`` (a qualified expression) instead of ``signed(...)``.
+    char : bool, default False
+        VHDL spelling of the zero bit as ``'0'`` instead of ``"0"``.
+    """
+
+    a: object
+    qualified: bool = False
+    char: bool = False
+    signed = True
+
+    def __post_init__(self):
+        if _check_expr(self.a, "ZeroExt").signed:
+            raise _refuse("ZeroExt", f"operand of {_kind(self.a)}; accepted: unsigned")
+
+    @property
+    def width(self) -> int:
+        """One more than the operand's."""
+        return self.a.width + 1
+
+
+@dataclass(frozen=True)
+class Resize:
+    """The operand at ``width`` bits as a Verilog assignment does it:
+    sign-extended (zero-extended when unsigned) or its low bits kept
+    (VHDL: ``wrap``).
+
+    Parameters
+    ----------
+    a : expression
+        The operand.
+    width : int
+        The new width, ``>= 1``.
+    signed : bool or None, default None
+        The result's signedness (None: the operand's); a change reinterprets the bits.
+    """
+
+    a: object
+    width: int
+    signed: bool | None = None
+
+    def __post_init__(self):
+        _check_expr(self.a, "Resize")
+        if self.signed is None:
+            object.__setattr__(self, "signed", self.a.signed)
+        if not isinstance(self.width, int) or self.width < 1:
+            raise _refuse("Resize", f"width {self.width!r}; accepted: an integer >= 1")
+        if self.signed != self.a.signed and self.width != self.a.width:
+            raise _refuse("Resize", "a change of width and signedness at once; accepted: one")
+
+
+@dataclass(frozen=True)
+class Extend:
+    """A signed operand sign-extended to ``width`` bits, never narrower
+    (VHDL: ``resize``).
+
+    Parameters
+    ----------
+    a : expression
+        The signed operand.
+    width : int
+        The new width, ``>= a.width``.
+    """
+
+    a: object
+    width: int
+    signed = True
+
+    def __post_init__(self):
+        _check_expr(self.a, "Extend")
+        if not self.a.signed or self.width < self.a.width:
+            raise _refuse("Extend", f"{_kind(self.a)} to {self.width}; accepted: a signed "
+                                    f"operand, a width at least its own")
+
+
+@dataclass(frozen=True)
+class Shl:
+    """Left shift by ``k`` bits within the operand's width (bits shifted out are lost).
+
+    Parameters
+    ----------
+    a : expression
+        The operand.
+    k : int
+        Bits, ``>= 0``.
+    """
+
+    a: object
+    k: int
+
+    def __post_init__(self):
+        _check_expr(self.a, "Shl")
+        if not isinstance(self.k, int) or self.k < 0:
+            raise _refuse(type(self).__name__, f"shift {self.k!r}; accepted: an integer >= 0")
+
+    @property
+    def width(self) -> int:
+        """The operand's width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """The operand's signedness."""
+        return self.a.signed
+
+
+@dataclass(frozen=True)
+class Shr(Shl):
+    """Right shift by ``k`` bits: arithmetic (floor) for a signed operand.
+
+    Parameters
+    ----------
+    a : expression
+        The operand.
+    k : int
+        Bits, ``>= 0``.
+    """
+
+
+@dataclass(frozen=True)
+class Neg:
+    """Two's complement negation of a signed operand (modulo its width).
+
+    Parameters
+    ----------
+    a : expression
+        The signed operand.
+    """
+
+    a: object
+    signed = True
+
+    def __post_init__(self):
+        if not _check_expr(self.a, "Neg").signed:
+            raise _refuse("Neg", f"operand of {_kind(self.a)}; accepted: signed")
+
+    @property
+    def width(self) -> int:
+        """The operand's width."""
+        return self.a.width
+
+
+@dataclass(frozen=True)
+class Add:
+    """Sum of terms of one signedness at the widest term's width (narrower
+    terms extended, as both languages do), modulo that width.
+
+    Parameters
+    ----------
+    terms : tuple
+        Two or more expressions.
+    """
+
+    terms: tuple
+
+    def __post_init__(self):
+        if len(self.terms) < 2:
+            raise _refuse("Add", f"{len(self.terms)} term(s); accepted: two or more")
+        for t in self.terms:
+            _same_sign("Add", self.terms[0], _check_expr(t, "Add"))
+
+    @property
+    def width(self) -> int:
+        """The widest term's width."""
+        return max(t.width for t in self.terms)
+
+    @property
+    def signed(self) -> bool:
+        """The terms' signedness."""
+        return self.terms[0].signed
+
+
+@dataclass(frozen=True)
+class Sub:
+    """``a - b``, one signedness, at the wider operand's width (modulo it).
+
+    Parameters
+    ----------
+    a, b : expression
+        The operands.
+    """
+
+    a: object
+    b: object
+
+    def __post_init__(self):
+        _same_sign("Sub", _check_expr(self.a, "Sub"), _check_expr(self.b, "Sub"))
+
+    @property
+    def width(self) -> int:
+        """The wider operand's width."""
+        return max(self.a.width, self.b.width)
+
+    @property
+    def signed(self) -> bool:
+        """The operands' signedness."""
+        return self.a.signed
+
+
+@dataclass(frozen=True)
+class Mul:
+    """The exact product of two signed operands, ``a.width + b.width`` bits
+    (wrap it with :class:`Resize` to keep fewer).
+
+    Parameters
+    ----------
+    a, b : expression
+        The signed operands.
+    """
+
+    a: object
+    b: object
+    signed = True
+
+    def __post_init__(self):
+        for e in (self.a, self.b):
+            if not _check_expr(e, "Mul").signed:
+                raise _refuse("Mul", f"operand of {_kind(e)}; accepted: signed operands")
+
+    @property
+    def width(self) -> int:
+        """Sum of the operands' widths."""
+        return self.a.width + self.b.width
+
+
+@dataclass(frozen=True)
+class Gate:
+    """``a`` where bit ``bit`` equals ``on``, else zero (a row of a truncated
+    multiplier: an AND with the bit repeated).
+
+    Parameters
+    ----------
+    a : Signal
+        The gated signal.
+    bit : Bit
+        The control bit.
+    on : bool, default True
+        The bit value that passes ``a``.
+    """
+
+    a: object
+    bit: object
+    on: bool = True
+
+    def __post_init__(self):
+        if not isinstance(self.a, Signal) or not isinstance(self.bit, Bit):
+            raise _refuse("Gate", "accepted: a Signal gated by a Bit")
+
+    @property
+    def width(self) -> int:
+        """The gated signal's width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """The gated signal's signedness."""
+        return self.a.signed
+
+
+@dataclass(frozen=True)
+class And:
+    """Logical AND of two one-bit operands.
+
+    Parameters
+    ----------
+    a, b : expression
+        One-bit unsigned operands.
+    """
+
+    a: object
+    b: object
+    width = 1
+    signed = False
+
+    def __post_init__(self):
+        for e in (self.a, self.b):
+            if _check_expr(e, type(self).__name__).width != 1 or e.signed:
+                raise _refuse(type(self).__name__, f"operand of {_kind(e)}; accepted: one bit")
+
+
+@dataclass(frozen=True)
+class Or(And):
+    """Logical OR of two one-bit operands.
+
+    Parameters
+    ----------
+    a, b : expression
+        One-bit unsigned operands.
+    """
+
+
+@dataclass(frozen=True)
+class ReduceOr:
+    """OR of all the bits of a slice (one bit).
+
+    Parameters
+    ----------
+    a : Slice
+        The bits.
+    """
+
+    a: object
+    width = 1
+    signed = False
+
+    def __post_init__(self):
+        if not isinstance(self.a, Slice):
+            raise _refuse("ReduceOr", "accepted: a Slice")
+
+
+@dataclass(frozen=True)
+class Group:
+    """Parentheses the Verilog text has (and the VHDL text has not): no
+    change of value.
+
+    Parameters
+    ----------
+    a : expression
+        The operand.
+    """
+
+    a: object
+
+    def __post_init__(self):
+        _check_expr(self.a, type(self).__name__)
+
+    @property
+    def width(self) -> int:
+        """The operand's width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """The operand's signedness."""
+        return self.a.signed
+
+
+@dataclass(frozen=True)
+class Paren(Group):
+    """Parentheses in both languages: no change of value.
+
+    Parameters
+    ----------
+    a : expression
+        The operand.
+    """
+
+
+_EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, Neg, Add, Sub,
+         Mul, Gate, And, ReduceOr, Group)
+
+
+# -- statements --------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Assign:
+    """``dst`` declared and driven by ``expr`` (a continuous assignment).
+
+    Parameters
+    ----------
+    dst : Signal
+        The driven signal.
+    expr : expression
+        Its value: the width and signedness of ``dst`` (a :class:`Const`, or a bit
+        vector -- a slice or concatenation of a ``logic`` signal -- may drive a signal of
+        its width of either signedness: VHDL converts it with ``signed()``/``unsigned()``).
+    """
+
+    dst: Signal
+    expr: object
+
+    def __post_init__(self):
+        _check_expr(self.expr, f"Assign {self.dst.name}")
+        signed_ok = (self.expr.signed == self.dst.signed or isinstance(self.expr, Const)
+                     or _is_logic(self.expr))   # a bit vector takes the signal's type
+        if self.expr.width != self.dst.width or not signed_ok:
+            raise _refuse(f"Assign {self.dst.name}",
+                          f"a value of {_kind(self.expr)} to a signal of {_kind(self.dst)}; "
+                          f"accepted: the signal's width and signedness (Resize, ZeroExt or "
+                          f"Slice make a change explicit)")
+
+
+@dataclass(frozen=True)
+class ConstDecl:
+    """A named signed constant (Verilog ``localparam``, VHDL ``constant``).
+
+    Parameters
+    ----------
+    dst : Signal
+        The constant's name and width (signed).
+    value : int
+        Its value.
+    """
+
+    dst: Signal
+    value: int
+
+    def __post_init__(self):
+        Const(self.value, self.dst.width)
+
+
+@dataclass(frozen=True)
+class Rom:
+    """Signed ROM columns read at one address: ``outputs[j] = rows[address][j]``.
+
+    Parameters
+    ----------
+    address : Signal
+        The unsigned address signal (declared by the ROM).
+    address_expr : expression
+        The address's value (unsigned, ``address.width`` bits).
+    outputs : tuple of Signal
+        One signed signal per column.
+    rows : tuple of tuple of int
+        ``2**address.width`` rows, one value per column.
+    """
+
+    address: Signal
+    address_expr: object
+    outputs: tuple
+    rows: tuple
+
+    def __post_init__(self):
+        Assign(self.address, self.address_expr)
+        if len(self.rows) != 2 ** self.address.width:
+            raise _refuse("Rom", f"{len(self.rows)} rows for a {self.address.width}-bit "
+                                 f"address; accepted: {2 ** self.address.width}")
+        for row in self.rows:
+            for q, o in zip(row, self.outputs, strict=True):
+                Const(int(q), o.width)
+
+
+@dataclass(frozen=True)
+class Registers:
+    """A pipeline register stage: each ``dst`` takes its ``src`` at the
+    rising edge of ``clk``.
+
+    Parameters
+    ----------
+    pairs : tuple of (Signal, Signal)
+        ``(register, source)``, one width and signedness each.
+    label : str or None, default None
+        The VHDL process label (None: an unlabelled process).
+    """
+
+    pairs: tuple
+    label: str | None = None
+
+    def __post_init__(self):
+        for dst, src in self.pairs:
+            _same(f"Registers {dst.name}", dst, src)
+
+
+@dataclass(frozen=True)
+class Saturate:
+    """``y = 0`` when ``raw`` is negative, all ones above ``ymax``, else
+    ``raw``'s low ``OUT_BITS`` bits.
+
+    Parameters
+    ----------
+    raw : Signal
+        The signed value.
+    ymax : Signal
+        The signed constant (a :class:`ConstDecl`) of the largest code.
+    """
+
+    raw: Signal
+    ymax: Signal
+
+
+@dataclass(frozen=True)
+class Output:
+    """The output port ``y`` driven by ``expr`` (``OUT_BITS`` wide).
+
+    Parameters
+    ----------
+    expr : expression
+        The value (its bits; the module checks its width).
+    """
+
+    expr: object
+
+    def __post_init__(self):
+        _check_expr(self.expr, "Output")
+
+
+@dataclass(frozen=True)
+class Comment:
+    """A comment line; ``{shr}`` and ``{shl}`` in ``text`` become each
+    language's shift operators.
+
+    Parameters
+    ----------
+    text : str
+        The comment (one line, made safe by the caller).
+    """
+
+    text: str
+
+
+@dataclass
+class Module:
+    """A module: ports ``x`` (``in_bits``) and ``y`` (``out_bits``), ``clk``
+    when ``latency > 0``, a banner and the statements.
+
+    Parameters
+    ----------
+    name : str
+        The module (entity) name.
+    in_bits, out_bits : int
+        Widths of ``x`` and ``y`` (the parameters/generics ``IN_BITS``, ``OUT_BITS``).
+    facts : list of str
+        The banner lines, without comment marker.
+    statements : list
+        The statements, in order.
+    latency : int, default 0
+        Pipeline latency in cycles: > 0 adds ``clk`` and ``LATENCY``.
+    """
+
+    name: str
+    in_bits: int
+    out_bits: int
+    facts: list = field(default_factory=list)
+    statements: list = field(default_factory=list)
+    latency: int = 0
+
+    @property
+    def x(self) -> Signal:
+        """The input port as a signal (a bit vector)."""
+        return Signal("x", self.in_bits, logic=True)
+
+
+# -- the printers: one template per node kind and language -----------------------------
+
+def _vhdl_type(s: Signal) -> str:
+    if s.logic:
+        return "std_logic" if s.width == 1 else f"std_logic_vector({s.width - 1} downto 0)"
+    return f"{'signed' if s.signed else 'unsigned'}({s.width - 1} downto 0)"
+
+
+def _verilog_type(s: Signal, kind: str = "wire") -> str:
+    if s.width == 1 and s.logic:
+        return kind
+    return f"{kind} {'signed ' if s.signed else ''}[{s.width - 1}:0]"
+
+
+def _v_gate(e, p):
+    return f"{p(e.a)} & {{{e.width}{{{'' if e.on else '~'}{p(e.bit)}}}}}"
+
+
+#: Verilog-2005 spelling of each node kind (the printer ``p`` prints the operands)
+_VERILOG = {
+    Signal: lambda e, p: e.name,
+    Const: lambda e, p: signed_literal(e.value, e.width),
+    Slice: lambda e, p: f"{e.src.name}[{e.hi}:{e.lo}]",
+    Bit: lambda e, p: f"{e.src.name}[{e.index}]",
+    BitVec: lambda e, p: f"{e.src.name}[{e.index}]",
+    Concat: lambda e, p: (p(e.parts[0]) if len(e.parts) == 1
+                          else "{" + ", ".join(p(x) for x in e.parts) + "}"),
+    Not: lambda e, p: f"~{p(e.a)}",
+    ZeroExt: lambda e, p: f"$signed({{1'b0, {p(e.a)}}})",
+    Resize: lambda e, p: p(e.a),
+    Extend: lambda e, p: p(e.a),
+    Shl: lambda e, p: f"{p(e.a)} <<< {e.k}",
+    Shr: lambda e, p: f"{p(e.a)} >>> {e.k}",
+    Neg: lambda e, p: f"-{p(e.a)}",
+    Add: lambda e, p: " + ".join(p(t) for t in e.terms),
+    Sub: lambda e, p: f"{p(e.a)} - {p(e.b)}",
+    Mul: lambda e, p: f"{p(e.a)} * {p(e.b)}",
+    Gate: _v_gate,
+    And: lambda e, p: f"{p(e.a)} & {p(e.b)}",
+    Or: lambda e, p: f"{p(e.a)} | {p(e.b)}",
+    ReduceOr: lambda e, p: f"|{p(e.a)}",
+    Group: lambda e, p: f"({p(e.a)})",
+    Paren: lambda e, p: f"({p(e.a)})",
+}
+
+
+def _vh_zeroext(e, p):
+    zero = "'0'" if e.char else '"0"'
+    return f"signed{chr(39) if e.qualified else ''}({zero} & {p(e.a)})"
+
+
+#: VHDL-2008 (``ieee.numeric_std``) spelling of each node kind
+_VHDL = {
+    Signal: lambda e, p: e.name,
+    Const: lambda e, p: vhdl_bits(e.value, e.width),
+    Slice: lambda e, p: f"{e.src.name}({e.hi} downto {e.lo})",
+    Bit: lambda e, p: f"{e.src.name}({e.index})",
+    BitVec: lambda e, p: f"{e.src.name}({e.index} downto {e.index})",
+    Concat: lambda e, p: " & ".join(p(x) for x in e.parts),
+    Not: lambda e, p: f"not {p(e.a)}",
+    ZeroExt: _vh_zeroext,
+    Resize: lambda e, p: f"wrap({p(e.a)}, {e.width})",
+    Extend: lambda e, p: f"resize({p(e.a)}, {e.width})",
+    Shl: lambda e, p: f"shift_left({p(e.a)}, {e.k})",
+    Shr: lambda e, p: f"shift_right({p(e.a)}, {e.k})",
+    Neg: lambda e, p: f"-{p(e.a)}",
+    Add: lambda e, p: " + ".join(p(t) for t in e.terms),
+    Sub: lambda e, p: f"{p(e.a)} - {p(e.b)}",
+    Mul: lambda e, p: f"{p(e.a)} * {p(e.b)}",
+    Gate: lambda e, p: f"{p(e.a)} when {p(e.bit)} = '{1 if e.on else 0}' else (others => '0')",
+    And: lambda e, p: f"{p(e.a)} and {p(e.b)}",
+    Or: lambda e, p: f"{p(e.a)} or {p(e.b)}",
+    ReduceOr: lambda e, p: f"or {p(e.a)}",
+    Group: lambda e, p: p(e.a),
+    Paren: lambda e, p: f"({p(e.a)})",
+}
+
+_TABLES = {"verilog": _VERILOG, "vhdl": _VHDL}
+_SHIFTS = {"verilog": {"shr": ">>>", "shl": "<<<"}, "vhdl": {"shr": ">>", "shl": "<<"}}
+_COMMENT = {"verilog": "//", "vhdl": "--"}
+
+
+def _comment(text: str, language: str) -> str:
+    for token, op in _SHIFTS[language].items():
+        text = text.replace("{" + token + "}", op)
+    return text
+
+
+def _expr(e, language: str) -> str:
+    table = _TABLES[language]
+
+    def p(node):
+        return table[type(node)](node, p)
+    return p(e)
+
+
+def _is_logic(e) -> bool:
+    """True when ``e`` is a VHDL bit vector (std_logic_vector) rather than a number."""
+    if isinstance(e, Signal):
+        return e.logic
+    if isinstance(e, (Slice, BitVec)):
+        return e.src.logic
+    return isinstance(e, (Concat, Not))
+
+
+def _vhdl_value(dst: Signal, e) -> str:
+    """``e`` converted to ``dst``'s VHDL type where the types differ."""
+    text = _expr(e, "vhdl")
+    if _is_logic(e) and not dst.logic:
+        return f"{'signed' if dst.signed else 'unsigned'}({text})"
+    return text
+
+
+def _verilog_context(e) -> None:
+    """Refuse a widening :class:`Resize` of a value Verilog would compute at the
+    wider width (a sum, a difference, a negation, a left shift): VHDL computes it
+    at the operands' width, the texts would differ in value."""
+    for name in ("a", "b"):
+        if hasattr(e, name) and isinstance(getattr(e, name), _EXPR):
+            _verilog_context(getattr(e, name))
+    for t in getattr(e, "terms", ()) or getattr(e, "parts", ()):
+        _verilog_context(t)
+    if isinstance(e, Resize) and e.width > e.a.width and isinstance(e.a, (Add, Sub, Neg, Shl)):
+        raise _refuse("Resize", f"{type(e.a).__name__} of {_kind(e.a)} widened to {e.width} "
+                                f"bits; accepted: widen the operands (Verilog computes it at "
+                                f"the wider width)")
+
+
+def _verilog_statement(s) -> list[str]:
+    if isinstance(s, Assign):
+        _verilog_context(s.expr)
+        return [f"    {_verilog_type(s.dst)} {s.dst.name} = {_expr(s.expr, 'verilog')};"]
+    if isinstance(s, ConstDecl):
+        return [f"    localparam signed [{s.dst.width - 1}:0] {s.dst.name} = "
+                f"{signed_literal(s.value, s.dst.width)};"]
+    if isinstance(s, Comment):
+        return [f"    // {_comment(s.text, 'verilog')}"]
+    if isinstance(s, Output):
+        return [f"    assign y = {_expr(s.expr, 'verilog')};"]
+    if isinstance(s, Saturate):
+        r, top = s.raw.name, s.raw.width - 1
+        return [f"    assign y = {r}[{top}] ? {{OUT_BITS{{1'b0}}}} : ({r} > {s.ymax.name}) ? "
+                f"{{OUT_BITS{{1'b1}}}} : {r}[OUT_BITS-1:0];"]
+    if isinstance(s, Registers):
+        out = [f"    {_verilog_type(d, 'reg')} {d.name};" for d, _ in s.pairs]
+        return out + ["    always @(posedge clk) begin",
+                      *(f"        {d.name} <= {src.name};" for d, src in s.pairs), "    end"]
+    if isinstance(s, Rom):
+        a = s.address
+        out = [f"    {_verilog_type(o, 'reg')} {o.name};" for o in s.outputs]
+        out += [f"    {_verilog_type(a)} {a.name} = {_expr(s.address_expr, 'verilog')};",
+                "    always @(*) begin", f"        case ({a.name})"]
+        for i, row in enumerate(s.rows):
+            body = " ".join(f"{o.name} = {signed_literal(int(q), o.width)};"
+                            for o, q in zip(s.outputs, row))
+            out.append(f"            {a.width}'d{i}: begin {body} end")
+        return out + ["        endcase", "    end"]
+    raise TypeError(f"statement {type(s).__name__}: not a netlist statement")
+
+
+def _vhdl_statement(s) -> tuple[list[str], list[str]]:
+    if isinstance(s, Assign):
+        return ([f"    signal {s.dst.name} : {_vhdl_type(s.dst)};"],
+                [f"    {s.dst.name} <= {_vhdl_value(s.dst, s.expr)};"])
+    if isinstance(s, ConstDecl):
+        w = s.dst.width
+        return ([f"    constant {s.dst.name} : signed({w - 1} downto 0) := "
+                 f"{vhdl_bits(s.value, w)};  -- {s.value}"], [])
+    if isinstance(s, Comment):
+        return [], [f"    -- {_comment(s.text, 'vhdl')}"]
+    if isinstance(s, Output):
+        return [], [f"    y <= std_logic_vector({_expr(s.expr, 'vhdl')});"]
+    if isinstance(s, Saturate):
+        r = s.raw.name
+        return [], [f"    y <= (others => '0') when {r}({s.raw.width - 1}) = '1' else",
+                    f"         (others => '1') when {r} > {s.ymax.name} else",
+                    f"         std_logic_vector({r}(OUT_BITS - 1 downto 0));"]
+    if isinstance(s, Registers):
+        decl = [f"    signal {d.name} : {_vhdl_type(d)};" for d, _ in s.pairs]
+        head = f"    {s.label} : process (clk)" if s.label else "    process (clk)"
+        tail = f"    end process {s.label};" if s.label else "    end process;"
+        return decl, [head, "    begin", "        if rising_edge(clk) then",
+                      *(f"            {d.name} <= {src.name};" for d, src in s.pairs),
+                      "        end if;", tail]
+    if isinstance(s, Rom):
+        a = s.address
+        decl, stmt = _vhdl_statement(Assign(a, s.address_expr))
+        for j, o in enumerate(s.outputs):
+            w, last = o.width, len(s.rows) - 1
+            decl.append(f"    type rom{j}_t is array (0 to {last}) of signed({w - 1} downto 0);")
+            rows = [f"        {vhdl_bits(int(row[j]), w)}{',' if i < last else ''}"
+                    f"  -- segment {i}: {row[j]}" for i, row in enumerate(s.rows)]
+            decl += [f"    constant ROM{j} : rom{j}_t := (", *rows, "    );",
+                     f"    signal {o.name} : {_vhdl_type(o)};"]
+            index = a.name if not a.signed and not a.logic else f"unsigned({a.name})"
+            stmt.append(f"    {o.name} <= ROM{j}(to_integer({index}));")
+        return decl, stmt
+    raise TypeError(f"statement {type(s).__name__}: not a netlist statement")
+
+
+def statement_lines(statement, language: str) -> tuple[list[str], list[str]]:
+    """The text of one statement: declarations and body lines (Verilog
+    declares in place: its declaration list is empty).
+
+    Parameters
+    ----------
+    statement : Assign, ConstDecl, Rom, Registers, Saturate or Comment
+        The statement.
+    language : {"verilog", "vhdl"}
+        The HDL.
+
+    Returns
+    -------
+    tuple of (list of str, list of str)
+        Declaration lines (VHDL architecture head) and body lines, indented.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown.
+    """
+    if language == "verilog":
+        return [], _verilog_statement(statement)
+    if language == "vhdl":
+        return _vhdl_statement(statement)
+    raise ValueError(f"language {language!r}: accepted: 'verilog' or 'vhdl'")
+
+
+#: the VHDL function every width change of the IR (:class:`Resize`) prints as
+VHDL_WRAP = [
+    "    -- a Verilog assignment: sign-extend to n bits, or keep the low n bits",
+    "    function wrap(a : signed; n : positive) return signed is",
+    "        variable v : signed(a'length - 1 downto 0) := a;",
+    "        variable r : signed(n - 1 downto 0);",
+    "    begin",
+    "        if n <= a'length then",
+    "            r := v(n - 1 downto 0);",
+    "        else",
+    "            r := resize(v, n);",
+    "        end if;",
+    "        return r;",
+    "    end function;",
+]
+
+
+def verilog(module: Module) -> str:
+    """The Verilog-2005 text of ``module``: banner, port list, statements.
+
+    Parameters
+    ----------
+    module : Module
+        The netlist.
+
+    Returns
+    -------
+    str
+        The module text, ending with ``endmodule`` and a newline.
+    """
+    m = module
+    clocked = m.latency > 0
+    out = comment_lines(m.facts, "verilog")
+    out += [f"module {m.name} #(",
+            f"    parameter IN_BITS = {m.in_bits},",
+            f"    parameter OUT_BITS = {m.out_bits}" + ("," if clocked else ""),
+            *([f"    parameter LATENCY = {m.latency}"] if clocked else []),
+            ") (",
+            *(["    input  wire                clk,"] if clocked else []),
+            "    input  wire [IN_BITS-1:0]  x,",
+            "    output wire [OUT_BITS-1:0] y",
+            ");"]
+    for s in m.statements:
+        out += _verilog_statement(s)
+    return "\n".join(out + ["endmodule", ""])
+
+
+def vhdl_entity(name: str, in_bits: int, out_bits: int, latency: int = 0) -> list[str]:
+    """The library clauses and the entity of a module with ports ``x``, ``y``
+    (and ``clk`` with generic ``LATENCY`` when ``latency > 0``).
+
+    Parameters
+    ----------
+    name : str
+        The entity name (a VHDL identifier, checked by the caller).
+    in_bits, out_bits : int
+        The generics' defaults.
+    latency : int, default 0
+        The pipeline latency (> 0: clocked).
+
+    Returns
+    -------
+    list of str
+        The lines, ending with an empty one.
+    """
+    clocked = latency > 0
+    generics = [f"        IN_BITS  : natural := {in_bits};",
+                f"        OUT_BITS : natural := {out_bits}" + (";" if clocked else "")]
+    if clocked:
+        generics.append(f"        LATENCY  : natural := {latency}")
+    ports = (["        clk : in  std_logic;"] if clocked else []) + [
+        "        x   : in  std_logic_vector(IN_BITS - 1 downto 0);",
+        "        y   : out std_logic_vector(OUT_BITS - 1 downto 0)"]
+    return ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
+            f"entity {name} is", "    generic (", *generics, "    );", "    port (", *ports,
+            "    );", f"end entity {name};", ""]
+
+
+def vhdl(module: Module) -> str:
+    """The VHDL-2008 text of ``module``: banner, entity, architecture
+    (``wrap``, the declarations, the statements).
+
+    Parameters
+    ----------
+    module : Module
+        The netlist.
+
+    Returns
+    -------
+    str
+        The entity and architecture text, ending with a newline.
+    """
+    m = module
+    out = comment_lines(m.facts, "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
+    decl, stmt = [], []
+    for s in m.statements:
+        d, b = _vhdl_statement(s)
+        decl += d
+        stmt += b
+    out += [f"architecture rtl of {m.name} is", *VHDL_WRAP, *decl, "begin", *stmt,
+            "end architecture rtl;", ""]
+    return "\n".join(out)
+
+
+# -- the independent evaluation ---------------------------------------------------------
+
+def _wrap(v: int, width: int, signed: bool) -> int:
+    v &= (1 << width) - 1
+    return v - (1 << width) if signed and v >> (width - 1) else v
+
+
+def _value(e, env: dict) -> int:
+    """The value of ``e`` (an integer in its width and signedness)."""
+    t = type(e)
+    if t is Signal:
+        return env[e.name]
+    if t is Const:
+        return e.value
+    if t in (Group, Paren):
+        return _value(e.a, env)
+    if t is Slice:
+        return (env[e.src.name] >> e.lo) & ((1 << e.width) - 1)
+    if t in (Bit, BitVec):
+        return (env[e.src.name] >> e.index) & 1
+    if t is Concat:
+        v = 0
+        for part in e.parts:
+            v = (v << part.width) | (_value(part, env) & ((1 << part.width) - 1))
+        return v
+    if t is Not:
+        return ~_value(e.a, env) & ((1 << e.width) - 1)
+    if t is ZeroExt:
+        return _value(e.a, env) & ((1 << e.a.width) - 1)
+    if t in (Resize, Extend):
+        return _wrap(_value(e.a, env), e.width, e.signed)
+    if t is Shl:
+        return _wrap(_value(e.a, env) << e.k, e.width, e.signed)
+    if t is Shr:
+        return _value(e.a, env) >> e.k   # floor: arithmetic for signed, logical for unsigned
+    if t is Neg:
+        return _wrap(-_value(e.a, env), e.width, True)
+    if t is Add:
+        return _wrap(sum(_value(x, env) for x in e.terms), e.width, e.signed)
+    if t is Sub:
+        return _wrap(_value(e.a, env) - _value(e.b, env), e.width, e.signed)
+    if t is Mul:
+        return _value(e.a, env) * _value(e.b, env)
+    if t is Gate:
+        return _value(e.a, env) if _value(e.bit, env) == int(e.on) else 0
+    if t is And:
+        return _value(e.a, env) & _value(e.b, env)
+    if t is Or:
+        return _value(e.a, env) | _value(e.b, env)
+    if t is ReduceOr:
+        return int(_value(e.a, env) != 0)
+    raise TypeError(f"{t.__name__}: not an expression node")
+
+
+def evaluate(module: Module, code: int) -> dict:
+    """Every signal of a combinational ``module`` for input code ``code``, in
+    Python: the meaning the printers' texts must have (registers pass their
+    source through, as the steady state of a pipeline).
+
+    Parameters
+    ----------
+    module : Module
+        The netlist.
+    code : int
+        The input code, ``0 <= code < 2**in_bits``.
+
+    Returns
+    -------
+    dict
+        Signal name -> value (signed signals as negative integers where negative);
+        ``"y"``: the output code.
+
+    Raises
+    ------
+    ValueError
+        If ``code`` is out of range.
+    """
+    if not 0 <= code < 2 ** module.in_bits:
+        raise ValueError(f"code {code}: accepted 0..{2 ** module.in_bits - 1}")
+    env = {"x": code}
+    for s in module.statements:
+        if isinstance(s, Assign):
+            env[s.dst.name] = _wrap(_value(s.expr, env), s.dst.width, s.dst.signed)
+        elif isinstance(s, ConstDecl):
+            env[s.dst.name] = s.value
+        elif isinstance(s, Rom):
+            env[s.address.name] = _value(s.address_expr, env)
+            for o, q in zip(s.outputs, s.rows[env[s.address.name]]):
+                env[o.name] = int(q)
+        elif isinstance(s, Registers):
+            for d, src in s.pairs:
+                env[d.name] = env[src.name]
+        elif isinstance(s, Output):
+            env["y"] = _value(s.expr, env) & (2 ** module.out_bits - 1)
+        elif isinstance(s, Saturate):
+            raw, ymax = env[s.raw.name], env[s.ymax.name]
+            env["y"] = 0 if raw < 0 else (2 ** module.out_bits - 1 if raw > ymax
+                                          else raw & (2 ** module.out_bits - 1))
+    return env
