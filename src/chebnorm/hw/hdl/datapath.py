@@ -20,12 +20,14 @@ True
 
 from __future__ import annotations
 
-from .common import module_name, piecewise_facts
-from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, ConstDecl, Extend, Gate,
-                      Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Registers, Resize, Rom,
-                      Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
+from .common import (horner_facts, module_name, piecewise_facts, pipelined_name, shifted_width,
+                     step_comment, variable_name)
+from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Extend,
+                      Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Registers, Resize,
+                      Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
 
-__all__ = ["round_to", "output_stage", "sized_piecewise_netlist"]
+__all__ = ["round_to", "output_stage", "piecewise_netlist", "sized_piecewise_netlist",
+           "horner_netlist"]
 
 
 def _sig(name: str, width: int) -> Signal:
@@ -119,6 +121,72 @@ def output_stage(top: Signal, top_frac: int, y_format, out_bits: int, rounding: 
                   Assign(raw, Sub(r, ky)), Saturate(raw, ymax)]
 
 
+def _rom(d, m: Module, cols: list, rows) -> list:
+    """The coefficient ROM: ``c_j`` of the segment the top bits of ``x`` index
+    (one segment: the constants themselves)."""
+    L, K = d.local_bits, d.index_bits
+    if K == 0:  # one segment: constants (a case on no input would never run)
+        return [Assign(c, _const(rows[0][j], c.width)) for j, c in enumerate(cols)]
+    return [Rom(Signal("idx", K), Slice(m.x, d.in_bits - 1, L), tuple(cols),
+                tuple(tuple(int(q) for q in row) for row in rows))]
+
+
+def piecewise_netlist(d, *, version: str = "", command: str | None = None) -> Module:
+    """The netlist of a (one-width) piecewise design ``d``: the coefficient
+    ROM indexed by the top bits of ``x`` and one Horner datapath in the local
+    variable ``t``, rounding after each multiply-add, the saturating output.
+
+    Parameters
+    ----------
+    d : PiecewiseDesign
+        The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`), not sized.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe).
+
+    Returns
+    -------
+    Module
+        The combinational netlist.
+    """
+    t = d.table
+    n, L, fc = t.degree, d.local_bits, t.coef_frac_bits
+    m = Module(module_name(d), d.in_bits, d.out_bits,
+               facts=piecewise_facts(d, version=version, command=command))
+    out = m.statements
+    low = Signal("low", L, logic=True)
+    tv = _sig("t", d.t_bits)
+    code = ZeroExt(low, zeros=2)
+    out += [Assign(low, Slice(m.x, L - 1, 0)),
+            Assign(tv, Sub(code, Const(1 << (L - 1), tv.width)) if t.centered else code)]
+    cols = [_sig(f"c{j}", d.rom_bits[j]) for j in range(n + 1)]
+    out += _rom(d, m, cols, [seg.integers for seg in t.segments])
+    prev, prev_frac = cols[n], fc
+    for i, j in enumerate(range(n - 1, -1, -1)):
+        pw, sw, ow = d.widths[i]
+        pf = prev_frac + L
+        sf = max(pf, fc)
+        p, s = _sig(f"p{j}", pw), _sig(f"s{j}", sw)
+        out += [Comment(f"step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits"),
+                Assign(p, Resize(Mul(prev, tv), pw))]
+        # the sum taken mod 2^sw: the same bits as in Verilog's wider context
+        terms = tuple(Group(Shl(Resize(v, sw), sh) if sh else Resize(v, sw))
+                      for v, sh in ((p, sf - pf), (cols[j], sf - fc)))
+        out.append(Assign(s, Add(terms)))
+        if j > 0:
+            f_out = min(d.acc_frac_bits, sf)
+            if sf > f_out:
+                out += round_to(s, f"a{j}", sf - f_out, ow, d.rounding)
+            else:
+                out.append(Assign(_sig(f"a{j}", ow), Resize(s, ow)))
+            prev, prev_frac = _sig(f"a{j}", ow), f_out
+        else:
+            prev, prev_frac = s, sf
+    out += output_stage(prev, prev_frac, d.y_format, d.out_bits, d.rounding)
+    return m
+
+
 def _truncated_rows(st: dict, a: Signal, low: Signal) -> list:
     """The truncated multiplier ``q_j`` of a sized step: one row per bit of
     ``t_j``'s code, ``a`` floored at column ``P`` (an arithmetic shift), gated by
@@ -165,7 +233,7 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
         The netlist (latency ``d.latency``).
     """
     t = d.table
-    n, L, K = t.degree, d.local_bits, d.index_bits
+    n, L = t.degree, d.local_bits
     m = Module(module_name(d), d.in_bits, d.out_bits,
                facts=piecewise_facts(d, version=version, command=command), latency=d.latency)
     out = m.statements
@@ -173,11 +241,7 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
     low = Signal("low", L, logic=True)
     out.append(Assign(low, Slice(x, L - 1, 0)))
     cols = [_sig(f"c{j}", d.rom_bits[j]) for j in range(n + 1)]
-    if K == 0:
-        out += [Assign(c, _const(d.coefficients[0][j], c.width)) for j, c in enumerate(cols)]
-    else:
-        out.append(Rom(Signal("idx", K), Slice(x, d.in_bits - 1, L), tuple(cols),
-                       tuple(tuple(int(q) for q in row) for row in d.coefficients)))
+    out += _rom(d, m, cols, d.coefficients)
     # live signals, in order: name -> the signal that carries it now; registered at each cut
     cur = {"low": low, **{c.name: c for c in cols}}
     acc = f"c{n}"
@@ -251,5 +315,125 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
 
 
 def _const(value, width):
-    from .netlist import Const
     return Const(int(value), width)
+
+
+def _variable(design, xs: Signal, v: str) -> list:
+    """The Horner variable of a one-parity design, ``v = R(xs * xs)``, or of a
+    shifted one, ``v = (xs << m) - C``; nothing for plain Horner in ``x``."""
+    if design.scheme == "monomial":
+        return []
+    vw = design.variable_bits
+    if design.scheme == "shifted":
+        sw, m = shifted_width(design), design.v_shift
+        c, d = _sig(f"{v}_C", sw), _sig(f"{v}_d", sw)
+        wide = Group(Shl(Resize(xs, sw), m)) if m else Resize(xs, sw)
+        return [Comment(f"{v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
+                        f"{design.v_offset} / 2^{design.x_format.frac_bits + m}"),
+                ConstDecl(c, design.v_offset), Assign(d, Sub(wide, c)),
+                Assign(_sig(v, vw), Resize(d, vw))]
+    rs = design.v_round_shift
+    sq = _sig(f"{v}_sq", 2 * design.xs_bits)
+    out = [Comment(f"{v}: x*x with {design.variable_frac_bits} fractional bits "
+                   f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} "
+                   f"powers in it"),
+           Assign(sq, Mul(xs, xs))]
+    if rs:
+        return out + round_to(sq, v, rs, vw, design.rounding)
+    return out + [Assign(_sig(v, vw), Resize(sq, vw))]
+
+
+def _horner_step(design, st, prev: Signal, xs: Signal) -> list:
+    """One Horner step ``a_j = R(a_{j+1} * x + q_j)`` (``prev``: a_{j+1})."""
+    j = st.power
+    p, c, t = _sig(f"p{j}", st.product_bits), _sig(f"C{j}", st.sum_bits), _sig(f"t{j}", st.sum_bits)
+    wide = Resize(p, st.sum_bits)
+    out = [Comment(f"step {j}: {step_comment(design, st)} with {st.sum_frac_bits} -> "
+                   f"{st.out_frac_bits} fractional bits"),
+           Assign(p, Resize(Mul(prev, xs), p.width)), ConstDecl(c, st.coef_shifted),
+           Assign(t, Add((Group(Shl(wide, st.product_shift) if st.product_shift else wide), c)))]
+    if j > 0:
+        out += round_to(t, f"a{j}", st.round_shift, st.out_bits, design.rounding)
+    return out
+
+
+def horner_netlist(design, *, pipelined: bool = False, language: str | None = None,
+                   version: str = "", command: str | None = None, budget=None) -> Module:
+    """The netlist of a Horner evaluator
+    (:class:`~chebnorm.hw.horner.HornerDesign`): the input code offset to
+    ``x``'s value, the Horner variable (``x``, ``x*x`` or ``(x - c')/s``), one
+    multiply-add-round per step, the saturating output; with ``pipelined`` a
+    register stage after each step (``x`` and ``v`` travel beside the
+    accumulator) and one on the last sum, latency ``design.steps``.
+
+    Parameters
+    ----------
+    design : HornerDesign
+        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    pipelined : bool, default False
+        The pipelined variant ``chebnorm_NAME_pipe`` (degree >= 1).
+    language : {"verilog", "vhdl"} or None, default None
+        The banner's language (it names parameters or generics); None: both.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe).
+    budget : ErrorBudget or None, default None
+        The certified budget stated in the banner; None: not stated.
+
+    Returns
+    -------
+    Module
+        The netlist.
+
+    Raises
+    ------
+    ValueError
+        If ``pipelined`` is asked for a degree-0 design.
+    """
+    if pipelined and design.degree < 1:
+        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
+                         f"degree >= 1")
+    facts = {lang: horner_facts(design, lang, version=version, command=command, budget=budget,
+                                pipelined=pipelined)
+             for lang in ((language,) if language else ("verilog", "vhdl"))}
+    m = Module(pipelined_name(design) if pipelined else module_name(design), design.in_bits,
+               design.out_bits, facts=facts, latency=design.steps if pipelined else 0)
+    out = m.statements
+    xf, xw = design.x_format, design.xs_bits
+    k0 = _sig("K0", xw)
+    xs = _sig("xs0" if pipelined else "xs", xw)
+    if not pipelined:
+        out.append(Comment(f"x value times 2^{xf.frac_bits}"))
+    out += [ConstDecl(k0, xf.offset_code),
+            Assign(xs, Add((Resize(ZeroExt(m.x, char=True), xw), k0)))]
+    out += _variable(design, xs, "v0" if pipelined else "v")
+    n = len(design.horner_integers) - 1
+    if n == 0:
+        top = _sig("top", max(design.top_bits, 2))
+        out.append(Assign(top, Const(int(design.integers[0]), top.width)))
+        top_frac = design.coef_frac_bits
+    else:
+        aw = max(design.stages[0].acc_bits, 2)
+        prev = _sig(f"A{n}", aw)
+        out.append(ConstDecl(prev, design.horner_integers[n]))
+        var = {"xs": xs, "v": _sig("v0" if pipelined else "v", design.variable_bits)}
+        for s, st in enumerate(design.stages):
+            j = st.power
+            out += _horner_step(design, st, prev, var[variable_name(design, st)])
+            if j > 0:
+                prev = _sig(f"a{j}", st.out_bits)
+                if pipelined:
+                    pairs = [(_sig(f"a{j}_r", st.out_bits), prev),
+                             (_sig(f"xs{s + 1}", xw), var["xs"])]
+                    if design.scheme != "monomial":
+                        pairs.append((_sig(f"v{s + 1}", design.variable_bits), var["v"]))
+                    out.append(Registers(tuple(pairs)))
+                    prev, var = pairs[0][0], {"xs": pairs[1][0], "v": pairs[-1][0]}
+        last = design.stages[-1]
+        top, top_frac = _sig("top", last.sum_bits), last.sum_frac_bits
+        t0 = _sig("t0", last.sum_bits)
+        out.append(Registers(((top, t0),)) if pipelined else Assign(top, t0))
+    out += output_stage(top, top_frac, design.y_format, design.out_bits, design.rounding,
+                        min_bits=design.raw_bits)
+    return m

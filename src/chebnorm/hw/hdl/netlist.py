@@ -292,7 +292,7 @@ class Not:
 
 @dataclass(frozen=True)
 class ZeroExt:
-    """An unsigned expression made signed by a zero bit on top (one bit wider).
+    """An unsigned expression made signed by zero bits on top (one by default).
 
     Parameters
     ----------
@@ -302,21 +302,26 @@ class ZeroExt:
         VHDL spelling ``signed'(...)`` (a qualified expression) instead of ``signed(...)``.
     char : bool, default False
         VHDL spelling of the zero bit as ``'0'`` instead of ``"0"``.
+    zeros : {1, 2}, default 1
+        The zero bits put on top.
     """
 
     a: object
     qualified: bool = False
     char: bool = False
+    zeros: int = 1
     signed = True
 
     def __post_init__(self):
         if _check_expr(self.a, "ZeroExt").signed:
             raise _refuse("ZeroExt", f"operand of {_kind(self.a)}; accepted: unsigned")
+        if self.zeros not in (1, 2) or (self.char and self.zeros != 1):
+            raise _refuse("ZeroExt", f"zeros {self.zeros!r}; accepted: 1 or 2 (1 with char)")
 
     @property
     def width(self) -> int:
-        """One more than the operand's."""
-        return self.a.width + 1
+        """The operand's width plus the zero bits."""
+        return self.a.width + self.zeros
 
 
 @dataclass(frozen=True)
@@ -809,8 +814,8 @@ class Module:
         The module (entity) name.
     in_bits, out_bits : int
         Widths of ``x`` and ``y`` (the parameters/generics ``IN_BITS``, ``OUT_BITS``).
-    facts : list of str
-        The banner lines, without comment marker.
+    facts : list of str or dict
+        The banner lines, without comment marker; or language -> its banner lines.
     statements : list
         The statements, in order.
     latency : int, default 0
@@ -858,7 +863,7 @@ _VERILOG = {
     Concat: lambda e, p: (p(e.parts[0]) if len(e.parts) == 1
                           else "{" + ", ".join(p(x) for x in e.parts) + "}"),
     Not: lambda e, p: f"~{p(e.a)}",
-    ZeroExt: lambda e, p: f"$signed({{1'b0, {p(e.a)}}})",
+    ZeroExt: lambda e, p: f"$signed({{{e.zeros}'b{'0' * e.zeros}, {p(e.a)}}})",
     Resize: lambda e, p: p(e.a),
     Extend: lambda e, p: p(e.a),
     Shl: lambda e, p: f"{p(e.a)} <<< {e.k}",
@@ -877,7 +882,7 @@ _VERILOG = {
 
 
 def _vh_zeroext(e, p):
-    zero = "'0'" if e.char else '"0"'
+    zero = "'0'" if e.char else '"' + "0" * e.zeros + '"'
     return f"signed{chr(39) if e.qualified else ''}({zero} & {p(e.a)})"
 
 
@@ -1075,6 +1080,10 @@ VHDL_WRAP = [
 ]
 
 
+def _facts(m: Module, language: str) -> list[str]:
+    return m.facts[language] if isinstance(m.facts, dict) else m.facts
+
+
 def verilog(module: Module) -> str:
     """The Verilog-2005 text of ``module``: banner, port list, statements.
 
@@ -1090,7 +1099,7 @@ def verilog(module: Module) -> str:
     """
     m = module
     clocked = m.latency > 0
-    out = comment_lines(m.facts, "verilog")
+    out = comment_lines(_facts(m, "verilog"), "verilog")
     out += [f"module {m.name} #(",
             f"    parameter IN_BITS = {m.in_bits},",
             f"    parameter OUT_BITS = {m.out_bits}" + ("," if clocked else ""),
@@ -1151,7 +1160,7 @@ def vhdl(module: Module) -> str:
         The entity and architecture text, ending with a newline.
     """
     m = module
-    out = comment_lines(m.facts, "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
+    out = comment_lines(_facts(m, "vhdl"), "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
     decl, stmt = [], []
     for s in m.statements:
         d, b = _vhdl_statement(s)

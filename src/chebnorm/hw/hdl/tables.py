@@ -23,6 +23,7 @@ from chebnorm.core.textsafe import comment_text
 from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
+from .netlist import Registers, Signal, statement_lines
 from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
@@ -169,15 +170,20 @@ def _verilog_rom(out: list[str], reg: str, addr: str, abits: int, width: int, va
     out += [f"            default: {reg} = {_hex(0, width)};", "        endcase", "    end"]
 
 
+def _regs(cur: dict, widths: dict, stage: int, language: str, label=None):
+    """Register every signal of ``cur`` (name -> current signal) at ``stage``:
+    the netlist's register stage, printed in ``language``."""
+    pairs = []
+    for key in cur:
+        r = Signal(f"{key}_r{stage}", widths[key])
+        pairs.append((r, Signal(cur[key], widths[key])))
+        cur[key] = r.name
+    return statement_lines(Registers(tuple(pairs), label=label), language)
+
+
 def _verilog_regs(out: list[str], cur: dict, widths: dict, stage: int) -> None:
     """Register every signal of ``cur`` (name -> current wire) at ``stage``."""
-    regs = []
-    for key in cur:
-        r = f"{key}_r{stage}"
-        out.append(f"    reg [{widths[key] - 1}:0] {r};")
-        regs.append(f"        {r} <= {cur[key]};")
-        cur[key] = r
-    out.extend(["    always @(posedge clk) begin", *regs, "    end"])
+    out += _regs(cur, widths, stage, "verilog")[1]
 
 
 def _verilog(design, facts: list[str]) -> str:
@@ -250,15 +256,9 @@ def _vhdl_rom(decl: list[str], stmt: list[str], sig: str, addr: str, width: int,
 
 def _vhdl_regs(decl: list[str], stmt: list[str], cur: dict, widths: dict, stage: int) -> None:
     """Register every signal of ``cur`` (name -> current signal) at ``stage``."""
-    regs = []
-    for key in cur:
-        r = f"{key}_r{stage}"
-        decl.append(f"    signal {r} : unsigned({widths[key] - 1} downto 0);")
-        regs.append(f"            {r} <= {cur[key]};")
-        cur[key] = r
-    stmt.extend([f"    regs{stage} : process (clk)", "    begin",
-                 "        if rising_edge(clk) then", *regs, "        end if;",
-                 f"    end process regs{stage};"])
+    d, b = _regs(cur, widths, stage, "vhdl", label=f"regs{stage}")
+    decl += d
+    stmt += b
 
 
 def _vhdl(design, facts: list[str]) -> str:

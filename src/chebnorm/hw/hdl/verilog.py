@@ -1,8 +1,10 @@
 """Verilog printers: the evaluator of a :class:`~chebnorm.hw.horner.HornerDesign`
 (combinational and pipelined) and of a
-:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), their
-self-checking test benches, and the text fragments they (and the
-normalization units of :mod:`chebnorm.hw.units`) share.
+:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner) -- each the
+netlist of :mod:`chebnorm.hw.hdl.datapath`, printed by
+:func:`chebnorm.hw.hdl.netlist.verilog` --, their self-checking test benches,
+and the text fragments the normalization units of :mod:`chebnorm.hw.units`
+use.
 
 The module follows one port contract::
 
@@ -26,11 +28,11 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
-from .common import (shifted_width, step_comment, variable_name)
-from .datapath import sized_piecewise_netlist
+from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to,
+                       sized_piecewise_netlist)
+from .netlist import Signal, signed_literal, statement_lines
 from .netlist import verilog as _verilog
-from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
-                     vectors_name)
+from .common import module_name, pipelined_name, vectors_name
 
 __all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
            "verilog_module", "verilog_pipelined_module", "verilog_testbench",
@@ -39,40 +41,6 @@ __all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict"
 
 
 # -- fragments -------------------------------------------------------------------
-def signed_literal(value: int, bits: int) -> str:
-    """A sized signed decimal literal ``[-]BITS'sdMAGNITUDE``.
-
-    Raises ValueError when ``value`` does not fit a signed ``bits``-bit word.
-
-    >>> signed_literal(5, 4), signed_literal(-8, 4)
-    ("4'sd5", "-4'sd8")
-    >>> signed_literal(8, 4)
-    Traceback (most recent call last):
-    ...
-    ValueError: constant 8 does not fit a signed 4-bit literal
-
-    Parameters
-    ----------
-    value : int
-        The constant.
-    bits : int
-        The literal's width, ``>= 1``; ``value`` must lie in ``[-2**(bits-1), 2**(bits-1) - 1]``.
-
-    Returns
-    -------
-    str
-        The literal, e.g. ``"4'sd5"`` or ``"-4'sd8"``.
-
-    Raises
-    ------
-    ValueError
-        If ``value`` does not fit a signed ``bits``-bit word.
-    """
-    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
-        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
-    return f"{'-' if value < 0 else ''}{bits}'sd{abs(value)}"
-
-
 def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
                 mode: str) -> list[str]:
     """Lines declaring ``dst = R(src / 2^shift)``: ``mode`` ``"trunc"`` (floor,
@@ -107,18 +75,9 @@ def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
     list of str
         Verilog declaration lines, indented by four spaces.
     """
-    lines = []
-    if mode != "trunc" and shift + 1 > src_bits:   # the round bit lies above src: extend it
-        lines.append(f"    wire signed [{shift}:0] {dst}_x = {src};")
-        src, src_bits = f"{dst}_x", shift + 1
-    lines.append(f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};")
-    if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
-        lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q;")
-        return lines
-    sticky = f"(|{src}[{shift - 2}:0]) | " if shift >= 2 else ""
-    lines.append(f"    wire {dst}_inc = {src}[{shift - 1}] & ({sticky}{dst}_q[0]);")
-    lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q + $signed({{1'b0, {dst}_inc}});")
-    return lines
+    return [line for s in round_to(Signal(src, src_bits, signed=True), dst, shift, dst_bits, mode)
+            for line in statement_lines(s, "verilog")[1]]
+
 
 
 def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat, out_bits: int,
@@ -162,22 +121,10 @@ def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat,
         If the offset code or ``max_code`` does not fit the working width (not expected: the
         width is chosen to hold them).
     """
-    shift = top_frac - y_format.frac_bits
-    rw = max(min_bits, top_bits + max(0, -shift) + 1, out_bits + 2,
-             y_format.offset_code.bit_length() + 2)
-    if shift > 0:
-        out = round_lines(top, "r", top_bits, shift, rw, rounding)
-    elif shift == 0:
-        out = [f"    wire signed [{rw - 1}:0] r = {top};"]
-    else:
-        out = [f"    wire signed [{rw - 1}:0] r = {top} <<< {-shift};"]
-    out += [f"    localparam signed [{rw - 1}:0] KY = {signed_literal(y_format.offset_code, rw)};",
-            f"    localparam signed [{rw - 1}:0] YMAX = {signed_literal(y_format.max_code, rw)};",
-            f"    wire signed [{rw - 1}:0] raw = r - KY;",
-            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
-            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
-            "endmodule", ""]
-    return out
+    stage = output_stage(Signal(top, top_bits, signed=True), top_frac, y_format, out_bits,
+                         rounding, min_bits=min_bits)[1:]   # no comment line
+    return [line for s in stage for line in statement_lines(s, "verilog")[1]] + ["endmodule", ""]
+
 
 
 def bench_verdict(name: str) -> list[str]:
@@ -246,91 +193,10 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
     >>> [line for line in v.splitlines() if line.startswith(("module", "    input", "    output"))]
     ['module chebnorm_dichotomy_d1 #(', '    input  wire [IN_BITS-1:0]  x,', '    output wire [OUT_BITS-1:0] y']
     """
-    xf, yf = design.x_format, design.y_format
-    n = design.degree
-    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
-                                     budget=budget), "verilog")
-    out += [f"module {module_name(design)} #(",
-            f"    parameter IN_BITS = {design.in_bits},",
-            f"    parameter OUT_BITS = {design.out_bits}",
-            ") (",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");"]
-    xw = design.xs_bits
-    out += [f"    // x value times 2^{xf.frac_bits}",
-            f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
-            f"    wire signed [{xw - 1}:0] xs = $signed({{1'b0, x}}) + K0;"]
-    out += _variable_lines(design, "xs", "v")
-    n = len(design.horner_integers) - 1
-    if n == 0:
-        top_bits = max(design.top_bits, 2)
-        out.append(f"    wire signed [{top_bits - 1}:0] top = {signed_literal(design.integers[0], top_bits)};")
-        top_frac = design.coef_frac_bits
-    else:
-        aw = max(design.stages[0].acc_bits, 2)
-        out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
-                   f"{signed_literal(design.horner_integers[n], aw)};")
-        prev = f"A{n}"
-        for st in design.stages:
-            j = st.power
-            out.append(f"    // step {j}: {step_comment(design, st)}"
-                       f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
-            out += _horner_step(design, st, prev, variable_name(design, st))
-            if j > 0:
-                prev = f"a{j}"
-        top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-        out.append(f"    wire signed [{top_bits - 1}:0] top = t0;")
-    out += _output_stage(design, yf, top_bits, top_frac)
-    return "\n".join(out)
+    return _verilog(horner_netlist(design, language="verilog", version=version, command=command,
+                                   budget=budget))
 
 
-
-def _variable_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
-    """The Horner variable ``v = R(xs * xs)`` of a one-parity design (no
-    lines for plain Horner in ``x``)."""
-    if design.scheme == "monomial":
-        return []
-    if design.scheme == "shifted":
-        return _shifted_lines(design, xs, v)
-    sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
-    out = [f"    // {v}: x*x with {design.variable_frac_bits} fractional bits "
-           f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} powers in it",
-           f"    wire signed [{sw - 1}:0] {v}_sq = {xs} * {xs};"]
-    if rs:
-        return out + round_lines(f"{v}_sq", v, sw, rs, vw, design.rounding)
-    return out + [f"    wire signed [{vw - 1}:0] {v} = {v}_sq;"]
-
-
-def _shifted_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
-    """``v = (xs << m) - C``: the shifted table's variable ``(x - c')/s``."""
-    sw, m = shifted_width(design), design.v_shift
-    shifted = f"({xs} <<< {m})" if m else xs
-    return [f"    // {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
-            f"{design.v_offset} / 2^{design.x_format.frac_bits + m}",
-            f"    localparam signed [{sw - 1}:0] {v}_C = {signed_literal(design.v_offset, sw)};",
-            f"    wire signed [{sw - 1}:0] {v}_d = {shifted} - {v}_C;",
-            f"    wire signed [{design.variable_bits - 1}:0] {v} = {v}_d;"]
-
-
-def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
-    """One Horner step ``a_j = R(a_{j+1} * x + q_j)``, shared by the
-    combinational and pipelined evaluators (``prev``: a_{j+1}; ``xs``: x)."""
-    j = st.power
-    shift = f" <<< {st.product_shift}" if st.product_shift else ""
-    out = [f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * {xs};",
-           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {signed_literal(st.coef_shifted, st.sum_bits)};",
-           f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};"]
-    if j > 0:
-        out += round_lines(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
-    return out
-
-def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
-    """The evaluator's last lines, shared by the combinational and pipelined
-    modules: round ``top`` to y's fractional bits, remove y's offset, saturate."""
-    return ([f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate"]
-            + saturating_output("top", top_bits, top_frac, yf, design.out_bits, design.rounding,
-                                min_bits=design.raw_bits))
 
 
 def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
@@ -373,54 +239,11 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
     >>> v = verilog_pipelined_module(d)
     >>> [line.strip() for line in v.splitlines() if "LATENCY =" in line or "posedge" in line]
-    ['parameter LATENCY = 1', 'always @(posedge clk) top <= t0;']
+    ['parameter LATENCY = 1', 'always @(posedge clk) begin']
     """
-    n = design.degree
-    if n < 1:
-        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
-                         f"degree >= 1")
-    xf, yf = design.x_format, design.y_format
-    name = pipelined_name(design)
-    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
-                                     budget=budget, pipelined=True), "verilog")
-    out += [f"module {name} #(",
-            f"    parameter IN_BITS = {design.in_bits},",
-            f"    parameter OUT_BITS = {design.out_bits},",
-            f"    parameter LATENCY = {design.steps}",
-            ") (",
-            "    input  wire                clk,",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");"]
-    xw = design.xs_bits
-    out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
-            f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
-    out += _variable_lines(design, "xs0", "v0")
-    vw, square = design.variable_bits, design.scheme != "monomial"   # v travels beside x
-    n = len(design.horner_integers) - 1
-    aw = max(design.stages[0].acc_bits, 2)
-    out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
-               f"{signed_literal(design.horner_integers[n], aw)};")
-    prev = f"A{n}"
-    for s, st in enumerate(design.stages):
-        j = st.power
-        out.append(f"    // stage {s + 1}: {step_comment(design, st)}")
-        out += _horner_step(design, st, prev, f"{variable_name(design, st)}{s}")
-        if j > 0:
-            out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
-                    f"    reg signed [{xw - 1}:0] xs{s + 1};"]
-            out += [f"    reg signed [{vw - 1}:0] v{s + 1};"] if square else []
-            out += ["    always @(posedge clk) begin",
-                    f"        a{j}_r <= a{j};",
-                    f"        xs{s + 1} <= xs{s};"]
-            out += [f"        v{s + 1} <= v{s};"] if square else []
-            out += ["    end"]
-            prev = f"a{j}_r"
-    top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-    out += [f"    reg signed [{top_bits - 1}:0] top;",
-            "    always @(posedge clk) top <= t0;"]
-    out += _output_stage(design, yf, top_bits, top_frac)
-    return "\n".join(out)
+    return _verilog(horner_netlist(design, pipelined=True, language="verilog", version=version,
+                                   command=command, budget=budget))
+
 
 
 def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -608,63 +431,8 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     """
     if d.sized:
         return sized_piecewise_verilog(d, version=version, command=command)
-    t = d.table
-    n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
-    yf = d.y_format
-    mod = module_name(d)
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
-    out += [f"module {mod} #(",
-            f"    parameter IN_BITS = {d.in_bits},",
-            f"    parameter OUT_BITS = {d.out_bits}",
-            ") (",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");",
-            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
-    tw = d.t_bits
-    if t.centered:
-        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}) - "
-                   f"{signed_literal(1 << (L - 1), tw)};")
-    else:
-        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
-    regs = [f"c{j}" for j in range(n + 1)]
-    if K == 0:  # one segment: constants (an always block with no input would never run)
-        for j in range(n + 1):
-            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
-    else:
-        for j in range(n + 1):
-            out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
-        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
-                "    always @(*) begin",
-                "        case (idx)"]
-        for s, seg in enumerate(t.segments):
-            body = " ".join(f"{regs[j]} = {signed_literal(q, d.rom_bits[j])};"
-                            for j, q in enumerate(seg.integers))
-            out.append(f"            {K}'d{s}: begin {body} end")
-        out += ["        endcase", "    end"]
-    prev, prev_frac = f"c{n}", fc
-    for i, j in enumerate(range(n - 1, -1, -1)):
-        pw, sw, ow = d.widths[i]
-        pf = prev_frac + L
-        sf = max(pf, fc)
-        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
-        out.append(f"    wire signed [{pw - 1}:0] p{j} = {prev} * t;")
-        sh_p = f" <<< {sf - pf}" if sf > pf else ""
-        sh_c = f" <<< {sf - fc}" if sf > fc else ""
-        out.append(f"    wire signed [{sw - 1}:0] s{j} = (p{j}{sh_p}) + (c{j}{sh_c});")
-        if j > 0:
-            f_out = min(d.acc_frac_bits, sf)
-            if sf > f_out:
-                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
-            else:
-                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
-            prev, prev_frac = f"a{j}", f_out
-        else:
-            prev, prev_frac = f"s{j}", sf
-    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
-    out += saturating_output(prev, top_bits, prev_frac, yf, d.out_bits, d.rounding)
-    return "\n".join(out)
+    return _verilog(piecewise_netlist(d, version=version, command=command))
+
 
 
 # -- sized piecewise evaluator (a width per coefficient, truncated steps, pipelined) --------

@@ -1,8 +1,10 @@
 """VHDL printers: the combinational and the pipelined evaluator of a
 :class:`~chebnorm.hw.horner.HornerDesign` and the evaluator of a
-:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), each
-bit-identical to :mod:`chebnorm.hw.hdl.verilog`'s, and their self-checking
-test benches (:func:`chebnorm.hw.run_vhdl.simulate_vhdl` runs them in GHDL).
+:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), each the
+netlist of :mod:`chebnorm.hw.hdl.datapath` that the Verilog printers print
+too, printed by :func:`chebnorm.hw.hdl.netlist.vhdl`, and their
+self-checking test benches (:func:`chebnorm.hw.run_vhdl.simulate_vhdl` runs
+them in GHDL).
 
 The entities follow the Verilog port contract::
 
@@ -34,11 +36,9 @@ from __future__ import annotations
 from chebnorm.core.textsafe import identifier
 
 from ..horner import HornerDesign
-from .common import (shifted_width, step_comment, variable_name)
-from .datapath import sized_piecewise_netlist
+from .datapath import horner_netlist, piecewise_netlist, sized_piecewise_netlist
 from .netlist import vhdl as _vhdl
-from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
-                     vectors_name)
+from .common import module_name, pipelined_name, vectors_name
 
 __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
            "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
@@ -46,131 +46,6 @@ __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"
-
-
-def _bits(value: int, bits: int) -> str:
-    """A ``signed`` bit-string literal of ``value`` in ``bits`` bits (range-checked)."""
-    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
-        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
-    return f'signed\'("{value & ((1 << bits) - 1):0{bits}b}")'
-
-
-def _const(name: str, value: int, bits: int) -> str:
-    return f"    constant {name} : signed({bits - 1} downto 0) := {_bits(value, bits)};  -- {value}"
-
-
-def _sig(name: str, bits: int) -> str:
-    return f"    signal {name} : signed({bits - 1} downto 0);"
-
-
-_WRAP = [
-    "    -- a Verilog assignment: sign-extend to n bits, or keep the low n bits",
-    "    function wrap(a : signed; n : positive) return signed is",
-    "        variable v : signed(a'length - 1 downto 0) := a;",
-    "        variable r : signed(n - 1 downto 0);",
-    "    begin",
-    "        if n <= a'length then",
-    "            r := v(n - 1 downto 0);",
-    "        else",
-    "            r := resize(v, n);",
-    "        end if;",
-    "        return r;",
-    "    end function;",
-]
-
-
-class _Body:
-    """Declarations and statements of the architecture, built side by side."""
-
-    def __init__(self):
-        self.decl: list[str] = []
-        self.stmt: list[str] = []
-
-    def wire(self, name: str, bits: int, expr: str) -> None:
-        self.decl.append(_sig(name, bits))
-        self.stmt.append(f"    {name} <= {expr};")
-
-
-def _round(b: _Body, src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
-           mode: str) -> None:
-    """``dst = round(src / 2^shift)`` as in the Verilog :func:`~chebnorm.hw.hdl.verilog.round_lines`."""
-    if mode != "trunc" and shift + 1 > src_bits:   # the round bit lies above src: extend it
-        b.wire(f"{dst}_x", shift + 1, f"resize({src}, {shift + 1})")
-        src, src_bits = f"{dst}_x", shift + 1
-    b.wire(f"{dst}_q", src_bits, f"shift_right({src}, {shift})")
-    if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
-        b.wire(dst, dst_bits, f"wrap({dst}_q, {dst_bits})")
-        return
-    sticky = f"(or {src}({shift - 2} downto 0)) or " if shift >= 2 else ""
-    b.decl.append(f"    signal {dst}_inc : std_logic;")
-    b.stmt.append(f"    {dst}_inc <= {src}({shift - 1}) and ({sticky}{dst}_q(0));")
-    w = max(dst_bits, src_bits, 2)
-    b.wire(dst, dst_bits, f"wrap(wrap({dst}_q, {w}) + signed'(\"0\" & {dst}_inc), {dst_bits})")
-
-
-def _variable(b: _Body, design: HornerDesign, xs: str, v: str) -> None:
-    """The Horner variable ``v = R(xs * xs)`` of a one-parity design
-    (nothing for plain Horner in ``x``), as the Verilog printer's."""
-    if design.scheme == "monomial":
-        return
-    if design.scheme == "shifted":   # v = (xs << m) - C: (x - c')/s
-        sw, m = shifted_width(design), design.v_shift
-        b.stmt.append(f"    -- {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
-                      f"{design.v_offset} / 2^{design.x_format.frac_bits + m}")
-        b.decl.append(_const(f"{v}_C", design.v_offset, sw))
-        wide = f"wrap({xs}, {sw})"
-        b.wire(f"{v}_d", sw, (f"shift_left({wide}, {m})" if m else wide) + f" - {v}_C")
-        b.wire(v, design.variable_bits, f"wrap({v}_d, {design.variable_bits})")
-        return
-    sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
-    b.stmt.append(f"    -- {v}: x*x with {design.variable_frac_bits} fractional bits "
-                  f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} "
-                  f"powers in it")
-    b.wire(f"{v}_sq", sw, f"{xs} * {xs}")
-    if rs:
-        _round(b, f"{v}_sq", v, sw, rs, vw, design.rounding)
-    else:
-        b.wire(v, vw, f"wrap({v}_sq, {vw})")
-
-
-def _step(b: _Body, design: HornerDesign, st, prev: str, xs: str) -> None:
-    j = st.power
-    pw = st.product_bits
-    b.stmt.append(f"    -- step {j}: {step_comment(design, st)}"
-                  f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
-    # Verilog extends both operands to pw bits and keeps the product mod 2^pw; the exact
-    # product of the narrower operands, wrapped to pw bits, is the same bits for less work
-    b.wire(f"p{j}", pw, f"wrap({prev} * {xs}, {pw})")
-    b.decl.append(_const(f"C{j}", st.coef_shifted, st.sum_bits))
-    shifted = f"shift_left(wrap(p{j}, {st.sum_bits}), {st.product_shift})" if st.product_shift \
-        else f"wrap(p{j}, {st.sum_bits})"
-    b.wire(f"t{j}", st.sum_bits, f"{shifted} + C{j}")
-    if j > 0:
-        _round(b, f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
-
-
-def _output(b: _Body, top: str, top_bits: int, top_frac: int, yf, out_bits: int, rounding: str,
-            min_bits: int = 0) -> None:
-    """The evaluator's last statements, as the Verilog
-    :func:`~chebnorm.hw.hdl.verilog.saturating_output`: round the signed
-    ``top`` to y's fractional bits, remove y's offset, saturate into ``y``."""
-    shift = top_frac - yf.frac_bits
-    rw = max(min_bits, top_bits + max(0, -shift) + 1, out_bits + 2,
-             yf.offset_code.bit_length() + 2)
-    b.stmt.append(f"    -- output: round to {yf.frac_bits} fractional bits, remove the offset, "
-                  f"saturate")
-    if shift > 0:
-        _round(b, top, "r", top_bits, shift, rw, rounding)
-    elif shift == 0:
-        b.wire("r", rw, f"wrap({top}, {rw})")
-    else:
-        b.wire("r", rw, f"shift_left(wrap({top}, {rw}), {-shift})")
-    b.decl.append(_const("KY", yf.offset_code, rw))
-    b.decl.append(_const("YMAX", yf.max_code, rw))
-    b.wire("raw", rw, "r - KY")
-    b.stmt += [f"    y <= (others => '0') when raw({rw - 1}) = '1' else",
-               "         (others => '1') when raw > YMAX else",
-               "         std_logic_vector(raw(OUT_BITS - 1 downto 0));"]
 
 
 def _vhdl_name(name: str) -> str:
@@ -181,22 +56,6 @@ def _vhdl_name(name: str) -> str:
                          f"underscores in a row and a trailing underscore; accepted: a table "
                          f"name without them")
     return name
-
-
-def _entity(name: str, design, clocked: bool) -> list[str]:
-    latency = design.latency if getattr(design, "latency", 0) else \
-        getattr(design, "steps", design.degree)
-    _vhdl_name(name)
-    generics = [f"        IN_BITS  : natural := {design.in_bits};",
-                f"        OUT_BITS : natural := {design.out_bits}" + (";" if clocked else "")]
-    if clocked:
-        generics.append(f"        LATENCY  : natural := {latency}")
-    ports = (["        clk : in  std_logic;"] if clocked else []) + [
-        "        x   : in  std_logic_vector(IN_BITS - 1 downto 0);",
-        "        y   : out std_logic_vector(OUT_BITS - 1 downto 0)"]
-    return ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
-            f"entity {name} is", "    generic (", *generics, "    );", "    port (", *ports,
-            "    );", f"end entity {name};", ""]
 
 
 def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None = None,
@@ -232,39 +91,10 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
     ValueError
         If the design's name is not a safe identifier.
     """
-    name = design.module_name
-    n = design.degree
-    xf = design.x_format
-    out = comment_lines(horner_facts(design, "vhdl", version=version, command=command,
-                                     budget=budget), "vhdl")
-    out += _entity(name, design, clocked=False)
-    b = _Body()
-    xw = design.xs_bits
-    b.decl.append(_const("K0", xf.offset_code, xw))
-    b.stmt.append(f"    -- x value times 2^{xf.frac_bits}")
-    b.wire("xs", xw, f"wrap(signed('0' & x), {xw}) + K0")
-    _variable(b, design, "xs", "v")
-    n = len(design.horner_integers) - 1
-    if n == 0:
-        top_bits = max(design.top_bits, 2)
-        b.decl.append(_const("TOPC", design.integers[0], top_bits))
-        b.wire("top", top_bits, "TOPC")
-        top_frac = design.coef_frac_bits
-    else:
-        aw = max(design.stages[0].acc_bits, 2)
-        b.decl.append(_const(f"A{n}", design.horner_integers[n], aw))
-        prev = f"A{n}"
-        for st in design.stages:
-            _step(b, design, st, prev, variable_name(design, st))
-            if st.power > 0:
-                prev = f"a{st.power}"
-        top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-        b.wire("top", top_bits, "t0")
-    _output(b, "top", top_bits, top_frac, design.y_format, design.out_bits, design.rounding,
-            design.raw_bits)
-    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
-            "end architecture rtl;", ""]
-    return "\n".join(out)
+    _vhdl_name(design.module_name)
+    return _vhdl(horner_netlist(design, language="vhdl", version=version, command=command,
+                                budget=budget))
+
 
 
 def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
@@ -307,47 +137,11 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
     >>> [line.strip() for line in v.splitlines() if line.startswith("entity")]
     ['entity chebnorm_dichotomy_d1_pipe is']
     """
-    n = design.degree
-    if n < 1:
-        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
-                         f"degree >= 1")
-    name = pipelined_name(design)
-    xf = design.x_format
-    out = comment_lines(horner_facts(design, "vhdl", version=version, command=command,
-                                     budget=budget, pipelined=True), "vhdl")
-    out += _entity(name, design, clocked=True)
-    b = _Body()
-    xw = design.xs_bits
-    b.decl.append(_const("K0", xf.offset_code, xw))
-    b.wire("xs0", xw, f"wrap(signed('0' & x), {xw}) + K0")
-    _variable(b, design, "xs0", "v0")
-    square = design.scheme != "monomial"
-    n = len(design.horner_integers) - 1
-    aw = max(design.stages[0].acc_bits, 2)
-    b.decl.append(_const(f"A{n}", design.horner_integers[n], aw))
-    prev = f"A{n}"
-    regs = []
-    for s, st in enumerate(design.stages):
-        j = st.power
-        _step(b, design, st, prev, f"{variable_name(design, st)}{s}")
-        if j > 0:
-            b.decl.append(_sig(f"a{j}_r", st.out_bits))
-            b.decl.append(_sig(f"xs{s + 1}", xw))
-            regs += [f"            a{j}_r <= a{j};", f"            xs{s + 1} <= xs{s};"]
-            if square:
-                b.decl.append(_sig(f"v{s + 1}", design.variable_bits))
-                regs.append(f"            v{s + 1} <= v{s};")
-            prev = f"a{j}_r"
-    top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-    b.decl.append(_sig("top", top_bits))
-    regs.append("            top <= t0;")
-    b.stmt += ["    regs : process (clk)", "    begin", "        if rising_edge(clk) then",
-               *regs, "        end if;", "    end process regs;"]
-    _output(b, "top", top_bits, top_frac, design.y_format, design.out_bits, design.rounding,
-            design.raw_bits)
-    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
-            "end architecture rtl;", ""]
-    return "\n".join(out)
+    if design.degree >= 1:
+        _vhdl_name(pipelined_name(design))
+    return _vhdl(horner_netlist(design, pipelined=True, language="vhdl", version=version,
+                                command=command, budget=budget))
+
 
 
 _HEX = [
@@ -529,25 +323,6 @@ def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -
 
 # -- piecewise evaluator -------------------------------------------------------------
 
-def _piecewise_rom(b: _Body, d) -> None:
-    """The coefficient ROM: ``c_j`` of the segment the top bits of ``x`` index
-    (one constant array per power; one segment: the constants themselves)."""
-    t = d.table
-    n, K, L = t.degree, d.index_bits, d.local_bits
-    if K == 0:  # one segment: constants, as the Verilog
-        for j in range(n + 1):
-            b.wire(f"c{j}", d.rom_bits[j], _bits(t.segments[0].integers[j], d.rom_bits[j]))
-        return
-    b.wire("idx", K, f"signed(x({d.in_bits - 1} downto {L}))")
-    for j in range(n + 1):
-        w = d.rom_bits[j]
-        b.decl.append(f"    type rom{j}_t is array (0 to {2 ** K - 1}) of signed({w - 1} downto 0);")
-        rows = [f"        {_bits(seg.integers[j], w)}{',' if s < len(t.segments) - 1 else ''}"
-                f"  -- segment {s}: {seg.integers[j]}" for s, seg in enumerate(t.segments)]
-        b.decl += [f"    constant ROM{j} : rom{j}_t := (", *rows, "    );"]
-        b.wire(f"c{j}", w, f"ROM{j}(to_integer(unsigned(idx)))")
-
-
 def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """The VHDL-2008 entity of a piecewise design ``d``
     (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`): the coefficient ROM
@@ -583,45 +358,9 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """
     if d.sized:
         return sized_piecewise_vhdl(d, version=version, command=command)
-    t = d.table
-    n, L, fc = t.degree, d.local_bits, t.coef_frac_bits
-    name = module_name(d)
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "vhdl")
-    out += _entity(name, d, clocked=False)
-    b = _Body()
-    tw = d.t_bits
-    low = f"signed(\"00\" & x({L - 1} downto 0))"
-    if t.centered:
-        b.decl.append(_const("TC", 1 << (L - 1), tw))
-        b.wire("t", tw, f"{low} - TC")
-    else:
-        b.wire("t", tw, low)
-    _piecewise_rom(b, d)
-    prev, prev_frac = f"c{n}", fc
-    for i, j in enumerate(range(n - 1, -1, -1)):
-        pw, sw, ow = d.widths[i]
-        pf = prev_frac + L
-        sf = max(pf, fc)
-        b.stmt.append(f"    -- step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
-        b.wire(f"p{j}", pw, f"wrap({prev} * t, {pw})")
-        # the Verilog sum, taken mod 2^sw: the same bits as in its wider context
-        terms = [f"shift_left(wrap({v}, {sw}), {sh})" if sh else f"wrap({v}, {sw})"
-                 for v, sh in ((f"p{j}", sf - pf), (f"c{j}", sf - fc))]
-        b.wire(f"s{j}", sw, " + ".join(terms))
-        if j > 0:
-            f_out = min(d.acc_frac_bits, sf)
-            if sf > f_out:
-                _round(b, f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
-            else:
-                b.wire(f"a{j}", ow, f"wrap(s{j}, {ow})")
-            prev, prev_frac = f"a{j}", f_out
-        else:
-            prev, prev_frac = f"s{j}", sf
-    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
-    _output(b, prev, top_bits, prev_frac, d.y_format, d.out_bits, d.rounding)
-    out += [f"architecture rtl of {name} is", *_WRAP, *b.decl, "begin", *b.stmt,
-            "end architecture rtl;", ""]
-    return "\n".join(out)
+    _vhdl_name(module_name(d))
+    return _vhdl(piecewise_netlist(d, version=version, command=command))
+
 
 
 def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
