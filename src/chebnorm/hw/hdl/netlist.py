@@ -41,7 +41,8 @@ from .common import comment_lines
 __all__ = ["Signal", "Const", "Slice", "Bit", "Concat", "Not", "ZeroExt", "Resize", "Extend",
            "Shl", "Shr", "Neg", "Add", "Sub", "Mul", "Gate", "And", "Or", "ReduceOr", "Group",
            "Paren", "BitVec", "Assign", "ConstDecl", "Rom", "Registers", "Saturate", "Output",
-           "Comment", "Module", "vhdl_entity", "VHDL_WRAP",
+           "Comment", "Module", "vhdl_entity", "VHDL_WRAP", "ShiftBy", "Declare", "Param",
+           "LeadingZeros", "rename",
            "verilog", "vhdl", "statement_lines", "evaluate", "signed_literal", "vhdl_bits"]
 
 
@@ -160,23 +161,30 @@ def _kind(e) -> str:
 
 @dataclass(frozen=True)
 class Const:
-    """A signed constant of ``width`` bits.
+    """A constant of ``width`` bits.
 
     Parameters
     ----------
     value : int
-        The value; it must fit a signed ``width``-bit word.
+        The value; it must fit a ``width``-bit word.
     width : int
         Bits.
+    signed : bool, default True
+        Two's complement; unsigned constants print as a VHDL integer literal (an
+        operand of ``unsigned`` arithmetic only).
     """
 
     value: int
     width: int
-    signed = True
+    signed: bool = True
 
     def __post_init__(self):
-        if not -(1 << (self.width - 1)) <= self.value < (1 << (self.width - 1)):
-            raise _refuse("Const", f"{self.value} does not fit a signed {self.width}-bit word")
+        lo, hi = ((-(1 << (self.width - 1)), 1 << (self.width - 1)) if self.signed
+                  else (0, 1 << self.width))
+        if not lo <= self.value < hi:
+            raise _refuse("Const", f"{self.value} does not fit a"
+                                   f"{' signed' if self.signed else 'n unsigned'} "
+                                   f"{self.width}-bit word")
 
 
 @dataclass(frozen=True)
@@ -356,26 +364,30 @@ class Resize:
 
 @dataclass(frozen=True)
 class Extend:
-    """A signed operand sign-extended to ``width`` bits, never narrower
-    (VHDL: ``resize``).
+    """An operand extended (sign-extended when signed) to ``width`` bits,
+    never narrower (VHDL: ``resize``).
 
     Parameters
     ----------
     a : expression
-        The signed operand.
+        The operand.
     width : int
         The new width, ``>= a.width``.
     """
 
     a: object
     width: int
-    signed = True
 
     def __post_init__(self):
         _check_expr(self.a, "Extend")
-        if not self.a.signed or self.width < self.a.width:
-            raise _refuse("Extend", f"{_kind(self.a)} to {self.width}; accepted: a signed "
-                                    f"operand, a width at least its own")
+        if self.width < self.a.width or _is_logic(self.a):
+            raise _refuse("Extend", f"{_kind(self.a)} to {self.width}; accepted: a number, "
+                                    f"a width at least its own")
+
+    @property
+    def signed(self) -> bool:
+        """The operand's signedness."""
+        return self.a.signed
 
 
 @dataclass(frozen=True)
@@ -420,6 +432,33 @@ class Shr(Shl):
     k : int
         Bits, ``>= 0``.
     """
+
+
+@dataclass(frozen=True)
+class ShiftBy:
+    """A bit vector shifted left by a variable amount (zeros in).
+
+    Parameters
+    ----------
+    a : Signal
+        The bit vector (a ``logic`` signal).
+    amount : Signal
+        The unsigned shift amount.
+    """
+
+    a: object
+    amount: object
+    signed = False
+
+    def __post_init__(self):
+        if not (isinstance(self.a, Signal) and self.a.logic and isinstance(self.amount, Signal)
+                and not self.amount.signed and not self.amount.logic):
+            raise _refuse("ShiftBy", "accepted: a logic Signal shifted by an unsigned Signal")
+
+    @property
+    def width(self) -> int:
+        """The vector's width."""
+        return self.a.width
 
 
 @dataclass(frozen=True)
@@ -651,7 +690,7 @@ class Paren(Group):
     """
 
 
-_EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, Neg, Add, Sub,
+_EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, ShiftBy, Neg, Add, Sub,
          Mul, Gate, And, ReduceOr, Group)
 
 
@@ -767,10 +806,73 @@ class Saturate:
         The signed value.
     ymax : Signal
         The signed constant (a :class:`ConstDecl`) of the largest code.
+    port : Signal or None, default None
+        The driven vector (None: the output port ``y``).
+    width_name : str, default "OUT_BITS"
+        The parameter (generic) that names its width.
     """
 
     raw: Signal
     ymax: Signal
+    port: Signal | None = None
+    width_name: str = "OUT_BITS"
+
+
+@dataclass(frozen=True)
+class Declare:
+    """A signal declared here and driven by a later statement.
+
+    Parameters
+    ----------
+    signal : Signal
+        The signal.
+    """
+
+    signal: Signal
+
+
+@dataclass(frozen=True)
+class Param:
+    """A named integer (Verilog ``localparam``, VHDL ``constant ... natural``).
+
+    Parameters
+    ----------
+    name : str
+        The identifier.
+    value : int
+        The value, ``>= 0``.
+    """
+
+    name: str
+    value: int
+
+
+@dataclass(frozen=True)
+class LeadingZeros:
+    """``dst`` = the number of leading zero bits of ``src`` (its width when
+    ``src`` is zero).
+
+    Parameters
+    ----------
+    dst : Signal
+        The unsigned count (wide enough for ``src.width``).
+    src : Signal
+        The bit vector.
+    index : str
+        The loop variable's name (Verilog ``integer``).
+    label : str
+        The VHDL process label.
+    """
+
+    dst: Signal
+    src: Signal
+    index: str
+    label: str
+
+    def __post_init__(self):
+        if self.dst.signed or self.dst.logic or self.src.width >= 1 << self.dst.width:
+            raise _refuse("LeadingZeros", f"count {self.dst!r}; accepted: an unsigned signal "
+                                          f"that holds {self.src.width}")
 
 
 @dataclass(frozen=True)
@@ -835,6 +937,46 @@ class Module:
         return Signal("x", self.in_bits, logic=True)
 
 
+def rename(node, signals: dict):
+    """``node`` (a statement or an expression, or a list of them) with every
+    :class:`Signal` named in ``signals`` replaced by its value -- how a module
+    is inlined into another: its ports become the host's signals.
+
+    Parameters
+    ----------
+    node : object
+        A netlist node, or a list or tuple of nodes.
+    signals : dict of str to Signal
+        Name -> the signal that takes its place (of the same width and type).
+
+    Returns
+    -------
+    object
+        The renamed copy.
+
+    Raises
+    ------
+    ValueError
+        If a replacement's width or signedness differs from the signal it replaces.
+    """
+    from dataclasses import fields, is_dataclass, replace
+
+    if isinstance(node, (list, tuple)):
+        return type(node)(rename(n, signals) for n in node)
+    if isinstance(node, Signal):
+        new = signals.get(node.name)
+        if new is None:
+            return node
+        if (new.width, new.signed, new.logic) != (node.width, node.signed, node.logic):
+            raise _refuse(f"rename {node.name}", f"{new!r} for {node!r}; accepted: the same "
+                                                 f"width and type")
+        return new
+    if not is_dataclass(node):
+        return node
+    return replace(node, **{f.name: rename(getattr(node, f.name), signals)
+                            for f in fields(node) if f.init})
+
+
 # -- the printers: one template per node kind and language -----------------------------
 
 def _vhdl_type(s: Signal) -> str:
@@ -856,7 +998,8 @@ def _v_gate(e, p):
 #: Verilog-2005 spelling of each node kind (the printer ``p`` prints the operands)
 _VERILOG = {
     Signal: lambda e, p: e.name,
-    Const: lambda e, p: signed_literal(e.value, e.width),
+    Const: lambda e, p: (signed_literal(e.value, e.width) if e.signed
+                         else f"{e.width}'d{e.value}"),
     Slice: lambda e, p: f"{e.src.name}[{e.hi}:{e.lo}]",
     Bit: lambda e, p: f"{e.src.name}[{e.index}]",
     BitVec: lambda e, p: f"{e.src.name}[{e.index}]",
@@ -868,6 +1011,7 @@ _VERILOG = {
     Extend: lambda e, p: p(e.a),
     Shl: lambda e, p: f"{p(e.a)} <<< {e.k}",
     Shr: lambda e, p: f"{p(e.a)} >>> {e.k}",
+    ShiftBy: lambda e, p: f"{p(e.a)} << {p(e.amount)}",
     Neg: lambda e, p: f"-{p(e.a)}",
     Add: lambda e, p: " + ".join(p(t) for t in e.terms),
     Sub: lambda e, p: f"{p(e.a)} - {p(e.b)}",
@@ -889,17 +1033,20 @@ def _vh_zeroext(e, p):
 #: VHDL-2008 (``ieee.numeric_std``) spelling of each node kind
 _VHDL = {
     Signal: lambda e, p: e.name,
-    Const: lambda e, p: vhdl_bits(e.value, e.width),
+    Const: lambda e, p: vhdl_bits(e.value, e.width) if e.signed else str(e.value),
     Slice: lambda e, p: f"{e.src.name}({e.hi} downto {e.lo})",
     Bit: lambda e, p: f"{e.src.name}({e.index})",
     BitVec: lambda e, p: f"{e.src.name}({e.index} downto {e.index})",
-    Concat: lambda e, p: " & ".join(p(x) for x in e.parts),
+    Concat: lambda e, p: " & ".join(p(x) if _is_logic(x) else f"std_logic_vector({p(x)})"
+                                    for x in e.parts),
     Not: lambda e, p: f"not {p(e.a)}",
     ZeroExt: _vh_zeroext,
     Resize: lambda e, p: f"wrap({p(e.a)}, {e.width})",
     Extend: lambda e, p: f"resize({p(e.a)}, {e.width})",
     Shl: lambda e, p: f"shift_left({p(e.a)}, {e.k})",
     Shr: lambda e, p: f"shift_right({p(e.a)}, {e.k})",
+    ShiftBy: lambda e, p: (f"std_logic_vector(shift_left(unsigned({p(e.a)}), "
+                           f"to_integer({p(e.amount)})))"),
     Neg: lambda e, p: f"-{p(e.a)}",
     Add: lambda e, p: " + ".join(p(t) for t in e.terms),
     Sub: lambda e, p: f"{p(e.a)} - {p(e.b)}",
@@ -937,7 +1084,7 @@ def _is_logic(e) -> bool:
         return e.logic
     if isinstance(e, (Slice, BitVec)):
         return e.src.logic
-    return isinstance(e, (Concat, Not))
+    return isinstance(e, (Concat, Not, ShiftBy))
 
 
 def _vhdl_value(dst: Signal, e) -> str:
@@ -974,10 +1121,21 @@ def _verilog_statement(s) -> list[str]:
         return [f"    // {_comment(s.text, 'verilog')}"]
     if isinstance(s, Output):
         return [f"    assign y = {_expr(s.expr, 'verilog')};"]
+    if isinstance(s, Declare):
+        return [f"    {_verilog_type(s.signal)} {s.signal.name};"]
+    if isinstance(s, Param):
+        return [f"    localparam {s.name} = {s.value};"]
+    if isinstance(s, LeadingZeros):
+        w, z, i = s.src.width, s.dst.width, s.index
+        return [f"    {_verilog_type(s.dst, 'reg')} {s.dst.name};", f"    integer {i};",
+                "    always @(*) begin", f"        {s.dst.name} = {z}'d{w};",
+                f"        for ({i} = 0; {i} < {w}; {i} = {i} + 1)",
+                f"            if ({s.src.name}[{i}]) {s.dst.name} = {w - 1} - {i};", "    end"]
     if isinstance(s, Saturate):
-        r, top = s.raw.name, s.raw.width - 1
-        return [f"    assign y = {r}[{top}] ? {{OUT_BITS{{1'b0}}}} : ({r} > {s.ymax.name}) ? "
-                f"{{OUT_BITS{{1'b1}}}} : {r}[OUT_BITS-1:0];"]
+        r, top, n = s.raw.name, s.raw.width - 1, s.width_name
+        port = s.port.name if s.port else "y"
+        return [f"    assign {port} = {r}[{top}] ? {{{n}{{1'b0}}}} : ({r} > {s.ymax.name}) ? "
+                f"{{{n}{{1'b1}}}} : {r}[{n}-1:0];"]
     if isinstance(s, Registers):
         out = [f"    {_verilog_type(d, 'reg')} {d.name};" for d, _ in s.pairs]
         return out + ["    always @(posedge clk) begin",
@@ -1006,12 +1164,26 @@ def _vhdl_statement(s) -> tuple[list[str], list[str]]:
     if isinstance(s, Comment):
         return [], [f"    -- {_comment(s.text, 'vhdl')}"]
     if isinstance(s, Output):
-        return [], [f"    y <= std_logic_vector({_expr(s.expr, 'vhdl')});"]
+        text = _expr(s.expr, "vhdl")
+        return [], [f"    y <= {text if _is_logic(s.expr) else f'std_logic_vector({text})'};"]
+    if isinstance(s, Declare):
+        return [f"    signal {s.signal.name} : {_vhdl_type(s.signal)};"], []
+    if isinstance(s, Param):
+        return [f"    constant {s.name} : natural := {s.value};"], []
+    if isinstance(s, LeadingZeros):
+        w, z = s.src.width, s.dst.width
+        return ([f"    signal {s.dst.name} : {_vhdl_type(s.dst)};"],
+                [f"    {s.label} : process ({s.src.name})",
+                 f"        variable c : natural range 0 to {w};", "    begin", f"        c := {w};",
+                 f"        for i in 0 to {w - 1} loop", f"            if {s.src.name}(i) = '1' then",
+                 f"                c := {w - 1} - i;", "            end if;", "        end loop;",
+                 f"        {s.dst.name} <= to_unsigned(c, {z});", f"    end process {s.label};"])
     if isinstance(s, Saturate):
-        r = s.raw.name
-        return [], [f"    y <= (others => '0') when {r}({s.raw.width - 1}) = '1' else",
+        r, n = s.raw.name, s.width_name
+        port = s.port.name if s.port else "y"
+        return [], [f"    {port} <= (others => '0') when {r}({s.raw.width - 1}) = '1' else",
                     f"         (others => '1') when {r} > {s.ymax.name} else",
-                    f"         std_logic_vector({r}(OUT_BITS - 1 downto 0));"]
+                    f"         std_logic_vector({r}({n} - 1 downto 0));"]
     if isinstance(s, Registers):
         decl = [f"    signal {d.name} : {_vhdl_type(d)};" for d, _ in s.pairs]
         head = f"    {s.label} : process (clk)" if s.label else "    process (clk)"
@@ -1208,6 +1380,8 @@ def _value(e, env: dict) -> int:
         return _value(e.a, env) >> e.k   # floor: arithmetic for signed, logical for unsigned
     if t is Neg:
         return _wrap(-_value(e.a, env), e.width, True)
+    if t is ShiftBy:
+        return (_value(e.a, env) << _value(e.amount, env)) & ((1 << e.width) - 1)
     if t is Add:
         return _wrap(sum(_value(x, env) for x in e.terms), e.width, e.signed)
     if t is Sub:
@@ -1265,8 +1439,12 @@ def evaluate(module: Module, code: int) -> dict:
                 env[d.name] = env[src.name]
         elif isinstance(s, Output):
             env["y"] = _value(s.expr, env) & (2 ** module.out_bits - 1)
+        elif isinstance(s, LeadingZeros):
+            v = env[s.src.name]
+            env[s.dst.name] = s.src.width - v.bit_length()
         elif isinstance(s, Saturate):
             raw, ymax = env[s.raw.name], env[s.ymax.name]
-            env["y"] = 0 if raw < 0 else (2 ** module.out_bits - 1 if raw > ymax
-                                          else raw & (2 ** module.out_bits - 1))
+            port = s.port or Signal("y", module.out_bits)
+            env[port.name] = 0 if raw < 0 else (2 ** port.width - 1 if raw > ymax
+                                                else raw & (2 ** port.width - 1))
     return env
