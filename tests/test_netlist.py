@@ -5,14 +5,16 @@ the IR's own evaluation; the IR refuses width and signedness mismatches."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import pytest
 
 from chebnorm.hw.hdl.datapath import output_stage, round_to
-from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Gate,
-                                     Group, Module, Mul, Neg, Not, Output, Registers, Resize,
-                                     Rom, Shl, Shr, Signal, Slice, Sub, ZeroExt, evaluate,
+from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Declare,
+                                     Extend, Gate, Group, LeadingZeros, Module, Mul, Neg, Not,
+                                     Output, Param, Registers, Resize, Rom, Saturate, Shl,
+                                     ShiftBy, Shr, Signal, Slice, Sub, ZeroExt, evaluate, rename,
                                      verilog, vhdl)
 from chebnorm.hw.hdl.verilog import piecewise_clocked_testbench, verilog_testbench
 from chebnorm.hw.hdl.vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
@@ -81,6 +83,34 @@ def _expected(k: int) -> int:
     return min(max(r - 2, 0), 15)
 
 
+def _composite() -> Module:
+    """A normalizer around an inlined sub-module, as the exponent composite is
+    built: a leading-zero count, a variable shift, an unsigned increment, a
+    second module's statements with its ports renamed, ``y = {h, m}``."""
+    core = Module("chebnorm_core", W, 3)
+    c, ky, ymax, raw = _s("c", 5), _s("KY", 5), _s("YMAX", 5), _s("raw", 5)
+    core.statements += [Assign(c, ZeroExt(Slice(core.x, 5, 2))), ConstDecl(ky, 4),
+                        ConstDecl(ymax, 7), Assign(raw, Sub(c, ky)), Saturate(raw, ymax)]
+    m = Module("chebnorm_lz", W, 6)
+    lz, mant = Signal("nrm_lz", 3), Signal("nrm_mant", W, logic=True)
+    lz2, h, mm = Signal("nrm_lz2", 4), Signal("nrm_h", 3), Signal("nrm_m", 3, logic=True)
+    body = [replace(s, port=mm, width_name="M_BITS") if isinstance(s, Saturate) else s
+            for s in rename(core.statements, {"x": mant})]
+    m.statements += [Param("M_BITS", 3), LeadingZeros(lz, m.x, "nrm_i", "nrm_count"),
+                     Assign(mant, ShiftBy(m.x, lz)),
+                     Assign(lz2, Add((Extend(lz, 4), Const(2, 2, signed=False)))),
+                     Assign(h, Slice(lz2, 3, 1)), Declare(mm), *body,
+                     Output(Concat((h, mm)))]
+    return m
+
+
+def _composite_expected(k: int) -> int:
+    lz = W - k.bit_length()
+    mant = (k << lz) & (2 ** W - 1)
+    raw = (mant >> 2) - 4
+    return (((lz + 2) >> 1) << 3) | min(max(raw, 0), 7)
+
+
 def _shim(m: Module):
     return SimpleNamespace(name=m.name[len("chebnorm_"):], module_name=m.name,
                            in_bits=m.in_bits, out_bits=m.out_bits, degree=0, latency=m.latency)
@@ -113,6 +143,36 @@ def test_both_printers_simulate_every_code(tmp_path, latency):
         assert r.passed and r.vectors == 2 ** W and r.mismatches == 0, r.line
 
 
+def test_composite_evaluation_matches_python_arithmetic():
+    m = _composite()
+    assert [evaluate(m, k)["y"] for k in range(2 ** W)] == [_composite_expected(k)
+                                                           for k in range(2 ** W)]
+    v = verilog(m)
+    assert "nrm_m = raw[4] ? {M_BITS{1'b0}}" in v and "core.x" not in v
+    assert "    y <= std_logic_vector(nrm_h) & nrm_m;" in vhdl(m)
+
+
+@requires_tool("iverilog", "ghdl")
+def test_composite_simulates_every_code(tmp_path):
+    m = _composite()
+    shim = _shim(m)
+    (tmp_path / f"{m.name}.hex").write_text("".join(f"{_composite_expected(k):02x}\n"
+                                                     for k in range(2 ** W)))
+    for ext, text, bench in (("v", verilog(m), verilog_testbench(shim)),
+                             ("vhd", vhdl(m), piecewise_vhdl_testbench(shim))):
+        (tmp_path / f"{m.name}.{ext}").write_text(text)
+        (tmp_path / f"tb_{m.name}.{ext}").write_text(bench)
+    for run in (simulate, simulate_vhdl):
+        r = run(tmp_path, m.name)
+        assert r.passed and r.vectors == 2 ** W and r.mismatches == 0, r.line
+
+
+def test_rename_refuses_another_type():
+    with pytest.raises(ValueError, match="rename x: .*accepted: the same width and type"):
+        rename(Assign(Signal("low", 4, logic=True), Slice(Signal("x", 6, logic=True), 3, 0)),
+               {"x": Signal("nrm", 6)})
+
+
 def test_output_statement_and_plain_rounding():
     """``round_to`` with floor: an arithmetic shift; Output drives y with the bits."""
     m = Module("chebnorm_fl", W, 4)
@@ -134,6 +194,10 @@ def test_output_statement_and_plain_rounding():
     (lambda: Assign(Signal("a", 4), _s("b", 4)), "Assign a: .*4 unsigned bits"),
     (lambda: Mul(_s("a", 4), Signal("b", 4)), "Mul: .*accepted: signed operands"),
     (lambda: Const(8, 4), "Const: 8 does not fit a signed 4-bit word"),
+    (lambda: Const(-1, 4, signed=False), "Const: -1 does not fit an unsigned 4-bit word"),
+    (lambda: LeadingZeros(Signal("z", 2), Signal("x", 4, logic=True), "i", "c"),
+     "LeadingZeros: .*that holds 4"),
+    (lambda: ShiftBy(_s("a", 4), Signal("k", 2)), "ShiftBy: accepted: a logic Signal"),
     (lambda: Slice(Signal("a", 4), 4, 0), "Slice: bits 4..0"),
     (lambda: Signal("a", 0), "signal 'a': width 0"),
     (lambda: Registers(((_s("r", 5), _s("a", 4)),)), "Registers r: operands of 5 signed bits "
