@@ -11,8 +11,9 @@ A *design* is a sized, bit-accurate evaluator of a table:
   architecture with ``pipeline=`` -- with registers at its cut points (the
   module then has ``clk`` and ``LATENCY``; its bench is clocked).
 
-Each is printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008 (:mod:`.vhdl`),
-bit for bit the design's model, with an exhaustive self-checking bench that
+Each is built once as a netlist (:mod:`.datapath` over the IR of
+:mod:`.netlist`) and printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008
+(:mod:`.vhdl`), bit for bit the design's model, with an exhaustive self-checking bench that
 reads the model's expected outputs (:func:`vector_file`). The banner is
 written once (:mod:`.common`). ``chebnorm hw verilog``, ``chebnorm export
 --format verilog|vhdl`` and :func:`chebnorm.hw.report.hdl_outputs` all call
