@@ -67,7 +67,7 @@ def round_to(src: Signal, dst: str, shift: int, dst_bits: int, mode: str) -> lis
     out.append(Assign(q, Shr(src, shift)))
     if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
         return out + [Assign(_sig(dst, dst_bits), Resize(q, dst_bits))]
-    inc = Signal(f"{dst}_inc", 1, logic=True)
+    inc = Signal(f"{dst}_inc", 1, logic=True, scalar=True)
     kept = Bit(q, 0)
     if shift >= 2:
         kept = Or(Paren(ReduceOr(Slice(src, shift - 2, 0))), kept)

@@ -26,12 +26,12 @@ from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
 from .common import SUFFIX, check_language, module_name, vector_file
-from .verilog import piecewise_clocked_testbench, verilog_testbench
-from .vhdl import _vhdl_name, piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 from .datapath import sized_piecewise_netlist
 from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend, LeadingZeros,
                       Module, Not, Output, Param, Registers, Saturate, ShiftBy, Signal, Slice,
                       rename, verilog, vhdl)
+from .verilog import piecewise_clocked_testbench, verilog_testbench
+from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 
 __all__ = ["exponent_facts", "exponent_netlist", "exponent_module", "exponent_testbench",
            "exponent_files"]
@@ -208,7 +208,6 @@ def exponent_module(design, language: str = "verilog", *, version: str = "",
     m = exponent_netlist(design, version=version, command=command)
     if check_language(language) == "verilog":
         return verilog(m)
-    _vhdl_name(module_name(design.core))
     return vhdl(m)
 
 

@@ -36,13 +36,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from chebnorm.core.textsafe import identifier
+
 from .common import comment_lines
 
 __all__ = ["Signal", "Const", "Slice", "Bit", "Concat", "Not", "ZeroExt", "Resize", "Extend",
            "Shl", "Shr", "Neg", "Add", "Sub", "Mul", "Gate", "And", "Or", "ReduceOr", "Group",
            "Paren", "BitVec", "Assign", "ConstDecl", "Rom", "Registers", "Saturate", "Output",
            "Comment", "Module", "vhdl_entity", "VHDL_WRAP", "ShiftBy", "Declare", "Param",
-           "LeadingZeros", "rename",
+           "LeadingZeros", "rename", "Flip", "Pad", "Table", "vhdl_name",
            "verilog", "vhdl", "statement_lines", "evaluate", "signed_literal", "vhdl_bits"]
 
 
@@ -121,20 +123,26 @@ class Signal:
     signed : bool, default False
         Two's complement (Verilog ``signed``, VHDL ``signed``); else unsigned.
     logic : bool, default False
-        A plain bit vector (VHDL ``std_logic_vector``, ``std_logic`` when one bit wide);
-        unsigned in arithmetic. Not with ``signed``.
+        A plain bit vector (VHDL ``std_logic_vector``); unsigned in arithmetic. Not
+        with ``signed``.
+    scalar : bool, default False
+        One bit, not a vector (VHDL ``std_logic``, a Verilog ``wire`` without range);
+        ``width`` 1, ``logic``.
     """
 
     name: str
     width: int
     signed: bool = False
     logic: bool = False
+    scalar: bool = False
 
     def __post_init__(self):
         if not isinstance(self.width, int) or self.width < 1:
             raise _refuse(f"signal {self.name!r}", f"width {self.width!r}; accepted: an integer >= 1")
         if self.signed and self.logic:
             raise _refuse(f"signal {self.name!r}", "signed and logic; accepted: one of them")
+        if self.scalar and (self.width != 1 or not self.logic):
+            raise _refuse(f"signal {self.name!r}", "scalar; accepted: with width 1 and logic")
 
 
 def _check_expr(e, what: str):
@@ -435,6 +443,62 @@ class Shr(Shl):
 
 
 @dataclass(frozen=True)
+class Flip:
+    """An unsigned vector with every bit XORed with one bit, or with its
+    complement (``invert``): a symmetric table's folding.
+
+    Parameters
+    ----------
+    a : expression
+        The unsigned vector.
+    bit : Bit
+        The bit.
+    invert : bool, default True
+        XOR with the complement of ``bit``.
+    """
+
+    a: object
+    bit: object
+    invert: bool = True
+
+    def __post_init__(self):
+        if _check_expr(self.a, "Flip").signed or not isinstance(self.bit, Bit):
+            raise _refuse("Flip", "accepted: an unsigned vector and a Bit")
+
+    @property
+    def width(self) -> int:
+        """The vector's width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """Unsigned."""
+        return False
+
+
+@dataclass(frozen=True)
+class Pad:
+    """An unsigned value zero-extended to ``width`` bits.
+
+    Parameters
+    ----------
+    a : expression
+        The unsigned value.
+    width : int
+        The new width, ``>= a.width``.
+    """
+
+    a: object
+    width: int
+    signed = False
+
+    def __post_init__(self):
+        if _check_expr(self.a, "Pad").signed or self.width < self.a.width:
+            raise _refuse("Pad", f"{_kind(self.a)} to {self.width}; accepted: unsigned, a "
+                                 f"width at least its own")
+
+
+@dataclass(frozen=True)
 class ShiftBy:
     """A bit vector shifted left by a variable amount (zeros in).
 
@@ -690,7 +754,8 @@ class Paren(Group):
     """
 
 
-_EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, ShiftBy, Neg, Add, Sub,
+_EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, ShiftBy, Flip, Pad,
+         Neg, Add, Sub,
          Mul, Gate, And, ReduceOr, Group)
 
 
@@ -772,6 +837,33 @@ class Rom:
         for row in self.rows:
             for q, o in zip(row, self.outputs, strict=True):
                 Const(int(q), o.width)
+
+
+@dataclass(frozen=True)
+class Table:
+    """An unsigned ROM of one column: ``dst = values[address]`` (0 past the
+    last value).
+
+    Parameters
+    ----------
+    dst : Signal
+        The unsigned output.
+    address : Signal
+        The address (a bit vector).
+    values : tuple of int
+        The entries, at most ``2**address.width``, each fitting ``dst``.
+    """
+
+    dst: Signal
+    address: Signal
+    values: tuple
+
+    def __post_init__(self):
+        if self.dst.signed or len(self.values) > 2 ** self.address.width:
+            raise _refuse("Table", f"{len(self.values)} values into {self.dst!r}; accepted: "
+                                   f"an unsigned signal, at most 2^{self.address.width} values")
+        for v in self.values:
+            Const(int(v), self.dst.width, signed=False)
 
 
 @dataclass(frozen=True)
@@ -981,12 +1073,12 @@ def rename(node, signals: dict):
 
 def _vhdl_type(s: Signal) -> str:
     if s.logic:
-        return "std_logic" if s.width == 1 else f"std_logic_vector({s.width - 1} downto 0)"
+        return "std_logic" if s.scalar else f"std_logic_vector({s.width - 1} downto 0)"
     return f"{'signed' if s.signed else 'unsigned'}({s.width - 1} downto 0)"
 
 
 def _verilog_type(s: Signal, kind: str = "wire") -> str:
-    if s.width == 1 and s.logic:
+    if s.scalar:
         return kind
     return f"{kind} {'signed ' if s.signed else ''}[{s.width - 1}:0]"
 
@@ -1012,6 +1104,8 @@ _VERILOG = {
     Shl: lambda e, p: f"{p(e.a)} <<< {e.k}",
     Shr: lambda e, p: f"{p(e.a)} >>> {e.k}",
     ShiftBy: lambda e, p: f"{p(e.a)} << {p(e.amount)}",
+    Flip: lambda e, p: f"{p(e.a)} ^ {{{e.width}{{{'~' if e.invert else ''}{p(e.bit)}}}}}",
+    Pad: lambda e, p: p(e.a),
     Neg: lambda e, p: f"-{p(e.a)}",
     Add: lambda e, p: " + ".join(p(t) for t in e.terms),
     Sub: lambda e, p: f"{p(e.a)} - {p(e.b)}",
@@ -1045,6 +1139,9 @@ _VHDL = {
     Extend: lambda e, p: f"resize({p(e.a)}, {e.width})",
     Shl: lambda e, p: f"shift_left({p(e.a)}, {e.k})",
     Shr: lambda e, p: f"shift_right({p(e.a)}, {e.k})",
+    Flip: lambda e, p: (f"{p(e.a)} xor ({e.width - 1} downto 0 => "
+                        f"{'not ' if e.invert else ''}{p(e.bit)})"),
+    Pad: lambda e, p: f"resize({p(e.a)}, {e.width})",
     ShiftBy: lambda e, p: (f"std_logic_vector(shift_left(unsigned({p(e.a)}), "
                            f"to_integer({p(e.amount)})))"),
     Neg: lambda e, p: f"-{p(e.a)}",
@@ -1095,6 +1192,10 @@ def _vhdl_value(dst: Signal, e) -> str:
     return text
 
 
+def _hex(value: int, bits: int) -> str:
+    return f"{bits}'h{int(value):0{(bits + 3) // 4}x}"
+
+
 def _verilog_context(e) -> None:
     """Refuse a widening :class:`Resize` of a value Verilog would compute at the
     wider width (a sum, a difference, a negation, a left shift): VHDL computes it
@@ -1123,6 +1224,13 @@ def _verilog_statement(s) -> list[str]:
         return [f"    assign y = {_expr(s.expr, 'verilog')};"]
     if isinstance(s, Declare):
         return [f"    {_verilog_type(s.signal)} {s.signal.name};"]
+    if isinstance(s, Table):
+        d, a, w = s.dst.name, s.address, s.dst.width
+        return [f"    {_verilog_type(s.dst, 'reg')} {d};", "    always @(*) begin",
+                f"        case ({a.name})",
+                *(f"            {_hex(i, a.width)}: {d} = {_hex(v, w)};"
+                  for i, v in enumerate(s.values)),
+                f"            default: {d} = {_hex(0, w)};", "        endcase", "    end"]
     if isinstance(s, Param):
         return [f"    localparam {s.name} = {s.value};"]
     if isinstance(s, LeadingZeros):
@@ -1168,6 +1276,15 @@ def _vhdl_statement(s) -> tuple[list[str], list[str]]:
         return [], [f"    y <= {text if _is_logic(s.expr) else f'std_logic_vector({text})'};"]
     if isinstance(s, Declare):
         return [f"    signal {s.signal.name} : {_vhdl_type(s.signal)};"], []
+    if isinstance(s, Table):
+        d, n, w = s.dst.name, len(s.values), s.dst.width
+        rows = [f"        \"{int(v):0{w}b}\"{',' if i < n - 1 else ''}"
+                for i, v in enumerate(s.values)]
+        address = s.address.name if s.address.logic else f"std_logic_vector({s.address.name})"
+        return ([f"    type {d}_t is array (0 to {n - 1}) of unsigned({w - 1} downto 0);",
+                 f"    constant {d.upper()}_ROM : {d}_t := (", *rows, "    );",
+                 f"    signal {d} : {_vhdl_type(s.dst)};"],
+                [f"    {d} <= {d.upper()}_ROM(to_integer(unsigned({address})));"])
     if isinstance(s, Param):
         return [f"    constant {s.name} : natural := {s.value};"], []
     if isinstance(s, LeadingZeros):
@@ -1317,6 +1434,33 @@ def vhdl_entity(name: str, in_bits: int, out_bits: int, latency: int = 0) -> lis
             "    );", f"end entity {name};", ""]
 
 
+def vhdl_name(name: str) -> str:
+    """``name`` if it is a VHDL basic identifier (no ``__``, no trailing ``_``).
+
+    Parameters
+    ----------
+    name : str
+        A module (entity) name.
+
+    Returns
+    -------
+    str
+        ``name``.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a safe identifier, or has two underscores in a row or a trailing
+        one.
+    """
+    identifier(name, field="module name")
+    if "__" in name or name.endswith("_"):
+        raise ValueError(f"module name {name!r} is not a VHDL identifier: VHDL forbids two "
+                         f"underscores in a row and a trailing underscore; accepted: a table "
+                         f"name without them")
+    return name
+
+
 def vhdl(module: Module) -> str:
     """The VHDL-2008 text of ``module``: banner, entity, architecture
     (``wrap``, the declarations, the statements).
@@ -1330,15 +1474,22 @@ def vhdl(module: Module) -> str:
     -------
     str
         The entity and architecture text, ending with a newline.
+
+    Raises
+    ------
+    ValueError
+        If the module's name is not a VHDL identifier (:func:`vhdl_name`).
     """
     m = module
+    vhdl_name(m.name)
     out = comment_lines(_facts(m, "vhdl"), "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
     decl, stmt = [], []
     for s in m.statements:
         d, b = _vhdl_statement(s)
         decl += d
         stmt += b
-    out += [f"architecture rtl of {m.name} is", *VHDL_WRAP, *decl, "begin", *stmt,
+    wrap = VHDL_WRAP if any("wrap(" in line for line in stmt) else []
+    out += [f"architecture rtl of {m.name} is", *wrap, *decl, "begin", *stmt,
             "end architecture rtl;", ""]
     return "\n".join(out)
 
@@ -1380,6 +1531,12 @@ def _value(e, env: dict) -> int:
         return _value(e.a, env) >> e.k   # floor: arithmetic for signed, logical for unsigned
     if t is Neg:
         return _wrap(-_value(e.a, env), e.width, True)
+    if t is Flip:
+        mask = (1 << e.width) - 1
+        bit = _value(e.bit, env) ^ int(e.invert)
+        return _value(e.a, env) ^ (mask if bit else 0)
+    if t is Pad:
+        return _value(e.a, env)
     if t is ShiftBy:
         return (_value(e.a, env) << _value(e.amount, env)) & ((1 << e.width) - 1)
     if t is Add:
@@ -1439,6 +1596,9 @@ def evaluate(module: Module, code: int) -> dict:
                 env[d.name] = env[src.name]
         elif isinstance(s, Output):
             env["y"] = _value(s.expr, env) & (2 ** module.out_bits - 1)
+        elif isinstance(s, Table):
+            a = env[s.address.name]
+            env[s.dst.name] = int(s.values[a]) if a < len(s.values) else 0
         elif isinstance(s, LeadingZeros):
             v = env[s.src.name]
             env[s.dst.name] = s.src.width - v.bit_length()

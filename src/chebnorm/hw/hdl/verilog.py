@@ -28,11 +28,12 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
+from .bench import bench_ports, bench_verdict, testbench
+from .common import module_name, pipelined_name
 from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to,
                        sized_piecewise_netlist)
 from .netlist import Signal, signed_literal, statement_lines
 from .netlist import verilog as _verilog
-from .common import module_name, pipelined_name, vectors_name
 
 __all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
            "verilog_module", "verilog_pipelined_module", "verilog_testbench",
@@ -125,34 +126,6 @@ def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat,
                          rounding, min_bits=min_bits)[1:]   # no comment line
     return [line for s in stage for line in statement_lines(s, "verilog")[1]] + ["endmodule", ""]
 
-
-
-def bench_verdict(name: str) -> list[str]:
-    """The last lines of an exhaustive test bench of ``name`` that counted
-    ``errors`` over ``COUNT`` vectors: print the one ``PASS:``/``FAIL:`` line
-    the simulation runners read, then ``$finish``.
-
-    >>> print("\\n".join(bench_verdict("chebnorm_f")[:2]))
-            if (errors == 0)
-                $display("PASS: %0d vectors, 0 mismatches (chebnorm_f)", COUNT);
-
-    Parameters
-    ----------
-    name : str
-        The module name printed in the verdict (an identifier).
-
-    Returns
-    -------
-    list of str
-        Verilog lines, ending with ``endmodule`` and an empty line.
-    """
-    return ["        if (errors == 0)",
-            f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
-            "        else",
-            f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
-            "        $finish;",
-            "    end",
-            "endmodule", ""]
 
 
 # -- Horner evaluator ---------------------------------------------------------------
@@ -280,57 +253,7 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     >>> verilog_pipelined_testbench(d).splitlines()[0]
     '// tb_chebnorm_dichotomy_d1_pipe: exhaustive self-checking test bench of chebnorm_dichotomy_d1_pipe, latency 1.'
     """
-    return _clocked_bench(design, pipelined_name(design), design.steps, vectors)
-
-
-def _clocked_bench(design, name: str, n: int, vectors: str | None) -> str:
-    """The exhaustive bench of clocked module ``name`` of latency ``n``."""
-    vectors = vectors_name(name, vectors)
-    count = 2 ** design.in_bits
-    return "\n".join([
-        f"// tb_{name}: exhaustive self-checking test bench of {name}, latency {n}.",
-        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
-        "`timescale 1ns/1ps",
-        f"module tb_{name};",
-        f"    localparam IN_BITS = {design.in_bits};",
-        f"    localparam OUT_BITS = {design.out_bits};",
-        f"    localparam LATENCY = {n};",
-        f"    localparam COUNT = {count};",
-        "    reg clk;",
-        "    reg  [IN_BITS-1:0]  x;",
-        "    wire [OUT_BITS-1:0] y;",
-        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
-        "    integer i, errors, checked;",
-        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS), .LATENCY(LATENCY)) dut "
-        "(.clk(clk), .x(x), .y(y));",
-        "    initial begin",
-        f"        $readmemh(\"{vectors}\", expected);",
-        "        errors = 0;",
-        "        checked = 0;",
-        "        clk = 0;",
-        "        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin",
-        "            x = (i < COUNT) ? i : 0;",
-        "            #1 clk = 1;",
-        "            #1;",
-        "            if (i >= LATENCY - 1) begin",
-        "                checked = checked + 1;",
-        "                if (y !== expected[i - LATENCY + 1]) begin",
-        "                    errors = errors + 1;",
-        "                    if (errors <= 10)",
-        "                        $display(\"MISMATCH x=%h y=%h expected=%h\", i - LATENCY + 1, y,",
-        "                                 expected[i - LATENCY + 1]);",
-        "                end",
-        "            end",
-        "            clk = 0;",
-        "        end",
-        "        if (errors == 0)",
-        f"            $display(\"PASS: %0d vectors, 0 mismatches ({name}, latency %0d)\", "
-        "checked, LATENCY);",
-        "        else",
-        f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", checked, errors);",
-        "        $finish;",
-        "    end",
-        "endmodule", ""])
+    return testbench(bench_ports(design, pipelined_name(design), design.steps), "verilog", vectors)
 
 
 def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -365,36 +288,7 @@ def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     >>> '$readmemh("chebnorm_dichotomy_d1.hex", expected);' in tb
     True
     """
-    name = module_name(design)
-    vectors = vectors_name(name, vectors)
-    count = 2 ** design.in_bits
-    return "\n".join([
-        f"// tb_{name}: exhaustive self-checking test bench of {name}.",
-        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
-        "`timescale 1ns/1ps",
-        f"module tb_{name};",
-        f"    localparam IN_BITS = {design.in_bits};",
-        f"    localparam OUT_BITS = {design.out_bits};",
-        f"    localparam COUNT = {count};",
-        "    reg  [IN_BITS-1:0]  x;",
-        "    wire [OUT_BITS-1:0] y;",
-        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
-        "    integer i, errors;",
-        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS)) dut (.x(x), .y(y));",
-        "    initial begin",
-        f"        $readmemh(\"{vectors}\", expected);",
-        "        errors = 0;",
-        "        for (i = 0; i < COUNT; i = i + 1) begin",
-        "            x = i;",
-        "            #1;",
-        "            if (y !== expected[i]) begin",
-        "                errors = errors + 1;",
-        "                if (errors <= 10)",
-        "                    $display(\"MISMATCH x=%h y=%h expected=%h\", x, y, expected[i]);",
-        "            end",
-        "        end",
-        *bench_verdict(name)])
-
+    return testbench(bench_ports(design, module_name(design)), "verilog", vectors)
 
 # -- piecewise evaluator -------------------------------------------------------------
 
@@ -505,4 +399,4 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     ValueError
         If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
-    return _clocked_bench(d, module_name(d), d.latency, vectors)
+    return testbench(bench_ports(d, module_name(d), d.latency), "verilog", vectors)

@@ -33,12 +33,12 @@ compared code for code) and reports one ``PASS:``/``FAIL:`` line. VHDL-2008
 
 from __future__ import annotations
 
-from chebnorm.core.textsafe import identifier
 
 from ..horner import HornerDesign
+from .bench import bench_ports, testbench
+from .common import module_name, pipelined_name
 from .datapath import horner_netlist, piecewise_netlist, sized_piecewise_netlist
 from .netlist import vhdl as _vhdl
-from .common import module_name, pipelined_name, vectors_name
 
 __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
            "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
@@ -46,16 +46,6 @@ __all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"
-
-
-def _vhdl_name(name: str) -> str:
-    """``name`` if it is a VHDL basic identifier (no ``__``, no trailing ``_``)."""
-    identifier(name, field="module name")
-    if "__" in name or name.endswith("_"):
-        raise ValueError(f"module name {name!r} is not a VHDL identifier: VHDL forbids two "
-                         f"underscores in a row and a trailing underscore; accepted: a table "
-                         f"name without them")
-    return name
 
 
 def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None = None,
@@ -91,7 +81,6 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
     ValueError
         If the design's name is not a safe identifier.
     """
-    _vhdl_name(design.module_name)
     return _vhdl(horner_netlist(design, language="vhdl", version=version, command=command,
                                 budget=budget))
 
@@ -137,118 +126,9 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
     >>> [line.strip() for line in v.splitlines() if line.startswith("entity")]
     ['entity chebnorm_dichotomy_d1_pipe is']
     """
-    if design.degree >= 1:
-        _vhdl_name(pipelined_name(design))
     return _vhdl(horner_netlist(design, pipelined=True, language="vhdl", version=version,
                                 command=command, budget=budget))
 
-
-
-_HEX = [
-    "    -- one hex word of a vector file (the $readmemh format the Verilog bench reads)",
-    "    function from_hex(s : string; n : positive) return std_logic_vector is",
-    "        variable v : unsigned(4 * s'length + n - 1 downto 0) := (others => '0');",
-    "        variable d : natural;",
-    "    begin",
-    "        for i in s'range loop",
-    "            case s(i) is",
-    "                when '0' to '9' => d := character'pos(s(i)) - character'pos('0');",
-    "                when 'a' to 'f' => d := character'pos(s(i)) - character'pos('a') + 10;",
-    "                when 'A' to 'F' => d := character'pos(s(i)) - character'pos('A') + 10;",
-    "                when others => report \"bad hex digit in vector file\" severity failure;",
-    "            end case;",
-    "            v := shift_left(v, 4) + to_unsigned(d, v'length);",
-    "        end loop;",
-    "        return std_logic_vector(v(n - 1 downto 0));",
-    "    end function;",
-]
-
-
-def _bench(design, name: str, vectors: str | None, clocked: bool,
-           latency: int | None = None) -> str:
-    vectors = vectors_name(name, vectors)
-    count = 2 ** design.in_bits
-    n = getattr(design, "steps", design.degree) if latency is None else latency
-    digits = (design.out_bits + 3) // 4
-    latency = n if clocked else 1
-    dut_generics = "IN_BITS => IN_BITS, OUT_BITS => OUT_BITS" + \
-        (", LATENCY => LATENCY" if clocked else "")
-    dut_ports = ("clk => clk, " if clocked else "") + "x => x, y => y"
-    step = (["            x <= std_logic_vector(to_unsigned(i mod COUNT, IN_BITS));",
-             "            wait for 1 ns;", "            clk <= '1';", "            wait for 1 ns;"]
-            if clocked else
-            ["            x <= std_logic_vector(to_unsigned(i, IN_BITS));",
-             "            wait for 1 ns;"])
-    k = "i - LATENCY + 1" if clocked else "i"
-    return "\n".join([
-        f"-- tb_{name}: exhaustive self-checking test bench of {name}"
-        + (f", latency {n}." if clocked else "."),
-        f"-- Expected outputs come from the chebnorm bit-accurate model ({vectors});",
-        f"-- the outputs seen are written to {name}_vhdl_y.hex. VHDL-2008.",
-        "library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;",
-        "use std.textio.all;", "",
-        f"entity tb_{name} is", f"end entity tb_{name};", "",
-        f"architecture bench of tb_{name} is",
-        f"    constant IN_BITS  : natural := {design.in_bits};",
-        f"    constant OUT_BITS : natural := {design.out_bits};",
-        f"    constant LATENCY  : natural := {latency};",
-        f"    constant COUNT    : natural := {count};",
-        "    type vectors_t is array (0 to COUNT - 1) of std_logic_vector(OUT_BITS - 1 downto 0);",
-        *_HEX,
-        "    signal clk : std_logic := '0';",
-        "    signal x   : std_logic_vector(IN_BITS - 1 downto 0) := (others => '0');",
-        "    signal y   : std_logic_vector(OUT_BITS - 1 downto 0);",
-        "    function to_hex(v : std_logic_vector) return string is",
-        f"        variable u : unsigned({4 * digits - 1} downto 0) := resize(unsigned(v), "
-        f"{4 * digits});",
-        f"        variable s : string(1 to {digits});",
-        "        constant HEX : string(1 to 16) := \"0123456789abcdef\";",
-        "    begin",
-        f"        for i in 0 to {digits - 1} loop",
-        f"            s({digits} - i) := HEX(to_integer(u(4 * i + 3 downto 4 * i)) + 1);",
-        "        end loop;",
-        "        return s;",
-        "    end function;",
-        "begin",
-        f"    dut : entity work.{name}",
-        f"        generic map ({dut_generics})",
-        f"        port map ({dut_ports});",
-        "    check : process",
-        f"        file vf : text open read_mode is \"{vectors}\";",
-        f"        file yf : text open write_mode is \"{name}_vhdl_y.hex\";",
-        "        variable l, o : line;",
-        "        variable expected : vectors_t;",
-        "        variable errors, checked : natural := 0;",
-        "    begin",
-        "        for i in 0 to COUNT - 1 loop",
-        "            readline(vf, l);",
-        "            expected(i) := from_hex(l.all, OUT_BITS);",
-        "        end loop;",
-        "        for i in 0 to COUNT + LATENCY - 2 loop",
-        *step,
-        "            if i >= LATENCY - 1 then",
-        "                checked := checked + 1;",
-        "                write(o, to_hex(y));",
-        "                writeline(yf, o);",
-        f"                if y /= expected({k}) then",
-        "                    errors := errors + 1;",
-        "                    if errors <= 10 then",
-        f"                        report \"MISMATCH x=\" & integer'image({k}) & \" y=\" & to_hex(y)",
-        f"                            & \" expected=\" & to_hex(expected({k}));",
-        "                    end if;",
-        "                end if;",
-        "            end if;",
-        *(["            clk <= '0';"] if clocked else []),
-        "        end loop;",
-        "        if errors = 0 then",
-        f"            report \"PASS: \" & integer'image(checked) & \" vectors, 0 mismatches ({name})\";",
-        "        else",
-        f"            report \"FAIL: \" & integer'image(checked) & \" vectors, \" & "
-        f"integer'image(errors) & \" mismatches ({name})\";",
-        "        end if;",
-        "        wait;",
-        "    end process check;",
-        "end architecture bench;", ""])
 
 
 def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -281,8 +161,7 @@ def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     >>> "chebnorm_dichotomy_d1.hex" in tb, "chebnorm_dichotomy_d1_vhdl_y.hex" in tb
     (True, True)
     """
-    name = design.module_name
-    return _bench(design, name, vectors, clocked=False)
+    return testbench(bench_ports(design, design.module_name), "vhdl", vectors)
 
 
 def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -317,8 +196,7 @@ def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -
     >>> [line.strip() for line in vhdl_pipelined_testbench(d).splitlines() if "LATENCY" in line][:1]
     ['constant LATENCY  : natural := 1;']
     """
-    name = pipelined_name(design)
-    return _bench(design, name, vectors, clocked=True)
+    return testbench(bench_ports(design, pipelined_name(design), design.steps), "vhdl", vectors)
 
 
 # -- piecewise evaluator -------------------------------------------------------------
@@ -358,7 +236,6 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """
     if d.sized:
         return sized_piecewise_vhdl(d, version=version, command=command)
-    _vhdl_name(module_name(d))
     return _vhdl(piecewise_netlist(d, version=version, command=command))
 
 
@@ -393,7 +270,7 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     >>> piecewise_vhdl_testbench(design_piecewise(t, 8, 8)).splitlines()[0]
     '-- tb_chebnorm_rs: exhaustive self-checking test bench of chebnorm_rs.'
     """
-    return _bench(d, module_name(d), vectors, clocked=False)
+    return testbench(bench_ports(d, module_name(d)), "vhdl", vectors)
 
 
 def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
@@ -426,7 +303,6 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
     >>> v.count("rising_edge(clk)"), "LATENCY  : natural := 2" in v
     (2, True)
     """
-    _vhdl_name(module_name(d))
     return _vhdl(sized_piecewise_netlist(d, version=version, command=command))
 
 
@@ -462,4 +338,4 @@ def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
     ValueError
         If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
-    return _bench(d, module_name(d), vectors, clocked=True, latency=d.latency)
+    return testbench(bench_ports(d, module_name(d), d.latency), "vhdl", vectors)
