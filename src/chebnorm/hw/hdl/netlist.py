@@ -167,6 +167,20 @@ def _kind(e) -> str:
     return f"{e.width} {'signed' if e.signed else 'unsigned'} bits"
 
 
+class _OfA:
+    """A node of its operand ``a``'s width and signedness (unless it says otherwise)."""
+
+    @property
+    def width(self) -> int:
+        """The operand's width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """The operand's signedness."""
+        return self.a.signed
+
+
 @dataclass(frozen=True)
 class Const:
     """A constant of ``width`` bits.
@@ -284,7 +298,7 @@ class Concat:
 
 
 @dataclass(frozen=True)
-class Not:
+class Not(_OfA):
     """Bitwise complement of an unsigned expression.
 
     Parameters
@@ -300,10 +314,6 @@ class Not:
         if _check_expr(self.a, "Not").signed:
             raise _refuse("Not", f"operand of {_kind(self.a)}; accepted: unsigned")
 
-    @property
-    def width(self) -> int:
-        """The operand's width."""
-        return self.a.width
 
 
 @dataclass(frozen=True)
@@ -392,14 +402,12 @@ class Extend:
             raise _refuse("Extend", f"{_kind(self.a)} to {self.width}; accepted: a number, "
                                     f"a width at least its own")
 
-    @property
-    def signed(self) -> bool:
-        """The operand's signedness."""
-        return self.a.signed
+    signed = _OfA.signed
+
 
 
 @dataclass(frozen=True)
-class Shl:
+class Shl(_OfA):
     """Left shift by ``k`` bits within the operand's width (bits shifted out are lost).
 
     Parameters
@@ -418,15 +426,7 @@ class Shl:
         if not isinstance(self.k, int) or self.k < 0:
             raise _refuse(type(self).__name__, f"shift {self.k!r}; accepted: an integer >= 0")
 
-    @property
-    def width(self) -> int:
-        """The operand's width."""
-        return self.a.width
 
-    @property
-    def signed(self) -> bool:
-        """The operand's signedness."""
-        return self.a.signed
 
 
 @dataclass(frozen=True)
@@ -443,7 +443,7 @@ class Shr(Shl):
 
 
 @dataclass(frozen=True)
-class Flip:
+class Flip(_OfA):
     """An unsigned vector with every bit XORed with one bit, or with its
     complement (``invert``): a symmetric table's folding.
 
@@ -465,10 +465,6 @@ class Flip:
         if _check_expr(self.a, "Flip").signed or not isinstance(self.bit, Bit):
             raise _refuse("Flip", "accepted: an unsigned vector and a Bit")
 
-    @property
-    def width(self) -> int:
-        """The vector's width."""
-        return self.a.width
 
     @property
     def signed(self) -> bool:
@@ -499,7 +495,7 @@ class Pad:
 
 
 @dataclass(frozen=True)
-class ShiftBy:
+class ShiftBy(_OfA):
     """A bit vector shifted left by a variable amount (zeros in).
 
     Parameters
@@ -519,14 +515,10 @@ class ShiftBy:
                 and not self.amount.signed and not self.amount.logic):
             raise _refuse("ShiftBy", "accepted: a logic Signal shifted by an unsigned Signal")
 
-    @property
-    def width(self) -> int:
-        """The vector's width."""
-        return self.a.width
 
 
 @dataclass(frozen=True)
-class Neg:
+class Neg(_OfA):
     """Two's complement negation of a signed operand (modulo its width).
 
     Parameters
@@ -542,10 +534,6 @@ class Neg:
         if not _check_expr(self.a, "Neg").signed:
             raise _refuse("Neg", f"operand of {_kind(self.a)}; accepted: signed")
 
-    @property
-    def width(self) -> int:
-        """The operand's width."""
-        return self.a.width
 
 
 @dataclass(frozen=True)
@@ -632,7 +620,7 @@ class Mul:
 
 
 @dataclass(frozen=True)
-class Gate:
+class Gate(_OfA):
     """``a`` where bit ``bit`` equals ``on``, else zero (a row of a truncated
     multiplier: an AND with the bit repeated).
 
@@ -654,15 +642,7 @@ class Gate:
         if not isinstance(self.a, Signal) or not isinstance(self.bit, Bit):
             raise _refuse("Gate", "accepted: a Signal gated by a Bit")
 
-    @property
-    def width(self) -> int:
-        """The gated signal's width."""
-        return self.a.width
 
-    @property
-    def signed(self) -> bool:
-        """The gated signal's signedness."""
-        return self.a.signed
 
 
 @dataclass(frozen=True)
@@ -717,7 +697,7 @@ class ReduceOr:
 
 
 @dataclass(frozen=True)
-class Group:
+class Group(_OfA):
     """Parentheses the Verilog text has (and the VHDL text has not): no
     change of value.
 
@@ -732,15 +712,7 @@ class Group:
     def __post_init__(self):
         _check_expr(self.a, type(self).__name__)
 
-    @property
-    def width(self) -> int:
-        """The operand's width."""
-        return self.a.width
 
-    @property
-    def signed(self) -> bool:
-        """The operand's signedness."""
-        return self.a.signed
 
 
 @dataclass(frozen=True)
