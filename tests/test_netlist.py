@@ -211,6 +211,24 @@ def test_mismatches_are_refused_naming_the_node(build, match):
         build()
 
 
+@pytest.mark.parametrize("expr, match", [
+    (lambda a: Shr(Resize(a, 3), 1), "Resize: 5 signed bits narrowed to 3 bits under an "
+                                     "operation that reads its high bits"),
+    (lambda a: Add((Gate(a, Bit(Signal("x", 4, logic=True), 0)), a)), "Gate: inside an "
+                                                                      "expression"),
+])
+def test_verilog_refuses_what_its_context_would_change(expr, match):
+    """Verilog sizes an expression by its context: a narrowing the IR makes under a
+    right shift, or an AND nested in a sum, would print as a different value."""
+    m = Module("chebnorm_w", 4, 4)
+    a = _s("a", 5)
+    e = expr(a)
+    m.statements += [Assign(a, ZeroExt(m.x)), Assign(_s("b", e.width), e)]
+    with pytest.raises(ValueError, match=match):
+        verilog(m)
+    vhdl(m)   # VHDL computes what the IR says: nothing to refuse
+
+
 def test_verilog_refuses_a_widened_sum():
     """A sum widened by Resize would be computed at the wider width by Verilog
     and at the operands' by VHDL: refused rather than printed two ways."""

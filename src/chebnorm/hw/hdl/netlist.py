@@ -1168,19 +1168,35 @@ def _hex(value: int, bits: int) -> str:
     return f"{bits}'h{int(value):0{(bits + 3) // 4}x}"
 
 
-def _verilog_context(e) -> None:
-    """Refuse a widening :class:`Resize` of a value Verilog would compute at the
-    wider width (a sum, a difference, a negation, a left shift): VHDL computes it
-    at the operands' width, the texts would differ in value."""
+def _verilog_context(e, top: bool = True, high: bool = False) -> None:
+    """Refuse what the Verilog text would compute otherwise than the IR says
+    (VHDL computes exactly the IR): Verilog sizes an expression by its context,
+    so a :class:`Resize` printed as nothing (1) must not widen a sum, a
+    difference, a negation or a left shift (Verilog would compute it at the
+    wider width), and (2) must not narrow a value whose high bits a consumer
+    reads (``high``: a right shift, an extension, a concatenation -- Verilog
+    would keep them); (3) a :class:`Gate` (an AND, unsigned in Verilog) must be
+    the whole value of its assignment."""
+    if isinstance(e, Gate) and not top:
+        raise _refuse("Gate", "inside an expression; accepted: the whole value of an Assign "
+                              "(Verilog's AND with a repeated bit is unsigned)")
+    if isinstance(e, Resize):
+        if e.width > e.a.width and type(e.a) in (Add, Sub, Neg, Shl):
+            raise _refuse("Resize", f"{type(e.a).__name__} of {_kind(e.a)} widened to "
+                                    f"{e.width} bits; accepted: widen the operands (Verilog "
+                                    f"computes it at the wider width)")
+        if e.width < e.a.width and high:
+            raise _refuse("Resize", f"{_kind(e.a)} narrowed to {e.width} bits under an "
+                                    f"operation that reads its high bits; accepted: narrow "
+                                    f"in an assignment of its own")
+    below = (isinstance(e, (Shr, Extend, Pad, ZeroExt, Concat))
+             or (isinstance(e, Resize) and e.width > e.a.width)
+             or (high and not (isinstance(e, Resize) and e.width < e.a.width)))
     for name in ("a", "b"):
-        if hasattr(e, name) and isinstance(getattr(e, name), _EXPR):
-            _verilog_context(getattr(e, name))
+        if isinstance(getattr(e, name, None), _EXPR):
+            _verilog_context(getattr(e, name), False, below)
     for t in getattr(e, "terms", ()) or getattr(e, "parts", ()):
-        _verilog_context(t)
-    if isinstance(e, Resize) and e.width > e.a.width and isinstance(e.a, (Add, Sub, Neg, Shl)):
-        raise _refuse("Resize", f"{type(e.a).__name__} of {_kind(e.a)} widened to {e.width} "
-                                f"bits; accepted: widen the operands (Verilog computes it at "
-                                f"the wider width)")
+        _verilog_context(t, False, below)
 
 
 def _verilog_statement(s) -> list[str]:
@@ -1193,6 +1209,7 @@ def _verilog_statement(s) -> list[str]:
     if isinstance(s, Comment):
         return [f"    // {_comment(s.text, 'verilog')}"]
     if isinstance(s, Output):
+        _verilog_context(s.expr)
         return [f"    assign y = {_expr(s.expr, 'verilog')};"]
     if isinstance(s, Declare):
         return [f"    {_verilog_type(s.signal)} {s.signal.name};"]
