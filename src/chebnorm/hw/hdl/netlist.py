@@ -22,14 +22,17 @@ printed module never relies on an implicit conversion the other language
 lacks. :func:`evaluate` computes any signal of a combinational module from
 its input code in Python (two's complement, the node semantics above).
 
->>> x = Signal("x", 4)
->>> m = Module("chebnorm_neg", 4, 5, facts=["negate"], statements=[
-...     Assign(Signal("n", 5, signed=True), Neg(ZeroExt(x))),
-...     Assign(Signal("y", 5), Resize(Signal("n", 5, signed=True), 5, signed=False))])
->>> print(verilog(m).splitlines()[-3])
+>>> m = Module("chebnorm_neg", 4, 5, facts=["negate"])
+>>> n = Signal("n", 5, signed=True)
+>>> m.statements += [Assign(n, Neg(ZeroExt(m.x))), Output(n)]
+>>> print(chr(10).join(verilog(m).splitlines()[-3:-1]))
     wire signed [4:0] n = -$signed({1'b0, x});
->>> evaluate(m, 3)["n"]
--3
+    assign y = n;
+>>> print(chr(10).join(vhdl(m).splitlines()[-3:-1]))
+    n <= -signed("0" & x);
+    y <= std_logic_vector(n);
+>>> evaluate(m, 3)["n"], evaluate(m, 3)["y"]
+(-3, 29)
 """
 
 from __future__ import annotations
