@@ -11,11 +11,11 @@ from types import SimpleNamespace
 import pytest
 
 from chebnorm.hw.hdl.datapath import output_stage, round_to
-from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Declare,
-                                     Extend, Gate, Group, LeadingZeros, Module, Mul, Neg, Not,
-                                     Output, Param, Registers, Resize, Rom, Saturate, Shl,
+from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Cut,
+                                     Declare, Extend, Gate, Group, LeadingZeros, Module, Mul, Neg,
+                                     Not, Output, Param, Registers, Resize, Rom, Saturate, Shl,
                                      ShiftBy, Shr, Signal, Slice, Sub, ZeroExt, evaluate, rename,
-                                     verilog, vhdl)
+                                     schedule, verilog, vhdl)
 from chebnorm.hw.hdl.verilog import piecewise_clocked_testbench, verilog_testbench
 from chebnorm.hw.hdl.vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 from chebnorm.hw.fixed import QFormat
@@ -165,6 +165,25 @@ def test_composite_simulates_every_code(tmp_path):
     for run in (simulate, simulate_vhdl):
         r = run(tmp_path, m.name)
         assert r.passed and r.vectors == 2 ** W and r.mismatches == 0, r.line
+
+
+def test_schedule_registers_what_is_live_across_each_cut():
+    """A cut registers the signals defined before it and read after it, in the
+    order they were defined (a constant, the port and a dead signal are not),
+    and the reads after it take the register."""
+    x = Signal("x", 4, logic=True)
+    u, v, w, dead = _s("u", 5), _s("v", 5), _s("w", 5), _s("dead", 5)
+    k = _s("K", 5)
+    st = schedule([ConstDecl(k, 3), Assign(u, ZeroExt(x)), Assign(dead, Neg(u)),
+                   Assign(v, Add((u, k))), Cut(0), Cut(1, label="two"),
+                   Assign(w, Sub(v, u)), Output(w)])
+    regs = [s for s in st if isinstance(s, Registers)]
+    assert [[(d.name, src.name) for d, src in r.pairs] for r in regs] == [
+        [("u_r0", "u"), ("v_r0", "v")], [("u_r1", "u_r0"), ("v_r1", "v_r0")]]
+    assert regs[1].label == "two"
+    assert st[-2] == Assign(w, Sub(_s("v_r1", 5), _s("u_r1", 5)))
+    m = Module("chebnorm_sch", 4, 5, statements=st, latency=2)
+    assert [evaluate(m, c)["y"] for c in range(16)] == [c + 3 - c for c in range(16)]
 
 
 def test_rename_refuses_another_type():

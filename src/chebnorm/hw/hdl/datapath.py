@@ -22,9 +22,8 @@ from __future__ import annotations
 
 from .common import (horner_facts, module_name, piecewise_facts, pipelined_name, shifted_width,
                      step_comment, variable_name)
-from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Extend,
-                      Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Registers, Resize,
-                      Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
+from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Cut,
+                      Extend, Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Resize, Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt, schedule)
 
 __all__ = ["round_to", "output_stage", "piecewise_netlist", "sized_piecewise_netlist",
            "horner_netlist"]
@@ -242,37 +241,24 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
     out.append(Assign(low, Slice(x, L - 1, 0)))
     cols = [_sig(f"c{j}", d.rom_bits[j]) for j in range(n + 1)]
     out += _rom(d, m, cols, d.coefficients)
-    # live signals, in order: name -> the signal that carries it now; registered at each cut
-    cur = {"low": low, **{c.name: c for c in cols}}
-    acc = f"c{n}"
-
-    def cut(stage) -> None:
-        pairs = []
-        for key, s in cur.items():
-            r = Signal(f"{key}_r{stage}", s.width, s.signed, s.logic)
-            pairs.append((r, s))
-            cur[key] = r
-        out.append(Registers(tuple(pairs)))
-
+    a = cols[n]   # the accumulator: c_n, then a_j
     if 0 in d.cuts:
-        cut(0)
+        out.append(Cut(0))
     for i, st in enumerate(d.sized_signals(), start=1):
         j, T = st["j"], st["T"]
-        lo = cur["low"]
         out.append(Comment(f"step {j}: a{j} = (((a{j + 1} * t{j}) {{shr}} {st['pshift']}) {{shl}} "
                            f"{st['qshift']} + c{j} {{shl}} {st['cshift']}) {{shr}} {st['ashift']}, "
                            f"t{j} = top {T} bits of t"
                            + (", truncated multiplier" if st["rows"] else "")))
         tj = _sig(f"t{j}", st["tw"])
         if t.centered:   # the top bit inverted is the sign of t - 1/2
-            top = (Not(BitVec(lo, L - 1)),) + ((Slice(lo, L - 2, L - T),) if T > 1 else ())
+            top = (Not(BitVec(low, L - 1)),) + ((Slice(low, L - 2, L - T),) if T > 1 else ())
             out.append(Assign(tj, Concat(top)))
         else:
-            out.append(Assign(tj, ZeroExt(Slice(lo, L - 1, L - T))))
-        a = cur[acc]
+            out.append(Assign(tj, ZeroExt(Slice(low, L - 1, L - T))))
         q = _sig(f"q{j}", st["qw"])
         if st["rows"]:
-            out += _truncated_rows(st, a, lo)
+            out += _truncated_rows(st, a, low)
         else:
             p = _sig(f"p{j}", st["pw"])
             ps = st["pshift"]
@@ -280,37 +266,26 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
                     Assign(q, Resize(Shr(p, ps), q.width) if ps > 0 else
                            Shl(Resize(p, q.width), -ps) if ps < 0 else Resize(p, q.width))]
         if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
-            cur.pop(acc, None)
-            if j == 0:
-                cur.pop("low", None)
-            cur[q.name] = q
-            cut(f"m{i}")
-            q = cur.pop(q.name)
-        c = cur.pop(f"c{j}")
+            out.append(Cut(f"m{i}"))
+        c = cols[j]
         ctx = max(st["qw"], st["sw"], c.width)
         qv = Group(Shl(Resize(q, ctx), st["qshift"])) if st["qshift"] else Resize(q, ctx)
         cv = Group(Shl(Resize(c, ctx), st["cshift"]) if st["cshift"] else Resize(c, ctx))
         s = _sig(f"s{j}", st["sw"])
         out.append(Assign(s, Resize(Add((qv, cv)), s.width)))
-        aj = _sig(f"a{j}", st["aw"])
-        out.append(Assign(aj, Resize(Shr(s, st["ashift"]), aj.width) if st["ashift"]
-                          else Resize(s, aj.width)))
-        cur.pop(acc, None)
-        acc = aj.name
-        cur[acc] = aj
-        if j == 0:
-            cur.pop("low", None)
+        a = _sig(f"a{j}", st["aw"])
+        out.append(Assign(a, Resize(Shr(s, st["ashift"]), a.width) if st["ashift"]
+                          else Resize(s, a.width)))
         if i in d.cuts:
-            cut(i)
+            out.append(Cut(i))
     if n == 0:
         f0, g0 = d.coef_frac[0], d.acc_frac[0]
-        wide = Resize(cur["c0"], d.rom_bits[0] + max(0, g0 - f0))
-        a0 = _sig("a0", wide.width)
-        out.append(Assign(a0, Shr(wide, f0 - g0) if f0 > g0 else
+        wide = Resize(cols[0], d.rom_bits[0] + max(0, g0 - f0))
+        a = _sig("a0", wide.width)
+        out.append(Assign(a, Shr(wide, f0 - g0) if f0 > g0 else
                           Shl(wide, g0 - f0) if g0 > f0 else wide))
-        cur[acc] = a0
-    top = cur[acc]
-    out += output_stage(top, d.y_format.frac_bits, d.y_format, d.out_bits, "trunc")
+    out += output_stage(a, d.y_format.frac_bits, d.y_format, d.out_bits, "trunc")
+    m.statements[:] = schedule(out)
     return m
 
 
@@ -364,7 +339,9 @@ def horner_netlist(design, *, pipelined: bool = False, language: str | None = No
     ``x``'s value, the Horner variable (``x``, ``x*x`` or ``(x - c')/s``), one
     multiply-add-round per step, the saturating output; with ``pipelined`` a
     register stage after each step (``x`` and ``v`` travel beside the
-    accumulator) and one on the last sum, latency ``design.steps``.
+    accumulator when a later step reads them) and one on the last sum,
+    latency ``design.steps``: the combinational netlist with cuts
+    (:func:`~chebnorm.hw.hdl.netlist.schedule` places the registers).
 
     Parameters
     ----------
@@ -399,15 +376,12 @@ def horner_netlist(design, *, pipelined: bool = False, language: str | None = No
              for lang in ((language,) if language else ("verilog", "vhdl"))}
     m = Module(pipelined_name(design) if pipelined else module_name(design), design.in_bits,
                design.out_bits, facts=facts, latency=design.steps if pipelined else 0)
-    out = m.statements
+    out = []
     xf, xw = design.x_format, design.xs_bits
-    k0 = _sig("K0", xw)
-    xs = _sig("xs0" if pipelined else "xs", xw)
-    if not pipelined:
-        out.append(Comment(f"x value times 2^{xf.frac_bits}"))
-    out += [ConstDecl(k0, xf.offset_code),
+    k0, xs = _sig("K0", xw), _sig("xs", xw)
+    out += [Comment(f"x value times 2^{xf.frac_bits}"), ConstDecl(k0, xf.offset_code),
             Assign(xs, Add((Resize(ZeroExt(m.x, char=True), xw), k0)))]
-    out += _variable(design, xs, "v0" if pipelined else "v")
+    out += _variable(design, xs, "v")
     n = len(design.horner_integers) - 1
     if n == 0:
         top = _sig("top", max(design.top_bits, 2))
@@ -417,23 +391,20 @@ def horner_netlist(design, *, pipelined: bool = False, language: str | None = No
         aw = max(design.stages[0].acc_bits, 2)
         prev = _sig(f"A{n}", aw)
         out.append(ConstDecl(prev, design.horner_integers[n]))
-        var = {"xs": xs, "v": _sig("v0" if pipelined else "v", design.variable_bits)}
+        var = {"xs": xs, "v": _sig("v", design.variable_bits)}
         for s, st in enumerate(design.stages):
             j = st.power
             out += _horner_step(design, st, prev, var[variable_name(design, st)])
             if j > 0:
                 prev = _sig(f"a{j}", st.out_bits)
-                if pipelined:
-                    pairs = [(_sig(f"a{j}_r", st.out_bits), prev),
-                             (_sig(f"xs{s + 1}", xw), var["xs"])]
-                    if design.scheme != "monomial":
-                        pairs.append((_sig(f"v{s + 1}", design.variable_bits), var["v"]))
-                    out.append(Registers(tuple(pairs)))
-                    prev, var = pairs[0][0], {"xs": pairs[1][0], "v": pairs[-1][0]}
+                if pipelined:   # a register stage after each step
+                    out.append(Cut(s + 1))
         last = design.stages[-1]
         top, top_frac = _sig("top", last.sum_bits), last.sum_frac_bits
-        t0 = _sig("t0", last.sum_bits)
-        out.append(Registers(((top, t0),)) if pipelined else Assign(top, t0))
+        if pipelined:
+            out.append(Cut(len(design.stages)))
+        out.append(Assign(top, _sig("t0", last.sum_bits)))
     out += output_stage(top, top_frac, design.y_format, design.out_bits, design.rounding,
                         min_bits=design.raw_bits)
+    m.statements[:] = schedule(out)
     return m

@@ -47,7 +47,7 @@ __all__ = ["Signal", "Const", "Slice", "Bit", "Concat", "Not", "ZeroExt", "Resiz
            "Shl", "Shr", "Neg", "Add", "Sub", "Mul", "Gate", "And", "Or", "ReduceOr", "Group",
            "Paren", "BitVec", "Assign", "ConstDecl", "Rom", "Registers", "Saturate", "Output",
            "Comment", "Module", "vhdl_entity", "VHDL_WRAP", "ShiftBy", "Declare", "Param",
-           "LeadingZeros", "rename", "Flip", "Pad", "Table", "vhdl_name",
+           "LeadingZeros", "rename", "Flip", "Pad", "Table", "vhdl_name", "Cut", "schedule",
            "verilog", "vhdl", "statement_lines", "evaluate", "signed_literal", "vhdl_bits"]
 
 
@@ -1042,6 +1042,93 @@ def rename(node, signals: dict):
         return node
     return replace(node, **{f.name: rename(getattr(node, f.name), signals)
                             for f in fields(node) if f.init})
+
+
+@dataclass(frozen=True)
+class Cut:
+    """A pipeline cut, placed by :func:`schedule`: every signal defined
+    before it and read after it is registered here (``NAME_rSTAGE``).
+
+    Parameters
+    ----------
+    stage : int or str
+        The stage's tag in the register names.
+    label : str or None, default None
+        The VHDL process label.
+    """
+
+    stage: object
+    label: str | None = None
+
+
+def _signals(node, out: list) -> list:
+    """Every :class:`Signal` ``node`` reads or writes, in field order."""
+    from dataclasses import fields, is_dataclass
+
+    if isinstance(node, (list, tuple)):
+        for n in node:
+            _signals(n, out)
+    elif isinstance(node, Signal):
+        out.append(node)
+    elif is_dataclass(node):
+        for f in fields(node):
+            _signals(getattr(node, f.name), out)
+    return out
+
+
+def _defines(s) -> list:
+    if isinstance(s, (Assign, Table, LeadingZeros)):
+        return [s.dst]
+    if isinstance(s, Rom):
+        return [s.address, *s.outputs]
+    if isinstance(s, Registers):
+        return [d for d, _ in s.pairs]
+    if isinstance(s, Declare):
+        return [s.signal]
+    return []
+
+
+def schedule(statements: list) -> list:
+    """The statements with each :class:`Cut` replaced by a register stage of
+    the signals live across it -- defined before it (not constants, not the
+    ports) and read after it, in the order they were defined -- and every later
+    read renamed to the register: the one place pipeline registers are placed.
+
+    Parameters
+    ----------
+    statements : list
+        Netlist statements with :class:`Cut` markers.
+
+    Returns
+    -------
+    list
+        The statements without markers (a cut with nothing live adds nothing).
+    """
+    reads = []   # names read at or after each position
+    later: set = set()
+    for s in reversed(statements):
+        if not isinstance(s, Cut):
+            own = {d.name for d in _defines(s)}
+            later = later | {x.name for x in _signals(s, []) if x.name not in own}
+        reads.append(later)
+    reads.reverse()
+    current, out = {}, []   # name as written -> the signal that carries it now
+    for k, s in enumerate(statements):
+        if not isinstance(s, Cut):
+            renamed = {n: c for n, c in current.items() if c.name != n}
+            out.append(rename(s, renamed) if renamed else s)
+            current.update({d.name: d for d in _defines(s)})
+            continue
+        after = reads[k + 1] if k + 1 < len(statements) else set()
+        pairs = []
+        for name, sig in current.items():
+            if name in after:
+                r = Signal(f"{name}_r{s.stage}", sig.width, sig.signed, sig.logic, sig.scalar)
+                pairs.append((r, sig))
+                current[name] = r
+        if pairs:
+            out.append(Registers(tuple(pairs), label=s.label))
+    return out
 
 
 # -- the printers: one template per node kind and language -----------------------------

@@ -24,8 +24,8 @@ from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
 from .common import SUFFIX, check_language, module_name, vector_file
-from .netlist import (Add, Assign, Bit, Concat, Flip, Module, Output, Pad, Registers, Signal,
-                      Slice, Table, verilog, vhdl)
+from .netlist import (Add, Assign, Bit, Concat, Cut, Flip, Module, Output, Pad, Signal, Slice,
+                      Table, schedule, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
@@ -209,7 +209,7 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
     addr, tiv = Signal("a", a, logic=True), Signal("tiv", s)
     out += [Assign(addr, Slice(x, w - 1, w - a)),
             Table(tiv, addr, tuple(int(v) for v in design.tiv))]
-    cur = {"tiv": tiv}
+    offsets = []
     for i, t in enumerate(design.offsets):
         fb, lb = t.field_bits, t.field_bits - 1
         b = Signal(f"b{i}", fb, logic=True)
@@ -223,28 +223,19 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
         o = Signal(f"o{i}", t.width)
         out += [Assign(ad, Concat(parts)), Table(ti, ad, tuple(int(v) for v in t.values)),
                 Assign(o, Flip(ti, Bit(b, lb)) if t.symmetric else ti)]
-        cur[o.name] = o
-
-    def regs(stage: int) -> None:
-        pairs = []
-        for key, sig in cur.items():
-            r = Signal(f"{key}_r{stage}", sig.width)
-            pairs.append((r, sig))
-            cur[key] = r
-        out.append(Registers(tuple(pairs), label=f"regs{stage}"))
-
+        offsets.append(o)
     if 0 in cuts:
-        regs(0)
+        out.append(Cut(0, label="regs0"))
     ob = _offset_sum_bits(design)
     osum = Signal("osum", ob)
-    terms = tuple(Pad(cur.pop(f"o{i}"), ob) for i in range(len(design.offsets)))
+    terms = tuple(Pad(o, ob) for o in offsets)
     out.append(Assign(osum, terms[0] if len(terms) == 1 else Add(terms)))
-    cur["osum"] = osum
     if 1 in cuts:
-        regs(1)
+        out.append(Cut(1, label="regs1"))
     acc = Signal("acc", s)
-    out += [Assign(acc, Add((cur["tiv"], Pad(cur["osum"], s)))),
+    out += [Assign(acc, Add((tiv, Pad(osum, s)))),
             Output(Pad(Slice(acc, s - 1, g), design.out_bits))]
+    m.statements[:] = schedule(out)
     return m
 
 
