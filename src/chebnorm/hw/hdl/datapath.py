@@ -23,7 +23,7 @@ from __future__ import annotations
 from .common import (horner_facts, module_name, piecewise_facts, pipelined_name, shifted_width,
                      step_comment, variable_name)
 from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Cut,
-                      Extend, Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Resize, Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt, schedule)
+                      Extend, Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Resize, Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
 
 __all__ = ["round_to", "output_stage", "piecewise_netlist", "sized_piecewise_netlist",
            "horner_netlist"]
@@ -285,7 +285,6 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
         out.append(Assign(a, Shr(wide, f0 - g0) if f0 > g0 else
                           Shl(wide, g0 - f0) if g0 > f0 else wide))
     out += output_stage(a, d.y_format.frac_bits, d.y_format, d.out_bits, "trunc")
-    m.statements[:] = schedule(out)
     return m
 
 
@@ -406,5 +405,5 @@ def horner_netlist(design, *, pipelined: bool = False, language: str | None = No
         out.append(Assign(top, _sig("t0", last.sum_bits)))
     out += output_stage(top, top_frac, design.y_format, design.out_bits, design.rounding,
                         min_bits=design.raw_bits)
-    m.statements[:] = schedule(out)
+    m.statements[:] = out
     return m

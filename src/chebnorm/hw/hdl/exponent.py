@@ -28,7 +28,7 @@ from ..trust import verify_design
 from .common import SUFFIX, check_language, module_name, vector_file
 from .datapath import sized_piecewise_netlist
 from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend, LeadingZeros,
-                      Module, Not, Output, Param, Registers, Saturate, ShiftBy, Signal, Slice,
+                      Module, Not, Output, Param, Saturate, ShiftBy, Signal, Slice,
                       rename, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
@@ -149,7 +149,7 @@ def exponent_netlist(design, *, version: str = "", command: str | None = None) -
                       + ["", "The core, inlined:"] + core.facts))
     lz, mant = Signal("nrm_lz", Z), Signal("nrm_mant", W, logic=True)
     inner, lz2 = Signal("nrm_inner", W, logic=True), Signal("nrm_lz2", Z + 1)
-    h = [Signal(f"nrm_h{i}", H) for i in range(n + 1)]
+    h0 = Signal("nrm_h0", H)
     nrm_m = Signal("nrm_m", M, logic=True)
     body = [replace(s, port=nrm_m, width_name="M_BITS") if isinstance(s, Saturate) else s
             for s in rename(core.statements, {"x": inner})]
@@ -159,13 +159,11 @@ def exponent_netlist(design, *, version: str = "", command: str | None = None) -
         Assign(mant, ShiftBy(m.x, lz)),
         Assign(inner, Concat((Not(Bit(lz, 0)), Slice(mant, W - 2, 0)))),
         Assign(lz2, Add((Extend(lz, Z + 1), Const(2, 2, signed=False)))),
-        Assign(h[0], Slice(lz2, H, 1)),
+        Assign(h0, Slice(lz2, H, 1)),
         Declare(nrm_m),
         Comment("the core: g(v) = 1/sqrt(v) of the inner code nrm_inner"),
         *body,
-        Comment("the shift, delayed as the core"),
-        *([Registers(tuple(zip(h[1:], h[:-1])), label="nrm_delay")] if n else []),
-        Output(Concat((h[n], nrm_m)))]
+        Output(Concat((h0, nrm_m)))]   # h0 registered at the core's cuts (schedule)
     return m
 
 

@@ -986,7 +986,8 @@ class Module:
     facts : list of str or dict
         The banner lines, without comment marker; or language -> its banner lines.
     statements : list
-        The statements, in order.
+        The statements, in order; :class:`Cut` markers place the pipeline registers
+        (:func:`schedule`, when printed or evaluated).
     latency : int, default 0
         Pipeline latency in cycles: > 0 adds ``clk`` and ``LATENCY``.
     """
@@ -1083,8 +1084,8 @@ def _defines(s) -> list:
         return [s.address, *s.outputs]
     if isinstance(s, Registers):
         return [d for d, _ in s.pairs]
-    if isinstance(s, Declare):
-        return [s.signal]
+    if isinstance(s, Saturate) and s.port is not None:
+        return [s.port]
     return []
 
 
@@ -1467,6 +1468,7 @@ def verilog(module: Module) -> str:
     """
     m = module
     clocked = m.latency > 0
+    statements = schedule(m.statements)
     out = comment_lines(_facts(m, "verilog"), "verilog")
     out += [f"module {m.name} #(",
             f"    parameter IN_BITS = {m.in_bits},",
@@ -1477,7 +1479,7 @@ def verilog(module: Module) -> str:
             "    input  wire [IN_BITS-1:0]  x,",
             "    output wire [OUT_BITS-1:0] y",
             ");"]
-    for s in m.statements:
+    for s in statements:
         out += _verilog_statement(s)
     return "\n".join(out + ["endmodule", ""])
 
@@ -1563,7 +1565,7 @@ def vhdl(module: Module) -> str:
     vhdl_name(m.name)
     out = comment_lines(_facts(m, "vhdl"), "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
     decl, stmt = [], []
-    for s in m.statements:
+    for s in schedule(m.statements):
         d, b = _vhdl_statement(s)
         decl += d
         stmt += b
@@ -1661,7 +1663,7 @@ def evaluate(module: Module, code: int) -> dict:
     if not 0 <= code < 2 ** module.in_bits:
         raise ValueError(f"code {code}: accepted 0..{2 ** module.in_bits - 1}")
     env = {"x": code}
-    for s in module.statements:
+    for s in schedule(module.statements):
         if isinstance(s, Assign):
             env[s.dst.name] = _wrap(_value(s.expr, env), s.dst.width, s.dst.signed)
         elif isinstance(s, ConstDecl):

@@ -25,7 +25,7 @@ from chebnorm.core.numeric import format_up
 from ..trust import verify_design
 from .common import SUFFIX, check_language, module_name, vector_file
 from .netlist import (Add, Assign, Bit, Concat, Cut, Flip, Module, Output, Pad, Signal, Slice,
-                      Table, schedule, verilog, vhdl)
+                      Table, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
@@ -235,7 +235,6 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
     acc = Signal("acc", s)
     out += [Assign(acc, Add((tiv, Pad(osum, s)))),
             Output(Pad(Slice(acc, s - 1, g), design.out_bits))]
-    m.statements[:] = schedule(out)
     return m
 
 
