@@ -33,7 +33,7 @@ from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend,
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 
-__all__ = ["exponent_facts", "exponent_netlist", "exponent_module", "exponent_testbench",
+__all__ = ["exponent_facts", "exponent_module", "exponent_testbench",
            "exponent_files"]
 
 

@@ -29,8 +29,8 @@ from .netlist import (Add, Assign, Bit, Concat, Cut, Flip, Module, Output, Pad, 
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
-__all__ = ["TABLE_CUTS", "table_cuts", "table_facts", "table_netlist", "table_module",
-           "table_testbench", "table_files"]
+__all__ = ["TABLE_CUTS", "table_cuts", "table_facts", "table_module", "table_testbench",
+           "table_files"]
 
 
 def _kind(design) -> str:
