@@ -202,17 +202,11 @@ ALLOWED = {
     ("trust.py", 'hasattr(value, "to_json")'),
     # PipelinedTable reads its base's attributes (a delegation, the same for every base)
     ("pipeline.py", "getattr(self.base, name)"),
-    # chebnorm.hw.hdl: the printers (the netlist IR replaces them; not edited here)
-    ("hdl/common.py", 'getattr(design, "mult_cuts", ())'),
-    ("hdl/verilog.py", 'getattr(d, "mult_cuts", ())'),
-    ("hdl/vhdl.py", 'getattr(d, "mult_cuts", ())'),
-    ("hdl/vhdl.py", 'getattr(design, "latency", 0)'),
-    ("hdl/vhdl.py", 'getattr(design, "steps", design.degree)'),
-    ("hdl/exponent.py", 'getattr(design, "architecture", None)'),
-    ("hdl/tables.py", 'getattr(design, "architecture", None)'),
-    ("hdl/tables.py", 'getattr(design, "cuts", ())'),
-    ("hdl/__init__.py", 'getattr(design, "table", None)'),
-    ("hdl/__init__.py", 'hasattr(design, "rom_bits")'),
+    # chebnorm.hw.hdl.netlist: the IR's own traversal of its nodes' dataclass fields
+    # (expressions, not designs)
+    ("hdl/netlist.py", "getattr(node, f.name)"),
+    ("hdl/netlist.py", "getattr(e, name, None)"), ("hdl/netlist.py", "getattr(e, name)"),
+    ("hdl/netlist.py", 'getattr(e, "terms", ())'), ("hdl/netlist.py", 'getattr(e, "parts", ())'),
 }
 
 

@@ -11,8 +11,9 @@ A *design* is a sized, bit-accurate evaluator of a table:
   architecture with ``pipeline=`` -- with registers at its cut points (the
   module then has ``clk`` and ``LATENCY``; its bench is clocked).
 
-Each is printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008 (:mod:`.vhdl`),
-bit for bit the design's model, with an exhaustive self-checking bench that
+Each is built once as a netlist (:mod:`.datapath` over the IR of
+:mod:`.netlist`) and printed in Verilog-2005 (:mod:`.verilog`) or VHDL-2008
+(:mod:`.vhdl`), bit for bit the design's model, with an exhaustive self-checking bench that
 reads the model's expected outputs (:func:`vector_file`). The banner is
 written once (:mod:`.common`). ``chebnorm hw verilog``, ``chebnorm export
 --format verilog|vhdl`` and :func:`chebnorm.hw.report.hdl_outputs` all call
@@ -29,8 +30,8 @@ are run by :mod:`chebnorm.hw.run_verilog` (Icarus Verilog, Yosys) and
 
 from __future__ import annotations
 
-from chebnorm.approx.piecewise_table import PiecewiseTable
 
+from ..design_base import Design
 from ..horner import HornerDesign
 from ..trust import verify_design
 from .common import (LANGUAGES, SUFFIX, check_language, comment_lines, horner_facts,
@@ -81,7 +82,7 @@ def is_piecewise(design) -> bool:
     """
     if isinstance(design, HornerDesign):
         return False
-    if isinstance(getattr(design, "table", None), PiecewiseTable) and hasattr(design, "rom_bits"):
+    if isinstance(design, Design) and design.architecture in ("piecewise", "piecewise-sized"):
         return True
     raise ValueError(f"design: a {type(design).__name__} is not a design; accepted: a "
                      f"HornerDesign (design_horner) or a PiecewiseDesign (design_piecewise)")

@@ -303,7 +303,7 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
               f"{format_up(b['horner_rounding'], '.6e')} + output "
               f"rounding {format_up(b['output_rounding'], '.6e')}"]
     if design.latency:
-        mult = getattr(design, "mult_cuts", ())
+        mult = design.mult_cuts
         lines.append(f"Pipelined: registers at cut points {list(design.cuts)} (0 after the ROM, "
                      f"i after the i-th multiply-add)"
                      + (f" and between the multiply and the add of steps {list(mult)}"

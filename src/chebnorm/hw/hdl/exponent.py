@@ -2,9 +2,9 @@
 (:class:`~chebnorm.hw.exponent.ExponentDesign`), one flat module: a
 leading-zero count, the normalizing shift, the core's inner code
 ``{~lz[0], mant[W-2:0]}``, the core itself (the sized piecewise module
-printed by :func:`chebnorm.hw.hdl.module_text`, its body inlined by
-:func:`core_parts`: the targets count the top module's cells, so no
-hierarchy), the shift ``h = (lz + 2) >> 1`` (delayed by the core's latency
+netlist of :func:`~chebnorm.hw.hdl.datapath.sized_piecewise_netlist`, its
+ports renamed by :func:`~chebnorm.hw.hdl.netlist.rename`: the targets count
+the top module's cells, so no hierarchy), the shift ``h = (lz + 2) >> 1`` (delayed by the core's latency
 when it is pipelined) and ``y = {h, m}``.
 
 Both languages are bit for bit :meth:`ExponentDesign.evaluate`; the benches
@@ -19,21 +19,27 @@ clocked when the core is pipelined).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from chebnorm.core.textsafe import comment_text
 from chebnorm.core.numeric import format_up
 
-from . import module_text
+from ..design_base import Design
 from ..trust import verify_design
-from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
+from .common import SUFFIX, check_language, module_name, vector_file
+from .datapath import sized_piecewise_netlist
+from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend, LeadingZeros,
+                      Module, Not, Output, Param, Saturate, ShiftBy, Signal, Slice,
+                      rename, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
 
-__all__ = ["core_parts", "exponent_facts", "exponent_module", "exponent_testbench",
+__all__ = ["exponent_facts", "exponent_module", "exponent_testbench",
            "exponent_files"]
 
 
 def _check(design):
-    if getattr(design, "architecture", None) != "exponent":
+    if not isinstance(design, Design) or design.architecture != "exponent":
         raise ValueError(f"design: a {type(design).__name__} is not an exponent-indexed design; "
                          f"accepted: an ExponentDesign (design_exponent)")
     return verify_design(design)   # changed since it was proved: proved again (or refused)
@@ -99,162 +105,73 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
     return lines
 
 
-#: the core's references to its ports, renamed when its body is inlined
-_RENAME = {"verilog": ((r"\bx\[", "nrm_inner[", 2), (r"\bassign y\b", "assign nrm_m", 1),
-                       (r"\bOUT_BITS\b", "M_BITS", None)),
-           "vhdl": ((r"\bx\(", "nrm_inner(", 2), (r"(?m)^(\s*)y <=", r"\1nrm_m <=", 1),
-                    (r"\bOUT_BITS\b", "M_BITS", None))}
 
-
-def core_parts(core_text: str, language: str) -> tuple[list[str], list[str], list[str]]:
-    """The core module's banner (comment lines), declarations and statements,
-    its ports renamed for inlining: ``x`` -> ``nrm_inner``, ``y`` -> ``nrm_m``,
-    ``OUT_BITS`` -> ``M_BITS``. The design is flat (one module: the targets'
-    cell counts are of the top module alone). ValueError when the core's text
-    is not shaped as the piecewise printers print it.
+def exponent_netlist(design, *, version: str = "", command: str | None = None) -> Module:
+    """The netlist of ``design``, flat: the leading-zero count, the
+    normalizing shift, the core's inner code, the core's netlist with its ports
+    renamed (``x`` -> ``nrm_inner``, ``y`` -> ``nrm_m``: one module, so a
+    target's cell count of the top is the whole design), the shift delayed as
+    the core and ``y = {h, m}``.
 
     Parameters
     ----------
-    core_text : str
-        The core module's text, as the sized piecewise printer prints it.
-    language : {"verilog", "vhdl"}
-        Its language.
+    design : ExponentDesign
+        The design (:func:`~chebnorm.hw.exponent.design_exponent`).
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe).
 
     Returns
     -------
-    banner, declarations, statements : tuple of list of str
-        The three parts, line by line.
+    Module
+        The netlist (latency: the core's).
 
     Raises
     ------
     ValueError
-        When the text has no port list end or body, or its ports are used a
-        number of times other than the printer's.
+        If ``design`` is not an exponent design.
 
     Examples
     --------
-
-    >>> text = chr(10).join(["// c", "module m (", "    input x", ");",
-    ...     "    wire [1:0] low = x[1:0];", "    wire idx = x[2];", "    assign y = low;",
-    ...     "endmodule"])
-    >>> core_parts(text, "verilog")
-    (['// c'], [], ['    wire [1:0] low = nrm_inner[1:0];', '    wire idx = nrm_inner[2];', '    assign nrm_m = low;'])
+    >>> from chebnorm.hw.exponent import design_exponent
+    >>> from chebnorm.hw.hdl.netlist import evaluate
+    >>> d = design_exponent("1/sqrt(x)", ("2^-8", "1"), 8, 8, degree=1)
+    >>> m = exponent_netlist(d)
+    >>> [evaluate(m, k)["y"] for k in range(1, 256)] == d.evaluate()[1:].tolist()
+    True
     """
-    import re
-
-    lines = core_text.splitlines()
-    mark = "//" if language == "verilog" else "--"
-    banner = []
-    for line in lines:
-        if not line.startswith(mark):
-            break
-        banner.append(line)
-    try:
-        if language == "verilog":
-            start = lines.index(");") + 1
-            end = len(lines) - 1 - lines[::-1].index("endmodule")
-            decls, body = [], lines[start:end]
-        else:
-            a = next(i for i, ln in enumerate(lines) if ln.startswith("architecture rtl of "))
-            b = lines.index("begin", a)
-            end = lines.index("end architecture rtl;", b)
-            decls, body = lines[a + 1:b], lines[b + 1:end]
-    except (ValueError, StopIteration):
-        raise ValueError("core: its module text is not the piecewise printer's (no port list "
-                         "end or body found); accepted: a sized piecewise core") from None
-    text = "\n".join(body)
-    for pattern, repl, count in _RENAME[language]:
-        text, n = re.subn(pattern, repl, text)
-        if count is not None and n != count:
-            raise ValueError(f"core: {n} uses of {pattern!r} in its body, expected {count}; "
-                             f"accepted: a sized piecewise core")
-    decls = [re.sub(r"\bOUT_BITS\b", "M_BITS", ln) for ln in decls]
-    return banner, decls, text.splitlines()
-
-
-def _verilog(d, facts) -> list[str]:
+    d = _check(design)
     W, M, H, n = d.in_bits, d.mant_bits, d.shift_bits, d.latency
     Z = W.bit_length()
-    banner, _, body = core_parts(module_text(d.core, "verilog"), "verilog")
-    out = comment_lines(facts, "verilog") + ["//", "// The core, inlined:"] + banner
-    out += [f"module {module_name(d)} #(", f"    parameter IN_BITS = {W},",
-            f"    parameter OUT_BITS = {H + M}" + ("," if n else ""),
-            *([f"    parameter LATENCY = {n}"] if n else []), ") (",
-            *(["    input  wire                clk,"] if n else []),
-            "    input  wire [IN_BITS-1:0]  x,", "    output wire [OUT_BITS-1:0] y", ");",
-            f"    localparam M_BITS = {M};",
-            f"    reg [{Z - 1}:0] nrm_lz;", "    integer nrm_i;", "    always @(*) begin",
-            f"        nrm_lz = {Z}'d{W};", f"        for (nrm_i = 0; nrm_i < {W}; nrm_i = nrm_i + 1)",
-            f"            if (x[nrm_i]) nrm_lz = {W - 1} - nrm_i;", "    end",
-            f"    wire [{W - 1}:0] nrm_mant = x << nrm_lz;",
-            f"    wire [{W - 1}:0] nrm_inner = {{~nrm_lz[0], nrm_mant[{W - 2}:0]}};",
-            f"    wire [{Z}:0] nrm_lz2 = nrm_lz + 2'd2;",
-            f"    wire [{H - 1}:0] nrm_h0 = nrm_lz2[{H}:1];",
-            f"    wire [{M - 1}:0] nrm_m;",
-            "    // -- the core: g(v) = 1/sqrt(v) of the inner code nrm_inner",
-            *body,
-            "    // -- the shift, delayed as the core"]
-    for i in range(1, n + 1):
-        out += [f"    reg [{H - 1}:0] nrm_h{i};",
-                f"    always @(posedge clk) nrm_h{i} <= nrm_h{i - 1};"]
-    out += [f"    assign y = {{nrm_h{n}, nrm_m}};", "endmodule", ""]
-    return out
-
-
-def _vhdl(d, facts) -> list[str]:
-    W, M, H, n = d.in_bits, d.mant_bits, d.shift_bits, d.latency
-    Z = W.bit_length()
-    name = module_name(d)
-    banner, decls, body = core_parts(module_text(d.core, "vhdl"), "vhdl")
-    out = comment_lines(facts, "vhdl") + ["-- ", "-- The core, inlined:"] + banner
-    generics = [f"        IN_BITS  : natural := {W};",
-                f"        OUT_BITS : natural := {H + M}" + (";" if n else "")]
-    if n:
-        generics.append(f"        LATENCY  : natural := {n}")
-    ports = (["        clk : in  std_logic;"] if n else []) + [
-        "        x   : in  std_logic_vector(IN_BITS - 1 downto 0);",
-        "        y   : out std_logic_vector(OUT_BITS - 1 downto 0)"]
-    out += ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
-            f"entity {name} is", "    generic (", *generics, "    );", "    port (", *ports,
-            "    );", f"end entity {name};", "", f"architecture rtl of {name} is",
-            f"    constant M_BITS  : natural := {M};",
-            f"    signal nrm_lz    : unsigned({Z - 1} downto 0);",
-            f"    signal nrm_mant  : std_logic_vector({W - 1} downto 0);",
-            f"    signal nrm_inner : std_logic_vector({W - 1} downto 0);",
-            f"    signal nrm_lz2   : unsigned({Z} downto 0);",
-            f"    signal nrm_m     : std_logic_vector({M - 1} downto 0);",
-            *[f"    signal nrm_h{i}    : unsigned({H - 1} downto 0);" for i in range(n + 1)],
-            *decls,
-            "begin",
-            "    nrm_count : process (x)",
-            f"        variable c : natural range 0 to {W};",
-            "    begin",
-            f"        c := {W};",
-            f"        for i in 0 to {W - 1} loop",
-            "            if x(i) = '1' then",
-            f"                c := {W - 1} - i;",
-            "            end if;",
-            "        end loop;",
-            f"        nrm_lz <= to_unsigned(c, {Z});",
-            "    end process nrm_count;",
-            "    nrm_mant <= std_logic_vector(shift_left(unsigned(x), to_integer(nrm_lz)));",
-            f"    nrm_inner <= (not nrm_lz(0)) & nrm_mant({W - 2} downto 0);",
-            f"    nrm_lz2 <= resize(nrm_lz, {Z + 1}) + 2;",
-            f"    nrm_h0 <= nrm_lz2({H} downto 1);",
-            "    -- the core: g(v) = 1/sqrt(v) of the inner code nrm_inner",
-            *body]
-    if n:
-        out += ["    nrm_delay : process (clk)", "    begin", "        if rising_edge(clk) then",
-                *[f"            nrm_h{i} <= nrm_h{i - 1};" for i in range(1, n + 1)],
-                "        end if;", "    end process nrm_delay;"]
-    out += [f"    y <= std_logic_vector(nrm_h{n}) & nrm_m;", "end architecture rtl;", ""]
-    return out
+    core = sized_piecewise_netlist(d.core)
+    m = Module(module_name(d), W, H + M, latency=n,
+               facts=(exponent_facts(d, version=version, command=command)
+                      + ["", "The core, inlined:"] + core.facts))
+    lz, mant = Signal("nrm_lz", Z), Signal("nrm_mant", W, logic=True)
+    inner, lz2 = Signal("nrm_inner", W, logic=True), Signal("nrm_lz2", Z + 1)
+    h0 = Signal("nrm_h0", H)
+    nrm_m = Signal("nrm_m", M, logic=True)
+    body = [replace(s, port=nrm_m, width_name="M_BITS") if isinstance(s, Saturate) else s
+            for s in rename(core.statements, {"x": inner})]
+    m.statements += [
+        Param("M_BITS", M),
+        LeadingZeros(lz, m.x, index="nrm_i", label="nrm_count"),
+        Assign(mant, ShiftBy(m.x, lz)),
+        Assign(inner, Concat((Not(Bit(lz, 0)), Slice(mant, W - 2, 0)))),
+        Assign(lz2, Add((Extend(lz, Z + 1), Const(2, 2, signed=False)))),
+        Assign(h0, Slice(lz2, H, 1)),
+        Declare(nrm_m),
+        Comment("the core: g(v) = 1/sqrt(v) of the inner code nrm_inner"),
+        *body,
+        Output(Concat((h0, nrm_m)))]   # h0 registered at the core's cuts (schedule)
+    return m
 
 
 def exponent_module(design, language: str = "verilog", *, version: str = "",
                     command: str | None = None) -> str:
     """The module of ``design`` in ``language``, flat: the normalization, the
-    core's body inlined (:func:`core_parts`; one module, so a target's cell
+    core's body inlined (:func:`exponent_netlist`; one module, so a target's cell
     count of the top is the whole design), the delayed shift.
 
     Parameters
@@ -287,10 +204,10 @@ def exponent_module(design, language: str = "verilog", *, version: str = "",
     >>> v.count("endmodule"), "assign y = {nrm_h0, nrm_m};" in v
     (1, True)
     """
-    d = _check(design)
-    check_language(language)
-    facts = exponent_facts(d, version=version, command=command)
-    return "\n".join(_verilog(d, facts) if language == "verilog" else _vhdl(d, facts))
+    m = exponent_netlist(design, version=version, command=command)
+    if check_language(language) == "verilog":
+        return verilog(m)
+    return vhdl(m)
 
 
 def exponent_testbench(design, language: str = "verilog", vectors: str | None = None) -> str:

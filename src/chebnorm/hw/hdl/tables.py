@@ -22,17 +22,20 @@ from __future__ import annotations
 from chebnorm.core.textsafe import comment_text
 from chebnorm.core.numeric import format_up
 
+from ..design_base import Design
 from ..trust import verify_design
-from .common import SUFFIX, check_language, comment_lines, module_name, vector_file
+from .common import SUFFIX, check_language, module_name, vector_file
+from .netlist import (Add, Assign, Bit, Concat, Cut, Flip, Module, Output, Pad, Signal, Slice,
+                      Table, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
 
-__all__ = ["TABLE_CUTS", "PLAIN_TABLE_CUTS", "cut_labels", "table_cuts", "table_facts", "table_module", "table_testbench",
+__all__ = ["TABLE_CUTS", "table_cuts", "table_facts", "table_module", "table_testbench",
            "table_files"]
 
 
 def _kind(design) -> str:
-    kind = getattr(design, "architecture", None)
+    kind = design.architecture if isinstance(design, Design) else None
     if kind not in ("multipartite", "plain_table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
@@ -149,7 +152,7 @@ def cut_labels(design) -> dict:
     ValueError
         If ``design`` is not a table design.
     """
-    kind = getattr(design, "architecture", None)
+    kind = design.architecture if isinstance(design, Design) else None
     if kind not in ("multipartite", "plain_table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
@@ -183,7 +186,7 @@ def table_cuts(design) -> tuple[int, ...]:
     ValueError
         If ``design.cuts`` is not a sorted set of 0 and 1.
     """
-    cuts = tuple(getattr(design, "cuts", ()) or ())
+    cuts = tuple(design.cuts) if isinstance(design, Design) and design.latency else ()
     if cuts and (not set(cuts) <= set(cut_labels(design)) or list(cuts) != sorted(set(cuts))
                  or any(isinstance(c, bool) for c in cuts)):
         if _kind(design) == "plain_table":
@@ -196,214 +199,90 @@ def table_cuts(design) -> tuple[int, ...]:
     return cuts
 
 
-def _hex(value: int, bits: int) -> str:
-    return f"{bits}'h{int(value):0{(bits + 3) // 4}x}"
-
-
-def _verilog_rom(out: list[str], reg: str, addr: str, abits: int, width: int, values) -> None:
-    out.append(f"    reg [{width - 1}:0] {reg};")
-    out += ["    always @(*) begin", f"        case ({addr})"]
-    for i, v in enumerate(values):
-        out.append(f"            {_hex(i, abits)}: {reg} = {_hex(v, width)};")
-    out += [f"            default: {reg} = {_hex(0, width)};", "        endcase", "    end"]
-
-
-def _verilog_regs(out: list[str], cur: dict, widths: dict, stage: int) -> None:
-    """Register every signal of ``cur`` (name -> current wire) at ``stage``."""
-    regs = []
-    for key in cur:
-        r = f"{key}_r{stage}"
-        out.append(f"    reg [{widths[key] - 1}:0] {r};")
-        regs.append(f"        {r} <= {cur[key]};")
-        cur[key] = r
-    out.extend(["    always @(posedge clk) begin", *regs, "    end"])
-
-
-def _verilog(design, facts: list[str]) -> str:
-    name = module_name(design)
-    w = design.in_bits
-    cuts = table_cuts(design)
-    out = comment_lines(facts, "verilog")
-    out += [f"module {name} #(", f"    parameter IN_BITS = {w},",
-            f"    parameter OUT_BITS = {design.out_bits}" + ("," if cuts else ""),
-            *([f"    parameter LATENCY = {len(cuts)}"] if cuts else []), ") (",
-            *(["    input  wire                clk,"] if cuts else []),
-            "    input  wire [IN_BITS-1:0]  x,", "    output wire [OUT_BITS-1:0] y", ");"]
-    if design.architecture == "plain_table":
-        if cuts:
-            _verilog_plain_pipelined(out, design, cuts)
-            return "\n".join(out)
-        _verilog_rom(out, "rom", "x", w, design.out_bits, design.values)
-        out += ["    assign y = rom;", "endmodule", ""]
-        return "\n".join(out)
-    a, s, g = design.tiv_bits, design.sum_bits, design.guard_bits
-    out.append(f"    wire [{a - 1}:0] a = x[{w - 1}:{w - a}];")
-    _verilog_rom(out, "tiv", "a", a, s, design.tiv)
-    terms = []
-    for i, t in enumerate(design.offsets):
-        fb, lb = t.field_bits, t.field_bits - 1
-        out.append(f"    wire [{fb - 1}:0] b{i} = x[{t.position + fb - 1}:{t.position}];")
-        c = f"x[{w - 1}:{w - t.slope_bits}]" if t.slope_bits else None
-        if t.symmetric:
-            out.append(f"    wire [{lb - 1}:0] l{i} = b{i}[{lb - 1}:0] ^ {{{lb}{{~b{i}[{lb}]}}}};")
-            addr = f"{{{c}, l{i}}}" if c else f"l{i}"
-        else:
-            addr = f"{{{c}, b{i}}}" if c else f"b{i}"
-        out.append(f"    wire [{t.address_bits - 1}:0] ad{i} = {addr};")
-        _verilog_rom(out, f"t{i}", f"ad{i}", t.address_bits, t.width, t.values)
-        if t.symmetric:
-            out.append(f"    wire [{t.width - 1}:0] o{i} = t{i} ^ {{{t.width}{{~b{i}[{lb}]}}}};")
-        else:
-            out.append(f"    wire [{t.width - 1}:0] o{i} = t{i};")
-        terms.append(f"o{i}")
-    ob = _offset_sum_bits(design)
-    cur = {"tiv": "tiv", **{o: o for o in terms}}
-    widths = {"tiv": s, "osum": ob, **{f"o{i}": t.width for i, t in enumerate(design.offsets)}}
-    if 0 in cuts:
-        _verilog_regs(out, cur, widths, 0)
-    out.append(f"    wire [{ob - 1}:0] osum = {' + '.join(cur.pop(o) for o in terms)};")
-    cur["osum"] = "osum"
-    if 1 in cuts:
-        _verilog_regs(out, cur, widths, 1)
-    out += [f"    wire [{s - 1}:0] acc = {cur['tiv']} + {cur['osum']};",
-            f"    assign y = acc[{s - 1}:{g}];" if s - g == design.out_bits else
-            f"    assign y = {{{{{design.out_bits - (s - g)}{{1'b0}}}}, acc[{s - 1}:{g}]}};",
-            "endmodule", ""]
-    return "\n".join(out)
-
-
-def _verilog_plain_pipelined(out: list[str], design, cuts) -> None:
-    """The body of a pipelined plain table: the address registered (cut 0), the ROM
-    read, its output registered (cut 1: a synchronous read, block RAM in yosys)."""
-    w, ob = design.in_bits, design.out_bits
-    addr = "x"
-    if 0 in cuts:
-        out += [f"    reg [{w - 1}:0] addr_r0;", "    always @(posedge clk) addr_r0 <= x;"]
-        addr = "addr_r0"
-    _verilog_rom(out, "rom", addr, w, ob, design.values)
-    if 1 in cuts:
-        out += [f"    reg [{ob - 1}:0] rom_r1;", "    always @(posedge clk) rom_r1 <= rom;",
-                "    assign y = rom_r1;"]
-    else:
-        out.append("    assign y = rom;")
-    out += ["endmodule", ""]
-
-
-def _vhdl_plain_pipelined(decl: list[str], stmt: list[str], design, cuts) -> None:
-    """The VHDL of :func:`_verilog_plain_pipelined`: address and ROM output registers."""
-    w, ob = design.in_bits, design.out_bits
-    addr = "x"
-    regs = []
-    if 0 in cuts:
-        decl.append(f"    signal addr_r0 : std_logic_vector({w - 1} downto 0);")
-        regs.append("            addr_r0 <= x;")
-        addr = "addr_r0"
-    _vhdl_rom(decl, stmt, "rom", addr, ob, design.values)
-    if 1 in cuts:
-        decl.append(f"    signal rom_r1 : unsigned({ob - 1} downto 0);")
-        regs.append("            rom_r1 <= rom;")
-        stmt.append("    y <= std_logic_vector(rom_r1);")
-    else:
-        stmt.append("    y <= std_logic_vector(rom);")
-    stmt.extend(["    regs : process (clk)", "    begin", "        if rising_edge(clk) then",
-                 *regs, "        end if;", "    end process regs;"])
-
-
 def _offset_sum_bits(design) -> int:
     return max(1, sum((1 << t.width) - 1 for t in design.offsets).bit_length())
 
 
-def _bits(value: int, bits: int) -> str:
-    return '"' + format(int(value), f"0{bits}b") + '"'
+def table_netlist(design, *, version: str = "", command: str | None = None) -> Module:
+    """The netlist of a table design: one ROM (a plain table), or the
+    multipartite ROMs -- the table of initial values, each offset table folded
+    when symmetric -- their sum, and the register stages at the design's cuts
+    (0: after the table reads, 1: after the offsets' sum).
 
+    Parameters
+    ----------
+    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
+        The table design.
+    version : str, default ""
+        chebnorm's version, stated in the banner (made comment-safe).
+    command : str or None, default None
+        The command line that made the file, stated in the banner (made comment-safe).
 
-def _vhdl_rom(decl: list[str], stmt: list[str], sig: str, addr: str, width: int,
-              values) -> None:
-    n = len(values)
-    decl.append(f"    type {sig}_t is array (0 to {n - 1}) of unsigned({width - 1} downto 0);")
-    rows = [f"        {_bits(v, width)}{',' if i < n - 1 else ''}" for i, v in enumerate(values)]
-    decl += [f"    constant {sig.upper()}_ROM : {sig}_t := (", *rows, "    );",
-             f"    signal {sig} : unsigned({width - 1} downto 0);"]
-    stmt.append(f"    {sig} <= {sig.upper()}_ROM(to_integer(unsigned({addr})));")
+    Returns
+    -------
+    Module
+        The netlist (latency: the number of cuts).
 
+    Raises
+    ------
+    ValueError
+        If the cuts are invalid.
 
-def _vhdl_regs(decl: list[str], stmt: list[str], cur: dict, widths: dict, stage: int) -> None:
-    """Register every signal of ``cur`` (name -> current signal) at ``stage``."""
-    regs = []
-    for key in cur:
-        r = f"{key}_r{stage}"
-        decl.append(f"    signal {r} : unsigned({widths[key] - 1} downto 0);")
-        regs.append(f"            {r} <= {cur[key]};")
-        cur[key] = r
-    stmt.extend([f"    regs{stage} : process (clk)", "    begin",
-                 "        if rising_edge(clk) then", *regs, "        end if;",
-                 f"    end process regs{stage};"])
-
-
-def _vhdl(design, facts: list[str]) -> str:
-    name = module_name(design)
-    if "__" in name or name.endswith("_"):
-        raise ValueError(f"name {design.name!r} is not a VHDL identifier (two underscores in a "
-                         f"row, or a trailing one); accepted: a name without them")
-    w = design.in_bits
+    Examples
+    --------
+    >>> from chebnorm.hw.plain_table import design_plain_table
+    >>> from chebnorm.hw.hdl.netlist import evaluate
+    >>> d = design_plain_table("1/sqrt(1+3*x)", ("0", "1"), 4, 4)
+    >>> [evaluate(table_netlist(d), k)["y"] for k in range(16)] == d.evaluate().tolist()
+    True
+    """
     cuts = table_cuts(design)
-    out = comment_lines(facts, "vhdl")
-    out += ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
-            f"entity {name} is", "    generic (", f"        IN_BITS  : natural := {w};",
-            f"        OUT_BITS : natural := {design.out_bits}" + (";" if cuts else ""),
-            *([f"        LATENCY  : natural := {len(cuts)}"] if cuts else []), "    );",
-            "    port (", *(["        clk : in  std_logic;"] if cuts else []),
-            "        x : in  std_logic_vector(IN_BITS - 1 downto 0);",
-            "        y : out std_logic_vector(OUT_BITS - 1 downto 0)", "    );",
-            f"end entity {name};", ""]
-    decl, stmt = [], []
-    if design.architecture == "plain_table" and cuts:
-        _vhdl_plain_pipelined(decl, stmt, design, cuts)
-    elif design.architecture == "plain_table":
-        _vhdl_rom(decl, stmt, "rom", "x", design.out_bits, design.values)
-        stmt.append("    y <= std_logic_vector(rom);")
-    else:
-        a, s, g = design.tiv_bits, design.sum_bits, design.guard_bits
-        _vhdl_rom(decl, stmt, "tiv", f"x({w - 1} downto {w - a})", s, design.tiv)
-        terms = []
-        ob = _offset_sum_bits(design)
-        for i, t in enumerate(design.offsets):
-            fb, lb = t.field_bits, t.field_bits - 1
-            b = f"x({t.position + fb - 1} downto {t.position})"
-            c = f"x({w - 1} downto {w - t.slope_bits})" if t.slope_bits else None
-            if t.symmetric:
-                sign = f"x({t.position + lb})"
-                decl.append(f"    signal l{i} : std_logic_vector({lb - 1} downto 0);")
-                stmt.append(f"    l{i} <= x({t.position + lb - 1} downto {t.position}) xor "
-                            f"({lb - 1} downto 0 => not {sign});")
-                addr = f"{c} & l{i}" if c else f"l{i}"
-            else:
-                addr = f"{c} & {b}" if c else b
-            decl.append(f"    signal ad{i} : std_logic_vector({t.address_bits - 1} downto 0);")
-            stmt.append(f"    ad{i} <= {addr};")
-            _vhdl_rom(decl, stmt, f"t{i}", f"ad{i}", t.width, t.values)
-            decl.append(f"    signal o{i} : unsigned({t.width - 1} downto 0);")
-            if t.symmetric:
-                stmt.append(f"    o{i} <= t{i} xor ({t.width - 1} downto 0 => not "
-                            f"x({t.position + lb}));")
-            else:
-                stmt.append(f"    o{i} <= t{i};")
-            terms.append(f"o{i}")
-        cur = {"tiv": "tiv", **{o: o for o in terms}}
-        widths = {"tiv": s, "osum": ob,
-                  **{f"o{i}": t.width for i, t in enumerate(design.offsets)}}
-        if 0 in cuts:
-            _vhdl_regs(decl, stmt, cur, widths, 0)
-        decl += [f"    signal osum : unsigned({ob - 1} downto 0);",
-                 f"    signal acc : unsigned({s - 1} downto 0);"]
-        stmt.append(f"    osum <= {' + '.join(f'resize({cur.pop(o)}, {ob})' for o in terms)};")
-        cur["osum"] = "osum"
-        if 1 in cuts:
-            _vhdl_regs(decl, stmt, cur, widths, 1)
-        stmt += [f"    acc <= {cur['tiv']} + resize({cur['osum']}, {s});",
-                 f"    y <= std_logic_vector(resize(acc({s - 1} downto {g}), OUT_BITS));"]
-    out += [f"architecture rtl of {name} is", *decl, "begin", *stmt, "end architecture rtl;", ""]
-    return "\n".join(out)
+    w = design.in_bits
+    m = Module(module_name(design), w, design.out_bits, latency=len(cuts),
+               facts=table_facts(design, version=version, command=command))
+    out, x = m.statements, m.x
+    if design.architecture == "plain_table":
+        addr = x
+        if 0 in cuts:   # the address registered
+            addr = Signal("addr", w, logic=True)
+            out += [Assign(addr, x), Cut(0, label="regs0")]
+        rom = Signal("rom", design.out_bits)
+        out.append(Table(rom, addr, tuple(int(v) for v in design.values)))
+        if 1 in cuts:   # the ROM output registered: a synchronous read
+            out.append(Cut(1, label="regs1"))
+        out.append(Output(rom))
+        return m
+    a, s, g = design.tiv_bits, design.sum_bits, design.guard_bits
+    addr, tiv = Signal("a", a, logic=True), Signal("tiv", s)
+    out += [Assign(addr, Slice(x, w - 1, w - a)),
+            Table(tiv, addr, tuple(int(v) for v in design.tiv))]
+    offsets = []
+    for i, t in enumerate(design.offsets):
+        fb, lb = t.field_bits, t.field_bits - 1
+        b = Signal(f"b{i}", fb, logic=True)
+        out.append(Assign(b, Slice(x, t.position + fb - 1, t.position)))
+        low = b
+        if t.symmetric:   # fold: the lower half's address, the value complemented
+            low = Signal(f"l{i}", lb, logic=True)
+            out.append(Assign(low, Flip(Slice(b, lb - 1, 0), Bit(b, lb))))
+        parts = ((Slice(x, w - 1, w - t.slope_bits),) if t.slope_bits else ()) + (low,)
+        ad, ti = Signal(f"ad{i}", t.address_bits, logic=True), Signal(f"t{i}", t.width)
+        o = Signal(f"o{i}", t.width)
+        out += [Assign(ad, Concat(parts)), Table(ti, ad, tuple(int(v) for v in t.values)),
+                Assign(o, Flip(ti, Bit(b, lb)) if t.symmetric else ti)]
+        offsets.append(o)
+    if 0 in cuts:
+        out.append(Cut(0, label="regs0"))
+    ob = _offset_sum_bits(design)
+    osum = Signal("osum", ob)
+    terms = tuple(Pad(o, ob) for o in offsets)
+    out.append(Assign(osum, terms[0] if len(terms) == 1 else Add(terms)))
+    if 1 in cuts:
+        out.append(Cut(1, label="regs1"))
+    acc = Signal("acc", s)
+    out += [Assign(acc, Add((tiv, Pad(osum, s)))),
+            Output(Pad(Slice(acc, s - 1, g), design.out_bits))]
+    return m
 
 
 def table_module(design, language: str = "verilog", *, version: str = "",
@@ -442,10 +321,14 @@ def table_module(design, language: str = "verilog", *, version: str = "",
     ValueError
         If ``language`` is unknown or the cuts are invalid.
     """
-    facts = table_facts(design, version=version, command=command)
+    m = table_netlist(design, version=version, command=command)
     if check_language(language) == "verilog":
-        return _verilog(design, facts)
-    return _vhdl(design, facts)
+        return verilog(m)
+    name = module_name(design)
+    if "__" in name or name.endswith("_"):
+        raise ValueError(f"name {design.name!r} is not a VHDL identifier (two underscores in a "
+                         f"row, or a trailing one); accepted: a name without them")
+    return vhdl(m)
 
 
 def table_testbench(design, language: str = "verilog") -> str:

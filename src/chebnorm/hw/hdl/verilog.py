@@ -1,8 +1,10 @@
 """Verilog printers: the evaluator of a :class:`~chebnorm.hw.horner.HornerDesign`
 (combinational and pipelined) and of a
-:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner), their
-self-checking test benches, and the text fragments they (and the
-normalization units of :mod:`chebnorm.hw.units`) share.
+:class:`~chebnorm.hw.piecewise.PiecewiseDesign` (ROM + Horner) -- each the
+netlist of :mod:`chebnorm.hw.hdl.datapath`, printed by
+:func:`chebnorm.hw.hdl.netlist.verilog` --, their self-checking test benches,
+and the text fragments the normalization units of :mod:`chebnorm.hw.units`
+use.
 
 The module follows one port contract::
 
@@ -26,51 +28,20 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
-from .common import (shifted_width, step_comment, variable_name)
-from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
-                     vectors_name)
+from .bench import bench_ports, bench_verdict, testbench
+from .common import module_name, pipelined_name
+from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to,
+                       sized_piecewise_netlist)
+from .netlist import Signal, signed_literal, statement_lines
+from .netlist import verilog as _verilog
 
 __all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
            "verilog_module", "verilog_pipelined_module", "verilog_testbench",
            "verilog_pipelined_testbench", "piecewise_verilog", "sized_piecewise_verilog",
-           "piecewise_clocked_testbench", "pipelined_piecewise_verilog"]
+           "piecewise_clocked_testbench"]
 
 
 # -- fragments -------------------------------------------------------------------
-def signed_literal(value: int, bits: int) -> str:
-    """A sized signed decimal literal ``[-]BITS'sdMAGNITUDE``.
-
-    Raises ValueError when ``value`` does not fit a signed ``bits``-bit word.
-
-    >>> signed_literal(5, 4), signed_literal(-8, 4)
-    ("4'sd5", "-4'sd8")
-    >>> signed_literal(8, 4)
-    Traceback (most recent call last):
-    ...
-    ValueError: constant 8 does not fit a signed 4-bit literal
-
-    Parameters
-    ----------
-    value : int
-        The constant.
-    bits : int
-        The literal's width, ``>= 1``; ``value`` must lie in ``[-2**(bits-1), 2**(bits-1) - 1]``.
-
-    Returns
-    -------
-    str
-        The literal, e.g. ``"4'sd5"`` or ``"-4'sd8"``.
-
-    Raises
-    ------
-    ValueError
-        If ``value`` does not fit a signed ``bits``-bit word.
-    """
-    if not -(1 << (bits - 1)) <= value < (1 << (bits - 1)):
-        raise ValueError(f"constant {value} does not fit a signed {bits}-bit literal")
-    return f"{'-' if value < 0 else ''}{bits}'sd{abs(value)}"
-
-
 def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
                 mode: str) -> list[str]:
     """Lines declaring ``dst = R(src / 2^shift)``: ``mode`` ``"trunc"`` (floor,
@@ -105,18 +76,9 @@ def round_lines(src: str, dst: str, src_bits: int, shift: int, dst_bits: int,
     list of str
         Verilog declaration lines, indented by four spaces.
     """
-    lines = []
-    if mode != "trunc" and shift + 1 > src_bits:   # the round bit lies above src: extend it
-        lines.append(f"    wire signed [{shift}:0] {dst}_x = {src};")
-        src, src_bits = f"{dst}_x", shift + 1
-    lines.append(f"    wire signed [{src_bits - 1}:0] {dst}_q = {src} >>> {shift};")
-    if mode == "trunc" or shift == 0:  # nothing dropped: nothing to round
-        lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q;")
-        return lines
-    sticky = f"(|{src}[{shift - 2}:0]) | " if shift >= 2 else ""
-    lines.append(f"    wire {dst}_inc = {src}[{shift - 1}] & ({sticky}{dst}_q[0]);")
-    lines.append(f"    wire signed [{dst_bits - 1}:0] {dst} = {dst}_q + $signed({{1'b0, {dst}_inc}});")
-    return lines
+    return [line for s in round_to(Signal(src, src_bits, signed=True), dst, shift, dst_bits, mode)
+            for line in statement_lines(s, "verilog")[1]]
+
 
 
 def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat, out_bits: int,
@@ -160,50 +122,10 @@ def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat,
         If the offset code or ``max_code`` does not fit the working width (not expected: the
         width is chosen to hold them).
     """
-    shift = top_frac - y_format.frac_bits
-    rw = max(min_bits, top_bits + max(0, -shift) + 1, out_bits + 2,
-             y_format.offset_code.bit_length() + 2)
-    if shift > 0:
-        out = round_lines(top, "r", top_bits, shift, rw, rounding)
-    elif shift == 0:
-        out = [f"    wire signed [{rw - 1}:0] r = {top};"]
-    else:
-        out = [f"    wire signed [{rw - 1}:0] r = {top} <<< {-shift};"]
-    out += [f"    localparam signed [{rw - 1}:0] KY = {signed_literal(y_format.offset_code, rw)};",
-            f"    localparam signed [{rw - 1}:0] YMAX = {signed_literal(y_format.max_code, rw)};",
-            f"    wire signed [{rw - 1}:0] raw = r - KY;",
-            f"    assign y = raw[{rw - 1}] ? {{OUT_BITS{{1'b0}}}} : "
-            f"(raw > YMAX) ? {{OUT_BITS{{1'b1}}}} : raw[OUT_BITS-1:0];",
-            "endmodule", ""]
-    return out
+    stage = output_stage(Signal(top, top_bits, signed=True), top_frac, y_format, out_bits,
+                         rounding, min_bits=min_bits)[1:]   # no comment line
+    return [line for s in stage for line in statement_lines(s, "verilog")[1]] + ["endmodule", ""]
 
-
-def bench_verdict(name: str) -> list[str]:
-    """The last lines of an exhaustive test bench of ``name`` that counted
-    ``errors`` over ``COUNT`` vectors: print the one ``PASS:``/``FAIL:`` line
-    the simulation runners read, then ``$finish``.
-
-    >>> print("\\n".join(bench_verdict("chebnorm_f")[:2]))
-            if (errors == 0)
-                $display("PASS: %0d vectors, 0 mismatches (chebnorm_f)", COUNT);
-
-    Parameters
-    ----------
-    name : str
-        The module name printed in the verdict (an identifier).
-
-    Returns
-    -------
-    list of str
-        Verilog lines, ending with ``endmodule`` and an empty line.
-    """
-    return ["        if (errors == 0)",
-            f"            $display(\"PASS: %0d vectors, 0 mismatches ({name})\", COUNT);",
-            "        else",
-            f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", COUNT, errors);",
-            "        $finish;",
-            "    end",
-            "endmodule", ""]
 
 
 # -- Horner evaluator ---------------------------------------------------------------
@@ -244,91 +166,10 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
     >>> [line for line in v.splitlines() if line.startswith(("module", "    input", "    output"))]
     ['module chebnorm_dichotomy_d1 #(', '    input  wire [IN_BITS-1:0]  x,', '    output wire [OUT_BITS-1:0] y']
     """
-    xf, yf = design.x_format, design.y_format
-    n = design.degree
-    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
-                                     budget=budget), "verilog")
-    out += [f"module {module_name(design)} #(",
-            f"    parameter IN_BITS = {design.in_bits},",
-            f"    parameter OUT_BITS = {design.out_bits}",
-            ") (",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");"]
-    xw = design.xs_bits
-    out += [f"    // x value times 2^{xf.frac_bits}",
-            f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
-            f"    wire signed [{xw - 1}:0] xs = $signed({{1'b0, x}}) + K0;"]
-    out += _variable_lines(design, "xs", "v")
-    n = len(design.horner_integers) - 1
-    if n == 0:
-        top_bits = max(design.top_bits, 2)
-        out.append(f"    wire signed [{top_bits - 1}:0] top = {signed_literal(design.integers[0], top_bits)};")
-        top_frac = design.coef_frac_bits
-    else:
-        aw = max(design.stages[0].acc_bits, 2)
-        out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
-                   f"{signed_literal(design.horner_integers[n], aw)};")
-        prev = f"A{n}"
-        for st in design.stages:
-            j = st.power
-            out.append(f"    // step {j}: {step_comment(design, st)}"
-                       f" with {st.sum_frac_bits} -> {st.out_frac_bits} fractional bits")
-            out += _horner_step(design, st, prev, variable_name(design, st))
-            if j > 0:
-                prev = f"a{j}"
-        top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-        out.append(f"    wire signed [{top_bits - 1}:0] top = t0;")
-    out += _output_stage(design, yf, top_bits, top_frac)
-    return "\n".join(out)
+    return _verilog(horner_netlist(design, language="verilog", version=version, command=command,
+                                   budget=budget))
 
 
-
-def _variable_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
-    """The Horner variable ``v = R(xs * xs)`` of a one-parity design (no
-    lines for plain Horner in ``x``)."""
-    if design.scheme == "monomial":
-        return []
-    if design.scheme == "shifted":
-        return _shifted_lines(design, xs, v)
-    sw, vw, rs = 2 * design.xs_bits, design.variable_bits, design.v_round_shift
-    out = [f"    // {v}: x*x with {design.variable_frac_bits} fractional bits "
-           f"({'rounded' if rs else 'exact'}); Horner's rule over the {design.scheme} powers in it",
-           f"    wire signed [{sw - 1}:0] {v}_sq = {xs} * {xs};"]
-    if rs:
-        return out + round_lines(f"{v}_sq", v, sw, rs, vw, design.rounding)
-    return out + [f"    wire signed [{vw - 1}:0] {v} = {v}_sq;"]
-
-
-def _shifted_lines(design: HornerDesign, xs: str, v: str) -> list[str]:
-    """``v = (xs << m) - C``: the shifted table's variable ``(x - c')/s``."""
-    sw, m = shifted_width(design), design.v_shift
-    shifted = f"({xs} <<< {m})" if m else xs
-    return [f"    // {v} = (x - c') / s times 2^{design.variable_frac_bits}, c' = "
-            f"{design.v_offset} / 2^{design.x_format.frac_bits + m}",
-            f"    localparam signed [{sw - 1}:0] {v}_C = {signed_literal(design.v_offset, sw)};",
-            f"    wire signed [{sw - 1}:0] {v}_d = {shifted} - {v}_C;",
-            f"    wire signed [{design.variable_bits - 1}:0] {v} = {v}_d;"]
-
-
-def _horner_step(design: HornerDesign, st, prev: str, xs: str) -> list[str]:
-    """One Horner step ``a_j = R(a_{j+1} * x + q_j)``, shared by the
-    combinational and pipelined evaluators (``prev``: a_{j+1}; ``xs``: x)."""
-    j = st.power
-    shift = f" <<< {st.product_shift}" if st.product_shift else ""
-    out = [f"    wire signed [{st.product_bits - 1}:0] p{j} = {prev} * {xs};",
-           f"    localparam signed [{st.sum_bits - 1}:0] C{j} = {signed_literal(st.coef_shifted, st.sum_bits)};",
-           f"    wire signed [{st.sum_bits - 1}:0] t{j} = (p{j}{shift}) + C{j};"]
-    if j > 0:
-        out += round_lines(f"t{j}", f"a{j}", st.sum_bits, st.round_shift, st.out_bits, design.rounding)
-    return out
-
-def _output_stage(design: HornerDesign, yf, top_bits: int, top_frac: int) -> list[str]:
-    """The evaluator's last lines, shared by the combinational and pipelined
-    modules: round ``top`` to y's fractional bits, remove y's offset, saturate."""
-    return ([f"    // output: round to {yf.frac_bits} fractional bits, remove the offset, saturate"]
-            + saturating_output("top", top_bits, top_frac, yf, design.out_bits, design.rounding,
-                                min_bits=design.raw_bits))
 
 
 def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
@@ -371,54 +212,11 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
     >>> d = design_horner(fit_target("dichotomy", 1), 6, 6, coef_bits=10)
     >>> v = verilog_pipelined_module(d)
     >>> [line.strip() for line in v.splitlines() if "LATENCY =" in line or "posedge" in line]
-    ['parameter LATENCY = 1', 'always @(posedge clk) top <= t0;']
+    ['parameter LATENCY = 1', 'always @(posedge clk) begin']
     """
-    n = design.degree
-    if n < 1:
-        raise ValueError(f"design {design.name!r} has degree 0: nothing to pipeline; accepted: "
-                         f"degree >= 1")
-    xf, yf = design.x_format, design.y_format
-    name = pipelined_name(design)
-    out = comment_lines(horner_facts(design, "verilog", version=version, command=command,
-                                     budget=budget, pipelined=True), "verilog")
-    out += [f"module {name} #(",
-            f"    parameter IN_BITS = {design.in_bits},",
-            f"    parameter OUT_BITS = {design.out_bits},",
-            f"    parameter LATENCY = {design.steps}",
-            ") (",
-            "    input  wire                clk,",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");"]
-    xw = design.xs_bits
-    out += [f"    localparam signed [{xw - 1}:0] K0 = {signed_literal(xf.offset_code, xw)};",
-            f"    wire signed [{xw - 1}:0] xs0 = $signed({{1'b0, x}}) + K0;"]
-    out += _variable_lines(design, "xs0", "v0")
-    vw, square = design.variable_bits, design.scheme != "monomial"   # v travels beside x
-    n = len(design.horner_integers) - 1
-    aw = max(design.stages[0].acc_bits, 2)
-    out.append(f"    localparam signed [{aw - 1}:0] A{n} = "
-               f"{signed_literal(design.horner_integers[n], aw)};")
-    prev = f"A{n}"
-    for s, st in enumerate(design.stages):
-        j = st.power
-        out.append(f"    // stage {s + 1}: {step_comment(design, st)}")
-        out += _horner_step(design, st, prev, f"{variable_name(design, st)}{s}")
-        if j > 0:
-            out += [f"    reg signed [{st.out_bits - 1}:0] a{j}_r;",
-                    f"    reg signed [{xw - 1}:0] xs{s + 1};"]
-            out += [f"    reg signed [{vw - 1}:0] v{s + 1};"] if square else []
-            out += ["    always @(posedge clk) begin",
-                    f"        a{j}_r <= a{j};",
-                    f"        xs{s + 1} <= xs{s};"]
-            out += [f"        v{s + 1} <= v{s};"] if square else []
-            out += ["    end"]
-            prev = f"a{j}_r"
-    top_bits, top_frac = design.stages[-1].sum_bits, design.stages[-1].sum_frac_bits
-    out += [f"    reg signed [{top_bits - 1}:0] top;",
-            "    always @(posedge clk) top <= t0;"]
-    out += _output_stage(design, yf, top_bits, top_frac)
-    return "\n".join(out)
+    return _verilog(horner_netlist(design, pipelined=True, language="verilog", version=version,
+                                   command=command, budget=budget))
+
 
 
 def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -455,57 +253,7 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     >>> verilog_pipelined_testbench(d).splitlines()[0]
     '// tb_chebnorm_dichotomy_d1_pipe: exhaustive self-checking test bench of chebnorm_dichotomy_d1_pipe, latency 1.'
     """
-    return _clocked_bench(design, pipelined_name(design), design.steps, vectors)
-
-
-def _clocked_bench(design, name: str, n: int, vectors: str | None) -> str:
-    """The exhaustive bench of clocked module ``name`` of latency ``n``."""
-    vectors = vectors_name(name, vectors)
-    count = 2 ** design.in_bits
-    return "\n".join([
-        f"// tb_{name}: exhaustive self-checking test bench of {name}, latency {n}.",
-        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
-        "`timescale 1ns/1ps",
-        f"module tb_{name};",
-        f"    localparam IN_BITS = {design.in_bits};",
-        f"    localparam OUT_BITS = {design.out_bits};",
-        f"    localparam LATENCY = {n};",
-        f"    localparam COUNT = {count};",
-        "    reg clk;",
-        "    reg  [IN_BITS-1:0]  x;",
-        "    wire [OUT_BITS-1:0] y;",
-        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
-        "    integer i, errors, checked;",
-        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS), .LATENCY(LATENCY)) dut "
-        "(.clk(clk), .x(x), .y(y));",
-        "    initial begin",
-        f"        $readmemh(\"{vectors}\", expected);",
-        "        errors = 0;",
-        "        checked = 0;",
-        "        clk = 0;",
-        "        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin",
-        "            x = (i < COUNT) ? i : 0;",
-        "            #1 clk = 1;",
-        "            #1;",
-        "            if (i >= LATENCY - 1) begin",
-        "                checked = checked + 1;",
-        "                if (y !== expected[i - LATENCY + 1]) begin",
-        "                    errors = errors + 1;",
-        "                    if (errors <= 10)",
-        "                        $display(\"MISMATCH x=%h y=%h expected=%h\", i - LATENCY + 1, y,",
-        "                                 expected[i - LATENCY + 1]);",
-        "                end",
-        "            end",
-        "            clk = 0;",
-        "        end",
-        "        if (errors == 0)",
-        f"            $display(\"PASS: %0d vectors, 0 mismatches ({name}, latency %0d)\", "
-        "checked, LATENCY);",
-        "        else",
-        f"            $display(\"FAIL: %0d vectors, %0d mismatches ({name})\", checked, errors);",
-        "        $finish;",
-        "    end",
-        "endmodule", ""])
+    return testbench(bench_ports(design, pipelined_name(design), design.steps), "verilog", vectors)
 
 
 def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
@@ -540,36 +288,7 @@ def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     >>> '$readmemh("chebnorm_dichotomy_d1.hex", expected);' in tb
     True
     """
-    name = module_name(design)
-    vectors = vectors_name(name, vectors)
-    count = 2 ** design.in_bits
-    return "\n".join([
-        f"// tb_{name}: exhaustive self-checking test bench of {name}.",
-        f"// Expected outputs come from the chebnorm bit-accurate model ({vectors}).",
-        "`timescale 1ns/1ps",
-        f"module tb_{name};",
-        f"    localparam IN_BITS = {design.in_bits};",
-        f"    localparam OUT_BITS = {design.out_bits};",
-        f"    localparam COUNT = {count};",
-        "    reg  [IN_BITS-1:0]  x;",
-        "    wire [OUT_BITS-1:0] y;",
-        "    reg  [OUT_BITS-1:0] expected [0:COUNT-1];",
-        "    integer i, errors;",
-        f"    {name} #(.IN_BITS(IN_BITS), .OUT_BITS(OUT_BITS)) dut (.x(x), .y(y));",
-        "    initial begin",
-        f"        $readmemh(\"{vectors}\", expected);",
-        "        errors = 0;",
-        "        for (i = 0; i < COUNT; i = i + 1) begin",
-        "            x = i;",
-        "            #1;",
-        "            if (y !== expected[i]) begin",
-        "                errors = errors + 1;",
-        "                if (errors <= 10)",
-        "                    $display(\"MISMATCH x=%h y=%h expected=%h\", x, y, expected[i]);",
-        "            end",
-        "        end",
-        *bench_verdict(name)])
-
+    return testbench(bench_ports(design, module_name(design)), "verilog", vectors)
 
 # -- piecewise evaluator -------------------------------------------------------------
 
@@ -606,65 +325,8 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     """
     if d.sized:
         return sized_piecewise_verilog(d, version=version, command=command)
-    if d.latency:
-        return pipelined_piecewise_verilog(d, version=version, command=command)
-    t = d.table
-    n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
-    yf = d.y_format
-    mod = module_name(d)
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
-    out += [f"module {mod} #(",
-            f"    parameter IN_BITS = {d.in_bits},",
-            f"    parameter OUT_BITS = {d.out_bits}",
-            ") (",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");",
-            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
-    tw = d.t_bits
-    if t.centered:
-        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}) - "
-                   f"{signed_literal(1 << (L - 1), tw)};")
-    else:
-        out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}});")
-    regs = [f"c{j}" for j in range(n + 1)]
-    if K == 0:  # one segment: constants (an always block with no input would never run)
-        for j in range(n + 1):
-            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
-    else:
-        for j in range(n + 1):
-            out.append(f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};")
-        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
-                "    always @(*) begin",
-                "        case (idx)"]
-        for s, seg in enumerate(t.segments):
-            body = " ".join(f"{regs[j]} = {signed_literal(q, d.rom_bits[j])};"
-                            for j, q in enumerate(seg.integers))
-            out.append(f"            {K}'d{s}: begin {body} end")
-        out += ["        endcase", "    end"]
-    prev, prev_frac = f"c{n}", fc
-    for i, j in enumerate(range(n - 1, -1, -1)):
-        pw, sw, ow = d.widths[i]
-        pf = prev_frac + L
-        sf = max(pf, fc)
-        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
-        out.append(f"    wire signed [{pw - 1}:0] p{j} = {prev} * t;")
-        sh_p = f" <<< {sf - pf}" if sf > pf else ""
-        sh_c = f" <<< {sf - fc}" if sf > fc else ""
-        out.append(f"    wire signed [{sw - 1}:0] s{j} = (p{j}{sh_p}) + (c{j}{sh_c});")
-        if j > 0:
-            f_out = min(d.acc_frac_bits, sf)
-            if sf > f_out:
-                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
-            else:
-                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
-            prev, prev_frac = f"a{j}", f_out
-        else:
-            prev, prev_frac = f"s{j}", sf
-    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
-    out += saturating_output(prev, top_bits, prev_frac, yf, d.out_bits, d.rounding)
-    return "\n".join(out)
+    return _verilog(piecewise_netlist(d, version=version, command=command))
+
 
 
 # -- sized piecewise evaluator (a width per coefficient, truncated steps, pipelined) --------
@@ -702,124 +364,9 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
     >>> v.count("always @(posedge clk)"), "parameter LATENCY = 3" in v
     (3, True)
     """
-    t = d.table
-    n, L, K = t.degree, d.local_bits, d.index_bits
-    mod = module_name(d)
-    clocked = d.latency > 0
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
-    out += [f"module {mod} #(",
-            f"    parameter IN_BITS = {d.in_bits},",
-            f"    parameter OUT_BITS = {d.out_bits}" + ("," if clocked else ""),
-            *([f"    parameter LATENCY = {d.latency}"] if clocked else []),
-            ") (",
-            *(["    input  wire                clk,"] if clocked else []),
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");",
-            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
-    if K == 0:
-        for j in range(n + 1):
-            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{signed_literal(d.coefficients[0][j], d.rom_bits[j])};")
-    else:
-        out += [f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};" for j in range(n + 1)]
-        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
-                "    always @(*) begin",
-                "        case (idx)"]
-        for s, row in enumerate(d.coefficients):
-            body = " ".join(f"c{j} = {signed_literal(q, d.rom_bits[j])};"
-                            for j, q in enumerate(row))
-            out.append(f"            {K}'d{s}: begin {body} end")
-        out += ["        endcase", "    end"]
-    # live signals: name -> (width, signed); registered at each cut point
-    live = {"low": (L, False), **{f"c{j}": (d.rom_bits[j], True) for j in range(n + 1)}}
-    cur = {k: k for k in live}
-    acc, accw = f"c{n}", d.rom_bits[n]
-
-    def cut(stage) -> None:
-        regs = []
-        for key, (w, sgn) in live.items():
-            r = f"{key}_r{stage}"
-            out.append(f"    reg {'signed ' if sgn else ''}[{w - 1}:0] {r};")
-            regs.append(f"        {r} <= {cur[key]};")
-            cur[key] = r
-        out.extend(["    always @(posedge clk) begin", *regs, "    end"])
-
-    if 0 in d.cuts:
-        cut(0)
-    for i, st in enumerate(d.sized_signals(), start=1):
-        j, T = st["j"], st["T"]
-        lo = cur["low"]
-        out.append(f"    // step {j}: a{j} = (((a{j + 1} * t{j}) >>> {st['pshift']}) <<< {st['qshift']}"
-                   f" + c{j} <<< {st['cshift']}) >>> {st['ashift']}, t{j} = top {T} bits of t"
-                   + (", truncated multiplier" if st["rows"] else ""))
-        if t.centered:
-            bits = f"~{lo}[{L - 1}]" if T == 1 else f"{{~{lo}[{L - 1}], {lo}[{L - 2}:{L - T}]}}"
-            out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = {bits};")
-        else:
-            out.append(f"    wire signed [{st['tw'] - 1}:0] t{j} = $signed({{1'b0, {lo}[{L - 1}:{L - T}]}});")
-        if st["rows"]:
-            out += _truncated_rows(st, cur[acc], accw, lo)
-        else:
-            out.append(f"    wire signed [{st['pw'] - 1}:0] p{j} = {cur[acc]} * t{j};")
-            ps = st["pshift"]
-            shift = f" >>> {ps}" if ps > 0 else (f" <<< {-ps}" if ps < 0 else "")
-            out.append(f"    wire signed [{st['qw'] - 1}:0] q{j} = p{j}{shift};")
-        q = f"q{j}"
-        if i in getattr(d, "mult_cuts", ()):  # a register between the multiply and the add
-            live.pop(acc, None)
-            cur.pop(acc, None)
-            if j == 0:
-                live.pop("low", None)
-            live[q], cur[q] = (st["qw"], True), q
-            cut(f"m{i}")
-            q = cur.pop(q)
-            del live[f"q{j}"]
-        cs = f" <<< {st['cshift']}" if st["cshift"] else ""
-        qs = f"({q} <<< {st['qshift']})" if st["qshift"] else q
-        out.append(f"    wire signed [{st['sw'] - 1}:0] s{j} = {qs} + ({cur[f'c{j}']}{cs});")
-        ash = f" >>> {st['ashift']}" if st["ashift"] else ""
-        out.append(f"    wire signed [{st['aw'] - 1}:0] a{j} = s{j}{ash};")
-        del live[f"c{j}"], cur[f"c{j}"]
-        live.pop(acc, None)
-        cur.pop(acc, None)
-        acc, accw = f"a{j}", st["aw"]
-        live[acc], cur[acc] = (st["aw"], True), acc
-        if j == 0:
-            live.pop("low", None)
-        if i in d.cuts:
-            cut(i)
-    top_bits = d.widths[-1][2] if n > 0 else d.rom_bits[0]
-    if n == 0:
-        f0, g0 = d.coef_frac[0], d.acc_frac[0]
-        sh = f" >>> {f0 - g0}" if f0 > g0 else (f" <<< {g0 - f0}" if g0 > f0 else "")
-        top_bits = d.rom_bits[0] + max(0, g0 - f0)
-        out.append(f"    wire signed [{top_bits - 1}:0] a0 = {cur['c0']}{sh};")
-        acc = "a0"
-        cur[acc] = acc
-    out += saturating_output(cur[acc], top_bits, d.y_format.frac_bits, d.y_format, d.out_bits,
-                             "trunc")
-    return "\n".join(out)
+    return _verilog(sized_piecewise_netlist(d, version=version, command=command))
 
 
-def _truncated_rows(st: dict, a: str, aw: int, low: str) -> list[str]:
-    """The truncated multiplier ``q_j`` of a sized step: one row per bit of
-    ``t_j``'s code, ``a`` floored at column ``P`` (an arithmetic shift), gated by
-    the bit (the inverted top bit, negated row, when ``t`` is centred), all
-    rows added modulo ``2^qw`` (the exact sum fits ``qw`` bits)."""
-    j, qw = st["j"], st["qw"]
-    out, terms = [], []
-    if any(neg for _, _, neg in st["rows"]):
-        out.append(f"    wire signed [{aw}:0] na{j} = -{a};")
-    for i, sh, neg in st["rows"]:
-        src = f"na{j}" if neg else a
-        expr = f"{src} >>> {sh}" if sh > 0 else (f"{src} <<< {-sh}" if sh < 0 else src)
-        bit = f"{low}[{st['tshift'] + i}]"
-        out += [f"    wire signed [{qw - 1}:0] r{j}_{i} = {expr};",
-                f"    wire [{qw - 1}:0] m{j}_{i} = r{j}_{i} & {{{qw}{{{'~' if neg else ''}{bit}}}}};"]
-        terms.append(f"m{j}_{i}")
-    out.append(f"    wire signed [{qw - 1}:0] q{j} = {' + '.join(terms)};")
-    return out
 
 
 def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
@@ -852,124 +399,4 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     ValueError
         If ``vectors`` (without ``.hex``) or the design's name is not a safe identifier.
     """
-    return _clocked_bench(d, module_name(d), d.latency, vectors)
-
-
-# -- one-width piecewise evaluator with pipeline registers ----------------------------------
-# (printed beside the combinational piecewise_verilog: the same wires, registered at the cuts)
-
-def pipelined_piecewise_verilog(d, *, version: str = "", command: str | None = None) -> str:
-    """The Verilog-2005 module of a one-width piecewise design with pipeline
-    registers (``d.latency > 0``, ``d.sized`` False): the wires of
-    :func:`piecewise_verilog`, every live signal registered after the ROM read
-    (cut ``0``), after step ``i``'s multiply (``i`` in ``d.mult_cuts``) and after
-    its add and rounding (``i`` in ``d.cuts``); ``clk`` port, ``LATENCY``
-    parameter, bit for bit :meth:`~chebnorm.hw.piecewise.PiecewiseDesign.evaluate`
-    ``LATENCY`` cycles later.
-
-    Parameters
-    ----------
-    d : PiecewiseDesign
-        A one-width piecewise design with cuts (``chebnorm.hw.pipeline.with_cuts``).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-
-    Returns
-    -------
-    str
-        The Verilog-2005 text, banner first.
-
-    Examples
-    --------
-    >>> from chebnorm.approx.piecewise_fit import piecewise_fit
-    >>> from chebnorm.hw.piecewise import design_piecewise
-    >>> from chebnorm.hw.pipeline import with_cuts
-    >>> t = piecewise_fit("1/sqrt(x)", ("1", "4"), 1, segments=4, coef_frac_bits=16, name="rs")
-    >>> v = pipelined_piecewise_verilog(with_cuts(design_piecewise(t, 8, 8), (0, 1, 2)))
-    >>> v.count("always @(posedge clk)"), "parameter LATENCY = 3" in v
-    (3, True)
-    """
-    t = d.table
-    n, L, K, fc = t.degree, d.local_bits, d.index_bits, t.coef_frac_bits
-    out = comment_lines(piecewise_facts(d, version=version, command=command), "verilog")
-    out += [f"module {module_name(d)} #(",
-            f"    parameter IN_BITS = {d.in_bits},",
-            f"    parameter OUT_BITS = {d.out_bits},",
-            f"    parameter LATENCY = {d.latency}",
-            ") (",
-            "    input  wire                clk,",
-            "    input  wire [IN_BITS-1:0]  x,",
-            "    output wire [OUT_BITS-1:0] y",
-            ");",
-            f"    wire [{L - 1}:0] low = x[{L - 1}:0];"]
-    tw = d.t_bits
-    centre = f" - {signed_literal(1 << (L - 1), tw)}" if t.centered else ""
-    out.append(f"    wire signed [{tw - 1}:0] t = $signed({{2'b00, low}}){centre};")
-    if K == 0:
-        for j in range(n + 1):
-            out.append(f"    wire signed [{d.rom_bits[j] - 1}:0] c{j} = "
-                       f"{signed_literal(t.segments[0].integers[j], d.rom_bits[j])};")
-    else:
-        out += [f"    reg signed [{d.rom_bits[j] - 1}:0] c{j};" for j in range(n + 1)]
-        out += [f"    wire [{K - 1}:0] idx = x[{d.in_bits - 1}:{L}];",
-                "    always @(*) begin",
-                "        case (idx)"]
-        for s, seg in enumerate(t.segments):
-            body = " ".join(f"c{j} = {signed_literal(q, d.rom_bits[j])};"
-                            for j, q in enumerate(seg.integers))
-            out.append(f"            {K}'d{s}: begin {body} end")
-        out += ["        endcase", "    end"]
-    # live signals: name -> width (all signed); registered at each cut point
-    live = {"t": tw, **{f"c{j}": d.rom_bits[j] for j in range(n + 1)}}
-    cur = {k: k for k in live}
-
-    def cut(stage) -> None:
-        regs = []
-        for key, w in live.items():
-            r = f"{key}_r{stage}"
-            out.append(f"    reg signed [{w - 1}:0] {r};")
-            regs.append(f"        {r} <= {cur[key]};")
-            cur[key] = r
-        out.extend(["    always @(posedge clk) begin", *regs, "    end"])
-
-    if 0 in d.cuts:
-        cut(0)
-    acc, prev_frac = f"c{n}", fc
-    for i, j in enumerate(range(n - 1, -1, -1), start=1):
-        pw, sw, ow = d.widths[i - 1]
-        pf = prev_frac + L
-        sf = max(pf, fc)
-        out.append(f"    // step {j}: a{j} = R(a{j + 1} * t + c{j}), {sf} fractional bits")
-        out.append(f"    wire signed [{pw - 1}:0] p{j} = {cur[acc]} * {cur['t']};")
-        p = f"p{j}"
-        del live[acc], cur[acc]
-        if j == 0:
-            del live["t"], cur["t"]
-        if i in d.mult_cuts:  # a register between the multiply and the add
-            live[p], cur[p] = pw, p
-            cut(f"m{i}")
-            p = cur.pop(p)
-            del live[f"p{j}"]
-        sh_p = f" <<< {sf - pf}" if sf > pf else ""
-        sh_c = f" <<< {sf - fc}" if sf > fc else ""
-        out.append(f"    wire signed [{sw - 1}:0] s{j} = ({p}{sh_p}) + ({cur[f'c{j}']}{sh_c});")
-        del live[f"c{j}"], cur[f"c{j}"]
-        if j > 0:
-            f_out = min(d.acc_frac_bits, sf)
-            if sf > f_out:
-                out += round_lines(f"s{j}", f"a{j}", sw, sf - f_out, ow, d.rounding)
-            else:
-                out.append(f"    wire signed [{ow - 1}:0] a{j} = s{j};")
-            acc, prev_frac, width = f"a{j}", f_out, ow
-        else:
-            acc, prev_frac, width = f"s{j}", sf, sw
-        live[acc], cur[acc] = width, acc
-        if i in d.cuts:
-            cut(i)
-    top_bits = d.widths[-1][1] if n > 0 else d.rom_bits[0]
-    out += saturating_output(cur[acc], top_bits, prev_frac, d.y_format, d.out_bits, d.rounding)
-    return "\n".join(out)
-
+    return testbench(bench_ports(d, module_name(d), d.latency), "verilog", vectors)
