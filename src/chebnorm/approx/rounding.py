@@ -147,6 +147,7 @@ def representable(m: int, s: int, fmt: str) -> bool:
 
 
 def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
+    """The ``count`` Chebyshev points of the first kind on ``[lo, hi]``, ascending."""
     k = np.arange(count)
     t = np.cos(np.pi * (2 * k + 1) / (2 * count))[::-1]
     return 0.5 * (lo + hi) + 0.5 * (hi - lo) * t

@@ -44,14 +44,17 @@ TINY = 1e-30
 
 # --------------------------------------------------------------- vectors
 def vadd(a, b):
+    """``a + b``: 3 add."""
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
 def vsub(a, b):
+    """``a - b``: 3 add."""
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def vmul(a, s):
+    """``a * s`` for a scalar ``s``: 3 mul."""
     return (a[0] * s, a[1] * s, a[2] * s)
 
 
