@@ -44,7 +44,8 @@ from chebnorm.core import clib
 from .certify import certify
 from chebnorm.core.detlinalg import matvec
 
-__all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: floating formats: (precision p including the hidden bit, emin, emax);
 #: representable: m * 2^(e - p + 1) with |m| < 2^p and emin <= e <= emax
