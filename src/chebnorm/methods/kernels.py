@@ -31,10 +31,8 @@ pixel, the difference once per span).
 
 from __future__ import annotations
 
-__all__ = ["SHAPES", "EXACT", "NONE", "NEWTON", "LYON", "SLERP", "QUADRATIC", "ANGULAR",
-           "DICHOTOMY", "dot", "normalize_classic", "normalize_newton", "normalize_lyon",
-           "angular_steps", "quadratic_steps", "dichotomy_tree", "dichotomy_pick",
-           "dichotomy_fraction", "horner", "TINY"]
+# an implementation module of chebnorm.methods: the API is what chebnorm.methods exports
+__all__: list[str] = []
 
 #: the kernel shapes (see the module docstring)
 SHAPES = ("direct", "steps", "tree")
