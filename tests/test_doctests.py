@@ -32,16 +32,10 @@ EXAMPLE_MODULES = ("chebnorm.approx.expr", "chebnorm.core.files", "chebnorm.core
 #: a design-space search whose smallest run takes minutes; its types have examples elsewhere
 EXAMPLE_SKIPPED_MODULES = ("chebnorm.hw.piecewise_search",)
 
-_GPU = "needs a GPU driver at run time (EGL/OpenGL 4.3 or a WebGPU adapter); tests/test_targets.py"
 _TOOL = "runs an external tool (iverilog, yosys, ghdl, glslangValidator) the suite skips without"
 _RESULT = "made only by a run of an external tool (simulate / synthesize)"
 #: public callables without an example, and why (keep this short)
 EXAMPLE_EXEMPT = {
-    "chebnorm.export.gpu.gl_context": _GPU,
-    "chebnorm.export.gpu.glsl_evaluate": _GPU,
-    "chebnorm.export.gpu.wgsl_evaluate": _GPU,
-    "chebnorm.export.gpu.glsl_runner": _GPU,
-    "chebnorm.export.gpu.glslang_validate": _TOOL,
     "chebnorm.hw.run_verilog.simulate": _TOOL,
     "chebnorm.hw.run_verilog.synthesize": _TOOL,
     "chebnorm.hw.run_verilog.synthesize_text": _TOOL,
