@@ -38,13 +38,7 @@ _RESULT = "made only by a run of an external tool (simulate / synthesize)"
 EXAMPLE_EXEMPT = {
     "chebnorm.hw.run_verilog.simulate": _TOOL,
     "chebnorm.hw.run_verilog.synthesize": _TOOL,
-    "chebnorm.hw.run_verilog.synthesize_text": _TOOL,
-    "chebnorm.hw.run_vhdl.simulate_vhdl": _TOOL,
-    "chebnorm.hw.piecewise.piecewise_cells": _TOOL,
-    "chebnorm.hw.piecewise.simulate_piecewise": _TOOL,
     "chebnorm.hw.targets.synthesize_target": _TOOL,
-    "chebnorm.hw.targets.module_ports": _TOOL,
-    "chebnorm.hw.targets.target_figures": _TOOL,
     "chebnorm.hw.targets.fmax_ice40": _TOOL + " (and nextpnr-ice40)",
     "chebnorm.hw.run_verilog.SimResult": _RESULT,
     "chebnorm.hw.run_verilog.SynthResult": _RESULT,

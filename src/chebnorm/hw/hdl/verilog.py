@@ -30,10 +30,8 @@ from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
-__all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
-           "verilog_module", "verilog_pipelined_module", "verilog_testbench",
-           "verilog_pipelined_testbench", "piecewise_verilog", "sized_piecewise_verilog",
-           "piecewise_clocked_testbench"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 
 # -- fragments -------------------------------------------------------------------

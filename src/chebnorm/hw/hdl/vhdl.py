@@ -38,9 +38,8 @@ from .common import (shifted_width, step_comment, variable_name)
 from .common import (comment_lines, horner_facts, module_name, piecewise_facts, pipelined_name,
                      vectors_name)
 
-__all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
-           "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
-           "sized_piecewise_vhdl", "piecewise_vhdl_clocked_testbench"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"
