@@ -133,7 +133,6 @@ def all_sizes(root: Path = SRC) -> dict[str, int]:
     return sizes
 
 
-@pytest.mark.xfail(strict=True, reason="the implementation modules still export their helpers")
 def test_the_package_exports_at_most_350_names():
     sizes = all_sizes()
     total = sum(sizes.values())
