@@ -353,3 +353,24 @@ def test_every_constant_is_checked_in_its_module():
     modules = set(_public_modules())
     assert _all_constants()
     assert {q.rsplit(".", 1)[0] for q in _all_constants()} <= modules
+
+
+def test_a_constant_a_stage_exports_is_checked_where_it_is_assigned():
+    """A stage re-exports constants its implementation modules assign (and no longer
+    export): each is checked in the module that assigns it, under the same name."""
+    checked = _all_constants()
+    modules = _public_modules()
+    own = {m: _assigned_names(importlib.import_module(m)) for m in modules}
+    seen = 0
+    for stage in modules:
+        pkg = importlib.import_module(stage)
+        if not hasattr(pkg, "__path__"):
+            continue
+        for n in pkg.__all__:
+            v = getattr(pkg, n)
+            if inspect.ismodule(v) or callable(v) or n.startswith("__") or n in own[stage]:
+                continue
+            where = [m for m in modules if m != stage and n in own[m] and getattr(importlib.import_module(m), n) is v]
+            seen += bool(where)
+            assert all(f"{m}.{n}" in checked for m in where), (stage, n, where)
+    assert seen > 10

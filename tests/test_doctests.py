@@ -115,3 +115,22 @@ def test_example_check_sees_a_missing_example():
     collected = {t.name for t in doctest.DocTestFinder().find(module) if t.examples}
     missing = [n for n in _own_callables(module) if f"{module.__name__}.{n}" not in collected]
     assert missing == ["g"]
+
+
+def test_example_check_sees_a_stage_name_its_module_does_not_export(monkeypatch):
+    """An implementation module exports nothing (``__all__ = []``); a function its stage
+    exports is checked there all the same, and a helper neither exports is not."""
+    import types
+
+    stage = types.ModuleType("chebnorm_fake_stage")
+    module = types.ModuleType("chebnorm_fake_stage.impl")
+    exec("__all__ = []\n"
+         "def f():\n    '''Exported by the stage, no example.'''\n"
+         "def helper():\n    '''Used by the stage's modules only.'''\n", module.__dict__)
+    stage.__all__ = ["f"]
+    stage.f = module.f
+    monkeypatch.setitem(sys.modules, stage.__name__, stage)
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    collected = {t.name for t in doctest.DocTestFinder().find(module) if t.examples}
+    missing = [n for n in _own_callables(module) if f"{module.__name__}.{n}" not in collected]
+    assert missing == ["f"]
