@@ -242,13 +242,28 @@ def _stage_modules() -> dict[str, list[str]]:
     return out
 
 
+def _stage_api_modules() -> dict[str, list[str]]:
+    """The modules each stage's ``__all__`` exports that have no ``__all__`` themselves:
+    every public name they define is public (``chebnorm.core.files.write_atomic``)."""
+    out = {}
+    for stage in STAGES:
+        pkg = importlib.import_module(f"chebnorm.{stage}")
+        mods = [getattr(pkg, n) for n in pkg.__all__ if inspect.ismodule(getattr(pkg, n))]
+        out[stage] = sorted(m.__name__ for m in mods if not hasattr(m, "__all__"))
+    return out
+
+
 def _module_page(modname: str) -> str:
     """The page of one module: the public names it defines, except those its stage
     re-exports (documented once, on the stage's page, and linked from here)."""
     stage = ".".join(modname.split(".")[:2])
     pkg = importlib.import_module(stage)
     mod = importlib.import_module(modname)
-    own = getattr(mod, "__all__", None) or [n for n in vars(mod) if not n.startswith("_")]
+    # what it exports, and every public name it defines (an implementation module's
+    # __all__ is empty: its stage exports the API)
+    own = list(getattr(mod, "__all__", None) or [])
+    own += [n for n, v in vars(mod).items() if not n.startswith("_") and n not in own
+            and getattr(v, "__module__", None) == modname]
     # the names this module shares with its stage (the same object): documented there
     shown = [n for n in own if n in pkg.__all__ and getattr(mod, n, None) is getattr(pkg, n)
              and (inspect.isfunction(getattr(pkg, n)) or inspect.isclass(getattr(pkg, n)))]
@@ -298,7 +313,8 @@ def _write_module_pages() -> None:
     index = ["Modules", "=======", "",
              "Every public module of every stage, with the names it defines that its stage",
              "does not export (those are on the stage's page). Import the stage's names from",
-             "the stage; a module's own names are stable too, but closer to the implementation.", ""]
+             "the stage: a module's other names are the stage's implementation, shown here for",
+             "readers of the code, and may change.", ""]
     for stage, mods in by_stage.items():
         if not mods:
             continue
@@ -449,6 +465,9 @@ _write_module_pages()
 # the stage pages list a facade object with a link to its entry (docs/_templates/autosummary)
 autosummary_context = {
     "facade_stubs": _facade_stubs(),
+    # a module a stage exports without an __all__ of its own (chebnorm.core.files): its page
+    # documents the names it defines (autosummary would list its imports too)
+    "plain_modules": sorted(m for mods in _stage_api_modules().values() for m in mods),
     "facade_calls": {m: "facade-" + m.removeprefix("chebnorm.").replace(".", "-") for m in FACADE_CALLS},
 }
 

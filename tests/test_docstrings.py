@@ -252,19 +252,32 @@ def _assigned_names(mod) -> set[str]:
 _one_object: dict[int, bool] = {}
 
 
+def _exports(mod) -> list[str]:
+    """The names ``mod`` exports: its ``__all__``, or without one every name its source
+    assigns that does not start with ``_`` (a module without ``__all__`` exports them all)."""
+    if hasattr(mod, "__all__"):
+        return list(mod.__all__)
+    return sorted(n for n in _assigned_names(mod) if not n.startswith("_"))
+
+
 def _constants() -> dict[str, bool]:
     """Qualified name (where assigned) -> whether it has a ``#:`` description there, for
-    every public constant: the non-callable, non-module names of the facade's and
-    each public module's ``__all__``. A constant is checked in every public module
+    every public constant: the non-callable, non-module names the facade and each public
+    module export (:func:`_exports`). A constant is checked in every public module
     that assigns it (a copy of another module's value included); a re-export, where
-    its value is assigned, or at its first exporter when no public module assigns it."""
+    its value is assigned (an implementation module whose stage exports it), or at
+    its first exporter when no public module assigns it."""
     from sphinx.pycode import ModuleAnalyzer
 
     docs: dict[str, set[str]] = {}
     assigned: dict[tuple[int, str], list[str]] = {}
     exported: dict[tuple[int, str], str] = {}
+    # every public module's own assignments, exported or not: where a re-export is defined
+    anywhere: dict[tuple[int, str], list[str]] = {}
+    anywhere_by_id: dict[int, list[str]] = {}
     _one_object.clear()
-    for modname in _public_modules():
+    modules = _public_modules()
+    for modname in modules:
         mod = importlib.import_module(modname)
         try:
             attrs = {n for (cls, n) in ModuleAnalyzer.for_module(modname).find_attr_docs() if cls == ""}
@@ -272,10 +285,17 @@ def _constants() -> dict[str, bool]:
             attrs = set()
         docs[modname] = attrs
         own = _assigned_names(mod)
-        for n in getattr(mod, "__all__", ()):
+        for n in sorted(own):
+            v = getattr(mod, n, None)
+            if n.startswith("_") or inspect.ismodule(v) or callable(v):
+                continue
+            anywhere.setdefault((id(v), n), []).append(f"{modname}.{n}")
+            if not isinstance(v, (int, float, str, bytes, bool)):
+                anywhere_by_id.setdefault(id(v), []).append(f"{modname}.{n}")
+        for n in _exports(mod):
             if n not in vars(mod) and n not in docs.get(modname, ()):
                 if hasattr(mod, "__getattr__") and not any(n in vars(importlib.import_module(m))
-                                                           for m in docs if m.startswith(modname + ".")):
+                                                           for m in modules if m.startswith(modname + ".")):
                     continue  # computed on access (PEP 562): described in the module docstring
             v = getattr(mod, n)
             if inspect.ismodule(v) or callable(v) or n.startswith("__"):
@@ -287,10 +307,18 @@ def _constants() -> dict[str, bool]:
                 assigned.setdefault(key, []).append(f"{modname}.{n}")
             else:
                 exported.setdefault(key, f"{modname}.{n}")
+    # a re-export whose value an implementation module assigns: checked there
+    for (i, n) in exported:
+        if (i, n) in anywhere:
+            assigned.setdefault((i, n), [])
+            assigned[(i, n)] += [q for q in anywhere[(i, n)] if q not in assigned[(i, n)]]
+        elif (i, n) not in assigned and _one_object[i] and i in anywhere_by_id:
+            for qual in anywhere_by_id[i]:  # under another name (``FORMATS as COEF_FORMATS``)
+                assigned.setdefault((i, qual.rsplit(".", 1)[1]), []).append(qual)
     # a re-export under another name (``FORMATS as COEF_FORMATS``) is the object assigned
     # elsewhere; an id says so only for objects that are not shared scalars
     objects = {i for i, _ in assigned}
-    quals = [q for qs in assigned.values() for q in qs]
+    quals = sorted({q for qs in assigned.values() for q in qs})
     quals += [q for (i, n), q in exported.items() if (i, n) not in assigned
               and not (i in objects and _one_object[i])]
     out = {}
@@ -325,3 +353,24 @@ def test_every_constant_is_checked_in_its_module():
     modules = set(_public_modules())
     assert _all_constants()
     assert {q.rsplit(".", 1)[0] for q in _all_constants()} <= modules
+
+
+def test_a_constant_a_stage_exports_is_checked_where_it_is_assigned():
+    """A stage re-exports constants its implementation modules assign (and no longer
+    export): each is checked in the module that assigns it, under the same name."""
+    checked = _all_constants()
+    modules = _public_modules()
+    own = {m: _assigned_names(importlib.import_module(m)) for m in modules}
+    seen = 0
+    for stage in modules:
+        pkg = importlib.import_module(stage)
+        if not hasattr(pkg, "__path__"):
+            continue
+        for n in pkg.__all__:
+            v = getattr(pkg, n)
+            if inspect.ismodule(v) or callable(v) or n.startswith("__") or n in own[stage]:
+                continue
+            where = [m for m in modules if m != stage and n in own[m] and getattr(importlib.import_module(m), n) is v]
+            seen += bool(where)
+            assert all(f"{m}.{n}" in checked for m in where), (stage, n, where)
+    assert seen > 10

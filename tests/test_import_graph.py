@@ -1,15 +1,18 @@
 """The module graph of ``src/chebnorm`` (issue 27): no file-level import
-cycles, and no private name crossing a module boundary.
+cycles, and no private name crossing a stage boundary (issue 45).
 
 The graph is built from the source with ``ast``, not by importing: an edge
 ``a -> b`` for every ``import`` or ``from ... import`` in ``a`` (at module
 level or inside a function) that names module ``b`` of the package, or a name
 defined in ``b``. A cycle is a strongly connected component of two or more
-modules. A private name (``_x``, not a dunder) crosses a boundary when a
-module imports it from another module (``from .m import _x``), imports a
-``_module`` of the package, or reads ``m._x`` through a module it imported
-(``from . import m`` / ``import chebnorm.m as m``). Tests are exempt: they may
-reach into a module's internals.
+modules. A stage is a top-level part of the package (``chebnorm.hw`` with
+everything below it, ``chebnorm.exceptions``, the facade ``chebnorm`` itself).
+The modules of one stage share their private helpers; a private name (``_x``,
+not a dunder) crosses a boundary when a module imports it from a module of
+another stage (``from ..approx.m import _x``), imports a ``_module`` of another
+stage, or reads ``m._x`` through a module of another stage it imported
+(``from chebnorm.approx import m`` / ``import chebnorm.approx.m as m``). Tests
+are exempt: they may reach into a module's internals.
 
 ``TestCheckerCatches`` writes each forbidden form into a small package and
 shows the checker reports it, so these tests can fail.
@@ -27,6 +30,12 @@ SRC = Path(__file__).resolve().parent.parent / "src"
 
 def _private(name: str) -> bool:
     return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def stage(module: str) -> str:
+    """The stage a dotted module name belongs to: ``chebnorm.hw.units.base`` ->
+    ``chebnorm.hw``; the facade ``chebnorm`` is its own."""
+    return ".".join(module.split(".")[:2])
 
 
 def modules(src: Path, package: str = "chebnorm") -> dict[str, tuple[Path, list[str]]]:
@@ -52,7 +61,7 @@ def _base(node: ast.ImportFrom, pkg: list[str]) -> str:
 
 def graph(src: Path, package: str = "chebnorm"):
     """``(edges, private)``: ``edges[a]`` the modules ``a`` imports; ``private`` a
-    list of ``(module, line, text)`` for each private name crossing a boundary."""
+    list of ``(module, line, text)`` for each private name crossing a stage boundary."""
     mods = modules(src, package)
     edges: dict[str, set[str]] = {m: set() for m in mods}
     private: list[tuple[str, int, str]] = []
@@ -61,11 +70,10 @@ def graph(src: Path, package: str = "chebnorm"):
         bound: dict[str, str] = {}  # local name -> module it stands for
 
         def link(target: str, line: int, text: str) -> None:
-            """An edge to module ``target``; a private module is private to itself."""
+            """An edge to module ``target``; a private module is private to its stage."""
             if target in mods and target != name:
                 edges[name].add(target)
-            if target != name and not name.startswith(target + ".") \
-                    and any(_private(p) for p in target.split(".")):
+            if stage(target) != stage(name) and any(_private(p) for p in target.split(".")):
                 private.append((name, line, text))
 
         for node in ast.walk(tree):
@@ -88,12 +96,12 @@ def graph(src: Path, package: str = "chebnorm"):
                         bound[a.asname or a.name] = full
                     else:  # a name defined in module `base`
                         link(base, node.lineno, text)
-                        if _private(a.name) and base != name:
+                        if _private(a.name) and stage(base) != stage(name):
                             private.append((name, node.lineno, text))
         for node in ast.walk(tree):
             if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
                     and node.value.id in bound and _private(node.attr) \
-                    and bound[node.value.id] != name:
+                    and stage(bound[node.value.id]) != stage(name):
                 private.append((name, node.lineno, f"{bound[node.value.id]}.{node.attr}"))
     return edges, sorted(set(private))
 
@@ -151,7 +159,7 @@ def test_the_package_has_no_import_cycle():
     assert cycles(edges) == []
 
 
-def test_no_private_name_crosses_a_module():
+def test_no_private_name_crosses_a_stage():
     _, private = graph(SRC)
     assert private == []
 
@@ -192,20 +200,52 @@ class TestCheckerCatches:
         assert cycles(edges) == [] and private == []
 
     @pytest.mark.parametrize("text, shown", [
-        ("from .y import _f\n", "from chebnorm.a.y import _f"),
+        ("from ..a.y import _f\n", "from chebnorm.a.y import _f"),
         ("from chebnorm.a.y import g, _f\n", "from chebnorm.a.y import _f"),
-        ("def h():\n    from .y import _f\n", "from chebnorm.a.y import _f"),
-        ("from . import y\nz = y._f\n", "chebnorm.a.y._f"),
+        ("def h():\n    from ..a.y import _f\n", "from chebnorm.a.y import _f"),
+        ("from ..a import y\nz = y._f\n", "chebnorm.a.y._f"),
         ("import chebnorm.a.y as m\nz = m._f()\n", "chebnorm.a.y._f"),
-        ("from . import _z\n", "from chebnorm.a import _z"),
-        ("from ._z import g\n", "from chebnorm.a._z import g"),
+        ("from ..a import _z\n", "from chebnorm.a import _z"),
+        ("from ..a._z import g\n", "from chebnorm.a._z import g"),
         ("import chebnorm.a._z\n", "import chebnorm.a._z"),
+        ("from ..a.sub.w import _f\n", "from chebnorm.a.sub.w import _f"),
     ])
-    def test_a_private_name(self, tmp_path, text, shown):
-        src = _package(tmp_path, {"chebnorm/a/x.py": text, "chebnorm/a/y.py": "def _f(): pass\n",
-                                  "chebnorm/a/_z.py": "def g(): pass\n"})
+    def test_a_private_name_of_another_stage(self, tmp_path, text, shown):
+        src = _package(tmp_path, {"chebnorm/b/__init__.py": "", "chebnorm/b/x.py": text,
+                                  "chebnorm/a/y.py": "def _f(): pass\n", "chebnorm/a/_z.py": "def g(): pass\n",
+                                  "chebnorm/a/sub/__init__.py": "", "chebnorm/a/sub/w.py": "def _f(): pass\n"})
         _, private = graph(src)
-        assert [(p[0], p[2]) for p in private] == [("chebnorm.a.x", shown)], private
+        assert [(p[0], p[2]) for p in private] == [("chebnorm.b.x", shown)], private
+
+    @pytest.mark.parametrize("path, text, shown", [
+        ("chebnorm/__init__.py", "from .a.y import _f\n", "from chebnorm.a.y import _f"),
+        ("chebnorm/m.py", "from .a import y\nz = y._f\n", "chebnorm.a.y._f"),
+    ])
+    def test_the_facade_and_a_top_level_module_are_stages_too(self, tmp_path, path, text, shown):
+        src = _package(tmp_path, {path: text, "chebnorm/a/y.py": "def _f(): pass\n"})
+        _, private = graph(src)
+        module = path.removesuffix(".py").removesuffix("/__init__").replace("/", ".")
+        assert [(p[0], p[2]) for p in private] == [(module, shown)], private
+
+    @pytest.mark.parametrize("path, text", [
+        ("chebnorm/a/x.py", "from .y import _f\n"),
+        ("chebnorm/a/x.py", "from chebnorm.a.y import g, _f\n"),
+        ("chebnorm/a/x.py", "def h():\n    from .y import _f\n"),
+        ("chebnorm/a/x.py", "from . import y\nz = y._f\n"),
+        ("chebnorm/a/x.py", "import chebnorm.a.y as m\nz = m._f()\n"),
+        ("chebnorm/a/x.py", "from . import _z\n"),
+        ("chebnorm/a/x.py", "from ._z import g\n"),
+        ("chebnorm/a/x.py", "import chebnorm.a._z\n"),
+        ("chebnorm/a/sub/w.py", "from ..y import _f\nfrom .._z import g\n"),
+        ("chebnorm/a/__init__.py", "from .y import _f\nfrom ._z import g\n"),
+    ])
+    def test_a_private_name_inside_its_stage_is_fine(self, tmp_path, path, text):
+        src = _package(tmp_path, {path: text, "chebnorm/a/y.py": "def _f(): pass\n",
+                                  "chebnorm/a/_z.py": "def g(): pass\n", "chebnorm/a/sub/__init__.py": "",
+                                  **({} if path.endswith("w.py") else {"chebnorm/a/sub/w.py": ""})})
+        edges, private = graph(src)
+        assert private == []
+        assert edges[path.removesuffix(".py").removesuffix("/__init__").replace("/", ".")]  # it was read
 
     def test_own_private_names_are_fine(self, tmp_path):
         src = _package(tmp_path, {"chebnorm/a/x.py": "def _f(): pass\nz = _f()\n",

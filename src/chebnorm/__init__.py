@@ -47,8 +47,13 @@ the engines of ``raster/engines/`` (numpy, the reference; numba, compiled);
 a helper two stages need in ``core/``; a public exception or warning class
 in ``exceptions.py``; a run of an external tool through ``core/tools.py``
 (the only module that looks tools up or starts processes). Within the package the module graph
-has no import cycle and a ``_name`` never leaves its module
+has no import cycle and a ``_name`` never leaves its stage
 (``tests/test_import_graph.py``).
+
+A stage's API is the ``__all__`` of its ``__init__`` (for ``core``, the
+modules it lists, whose own names are public). An implementation module
+declares ``__all__ = []``: what it defines is the stage's implementation,
+shared by the stage's modules, and the names users need the stage exports.
 
 This module (the package root) loads no stage at import time.
 A lazy facade is allowed: names resolved by a module-level ``__getattr__``

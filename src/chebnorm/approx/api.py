@@ -23,8 +23,8 @@ from .schema import BASES, ERROR_KINDS, KINDS, MAX_DEGREE, versions
 from .table import CoefficientTable, FixedPoint, Quantized
 from chebnorm.exceptions import FitWarning
 
-__all__ = ["fit", "quantize", "warnings_of", "MAX_DEGREE", "Interval", "check_interval",
-           "FitWarning", "degree_lower_bounds"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 def _warn(notes) -> None:

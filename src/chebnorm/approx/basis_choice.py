@@ -62,8 +62,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BasisChoice", "half_ulp", "rounding_estimate", "sample_points", "choose", "read_basis_choice",
-           "REACH", "WARN", "OVERFLOW"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: the estimate of an evaluator that overflows binary32 (the largest double: JSON
 #: holds no infinity)

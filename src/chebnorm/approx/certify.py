@@ -62,7 +62,8 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from .expr import Function1D, compile_arb
 
-__all__ = ["Certificate", "certify", "arb_enclose"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: default relative tightness of certified bounds: bound <= (1 + TOL) * sup.
 TOL = 2.0 ** -8

@@ -82,7 +82,8 @@ from chebnorm.exceptions import SegmentError
 from .certify import TOL, Certificate, arb_enclose, certify
 from .expr import Function1D
 
-__all__ = ["certify_batch"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: Taylor orders tried in turn, above the polynomial's degree (the first whose
 #: remainder is small enough for the segment)

@@ -66,9 +66,8 @@ from chebnorm.core import clib
 from chebnorm.core.numeric import arb_precision
 from chebnorm.exceptions import UndefinedError
 
-__all__ = ["Function1D", "AccurateFunction1D", "UndefinedError", "parse_function",
-           "parse_number", "read_expression", "FUNCTIONS",
-           "CONSTANTS", "MAX_LENGTH", "MAX_NODES", "MAX_DEPTH", "MAX_NUMBER_BITS", "MAX_EXPONENT"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: the functions an expression may call, by name (one argument each; ``log``
 #: also accepts a base). Each is certified by the Arb compiler below; ``log2``,

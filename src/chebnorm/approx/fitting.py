@@ -19,8 +19,8 @@ from numpy.polynomial import chebyshev as C
 from chebnorm.core import clib, detlinalg
 from chebnorm.core.numeric import arb_precision
 
-__all__ = ["chebyshev_interpolant", "remez", "RemezResult", "cheb_to_monomial", "shift_for",
-           "polish", "minimax_powers", "PowersFit"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 def chebyshev_interpolant(f_mp: Callable, lo, hi, degree: int, dps: int = 40) -> list[float]:

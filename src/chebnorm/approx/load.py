@@ -21,7 +21,8 @@ from .piecewise_table import PiecewiseTable
 from .schema import MAX_PIECEWISE_BYTES, PIECEWISE_KIND, SCHEMA_VERSION, parse_json, show
 from .table import CoefficientTable
 
-__all__ = ["load_table", "table_from_json", "table_kind"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: the kinds of table, by the class that reads them
 _ACCEPTED = (f"a coefficient table (a JSON object with schema_version {SCHEMA_VERSION}) or a "

@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 from .targets import get_target
 
-__all__ = ["TableSpec", "MethodSpec", "register", "unregister", "get_method", "method_names",
-           "registered_methods", "unit_tables", "IDEALS"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: the curves a method's pixels ideally lie on: the exactly normalized linear
 #: interpolant, or the slerp points (evenly spaced in angle)

@@ -36,7 +36,8 @@ from .schema import (ERROR_KINDS as ERRORS, MAX_COEF_FRAC_BITS, MAX_COEF_INT_BIT
                      MAX_EXPONENT_SPAN, MAX_INDEX_BITS, MAX_PIECEWISE_DEGREE,
                      PIECEWISE_FITS as FITS, SEGMENT_BY, versions)
 
-__all__ = ["piecewise_fit"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: points of the grid a segment's rounding is judged on
 _DENSE = 257

@@ -60,7 +60,8 @@ from flint import arb, arb_series, ctx
 
 from chebnorm.core.numeric import arb_precision
 
-__all__ = ["Removable", "analyse"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: highest order of a common zero that is looked for
 MAX_ORDER = 8

@@ -44,7 +44,8 @@ from chebnorm.core import clib
 from .certify import certify
 from chebnorm.core.detlinalg import matvec
 
-__all__ = ["FLOAT_FORMATS", "FORMATS", "Candidate", "round_coefficients"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 #: floating formats: (precision p including the hidden bit, emin, emax);
 #: representable: m * 2^(e - p + 1) with |m| < 2^p and emin <= e <= emax
@@ -147,6 +148,7 @@ def representable(m: int, s: int, fmt: str) -> bool:
 
 
 def chebyshev_nodes(lo: float, hi: float, count: int) -> np.ndarray:
+    """The ``count`` Chebyshev points of the first kind on ``[lo, hi]``, ascending."""
     k = np.arange(count)
     t = np.cos(np.pi * (2 * k + 1) / (2 * count))[::-1]
     return 0.5 * (lo + hi) + 0.5 * (hi - lo) * t

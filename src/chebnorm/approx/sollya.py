@@ -17,8 +17,8 @@ import sympy as sp
 from .expr import parse_function, parse_number
 from chebnorm.core.tools import require, run_tool, which
 
-__all__ = ["available", "SollyaSupnorm", "supnorm", "remez", "script_supnorm", "function_text",
-           "interval_text", "FpminimaxCase", "fpminimax"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 def available() -> bool:

@@ -36,13 +36,14 @@ from chebnorm.core.numeric import format_down, format_up
 
 from .basis_choice import BasisChoice, read_basis_choice
 from .contract import Table
+from .schema import MAX_TEXT  # noqa: F401  (the table's text limit, read from here)
 from .schema import (ERROR_KINDS, FIXED_METHODS, KINDS, MAX_DEGREE, MAX_FRAC_BITS,
-                     MAX_TABLE_BYTES, MAX_TEXT, MAX_WORD_BITS, QUANT_FORMATS,
+                     MAX_TABLE_BYTES, MAX_WORD_BITS, QUANT_FORMATS,
                      SCHEMA_VERSION, array, bad, boolean, check_object, choice, integer, number,
                      provenance, show, text)
 
-__all__ = ["MAX_TABLE_BYTES", "MAX_TEXT", "SCHEMA_VERSION", "CoefficientTable", "FixedPoint",
-           "Quantized"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,8 @@ from chebnorm.core.display import summary_html, summary_repr
 
 from .expr import compare, read_expression, parse_number
 
-__all__ = ["Target", "TARGETS", "get_target", "target_names"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,8 @@ import types
 import numpy as np
 import sympy as sp
 
-__all__ = ["trace_callable", "UFUNCS", "MATH_FUNCTIONS"]
+# an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
+__all__: list[str] = []
 
 
 def _log_base(base):

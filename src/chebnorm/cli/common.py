@@ -295,6 +295,7 @@ def refuse_unused(args, where: str, **flags) -> None:
 #: defaults of --eta-threshold and --q (None in the parser, so that a given value
 #: can be told from the default)
 ETA_THRESHOLD = 0.005
+#: default of --q: one step of an 8-bit channel
 Q_THRESHOLD = 1.0 / 255.0
 
 

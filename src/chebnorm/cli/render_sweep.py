@@ -11,6 +11,7 @@ from .vocab import BUMP_VARIANTS, MESH_NAMES, SHADING_MODES
 
 #: the CSV and the image folder inside ``-o DIR``
 CSV_NAME = "render_sweep.csv"
+#: the folder of the images inside ``-o DIR``
 IMAGE_FOLDER = "render_sweep_images"
 
 

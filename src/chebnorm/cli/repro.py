@@ -36,6 +36,7 @@ EXPORT_FRAC_BITS = 24
 #: the distributions whose versions can change the bytes ``chebnorm repro`` writes
 NUMERIC_DEPENDENCIES = ("numpy", "scipy", "mpmath", "sympy", "python-flint", "matplotlib",
                         "kiwisolver", "Pillow", "scikit-image", "trimesh", "flip-evaluator")
+#: the file in the output folder that records the versions of NUMERIC_DEPENDENCIES
 PROVENANCE = "provenance.json"
 
 

@@ -31,8 +31,6 @@ import math
 
 import numpy as np
 
-__all__ = ["elementwise", "power", "FUNCTIONS"]
-
 
 def elementwise(fn, x, *args: float, numpy_fn=None) -> np.ndarray:
     """``fn(v, *args)`` (a :mod:`math` function, scalar ``args``) for every element of

@@ -12,8 +12,6 @@ import warnings
 
 from chebnorm.exceptions import ChebnormDeprecationWarning
 
-__all__ = ["ChebnormDeprecationWarning", "renamed"]
-
 
 def renamed(old_value, new_value, old: str, new: str, func: str, *, stacklevel: int = 3):
     """The value of an argument renamed from ``old`` to ``new``.

@@ -24,8 +24,6 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["matvec", "solve"]
-
 
 def matvec(a: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``a @ x`` over the last axis of ``a``, summed from the first column to the

@@ -20,7 +20,8 @@ from html import escape
 
 import numpy as np
 
-__all__ = ["short", "summary_repr", "summary_html", "field_rows"]
+# an implementation module of chebnorm.core: the API is what chebnorm.core exports
+__all__: list[str] = []
 
 #: the most characters one value takes in a repr
 MAX_VALUE = 60

@@ -38,9 +38,6 @@ from pathlib import Path
 
 from chebnorm.exceptions import WriteError
 
-__all__ = ["write_atomic", "write_all", "write_folder", "make_folder", "check_writable",
-           "refuse_inputs", "WriteError"]
-
 
 _REASONS = {
     errno.EACCES: "permission denied",

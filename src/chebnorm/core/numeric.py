@@ -26,9 +26,6 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["float_up", "float_down", "ball_float_up", "ball_float_down", "signed_bits",
-           "unsigned_bits", "check_int", "arb_precision", "format_up", "format_down"]
-
 
 def float_up(x: Fraction) -> float:
     """The smallest float64 ``>= x`` (``x`` a rational, or an int or float).

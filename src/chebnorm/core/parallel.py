@@ -23,8 +23,6 @@ from typing import Callable, Iterable
 
 from .progress import progress_bar
 
-__all__ = ["map_ordered", "default_workers", "check_workers", "check_scheduler"]
-
 
 def default_workers() -> int:
     """The number of cores this process may run on.

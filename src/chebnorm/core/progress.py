@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["progress_bar"]
-
 
 def progress_bar(total: int, desc: str, *, unit: str = "it"):
     """A tqdm bar over ``total`` units, shown only on a terminal.

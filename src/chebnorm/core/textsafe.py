@@ -30,8 +30,6 @@ from __future__ import annotations
 import hashlib
 import re
 
-__all__ = ["identifier", "default_name", "design_name", "comment_text", "csv_cell", "IDENTIFIER_PATTERN"]
-
 #: the identifiers accepted in generated sources (a regular expression; at most 63 characters)
 IDENTIFIER_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*"
 _IDENT = re.compile(IDENTIFIER_PATTERN + r"\Z")

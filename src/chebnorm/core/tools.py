@@ -36,9 +36,6 @@ from chebnorm.exceptions import ToolFailed, ToolMissing, ToolTimeout
 
 from .progress import progress_bar
 
-__all__ = ["run_tool", "which", "require", "ToolTimeout", "ToolMissing", "ToolFailed",
-           "DEBIAN_PACKAGES"]
-
 #: the Debian package that installs each tool chebnorm runs (:func:`require`'s message)
 DEBIAN_PACKAGES = {
     "gcc": "gcc", "clang": "clang", "sollya": "sollya", "gappa": "gappa",

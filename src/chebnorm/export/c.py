@@ -62,8 +62,8 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from .evalbound import BINARY32, BINARY64, Evaluator, Piece, fixed_arithmetic
 
-__all__ = ["c_header", "banner_head", "horner_rounding_bound", "FLOAT_TYPES", "inner_interval",
-           "range_problem", "underflow_bound", "round_inward", "interval_max_abs"]
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
 
 #: The floating types a header evaluates in, one row each: the C type, the
 #: literal suffix (``""`` or ``"f"``), the function-name suffix (``""`` or

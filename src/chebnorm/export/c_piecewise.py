@@ -36,7 +36,8 @@ from chebnorm.core.textsafe import comment_text, identifier
 from .c import banner_head, range_problem
 from .evalbound import BINARY64, Evaluator, Piece
 
-__all__ = ["DEFAULT_C_IN_BITS", "piecewise_c_header", "piecewise_eval_bound", "piecewise_evaluator"]
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
 
 #: The default width (bits) of a uniform table's input code ``k`` in the C
 #: evaluator ``chebnorm_NAME(uint32_t k)``.

@@ -47,7 +47,8 @@ from fractions import Fraction
 
 from .evalbound import Evaluator
 
-__all__ = ["gappa_script", "gappa_proofs", "PROOF_FORMATS"]
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
 
 #: the formats whose evaluators get proofs (json, verilog and vhdl have none
 #: here: the HDL budget is checked by ``hw report``)

@@ -32,9 +32,8 @@ from chebnorm.exceptions import ToolMissing
 from .shader import interval32, shader_source
 from chebnorm.core.tools import require, run_tool
 
-__all__ = ["ToolMissing", "float32_inputs", "glslang_validate", "glsl_evaluate",
-           "wgsl_evaluate", "gl_context", "compute_shader_source", "compute_shader_around",
-           "glsl_runner", "MAX_SAMPLES"]
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
 
 #: The most inputs :func:`float32_inputs` returns by default (and the batch size
 #: of :func:`glsl_runner`): ``2**20``.

@@ -72,9 +72,8 @@ from .c import (coefficient_parity, evaluator_range_problem, inner_interval, int
                 range_problem, round_inward)
 from .evalbound import BINARY32_FTZ, Evaluator, Piece
 
-__all__ = ["ShaderLanguage", "SHADER_LANGUAGES", "ShaderBound", "float32_eval_bound",
-           "float32_literal", "shader_source", "glsl_source", "wgsl_source", "hlsl_source",
-           "interval32", "shader_evaluator"]
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
 
 U32 = Fraction(1, 2 ** 24)
 _FLUSH = Fraction(1, 2 ** 126)  # largest magnitude a flushed subnormal float32 loses

@@ -28,7 +28,8 @@ from chebnorm.core.textsafe import csv_cell, design_name, identifier
 
 from .targets import get_target
 
-__all__ = ["design", "DesignResult", "Winner"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 #: the accuracies a design meets, as the result names them
 ACCURACIES = ("max-error", "faithful", "correctly-rounded")

@@ -49,8 +49,8 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from types import MappingProxyType
 
-__all__ = ["Design", "ARCHITECTURES", "register", "architecture", "architecture_names",
-           "provide", "provided"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 _REGISTRY: dict[str, type] = {}
 #: architecture name -> its :class:`Design` subclass (read-only; :func:`register` adds)

@@ -36,11 +36,12 @@ from fractions import Fraction
 
 import numpy as np
 
-from chebnorm.core.numeric import check_int as check_width
-from chebnorm.core.numeric import signed_bits, unsigned_bits
+# the modules of chebnorm.hw import these from here, with the rest of the fixed-point helpers
+from chebnorm.core.numeric import check_int as check_width  # noqa: F401
+from chebnorm.core.numeric import signed_bits, unsigned_bits  # noqa: F401
 
-__all__ = ["QFormat", "ROUNDINGS", "OVERFLOWS", "shift_round", "fit_bits", "signed_bits",
-           "unsigned_bits", "rounding_error_bound", "check_int64", "check_width"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 #: rounding modes: toward minus infinity (drop bits), to nearest with ties to even
 ROUNDINGS = ("trunc", "rne")

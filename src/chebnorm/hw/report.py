@@ -34,7 +34,8 @@ from .horner import HornerDesign, design_horner
 from .hdl import hdl_files, module_text
 from .run_verilog import SynthResult, synthesize_text
 
-__all__ = ["HardwareReport", "analyze", "hdl_outputs", "verilog_outputs", "write_outputs"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

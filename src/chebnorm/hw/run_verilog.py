@@ -16,7 +16,8 @@ from chebnorm.core.tools import require, run_tool
 from chebnorm.exceptions import ToolFailed
 
 
-__all__ = ["SimResult", "SynthResult", "simulate", "synthesize", "synthesize_text", "tool_env"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

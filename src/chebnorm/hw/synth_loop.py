@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 from chebnorm.core.parallel import check_workers, map_ordered
 
-__all__ = ["SYNTH_ROUND", "SynthJob", "PrunedRun", "pruned_synthesis", "map_synth"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 #: jobs synthesized per round of the pruned synthesis (fixed, so the jobs
 #: synthesized, and the CSV, do not depend on the worker count)

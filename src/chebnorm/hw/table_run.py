@@ -15,7 +15,8 @@ from .hdl.tables import table_files
 from .run_verilog import SimResult, simulate
 from .run_vhdl import simulate_vhdl
 
-__all__ = ["simulate_table"]
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
 
 
 def simulate_table(design, directory, language: str = "verilog") -> SimResult:

@@ -50,7 +50,8 @@ import numpy as np
 
 from chebnorm.core import clib
 
-__all__ = ["sin", "cos", "arccos", "arctan2", "power", "log2", "powers"]
+# an implementation module of chebnorm.methods: the API is what chebnorm.methods exports
+__all__: list[str] = []
 
 #: float32 results within this fraction of a float32 ulp of a rounding boundary are recomputed
 _TIE_MARGIN = 2.0 ** -16

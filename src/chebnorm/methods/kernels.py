@@ -31,10 +31,8 @@ pixel, the difference once per span).
 
 from __future__ import annotations
 
-__all__ = ["SHAPES", "EXACT", "NONE", "NEWTON", "LYON", "SLERP", "QUADRATIC", "ANGULAR",
-           "DICHOTOMY", "dot", "normalize_classic", "normalize_newton", "normalize_lyon",
-           "angular_steps", "quadratic_steps", "dichotomy_tree", "dichotomy_pick",
-           "dichotomy_fraction", "horner", "TINY"]
+# an implementation module of chebnorm.methods: the API is what chebnorm.methods exports
+__all__: list[str] = []
 
 #: the kernel shapes (see the module docstring)
 SHAPES = ("direct", "steps", "tree")
@@ -44,14 +42,17 @@ TINY = 1e-30
 
 # --------------------------------------------------------------- vectors
 def vadd(a, b):
+    """``a + b``: 3 add."""
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
 def vsub(a, b):
+    """``a - b``: 3 add."""
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def vmul(a, s):
+    """``a * s`` for a scalar ``s``: 3 mul."""
     return (a[0] * s, a[1] * s, a[2] * s)
 
 

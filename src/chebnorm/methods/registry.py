@@ -18,15 +18,15 @@ import importlib
 from functools import lru_cache
 
 from chebnorm.approx import CoefficientTable, fit_target
-from chebnorm.approx.method_registry import (MethodSpec, TableSpec, get_method, method_names,
-                                             register, registered_methods, unit_tables,
-                                             unregister)
+# the registry lives in chebnorm.approx; the modules of this stage read it through here
+from chebnorm.approx.method_registry import (MethodSpec, TableSpec, get_method,  # noqa: F401
+                                             method_names, register, registered_methods,
+                                             unit_tables, unregister)
 
 from .kernels import SHAPES
 
-__all__ = ["MethodSpec", "TableSpec", "register", "unregister", "get_method", "method_names",
-           "registered_methods", "unit_tables", "method_kernel", "method_kernels",
-           "table_methods", "default_tables"]
+# an implementation module of chebnorm.methods: the API is what chebnorm.methods exports
+__all__: list[str] = []
 
 _REQUIRED = {"direct": ("setup", "pixel"), "steps": ("steps",),
              "tree": ("tree", "fraction", "pick")}

@@ -30,10 +30,8 @@ import numpy as np
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 from chebnorm.methods import detmath
 
-__all__ = [
-    "Mesh", "MESH_NAMES", "MAX_FACES", "MAX_COORDINATE", "MIN_EXTENT", "get_mesh", "uv_sphere", "icosphere", "torus", "square",
-    "teapot", "load_mesh", "crease_normals", "unit",
-]
+# an implementation module of chebnorm.raster: the API is what chebnorm.raster exports
+__all__: list[str] = []
 
 #: the generated meshes :func:`get_mesh` knows by name
 MESH_NAMES = ("teapot", "sphere", "icosphere", "torus", "square")

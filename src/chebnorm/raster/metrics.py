@@ -20,8 +20,8 @@ import numpy as np
 
 from chebnorm.core.display import summary_html
 
-__all__ = ["ImageMetrics", "compare", "error_map_rgb", "write_image", "write_png", "image_bytes",
-           "image_format", "IMAGE_FORMATS", "ImageFrame", "to_8bit"]
+# an implementation module of chebnorm.raster: the API is what chebnorm.raster exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

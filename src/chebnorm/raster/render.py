@@ -37,10 +37,8 @@ from .meshes import get_mesh, unit
 from .metrics import ImageFrame, to_8bit
 from .scanline import Camera
 
-__all__ = [
-    "SHADING_MODES", "BUMP_VARIANTS", "Lighting", "HeightMap", "RenderResult", "render",
-    "available_methods", "get_span_normals", "to_8bit", "check_options",
-]
+# an implementation module of chebnorm.raster: the API is what chebnorm.raster exports
+__all__: list[str] = []
 
 #: the shading modes of :func:`render`
 SHADING_MODES = ("gouraud", "phong", "adaptive", "split-gouraud", "bump")

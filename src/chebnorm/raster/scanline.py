@@ -31,7 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Camera", "default_camera", "fit_camera", "project", "Spans", "setup_spans", "zbuffer"]
+# an implementation module of chebnorm.raster: the API is what chebnorm.raster exports
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

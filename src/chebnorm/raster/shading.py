@@ -19,7 +19,8 @@ from .engines.numpy import to_image
 from .meshes import unit
 from .scanline import project
 
-__all__ = ["gouraud", "phong", "split_gouraud", "bump", "interpolated_normals"]
+# an implementation module of chebnorm.raster: the API is what chebnorm.raster exports
+__all__: list[str] = []
 
 
 def _rasterize(engine, st, extra):

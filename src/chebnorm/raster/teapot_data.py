@@ -6,6 +6,7 @@ top (a degenerate row: pole at point 204), 24-27 lid, 28-31 bottom (pole at
 point 270).
 """
 
+#: the 32 patches, one a line: 16 control-point indices (1-based, row-major 4x4)
 PATCHES = """
 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16
 4 17 18 19 8 20 21 22 12 23 24 25 16 26 27 28
@@ -41,6 +42,7 @@ PATCHES = """
 270 270 270 270 300 305 306 279 297 303 304 275 294 301 302 271
 """
 
+#: the 306 control points, x y z, separated by semicolons and line breaks
 POINTS = """
 1.4 0.0 2.4; 1.4 -0.784 2.4; 0.784 -1.4 2.4; 0.0 -1.4 2.4; 1.3375 0.0 2.53125
 1.3375 -0.749 2.53125; 0.749 -1.3375 2.53125; 0.0 -1.3375 2.53125; 1.4375 0.0 2.53125

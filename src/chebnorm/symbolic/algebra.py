@@ -17,7 +17,8 @@ from collections.abc import Iterable, Sequence
 
 import sympy as sp
 
-__all__ = ["vector", "reduce_modulo"]
+# an implementation module of chebnorm.symbolic: the API is what chebnorm.symbolic exports
+__all__: list[str] = []
 
 
 def vector(name: str) -> sp.Matrix:

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["UNIT_RTOL", "DOT_ATOL"]
+# an implementation module of chebnorm.symbolic: the API is what chebnorm.symbolic exports
+__all__: list[str] = []
 
 #: accepted relative deviation ``| |N| - 1 |`` of a vector called unit
 UNIT_RTOL = 1e-6

@@ -23,11 +23,6 @@ Bump mapping (seed 001)
 
 import sympy as sp
 
-__all__ = [
-    "t", "c", "phi", "n", "c_ab", "c_bc", "c_ac", "N_l", "N_c", "N_r",
-    "a", "b", "F_u", "F_v", "k", "Pu_norm", "PuxPv_norm", "Pu_dot_Pv",
-]
-
 # One assignment per symbol, so each has its own ``#:`` description in the API
 # reference (sympy.Symbol's docstring is not theirs); the same names and assumptions
 # as ``sp.symbols("t c phi", real=True)`` etc., hence the same symbols.

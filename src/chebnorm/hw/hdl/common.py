@@ -23,9 +23,8 @@ from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
 
-__all__ = ["LANGUAGES", "COMMENT", "SUFFIX", "check_language", "module_name", "pipelined_name",
-           "horner_facts", "piecewise_facts", "comment_lines", "vectors_name", "vector_file",
-           "variable_name", "step_comment", "shifted_width"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 #: the hardware description languages the printers write
 LANGUAGES = ("verilog", "vhdl")

@@ -25,8 +25,8 @@ from .common import (horner_facts, module_name, piecewise_facts, pipelined_name,
 from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Cut,
                       Extend, Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Resize, Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
 
-__all__ = ["round_to", "output_stage", "piecewise_netlist", "sized_piecewise_netlist",
-           "horner_netlist"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 
 def _sig(name: str, width: int) -> Signal:

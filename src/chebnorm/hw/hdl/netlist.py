@@ -43,12 +43,8 @@ from chebnorm.core.textsafe import identifier
 
 from .common import comment_lines
 
-__all__ = ["Signal", "Const", "Slice", "Bit", "Concat", "Not", "ZeroExt", "Resize", "Extend",
-           "Shl", "Shr", "Neg", "Add", "Sub", "Mul", "Gate", "And", "Or", "ReduceOr", "Group",
-           "Paren", "BitVec", "Assign", "ConstDecl", "Rom", "Registers", "Saturate", "Output",
-           "Comment", "Module", "vhdl_entity", "VHDL_WRAP", "ShiftBy", "Declare", "Param",
-           "LeadingZeros", "rename", "Flip", "Pad", "Table", "vhdl_name", "Cut", "schedule",
-           "verilog", "vhdl", "statement_lines", "evaluate", "signed_literal", "vhdl_bits"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 
 def _refuse(what: str, detail: str) -> ValueError:

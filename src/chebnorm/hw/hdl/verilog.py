@@ -35,10 +35,8 @@ from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to
 from .netlist import Signal, signed_literal, statement_lines
 from .netlist import verilog as _verilog
 
-__all__ = ["signed_literal", "round_lines", "saturating_output", "bench_verdict",
-           "verilog_module", "verilog_pipelined_module", "verilog_testbench",
-           "verilog_pipelined_testbench", "piecewise_verilog", "sized_piecewise_verilog",
-           "piecewise_clocked_testbench"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 
 # -- fragments -------------------------------------------------------------------

@@ -40,9 +40,8 @@ from .common import module_name, pipelined_name
 from .datapath import horner_netlist, piecewise_netlist, sized_piecewise_netlist
 from .netlist import vhdl as _vhdl
 
-__all__ = ["VHDL_STD", "vhdl_module", "vhdl_pipelined_module", "vhdl_testbench",
-           "vhdl_pipelined_testbench", "piecewise_vhdl", "piecewise_vhdl_testbench",
-           "sized_piecewise_vhdl", "piecewise_vhdl_clocked_testbench"]
+# an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
+__all__: list[str] = []
 
 #: the VHDL standard of the printed text (``ghdl --std=08``)
 VHDL_STD = "08"

@@ -31,9 +31,8 @@ from chebnorm.core.display import field_rows, summary_html, summary_repr
 from ..cost import Block
 from ..horner import HornerDesign
 
-__all__ = ["Port", "UnitDesign", "UnitKind", "UNITS", "register", "get_unit", "unit_names",
-           "vec_ports", "MAX_COMP_BITS", "MAX_UNIT_FRAC_BITS", "MAX_LOG_M", "MAX_GUARD",
-           "EXHAUSTIVE_BITS"]
+# an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
+__all__: list[str] = []
 
 #: widest vector component (``comp_bits``, W) a unit accepts
 MAX_COMP_BITS = 28

@@ -17,7 +17,8 @@ from .base import Port, UnitDesign, put, register, vec, vec_ports
 from .evaluator import EvaluatorUnit, ky_localparam, scale_lines, scaled_range
 from .hdl import banner, isqrt_module, ports_decl
 
-__all__ = ["DichotomyUnit"]
+# an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
+__all__: list[str] = []
 
 
 class DichotomyUnit(EvaluatorUnit):

@@ -7,7 +7,8 @@ from chebnorm.core.textsafe import comment_text
 
 from .base import UnitDesign
 
-__all__ = ["banner", "ports_decl", "isqrt_module"]
+# an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
+__all__: list[str] = []
 
 #: long commands and expressions are kept whole (only made inert)
 _MAX_TEXT = 100_000

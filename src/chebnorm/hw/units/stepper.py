@@ -16,7 +16,8 @@ from ..hdl.verilog import round_lines
 from .base import MAX_GUARD, MAX_LOG_M, Port, UnitDesign, UnitKind, put, register, vec, vec_ports
 from .hdl import banner, ports_decl
 
-__all__ = ["StepperUnit"]
+# an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
+__all__: list[str] = []
 
 
 class StepperUnit(UnitKind):

@@ -28,8 +28,8 @@ from chebnorm.methods import default_tables
 from ..meshes import Mesh, unit
 from ..scanline import Camera
 
-__all__ = ["Engine", "Setup", "ModeResult", "FrameUnsupported", "dot", "half_vectors",
-           "triangle_half_vectors", "auto_tables"]
+# an implementation module of chebnorm.raster.engines: the API is what chebnorm.raster.engines exports
+__all__: list[str] = []
 
 
 @dataclass

@@ -9,7 +9,8 @@ from chebnorm.methods import span_normals as _span_normals
 from ..scanline import fit_camera, project, setup_spans, zbuffer
 from .base import Engine, Setup, dot, half_vectors
 
-__all__ = ["NumpyEngine", "to_image", "pixel_map"]
+# an implementation module of chebnorm.raster.engines: the API is what chebnorm.raster.engines exports
+__all__: list[str] = []
 
 
 class NumpyEngine(Engine):

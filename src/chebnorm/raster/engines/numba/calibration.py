@@ -24,9 +24,8 @@ from chebnorm.methods.ops import NumpyOps
 
 from .jit import HAVE_NUMBA, f2i, fma, i2f, njit
 
-__all__ = ["dot3", "dot3_select", "dots", "calibrated", "first_orders", "f32_round", "det", "DetOps",
-           "powers", "pow_calibrated", "trig64", "sin_small", "trig_calibrated",
-           "ends_orders"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 # ------------------------------------------------------- reduction orders

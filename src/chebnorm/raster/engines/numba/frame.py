@@ -67,7 +67,8 @@ from .setup import (DEPTH_THRESHOLDS, angular_part, clear_table, cos_range, ends
                     setup_consts, span_input, span_level_libm, widest_dot)
 from .workspace import give, keep_maps, output_maps, scratch, take
 
-__all__ = ["MODES", "supports", "phong", "stage_times"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 #: kernel -> mode number of the fused kernel

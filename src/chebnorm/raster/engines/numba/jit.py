@@ -42,10 +42,8 @@ except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
     objmode = None
 
-__all__ = ["HAVE_NUMBA", "JIT_DISABLED", "njit", "objmode", "fma", "f2i", "i2f", "unowned", "prefetch",
-           "stream16",
-           "store_fence", "threads", "pool",
-           "run", "run_with_caller", "NumbaCompileWarning", "announce_slow", "ANNOUNCE_AFTER"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 #: seconds a warm-up (compile or cache load) may take before it is announced

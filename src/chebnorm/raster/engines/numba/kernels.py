@@ -26,9 +26,8 @@ from chebnorm.methods.spans import MAX_LEVELS, SpanNormals, check_span_input, sp
 from ...scanline import Spans
 from .jit import HAVE_NUMBA, njit
 
-__all__ = ["supports", "fast_span_normals", "dichotomy_denominators",
-           "dichotomy_denominators_into", "quadratic_setup",
-           "angular_setup", "fast_half_vectors", "fast_shade"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 # ------------------------------------------------------------ span normals

@@ -17,9 +17,8 @@ from ...scanline import project as reference_project
 from .jit import HAVE_NUMBA, fma, njit, prefetch, run_with_caller, threads
 from .workspace import scratch, setup_buffers, span_arrays, span_buffers
 
-__all__ = ["count_rows", "fast_setup_spans", "fast_zbuffer", "fast_lerp", "gather_setup",
-           "span_geom", "span_write", "row_span_set", "row_buckets", "part_buckets",
-           "row_spans", "project", "default_camera_of"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 # --------------------------------------------------------------- span set-up

@@ -35,8 +35,8 @@ from .jit import HAVE_NUMBA, f2i, i2f, njit, run_with_caller, threads
 from .kernels import angular_setup
 from .workspace import scratch
 
-__all__ = ["widest_dot", "span_input", "end_arrays", "method_setup", "end_checks",
-           "span_level_libm", "levels_calibrated", "setup_consts", "cos_range"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 #: the position tolerance of ``check_span_input`` (pixels at ``t`` in [-tol, 1 + tol])

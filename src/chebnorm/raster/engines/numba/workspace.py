@@ -13,8 +13,8 @@ import threading
 
 import numpy as np
 
-__all__ = ["Workspace", "take", "give", "output_maps", "keep_maps", "scratch", "span_arrays",
-           "span_buffers", "setup_buffers"]
+# an implementation module of chebnorm.raster.engines.numba: the API is what chebnorm.raster.engines.numba exports
+__all__: list[str] = []
 
 
 class Workspace:
