@@ -314,7 +314,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
         :func:`prune_lower` is not below the best synthesized score
         (``bound`` or a candidate's) keeps ``cost`` None and says so in
         ``note``. Candidates are synthesized cheapest model first,
-        :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND` at a time (whatever
+        :data:`~chebnorm.hw.synth_loop.SYNTH_ROUND` at a time (whatever
         ``workers``: the same ones are synthesized), so the best score found prunes the rest: a pruned candidate
         would have scored at least its lower bound, never less than the best.
 
@@ -373,7 +373,7 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
     pruned queue: every job (a candidate, or a meeting point of the search's
     Pareto front, :func:`~chebnorm.hw.piecewise_search.synthesis_queue`) in
     order of its lower bound (:func:`prune_lower`; a search point's model
-    over ``MODEL_SPREAD``), :data:`~chebnorm.hw.piecewise_search.SYNTH_ROUND`
+    over ``MODEL_SPREAD``), :data:`~chebnorm.hw.synth_loop.SYNTH_ROUND`
     at a time; a job whose lower bound is not below the best score
     synthesized so far is skipped (it cannot win). The first round takes
     candidates only, so the search may still be running then (``result`` a

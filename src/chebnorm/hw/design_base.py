@@ -6,7 +6,7 @@ A *design* is a sized, bit-accurate evaluator of one function of an
 architecture (a Horner evaluator, a piecewise ROM + Horner evaluator, its
 sized variant, the exponent-indexed ``1/sqrt``, a plain table, a
 multipartite table) is one subclass of :class:`Design`, registered under the
-name the CLI and the CSVs print (:func:`register`, :data:`ARCHITECTURES`).
+name the CLI and the CSVs print (``register``, ``ARCHITECTURES``).
 Whatever works on any design (the architecture search, the pruned synthesis
 queue, pipelining, the reports, the trust checks) calls the interface and
 never asks a design what kind it is.
@@ -53,7 +53,7 @@ from types import MappingProxyType
 __all__: list[str] = []
 
 _REGISTRY: dict[str, type] = {}
-#: architecture name -> its :class:`Design` subclass (read-only; :func:`register` adds)
+#: architecture name -> its :class:`Design` subclass (read-only; ``register`` adds)
 ARCHITECTURES = MappingProxyType(_REGISTRY)
 _PROVIDED: dict[str, object] = {}
 

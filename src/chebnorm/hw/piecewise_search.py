@@ -49,7 +49,7 @@ from chebnorm.core.numeric import format_up
 from .fixed import check_width
 from .piecewise import MAX_PW_IN_BITS, MAX_PW_OUT_BITS, PiecewiseDesign, design_piecewise
 from .sweep import pareto_png
-from .synth_loop import SYNTH_ROUND, SynthJob, map_synth, pruned_synthesis
+from .synth_loop import SynthJob, map_synth, pruned_synthesis
 from .targets import TargetCost, get_target
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
@@ -394,7 +394,7 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     target's model and synthesizes the front's meeting points on it.
 
     The front's meeting points are synthesized cheapest model first,
-    :data:`SYNTH_ROUND` at a time; a point whose model lower bound (its
+    :data:`~chebnorm.hw.synth_loop.SYNTH_ROUND` at a time; a point whose model lower bound (its
     :func:`~chebnorm.hw.target_model.model_score` over
     :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
     score synthesized so far, or ``bound`` (a score synthesized elsewhere,
@@ -531,7 +531,7 @@ def synthesize_search(result: SearchResult, *, bound: float | None = None,
     :func:`search` with ``synth=True``; separate so a caller can overlap the
     search with other synthesis runs and pass their best score as ``bound``).
 
-    Points are synthesized cheapest model first, :data:`SYNTH_ROUND` at a
+    Points are synthesized cheapest model first, :data:`~chebnorm.hw.synth_loop.SYNTH_ROUND` at a
     time, skipping a point whose model lower bound (model score over
     :data:`~chebnorm.hw.target_model.MODEL_SPREAD`) is not below the best
     score so far or ``bound``. Without ``bound`` the cheapest point by the
@@ -704,7 +704,7 @@ def with_costs(result: SearchResult, costs: dict) -> SearchResult:
 
 
 def _synth_pruned(points, designs, chosen, target, bound, par) -> int:
-    """Synthesize the ``chosen`` keys in rounds of :data:`SYNTH_ROUND`, cheapest
+    """Synthesize the ``chosen`` keys in rounds of :data:`~chebnorm.hw.synth_loop.SYNTH_ROUND`, cheapest
     target model first, skipping those whose model lower bound cannot beat
     the best score so far (or ``bound``; the first key always runs); update
     ``points``. Returns the number synthesized."""

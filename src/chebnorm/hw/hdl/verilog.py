@@ -28,11 +28,11 @@ from __future__ import annotations
 
 from ..fixed import QFormat
 from ..horner import HornerDesign
-from .bench import bench_ports, bench_verdict, testbench
+from .bench import bench_ports, testbench
 from .common import module_name, pipelined_name
 from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to,
                        sized_piecewise_netlist)
-from .netlist import Signal, signed_literal, statement_lines
+from .netlist import Signal, statement_lines
 from .netlist import verilog as _verilog
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports

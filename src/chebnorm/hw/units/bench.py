@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fixed import check_width
-from ..hdl.verilog import bench_verdict
+from ..hdl.bench import bench_verdict
 from .base import EXHAUSTIVE_BITS, Port, UnitDesign
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports

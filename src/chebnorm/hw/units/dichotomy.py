@@ -12,7 +12,7 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import dichotomy_midpoint, dichotomy_next_z, dichotomy_unit
 from ..fixed import signed_bits, unsigned_bits
-from ..hdl.verilog import signed_literal
+from ..hdl.netlist import signed_literal
 from .base import Port, UnitDesign, put, register, vec, vec_ports
 from .evaluator import EvaluatorUnit, ky_localparam, scale_lines, scaled_range
 from .hdl import banner, isqrt_module, ports_decl

@@ -11,7 +11,7 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import eta_criterion, eta_unit
 from ..fixed import check_int64, signed_bits
-from ..hdl.verilog import signed_literal
+from ..hdl.netlist import signed_literal
 from .base import Port, UnitDesign, register, vec, vec_ports
 from .bench import codes, edges, near
 from .evaluator import EvaluatorUnit, check_dot, dot_code

@@ -15,7 +15,8 @@ from chebnorm.core.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
 from ..horner import HornerDesign, cover_frac_bits, design_horner
-from ..hdl.verilog import round_lines, signed_literal
+from ..hdl.netlist import signed_literal
+from ..hdl.verilog import round_lines
 from ..hdl.verilog import verilog_module
 from .base import UnitDesign, UnitKind, get_unit
 from .bench import codes, combinational_rows, near
