@@ -12,8 +12,8 @@ import pytest
 
 from chebnorm.hw.hdl.datapath import output_stage, round_to
 from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Cut,
-                                     Declare, Extend, Gate, Group, LeadingZeros, Module, Mul, Neg,
-                                     Not, Output, Param, Registers, Resize, Rom, Saturate, Shl,
+                                     Declare, Extend, Gate, Group, Instance, LeadingZeros, Module,
+                                     Mul, Neg, Not, Output, Param, Port, Registers, Resize, Rom, Saturate, Shl,
                                      ShiftBy, Shr, Signal, Slice, Sub, ZeroExt, evaluate, rename,
                                      schedule, verilog, vhdl)
 from chebnorm.hw.hdl.verilog import piecewise_clocked_testbench, verilog_testbench
@@ -257,3 +257,95 @@ def test_verilog_refuses_a_widened_sum():
                      Assign(_s("b", 8), Resize(Add((a, a)), 8))]
     with pytest.raises(ValueError, match="Resize: Add of 5 signed bits widened to 8 bits"):
         verilog(m)
+
+
+def _instance_host(inner: Module) -> Module:
+    """A module of ports x, y that instantiates ``inner`` by name (ports mapped by name)."""
+    m = Module("chebnorm_host", inner.in_bits, inner.out_bits, facts=["instance test"])
+    yw = Signal("yw", inner.out_bits, logic=True)
+    m.statements += [Declare(yw),
+                     Instance(inner.name, "dut", (("x", "input", inner.in_bits, m.x),
+                                                  ("y", "output", inner.out_bits, yw))),
+                     Output(yw)]
+    return m
+
+
+@requires_tool("iverilog", "ghdl")
+def test_instance_simulates_every_code_in_both_languages(tmp_path):
+    inner = _arith()
+    m = _instance_host(inner)
+    assert "    chebnorm_nl dut (.x(x), .y(yw));" in verilog(m)
+    assert "    dut : entity work.chebnorm_nl port map (x => x, y => yw);" in vhdl(m)
+    shim = _shim(m)
+    (tmp_path / f"{m.name}.hex").write_text("".join(f"{_expected(k):02x}\n"
+                                                     for k in range(2 ** W)))
+    for ext, text, bench in (("v", verilog(inner) + verilog(m), verilog_testbench(shim)),
+                             ("vhd", vhdl(inner) + vhdl(m), piecewise_vhdl_testbench(shim))):
+        (tmp_path / f"{m.name}.{ext}").write_text(text)
+        (tmp_path / f"tb_{m.name}.{ext}").write_text(bench)
+    for run in (simulate, simulate_vhdl):
+        r = run(tmp_path, m.name)
+        assert r.passed and r.vectors == 2 ** W and r.mismatches == 0, r.line
+    with pytest.raises(ValueError, match="instance"):
+        evaluate(m, 0)
+
+
+@pytest.mark.parametrize("build, match", [
+    (lambda: Instance("m", "dut", (("x", "input", 5, Signal("v", 4, logic=True)),)),
+     "port x: 4 bits connected to a 5-bit port"),
+    (lambda: Instance("m", "dut", (("x", "input", 4, Signal("v", 4, signed=True)),)),
+     "port x: Signal; accepted: a logic Signal"),
+    (lambda: Instance("m", "dut", (("x", "inout", 4, Signal("v", 4, logic=True)),)),
+     "direction 'inout'"),
+    (lambda: Instance("m", "dut", (("x", "input", 4, Signal("v", 4, logic=True)),) * 2),
+     "connected twice"),
+    (lambda: Instance("m;", "dut", ()), "instance module"),
+    (lambda: Port(Signal("p", 4, signed=True)), "Port p: 4 signed bits"),
+    (lambda: Output(Signal("v", 3, logic=True), port=Signal("p", 4, logic=True)),
+     "Output p: a value of 3 unsigned bits to a port of 4"),
+])
+def test_instance_and_port_refusals_name_the_node(build, match):
+    with pytest.raises(ValueError, match=match):
+        build()
+
+
+@requires_tool("ghdl", "iverilog")
+def test_register_wrapper_netlist_passes_values_in_both_languages(tmp_path):
+    """The I/O register wrapper around a module: two clocks after pin_i is
+    applied, pin_o holds the module's output (Verilog and VHDL)."""
+    import subprocess
+
+    from chebnorm.hw.targets import register_wrapper, wrapper_netlist
+
+    inner = _arith()
+    wrap = wrapper_netlist(inner.name, [("x", W)], [("y", 4)], clocked=False)
+    codes = [0, 5, 17, 42, 63]
+    vtb = ["module tb;", "    reg clk = 0;", f"    reg [{W - 1}:0] pi;", "    wire [3:0] po;",
+           "    chebnorm_fmax_wrap w (.clk(clk), .pin_i(pi), .pin_o(po));", "    initial begin"]
+    for k in codes:
+        vtb += [f"        pi = {k}; #1 clk = 1; #1 clk = 0; #1 clk = 1; #1 clk = 0;",
+                f'        $display("%0d", po);']
+    vtb += ["    end", "endmodule", ""]
+    (tmp_path / "w.v").write_text(verilog(inner) + register_wrapper(inner.name, [
+        ("x", "input", W), ("y", "output", 4)], clocked=False) + "\n" + "\n".join(vtb))
+    subprocess.run(["iverilog", "-o", str(tmp_path / "w.vvp"), str(tmp_path / "w.v")], check=True)
+    out = subprocess.run(["vvp", "-n", str(tmp_path / "w.vvp")], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert [int(v) for v in out] == [_expected(k) for k in codes]
+    htb = ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;",
+           "use std.textio.all;", "entity tb is end entity;", "architecture a of tb is",
+           "    signal clk : std_logic := '0';", f"    signal pi : std_logic_vector({W - 1} downto 0);",
+           "    signal po : std_logic_vector(3 downto 0);", "begin",
+           "    w : entity work.chebnorm_fmax_wrap port map (clk => clk, pin_i => pi, pin_o => po);",
+           "    process", "        variable l : line;", "    begin"]
+    for k in codes:
+        htb += [f"        pi <= std_logic_vector(to_unsigned({k}, {W}));",
+                *["        wait for 1 ns; clk <= '1'; wait for 1 ns; clk <= '0';"] * 2,
+                "        write(l, to_integer(unsigned(po))); writeline(output, l);"]
+    htb += ["        wait;", "    end process;", "end architecture;", ""]
+    (tmp_path / "w.vhd").write_text(vhdl(inner) + vhdl(wrap) + "\n".join(htb))
+    for step in (["-a", "--std=08", "w.vhd"], ["-e", "--std=08", "tb"],
+                 ["-r", "--std=08", "tb", "--ieee-asserts=disable-at-0"]):
+        r = subprocess.run(["ghdl", *step], cwd=tmp_path, capture_output=True, text=True,
+                           check=True)
+    assert [int(v) for v in r.stdout.split()] == [_expected(k) for k in codes]

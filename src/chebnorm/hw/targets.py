@@ -54,6 +54,7 @@ from pathlib import Path
 
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
+from .hdl import netlist
 from .run_verilog import tool_env
 from chebnorm.core.tools import require, run_tool
 from chebnorm.exceptions import ToolFailed
@@ -582,8 +583,9 @@ def register_wrapper(top: str, ports, *, clocked: bool) -> str:
     Returns
     -------
     str
-        The Verilog text of the wrapper (no trailing newline): inputs
-        concatenated into ``pin_i``, outputs into ``pin_o``, in port order.
+        The Verilog text of the wrapper (no trailing newline), printed from
+        its netlist (:func:`wrapper_netlist`): inputs concatenated into
+        ``pin_i``, outputs into ``pin_o``, in port order.
 
     Raises
     ------
@@ -594,11 +596,20 @@ def register_wrapper(top: str, ports, *, clocked: bool) -> str:
     Examples
     --------
     >>> print(register_wrapper("m", [("x", "input", 2), ("y", "output", 3)], clocked=False))
-    module chebnorm_fmax_wrap (input wire clk, input wire [1:0] pin_i, output reg [2:0] pin_o);
-        reg [1:0] in_r;
+    module chebnorm_fmax_wrap (
+        input  wire clk,
+        input  wire [1:0] pin_i,
+        output wire [2:0] pin_o
+    );
         wire [2:0] out_w;
-        always @(posedge clk) begin in_r <= pin_i; pin_o <= out_w; end
+        reg [1:0] in_r;
+        reg [2:0] out_r;
+        always @(posedge clk) begin
+            in_r <= pin_i;
+            out_r <= out_w;
+        end
         m dut (.x(in_r[1:0]), .y(out_w[2:0]));
+        assign pin_o = out_r;
     endmodule
     """
     top = _check_top(top)
@@ -609,25 +620,54 @@ def register_wrapper(top: str, ports, *, clocked: bool) -> str:
                          f"for a module clocked by an input named clk")
     if not ins or not outs:
         raise ValueError(f"module {top} needs an input and an output port to be timed")
+    return netlist.verilog(wrapper_netlist(top, ins, outs, clocked=clocked)).rstrip("\n")
+
+
+def wrapper_netlist(top: str, ins, outs, *, clocked: bool) -> netlist.Module:
+    """The netlist of :func:`register_wrapper`: ports ``clk``, ``pin_i``,
+    ``pin_o``; registers ``in_r`` and ``out_r``; the instance ``dut`` of ``top``.
+
+    Parameters
+    ----------
+    top : str
+        The wrapped module's name (an identifier).
+    ins, outs : list of (str, int)
+        Its input ports (without ``clk``) and output ports, name and width, in order.
+    clocked : bool
+        ``top``'s input ``clk`` is connected to the clock.
+
+    Returns
+    -------
+    chebnorm.hw.hdl.netlist.Module
+        The wrapper (printable in Verilog and VHDL).
+
+    Examples
+    --------
+    >>> m = wrapper_netlist("m", [("x", 2)], [("y", 3)], clocked=False)
+    >>> [p.signal.name for p in m.ports]
+    ['clk', 'pin_i', 'pin_o']
+    """
+    nl = netlist
     wi, wo = sum(w for _, w in ins), sum(w for _, w in outs)
+    clk = nl.Signal("clk", 1, logic=True, scalar=True)
+    pin_i, pin_o = nl.Signal("pin_i", wi, logic=True), nl.Signal("pin_o", wo, logic=True)
+    in_r, out_w = nl.Signal("in_r", wi, logic=True), nl.Signal("out_w", wo, logic=True)
+    out_r = nl.Signal("out_r", wo, logic=True)
     conns, lo = [], 0
     for n, w in ins:
-        conns.append(f".{n}(in_r[{lo + w - 1}:{lo}])")
+        conns.append((n, "input", w, nl.Slice(in_r, lo + w - 1, lo)))
         lo += w
     lo = 0
     for n, w in outs:
-        conns.append(f".{n}(out_w[{lo + w - 1}:{lo}])")
+        conns.append((n, "output", w, nl.Slice(out_w, lo + w - 1, lo)))
         lo += w
     if clocked:
-        conns.insert(0, ".clk(clk)")
-    return "\n".join([
-        f"module {WRAP} (input wire clk, input wire [{wi - 1}:0] pin_i, "
-        f"output reg [{wo - 1}:0] pin_o);",
-        f"    reg [{wi - 1}:0] in_r;",
-        f"    wire [{wo - 1}:0] out_w;",
-        "    always @(posedge clk) begin in_r <= pin_i; pin_o <= out_w; end",
-        f"    {top} dut ({', '.join(conns)});",
-        "endmodule"])
+        conns.insert(0, ("clk", "input", 1, clk))
+    return nl.Module(WRAP, wi, wo, ports=(nl.Port(clk), nl.Port(pin_i), nl.Port(pin_o, True)),
+                     statements=[nl.Declare(out_w),
+                                 nl.Registers(((in_r, pin_i), (out_r, out_w))),
+                                 nl.Instance(top, "dut", tuple(conns)),
+                                 nl.Output(out_r, port=pin_o)])
 
 
 #: user I/O pins of the iCE40 HX8K in the ct256 package

@@ -940,18 +940,89 @@ class LeadingZeros:
 
 @dataclass(frozen=True)
 class Output:
-    """The output port ``y`` driven by ``expr`` (``OUT_BITS`` wide).
+    """The output port ``y`` (or ``port``) driven by ``expr`` (``OUT_BITS`` wide).
 
     Parameters
     ----------
     expr : expression
         The value (its bits; the module checks its width).
+    port : Signal or None, default None
+        An output port of a module with a port list (:class:`Port`), of
+        ``expr``'s width (None: ``y``).
     """
 
     expr: object
+    port: Signal | None = None
 
     def __post_init__(self):
         _check_expr(self.expr, "Output")
+        if self.port is not None and self.port.width != self.expr.width:
+            raise _refuse(f"Output {self.port.name}", f"a value of {_kind(self.expr)} to a port "
+                                                      f"of {_kind(self.port)}; accepted: the "
+                                                      f"port's width")
+
+
+@dataclass(frozen=True)
+class Port:
+    """A port of a module with its own port list (:attr:`Module.ports`).
+
+    Parameters
+    ----------
+    signal : Signal
+        The port: a ``logic`` bit vector (``scalar`` for one bit), as HDL ports are.
+    output : bool, default False
+        An output (driven by an :class:`Output` with ``port``); else an input.
+    """
+
+    signal: Signal
+    output: bool = False
+
+    def __post_init__(self):
+        identifier(self.signal.name, field="port name")
+        if not self.signal.logic:
+            raise _refuse(f"Port {self.signal.name}", f"{_kind(self.signal)}; accepted: a logic "
+                                                      f"bit vector (Signal(..., logic=True))")
+
+
+@dataclass(frozen=True)
+class Instance:
+    """An instance ``label`` of module (entity) ``module``, its ports mapped by name.
+
+    Parameters
+    ----------
+    module : str
+        The instantiated module's name (an identifier).
+    label : str
+        The instance name (an identifier).
+    connections : tuple of (str, str, int, expression)
+        ``(port, "input" | "output", width, value)``: the port's name, direction
+        and width, and the bit vector connected to it (a ``logic`` signal or a
+        slice of one, of the port's width; an output's a signal or slice this
+        module declares).
+    """
+
+    module: str
+    label: str
+    connections: tuple
+
+    def __post_init__(self):
+        identifier(self.module, field="instance module")
+        identifier(self.label, field="instance label")
+        names = set()
+        for name, direction, width, value in self.connections:
+            what = f"Instance {self.label} port {name}"
+            identifier(name, field="port name")
+            if name in names:
+                raise _refuse(what, "connected twice; accepted: each port once")
+            names.add(name)
+            if direction not in ("input", "output"):
+                raise _refuse(what, f"direction {direction!r}; accepted: 'input' or 'output'")
+            if not isinstance(value, (Signal, Slice)) or not _is_logic(value):
+                raise _refuse(what, f"{type(value).__name__}; accepted: a logic Signal or a "
+                                    f"Slice of one")
+            if value.width != width:
+                raise _refuse(what, f"{value.width} bits connected to a {width}-bit port; "
+                                    f"accepted: the port's width")
 
 
 @dataclass(frozen=True)
@@ -986,6 +1057,10 @@ class Module:
         (:func:`schedule`, when printed or evaluated).
     latency : int, default 0
         Pipeline latency in cycles: > 0 adds ``clk`` and ``LATENCY``.
+    ports : tuple of Port, default ()
+        A port list of its own in place of ``x``, ``y`` (and ``clk``), without
+        parameters (generics): ``in_bits``, ``out_bits`` and ``latency`` are then
+        not printed. Not :func:`evaluate` d.
     """
 
     name: str
@@ -994,6 +1069,7 @@ class Module:
     facts: list = field(default_factory=list)
     statements: list = field(default_factory=list)
     latency: int = 0
+    ports: tuple = ()
 
     @property
     def x(self) -> Signal:
@@ -1297,7 +1373,10 @@ def _verilog_statement(s) -> list[str]:
         return [f"    // {_comment(s.text, 'verilog')}"]
     if isinstance(s, Output):
         _verilog_context(s.expr)
-        return [f"    assign y = {_expr(s.expr, 'verilog')};"]
+        return [f"    assign {s.port.name if s.port else 'y'} = {_expr(s.expr, 'verilog')};"]
+    if isinstance(s, Instance):
+        conns = ", ".join(f".{n}({_expr(v, 'verilog')})" for n, _, _, v in s.connections)
+        return [f"    {s.module} {s.label} ({conns});"]
     if isinstance(s, Declare):
         return [f"    {_verilog_type(s.signal)} {s.signal.name};"]
     if isinstance(s, Table):
@@ -1349,7 +1428,11 @@ def _vhdl_statement(s) -> tuple[list[str], list[str]]:
         return [], [f"    -- {_comment(s.text, 'vhdl')}"]
     if isinstance(s, Output):
         text = _expr(s.expr, "vhdl")
-        return [], [f"    y <= {text if _is_logic(s.expr) else f'std_logic_vector({text})'};"]
+        return [], [f"    {s.port.name if s.port else 'y'} <= "
+                    f"{text if _is_logic(s.expr) else f'std_logic_vector({text})'};"]
+    if isinstance(s, Instance):
+        conns = ", ".join(f"{n} => {_expr(v, 'vhdl')}" for n, _, _, v in s.connections)
+        return [], [f"    {s.label} : entity work.{s.module} port map ({conns});"]
     if isinstance(s, Declare):
         return [f"    signal {s.signal.name} : {_vhdl_type(s.signal)};"], []
     if isinstance(s, Table):
@@ -1466,6 +1549,11 @@ def verilog(module: Module) -> str:
     clocked = m.latency > 0
     statements = schedule(m.statements)
     out = comment_lines(_facts(m, "verilog"), "verilog")
+    if m.ports:
+        out += [f"module {m.name} (", *_verilog_ports(m.ports), ");"]
+        for s in statements:
+            out += _verilog_statement(s)
+        return "\n".join(out + ["endmodule", ""])
     out += [f"module {m.name} #(",
             f"    parameter IN_BITS = {m.in_bits},",
             f"    parameter OUT_BITS = {m.out_bits}" + ("," if clocked else ""),
@@ -1478,6 +1566,18 @@ def verilog(module: Module) -> str:
     for s in statements:
         out += _verilog_statement(s)
     return "\n".join(out + ["endmodule", ""])
+
+
+def _verilog_ports(ports) -> list[str]:
+    """The port declarations of a module with a port list, comma-separated."""
+    return [f"    {'output' if p.output else 'input '} {_verilog_type(p.signal)} {p.signal.name}"
+            f"{',' if i < len(ports) - 1 else ''}" for i, p in enumerate(ports)]
+
+
+def _vhdl_ports(ports) -> list[str]:
+    """The port clause entries of a module with a port list, semicolon-separated."""
+    return [f"        {p.signal.name} : {'out' if p.output else 'in '} {_vhdl_type(p.signal)}"
+            f"{';' if i < len(ports) - 1 else ''}" for i, p in enumerate(ports)]
 
 
 def vhdl_entity(name: str, in_bits: int, out_bits: int, latency: int = 0) -> list[str]:
@@ -1559,7 +1659,13 @@ def vhdl(module: Module) -> str:
     """
     m = module
     vhdl_name(m.name)
-    out = comment_lines(_facts(m, "vhdl"), "vhdl") + vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
+    out = comment_lines(_facts(m, "vhdl"), "vhdl")
+    if m.ports:
+        out += ["library ieee;", "use ieee.std_logic_1164.all;", "use ieee.numeric_std.all;", "",
+                f"entity {m.name} is", "    port (", *_vhdl_ports(m.ports), "    );",
+                f"end entity {m.name};", ""]
+    else:
+        out += vhdl_entity(m.name, m.in_bits, m.out_bits, m.latency)
     decl, stmt = [], []
     for s in schedule(m.statements):
         d, b = _vhdl_statement(s)
@@ -1656,6 +1762,9 @@ def evaluate(module: Module, code: int) -> dict:
     ValueError
         If ``code`` is out of range.
     """
+    if module.ports or any(isinstance(s, Instance) for s in module.statements):
+        raise ValueError(f"module {module.name}: a port list or an instance; accepted: a "
+                         f"module of ports x and y without instances")
     if not 0 <= code < 2 ** module.in_bits:
         raise ValueError(f"code {code}: accepted 0..{2 ** module.in_bits - 1}")
     env = {"x": code}
