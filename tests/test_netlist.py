@@ -324,7 +324,7 @@ def test_register_wrapper_netlist_passes_values_in_both_languages(tmp_path):
            "    chebnorm_fmax_wrap w (.clk(clk), .pin_i(pi), .pin_o(po));", "    initial begin"]
     for k in codes:
         vtb += [f"        pi = {k}; #1 clk = 1; #1 clk = 0; #1 clk = 1; #1 clk = 0;",
-                f'        $display("%0d", po);']
+                '        $display("%0d", po);']
     vtb += ["    end", "endmodule", ""]
     (tmp_path / "w.v").write_text(verilog(inner) + register_wrapper(inner.name, [
         ("x", "input", W), ("y", "output", 4)], clocked=False) + "\n" + "\n".join(vtb))
