@@ -245,3 +245,40 @@ def test_one_queue_for_candidates_and_search_points(monkeypatch):
             assert lows[c.design.module_name] >= best and "cannot win" in c.note
     assert one[1].cost is None   # ten times the points' models: never synthesized
     assert first[0] == "m0"      # the lowest bound first
+
+
+@pytest.mark.parametrize("queue", ["candidates", "with_search"])
+def test_a_skipped_candidates_lower_bound_is_printed_rounded_down(monkeypatch, queue):
+    """Both pruned queues print a skipped candidate's lower bound rounded down
+    (issue 45: synthesize_with_search rounded it to nearest). The bound here is
+    ~123.46, whose nearest one-decimal text 123.5 reads above it; the text is
+    read back and compared with the bound exactly."""
+    import re
+    from decimal import Decimal
+    from fractions import Fraction
+
+    from chebnorm.hw import architectures as A
+    from chebnorm.hw.piecewise_search import search
+
+    s = max(A.prune_spread("piecewise-sized", "xc7"))   # no ROM part: the larger ratio
+    cands = _fake_candidates([50.0 * s, 60.0 * s, 123.46 * s])   # m2 skipped: 123.46 >= 100
+
+    def fake(item):
+        return type("C", (), {"score": 100.0, "line": lambda self: "x"})()
+
+    if queue == "candidates":
+        monkeypatch.setattr(A, "_synth_item", fake)
+        out = A.synthesize_candidates(cands, "xc7", workers=1)
+    else:   # a search with no point meeting the error: the candidates alone queue
+        r = search("1/sqrt(x)", ("1", "4"), 6, 6, 1e-9, degrees=(1,), max_index_bits=2,
+                   synth=False, progress=False, workers=1)
+        monkeypatch.setattr(A, "_synth_job", lambda item: fake(item[1]))
+        out, _ = A.synthesize_with_search(cands, r, "xc7", workers=1)
+    assert [c.cost is None for c in out] == [False, False, True]
+    low = A.prune_lower("piecewise-sized", "xc7", cands[2].model)
+    assert f"{low:.1f}" == "123.5"   # what rounding to nearest printed
+    printed = re.search(r"lower bound (\S+) >= best synthesized 100\.0: cannot win",
+                        out[2].note)[1]
+    assert printed == "123.4"
+    assert Fraction(Decimal(printed)) <= Fraction(low) < Fraction(Decimal(printed)) + \
+        Fraction(1, 10)

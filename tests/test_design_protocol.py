@@ -87,8 +87,7 @@ def test_architecture_implements_the_protocol(designs, name):
     d = designs[name]
     assert isinstance(d, architecture(name))
     assert isinstance(d, Design)
-    tag = {"table": "plain_table"}.get(name, name)   # the plain table keeps its class tag
-    assert d.architecture == tag
+    assert d.architecture == name   # the tag is the registered name
     assert isinstance(d.in_bits, int) and isinstance(d.out_bits, int)
     assert d.module_name == f"chebnorm_{d.name}"
     assert d.verify() is d
@@ -97,6 +96,8 @@ def test_architecture_implements_the_protocol(designs, name):
     cuts = d.cut_points()
     assert isinstance(cuts, tuple) and all(isinstance(c, str) for c in cuts)
     assert bool(cuts) == (name in ("piecewise", "piecewise-sized", "multipartite", "table"))
+    if cuts:   # pipelined, a design keeps its tag
+        assert d.with_cuts((0,)).architecture == name
     text = d.verilog()
     assert f"module {d.module_name}" in text
     assert f"entity {d.module_name} is" in d.vhdl()
@@ -180,6 +181,19 @@ def test_registry_refuses_unknown_names_and_double_registration():
         @register("table")
         class Other(type(_table())):
             pass
+
+
+def test_registry_refuses_a_tag_other_than_the_registered_name():
+    """A design's own tag is the name it is registered (and printed) as: a class
+    tagged otherwise is refused, and nothing of it is registered."""
+    from chebnorm.hw.design_base import register
+
+    with pytest.raises(ValueError, match=r"architecture is 'plain_table'; accepted: one of "
+                                         r"the names it is registered as \(tablette\)"):
+        @register("tablette")
+        class Tagged(type(_table())):
+            architecture = "plain_table"
+    assert "tablette" not in ARCHITECTURES
 
 
 # -- the scan: no hasattr / getattr dispatch on design kinds in chebnorm.hw ----------
@@ -361,4 +375,5 @@ def test_candidates_name_registered_architectures():
     for c in cs:
         if c.design is not None:
             assert isinstance(c.design, architecture(c.architecture))
+            assert c.design.architecture == c.architecture   # one tag, the CSVs' name
             assert c.verilog == c.design.verilog()

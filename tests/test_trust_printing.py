@@ -30,7 +30,7 @@ SRC = Path(__file__).resolve().parent.parent / "src" / "chebnorm"
 BOUNDISH = re.compile(
     r"bound|err|eps|budget|total|rounding|approx|quantiz|upper|lower|maximum|mantissa|"
     r"relative|certif|floor|flush|worst|level|gappa|sup|(?<!f)max|meas|a_priori|"
-    r"\btarget\b|mismatch|\bb\[|ulp|lsb|slack|tol|\b_local\b", re.I)
+    r"\btarget\b|mismatch|\bb\[|ulp|lsb|slack|tol|\b_local\b|\blow", re.I)
 
 #: (module path relative to src/chebnorm, value source) -> why it is not an
 #: error bound, or is one printed where rounding to nearest is the meaning
@@ -146,9 +146,31 @@ def test_the_allowlist_is_short_and_every_entry_is_used():
     ('f"x = {x:.6e}"', False),               # not a bound's name
     ('f"{bound / lsb:.3f} LSB"', True),      # fixed point too
     ('f"ratio {ratio:.3f}"', False),
+    ('f"lower bound {low:.1f} >= best"', True),   # a lower bound held in `low`
+    ('format(lower, ".1f")', True),
+    ('"{:.2e}".format(lows[k])', True),
+    ('f"lower bound {format_down(low, \'.1f\')}"', False),
+    ('f"{flow:.3f} {below:.3f}"', False),        # `low` only at a name's start
 ])
 def test_the_scan_catches_each_form(source, caught):
     assert bool(scan(source)) is caught
+
+
+def test_the_scan_fails_on_a_lower_bound_rounded_to_nearest(tmp_path, monkeypatch):
+    """The pruned queue's note as synthesize_with_search printed it (issue 45):
+    a skipped candidate's lower bound in ``low``, rounded to nearest; the scan
+    of the package flags it, and passes once it goes through format_down."""
+    import sys
+
+    hw = tmp_path / "hw"
+    hw.mkdir()
+    before = 'out[i] = _skipped(out[i], f"{low:.1f}", run.best)\n'
+    (hw / "architectures.py").write_text(before, encoding="utf-8")
+    monkeypatch.setattr(sys.modules[__name__], "SRC", tmp_path)
+    assert _offenders() == ["hw/architectures.py:1: {low:.1f}"]
+    (hw / "architectures.py").write_text(
+        "out[i] = _skipped(out[i], format_down(low, '.1f'), run.best)\n", encoding="utf-8")
+    assert _offenders() == []
 
 
 @pytest.mark.slow

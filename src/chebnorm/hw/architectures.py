@@ -454,8 +454,8 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
             costs[i] = cost
     for j in run.skipped:
         low, (kind, i) = j.lower, j.key
-        if kind == "arch":   # rounded to nearest, as this queue always printed it
-            out[i] = _skipped(out[i], f"{low:.1f}", run.best)
+        if kind == "arch":   # a lower bound: printed rounded down
+            out[i] = _skipped(out[i], format_down(low, '.1f'), run.best)
     return out, with_costs(searched[0], costs)
 
 

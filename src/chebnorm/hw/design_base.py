@@ -65,8 +65,8 @@ class Design(ABC):
     Attributes
     ----------
     architecture : str
-        The architecture's name (a key of :data:`ARCHITECTURES`; the plain
-        table's tag is ``"plain_table"``, registered as ``"table"``).
+        The architecture's name: the key of :data:`ARCHITECTURES` it is
+        registered under, the name the CLI and the CSVs print.
     name : str
         The design's name (its module is ``chebnorm_<name>``).
     in_bits : int
@@ -184,8 +184,9 @@ def register(*names: str):
     Raises
     ------
     ValueError
-        No name, a name taken by another class, or a class that is not a
-        :class:`Design`.
+        No name, a name taken by another class, a class that is not a
+        :class:`Design`, or a class whose ``architecture`` tag (a string) is
+        not one of ``names``.
 
     Examples
     --------
@@ -200,6 +201,10 @@ def register(*names: str):
     def add(cls):
         if not (isinstance(cls, type) and issubclass(cls, Design)):
             raise ValueError(f"register: {cls!r} is not a Design subclass")
+        tag = cls.architecture   # a str, or a property choosing among the names
+        if isinstance(tag, str) and tag not in names:
+            raise ValueError(f"register: {cls.__name__}.architecture is {tag[:40]!r}; accepted: "
+                             f"one of the names it is registered as ({', '.join(names)})")
         for n in names:
             old = _REGISTRY.get(n)
             if old is not None and old.__qualname__ != cls.__qualname__:

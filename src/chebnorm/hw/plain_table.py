@@ -95,7 +95,7 @@ class PlainTableDesign(Design):
     __repr__ = summary_repr
     _repr_html_ = summary_html
 
-    architecture = "plain_table"
+    architecture = "table"
     degree = 0   # the VHDL bench reads it (a latency of 1 when combinational)
 
     def __post_init__(self):

@@ -36,7 +36,7 @@ __all__: list[str] = []
 
 def _kind(design) -> str:
     kind = design.architecture if isinstance(design, Design) else None
-    if kind not in ("multipartite", "plain_table"):
+    if kind not in ("multipartite", "table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
     verify_design(design)   # changed since it was proved: proved again (or refused)
@@ -77,7 +77,7 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
     expr = comment_text(design.expression)
     w = design.in_bits
     c = design.certificate
-    if kind == "plain_table":
+    if kind == "table":
         what = "plain table (correctly rounded)" if design.correctly_rounded else \
             f"plain table (nearest; {design.unproved} roundings unproved)"
     else:
@@ -89,7 +89,7 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
     lines += [f"x: unsigned {w}-bit code k, value = lo + (hi - lo) * k / 2^{w}",
               f"y: unsigned {design.out_bits}-bit code k, value = ({yf.offset_code} + k) / "
               f"2^{yf.frac_bits}"]
-    if kind == "plain_table":
+    if kind == "table":
         lines.append(f"ROM: 2^{w} x {design.out_bits} bits = {design.rom_bits} bits, "
                      f"y = round(f(x) * 2^{yf.frac_bits}) - {yf.offset_code} (ties to even).")
     else:
@@ -153,10 +153,10 @@ def cut_labels(design) -> dict:
         If ``design`` is not a table design.
     """
     kind = design.architecture if isinstance(design, Design) else None
-    if kind not in ("multipartite", "plain_table"):
+    if kind not in ("multipartite", "table"):
         raise ValueError(f"design: a {type(design).__name__} is not a table design; accepted: a "
                          f"MultipartiteDesign or a PlainTableDesign")
-    return PLAIN_TABLE_CUTS if kind == "plain_table" else TABLE_CUTS
+    return PLAIN_TABLE_CUTS if kind == "table" else TABLE_CUTS
 
 
 def table_cuts(design) -> tuple[int, ...]:
@@ -189,7 +189,7 @@ def table_cuts(design) -> tuple[int, ...]:
     cuts = tuple(design.cuts) if isinstance(design, Design) and design.latency else ()
     if cuts and (not set(cuts) <= set(cut_labels(design)) or list(cuts) != sorted(set(cuts))
                  or any(isinstance(c, bool) for c in cuts)):
-        if _kind(design) == "plain_table":
+        if _kind(design) == "table":
             raise ValueError(f"cuts {list(cuts)[:8]}: accepted: a plain table's sorted cut "
                              f"points among 0 (the address register) and 1 (the ROM output "
                              f"register)")
@@ -241,7 +241,7 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
     m = Module(module_name(design), w, design.out_bits, latency=len(cuts),
                facts=table_facts(design, version=version, command=command))
     out, x = m.statements, m.x
-    if design.architecture == "plain_table":
+    if design.architecture == "table":
         addr = x
         if 0 in cuts:   # the address registered
             addr = Signal("addr", w, logic=True)
