@@ -33,6 +33,7 @@ from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend,
                       rename, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -106,6 +107,7 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
 
 
 
+@hw_doc
 def exponent_netlist(design, *, version: str = "", command: str | None = None) -> Module:
     """The netlist of ``design``, flat: the leading-zero count, the
     normalizing shift, the core's inner code, the core's netlist with its ports
@@ -117,10 +119,8 @@ def exponent_netlist(design, *, version: str = "", command: str | None = None) -
     ----------
     design : ExponentDesign
         The design (:func:`~chebnorm.hw.exponent.design_exponent`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe).
+    %(version)s
+    %(command)s
 
     Returns
     -------
