@@ -28,6 +28,9 @@ from __future__ import annotations
 import re
 import textwrap
 
+# an implementation module of chebnorm.core: the API is what chebnorm.core exports
+__all__: list[str] = []
+
 #: ``%(name)s``: a fragment's placeholder (the name: letters, digits, underscores)
 _PLACEHOLDER = re.compile(r"%\((\w+)\)s")
 #: a placeholder alone on its line (leading and trailing blanks allowed)

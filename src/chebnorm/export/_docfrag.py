@@ -7,6 +7,9 @@ from __future__ import annotations
 
 from ..core.docfrag import docstring
 
+# an implementation module of chebnorm.export: the API is what chebnorm.export exports
+__all__: list[str] = []
+
 #: placeholder name -> parameter block (``name : type`` line, description indented by four)
 EXPORT_FRAGMENTS = {
     "command": '''\

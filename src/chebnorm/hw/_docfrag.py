@@ -7,6 +7,9 @@ from __future__ import annotations
 
 from ..core.docfrag import docstring
 
+# an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
+__all__: list[str] = []
+
 #: placeholder name -> parameter block (``name : type`` line, description indented by four)
 HW_FRAGMENTS = {
     "version": '''\
@@ -53,6 +56,15 @@ design : MultipartiteDesign, PlainTableDesign or PipelinedTable
     "sized_piecewise": '''\
 d : PiecewiseDesign
     A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).''',
+    "component_width": '''\
+w : int
+    Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).''',
+    "frac_bits": '''\
+frac_bits : int
+    ``F``: fractional bits of the vector components, ``>= 0``.''',
+    "target": '''\
+target : str
+    A target name (:func:`chebnorm.hw.targets.target_names`).''',
 }
 
 #: the decorator that fills :data:`HW_FRAGMENTS` into a docstring
