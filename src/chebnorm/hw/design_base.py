@@ -53,7 +53,7 @@ from types import MappingProxyType
 __all__: list[str] = []
 
 _REGISTRY: dict[str, type] = {}
-#: architecture name -> its :class:`Design` subclass (read-only; :func:`register` adds)
+#: architecture name -> its :class:`Design` subclass (read-only; :func:`~chebnorm.hw.design_base.register` adds)
 ARCHITECTURES = MappingProxyType(_REGISTRY)
 _PROVIDED: dict[str, object] = {}
 
