@@ -16,6 +16,8 @@
   (``arb_precision``, the one way the package sets it).
 * :mod:`chebnorm.core.tools`     -- the one place that finds external tools
   (``which``, ``require``) and runs them (``run_tool``, with a time limit).
+* :mod:`chebnorm.core.docfrag`   -- docstring fragments: a parameter block
+  written once, filled into ``%(name)s`` placeholders at import.
 
 This stage imports no other stage of chebnorm, only :mod:`chebnorm.exceptions`
 (the classes it raises and warns with).

@@ -28,6 +28,7 @@ from chebnorm.core.files import refuse_inputs, write_all, write_atomic
 from .c import c_header, horner_rounding_bound
 from .c_piecewise import DEFAULT_C_IN_BITS, piecewise_c_header
 from .shader import float32_eval_bound, glsl_source, hlsl_source, shader_source, wgsl_source
+from ._docfrag import export_doc
 
 
 def json_text(table, command: str = "") -> str:
@@ -260,6 +261,7 @@ def hdl_export(table, language: str, command: str = "", *, in_bits: int, out_bit
                     budget=report.budget)
 
 
+@export_doc
 def export_text(table, fmt: str, command: str = "", *, name: str | None = None,
                 **options) -> str:
     """The text of ``table`` in format ``fmt``.
@@ -275,8 +277,7 @@ def export_text(table, fmt: str, command: str = "", *, name: str | None = None,
         One of :func:`formats_for` ``(table)``: ``"c"``, ``"json"``,
         ``"glsl"``, ``"wgsl"``, ``"hlsl"``, ``"verilog"``, ``"vhdl"``
         (:data:`FORMATS`).
-    command : str, optional
-        The command line stated in the generated file's banner.
+    %(command)s
     name : str, optional
         The identifier of the generated function, macro or module (default:
         the table's own ``name``); ``[A-Za-z_][A-Za-z0-9_]*``.
@@ -400,6 +401,7 @@ def _renamed(table, name):
         return replace(table, name=name)
 
 
+@export_doc
 def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     """Print ``table`` in format ``fmt`` (:func:`export_text`, with the same
     ``options``) and write it to ``path`` atomically; nothing is written when
@@ -414,8 +416,7 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     path : str or os.PathLike
         The output file, written atomically (a temporary file in the same
         folder renamed into place; nothing is written when printing fails).
-    command : str, optional
-        The command line stated in the banner. Default ``""``.
+    %(command)s
     **options
         The format's keyword options, as :func:`export_text` takes them
         (``name``, ``in_bits``, ...).
@@ -447,6 +448,7 @@ def export_table(table, fmt: str, path, command: str = "", **options) -> str:
     return text
 
 
+@export_doc
 def export_with_proofs(table, fmt: str, path, command: str = "", *, inputs=None,
                        **options) -> dict[str, str]:
     """Print ``table`` in ``fmt`` naming a Gappa proof beside each stated
@@ -466,8 +468,7 @@ def export_with_proofs(table, fmt: str, path, command: str = "", *, inputs=None,
         The format.
     path : str or os.PathLike
         The output file; the proofs go to its directory.
-    command : str, optional
-        The command line stated in the banner. Default ``""``.
+    %(command)s
     inputs : dict of str to (str or os.PathLike), optional
         The command's input files (what each is -> path): no file written
         may resolve to one of them. Default: none.

@@ -61,6 +61,7 @@ from chebnorm.approx import CoefficientTable
 from chebnorm.core.textsafe import comment_text, identifier
 
 from .evalbound import BINARY32, BINARY64, Evaluator, Piece, fixed_arithmetic
+from ._docfrag import export_doc
 
 # an implementation module of chebnorm.export: the API is what chebnorm.export exports
 __all__: list[str] = []
@@ -831,6 +832,7 @@ def banner_head(fn: str, table, command: str) -> list[str]:
     return out
 
 
+@export_doc
 def c_header(table: CoefficientTable, command: str = "") -> str:
     """The C99 header text for ``table`` (see the module docstring).
 
@@ -839,9 +841,7 @@ def c_header(table: CoefficientTable, command: str = "") -> str:
     table : CoefficientTable
         The table to print; its name must be an identifier (it makes
         ``chebnorm_<name>`` and ``CHEBNORM_<NAME>_*``).
-    command : str, optional
-        The generating command, stated in the banner. Default ``""``
-        (no command line).
+    %(command)s
 
     Returns
     -------

@@ -35,6 +35,7 @@ from chebnorm.core.textsafe import comment_text, identifier
 
 from .c import banner_head, range_problem
 from .evalbound import BINARY64, Evaluator, Piece
+from ._docfrag import export_doc
 
 # an implementation module of chebnorm.export: the API is what chebnorm.export exports
 __all__: list[str] = []
@@ -133,6 +134,7 @@ def piecewise_eval_bound(table: PiecewiseTable) -> float:
     return piecewise_evaluator(table).bound().stated
 
 
+@export_doc
 def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
                        in_bits: int = DEFAULT_C_IN_BITS, proof: str = "") -> str:
     """The C99 header text for a piecewise table (see the module docstring).
@@ -141,8 +143,7 @@ def piecewise_c_header(table: PiecewiseTable, command: str = "", *,
     ----------
     table : PiecewiseTable
         The piecewise table; its name must be an identifier.
-    command : str, optional
-        The generating command, stated in the banner. Default ``""`` (none).
+    %(command)s
     in_bits : int, optional
         For a uniform table: the width of the input code ``k`` the function
         takes, ``max(K, 1) <= in_bits <= 32`` with ``2**K`` segments.

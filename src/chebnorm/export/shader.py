@@ -71,6 +71,7 @@ from chebnorm.core.numeric import float_up, format_up
 from .c import (coefficient_parity, evaluator_range_problem, inner_interval, interval_max_abs,
                 range_problem, round_inward)
 from .evalbound import BINARY32_FTZ, Evaluator, Piece
+from ._docfrag import export_doc
 
 # an implementation module of chebnorm.export: the API is what chebnorm.export exports
 __all__: list[str] = []
@@ -520,6 +521,7 @@ def interval32(table: CoefficientTable) -> tuple[float, float]:
     return round_inward(*inner_interval(table), "f")
 
 
+@export_doc
 def shader_source(table: CoefficientTable, language: str, command: str = "", *,
                   proof: str = "") -> str:
     """The shader function of ``table`` in ``language`` (glsl, wgsl or hlsl);
@@ -528,13 +530,10 @@ def shader_source(table: CoefficientTable, language: str, command: str = "", *,
 
     Parameters
     ----------
-    table : CoefficientTable
-        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
-        power of two); its name must be an identifier.
+    %(shader_table)s
     language : {"glsl", "wgsl", "hlsl"}
         The shading language (a key of :data:`SHADER_LANGUAGES`).
-    command : str, optional
-        The generating command, stated in the banner. Default ``""`` (none).
+    %(command)s
     proof : str, optional
         The stem of the Gappa proof file named beside the bound. Default
         ``""`` (none).
@@ -668,16 +667,14 @@ def _up_f32(value: float) -> float:
     return float(f)
 
 
+@export_doc
 def glsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in GLSL.
 
     Parameters
     ----------
-    table : CoefficientTable
-        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
-        power of two); its name must be an identifier.
-    command : str, optional
-        The generating command, stated in the banner. Default ``""``.
+    %(shader_table)s
+    %(command)s
 
     Returns
     -------
@@ -701,16 +698,14 @@ def glsl_source(table: CoefficientTable, command: str = "") -> str:
     return shader_source(table, "glsl", command)
 
 
+@export_doc
 def wgsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in WGSL.
 
     Parameters
     ----------
-    table : CoefficientTable
-        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
-        power of two); its name must be an identifier.
-    command : str, optional
-        The generating command, stated in the banner. Default ``""``.
+    %(shader_table)s
+    %(command)s
 
     Returns
     -------
@@ -733,16 +728,14 @@ def wgsl_source(table: CoefficientTable, command: str = "") -> str:
     return shader_source(table, "wgsl", command)
 
 
+@export_doc
 def hlsl_source(table: CoefficientTable, command: str = "") -> str:
     """:func:`shader_source` in HLSL.
 
     Parameters
     ----------
-    table : CoefficientTable
-        A table in powers of ``x`` or of a shifted ``t = (x - c)/s`` (``s`` a
-        power of two); its name must be an identifier.
-    command : str, optional
-        The generating command, stated in the banner. Default ``""``.
+    %(shader_table)s
+    %(command)s
 
     Returns
     -------

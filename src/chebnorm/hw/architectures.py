@@ -43,6 +43,7 @@ from .piecewise_search import SearchResult, synthesis_queue, synthesize_point, w
 from .plain_table import design_plain_table
 from .synth_loop import SynthJob, map_synth, pruned_synthesis
 from .targets import get_target, synthesize_target
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -213,6 +214,7 @@ def _cheapest_per_degree(cands: list[Candidate]) -> list[Candidate]:
     return [best[k][1] for k in sorted(best)]
 
 
+@hw_doc
 def prune_spread(architecture: str, target: str) -> tuple[float, float]:
     """The ratios by which a candidate's synthesized score may fall below the
     logic and the ROM parts of its model score (:data:`PRUNE_SPREAD`; an
@@ -224,8 +226,7 @@ def prune_spread(architecture: str, target: str) -> tuple[float, float]:
     architecture : str
         ``"piecewise-sized"``, ``"multipartite"`` or ``"table"``; any other name
         has no measurement of its own.
-    target : str
-        A target name (:func:`chebnorm.hw.targets.target_names`).
+    %(target)s
 
     Returns
     -------
@@ -288,6 +289,7 @@ def prune_lower(architecture: str, target: str, model: float,
     return (model - r) / logic + r / rom
 
 
+@hw_doc
 def synthesize_candidates(cands, target: str, *, bound: float | None = None,
                           prune: bool = True, workers: int | None = 1,
                           scheduler=None) -> list[Candidate]:
@@ -297,8 +299,7 @@ def synthesize_candidates(cands, target: str, *, bound: float | None = None,
     ----------
     cands : list of Candidate
         As :func:`architecture_candidates` builds them (``model`` set).
-    target : str
-        A target name (:func:`chebnorm.hw.targets.target_names`).
+    %(target)s
     bound : float, optional
         A score already synthesized elsewhere (the one-width search's winner):
         a candidate that cannot beat it is not synthesized.
@@ -367,6 +368,7 @@ def _synth_job(item):
     return _synth_item(payload) if kind == "arch" else synthesize_point(payload)
 
 
+@hw_doc
 def synthesize_with_search(cands, result, target: str, *, workers: int | None = None,
                            scheduler=None):
     """Synthesize the built candidates and the one-width search's front in one
@@ -389,8 +391,7 @@ def synthesize_with_search(cands, result, target: str, *, workers: int | None = 
         The one-width search with ``synth=False``
         (:func:`chebnorm.hw.piecewise_search.search`), or a future of it
         (waited for after the first round).
-    target : str
-        A target name (:func:`chebnorm.hw.targets.target_names`).
+    %(target)s
     workers, scheduler
         Parallel yosys runs (:func:`chebnorm.hw.piecewise_search.map_synth`).
 

@@ -29,6 +29,7 @@ import numpy as np
 from .cost import Block, Cost
 from .fixed import shift_round
 from .horner import HornerDesign
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -83,13 +84,13 @@ def horner_block(design: HornerDesign) -> Block:
                       f"{design.out_bits}-bit y")
 
 
+@hw_doc
 def dot_block(w: int) -> Block:
     """``A.B`` of two 3-vectors of ``w``-bit components.
 
     Parameters
     ----------
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
 
     Returns
     -------
@@ -106,6 +107,7 @@ def dot_block(w: int) -> Block:
                                      latency=3))
 
 
+@hw_doc
 def classic_unit(w: int, frac_bits: int | None = None) -> Block:
     """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div.
 
@@ -114,8 +116,7 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
 
     Parameters
     ----------
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
     frac_bits : int or None, default None
         ``F``: price the dividers as ``W + F``-bit quotients; None: ``W``-bit ones.
 
@@ -138,6 +139,7 @@ def classic_unit(w: int, frac_bits: int | None = None) -> Block:
     ))
 
 
+@hw_doc
 def dichotomy_unit(design: HornerDesign, w: int) -> Block:
     """Dichotomy midpoint ``(N1 + N2) p(z)`` and next level ``z' = sqrt(2 + z)``.
 
@@ -145,8 +147,7 @@ def dichotomy_unit(design: HornerDesign, w: int) -> Block:
     ----------
     design : HornerDesign
         The polynomial evaluator of ``1/sqrt(2 + z)``; its ``in_bits`` size the next level.
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
 
     Returns
     -------
@@ -171,6 +172,7 @@ def dichotomy_unit(design: HornerDesign, w: int) -> Block:
     ), note="seed 000, method 4")
 
 
+@hw_doc
 def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
     """Midpoint ``N_c = (N_l + N_r) p(N_l.N_r)`` and ``G, P, Q`` (seed 000, method 5).
 
@@ -178,8 +180,7 @@ def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
     ----------
     design : HornerDesign
         The polynomial evaluator of ``1/sqrt(2(1 + x))``.
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
 
     Returns
     -------
@@ -205,13 +206,13 @@ def quadratic_midpoint_unit(design: HornerDesign, w: int) -> Block:
     ), note="seed 000, method 5")
 
 
+@hw_doc
 def forward_difference_stepper(w: int, guard: int = 8) -> Block:
     """Per pixel ``N += D1; D1 += D2`` for each component: 6 adders, no multiplier.
 
     Parameters
     ----------
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
     guard : int, default 8
         Guard bits of the accumulators (``>= 0``).
 
@@ -230,6 +231,7 @@ def forward_difference_stepper(w: int, guard: int = 8) -> Block:
                  note="seed 000, method 5: additions only")
 
 
+@hw_doc
 def eta_unit(design: HornerDesign, w: int) -> Block:
     """eta = 3 - sum of three g(N_i.N_j) (seed 003) and the threshold compare.
 
@@ -237,8 +239,7 @@ def eta_unit(design: HornerDesign, w: int) -> Block:
     ----------
     design : HornerDesign
         The polynomial evaluator ``g`` of ``sqrt(2(1 + x))/2``, instantiated three times.
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
 
     Returns
     -------
@@ -270,13 +271,13 @@ def _intensity(w: int, shininess_bits: int = 7) -> Block:
     ))
 
 
+@hw_doc
 def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
     """Phong pipeline (seed 001): interpolate N, L, H; normalize each; intensity.
 
     Parameters
     ----------
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
     normalizer : Block or None, default None
         The normalization block used for each of N, L, H; None: :func:`classic_unit` of ``w``.
 
@@ -299,6 +300,7 @@ def phong_pipeline(w: int, normalizer: Block | None = None) -> Block:
     ), note="seed 001")
 
 
+@hw_doc
 def bump_pipeline(w: int, normalizer: Block | None = None) -> Block:
     """Bump mapping on the Phong pipeline (seed 001): the perturbed normal comes
     from a texture; one added 3w-bit 2:1 multiplexer selects it over the
@@ -306,8 +308,7 @@ def bump_pipeline(w: int, normalizer: Block | None = None) -> Block:
 
     Parameters
     ----------
-    w : int
-        Signed width of a vector component, ``>= 1`` (``frac_bits + 2`` holds ``[-2, 2)``).
+    %(component_width)s
     normalizer : Block or None, default None
         The normalization block used for each of N, L, H; None: :func:`classic_unit` of ``w``.
 
@@ -337,6 +338,7 @@ def _isqrt(v: np.ndarray) -> np.ndarray:
     return r
 
 
+@hw_doc
 def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
     """Bit-accurate classic unit: ``s = isqrt(N.N)`` (``F`` fractional bits),
     each component ``(n_i << F) / s`` rounded (``"trunc"``: toward minus
@@ -350,8 +352,7 @@ def classic_normalize(n, frac_bits: int, rounding: str = "trunc") -> np.ndarray:
     n : array_like of int
         Component codes, shape ``(..., 3)``, ``W``-bit with ``W + F <= 62``
         (int64 arithmetic, unchecked here).
-    frac_bits : int
-        ``F``: fractional bits of the vector components, ``>= 0``.
+    %(frac_bits)s
     rounding : {"trunc", "rne"}, default "trunc"
         The quotient's rounding: toward minus infinity, or to nearest with ties to even;
         any other value behaves as ``"trunc"``.
@@ -495,6 +496,7 @@ def _scaled_sum(n1, n2, y_codes, design: HornerDesign) -> np.ndarray:
     return shift_round(s * y, design.y_format.frac_bits, "rne")
 
 
+@hw_doc
 def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
     """Bit-accurate quadratic-interpolation set-up (seed 000, method 5).
 
@@ -511,8 +513,7 @@ def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
         The span's end normals, codes of shape ``(..., 3)``.
     design : HornerDesign
         The polynomial evaluator of ``1/sqrt(2(1 + x))``.
-    frac_bits : int
-        ``F``: fractional bits of the vector components, ``>= 0``.
+    %(frac_bits)s
 
     Returns
     -------
@@ -535,6 +536,7 @@ def quadratic_midpoint(nl, nr, design: HornerDesign, frac_bits: int):
     return 2 * nl + 2 * nr - 4 * nc, 4 * nc - 3 * nl - nr, nl, nc
 
 
+@hw_doc
 def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarray:
     """Bit-accurate ``eta = 3 - g(N_A.N_B) - g(N_B.N_C) - g(N_A.N_C)`` (seed 003)
     with ``g ~ sqrt(2(1+x))/2`` the polynomial of ``design``: each dot product
@@ -552,8 +554,7 @@ def eta_criterion(na, nb, nc, design: HornerDesign, frac_bits: int) -> np.ndarra
         :func:`~chebnorm.hw.horner.cover_frac_bits`, as the eta unit's evaluator):
         under the input-code mapping onto ``[0, 1)`` ``x = 1`` saturates to
         ``1 - 2**-in_bits``.
-    frac_bits : int
-        ``F``: fractional bits of the vector components, ``>= 0``.
+    %(frac_bits)s
 
     Returns
     -------

@@ -76,6 +76,7 @@ from .hdl import hdl_files, module_text, testbench_text
 from .design_base import Design, register
 from .trust import check, drafting, seal
 from .run_verilog import simulate, synthesize_text
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -1382,6 +1383,7 @@ def _error_limit(max_error) -> Fraction:
 
 # -- HDL (printed by chebnorm.hw.hdl) ----------------------------------------------
 
+@hw_doc
 def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | None = None) -> str:
     """The synthesizable Verilog-2005 module: ROM (a case on the index) + Horner
     (:func:`chebnorm.hw.hdl.module_text` in Verilog).
@@ -1390,11 +1392,8 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
     ----------
     d : PiecewiseDesign
         The design.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner; None or
-        empty: no such line.
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -1413,6 +1412,7 @@ def piecewise_verilog(d: PiecewiseDesign, *, version: str = "", command: str | N
     return module_text(d, "verilog", version=version, command=command)
 
 
+@hw_doc
 def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
     """The exhaustive self-checking bench (expected codes from ``d.evaluate``).
 
@@ -1420,8 +1420,7 @@ def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
     ----------
     d : PiecewiseDesign
         The design.
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
+    %(language)s
 
     Returns
     -------
@@ -1445,6 +1444,7 @@ def piecewise_testbench(d: PiecewiseDesign, language: str = "verilog") -> str:
     return testbench_text(d, language)
 
 
+@hw_doc
 def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | None = None,
                       language: str = "verilog") -> dict[str, str]:
     """``{file name: text}``: the module, its bench and the expected-output
@@ -1457,8 +1457,7 @@ def piecewise_outputs(d: PiecewiseDesign, *, version: str = "", command: str | N
         The design.
     version, command
         As in :func:`piecewise_verilog`.
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
+    %(language)s
 
     Returns
     -------

@@ -44,6 +44,7 @@ from chebnorm.exceptions import FrequencyWarning
 from .design_base import Design
 from .hdl.tables import table_cuts, table_files, table_module
 from .targets import fmax_ice40, get_target, synthesize_target
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -223,6 +224,7 @@ def _verilog(design) -> str:
     return design.verilog()
 
 
+@hw_doc
 def design_files(design, language: str = "verilog") -> dict:
     """File name -> text of ``design``'s module, its exhaustive bench (clocked
     when pipelined) and its vector file in ``language``.
@@ -236,8 +238,7 @@ def design_files(design, language: str = "verilog") -> dict:
     ----------
     design : HornerDesign, PiecewiseDesign, MultipartiteDesign, PlainTableDesign or PipelinedTable
         The design to print (combinational or with cuts).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
+    %(language)s
 
     Returns
     -------

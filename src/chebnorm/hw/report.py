@@ -33,6 +33,7 @@ from .datapaths import horner_block
 from .horner import HornerDesign, design_horner
 from .hdl import hdl_files, module_text
 from .run_verilog import SynthResult, synthesize_text
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -279,6 +280,7 @@ def analyze(table: CoefficientTable, in_bits: int, out_bits: int, *, coef_frac_b
     return HardwareReport(design, budget, meas, horner_block(design), syn)
 
 
+@hw_doc
 def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: str = "",
                 command: str | None = None, pipelined: bool = False) -> dict[str, str]:
     """File name -> text of the module, its test bench and its vector file in
@@ -300,12 +302,9 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
     ----------
     report : HardwareReport
         The analysed design; its budget goes into the banner.
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, for the banner.
-    command : str or None, default None
-        The command line that made the files, for the banner (None: no line).
+    %(language)s
+    %(version)s
+    %(files_command)s
     pipelined : bool, default False
         Also write the pipelined variant.
 
@@ -323,6 +322,7 @@ def hdl_outputs(report: HardwareReport, language: str = "verilog", *, version: s
                      budget=report.budget, pipelined=pipelined)
 
 
+@hw_doc
 def verilog_outputs(report: HardwareReport, *, version: str = "", command: str | None = None,
                     pipelined: bool = False) -> dict[str, str]:
     """File name -> text of the module, its test bench and its vector file; with
@@ -338,10 +338,8 @@ def verilog_outputs(report: HardwareReport, *, version: str = "", command: str |
     ----------
     report : HardwareReport
         The analysed design; its budget goes into the banner.
-    version : str, default ""
-        chebnorm's version, for the banner.
-    command : str or None, default None
-        The command line that made the files, for the banner (None: no line).
+    %(version)s
+    %(files_command)s
     pipelined : bool, default False
         Also write the pipelined variant.
 

@@ -16,6 +16,7 @@ from .hdl.vhdl import VHDL_STD
 from .run_verilog import SimResult
 from chebnorm.core.tools import require, run_tool
 from chebnorm.exceptions import ToolFailed
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -70,6 +71,7 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
                      mismatches=int(m.group(3)), line=m.group(0))
 
 
+@hw_doc
 def vhdl_outputs(report, *, version: str = "", command: str | None = None,
                  pipelined: bool = False) -> dict[str, str]:
     """File name -> text of the VHDL entity, its bench and the vector file of a
@@ -87,10 +89,8 @@ def vhdl_outputs(report, *, version: str = "", command: str | None = None,
     ----------
     report : HardwareReport
         The analysed design; its budget goes into the banner.
-    version : str, default ""
-        chebnorm's version, for the banner.
-    command : str or None, default None
-        The command line that made the files, for the banner (None: no line).
+    %(version)s
+    %(files_command)s
     pipelined : bool, default False
         Also write the pipelined entity and its bench.
 

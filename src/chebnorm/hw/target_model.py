@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 from .design_base import Design
 from .targets import DEVICE_WEIGHTS, get_target
+from ._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw: the API is what chebnorm.hw exports
 __all__: list[str] = []
@@ -165,6 +166,7 @@ def dsp_mapped(a: int, b: int) -> bool:
     return min(a, b) >= 2 and a + b - 1 >= 9
 
 
+@hw_doc
 def model_terms(f: DesignFeatures, target: str) -> dict:
     """The uncalibrated terms of ``target``'s model: ROM, multiplier and adder
     sizes (each multiplied by its constant in :func:`model_score`), and the
@@ -174,8 +176,7 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
     ----------
     f : DesignFeatures
         The design's features.
-    target : str
-        A target name (:func:`chebnorm.hw.targets.target_names`).
+    %(target)s
 
     Returns
     -------
@@ -224,6 +225,7 @@ def model_terms(f: DesignFeatures, target: str) -> dict:
     return {"rom": rom, "mul": mul, "add": add, "fixed": fixed}
 
 
+@hw_doc
 def model_score(features: DesignFeatures, target: str) -> float:
     """Predicted score of a design on ``target`` (yosys cells on ``generic``, LUT
     equivalents otherwise), within :data:`MODEL_SPREAD` of yosys on the
@@ -233,8 +235,7 @@ def model_score(features: DesignFeatures, target: str) -> float:
     ----------
     features : DesignFeatures
         The design's features (:func:`design_features`).
-    target : str
-        A target name (:func:`chebnorm.hw.targets.target_names`).
+    %(target)s
 
     Returns
     -------

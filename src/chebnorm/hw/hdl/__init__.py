@@ -40,6 +40,7 @@ from .verilog import (piecewise_clocked_testbench, piecewise_verilog, verilog_mo
                       verilog_pipelined_module, verilog_pipelined_testbench, verilog_testbench)
 from .vhdl import (piecewise_vhdl, piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench,
                    vhdl_module, vhdl_pipelined_module, vhdl_pipelined_testbench, vhdl_testbench)
+from .._docfrag import hw_doc
 
 __all__ = ["LANGUAGES", "SUFFIX", "check_language", "is_piecewise", "module_text",
            "testbench_text", "hdl_text", "hdl_files", "banner_facts", "comment_lines",
@@ -102,6 +103,7 @@ def _printers(design, language: str, pipelined: bool):
     return _PRINTERS[language, piecewise, bool(pipelined)]
 
 
+@hw_doc
 def banner_facts(design, language: str = "verilog", *, version: str = "",
                  command: str | None = None, budget=None, pipelined: bool = False) -> list[str]:
     """The banner of ``design``'s module as text lines without comment marker
@@ -118,23 +120,12 @@ def banner_facts(design, language: str = "verilog", *, version: str = "",
 
     Parameters
     ----------
-    design : HornerDesign or PiecewiseDesign
-        The design to print: a Horner evaluator
-        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
-        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
-    pipelined : bool, default False
-        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
-        Horner design of degree >= 1 only).
+    %(hdl_design)s
+    %(language)s
+    %(version)s
+    %(command)s
+    %(budget)s
+    %(pipelined)s
 
     Returns
     -------
@@ -154,6 +145,7 @@ def banner_facts(design, language: str = "verilog", *, version: str = "",
                         pipelined=pipelined)
 
 
+@hw_doc
 def module_text(design, language: str = "verilog", *, pipelined: bool = False,
                 version: str = "", command: str | None = None, budget=None) -> str:
     """The module (entity) of ``design`` in ``language``: ``"verilog"`` or
@@ -170,23 +162,12 @@ def module_text(design, language: str = "verilog", *, pipelined: bool = False,
 
     Parameters
     ----------
-    design : HornerDesign or PiecewiseDesign
-        The design to print: a Horner evaluator
-        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
-        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    pipelined : bool, default False
-        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
-        Horner design of degree >= 1 only).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(hdl_design)s
+    %(language)s
+    %(pipelined)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -205,6 +186,7 @@ def module_text(design, language: str = "verilog", *, pipelined: bool = False,
     return module(design, version=version, command=command, budget=budget)
 
 
+@hw_doc
 def testbench_text(design, language: str = "verilog", *, pipelined: bool = False,
                    vectors: str | None = None) -> str:
     """The exhaustive self-checking bench of :func:`module_text`'s module; it
@@ -219,18 +201,10 @@ def testbench_text(design, language: str = "verilog", *, pipelined: bool = False
 
     Parameters
     ----------
-    design : HornerDesign or PiecewiseDesign
-        The design to print: a Horner evaluator
-        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
-        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    pipelined : bool, default False
-        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
-        Horner design of degree >= 1 only).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(hdl_design)s
+    %(language)s
+    %(pipelined)s
+    %(vectors)s
 
     Returns
     -------
@@ -252,6 +226,7 @@ def testbench_text(design, language: str = "verilog", *, pipelined: bool = False
     return bench(design, vectors)
 
 
+@hw_doc
 def hdl_text(design, language: str = "verilog", *, version: str = "", command: str | None = None,
              budget=None) -> str:
     """The text ``chebnorm export --format verilog|vhdl`` writes: the
@@ -266,20 +241,11 @@ def hdl_text(design, language: str = "verilog", *, version: str = "", command: s
 
     Parameters
     ----------
-    design : HornerDesign or PiecewiseDesign
-        The design to print: a Horner evaluator
-        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
-        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(hdl_design)s
+    %(language)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -298,6 +264,7 @@ def hdl_text(design, language: str = "verilog", *, version: str = "", command: s
     return text
 
 
+@hw_doc
 def hdl_files(design, language: str = "verilog", *, version: str = "",
               command: str | None = None, budget=None, pipelined: bool = False) -> dict[str, str]:
     """File name -> text of the module, its test bench and its vector file in
@@ -313,23 +280,12 @@ def hdl_files(design, language: str = "verilog", *, version: str = "",
 
     Parameters
     ----------
-    design : HornerDesign or PiecewiseDesign
-        The design to print: a Horner evaluator
-        (:func:`~chebnorm.hw.horner.design_horner`) or a piecewise ROM + Horner one
-        (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
-    pipelined : bool, default False
-        The pipelined variant ``chebnorm_NAME_pipe`` (one register per Horner step; a
-        Horner design of degree >= 1 only).
+    %(hdl_design)s
+    %(language)s
+    %(version)s
+    %(command)s
+    %(budget)s
+    %(pipelined)s
 
     Returns
     -------

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from .common import check_language, vectors_name
 from .netlist import Module
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -70,6 +71,7 @@ def bench_verdict(name: str) -> list[str]:
             "endmodule", ""]
 
 
+@hw_doc
 def testbench(module, language: str, vectors: str | None = None) -> str:
     """The exhaustive self-checking bench of ``module`` in ``language``.
 
@@ -77,11 +79,8 @@ def testbench(module, language: str, vectors: str | None = None) -> str:
     ----------
     module : Module
         The netlist (only its name, ``in_bits``, ``out_bits`` and ``latency`` are read).
-    language : {"verilog", "vhdl"}
-        The HDL.
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(language_required)s
+    %(vectors)s
 
     Returns
     -------

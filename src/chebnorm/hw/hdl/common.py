@@ -22,6 +22,7 @@ from chebnorm.core.textsafe import comment_text, identifier
 from chebnorm.core.numeric import format_up
 
 from ..trust import verify_design
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -123,6 +124,7 @@ def pipelined_name(design) -> str:
     return f"{module_name(design)}_pipe"
 
 
+@hw_doc
 def horner_facts(design, language: str, *, version: str = "", command: str | None = None,
                  budget=None, pipelined: bool = False) -> list[str]:
     """The banner of a Horner evaluator as text lines without comment marker
@@ -134,18 +136,11 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    language : {"verilog", "vhdl"}
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(horner_design)s
+    %(language_required)s
+    %(version)s
+    %(command)s
+    %(budget)s
     pipelined : bool, default False
         State the pipelined variant's name and latency instead of the combinational one's.
 
@@ -226,6 +221,7 @@ def horner_facts(design, language: str, *, version: str = "", command: str | Non
     return lines
 
 
+@hw_doc
 def piecewise_facts(design, *, version: str = "", command: str | None = None) -> list[str]:
     """The banner of a piecewise (ROM + Horner) evaluator as text lines without
     comment marker: the function, the segments, the tool, the command, the
@@ -236,11 +232,8 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
     ----------
     design : PiecewiseDesign
         The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -311,6 +304,7 @@ def piecewise_facts(design, *, version: str = "", command: str | None = None) ->
     return lines
 
 
+@hw_doc
 def comment_lines(facts: list[str], language: str) -> list[str]:
     """The banner ``facts`` as comment lines of ``language``: ``// `` before
     each Verilog line (``//`` alone for an empty one); ``-- `` before each
@@ -326,8 +320,7 @@ def comment_lines(facts: list[str], language: str) -> list[str]:
     ----------
     facts : list of str
         The banner lines (no line breaks).
-    language : {"verilog", "vhdl"}
-        The HDL.
+    %(language_required)s
 
     Returns
     -------

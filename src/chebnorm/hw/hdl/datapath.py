@@ -24,6 +24,7 @@ from .common import (horner_facts, module_name, piecewise_facts, pipelined_name,
                      step_comment, variable_name)
 from .netlist import (Add, And, Assign, Bit, BitVec, Comment, Concat, Const, ConstDecl, Cut,
                       Extend, Gate, Group, Module, Mul, Neg, Not, Or, Paren, ReduceOr, Resize, Rom, Saturate, Shl, Shr, Signal, Slice, Sub, ZeroExt)
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -130,6 +131,7 @@ def _rom(d, m: Module, cols: list, rows) -> list:
                 tuple(tuple(int(q) for q in row) for row in rows))]
 
 
+@hw_doc
 def piecewise_netlist(d, *, version: str = "", command: str | None = None) -> Module:
     """The netlist of a (one-width) piecewise design ``d``: the coefficient
     ROM indexed by the top bits of ``x`` and one Horner datapath in the local
@@ -142,10 +144,8 @@ def piecewise_netlist(d, *, version: str = "", command: str | None = None) -> Mo
     ----------
     d : PiecewiseDesign
         The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`), not sized.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe).
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -217,6 +217,7 @@ def _truncated_rows(st: dict, a: Signal, low: Signal) -> list:
     return out
 
 
+@hw_doc
 def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None) -> Module:
     """The netlist of a sized piecewise design ``d`` (``d.sized``): ROM
     columns of their own widths, each Horner step multiplying by the top
@@ -227,13 +228,9 @@ def sized_piecewise_netlist(d, *, version: str = "", command: str | None = None)
 
     Parameters
     ----------
-    d : PiecewiseDesign
-        A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(sized_piecewise)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -340,6 +337,7 @@ def _horner_step(design, st, prev: Signal, xs: Signal) -> list:
     return out
 
 
+@hw_doc
 def horner_netlist(design, *, pipelined: bool = False, language: str | None = None,
                    version: str = "", command: str | None = None, budget=None) -> Module:
     """The netlist of a Horner evaluator
@@ -353,16 +351,13 @@ def horner_netlist(design, *, pipelined: bool = False, language: str | None = No
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
+    %(horner_design)s
     pipelined : bool, default False
         The pipelined variant ``chebnorm_NAME_pipe`` (degree >= 1).
     language : {"verilog", "vhdl"} or None, default None
         The banner's language (it names parameters or generics); None: both.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe).
+    %(version)s
+    %(command)s
     budget : ErrorBudget or None, default None
         The certified budget stated in the banner; None: not stated.
 

@@ -33,6 +33,7 @@ from .netlist import (Add, Assign, Bit, Comment, Concat, Const, Declare, Extend,
                       rename, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, piecewise_vhdl_testbench
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -45,6 +46,7 @@ def _check(design):
     return verify_design(design)   # changed since it was proved: proved again (or refused)
 
 
+@hw_doc
 def exponent_facts(design, *, version: str = "", command: str | None = None) -> list[str]:
     """The top module's banner as text lines without comment marker: what it
     evaluates, the formats, the normalization, the certified bounds.
@@ -53,10 +55,8 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
     ----------
     design : ExponentDesign
         The design described.
-    version : str
-        The chebnorm version written in the banner.
-    command : str, optional
-        The command line that generated it (written when given).
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -106,6 +106,7 @@ def exponent_facts(design, *, version: str = "", command: str | None = None) -> 
 
 
 
+@hw_doc
 def exponent_netlist(design, *, version: str = "", command: str | None = None) -> Module:
     """The netlist of ``design``, flat: the leading-zero count, the
     normalizing shift, the core's inner code, the core's netlist with its ports
@@ -117,10 +118,8 @@ def exponent_netlist(design, *, version: str = "", command: str | None = None) -
     ----------
     design : ExponentDesign
         The design (:func:`~chebnorm.hw.exponent.design_exponent`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe).
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -168,6 +167,7 @@ def exponent_netlist(design, *, version: str = "", command: str | None = None) -
     return m
 
 
+@hw_doc
 def exponent_module(design, language: str = "verilog", *, version: str = "",
                     command: str | None = None) -> str:
     """The module of ``design`` in ``language``, flat: the normalization, the
@@ -178,12 +178,9 @@ def exponent_module(design, language: str = "verilog", *, version: str = "",
     ----------
     design : ExponentDesign
         The design printed.
-    language : {"verilog", "vhdl"}
-        The language (default Verilog).
-    version : str
-        The chebnorm version written in the banner.
-    command : str, optional
-        The command line written in the banner.
+    %(language)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -249,6 +246,7 @@ def exponent_testbench(design, language: str = "verilog", vectors: str | None = 
     return (piecewise_vhdl_clocked_testbench if d.latency else piecewise_vhdl_testbench)(d, vectors)
 
 
+@hw_doc
 def exponent_files(design, language: str = "verilog", *, version: str = "",
                    command: str | None = None) -> dict[str, str]:
     """File name -> text: ``NAME.v|.vhd`` (core and top), ``tb_NAME.v|.vhd`` and
@@ -260,10 +258,8 @@ def exponent_files(design, language: str = "verilog", *, version: str = "",
         The design written.
     language : {"verilog", "vhdl"}
         The language of the module and bench (default Verilog).
-    version : str
-        The chebnorm version written in the banner.
-    command : str, optional
-        The command line written in the banner.
+    %(version)s
+    %(command)s
 
     Returns
     -------

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 from chebnorm.core.textsafe import identifier
 
 from .common import comment_lines
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -1483,6 +1484,7 @@ def _vhdl_statement(s) -> tuple[list[str], list[str]]:
     raise TypeError(f"statement {type(s).__name__}: not a netlist statement")
 
 
+@hw_doc
 def statement_lines(statement, language: str) -> tuple[list[str], list[str]]:
     """The text of one statement: declarations and body lines (Verilog
     declares in place: its declaration list is empty).
@@ -1491,8 +1493,7 @@ def statement_lines(statement, language: str) -> tuple[list[str], list[str]]:
     ----------
     statement : Assign, ConstDecl, Rom, Registers, Saturate or Comment
         The statement.
-    language : {"verilog", "vhdl"}
-        The HDL.
+    %(language_required)s
 
     Returns
     -------

@@ -29,6 +29,7 @@ from .netlist import (Add, Assign, Bit, Concat, Cut, Flip, Module, Output, Pad, 
                       Table, verilog, vhdl)
 from .verilog import piecewise_clocked_testbench, verilog_testbench
 from .vhdl import piecewise_vhdl_clocked_testbench, vhdl_testbench
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -43,6 +44,7 @@ def _kind(design) -> str:
     return kind
 
 
+@hw_doc
 def table_facts(design, *, version: str = "", command: str | None = None) -> list[str]:
     """The banner of a table design as text lines without comment marker:
     what it evaluates, the tool, the command, the formats, the ROMs, the
@@ -55,15 +57,9 @@ def table_facts(design, *, version: str = "", command: str | None = None) -> lis
 
     Parameters
     ----------
-    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
-        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
-        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
-        pipeline cuts).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(table_design)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -159,6 +155,7 @@ def cut_labels(design) -> dict:
     return PLAIN_TABLE_CUTS if kind == "table" else TABLE_CUTS
 
 
+@hw_doc
 def table_cuts(design) -> tuple[int, ...]:
     """The pipeline cut points of a table design (``design.cuts``): for a
     multipartite design ``0`` after the table reads, ``1`` after the sum of the
@@ -171,10 +168,7 @@ def table_cuts(design) -> tuple[int, ...]:
 
     Parameters
     ----------
-    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
-        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
-        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
-        pipeline cuts).
+    %(table_design)s
 
     Returns
     -------
@@ -203,6 +197,7 @@ def _offset_sum_bits(design) -> int:
     return max(1, sum((1 << t.width) - 1 for t in design.offsets).bit_length())
 
 
+@hw_doc
 def table_netlist(design, *, version: str = "", command: str | None = None) -> Module:
     """The netlist of a table design: one ROM (a plain table), or the
     multipartite ROMs -- the table of initial values, each offset table folded
@@ -213,10 +208,8 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
     ----------
     design : MultipartiteDesign, PlainTableDesign or PipelinedTable
         The table design.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe).
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -285,6 +278,7 @@ def table_netlist(design, *, version: str = "", command: str | None = None) -> M
     return m
 
 
+@hw_doc
 def table_module(design, language: str = "verilog", *, version: str = "",
                  command: str | None = None) -> str:
     """The module (entity) of a table design in ``language`` (``"verilog"``
@@ -299,17 +293,10 @@ def table_module(design, language: str = "verilog", *, version: str = "",
 
     Parameters
     ----------
-    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
-        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
-        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
-        pipeline cuts).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(table_design)s
+    %(language)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -331,6 +318,7 @@ def table_module(design, language: str = "verilog", *, version: str = "",
     return vhdl(m)
 
 
+@hw_doc
 def table_testbench(design, language: str = "verilog") -> str:
     """The exhaustive self-checking bench (every code against ``NAME.hex``).
 
@@ -341,12 +329,8 @@ def table_testbench(design, language: str = "verilog") -> str:
 
     Parameters
     ----------
-    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
-        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
-        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
-        pipeline cuts).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
+    %(table_design)s
+    %(language)s
 
     Returns
     -------
@@ -369,6 +353,7 @@ def table_testbench(design, language: str = "verilog") -> str:
     return vhdl_testbench(design)
 
 
+@hw_doc
 def table_files(design, language: str = "verilog", *, version: str = "",
                 command: str | None = None) -> dict[str, str]:
     """File name -> text: the module, its bench and the expected-output
@@ -381,17 +366,10 @@ def table_files(design, language: str = "verilog", *, version: str = "",
 
     Parameters
     ----------
-    design : MultipartiteDesign, PlainTableDesign or PipelinedTable
-        The table design (:func:`~chebnorm.hw.multipartite.design_multipartite`,
-        :func:`~chebnorm.hw.plain_table.design_plain_table`, or a multipartite one with
-        pipeline cuts).
-    language : {"verilog", "vhdl"}, default "verilog"
-        The HDL.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(table_design)s
+    %(language)s
+    %(version)s
+    %(command)s
 
     Returns
     -------

@@ -34,6 +34,7 @@ from .datapath import (horner_netlist, output_stage, piecewise_netlist, round_to
                        sized_piecewise_netlist)
 from .netlist import Signal, statement_lines
 from .netlist import verilog as _verilog
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -128,22 +129,17 @@ def saturating_output(top: str, top_bits: int, top_frac: int, y_format: QFormat,
 
 # -- Horner evaluator ---------------------------------------------------------------
 
+@hw_doc
 def verilog_module(design: HornerDesign, *, version: str = "", command: str | None = None,
                    budget=None) -> str:
     """The synthesizable Verilog-2005 module of ``design``.
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(horner_design)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -170,6 +166,7 @@ def verilog_module(design: HornerDesign, *, version: str = "", command: str | No
 
 
 
+@hw_doc
 def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
                              command: str | None = None, budget=None) -> str:
     """The pipelined variant of :func:`verilog_module`: the same datapath, bit
@@ -180,16 +177,10 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(horner_design)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -217,6 +208,7 @@ def verilog_pipelined_module(design: HornerDesign, *, version: str = "",
 
 
 
+@hw_doc
 def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive self-checking bench of the pipelined variant: one new input
     code per cycle; the output after edge ``i`` is checked against the model's
@@ -225,11 +217,8 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(horner_design)s
+    %(vectors)s
 
     Returns
     -------
@@ -254,16 +243,14 @@ def verilog_pipelined_testbench(design: HornerDesign, vectors: str | None = None
     return testbench(bench_ports(design, pipelined_name(design), design.steps), "verilog", vectors)
 
 
+@hw_doc
 def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """A self-checking test bench comparing every input code with the model.
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(horner_design)s
+    %(vectors)s
 
     Returns
     -------
@@ -290,6 +277,7 @@ def verilog_testbench(design: HornerDesign, vectors: str | None = None) -> str:
 
 # -- piecewise evaluator -------------------------------------------------------------
 
+@hw_doc
 def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> str:
     """The synthesizable Verilog-2005 module of a piecewise design ``d``
     (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`): ROM (a case on the
@@ -300,11 +288,8 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
     d : PiecewiseDesign
         The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`); a sized
         one (``d.sized``) is printed by :func:`sized_piecewise_verilog`.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -329,6 +314,7 @@ def piecewise_verilog(d, *, version: str = "", command: str | None = None) -> st
 
 # -- sized piecewise evaluator (a width per coefficient, truncated steps, pipelined) --------
 
+@hw_doc
 def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None) -> str:
     """The Verilog-2005 module of a sized piecewise design ``d`` (``d.sized``):
     ROM columns of their own widths, each Horner step multiplying by the top
@@ -339,13 +325,9 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
 
     Parameters
     ----------
-    d : PiecewiseDesign
-        A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(sized_piecewise)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -367,6 +349,7 @@ def sized_piecewise_verilog(d, *, version: str = "", command: str | None = None)
 
 
 
+@hw_doc
 def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     """Exhaustive bench of a pipelined piecewise module (``d.latency > 0``):
     one code per cycle, the output after edge ``i`` checked against the
@@ -383,9 +366,7 @@ def piecewise_clocked_testbench(d, vectors: str | None = None) -> str:
     ----------
     d : PiecewiseDesign
         A sized piecewise design with pipeline cuts (``d.latency > 0``).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(vectors)s
 
     Returns
     -------

@@ -39,6 +39,7 @@ from .bench import bench_ports, testbench
 from .common import module_name, pipelined_name
 from .datapath import horner_netlist, piecewise_netlist, sized_piecewise_netlist
 from .netlist import vhdl as _vhdl
+from .._docfrag import hw_doc
 
 # an implementation module of chebnorm.hw.hdl: the API is what chebnorm.hw.hdl exports
 __all__: list[str] = []
@@ -47,6 +48,7 @@ __all__: list[str] = []
 VHDL_STD = "08"
 
 
+@hw_doc
 def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None = None,
                 budget=None) -> str:
     """The combinational VHDL evaluator of ``design`` (see the module docstring).
@@ -59,16 +61,10 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(horner_design)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -85,6 +81,7 @@ def vhdl_module(design: HornerDesign, *, version: str = "", command: str | None 
 
 
 
+@hw_doc
 def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
                           command: str | None = None, budget=None) -> str:
     """The pipelined VHDL evaluator ``chebnorm_NAME_pipe``: the datapath of
@@ -93,16 +90,10 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
-    budget : ErrorBudget or None, default None
-        A Horner design's certified budget (:func:`~chebnorm.hw.budget.error_budget`),
-        stated in the banner; None: not stated. A piecewise design states its own.
+    %(horner_design)s
+    %(version)s
+    %(command)s
+    %(budget)s
 
     Returns
     -------
@@ -130,16 +121,14 @@ def vhdl_pipelined_module(design: HornerDesign, *, version: str = "",
 
 
 
+@hw_doc
 def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive self-checking bench of :func:`vhdl_module` (every input code).
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(horner_design)s
+    %(vectors)s
 
     Returns
     -------
@@ -163,17 +152,15 @@ def vhdl_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     return testbench(bench_ports(design, design.module_name), "vhdl", vectors)
 
 
+@hw_doc
 def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -> str:
     """Exhaustive bench of the pipelined entity: one code per cycle, the output
     after edge ``i`` checked against code ``i - LATENCY + 1``.
 
     Parameters
     ----------
-    design : HornerDesign
-        The Horner evaluator (:func:`~chebnorm.hw.horner.design_horner`).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(horner_design)s
+    %(vectors)s
 
     Returns
     -------
@@ -200,6 +187,7 @@ def vhdl_pipelined_testbench(design: HornerDesign, vectors: str | None = None) -
 
 # -- piecewise evaluator -------------------------------------------------------------
 
+@hw_doc
 def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """The VHDL-2008 entity of a piecewise design ``d``
     (:class:`~chebnorm.hw.piecewise.PiecewiseDesign`): the coefficient ROM
@@ -213,11 +201,8 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     d : PiecewiseDesign
         The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`); a sized
         one (``d.sized``) is printed by :func:`sized_piecewise_vhdl`.
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -239,6 +224,7 @@ def piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
 
 
 
+@hw_doc
 def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     """Exhaustive self-checking bench of :func:`piecewise_vhdl` (every input
     code against the model's ``NAME.hex``, as the Verilog bench).
@@ -247,9 +233,7 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     ----------
     d : PiecewiseDesign
         The piecewise design (:func:`~chebnorm.hw.piecewise.design_piecewise`).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(vectors)s
 
     Returns
     -------
@@ -272,6 +256,7 @@ def piecewise_vhdl_testbench(d, vectors: str | None = None) -> str:
     return testbench(bench_ports(d, module_name(d)), "vhdl", vectors)
 
 
+@hw_doc
 def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) -> str:
     """The VHDL-2008 entity of a sized piecewise design ``d`` (``d.sized``),
     bit for bit :func:`~chebnorm.hw.hdl.verilog.sized_piecewise_verilog`
@@ -280,13 +265,9 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
 
     Parameters
     ----------
-    d : PiecewiseDesign
-        A sized piecewise design (``design_piecewise(..., widths="auto")``, ``d.sized``).
-    version : str, default ""
-        chebnorm's version, stated in the banner (made comment-safe).
-    command : str or None, default None
-        The command line that made the file, stated in the banner (made comment-safe);
-        None or empty: no such line.
+    %(sized_piecewise)s
+    %(version)s
+    %(command)s
 
     Returns
     -------
@@ -307,6 +288,7 @@ def sized_piecewise_vhdl(d, *, version: str = "", command: str | None = None) ->
 
 
 
+@hw_doc
 def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
     """Exhaustive bench of a pipelined piecewise entity (``d.latency > 0``):
     one code per cycle, the output after edge ``i`` checked against code
@@ -323,9 +305,7 @@ def piecewise_vhdl_clocked_testbench(d, vectors: str | None = None) -> str:
     ----------
     d : PiecewiseDesign
         A sized piecewise design with pipeline cuts (``d.latency > 0``).
-    vectors : str or None, default None
-        The vector file the bench reads: an identifier, optionally with ``.hex``; None:
-        ``NAME.hex``.
+    %(vectors)s
 
     Returns
     -------
