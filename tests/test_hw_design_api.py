@@ -48,7 +48,7 @@ def same_as_cli(tmp_path, expr, interval, **kw) -> DesignResult:
     res = design(expr, interval, **kw)
     files = res.files(command=shlex.join(["chebnorm", *argv]), version=__version__)
     written = {p.name: p.read_bytes() for p in (tmp_path / "cli").iterdir()}
-    assert sorted(written) == sorted(files)
+    assert sorted(written) == sorted(files), r.out   # the command's report says why
     for fname, content in files.items():
         want = content if isinstance(content, bytes) else content.encode("utf-8")
         assert written[fname] == want, fname
