@@ -289,6 +289,27 @@ def test_an_architecture_the_tools_refuse_is_reported_and_left_out(monkeypatch):
         _time_all(_spec(), others, None)
 
 
+def test_a_tool_timeout_stops_the_choice_instead_of_changing_the_winner(monkeypatch):
+    # a timeout says how busy the machine was, not what the design is: leaving that
+    # architecture out would let another win on a loaded machine only
+    import chebnorm.hw.design_api as design_api
+    import chebnorm.hw.pipeline as pipeline
+    from chebnorm.exceptions import ToolTimeout
+    from chebnorm.hw.design_api import _time_all
+
+    monkeypatch.setattr(design_api, "_placed_score", lambda run, device: run.cost.score)
+    others = _candidates(("multipartite", 150.0), ("table", 300.0))
+
+    def timing(d, target, f, warn=True):
+        if d == "design-multipartite":
+            raise ToolTimeout("nextpnr-ice40", ["nextpnr-ice40"], 900)
+        return _result(230.0, 190.0, 2)
+
+    monkeypatch.setattr(pipeline, "pipeline_to_frequency", timing)
+    with pytest.raises(ToolTimeout, match="nextpnr-ice40"):
+        _time_all(_spec(), others, None)
+
+
 @pytest.mark.requires_tool("yosys")
 def test_table_is_priced_as_the_netlist_nextpnr_times():
     # between the input and output registers the ROM read becomes a block RAM read:

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from chebnorm.approx.piecewise_table import MAX_PIECEWISE_DEGREE
 from chebnorm.core.numeric import check_int, format_up
 from chebnorm.core.textsafe import csv_cell, design_name, identifier
+from chebnorm.exceptions import ToolTimeout
 
 from .targets import get_target
 
@@ -593,6 +594,8 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
     for i, (arch, desc, _, d) in enumerate(entries):
         try:
             runs.append(pipeline_to_frequency(d, spec.device, spec.frequency, warn=False))
+        except ToolTimeout:   # the machine's speed, not the design's: never a changed winner
+            raise
         except ValueError as exc:   # a tool's refusal: one line, the others still compete
             runs.append(None)
             failed[i] = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
