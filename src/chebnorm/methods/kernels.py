@@ -31,8 +31,14 @@ pixel, the difference once per span).
 
 from __future__ import annotations
 
+from chebnorm.core.docfrag import docstring
+
 # an implementation module of chebnorm.methods: the API is what chebnorm.methods exports
 __all__: list[str] = []
+
+#: the one parameter block every kernel shares
+_ops_doc = docstring(ops="ops : NumpyOps or CountingOps\n"
+                           "    The arithmetic backend (numpy arrays of one dtype, or counted float64).")
 
 #: the kernel shapes (see the module docstring)
 SHAPES = ("direct", "steps", "tree")
@@ -82,13 +88,13 @@ def lerp(a, d, t):
     return (a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2])
 
 
+@_ops_doc
 def horner(ops, coefficients, x):
     """``p(x)`` from ascending coefficients (degree d: d mul, d add).
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     coefficients : sequence of float
         Ascending coefficients (constants of the backend).
     x : scalar or array
@@ -113,13 +119,13 @@ def horner(ops, coefficients, x):
 
 
 # ---------------------------------------------------------- normalizers
+@_ops_doc
 def normalize_classic(ops, n):
     """Classic normalization ``N / sqrt(N.N)`` (seed 000): 3 mul, 2 add, 1 sqrt, 3 div.
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     n : tuple of 3 scalars or arrays
         The vector to normalize.
 
@@ -139,6 +145,7 @@ def normalize_classic(ops, n):
     return (n[0] / r, n[1] / r, n[2] / r)
 
 
+@_ops_doc
 def normalize_newton(ops, n):
     """One Newton-Raphson step from 1 for ``1/sqrt(x)``: ``N (3 - N.N) / 2`` (seed 000, method 1).
 
@@ -149,8 +156,7 @@ def normalize_newton(ops, n):
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     n : tuple of 3 scalars or arrays
         The vector to normalize.
 
@@ -170,6 +176,7 @@ def normalize_newton(ops, n):
     return vmul(n, s)
 
 
+@_ops_doc
 def normalize_lyon(ops, n):
     """Lyon's three-term Taylor series ``N (15 - 10 x + 3 x^2) / 8``, ``x = N.N``
     (seed 000, method 2), the 1/8 folded into the coefficients (Horner).
@@ -178,8 +185,7 @@ def normalize_lyon(ops, n):
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     n : tuple of 3 scalars or arrays
         The vector to normalize.
 
@@ -256,6 +262,7 @@ def _angular_point(ops, nl, nk, angle):
     return vadd(vmul(nl, ca), vmul(nk, sa)), ca, sa
 
 
+@_ops_doc
 def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None):
     """Seed 000, method 6: ``N(t) = N_a cos(t psi) + N_k sin(t psi)`` by the recurrence
     ``N_{j+1} = 2 cos(phi) N_j - N_{j-1}``, ``phi = psi dt`` (``psi/m`` by default).
@@ -268,8 +275,7 @@ def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None)
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     nl, nr : tuple of 3 scalars or arrays
         The span's unit end normals, component by component.
     t0 : float or array
@@ -333,6 +339,7 @@ def angular_steps(ops, nl, nr, t0, dt, n, *, start_at_left=False, reanchor=None)
         yield p1
 
 
+@_ops_doc
 def quadratic_steps(ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=False):
     """Seed 000, method 5: ``N(t) = G t^2 + P t + Q`` through ``N_l``, ``N_c``, ``N_r``,
     ``N_c = (N_l + N_r) p(N_l.N_r)`` with ``p ~ 1/sqrt(2(1+x))`` (the ``midpoint``
@@ -343,8 +350,7 @@ def quadratic_steps(ops, nl, nr, t0, dt, n, *, coefficients=None, start_at_left=
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     nl, nr : tuple of 3 scalars or arrays
         The span's unit end normals.
     t0 : float or array
@@ -425,6 +431,7 @@ ANGULAR = _Steps(angular_steps, ("reanchor",))
 
 
 # ------------------------------------------------------------ dichotomy
+@_ops_doc
 def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
     """Seed 000, method 4: ``levels`` rounds of angle halving; returns the
     ``2**levels + 1`` nodes from ``N_l`` to ``N_r`` (the slerp points at
@@ -437,8 +444,7 @@ def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     nl, nr : tuple of 3 scalars or arrays
         The span's unit end normals.
     levels : int
@@ -483,14 +489,14 @@ def dichotomy_tree(ops, nl, nr, levels, coefficients=None):
     return nodes
 
 
+@_ops_doc
 def dichotomy_fraction(ops, t, levels):
     """Position ``t`` on the dyadic grid: node index ``k = floor(t 2**levels)`` (a scalar)
     and fraction ``f`` (1 pow2 mul, 1 cmp, 1 add).
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     t : array
         Pixel positions in ``[0, 1]``.
     levels : int
@@ -515,13 +521,13 @@ def dichotomy_fraction(ops, t, levels):
     return k, u - k
 
 
+@_ops_doc
 def dichotomy_pick(ops, a, b, f):
     """Linear pick between the nodes around an off-grid pixel: ``A + f (B - A)``.
 
     Parameters
     ----------
-    ops : NumpyOps or CountingOps
-        The arithmetic backend (numpy arrays of one dtype, or counted float64).
+    %(ops)s
     a, b : tuple of 3 scalars or arrays
         The nodes left and right of the pixel.
     f : array
