@@ -1265,6 +1265,8 @@ def schedule(statements: list) -> list:
     list
         The statements without markers (a cut with nothing live adds nothing).
     """
+    if not any(isinstance(s, Cut) for s in statements):
+        return list(statements)   # no cut: nothing registered, nothing renamed
     reads = []   # names read at or after each position
     later: set = set()
     for s in reversed(statements):
@@ -1349,6 +1351,16 @@ def _vh_zeroext(e, p):
     return f"signed{chr(39) if e.qualified else ''}({zero} & {p(e.a)})"
 
 
+def _vh_concat(e, p):
+    text = " & ".join(f'"{x.value:0{x.width}b}"' if isinstance(x, Const)
+                      else p(x) if _is_logic(x) or type(x) is Bit
+                      else f"std_logic_vector({p(x)})" for x in e.parts)
+    if len(e.parts) > 1 and all(type(x) is Bit or isinstance(x, Signal) and x.scalar
+                                for x in e.parts):   # bits only: the vector type is named
+        return f"std_logic_vector'({text})"
+    return text
+
+
 #: VHDL-2008 (``ieee.numeric_std``) spelling of each node kind
 _VHDL = {
     Signal: lambda e, p: e.name,
@@ -1356,9 +1368,7 @@ _VHDL = {
     Slice: lambda e, p: f"{e.src.name}({e.hi} downto {e.lo})",
     Bit: lambda e, p: f"{e.src.name}({e.index})",
     BitVec: lambda e, p: f"{e.src.name}({e.index} downto {e.index})",
-    Concat: lambda e, p: " & ".join(f'"{x.value:0{x.width}b}"' if isinstance(x, Const)
-                                    else p(x) if _is_logic(x) or type(x) is Bit
-                                    else f"std_logic_vector({p(x)})" for x in e.parts),
+    Concat: lambda e, p: _vh_concat(e, p),
     Not: lambda e, p: f"not {p(e.a)}",
     ZeroExt: _vh_zeroext,
     Resize: lambda e, p: (f"wrap({p(e.a)}, {e.width})" if e.signed == e.a.signed
