@@ -7,7 +7,9 @@ A :class:`Module` holds typed :class:`Signal` s and statements
 :class:`Slice`, :class:`Bit`, :class:`Concat`, :class:`Not`, :class:`ZeroExt`,
 :class:`Resize`, :class:`Extend`, :class:`Shl`, :class:`Shr`, :class:`Neg`,
 :class:`Add`, :class:`Sub`, :class:`Mul`, :class:`Gate`, :class:`And`,
-:class:`Or`, :class:`ReduceOr`, :class:`Group`, :class:`Paren`). The logic is
+:class:`Or`, :class:`ReduceOr`, :class:`Group`, :class:`Paren`, and the
+comparison :class:`Compare` and multiplexer :class:`Select` an assignment
+takes whole). The logic is
 held once; each language is a table of templates, one per node kind
 (:data:`_VERILOG`, :data:`_VHDL`), as :mod:`chebnorm.export.shader` prints
 GLSL, WGSL and HLSL from one table.
