@@ -130,6 +130,15 @@ class TestUnits:
         res = simulate_vhdl(tmp_path, unit)
         assert not res.passed and res.mismatches == 1, res.line
 
+    @pytest.mark.slow
+    @requires_tool("ghdl")
+    @pytest.mark.parametrize("rounding", ["trunc", "rne"])
+    def test_classic_exhaustive_vhdl(self, rounding, tmp_path):
+        unit = design_unit("classic", frac_bits=3, comp_bits=5, rounding=rounding)
+        write_outputs(tmp_path, unit_outputs(unit))
+        res = simulate_vhdl(tmp_path, unit)
+        assert res.passed and res.vectors == 2 ** 15 and res.mismatches == 0, res.line
+
     @pytest.mark.parametrize("kind", ["classic", "dichotomy", "eta", "quadratic"])
     def test_netlist_evaluates_as_the_model(self, kind):
         """The unit's netlist, evaluated node by node in Python, equals the
