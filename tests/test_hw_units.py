@@ -384,7 +384,7 @@ class TestRegistry:
 
 class TestHostileText:
     """Text a user controls (paths in the command line, a table's expression or
-    name) reaches the unit's Verilog only as inert comment text."""
+    name) reaches the unit's Verilog and VHDL only as inert comment text."""
 
     EVIL = 'x\nmodule injected; initial $display("INJECTED"); endmodule\n'
 
@@ -415,9 +415,17 @@ class TestHostileText:
             assert all(ln.startswith("//") for ln in lines if "injected" in ln), f.name
             modules = re.findall(r"^\s*module\s+(\w+)", "\n".join(lines), re.M)
             assert modules and all(m.startswith(("chebnorm_", "tb_chebnorm_")) for m in modules)
+        for f in (tmp_path / self.EVIL / "out").glob("*.vhd"):
+            lines = f.read_text().splitlines()
+            assert all(ln.startswith("--") for ln in lines if "injected" in ln), f.name
+            entities = re.findall(r"^entity\s+(\w+)\s+is", "\n".join(lines), re.M)
+            assert entities and all(e.startswith(("chebnorm_", "tb_chebnorm_"))
+                                    for e in entities)
         banner = (tmp_path / self.EVIL / "out" / "chebnorm_dichotomy_unit.v").read_text()
         assert '// Command: chebnorm hw unit dichotomy --table ' in banner
         assert '_module injected; initial $display("INJECTED"); endmodule_' in banner
+        vhd = (tmp_path / self.EVIL / "out" / "chebnorm_dichotomy_unit.vhd").read_text()
+        assert '-- Command: chebnorm hw unit dichotomy --table ' in vhd
 
     @pytest.mark.parametrize("name", ["d2; initial $finish", "a\nb", "x" * 64])
     def test_hostile_table_name_refused(self, tmp_path, capsys, name):
