@@ -445,3 +445,17 @@ def test_a_nested_select_is_refused():
                      Assign(_s("b", 5), Add((Select(c, a, a), a)))]
     with pytest.raises(ValueError, match="Select: inside an expression"):
         verilog(m)
+
+
+def test_a_vector_of_bits_only_names_its_type_in_vhdl():
+    """Bits concatenated (std_logic & std_logic) have no type of their own in
+    VHDL: the printer qualifies them; Verilog needs nothing."""
+    m = Module("chebnorm_bits", 4, 3)
+    b = [Signal(f"b{i}", 1, logic=True, scalar=True) for i in range(3)]
+    q = Signal("q", 3)
+    m.statements += [*(Assign(s, Bit(m.x, i)) for i, s in enumerate(b)),
+                     Assign(q, Concat(tuple(b))), Output(q)]
+    assert "    q <= unsigned(std_logic_vector'(b0 & b1 & b2));" in vhdl(m)
+    assert "    wire [2:0] q = {b0, b1, b2};" in verilog(m)
+    assert [evaluate(m, k)["y"] for k in range(8)] == [int(f"{k:03b}"[::-1], 2)
+                                                       for k in range(8)]
