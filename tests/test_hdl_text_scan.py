@@ -1,8 +1,8 @@
 """HDL text is printed in one place, chebnorm.hw.hdl (issue 45): a source scan
 (ast) of every other module's string literals -- f-strings read whole, their
-fields as a placeholder; docstrings left out -- for HDL keywords. The normalization
-units (hw/units) still print their Verilog as text: they are listed, and the list
-may only shrink."""
+fields as a placeholder; docstrings left out -- for HDL keywords. Every other
+module, the normalization units (hw/units) included, builds netlists or calls the
+printers."""
 
 from __future__ import annotations
 
@@ -20,10 +20,6 @@ HDL = re.compile(r"\bendmodule\b|^\s*module\s+\w+\s*(#\(|\(\s*$|\(\s*(input|outp
                  r"\balways\s*@|\bentity\s+\w+\s+is\b|\bend\s+architecture\b|\bport\s+map\b|"
                  r"^\s*assign\s+\w+(\[[^\]]*\])?\s*=|\bposedge\b|\bwire\s+(signed\s+)?\[", re.M)
 
-#: modules outside hw/hdl that still print HDL text: the units, not yet built as netlists
-NOT_YET_NETLISTS = {"hw/units/bench.py", "hw/units/classic.py", "hw/units/dichotomy.py",
-                    "hw/units/eta.py", "hw/units/evaluator.py", "hw/units/hdl.py",
-                    "hw/units/quadratic.py", "hw/units/stepper.py"}
 
 
 def _literals(tree):
@@ -64,11 +60,8 @@ def _printers() -> dict[str, list]:
 
 
 def test_hdl_text_is_printed_only_in_hw_hdl():
-    found = _printers()
-    others = {k: v[:3] for k, v in found.items() if k not in NOT_YET_NETLISTS}
-    assert not others, f"HDL text outside chebnorm.hw.hdl: {others}"
-    stale = NOT_YET_NETLISTS - found.keys()
-    assert not stale, f"no HDL text left in {sorted(stale)}: take them off NOT_YET_NETLISTS"
+    found = {k: v[:3] for k, v in _printers().items()}
+    assert not found, f"HDL text outside chebnorm.hw.hdl: {found}"
 
 
 def test_the_hdl_package_itself_is_found():

@@ -1,5 +1,6 @@
-"""Tests of chebnorm.hw.units: Verilog normalization units bit-for-bit against
-the Python kernels (iverilog), yosys cell counts, kernels, errors and CLI."""
+"""Tests of chebnorm.hw.units: the normalization units' netlists, printed in
+Verilog and VHDL, bit-for-bit against the Python kernels (iverilog, ghdl, and
+the netlist evaluated in Python), yosys cell counts, kernels, errors and CLI."""
 
 from __future__ import annotations
 
@@ -18,7 +19,10 @@ from chebnorm.hw.datapaths import (dichotomy_next_z, eta_criterion, forward_diff
 from chebnorm.hw.report import write_outputs
 from chebnorm.hw.units import (UNIT_KINDS, analyze_unit, design_unit, unit_outputs,
                                unit_vectors)
+from chebnorm.core.tools import which
+from chebnorm.hw.hdl.netlist import evaluate
 from chebnorm.hw.run_verilog import simulate
+from chebnorm.hw.run_vhdl import simulate_vhdl
 from conftest import requires_tool, run_cli
 
 no_iverilog = requires_tool("iverilog")
@@ -104,6 +108,54 @@ class TestUnits:
         res = simulate(tmp_path, unit)
         assert res.passed and res.mismatches == 0 and res.vectors >= 300, res.line
 
+    @requires_tool("ghdl")
+    @pytest.mark.parametrize("kind", UNIT_KINDS)
+    def test_vhdl_bit_for_bit(self, kind, tmp_path):
+        unit = small(kind)
+        write_outputs(tmp_path, unit_outputs(unit, count=300, seed=1))
+        res = simulate_vhdl(tmp_path, unit)
+        assert res.passed and res.mismatches == 0 and res.vectors >= 300, res.line
+
+    @requires_tool("ghdl")
+    @pytest.mark.parametrize("kind", ["classic", "stepper"])
+    def test_vhdl_bench_detects_a_wrong_vector(self, kind, tmp_path):
+        unit = small(kind)
+        files = unit_outputs(unit, count=100)
+        name = f"{unit.module_name}.hex"
+        lines = files[name].splitlines(keepends=True)
+        last = lines[20][-2]
+        lines[20] = lines[20][:-2] + ("1" if last != "1" else "0") + "\n"
+        files[name] = "".join(lines)
+        write_outputs(tmp_path, files)
+        res = simulate_vhdl(tmp_path, unit)
+        assert not res.passed and res.mismatches == 1, res.line
+
+    @pytest.mark.slow
+    @requires_tool("ghdl")
+    @pytest.mark.parametrize("rounding", ["trunc", "rne"])
+    def test_classic_exhaustive_vhdl(self, rounding, tmp_path):
+        unit = design_unit("classic", frac_bits=3, comp_bits=5, rounding=rounding)
+        write_outputs(tmp_path, unit_outputs(unit))
+        res = simulate_vhdl(tmp_path, unit)
+        assert res.passed and res.vectors == 2 ** 15 and res.mismatches == 0, res.line
+
+    @pytest.mark.parametrize("kind", ["classic", "dichotomy", "eta", "quadratic"])
+    def test_netlist_evaluates_as_the_model(self, kind):
+        """The unit's netlist, evaluated node by node in Python, equals the
+        bit-accurate kernel on a few hundred random rows (every port's bits)."""
+        unit = small(kind, rounding="rne") if kind == "classic" else small(kind)
+        spec = unit.spec
+        top, *others = spec.modules(unit, version="", command=None)
+        rows = unit_vectors(unit, count=100, seed=5)
+        n = len(rows[unit.inputs[0].name])
+        pick = np.random.default_rng(5).choice(n, size=min(n, 300), replace=False)
+        want = unit.evaluate({k: v[pick] for k, v in rows.items()})
+        for j, i in enumerate(pick):
+            ins = {p.name: int(rows[p.name][i]) & ((1 << p.bits) - 1) for p in unit.inputs}
+            got = evaluate(top, inputs=ins, modules={m.name: m for m in others})
+            for p in unit.outputs:
+                assert got[p.name] == int(want[p.name][j]) & ((1 << p.bits) - 1), (p.name, ins)
+
     @no_iverilog
     @pytest.mark.parametrize("rounding", ["trunc", "rne"])
     def test_classic_exhaustive(self, rounding, tmp_path):
@@ -141,11 +193,22 @@ class TestUnits:
         assert unit_outputs(u, count=50, seed=4) != a
 
     def test_module_text(self):
-        text = unit_outputs(small("classic"), count=10)["chebnorm_classic_unit.v"]
-        assert "parameter W = 8," in text and "parameter F = 6," in text
-        assert "output wire signed [F+1:0] u_x" in text
-        text = unit_outputs(small("dichotomy"), count=10)["chebnorm_dichotomy_unit.v"]
-        assert "module chebnorm_dichotomy_d2 #(" in text and "poly (.x(z), .y(y))" in text
+        files = unit_outputs(small("classic"), count=10)
+        text = files["chebnorm_classic_unit.v"]
+        # printed at the generated widths: no parameters, concrete ports, one module
+        assert "parameter" not in text and text.count("endmodule") == 1
+        assert "    output wire [7:0] u_x," in text and "    input  wire [7:0] n_x," in text
+        assert "        u_x : out std_logic_vector(7 downto 0);" in files[
+            "chebnorm_classic_unit.vhd"]
+        files = unit_outputs(small("dichotomy"), count=10)
+        text = files["chebnorm_dichotomy_unit.v"]
+        assert "module chebnorm_dichotomy_d2 #(" in text
+        assert "    chebnorm_dichotomy_d2 poly (.x(z_s_v), .y(y));" in text
+        vhd = files["chebnorm_dichotomy_unit.vhd"]
+        assert "    poly : entity work.chebnorm_dichotomy_d2 port map (x => z_s_v, y => y);" in vhd
+        # the evaluator's entity comes first: VHDL analyses it before the unit names it
+        assert vhd.index("entity chebnorm_dichotomy_d2 is") < vhd.index(
+            "entity chebnorm_dichotomy_unit is")
 
     @pytest.mark.parametrize("kw, msg", [
         (dict(kind="cordic"), "unit 'cordic' is unknown; accepted: dichotomy, classic"),
@@ -185,9 +248,11 @@ class TestCLI:
                                         "--in-bits", "8", "--out-bits", "8", "--vectors", "200",
                                         "-o", str(tmp_path), "--simulate"]))
         assert code == 0 and "PASS:" in out and " 0 mismatches" in out
-        names = sorted(p.name for p in tmp_path.iterdir())
+        assert out.count("PASS:") == (2 if which("ghdl") else 1)   # GHDL too, when installed
+        names = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("work-obj"))
         assert names == ["chebnorm_quadratic_unit.hex", "chebnorm_quadratic_unit.v",
-                         "chebnorm_quadratic_unit_report.json", "tb_chebnorm_quadratic_unit.v"]
+                         "chebnorm_quadratic_unit.vhd", "chebnorm_quadratic_unit_report.json",
+                         "tb_chebnorm_quadratic_unit.v", "tb_chebnorm_quadratic_unit.vhd"]
 
     def test_report_with_units(self, tmp_path, capsys):
         t = tmp_path / "t.json"
@@ -319,7 +384,7 @@ class TestRegistry:
 
 class TestHostileText:
     """Text a user controls (paths in the command line, a table's expression or
-    name) reaches the unit's Verilog only as inert comment text."""
+    name) reaches the unit's Verilog and VHDL only as inert comment text."""
 
     EVIL = 'x\nmodule injected; initial $display("INJECTED"); endmodule\n'
 
@@ -350,9 +415,17 @@ class TestHostileText:
             assert all(ln.startswith("//") for ln in lines if "injected" in ln), f.name
             modules = re.findall(r"^\s*module\s+(\w+)", "\n".join(lines), re.M)
             assert modules and all(m.startswith(("chebnorm_", "tb_chebnorm_")) for m in modules)
+        for f in (tmp_path / self.EVIL / "out").glob("*.vhd"):
+            lines = f.read_text().splitlines()
+            assert all(ln.startswith("--") for ln in lines if "injected" in ln), f.name
+            entities = re.findall(r"^entity\s+(\w+)\s+is", "\n".join(lines), re.M)
+            assert entities and all(e.startswith(("chebnorm_", "tb_chebnorm_"))
+                                    for e in entities)
         banner = (tmp_path / self.EVIL / "out" / "chebnorm_dichotomy_unit.v").read_text()
         assert '// Command: chebnorm hw unit dichotomy --table ' in banner
         assert '_module injected; initial $display("INJECTED"); endmodule_' in banner
+        vhd = (tmp_path / self.EVIL / "out" / "chebnorm_dichotomy_unit.vhd").read_text()
+        assert '-- Command: chebnorm hw unit dichotomy --table ' in vhd
 
     @pytest.mark.parametrize("name", ["d2; initial $finish", "a\nb", "x" * 64])
     def test_hostile_table_name_refused(self, tmp_path, capsys, name):

@@ -1,7 +1,8 @@
-"""The normalization units write the same bytes as before they were split into
-one module per kind: every file of a grid of designs and command lines
-against sha256 sums recorded by tests/units_golden.py at the commit named in
-tests/data/units_golden.json (made before the split)."""
+"""The normalization units write the bytes recorded for them: every file of a
+grid of designs and command lines (Verilog and VHDL modules and benches,
+vectors, reports) against the sha256 sums tests/units_golden.py recorded at
+the commit named in tests/data/units_golden.json (see its docstring for what
+they are)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import units_golden as ug
 GOLDEN = json.loads(ug.GOLDEN.read_text())
 
 
-def test_fixture_made_before_the_split():
+def test_fixture_made_from_a_clean_commit():
     assert GOLDEN["src_clean"] and len(GOLDEN["generated_at_commit"]) == 40
     assert len(GOLDEN["units"]) == len(ug._cases())
 

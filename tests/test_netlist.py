@@ -11,9 +11,10 @@ from types import SimpleNamespace
 import pytest
 
 from chebnorm.hw.hdl.datapath import output_stage, round_to
-from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Concat, Const, ConstDecl, Cut,
-                                     Declare, Extend, Gate, Group, Instance, LeadingZeros, Module,
-                                     Mul, Neg, Not, Output, Param, Port, Registers, Resize, Rom, Saturate, Shl,
+from chebnorm.hw.hdl.netlist import (Add, Assign, Bit, BitVec, Compare, Concat, Const, ConstDecl,
+                                     Cut, Declare, Extend, Gate, Group, Instance, LeadingZeros,
+                                     Module, Mul, Neg, Not, Output, Param, Port, Registers, Resize,
+                                     Rom, Saturate, Select, Shl,
                                      ShiftBy, Shr, Signal, Slice, Sub, ZeroExt, evaluate, rename,
                                      schedule, verilog, vhdl)
 from chebnorm.hw.hdl.verilog import piecewise_clocked_testbench, verilog_testbench
@@ -349,3 +350,112 @@ def test_register_wrapper_netlist_passes_values_in_both_languages(tmp_path):
         r = subprocess.run(["ghdl", *step], cwd=tmp_path, capture_output=True, text=True,
                            check=True)
     assert [int(v) for v in r.stdout.split()] == [_expected(k) for k in codes]
+
+
+def _select() -> Module:
+    """Comparisons (signed and unsigned), a chain of selects with unsigned
+    constants, a concatenation with a constant, a signed value read as
+    unsigned bits."""
+    m = Module("chebnorm_sel", W, 9, facts=["select test module"])
+    a, b, sa, sb = Signal("a", 3), Signal("b", 3), _s("sa", 3), _s("sb", 3)
+    lt, ge = Signal("lt", 1, logic=True, scalar=True), Signal("ge", 1, logic=True, scalar=True)
+    sel, c, u = Signal("sel", 3), Signal("c", 5), Signal("u", 3)
+    m.statements += [Assign(a, Slice(m.x, 5, 3)), Assign(b, Slice(m.x, 2, 0)),
+                     Assign(sa, Slice(m.x, 5, 3)), Assign(sb, Slice(m.x, 2, 0)),
+                     Assign(lt, Compare("<", sa, sb)), Assign(ge, Compare(">=", a, b)),
+                     Assign(sel, Select(lt, a, Select(Compare("==", a, Const(3, 3, signed=False)),
+                                                      Const(5, 3, signed=False), b))),
+                     Assign(c, Concat((Const(1, 2, signed=False), sel))),
+                     Assign(u, Resize(Neg(sa), 3, signed=False)),
+                     Output(Concat((lt, ge, Slice(c, 3, 0), u)))]
+    return m
+
+
+def _select_expected(k: int) -> int:
+    a, b = k >> 3, k & 7
+    sa, sb = _wrap(a, 3), _wrap(b, 3)
+    lt, ge = int(sa < sb), int(a >= b)
+    sel = a if lt else (5 if a == 3 else b)
+    c = 8 | sel
+    return (lt << 8) | (ge << 7) | ((c & 15) << 3) | (-sa & 7)
+
+
+def test_select_and_compare_evaluate_as_python():
+    m = _select()
+    got = [evaluate(m, k)["y"] for k in range(2 ** W)]
+    assert got == [_select_expected(k) for k in range(2 ** W)]
+    assert len(set(got)) >= 40   # the selects and comparisons vary
+    v, h = verilog(m), vhdl(m)
+    assert "    wire [2:0] sel = lt ? a : a == 3'd3 ? 3'd5 : b;" in v
+    assert "    sel <= a when lt = '1' else to_unsigned(5, 3) when a = 3 else b;" in h
+    assert "    lt <= '1' when sa < sb else '0';" in h
+    assert "    u <= unsigned(-sa);" in h and "    c <= unsigned(\"01\" & std_logic_vector(sel));" in h
+
+
+@requires_tool("iverilog", "ghdl")
+def test_select_and_compare_simulate_every_code(tmp_path):
+    m = _select()
+    shim = _shim(m)
+    (tmp_path / f"{m.name}.hex").write_text("".join(f"{_select_expected(k):03x}\n"
+                                                     for k in range(2 ** W)))
+    for ext, text, bench in (("v", verilog(m), verilog_testbench(shim)),
+                             ("vhd", vhdl(m), piecewise_vhdl_testbench(shim))):
+        (tmp_path / f"{m.name}.{ext}").write_text(text)
+        (tmp_path / f"tb_{m.name}.{ext}").write_text(bench)
+    for run in (simulate, simulate_vhdl):
+        r = run(tmp_path, m.name)
+        assert r.passed and r.vectors == 2 ** W and r.mismatches == 0, r.line
+
+
+def test_a_register_fed_by_its_own_value_is_declared_first():
+    """An accumulator: Declare(reg=True), the next value, Registers(declare=False)."""
+    m = Module("chebnorm_acc", 4, 4, latency=1)
+    acc, nxt = Signal("acc", 4), Signal("acc_next", 4)
+    m.statements += [Declare(acc, reg=True),
+                     Assign(nxt, Select(Bit(m.x, 3), Const(0, 4, signed=False),
+                                        Add((acc, Slice(m.x, 3, 0))))),
+                     Registers(((acc, nxt),), declare=False), Output(acc)]
+    v, h = verilog(m), vhdl(m)
+    assert v.count("reg [3:0] acc;") == 1 and "acc <= acc_next;" in v
+    assert h.count("signal acc : unsigned(3 downto 0);") == 1
+
+
+@pytest.mark.parametrize("build, match", [
+    (lambda: Compare("<", _s("a", 4), Signal("b", 4)), "Compare: operands of 4 signed bits "
+                                                       "and 4 unsigned bits"),
+    (lambda: Compare("=", _s("a", 4), _s("b", 4)), "Compare: operator '='"),
+    (lambda: Compare("<", Signal("a", 4, logic=True), Signal("b", 4)), "Compare: a bit vector"),
+    (lambda: Select(Signal("c", 2), _s("a", 4), _s("b", 4)), "Select: condition of 2 unsigned"),
+    (lambda: Select(Bit(Signal("c", 2), 0), _s("a", 4), _s("b", 5)), "Select: operands of 4 "
+                                                                     "signed bits and 5"),
+    (lambda: Assign(Signal("v", 1), Compare("<", _s("a", 4), _s("b", 4))),
+     "Assign v: a Compare to a vector"),
+    (lambda: Output(Select(Bit(Signal("c", 2), 0), _s("a", 4), _s("b", 4))), "Output: a Select"),
+])
+def test_select_and_compare_refusals_name_the_node(build, match):
+    with pytest.raises(ValueError, match=match):
+        build()
+
+
+def test_a_nested_select_is_refused():
+    m = Module("chebnorm_w", 4, 4)
+    c = Bit(m.x, 0)
+    a = _s("a", 5)
+    m.statements += [Assign(a, ZeroExt(m.x)),
+                     Assign(_s("b", 5), Add((Select(c, a, a), a)))]
+    with pytest.raises(ValueError, match="Select: inside an expression"):
+        verilog(m)
+
+
+def test_a_vector_of_bits_only_names_its_type_in_vhdl():
+    """Bits concatenated (std_logic & std_logic) have no type of their own in
+    VHDL: the printer qualifies them; Verilog needs nothing."""
+    m = Module("chebnorm_bits", 4, 3)
+    b = [Signal(f"b{i}", 1, logic=True, scalar=True) for i in range(3)]
+    q = Signal("q", 3)
+    m.statements += [*(Assign(s, Bit(m.x, i)) for i, s in enumerate(b)),
+                     Assign(q, Concat(tuple(b))), Output(q)]
+    assert "    q <= unsigned(std_logic_vector'(b0 & b1 & b2));" in vhdl(m)
+    assert "    wire [2:0] q = {b0, b1, b2};" in verilog(m)
+    assert [evaluate(m, k)["y"] for k in range(8)] == [int(f"{k:03b}"[::-1], 2)
+                                                       for k in range(8)]

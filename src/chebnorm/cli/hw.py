@@ -100,9 +100,11 @@ def register(sub) -> None:
     _unit_width_args(r)
     r.set_defaults(func=run_report)
 
-    u = hsub.add_parser("unit", help="Verilog of a normalization unit, its test bench, vectors",
-                        description="A normalization unit as synthesizable Verilog, bit-for-bit "
-                        "equal to the Python kernels, with a self-checking test bench.")
+    u = hsub.add_parser("unit", help="Verilog and VHDL of a normalization unit, test benches, "
+                        "vectors",
+                        description="A normalization unit as synthesizable Verilog and VHDL "
+                        "(one netlist, at the generated widths), bit-for-bit equal to the Python "
+                        "kernels, with a self-checking test bench in each language.")
     u.add_argument("kind", choices=UNIT_NAMES)
     table = u.add_argument("--table", metavar="TABLE.json", default=None,
                            help="table of the unit's evaluator (default: the degree-2 fit of "
@@ -122,7 +124,8 @@ def register(sub) -> None:
                    "inputs have at most 16 bits)")
     u.add_argument("--seed", type=int, default=0)
     u.add_argument("-o", "--output", metavar="DIR", required=True, help="existing folder")
-    u.add_argument("--simulate", action="store_true", help="also run the test bench in iverilog")
+    u.add_argument("--simulate", action="store_true",
+                   help="also run the test benches in iverilog and, when installed, ghdl")
     u.add_argument("--synth", action="store_true", help="also count cells with yosys")
     u.set_defaults(func=run_unit)
 
@@ -358,9 +361,9 @@ def check_report_target(args) -> None:
 
 
 def run_unit(args) -> int:
-    """Run ``chebnorm hw unit``: the Verilog of a normalization unit
-    (``--kind``), its test bench, vectors and report written into the folder
-    ``-o``, simulated with ``--simulate``.
+    """Run ``chebnorm hw unit``: the Verilog and VHDL of a normalization unit
+    (``--kind``), their test benches, vectors and report written into the folder
+    ``-o``, simulated with ``--simulate`` (Icarus Verilog, and GHDL when installed).
 
     Parameters
     ----------
@@ -385,6 +388,7 @@ def run_unit(args) -> int:
     from chebnorm.hw.report import write_outputs
     from chebnorm.hw.units import analyze_unit, unit_outputs
     from chebnorm.approx import load_table
+    from chebnorm.core.tools import which
     from chebnorm.hw.run_verilog import simulate
 
     _check_output(args.output)
@@ -402,9 +406,14 @@ def run_unit(args) -> int:
         print(path)
     print("\n".join(rep.lines()))
     if args.simulate:
-        res = simulate(args.output, unit)
-        print(res.line)
-        return 0 if res.passed else 1
+        results = [simulate(args.output, unit)]
+        if which("ghdl") is not None:   # the VHDL beside it, when GHDL is installed
+            from chebnorm.hw.run_vhdl import simulate_vhdl
+
+            results.append(simulate_vhdl(args.output, unit))
+        for res in results:
+            print(res.line)
+        return 0 if all(res.passed for res in results) else 1
     return 0
 
 

@@ -7,7 +7,7 @@ interface, one registry of architectures by name: :mod:`.design_base`);
 model); :mod:`.hdl` prints any design in Verilog or VHDL (the one HDL printer, with the benches and vector files); :mod:`.run_verilog` and
 :mod:`.run_vhdl` run the simulators and Yosys on what it printed; :mod:`.report`
 checks a design against its error budget; :mod:`.units` are the
-normalization units (Verilog); :func:`design` (:mod:`.design_api`) picks the
+normalization units (Verilog and VHDL); :func:`design` (:mod:`.design_api`) picks the
 cheapest certified evaluator of a function on a device (``chebnorm design``). Every design object re-proves its bound and
 claims when it is constructed and before it prints (:mod:`.trust`).
 

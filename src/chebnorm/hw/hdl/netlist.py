@@ -7,7 +7,9 @@ A :class:`Module` holds typed :class:`Signal` s and statements
 :class:`Slice`, :class:`Bit`, :class:`Concat`, :class:`Not`, :class:`ZeroExt`,
 :class:`Resize`, :class:`Extend`, :class:`Shl`, :class:`Shr`, :class:`Neg`,
 :class:`Add`, :class:`Sub`, :class:`Mul`, :class:`Gate`, :class:`And`,
-:class:`Or`, :class:`ReduceOr`, :class:`Group`, :class:`Paren`). The logic is
+:class:`Or`, :class:`ReduceOr`, :class:`Group`, :class:`Paren`, and the
+comparison :class:`Compare` and multiplexer :class:`Select` an assignment
+takes whole). The logic is
 held once; each language is a table of templates, one per node kind
 (:data:`_VERILOG`, :data:`_VHDL`), as :mod:`chebnorm.export.shader` prints
 GLSL, WGSL and HLSL from one table.
@@ -726,9 +728,84 @@ class Paren(Group):
     """
 
 
+#: the comparison operators of :class:`Compare` and their Python meaning
+COMPARE_OPS = {"<": int.__lt__, "<=": int.__le__, ">": int.__gt__, ">=": int.__ge__,
+               "==": int.__eq__, "!=": int.__ne__}
+
+
+@dataclass(frozen=True)
+class Compare:
+    """``a OP b`` (one bit): operands of one width and signedness, compared
+    as numbers (signed or unsigned); the condition of a :class:`Select`, or
+    the whole value of an :class:`Assign` to a one-bit ``scalar`` signal.
+
+    Parameters
+    ----------
+    op : {"<", "<=", ">", ">=", "==", "!="}
+        The comparison.
+    a, b : expression
+        The operands (numbers: neither a bit vector).
+    """
+
+    op: str
+    a: object
+    b: object
+    width = 1
+    signed = False
+
+    def __post_init__(self):
+        if self.op not in COMPARE_OPS:
+            raise _refuse("Compare", f"operator {self.op!r}; accepted: {', '.join(COMPARE_OPS)}")
+        for e in (self.a, self.b):
+            if _is_logic(_check_expr(e, "Compare")):
+                raise _refuse("Compare", f"a bit vector {type(e).__name__} operand; accepted: "
+                                         f"numbers (assign the vector to a signal first)")
+        _same("Compare", self.a, self.b)
+
+
+@dataclass(frozen=True)
+class Select:
+    """``a`` when ``cond`` holds, else ``b`` (a multiplexer): the whole value
+    of an :class:`Assign` (VHDL prints it as a conditional assignment); ``b``
+    may be another Select (a chain).
+
+    Parameters
+    ----------
+    cond : Compare or expression
+        A :class:`Compare`, or a one-bit unsigned expression (true when 1).
+    a, b : expression
+        The operands, of one width and signedness.
+    """
+
+    cond: object
+    a: object
+    b: object
+
+    def __post_init__(self):
+        c = self.cond
+        if not isinstance(c, Compare):
+            if _check_expr(c, "Select").width != 1 or c.signed:
+                raise _refuse("Select", f"condition of {_kind(c)}; accepted: a Compare or one "
+                                        f"unsigned bit")
+        for e in (self.a, self.b):
+            if not isinstance(e, Select):
+                _check_expr(e, "Select")
+        _same("Select", self.a, self.b)
+
+    @property
+    def width(self) -> int:
+        """The operands' width."""
+        return self.a.width
+
+    @property
+    def signed(self) -> bool:
+        """The operands' signedness."""
+        return self.a.signed
+
+
 _EXPR = (Signal, Const, Slice, Bit, Concat, Not, ZeroExt, Resize, Extend, Shl, ShiftBy, Flip, Pad,
          Neg, Add, Sub,
-         Mul, Gate, And, ReduceOr, Group)
+         Mul, Gate, And, ReduceOr, Group, Compare, Select)
 
 
 # -- statements --------------------------------------------------------------------------
@@ -752,6 +829,9 @@ class Assign:
 
     def __post_init__(self):
         _check_expr(self.expr, f"Assign {self.dst.name}")
+        if isinstance(self.expr, Compare) and not self.dst.scalar:
+            raise _refuse(f"Assign {self.dst.name}", "a Compare to a vector; accepted: a scalar "
+                                                     "one-bit signal")
         signed_ok = (self.expr.signed == self.dst.signed or isinstance(self.expr, Const)
                      or _is_logic(self.expr))   # a bit vector takes the signal's type
         if self.expr.width != self.dst.width or not signed_ok:
@@ -849,10 +929,14 @@ class Registers:
         ``(register, source)``, one width and signedness each.
     label : str or None, default None
         The VHDL process label (None: an unlabelled process).
+    declare : bool, default True
+        Declare the registers here; False: a :class:`Declare` with ``reg`` did (a
+        register read by the logic that feeds it, as a counter or an accumulator).
     """
 
     pairs: tuple
     label: str | None = None
+    declare: bool = True
 
     def __post_init__(self):
         for dst, src in self.pairs:
@@ -890,9 +974,12 @@ class Declare:
     ----------
     signal : Signal
         The signal.
+    reg : bool, default False
+        Driven by :class:`Registers` (with ``declare=False``): a Verilog ``reg``.
     """
 
     signal: Signal
+    reg: bool = False
 
 
 @dataclass(frozen=True)
@@ -956,7 +1043,9 @@ class Output:
     port: Signal | None = None
 
     def __post_init__(self):
-        _check_expr(self.expr, "Output")
+        if isinstance(_check_expr(self.expr, "Output"), (Select, Compare)):
+            raise _refuse("Output", f"a {type(self.expr).__name__}; accepted: assign it to a "
+                                    f"signal first")
         if self.port is not None and self.port.width != self.expr.width:
             raise _refuse(f"Output {self.port.name}", f"a value of {_kind(self.expr)} to a port "
                                                       f"of {_kind(self.port)}; accepted: the "
@@ -1178,6 +1267,8 @@ def schedule(statements: list) -> list:
     list
         The statements without markers (a cut with nothing live adds nothing).
     """
+    if not any(isinstance(s, Cut) for s in statements):
+        return list(statements)   # no cut: nothing registered, nothing renamed
     reads = []   # names read at or after each position
     later: set = set()
     for s in reversed(statements):
@@ -1252,12 +1343,24 @@ _VERILOG = {
     ReduceOr: lambda e, p: f"|{p(e.a)}",
     Group: lambda e, p: f"({p(e.a)})",
     Paren: lambda e, p: f"({p(e.a)})",
+    Compare: lambda e, p: f"{p(e.a)} {e.op} {p(e.b)}",
+    Select: lambda e, p: f"{p(e.cond)} ? {p(e.a)} : {p(e.b)}",
 }
 
 
 def _vh_zeroext(e, p):
     zero = "'0'" if e.char else '"' + "0" * e.zeros + '"'
     return f"signed{chr(39) if e.qualified else ''}({zero} & {p(e.a)})"
+
+
+def _vh_concat(e, p):
+    text = " & ".join(f'"{x.value:0{x.width}b}"' if isinstance(x, Const)
+                      else p(x) if _is_logic(x) or type(x) is Bit
+                      else f"std_logic_vector({p(x)})" for x in e.parts)
+    if len(e.parts) > 1 and all(type(x) is Bit or isinstance(x, Signal) and x.scalar
+                                for x in e.parts):   # bits only: the vector type is named
+        return f"std_logic_vector'({text})"
+    return text
 
 
 #: VHDL-2008 (``ieee.numeric_std``) spelling of each node kind
@@ -1267,11 +1370,11 @@ _VHDL = {
     Slice: lambda e, p: f"{e.src.name}({e.hi} downto {e.lo})",
     Bit: lambda e, p: f"{e.src.name}({e.index})",
     BitVec: lambda e, p: f"{e.src.name}({e.index} downto {e.index})",
-    Concat: lambda e, p: " & ".join(p(x) if _is_logic(x) else f"std_logic_vector({p(x)})"
-                                    for x in e.parts),
+    Concat: lambda e, p: _vh_concat(e, p),
     Not: lambda e, p: f"not {p(e.a)}",
     ZeroExt: _vh_zeroext,
-    Resize: lambda e, p: f"wrap({p(e.a)}, {e.width})",
+    Resize: lambda e, p: (f"wrap({p(e.a)}, {e.width})" if e.signed == e.a.signed
+                          else f"{'signed' if e.signed else 'unsigned'}({p(e.a)})"),
     Extend: lambda e, p: f"resize({p(e.a)}, {e.width})",
     Shl: lambda e, p: f"shift_left({p(e.a)}, {e.k})",
     Shr: lambda e, p: f"shift_right({p(e.a)}, {e.k})",
@@ -1290,7 +1393,11 @@ _VHDL = {
     ReduceOr: lambda e, p: f"or {p(e.a)}",
     Group: lambda e, p: p(e.a),
     Paren: lambda e, p: f"({p(e.a)})",
+    Compare: lambda e, p: f"{p(e.a)} {_VHDL_OPS.get(e.op, e.op)} {p(e.b)}",
 }
+
+#: VHDL spelling of the comparisons that differ from Verilog's
+_VHDL_OPS = {"==": "=", "!=": "/="}
 
 _TABLES = {"verilog": _VERILOG, "vhdl": _VHDL}
 _SHIFTS = {"verilog": {"shr": ">>>", "shl": "<<<"}, "vhdl": {"shr": ">>", "shl": "<<"}}
@@ -1320,11 +1427,31 @@ def _is_logic(e) -> bool:
     return isinstance(e, (Concat, Not, ShiftBy))
 
 
+def _vhdl_cond(c) -> str:
+    """A VHDL condition (boolean): a comparison, or a bit equal to '1'."""
+    return _expr(c, "vhdl") if isinstance(c, Compare) else f"{_expr(c, 'vhdl')} = '1'"
+
+
 def _vhdl_value(dst: Signal, e) -> str:
     """``e`` converted to ``dst``'s VHDL type where the types differ."""
+    if isinstance(e, Select):   # a conditional assignment, one arm per condition
+        arms = []
+        while isinstance(e, Select):
+            arms.append(f"{_vhdl_value(dst, e.a)} when {_vhdl_cond(e.cond)} else")
+            e = e.b
+        return " ".join(arms + [_vhdl_value(dst, e)])
+    if isinstance(e, Compare):
+        return f"'1' when {_vhdl_cond(e)} else '0'"
+    if isinstance(e, Const) and (dst.logic or not dst.signed):
+        if dst.scalar:
+            return f"'{e.value}'"
+        bits = f"to_unsigned({e.value}, {dst.width})"
+        return f"std_logic_vector({bits})" if dst.logic else bits
     text = _expr(e, "vhdl")
     if _is_logic(e) and not dst.logic:
         return f"{'signed' if dst.signed else 'unsigned'}({text})"
+    if dst.logic and not dst.scalar and not _is_logic(e):
+        return f"std_logic_vector({text})"
     return text
 
 
@@ -1344,6 +1471,13 @@ def _verilog_context(e, top: bool = True, high: bool = False) -> None:
     if isinstance(e, Gate) and not top:
         raise _refuse("Gate", "inside an expression; accepted: the whole value of an Assign "
                               "(Verilog's AND with a repeated bit is unsigned)")
+    if isinstance(e, Select):
+        if not top:
+            raise _refuse("Select", "inside an expression; accepted: the whole value of an "
+                                    "Assign (VHDL's conditional assignment)")
+        _verilog_context(e.a)
+        _verilog_context(e.b)
+        return
     if isinstance(e, Resize):
         if e.width > e.a.width and type(e.a) in (Add, Sub, Neg, Shl):
             raise _refuse("Resize", f"{type(e.a).__name__} of {_kind(e.a)} widened to "
@@ -1379,7 +1513,7 @@ def _verilog_statement(s) -> list[str]:
         conns = ", ".join(f".{n}({_expr(v, 'verilog')})" for n, _, _, v in s.connections)
         return [f"    {s.module} {s.label} ({conns});"]
     if isinstance(s, Declare):
-        return [f"    {_verilog_type(s.signal)} {s.signal.name};"]
+        return [f"    {_verilog_type(s.signal, 'reg' if s.reg else 'wire')} {s.signal.name};"]
     if isinstance(s, Table):
         d, a, w = s.dst.name, s.address, s.dst.width
         return [f"    {_verilog_type(s.dst, 'reg')} {d};", "    always @(*) begin",
@@ -1401,7 +1535,7 @@ def _verilog_statement(s) -> list[str]:
         return [f"    assign {port} = {r}[{top}] ? {{{n}{{1'b0}}}} : ({r} > {s.ymax.name}) ? "
                 f"{{{n}{{1'b1}}}} : {r}[{n}-1:0];"]
     if isinstance(s, Registers):
-        out = [f"    {_verilog_type(d, 'reg')} {d.name};" for d, _ in s.pairs]
+        out = [f"    {_verilog_type(d, 'reg')} {d.name};" for d, _ in s.pairs if s.declare]
         return out + ["    always @(posedge clk) begin",
                       *(f"        {d.name} <= {src.name};" for d, src in s.pairs), "    end"]
     if isinstance(s, Rom):
@@ -1462,7 +1596,7 @@ def _vhdl_statement(s) -> tuple[list[str], list[str]]:
                     f"         (others => '1') when {r} > {s.ymax.name} else",
                     f"         std_logic_vector({r}({n} - 1 downto 0));"]
     if isinstance(s, Registers):
-        decl = [f"    signal {d.name} : {_vhdl_type(d)};" for d, _ in s.pairs]
+        decl = [f"    signal {d.name} : {_vhdl_type(d)};" for d, _ in s.pairs if s.declare]
         head = f"    {s.label} : process (clk)" if s.label else "    process (clk)"
         tail = f"    end process {s.label};" if s.label else "    end process;"
         return decl, [head, "    begin", "        if rising_edge(clk) then",
@@ -1708,7 +1842,8 @@ def _value(e, env: dict) -> int:
     if t is ZeroExt:
         return _value(e.a, env) & ((1 << e.a.width) - 1)
     if t in (Resize, Extend):
-        return _wrap(_value(e.a, env), e.width, e.signed)
+        return _wrap(_value(e.a, env) & ((1 << e.a.width) - 1) if e.signed != e.a.signed
+                     else _value(e.a, env), e.width, e.signed)
     if t is Shl:
         return _wrap(_value(e.a, env) << e.k, e.width, e.signed)
     if t is Shr:
@@ -1737,10 +1872,15 @@ def _value(e, env: dict) -> int:
         return _value(e.a, env) | _value(e.b, env)
     if t is ReduceOr:
         return int(_value(e.a, env) != 0)
+    if t is Compare:
+        return int(COMPARE_OPS[e.op](_value(e.a, env), _value(e.b, env)))
+    if t is Select:
+        return _value(e.a, env) if _value(e.cond, env) else _value(e.b, env)
     raise TypeError(f"{t.__name__}: not an expression node")
 
 
-def evaluate(module: Module, code: int) -> dict:
+def evaluate(module: Module, code: int | None = None, *, inputs: dict | None = None,
+             modules: dict | None = None) -> dict:
     """Every signal of a combinational ``module`` for input code ``code``, in
     Python: the meaning the printers' texts must have (registers pass their
     source through, as the steady state of a pipeline).
@@ -1749,26 +1889,48 @@ def evaluate(module: Module, code: int) -> dict:
     ----------
     module : Module
         The netlist.
-    code : int
-        The input code, ``0 <= code < 2**in_bits``.
+    code : int or None, default None
+        The input code, ``0 <= code < 2**in_bits`` (a module of ports ``x``, ``y``).
+    inputs : dict of str to int or None, default None
+        A module with a port list: input port name -> its bits (an unsigned integer).
+    modules : dict of str to Module or None, default None
+        The modules its :class:`Instance` s name (modules of ports ``x``, ``y``), by name.
 
     Returns
     -------
     dict
         Signal name -> value (signed signals as negative integers where negative);
-        ``"y"``: the output code.
+        ``"y"`` (or each output port): the output code.
 
     Raises
     ------
     ValueError
-        If ``code`` is out of range.
+        If ``code`` or an input is out of range or missing, or an instance names a
+        module not given.
     """
-    if module.ports or any(isinstance(s, Instance) for s in module.statements):
-        raise ValueError(f"module {module.name}: a port list or an instance; accepted: a "
-                         f"module of ports x and y without instances")
-    if not 0 <= code < 2 ** module.in_bits:
+    modules = modules or {}
+    for s in module.statements:
+        if isinstance(s, Instance) and s.module not in modules:
+            raise ValueError(f"module {module.name}: an instance of {s.module}, not given; "
+                             f"accepted: modules={{name: Module}} for each instance")
+    if module.ports:
+        env = {}
+        for p in module.ports:
+            if p.output:
+                continue
+            v = (inputs or {}).get(p.signal.name)
+            if v is None or not 0 <= v < 2 ** p.signal.width:
+                raise ValueError(f"input {p.signal.name} = {v!r}: accepted 0.."
+                                 f"{2 ** p.signal.width - 1}")
+            env[p.signal.name] = int(v)
+        return _run(module, env, modules)
+    if code is None or not 0 <= code < 2 ** module.in_bits:
         raise ValueError(f"code {code}: accepted 0..{2 ** module.in_bits - 1}")
-    env = {"x": code}
+    return _run(module, {"x": code}, modules)
+
+
+def _run(module: Module, env: dict, modules: dict) -> dict:
+    """Evaluate the statements of ``module`` from the inputs in ``env``."""
     for s in schedule(module.statements):
         if isinstance(s, Assign):
             env[s.dst.name] = _wrap(_value(s.expr, env), s.dst.width, s.dst.signed)
@@ -1782,7 +1944,15 @@ def evaluate(module: Module, code: int) -> dict:
             for d, src in s.pairs:
                 env[d.name] = env[src.name]
         elif isinstance(s, Output):
-            env["y"] = _value(s.expr, env) & (2 ** module.out_bits - 1)
+            width = s.port.width if s.port else module.out_bits
+            env[s.port.name if s.port else "y"] = _value(s.expr, env) & (2 ** width - 1)
+        elif isinstance(s, Instance):
+            sub = modules[s.module]
+            ins = {n: _value(v, env) for n, d, _, v in s.connections if d == "input"}
+            got = evaluate(sub, ins.get("x"), modules=modules)
+            for n, d, _, v in s.connections:
+                if d == "output":
+                    env[v.name] = got[n]
         elif isinstance(s, Table):
             a = env[s.address.name]
             env[s.dst.name] = int(s.values[a]) if a < len(s.values) else 0

@@ -1,17 +1,20 @@
-"""Verilog normalization units, bit-for-bit equal to the kernels of
-:mod:`chebnorm.hw.datapaths`, with self-checking test benches and costs.
+"""Normalization units in Verilog and VHDL, bit-for-bit equal to the kernels
+of :mod:`chebnorm.hw.datapaths`, with self-checking test benches and costs.
 
 Units (``kind``), each one module ``chebnorm_<kind>_unit`` and one Python
 module here (:mod:`.classic`, :mod:`.dichotomy`, :mod:`.quadratic`,
 :mod:`.stepper`, :mod:`.eta`), registered by name in :data:`UNITS`
 (:func:`get_unit`, :func:`unit_names`); what they share is written once
 (:mod:`.base`: ports, design, the :class:`UnitKind` interface, the registry;
-:mod:`.hdl`: banner and port list; :mod:`.bench`: vectors and test bench;
-:mod:`.evaluator`: the units with a polynomial evaluator):
+:mod:`.hdl`: banner, port list, square root, divider, saturation as netlist
+statements; :mod:`.bench`: vectors and test benches; :mod:`.evaluator`: the
+units with a polynomial evaluator). Each kind builds its netlist
+(:meth:`UnitKind.modules`, :mod:`chebnorm.hw.hdl.netlist`), which
+:meth:`UnitKind.verilog` and :meth:`UnitKind.vhdl` print:
 
 * ``"classic"`` -- ``N / sqrt(N.N)`` (:func:`~chebnorm.hw.datapaths.classic_normalize`):
-  dot product, restoring integer square root, three restoring dividers,
-  floor or nearest-even quotient. Fully parametric (``W``, ``F``, ``RNE``).
+  dot product, restoring integer square root, three restoring dividers
+  (unrolled, one result bit per step), floor or nearest-even quotient.
 * ``"dichotomy"`` -- ``M = (N1 + N2) p(z)`` and ``z' = sqrt(2 + z)``
   (:func:`~chebnorm.hw.datapaths.dichotomy_midpoint`,
   :func:`~chebnorm.hw.datapaths.dichotomy_next_z`), the polynomial ``p``
@@ -32,18 +35,18 @@ Vector components are signed ``W``-bit codes with ``F`` fractional bits
 (``W = F + 2`` holds ``[-2, 2)``; unit vectors need ``W >= F + 2``), ports
 ``<name>_x``, ``<name>_y``, ``<name>_z``.
 
-Widths: ``W`` (and ``F``, ``RNE``, ``LOG_M``, ``GUARD``) are Verilog
-parameters. In the classic unit every width inside is an expression of them.
-In the others the evaluator's constants, the output offsets and the output
-widths (written ``W+c``) were sized for the generated widths, exactly, from
-the extremes of every input code: regenerate to change them. Every output
+Widths: every unit is printed at its generated widths (no parameters): the
+evaluator's constants, the output offsets and the output widths were sized,
+exactly, from the extremes of every input code; regenerate to change
+them. Every output
 is wide enough to hold the kernel's exact result for *every* input code,
 so the model and the circuit agree everywhere, not only on unit normals.
 
-The test bench reads rows ``{inputs, expected outputs}`` made by the Python
-kernels (seeded random vectors, realistic normals, edge cases; every input
-code when the inputs have at most 16 bits) from ``chebnorm_<kind>_unit.hex``
-and prints one ``PASS:``/``FAIL:`` line.
+The test benches (Verilog and VHDL, :mod:`chebnorm.hw.hdl.unit_bench`) read
+rows ``{inputs, expected outputs}`` made by the Python kernels (seeded random
+vectors, realistic normals, edge cases; every input code when the inputs have
+at most 16 bits) from ``chebnorm_<kind>_unit.hex`` and print one
+``PASS:``/``FAIL:`` line.
 
 Adding a kind: one module with a subclass of :class:`UnitKind` (or of
 :class:`~chebnorm.hw.units.evaluator.EvaluatorUnit` when it has a polynomial

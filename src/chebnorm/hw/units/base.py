@@ -5,8 +5,9 @@ by name.
 A kind is one object registered under its name (``"classic"``, ...): it
 sizes a design (:meth:`UnitKind.design`), evaluates it bit-accurately
 (:meth:`UnitKind.evaluate`), prices it (:meth:`UnitKind.block`), makes its
-test rows (:meth:`UnitKind.vector_rows`) and writes its Verilog
-(:meth:`UnitKind.verilog`). Everything else (test bench, vector file, report)
+test rows (:meth:`UnitKind.vector_rows`) and builds its netlist
+(:meth:`UnitKind.modules`), printed in Verilog (:meth:`UnitKind.verilog`) and VHDL
+(:meth:`UnitKind.vhdl`). Everything else (test bench, vector file, report)
 is the same for every kind and dispatches through :func:`get_unit`.
 
 >>> from chebnorm.hw.units import get_unit, unit_names
@@ -29,6 +30,8 @@ from chebnorm.core.textsafe import identifier
 from chebnorm.core.display import field_rows, summary_html, summary_repr
 
 from ..cost import Block
+from ..hdl.netlist import verilog as _verilog
+from ..hdl.netlist import vhdl as _vhdl
 from ..horner import HornerDesign
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
@@ -255,8 +258,19 @@ class UnitKind(ABC):
         :func:`~chebnorm.hw.units.bench.combinational_rows`."""
 
     @abstractmethod
+    def modules(self, unit: UnitDesign, *, version: str, command: str | None) -> list:
+        """The unit's netlist (:class:`~chebnorm.hw.hdl.netlist.Module`), then the
+        modules it instantiates."""
+
     def verilog(self, unit: UnitDesign, *, version: str, command: str | None) -> str:
-        """The unit module and its helper modules."""
+        """The Verilog-2005 text of :meth:`modules`, the unit first."""
+        return "\n".join(_verilog(m) for m in self.modules(unit, version=version,
+                                                            command=command))
+
+    def vhdl(self, unit: UnitDesign, *, version: str, command: str | None) -> str:
+        """The VHDL-2008 text of :meth:`modules`, each entity after those it instantiates."""
+        return "\n".join(_vhdl(m) for m in reversed(self.modules(unit, version=version,
+                                                                  command=command)))
 
 
 _UNITS: dict[str, UnitKind] = {}

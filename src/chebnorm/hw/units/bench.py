@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..fixed import check_width
-from ..hdl.bench import bench_verdict
+from ..hdl.unit_bench import row_layout
+from ..hdl.unit_bench import unit_testbench as _bench
 from .base import EXHAUSTIVE_BITS, Port, UnitDesign
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
@@ -215,16 +216,6 @@ def combinational_rows(unit: UnitDesign, rng, count: int, realistic) -> dict:
     return {k: np.concatenate(v) for k, v in rows.items()}
 
 
-def _layout(unit: UnitDesign) -> tuple[list[tuple[Port, int, int]], int]:
-    """Each port's ``[hi:lo]`` in a vector row, inputs first from the MSB."""
-    total = sum(p.bits for p in unit.ports)
-    pos, out = total, []
-    for p in unit.ports:
-        out.append((p, pos - 1, pos - p.bits))
-        pos -= p.bits
-    return out, total
-
-
 def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
     """Rows ``{inputs, expected outputs}`` in hex (``$readmemh``).
 
@@ -253,7 +244,7 @@ def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
     '0c8010c0\\n'
     """
     outs = unit.evaluate(inputs)
-    layout, total = _layout(unit)
+    layout, total = row_layout(unit.ports)
     vals = {**inputs, **outs}
     n = len(next(iter(inputs.values())))
     row = [0] * n
@@ -271,16 +262,10 @@ def unit_vector_file(unit: UnitDesign, inputs: dict) -> str:
     return "".join(f"{r:0{digits}x}\n" for r in row)
 
 
-def _declarations(unit: UnitDesign, layout) -> list[str]:
-    lines = ["    reg clk;"] if unit.clocked else []
-    for p, _, _ in layout:
-        lines.append(f"    {'wire' if p.output else 'reg'} "
-                     f"{'signed ' if p.signed and p.bits > 1 else ''}[{p.bits - 1}:0] {p.name};")
-    return lines
-
-
-def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> str:
-    """A self-checking test bench of ``count`` rows read from ``vectors``.
+def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None,
+                   language: str = "verilog") -> str:
+    """A self-checking test bench of ``count`` rows read from ``vectors``
+    (printed by :func:`chebnorm.hw.hdl.unit_bench.unit_testbench`).
 
     Parameters
     ----------
@@ -290,11 +275,18 @@ def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> 
         How many rows the vector file holds.
     vectors : str or None, default None
         The vector file name; None: ``NAME.hex``.
+    language : {"verilog", "vhdl"}, default "verilog"
+        The bench's language.
 
     Returns
     -------
     str
-        The Verilog bench text.
+        The bench text.
+
+    Raises
+    ------
+    ValueError
+        If ``language`` is unknown.
 
     Examples
     --------
@@ -302,44 +294,9 @@ def unit_testbench(unit: UnitDesign, count: int, vectors: str | None = None) -> 
     >>> tb = unit_testbench(design_unit("classic", frac_bits=6), 100)
     >>> tb.splitlines()[0][:40], "localparam COUNT = 100;" in tb
     ('// tb_chebnorm_classic_unit: self-checki', True)
+    >>> "constant COUNT : natural := 100;" in unit_testbench(design_unit("classic"), 100,
+    ...                                                    language="vhdl")
+    True
     """
-    name = unit.module_name
-    vectors = vectors or f"{name}.hex"
-    layout, total = _layout(unit)
-    ins = [(p, hi, lo) for p, hi, lo in layout if not p.output]
-    outs = [(p, hi, lo) for p, hi, lo in layout if p.output]
-    ohi, olo = outs[0][1], outs[-1][2]
-    lines = [f"// tb_{name}: self-checking test bench of {name}.",
-             f"// Rows {{inputs, expected outputs}} come from the chebnorm bit-accurate model "
-             f"({vectors}).",
-             "`timescale 1ns/1ps",
-             f"module tb_{name};",
-             f"    localparam COUNT = {count};",
-             f"    reg [{total - 1}:0] vec [0:COUNT-1];",
-             f"    reg [{total - 1}:0] row;"]
-    lines += _declarations(unit, ins + outs)
-    conns = ([".clk(clk)"] if unit.clocked else []) + [f".{p.name}({p.name})" for p in unit.ports]
-    got = "{" + ", ".join(p.name for p, _, _ in outs) + "}"
-    lines += [f"    {name} dut ({', '.join(conns)});",
-              "    integer i, errors;",
-              "    initial begin",
-              f"        $readmemh(\"{vectors}\", vec);",
-              "        errors = 0;"]
-    if unit.clocked:
-        lines.append("        clk = 0;")
-    lines.append("        for (i = 0; i < COUNT; i = i + 1) begin")
-    lines.append("            row = vec[i];")
-    for p, hi, lo in ins:
-        lines.append(f"            {p.name} = row[{hi}:{lo}];")
-    lines += (["            #1 clk = 1;", "            #1;"] if unit.clocked
-              else ["            #1;"])
-    lines += [f"            if ({got} !== row[{ohi}:{olo}]) begin",
-              "                errors = errors + 1;",
-              "                if (errors <= 10)",
-              f"                    $display(\"MISMATCH row %0d: got %h expected %h\", i, {got}, "
-              f"row[{ohi}:{olo}]);",
-              "            end"]
-    if unit.clocked:
-        lines.append("            clk = 0;")
-    lines += ["        end", *bench_verdict(name)]
-    return "\n".join(lines)
+    return _bench(unit.module_name, unit.ports, count, language, clocked=unit.clocked,
+                  vectors=vectors)

@@ -1,7 +1,7 @@
 """``"classic"``: ``N / sqrt(N.N)`` (seed 000), bit-for-bit
 :func:`~chebnorm.hw.datapaths.classic_normalize`: dot product, restoring
 integer square root, three restoring dividers, floor or nearest-even
-quotient. Fully parametric (``W``, ``F``, ``RNE``)."""
+quotient; a netlist at the generated widths."""
 
 from __future__ import annotations
 
@@ -12,7 +12,9 @@ from ..datapaths import classic_normalize, classic_unit
 from ..fixed import check_int64
 from .base import UnitDesign, UnitKind, put, register, vec, vec_ports
 from .bench import codes, combinational_rows
-from .hdl import banner, isqrt_module, ports_decl
+from ..hdl.netlist import (Add, And, Assign, Bit, Comment, Compare, Concat, Const, Extend, Mul,
+                           Neg, Or, Paren, ReduceOr, Resize, Select, Signal, Slice, Sub, ZeroExt)
+from .hdl import banner, divide, isqrt, output, unit_module
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -61,87 +63,70 @@ class ClassicUnit(UnitKind):
             return {f"n_{c}": codes(n[:, i], f, w) for i, c in enumerate("xyz")}
         return combinational_rows(unit, rng, count, realistic)
 
-    def verilog(self, unit, *, version, command) -> str:
-        name = unit.module_name
-        out = banner(unit, version, command, [
+    def modules(self, unit, *, version, command) -> list:
+        f, w, rne = unit.frac_bits, unit.comp_bits, unit.rounding == "rne"
+        m, ports = unit_module(unit, banner(unit, version, command, [
             "classic normalization u = n / sqrt(n.n) (seed 000), bit-for-bit",
             "chebnorm.hw.datapaths.classic_normalize: s = max(isqrt(n.n), 1),",
-            "u_i = (n_i << F) / s rounded to floor (RNE = 0) or nearest-even (RNE = 1).",
-            "Every width below is an expression of the parameters W, F (W >= 2, F >= 1)."])
-        out += ["// Combinational.",
-                f"module {name} #(",
-                f"    parameter W = {unit.comp_bits},",
-                f"    parameter F = {unit.frac_bits},",
-                f"    parameter RNE = {int(unit.rounding == 'rne')}",
-                ") ("]
-        out += ports_decl(unit, {"n_x": "W-1", "n_y": "W-1", "n_z": "W-1",
-                                 "u_x": "F+1", "u_y": "F+1", "u_z": "F+1"})
-        out += [");",
-                "    // n.n < 3 * 2^(2W-2): 2W+1 bits; its root < 2^W",
-                "    wire signed [2*W+1:0] dot = n_x * n_x + n_y * n_y + n_z * n_z;",
-                "    wire [W:0] root;",
-                f"    {name}_isqrt #(.RW(W + 1)) sq (.v(dot), .r(root));",
-                "    wire [W:0] s = (root == 0) ? 1 : root;"]
+            f"u_i = (n_i << {f}) / s rounded to "
+            f"{'nearest-even' if rne else 'floor'}; the square root and the",
+            "dividers restoring, unrolled one result bit per step."]))
+        st = m.statements
+        st.append(Comment(f"n.n < 3 * 2^{2 * w - 2}: {2 * w + 1} bits; its root < 2^{w}"))
+        prods = []
         for c in "xyz":
-            out.append(f"    {name}_comp #(.W(W), .F(F), .RNE(RNE)) c_{c} (.n(n_{c}), .s(s), "
-                       f".u(u_{c}));")
-        out += ["endmodule", ""]
-        out += _component_module(f"{name}_comp", f"{name}_div")
-        out += isqrt_module(f"{name}_isqrt") + _div_module(f"{name}_div")
-        return "\n".join(out)
+            n = ports[f"n_{c}"]
+            prods.append(Signal(f"sq_{c}", 2 * w, signed=True))
+            st.append(Assign(prods[-1], Mul(n, n)))
+        dot = Signal("dot", 2 * w + 2, signed=True)
+        st.append(Assign(dot, Add(tuple(Extend(p, 2 * w + 2) for p in prods))))
+        st += isqrt(dot, w + 1, "root", "sr_")
+        root, s = Signal("root", w + 1), Signal("s", w + 1)
+        st.append(Assign(s, Select(Compare("==", root, Const(0, w + 1, signed=False)),
+                                   Const(1, w + 1, signed=False), root)))
+        for c in "xyz":
+            st += _component(ports[f"n_{c}"], s, f, w, rne, f"{c}_")
+            st += output(ports[f"u_{c}"], Signal(f"{c}_u", f + 2, logic=True))
+        return [m]
 
 
-def _component_module(name: str, div: str) -> list[str]:
-    """Module ``name``: one component ``floor(n 2^F / s)``, then nearest-even if RNE."""
-    return [
-        f"// {name}: one component, floor(n 2^F / s), then nearest-even if RNE.",
-        f"module {name} #(parameter W = 16, parameter F = 14, parameter RNE = 0) (",
-        "    input  wire signed [W-1:0] n,",
-        "    input  wire [W:0]          s,",
-        "    output wire signed [F+1:0] u",
-        ");",
-        "    wire neg = n[W-1];",
-        "    wire [W-1:0] mag = neg ? -n : n;",
-        "    wire [W+F-1:0] q;",
-        "    wire [W:0] r;",
-        f"    {div} #(.NB(W + F), .DB(W + 1)) dv (.a({{mag, {{F{{1'b0}}}}}}), "
-        ".d(s), .q(q), .r(r));",
-        "    wire nz = |r;",
-        "    // floor of a negative quotient: -(q + 1) when the remainder is not 0",
-        "    wire signed [W+F:0] qf = neg ? -$signed({1'b0, q} + nz) : $signed({1'b0, q});",
-        "    wire [W:0] rf = (neg && nz) ? s - r : r;",
-        "    wire [W+1:0] r2 = {rf, 1'b0};",
-        "    wire inc = (RNE != 0) && ((r2 > {1'b0, s}) || ((r2 == {1'b0, s}) && qf[0]));",
-        "    wire signed [W+F:0] ur = qf + $signed({1'b0, inc});",
-        "    assign u = ur[F+1:0];",
-        "endmodule", ""]
-
-
-def _div_module(name: str) -> list[str]:
-    """Module ``name``: unsigned restoring divider, quotient and remainder."""
-    return [
-        f"// {name}: unsigned a / d and a % d (d > 0), restoring (combinational).",
-        f"module {name} #(parameter NB = 16, parameter DB = 8) (",
-        "    input  wire [NB-1:0] a,",
-        "    input  wire [DB-1:0] d,",
-        "    output reg  [NB-1:0] q,",
-        "    output reg  [DB-1:0] r",
-        ");",
-        "    reg [DB:0] rem;",
-        "    integer i;",
-        "    always @* begin",
-        "        rem = 0;",
-        "        q = 0;",
-        "        for (i = NB - 1; i >= 0; i = i - 1) begin",
-        "            rem = {rem[DB-1:0], a[i]};",
-        "            if (rem >= {1'b0, d}) begin",
-        "                rem = rem - {1'b0, d};",
-        "                q[i] = 1'b1;",
-        "            end",
-        "        end",
-        "        r = rem[DB-1:0];",
-        "    end",
-        "endmodule", ""]
+def _component(n: Signal, s: Signal, f: int, w: int, rne: bool, pre: str) -> list:
+    """One component: ``floor(n 2^F / s)``, then nearest-even when ``rne``;
+    the result is the bit vector ``<pre>u``."""
+    neg = Signal(f"{pre}neg", 1, logic=True, scalar=True)
+    nn, mag = Signal(f"{pre}nn", w, signed=True), Signal(f"{pre}mag", w)
+    a = Signal(f"{pre}a", w + f, logic=True)
+    q, r = Signal(f"{pre}q", w + f), Signal(f"{pre}r", w + 1)
+    nz = Signal(f"{pre}nz", 1, logic=True, scalar=True)
+    qs, qn = Signal(f"{pre}qs", w + f + 1, signed=True), Signal(f"{pre}qn", w + f + 1, signed=True)
+    qf = Signal(f"{pre}qf", w + f + 1, signed=True)
+    out = [Comment(f"component {pre[0]}: floor(n 2^{f} / s)"),
+           Assign(neg, Bit(n, w - 1)), Assign(nn, Neg(n)),
+           Assign(mag, Select(neg, Resize(nn, w, signed=False), Resize(n, w, signed=False))),
+           Assign(a, Concat((mag, Const(0, f, signed=False)))),
+           *divide(a, s, q.name, r.name, f"{pre}dv_"),
+           Assign(nz, ReduceOr(Slice(r, w, 0))),
+           Comment("floor of a negative quotient: -(q + 1) when the remainder is not 0"),
+           Assign(qs, ZeroExt(q)),
+           Assign(qn, Neg(Paren(Add((ZeroExt(q), ZeroExt(nz, qualified=True)))))),
+           Assign(qf, Select(neg, qn, qs))]
+    u = Signal(f"{pre}u", f + 2, logic=True)
+    if not rne:
+        return out + [Assign(u, Slice(qf, f + 1, 0))]
+    rf, r2, s2 = Signal(f"{pre}rf", w + 1), Signal(f"{pre}r2", w + 2), Signal(f"{pre}s2", w + 2)
+    negnz, gt, eq = (Signal(f"{pre}{t}", 1, logic=True, scalar=True) for t in ("negnz", "gt", "eq"))
+    inc, ur = Signal(f"{pre}inc", 1, logic=True, scalar=True), Signal(f"{pre}ur", w + f + 1,
+                                                                     signed=True)
+    return out + [
+        Comment("nearest-even: the remainder of the floor quotient against s / 2"),
+        Assign(negnz, And(neg, nz)),
+        Assign(rf, Select(negnz, Sub(s, r), r)),
+        Assign(r2, Concat((rf, Const(0, 1, signed=False)))),
+        Assign(s2, Concat((Const(0, 1, signed=False), s))),
+        Assign(gt, Compare(">", r2, s2)), Assign(eq, Compare("==", r2, s2)),
+        Assign(inc, Or(gt, Paren(And(eq, Bit(qf, 0))))),
+        Assign(ur, Add((qf, ZeroExt(inc, qualified=True)))),
+        Assign(u, Slice(ur, f + 1, 0))]
 
 
 register(ClassicUnit())

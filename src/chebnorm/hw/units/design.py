@@ -111,8 +111,10 @@ def design_unit(kind: str, *, frac_bits: int = 14, comp_bits: int | None = None,
 
 
 def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = None) -> str:
-    """The synthesizable Verilog-2005 text of ``unit``: the unit module, then
-    its helper modules (square root, divider, polynomial evaluator).
+    """The synthesizable Verilog-2005 text of ``unit`` at its generated widths:
+    the unit module (its square root and dividers unrolled inside), then the
+    polynomial evaluator it instantiates, if any (:meth:`UnitKind.vhdl
+    <chebnorm.hw.units.UnitKind.vhdl>` prints the same netlist in VHDL).
 
     Parameters
     ----------
@@ -131,16 +133,17 @@ def unit_verilog(unit: UnitDesign, *, version: str = "", command: str | None = N
 
     Examples
     --------
-    >>> v = unit_verilog(design_unit("classic", frac_bits=6))
+    >>> v = unit_verilog(design_unit("dichotomy", frac_bits=6, in_bits=8, out_bits=8))
     >>> [line.split()[1] for line in v.splitlines() if line.startswith("module")]
-    ['chebnorm_classic_unit', 'chebnorm_classic_unit_comp', 'chebnorm_classic_unit_isqrt', 'chebnorm_classic_unit_div']
+    ['chebnorm_dichotomy_unit', 'chebnorm_dichotomy_d2']
     """
     return unit.spec.verilog(unit, version=version, command=command)
 
 
 def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version: str = "",
                  command: str | None = None) -> dict[str, str]:
-    """File name -> text: the unit's Verilog, its test bench and its vectors.
+    """File name -> text: the unit's Verilog and VHDL (one netlist printed
+    twice), a test bench in each language and the vectors both read.
 
     Parameters
     ----------
@@ -159,7 +162,8 @@ def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version:
     Returns
     -------
     dict of str to str
-        File name -> file text: ``NAME.v``, ``tb_NAME.v``, ``NAME.hex``.
+        File name -> file text: ``NAME.v``, ``tb_NAME.v``, ``NAME.vhd``, ``tb_NAME.vhd``,
+        ``NAME.hex``.
 
     Raises
     ------
@@ -168,14 +172,17 @@ def unit_outputs(unit: UnitDesign, *, count: int = 2000, seed: int = 0, version:
 
     Examples
     --------
-    >>> sorted(unit_outputs(design_unit("classic", frac_bits=3, comp_bits=5)))
-    ['chebnorm_classic_unit.hex', 'chebnorm_classic_unit.v', 'tb_chebnorm_classic_unit.v']
+    >>> sorted(unit_outputs(design_unit("classic", frac_bits=3, comp_bits=5)))  # doctest: +NORMALIZE_WHITESPACE
+    ['chebnorm_classic_unit.hex', 'chebnorm_classic_unit.v', 'chebnorm_classic_unit.vhd',
+     'tb_chebnorm_classic_unit.v', 'tb_chebnorm_classic_unit.vhd']
     """
     rows = unit_vectors(unit, count, seed)
     n = len(next(iter(rows.values())))
     name = unit.module_name
     return {f"{name}.v": unit_verilog(unit, version=version, command=command),
             f"tb_{name}.v": unit_testbench(unit, n),
+            f"{name}.vhd": unit.spec.vhdl(unit, version=version, command=command),
+            f"tb_{name}.vhd": unit_testbench(unit, n, language="vhdl"),
             f"{name}.hex": unit_vector_file(unit, rows)}
 
 

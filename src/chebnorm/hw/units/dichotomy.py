@@ -12,10 +12,11 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import dichotomy_midpoint, dichotomy_next_z, dichotomy_unit
 from ..fixed import signed_bits, unsigned_bits
-from ..hdl.netlist import signed_literal
+from ..hdl.netlist import (Add, Assign, Comment, Const, Extend, Group, Output, Pad, Shl, Shr,
+                           Signal, Sub, ZeroExt)
 from .base import Port, UnitDesign, put, register, vec, vec_ports
-from .evaluator import EvaluatorUnit, ky_localparam, scale_lines, scaled_range
-from .hdl import banner, isqrt_module, ports_decl
+from .evaluator import EvaluatorUnit, scale_lines, scaled_range
+from .hdl import banner, evaluator, isqrt, saturate, unit_module
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -70,53 +71,44 @@ class DichotomyUnit(EvaluatorUnit):
         real["z"] = np.clip(np.rint((z - float(d.x_format.offset)) * 2.0 ** d.x_format.frac_bits),
                             *d.valid_codes).astype(np.int64)
 
-    def module_lines(self, unit, version, command) -> list[str]:
-        d, w, name = unit.horner, unit.comp_bits, unit.module_name
-        out = banner(unit, version, command, [
+    def unit_netlist(self, unit, version, command):
+        d = unit.horner
+        m, views = unit_module(unit, banner(unit, version, command, [
             "dichotomy midpoint M = (N1 + N2) p(z), z = 2 cos(theta) (seed 000, method 4),",
             "and the next level's z' = sqrt(2 + z), bit-for-bit",
             "chebnorm.hw.datapaths.dichotomy_midpoint (product rounded to nearest-even by",
             f"the {d.y_format.frac_bits} fractional bits of p) and dichotomy_next_z (square root "
             "to nearest,",
-            "code saturated). M has F fractional bits. Output widths W+c and the constants",
-            "were sized for the generated widths."])
-        mw = unit.sizes["m_bits"]
-        widths = {f"m_{c}": f"W+{mw - w - 1}" for c in "xyz"}
-        widths.update({f"n{i}_{c}": "W-1" for i in (1, 2) for c in "xyz"})
-        out += ["// Combinational.",
-                f"module {name} #(",
-                f"    parameter W = {w}",
-                ") ("]
-        out += ports_decl(unit, widths)
-        out += [");"]
-        out += [f"    wire [{d.out_bits - 1}:0] y;",
-                f"    {d.module_name} poly (.x(z), .y(y));",
-                ky_localparam(unit)]
-        out += scale_lines(unit, "n1", "n2", "m", "y")
-        out += _next_z_lines(unit)
-        out += ["endmodule", ""]
-        out += isqrt_module(f"{name}_isqrt")
-        return out
+            "code saturated). M has F fractional bits; the output widths and the constants",
+            "were sized for the generated widths."]))
+        st = m.statements
+        st += evaluator(unit, views["z"], "y", "poly")
+        st += scale_lines(unit, views, "n1", "n2", "m", Signal("y", d.out_bits, logic=True))
+        st += _next_z(unit, views["z"], views["z_next"])
+        return m
 
 
-def _next_z_lines(unit: UnitDesign) -> list[str]:
-    """Lines: ``z_next``, the code of ``sqrt(2 + z)`` rounded to nearest, saturated."""
-    d, name = unit.horner, unit.module_name
+def _next_z(unit: UnitDesign, z: Signal, port: Signal) -> list:
+    """Statements: ``z_next``, the code of ``sqrt(2 + z)`` rounded to nearest, saturated."""
+    d = unit.horner
     fx, k0 = d.x_format.frac_bits, d.x_format.offset_code
     xmax = (2 << fx) + k0 + 2 ** d.in_bits - 1
     rad_bits = unsigned_bits(xmax) + fx + 2
     rw = (rad_bits + 1) // 2
     zw = signed_bits(min(-k0, 0), max((1 << rw) - k0, 2 ** d.in_bits)) + 1
+    ww = max(zw, rw + 2)
     kmax = 2 ** d.in_bits - 1
-    return [f"    // z' = sqrt(2 + z): X = 2^{fx + 1} + K0 + z, root of X 2^{fx + 2} to "
-            "nearest = (isqrt + 1) >> 1",
-            f"    wire [{2 * rw - 1}:0] rad = ({2 * rw}'d{(2 << fx) + k0} + z) << {fx + 2};",
-            f"    wire [{rw - 1}:0] r2;",
-            f"    {name}_isqrt #(.RW({rw})) sq (.v(rad), .r(r2));",
-            f"    wire [{rw}:0] zr = ({{1'b0, r2}} + 1'b1) >> 1;",
-            f"    wire signed [{zw - 1}:0] zd = $signed({{1'b0, zr}}) - {signed_literal(k0, zw)};",
-            f"    assign z_next = zd[{zw - 1}] ? {d.in_bits}'d0 : (zd > {signed_literal(kmax, zw)}) ? "
-            f"{d.in_bits}'d{kmax} : zd[{d.in_bits - 1}:0];"]
+    rad, r2 = Signal("rad", 2 * rw), Signal("r2", rw)
+    zr, zd = Signal("zr", rw + 1), Signal("zd", ww, signed=True)
+    return [Comment(f"z' = sqrt(2 + z): X = 2^{fx + 1} + K0 + z, root of X 2^{fx + 2} to "
+                    "nearest = (isqrt + 1) >> 1"),
+            Assign(rad, Shl(Group(Add((Const((2 << fx) + k0, 2 * rw, signed=False),
+                                       Pad(z, 2 * rw)))), fx + 2)),
+            *isqrt(rad, rw, r2.name, "sq_"),
+            Assign(zr, Shr(Group(Add((Pad(r2, rw + 1), Const(1, rw + 1, signed=False)))), 1)),
+            Assign(zd, Sub(Extend(ZeroExt(zr), ww), Const(k0, ww))),
+            *saturate(zd, kmax, d.in_bits, "zn"),
+            Output(Signal("zn", d.in_bits), port=port)]
 
 
 register(DichotomyUnit())

@@ -11,11 +11,11 @@ import numpy as np
 from ..cost import Block
 from ..datapaths import eta_criterion, eta_unit
 from ..fixed import check_int64, signed_bits
-from ..hdl.netlist import signed_literal
+from ..hdl.netlist import Assign, Compare, ConstDecl, Output, Resize, Signal, Sub, ZeroExt
 from .base import Port, UnitDesign, register, vec, vec_ports
 from .bench import codes, edges, near
 from .evaluator import EvaluatorUnit, check_dot, dot_code
-from .hdl import banner, ports_decl
+from .hdl import banner, evaluator, unit_module
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -71,36 +71,34 @@ class EtaUnit(EvaluatorUnit):
         real["thr"] = np.clip(eta + rng.integers(-2, 3, count),
                               edges(thr_port)[0], edges(thr_port)[-1])
 
-    def module_lines(self, unit, version, command) -> list[str]:
-        d, w, name = unit.horner, unit.comp_bits, unit.module_name
+    def unit_netlist(self, unit, version, command):
+        d = unit.horner
         ew = unit.sizes["eta_bits"]
         fy, ky = d.y_format.frac_bits, d.y_format.offset_code
-        out = banner(unit, version, command, [
+        m, views = unit_module(unit, banner(unit, version, command, [
             "normalization criterion eta = 3 - g(Na.Nb) - g(Nb.Nc) - g(Na.Nc) (seed 003)",
             "and skip = eta < thr, bit-for-bit chebnorm.hw.datapaths.eta_criterion: each dot",
             "product exact, to the evaluator's input code (nearest-even, saturated), three",
             f"evaluators, the sum exact; eta and thr have {fy} fractional bits (value code / "
             f"2^{fy}).",
-            "The eta width and the constants were sized for the generated widths."])
-        widths = {f"{n}_{c}": "W-1" for n in ("na", "nb", "nc") for c in "xyz"}
-        out += ["// Combinational.", f"module {name} #(", f"    parameter W = {w}", ") ("]
-        out += ports_decl(unit, widths)
-        out += [");"]
-        sw = ew + 2
-        terms = []
+            "The eta width and the constants were sized for the generated widths."]))
+        st = m.statements
+        ys = []
         for a, b in (("na", "nb"), ("nb", "nc"), ("na", "nc")):
             tag = a[1] + b[1]
-            out += dot_code(unit, a, b, tag)
-            out += [f"    wire [{d.out_bits - 1}:0] y_{tag};",
-                    f"    {d.module_name} poly_{tag} (.x(k_{tag}), .y(y_{tag}));"]
-            terms.append(f"$signed({{1'b0, y_{tag}}})")
-        out += [f"    localparam signed [{sw - 1}:0] THREE_MINUS_KY = "
-                f"{signed_literal((3 << fy) - 3 * ky, sw)};",
-                f"    wire signed [{sw - 1}:0] e = THREE_MINUS_KY - {' - '.join(terms)};",
-                f"    assign eta = e[{ew - 1}:0];",
-                "    assign skip = eta < thr;",
-                "endmodule", ""]
-        return out
+            dot, k = dot_code(unit, views, a, b, tag)
+            st += dot + evaluator(unit, k, f"y_{tag}", f"poly_{tag}")
+            ys.append(ZeroExt(Signal(f"y_{tag}", d.out_bits, logic=True)))
+        sw = max(ew + 2, d.out_bits + 1)
+        three = Signal("THREE_MINUS_KY", sw, signed=True)
+        e, eta = Signal("e", sw, signed=True), Signal("eta_v", ew, signed=True)
+        skip = Signal("skip_v", 1, logic=True, scalar=True)
+        st += [ConstDecl(three, (3 << fy) - 3 * ky),
+               Assign(e, Sub(Sub(Sub(three, ys[0]), ys[1]), ys[2])),
+               Assign(eta, Resize(e, ew)),
+               Assign(skip, Compare("<", eta, views["thr"])),
+               Output(eta, port=views["eta"]), Output(skip, port=views["skip"])]
+        return m
 
 
 register(EtaUnit())

@@ -1,7 +1,7 @@
 """What the units with a polynomial evaluator share (dichotomy, quadratic,
 eta): the table check and the evaluator's sizing, the realistic test rows,
 the exact dot product to the evaluator's input code, the scaled sum
-``(A + B) p`` and the evaluator module appended to the unit's text.
+``(A + B) p`` (netlist statements) and the evaluator's netlist beside the unit's.
 
 Their output offsets, widths and constants are sized, exactly, from the
 extremes of every input code (see :mod:`chebnorm.hw.units`)."""
@@ -15,11 +15,12 @@ from chebnorm.core.textsafe import identifier
 
 from ..fixed import check_int64, shift_round, signed_bits
 from ..horner import HornerDesign, cover_frac_bits, design_horner
-from ..hdl.netlist import signed_literal
-from ..hdl.verilog import round_lines
-from ..hdl.verilog import verilog_module
+from ..hdl.datapath import horner_netlist, round_to
+from ..hdl.netlist import (Add, Assign, Const, ConstDecl, Extend, Mul, Output, Shl, Signal, Sub,
+                           ZeroExt)
 from .base import UnitDesign, UnitKind, get_unit
 from .bench import codes, combinational_rows, near
+from .hdl import saturate, widen
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -158,95 +159,108 @@ def check_dot(w: int, f: int, d: HornerDesign) -> None:
     check_int64(signed_bits(dlo, dhi) + max(0, d.x_format.frac_bits - 2 * f), "the dot product")
 
 
-def dot_code(unit: UnitDesign, a: str, b: str, tag: str) -> list[str]:
-    """Lines: the exact dot product of vectors ``a``, ``b`` and its input code ``k_tag``.
+def dot_code(unit: UnitDesign, views: dict, a: str, b: str, tag: str) -> tuple[list, Signal]:
+    """Statements: the exact dot product of vectors ``a``, ``b`` and its
+    evaluator input code ``k_TAG`` (rounded to nearest-even, saturated).
 
     Parameters
     ----------
     unit : UnitDesign
         A unit with a polynomial evaluator (``unit.horner`` set).
+    views : dict
+        Port name -> its numeric signal (:func:`~chebnorm.hw.units.hdl.unit_module`).
     a, b : str
         The two vectors' port-name stems.
     tag : str
-        Suffix of the declared wires (``dot_TAG``, ``k_TAG``).
+        Suffix of the declared signals (``dot_TAG``, ``k_TAG``, ...).
 
     Returns
     -------
-    list of str
-        Verilog lines: the dot product, its rounding to the evaluator's input
-        fractional bits, and the saturated input code ``k_TAG``.
+    tuple of (list, Signal)
+        Netlist statements, and the unsigned code ``k_TAG``.
 
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
+    >>> from chebnorm.hw.units.hdl import unit_module
     >>> u = design_unit("eta", frac_bits=6, in_bits=8, out_bits=8)
-    >>> dot_code(u, "na", "nb", "ab")[0]
-    '    wire signed [16:0] dot_ab = na_x * nb_x + na_y * nb_y + na_z * nb_z;'
+    >>> st, k = dot_code(u, unit_module(u, [])[1], "na", "nb", "ab")
+    >>> k.name, k.width, st[3].dst.name, st[3].dst.width
+    ('k_ab', 8, 'dot_ab', 17)
     """
     d, f, w = unit.horner, unit.frac_bits, unit.comp_bits
     fx, k0, kmax = d.x_format.frac_bits, d.x_format.offset_code, 2 ** d.in_bits - 1
     dlo, dhi = dot_range(w)
     dw = signed_bits(dlo, dhi)
-    lines = [f"    wire signed [{dw - 1}:0] dot_{tag} = {a}_x * {b}_x + {a}_y * {b}_y + "
-             f"{a}_z * {b}_z;"]
+    st, prods = [], []
+    for c in "xyz":
+        prods.append(Signal(f"pr_{tag}_{c}", 2 * w, signed=True))
+        st.append(Assign(prods[-1], Mul(views[f"{a}_{c}"], views[f"{b}_{c}"])))
+    dot = Signal(f"dot_{tag}", dw, signed=True)
+    st.append(Assign(dot, Add(tuple(Extend(p, dw) for p in prods))))
     sh = 2 * f - fx
     if sh > 0:
         rlo, rhi = _rne_range(dlo, dhi, sh)
         rw = signed_bits(rlo, rhi)
-        lines += round_lines(f"dot_{tag}", f"dr_{tag}", dw, sh, rw, "rne")
+        st += round_to(dot, f"dr_{tag}", sh, rw, "rne")
     else:
         rlo, rhi = dlo << -sh, dhi << -sh
         rw = signed_bits(rlo, rhi)
-        lines.append(f"    wire signed [{rw - 1}:0] dr_{tag} = dot_{tag} <<< {-sh};")
+        st.append(Assign(Signal(f"dr_{tag}", rw, signed=True),
+                         Shl(Extend(dot, rw), -sh) if sh else Extend(dot, rw)))
     cw = signed_bits(min(rlo - k0, 0), max(rhi - k0, kmax)) + 1
-    lines += [f"    wire signed [{cw - 1}:0] dc_{tag} = dr_{tag} - {signed_literal(k0, cw)};",
-              f"    wire [{d.in_bits - 1}:0] k_{tag} = dc_{tag}[{cw - 1}] ? {d.in_bits}'d0 : "
-              f"(dc_{tag} > {signed_literal(kmax, cw)}) ? {d.in_bits}'d{kmax} : dc_{tag}[{d.in_bits - 1}:0];"]
-    return lines
+    ww = max(cw, rw)
+    dc = Signal(f"dc_{tag}", ww, signed=True)
+    st.append(Assign(dc, Sub(Extend(Signal(f"dr_{tag}", rw, signed=True), ww), Const(k0, ww))))
+    st += saturate(dc, kmax, d.in_bits, f"k_{tag}")
+    return st, Signal(f"k_{tag}", d.in_bits)
 
 
-def scale_lines(unit: UnitDesign, a: str, b: str, out: str, ycode: str) -> list[str]:
-    """Lines: ``out_c = R((a_c + b_c) * (ycode + KY))`` for c in x, y, z.
+def scale_lines(unit: UnitDesign, views: dict, a: str, b: str, out: str, ycode: Signal) -> list:
+    """Statements: ``out_c = R((a_c + b_c) * (ycode + KY))`` for c in x, y, z
+    (nearest-even), each driving the output port ``out_c``.
 
     Parameters
     ----------
     unit : UnitDesign
         A unit with a polynomial evaluator (``unit.horner`` set).
+    views : dict
+        Port name -> its numeric signal, or the output port
+        (:func:`~chebnorm.hw.units.hdl.unit_module`).
     a, b : str
         The two vectors' port-name stems.
     out : str
         The output vector's stem.
-    ycode : str
-        The evaluator's output wire.
+    ycode : Signal
+        The evaluator's output (a bit vector).
 
     Returns
     -------
-    list of str
-        Verilog lines, rounding to nearest-even.
+    list
+        Netlist statements.
 
     Examples
     --------
     >>> from chebnorm.hw.units import design_unit
+    >>> from chebnorm.hw.units.hdl import unit_module
+    >>> from chebnorm.hw.hdl.netlist import Signal
     >>> u = design_unit("dichotomy", frac_bits=6, in_bits=8, out_bits=8)
-    >>> scale_lines(u, "n1", "n2", "m", "y")[-1]
-    '    assign m_z = m_z_r;'
+    >>> st = scale_lines(u, unit_module(u, [])[1], "n1", "n2", "m", Signal("y", 8, logic=True))
+    >>> st[-1].port.name, st[-1].expr.name
+    ('m_z', 'm_z_r')
     """
     d, w = unit.horner, unit.comp_bits
     yw, mw, fy = unit.sizes["yv_bits"], unit.sizes["m_bits"], d.y_format.frac_bits
-    lines = [f"    wire signed [{yw - 1}:0] yv = $signed({{1'b0, {ycode}}}) + KY;"]
+    ky, yv = Signal("KY", yw, signed=True), Signal("yv", yw, signed=True)
+    st = [ConstDecl(ky, unit.horner.y_format.offset_code)]
+    st += widen(yv, Add((ZeroExt(ycode), ky)))
     for c in "xyz":
-        lines += [f"    wire signed [W:0] s_{c} = {a}_{c} + {b}_{c};",
-                  f"    wire signed [W+{yw}:0] t_{c} = s_{c} * yv;"]
-        lines += round_lines(f"t_{c}", f"{out}_{c}_r", w + 1 + yw, fy, mw, "rne")
-        lines.append(f"    assign {out}_{c} = {out}_{c}_r;")
-    return lines
-
-
-def ky_localparam(unit: UnitDesign) -> str:
-    """Line: the evaluator's output offset ``KY`` as a signed constant."""
-    yw = unit.sizes["yv_bits"]
-    return (f"    localparam signed [{yw - 1}:0] KY = "
-            f"{signed_literal(unit.horner.y_format.offset_code, yw)};")
+        sc, tc = Signal(f"s_{c}", w + 1, signed=True), Signal(f"t_{c}", w + 1 + yw, signed=True)
+        st += [Assign(sc, Add((Extend(views[f"{a}_{c}"], w + 1), views[f"{b}_{c}"]))),
+               Assign(tc, Mul(sc, yv))]
+        st += round_to(tc, f"{out}_{c}_r", fy, mw, "rne")
+        st.append(Output(Signal(f"{out}_{c}_r", mw, signed=True), port=views[f"{out}_{c}"]))
+    return st
 
 
 def _isfloat(s) -> bool:
@@ -261,7 +275,7 @@ class EvaluatorUnit(UnitKind):
     """A unit built around the evaluator of its table (:attr:`table_spec`, which
     the method registry declares);
     subclasses size it (:meth:`size`), add their realistic rows
-    (:meth:`realistic_extra`) and write the unit module (:meth:`module_lines`).
+    (:meth:`realistic_extra`) and build the unit's netlist (:meth:`unit_netlist`).
 
     Examples
     --------
@@ -308,9 +322,8 @@ class EvaluatorUnit(UnitKind):
         return combinational_rows(unit, rng, count, realistic)
 
     @abstractmethod
-    def module_lines(self, unit: UnitDesign, version: str, command: str | None) -> list[str]:
-        """The unit module (banner included) and its helpers, before the evaluator."""
+    def unit_netlist(self, unit: UnitDesign, version: str, command: str | None):
+        """The unit's netlist (banner included), which instantiates the evaluator."""
 
-    def verilog(self, unit, *, version, command) -> str:
-        ev = verilog_module(unit.horner, version=version)
-        return "\n".join(self.module_lines(unit, version, command)) + ev
+    def modules(self, unit, *, version, command) -> list:
+        return [self.unit_netlist(unit, version, command), horner_netlist(unit.horner)]

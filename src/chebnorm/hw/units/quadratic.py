@@ -11,9 +11,9 @@ from ..cost import Block
 from ..datapaths import quadratic_midpoint, quadratic_midpoint_unit
 from ..fixed import signed_bits
 from .base import UnitDesign, put, register, vec, vec_ports
-from .evaluator import (EvaluatorUnit, check_dot, dot_code, ky_localparam, scale_lines,
-                        scaled_range)
-from .hdl import banner, ports_decl
+from ..hdl.netlist import Add, Assign, Const, Extend, Group, Mul, Output, Shl, Signal, Sub
+from .evaluator import EvaluatorUnit, check_dot, dot_code, scale_lines, scaled_range
+from .hdl import banner, evaluator, unit_module
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -58,32 +58,30 @@ class QuadraticUnit(EvaluatorUnit):
     def psi(self, lo: float) -> float:
         return math.acos(min(1.0, lo))
 
-    def module_lines(self, unit, version, command) -> list[str]:
-        d, w, name = unit.horner, unit.comp_bits, unit.module_name
-        mw, gw = unit.sizes["m_bits"], unit.sizes["g_bits"]
-        out = banner(unit, version, command, [
+    def unit_netlist(self, unit, version, command):
+        d = unit.horner
+        gw = unit.sizes["g_bits"]
+        m, views = unit_module(unit, banner(unit, version, command, [
             "quadratic-interpolation set-up (seed 000, method 5), bit-for-bit",
             "chebnorm.hw.datapaths.quadratic_midpoint: x = Nl.Nr (exact) to the evaluator's",
             "input code (nearest-even, saturated), Nc = (Nl + Nr) p(x) (nearest-even),",
             "G = 2Nl + 2Nr - 4Nc, P = 4Nc - 3Nl - Nr, Q = Nl (exact), all F fractional bits.",
-            "Output widths W+c and the constants were sized for the generated widths."])
-        widths = {f"{n}_{c}": "W-1" for n in ("nl", "nr", "q") for c in "xyz"}
-        widths.update({f"nc_{c}": f"W+{mw - w - 1}" for c in "xyz"})
-        widths.update({f"{n}_{c}": f"W+{gw - w - 1}" for n in "gp" for c in "xyz"})
-        out += ["// Combinational.", f"module {name} #(", f"    parameter W = {w}", ") ("]
-        out += ports_decl(unit, widths)
-        out += [");"]
-        out += dot_code(unit, "nl", "nr", "lr")
-        out += [f"    wire [{d.out_bits - 1}:0] y;",
-                f"    {d.module_name} poly (.x(k_lr), .y(y));",
-                ky_localparam(unit)]
-        out += scale_lines(unit, "nl", "nr", "nc", "y")
+            "The output widths and the constants were sized for the generated widths."]))
+        st = m.statements
+        dot, k = dot_code(unit, views, "nl", "nr", "lr")
+        st += dot + evaluator(unit, k, "y", "poly")
+        st += scale_lines(unit, views, "nl", "nr", "nc", Signal("y", d.out_bits, logic=True))
+        mw = unit.sizes["m_bits"]
         for c in "xyz":
-            out += [f"    assign g_{c} = ((nl_{c} + nr_{c}) <<< 1) - (nc_{c} <<< 2);",
-                    f"    assign p_{c} = (nc_{c} <<< 2) - 3 * nl_{c} - nr_{c};",
-                    f"    assign q_{c} = nl_{c};"]
-        out += ["endmodule", ""]
-        return out
+            nl, nr = views[f"nl_{c}"], views[f"nr_{c}"]
+            nc = Signal(f"nc_{c}_r", mw, signed=True)
+            four_nc = Group(Shl(Extend(nc, gw), 2))
+            g, p = Signal(f"g_{c}_v", gw, signed=True), Signal(f"p_{c}_v", gw, signed=True)
+            st += [Assign(g, Sub(Group(Shl(Add((Extend(nl, gw), nr)), 1)), four_nc)),
+                   Assign(p, Sub(Sub(four_nc, Extend(Mul(Const(3, 3), nl), gw)), Extend(nr, gw))),
+                   Output(g, port=views[f"g_{c}"]), Output(p, port=views[f"p_{c}"]),
+                   Output(nl, port=views[f"q_{c}"])]
+        return m
 
 
 register(QuadraticUnit())

@@ -12,9 +12,11 @@ from ..cost import Block
 from ..datapaths import (forward_difference_codes, forward_difference_setup,
                          forward_difference_stepper)
 from ..fixed import check_int64, check_width, signed_bits
-from ..hdl.verilog import round_lines
+from ..hdl.datapath import round_to
+from ..hdl.netlist import (Add, Assign, Comment, Declare, Extend, Group, Output, Registers, Resize,
+                           Select, Shl, Signal)
 from .base import MAX_GUARD, MAX_LOG_M, Port, UnitDesign, UnitKind, put, register, vec, vec_ports
-from .hdl import banner, ports_decl
+from .hdl import banner, unit_module
 
 # an implementation module of chebnorm.hw.units: the API is what chebnorm.hw.units exports
 __all__: list[str] = []
@@ -88,61 +90,63 @@ class StepperUnit(UnitKind):
                         rows[f"{n}_{c}"].append(v)
         return {k: np.array(v, dtype=np.int64) for k, v in rows.items()}
 
-    def verilog(self, unit, *, version, command) -> str:
-        w, name = unit.comp_bits, unit.module_name
+    def modules(self, unit, *, version, command) -> list:
+        w = unit.comp_bits
         vb, db = unit.sizes["v_bits"], unit.sizes["d_bits"]
         m = 1 << unit.log_m
-        out = banner(unit, version, command, [
+        mod, views = unit_module(unit, banner(unit, version, command, [
             "forward-difference stepper of N(t) = G t^2 + P t + Q (seed 000, method 5),",
             "bit-for-bit chebnorm.hw.datapaths.forward_difference_setup/_codes: on load,",
-            "v = Q 2^GUARD, d1 = R((G + P 2^LOG_M) 2^GUARD / 4^LOG_M), d2 = R(2 G 2^GUARD / "
-            "4^LOG_M)",
+            f"v = Q 2^{unit.guard}, d1 = R((G + P 2^{unit.log_m}) 2^{unit.guard} / 4^{unit.log_m}),"
+            f" d2 = R(2 G 2^{unit.guard} / 4^{unit.log_m})",
             "(R: nearest-even); then each cycle v += d1, d1 += d2: additions only.",
-            f"v has F + GUARD fractional bits; registers sized for m = {m} steps after a load."])
-        vdecl = {f"v_{c}": f"{vb - 1}" for c in "xyz"}
-        vdecl.update({f"{n}_{c}": "W-1" for n in "gpq" for c in "xyz"})
-        out += ["// Clocked: one pixel per rising edge of clk.",
-                f"module {name} #(",
-                f"    parameter W = {w},",
-                f"    parameter LOG_M = {unit.log_m},",
-                f"    parameter GUARD = {unit.guard}",
-                ") ("]
-        out += ports_decl(unit, vdecl)
-        out += [");"]
+            f"v has F + {unit.guard} fractional bits; registers sized for m = {m} steps after a "
+            f"load."]))
         big = 1 << (w - 1)
         sh1 = 2 * unit.log_m - unit.guard
         aw = max(db, signed_bits(-big * (1 + m), (big - 1) * (1 + m))) + 1
         for c in "xyz":
-            out += _component_lines(c, vb, db, aw, sh1)
-        out += ["endmodule", ""]
-        return "\n".join(out)
+            mod.statements += _component(unit, views, c, vb, db, aw, sh1)
+        return [mod]
 
 
-def _component_lines(c: str, vb: int, db: int, aw: int, sh1: int) -> list[str]:
-    """Registers, set-up and step of component ``c``."""
-    out = [f"    reg signed [{vb - 1}:0] v_{c}_r;",
-           f"    reg signed [{db - 1}:0] d1_{c}, d2_{c};",
-           f"    assign v_{c} = v_{c}_r;",
-           f"    wire signed [{aw - 1}:0] a1_{c} = g_{c} + (p_{c} <<< LOG_M);"]
-    out += _setup_shift(f"a1_{c}", f"e1_{c}", aw, sh1, db)
-    out += [f"    wire signed [{aw - 1}:0] a2_{c} = g_{c};"]
-    out += _setup_shift(f"a2_{c}", f"e2_{c}", aw, sh1 - 1, db)
-    out += ["    always @(posedge clk)",
-            "        if (load) begin",
-            f"            v_{c}_r <= q_{c} <<< GUARD;",
-            f"            d1_{c} <= e1_{c};",
-            f"            d2_{c} <= e2_{c};",
-            "        end else begin",
-            f"            v_{c}_r <= v_{c}_r + d1_{c};",
-            f"            d1_{c} <= d1_{c} + d2_{c};",
-            "        end"]
-    return out
+def _component(unit, views: dict, c: str, vb: int, db: int, aw: int, sh1: int) -> list:
+    """Set-up, registers and step of component ``c``."""
+    g, p, q = views[f"g_{c}"], views[f"p_{c}"], views[f"q_{c}"]
+    load = views["load"]
+    a1, a2 = Signal(f"a1_{c}", aw, signed=True), Signal(f"a2_{c}", aw, signed=True)
+    v, d1, d2 = (Signal(f"{n}_{c}_r", b, signed=True) for n, b in (("v", vb), ("d1", db),
+                                                                   ("d2", db)))
+    vn, d1n, d2n = (Signal(f"{n}_{c}_next", b, signed=True) for n, b in (("v", vb), ("d1", db),
+                                                                         ("d2", db)))
+    e1, e2 = Signal(f"e1_{c}", db, signed=True), Signal(f"e2_{c}", db, signed=True)
+    return [Comment(f"component {c}: set-up on load, then v += d1, d1 += d2"),
+            Declare(v, reg=True), Declare(d1, reg=True), Declare(d2, reg=True),
+            Assign(a1, Add((Extend(g, aw), Group(Shl(Extend(p, aw), unit.log_m))))),
+            *_setup_shift(a1, e1, sh1),
+            Assign(a2, Extend(g, aw)),
+            *_setup_shift(a2, e2, sh1 - 1),
+            Assign(vn, Select(load, Shl(Extend(q, vb), unit.guard), _sum(v, d1, vb))),
+            Assign(d1n, Select(load, e1, _sum(d1, d2, db))),
+            Assign(d2n, Select(load, e2, d2)),
+            Registers(((v, vn), (d1, d1n), (d2, d2n)), label=f"step_{c}", declare=False),
+            Output(v, port=views[f"v_{c}"])]
 
 
-def _setup_shift(src: str, dst: str, bits: int, sh: int, dst_bits: int) -> list[str]:
+def _sum(a: Signal, b: Signal, width: int):
+    """``a + b`` wrapped to ``width`` bits (``a`` has that width)."""
+    if b.width <= width:
+        return Add((a, Extend(b, width)) if b.width < width else (a, b))
+    return Resize(Add((Extend(a, b.width), b)), width)
+
+
+def _setup_shift(src: Signal, dst: Signal, sh: int) -> list:
+    """``dst = R(src / 2^sh)`` (nearest-even) for ``sh > 0``, else ``src << -sh``."""
     if sh > 0:
-        return round_lines(src, dst, bits, sh, dst_bits, "rne")
-    return [f"    wire signed [{dst_bits - 1}:0] {dst} = {src} <<< {-sh};"]
+        return round_to(src, dst.name, sh, dst.width, "rne")
+    if dst.width >= src.width:
+        return [Assign(dst, Shl(Extend(src, dst.width), -sh) if sh else Extend(src, dst.width))]
+    return [Assign(dst, Resize(Shl(src, -sh), dst.width) if sh else Resize(src, dst.width))]
 
 
 register(StepperUnit())
