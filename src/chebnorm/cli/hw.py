@@ -406,14 +406,14 @@ def run_unit(args) -> int:
         print(path)
     print("\n".join(rep.lines()))
     if args.simulate:
-        results = [simulate(args.output, unit)]
+        results = [("Icarus Verilog", simulate(args.output, unit))]
         if which("ghdl") is not None:   # the VHDL beside it, when GHDL is installed
             from chebnorm.hw.run_vhdl import simulate_vhdl
 
-            results.append(simulate_vhdl(args.output, unit))
-        for res in results:
-            print(res.line)
-        return 0 if all(res.passed for res in results) else 1
+            results.append(("GHDL", simulate_vhdl(args.output, unit)))
+        for simulator, res in results:   # one verdict per language, each naming its simulator
+            print(f"{res.line} [{simulator}]")
+        return 0 if all(res.passed for _, res in results) else 1
     return 0
 
 

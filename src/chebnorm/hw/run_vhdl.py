@@ -9,6 +9,7 @@ every design and language, bit-identical to the Verilog).
 from __future__ import annotations
 
 import re
+import tempfile
 from pathlib import Path
 
 from .hdl import hdl_files
@@ -53,15 +54,17 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     ghdl = require("ghdl", "this step")
     d = Path(directory)
     name = design if isinstance(design, str) else design.module_name
-    std = f"--std={VHDL_STD}"
-    for cmd in ([ghdl, "-a", std, f"{name}.vhd"], [ghdl, "-a", std, f"tb_{name}.vhd"],
-                [ghdl, "-e", std, f"tb_{name}"]):
-        proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=d)
-        if proc.returncode != 0:
-            raise ToolFailed(f"ghdl {cmd[1]}", proc.returncode, proc.stdout + "\n" + proc.stderr,
-                             subject=name)
-    run = run_tool([ghdl, "-r", std, f"tb_{name}", "--ieee-asserts=disable-at-0"],
-                   tool="ghdl -r", timeout=timeout, cwd=d)
+    with tempfile.TemporaryDirectory() as work:
+        # GHDL's library (work-obj08.cf) goes to a folder of its own, not the user's
+        std = [f"--std={VHDL_STD}", f"--workdir={work}"]
+        for cmd in ([ghdl, "-a", *std, f"{name}.vhd"], [ghdl, "-a", *std, f"tb_{name}.vhd"],
+                    [ghdl, "-e", *std, f"tb_{name}"]):
+            proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=d)
+            if proc.returncode != 0:
+                raise ToolFailed(f"ghdl {cmd[1]}", proc.returncode,
+                                 proc.stdout + "\n" + proc.stderr, subject=name)
+        run = run_tool([ghdl, "-r", *std, f"tb_{name}", "--ieee-asserts=disable-at-0"],
+                       tool="ghdl -r", timeout=timeout, cwd=d)
     text = run.stdout + run.stderr
     m = re.search(r"(PASS|FAIL): (\d+) vectors, (\d+) mismatches[^\n]*", text)
     if not m:
