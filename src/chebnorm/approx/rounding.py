@@ -488,8 +488,8 @@ def _select(prob: Problem, sampler: _Sampler, cands: dict, best: Candidate | Non
     ranked = []
     seen = set()
     for method, (ms, es) in cands.items():
-        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
-        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+        coeffs = tuple(map(math.ldexp, ms, es))
+        if coeffs in seen or not all(map(math.isfinite, coeffs)):
             continue
         seen.add(coeffs)
         ranked.append((method, ms, es, coeffs))
@@ -590,7 +590,7 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     out = {}
     for method, (ms, es) in cands.items():
         if fmt == "fixed":
-            if prob.word_limit is not None and max(abs(m) for m in ms) > prob.word_limit:
+            if prob.word_limit is not None and max(map(abs, ms)) > prob.word_limit:
                 continue
             out[method] = (ms, es)
         else:
@@ -691,8 +691,8 @@ def _distinct(cands) -> list:
     the first of each set of values kept, non-finite ones dropped."""
     rows, seen = [], set()
     for method, ms, es in cands:
-        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
-        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+        coeffs = tuple(map(math.ldexp, ms, es))
+        if coeffs in seen or not all(map(math.isfinite, coeffs)):
             continue
         seen.add(coeffs)
         rows.append((method, list(ms), list(es), coeffs))
@@ -985,7 +985,7 @@ def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy,
     def members(level):
         out = _chain_level(prob, coarse, real, fracs, level, greedy)
         if prob.word_limit is not None:
-            out = [c for c in out if max(abs(m) for m in c[1]) <= prob.word_limit]
+            out = [c for c in out if max(map(abs, c[1])) <= prob.word_limit]
         return out
 
     for level in range(min(fracs) + 1):       # F bits first, then fewer
