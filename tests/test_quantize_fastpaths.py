@@ -246,3 +246,76 @@ def test_quantize_with_shared_grids_gives_the_same_table():
         cold = quantize(base, **kw)
         warm = quantize(base, **kw)
         assert cold.to_json() == warm.to_json(), expr
+
+
+def test_to_monomial_is_cheb_to_monomial_bit_for_bit():
+    """The greedy refit's conversion (integers over one common denominator) rounds
+    the same exact rationals as ``cheb_to_monomial`` (fmpq polynomials): the same
+    floats, on awkward intervals (denominators with factors of 3, pi/4 rounded)
+    and coefficients from 1e-300 to 1e3 (zeros and signs included)."""
+    import random
+
+    import numpy as np
+
+    from chebnorm.approx.fitting import cheb_to_monomial
+    from chebnorm.approx.rounding import Problem as _Problem, _to_monomial
+
+    rng = random.Random(41)
+    for _ in range(300):
+        lo = rng.choice([0.0, 0.25, 1.0, -math.pi / 4, -1.0, -0.125])
+        hi = lo + rng.choice([1.0, 0.75, math.pi / 2, 3.0, 0.25])
+        n = rng.randint(1, 11)
+        cheb = [0.0 if rng.random() < 0.1 else
+                rng.uniform(-1, 1) * 10.0 ** rng.randint(-300, 3) for _ in range(n)]
+        prob = _Problem(fn=None, lo=sp.Float(lo), hi=sp.Float(hi), lo_f=lo, hi_f=hi,
+                        error_kind="abs", degree=n - 1, powers=tuple(range(n)), fixed={},
+                        word_limit=None)
+        got = _to_monomial(prob, np.array(cheb))
+        assert [v.hex() for v in got] == [v.hex() for v in cheb_to_monomial(cheb, lo, hi)]
+
+
+@pytest.mark.parametrize("expr, lo, hi, degree, quantum", [
+    ("log(1+x)", 0.0, 1.0, 8, -24), ("exp(x)", -0.5, 0.5, 6, -20),
+    ("1/sqrt(x)", 0.25, 1.0, 5, -12), ("atan(x)", 0.0, 1.0, 9, -28)])
+def test_greedy_sums_as_the_plain_loop(expr, lo, hi, degree, quantum):
+    """The greedy refit's running sums (``add.accumulate``) give the integers of
+    the plain loop: residual ``f - sum(c_j x^j)`` from the highest power down,
+    each Chebyshev coefficient a left-to-right sum of products, converted by
+    ``cheb_to_monomial``."""
+    import numpy as np
+
+    from chebnorm.approx.fitting import cheb_to_monomial
+    from chebnorm.approx.rounding import Problem as _Problem, greedy
+    from chebnorm.core import clib
+
+    fn = parse_function(expr)
+    real = list(fit(expr, (sp.nsimplify(lo), sp.nsimplify(hi)), degree, kind="minimax",
+                    basis="monomial").coefficients)
+    quanta = [quantum - k for k in range(degree + 1)]
+    prob = _Problem(fn=fn, lo=sp.nsimplify(lo), hi=sp.nsimplify(hi), lo_f=lo, hi_f=hi,
+                    error_kind="abs", degree=degree, powers=tuple(range(degree + 1)),
+                    fixed={}, word_limit=None)
+    current, ints = list(real), {}
+    for k in range(degree, -1, -1):
+        ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        if k == 0:
+            break
+        t = np.polynomial.chebyshev.chebpts1(k)
+        x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+        resid = np.asarray(fn.numpy(x), dtype=float)
+        acc = np.zeros_like(x)
+        for j in range(degree, k - 1, -1):
+            acc = acc + math.ldexp(ints[j], quanta[j]) * clib.power(x, j)
+        resid = resid - acc
+        vt = np.polynomial.chebyshev.chebvander(t, k - 1).T
+        cheb = np.zeros(k)
+        for i in range(k):
+            s = vt[i, 0] * resid[0]
+            for j in range(1, k):
+                s = s + vt[i, j] * resid[j]
+            cheb[i] = s
+        cheb[0] /= k
+        cheb[1:] /= 0.5 * k
+        current = cheb_to_monomial(cheb, lo, hi) + [math.ldexp(ints[j], quanta[j])
+                                                    for j in range(k, degree + 1)]
+    assert greedy(prob, real, quanta) == [ints[k] for k in range(degree + 1)]

@@ -35,6 +35,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,7 +43,6 @@ from flint import fmpz_mat
 
 from chebnorm.core import clib
 from .certify import certify
-from chebnorm.core.detlinalg import matvec
 
 # an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
 __all__: list[str] = []
@@ -609,15 +609,28 @@ def _to_monomial(prob: Problem, cheb) -> list[float]:
     interval, the same exact rationals rounded once (so the same floats): the
     monomial coefficients of each ``T_k(u(x))`` are kept (:func:`_cheb_rows`),
     and each answer is an exact sum of their multiples (one exact
-    matrix-vector product)."""
-    from flint import fmpq_mat
-
-    from .fitting import exact_rational
-
+    matrix-vector product in integers over one common denominator, each
+    quotient rounded once by Python's correctly rounded integer division)."""
     n = len(cheb)
-    rows = _cheb_rows(float(prob.lo_f), float(prob.hi_f), n)
-    total = rows * fmpq_mat(n, 1, [exact_rational(c) for c in cheb])
-    return [int(t.p) / int(t.q) for t in total.entries()]
+    num, den = _cheb_rows_int(float(prob.lo_f), float(prob.hi_f), n)
+    ratios = [float(c).as_integer_ratio() for c in cheb]   # raises on inf and nan
+    scale = max(q for _, q in ratios)                       # powers of two
+    ints = [p * (scale // q) for p, q in ratios]
+    den = den * scale
+    return [sum(map(operator.mul, row, ints)) / den for row in num]
+
+
+@functools.lru_cache(maxsize=256)
+def _cheb_rows_int(lo: float, hi: float, n: int):
+    """:func:`_cheb_rows` as integers over one positive common denominator:
+    ``(rows, den)``, ``rows`` a tuple of tuples of int (read only)."""
+    rows = _cheb_rows(lo, hi, n)
+    entries = [[rows[i, j] for j in range(n)] for i in range(n)]
+    den = 1
+    for row in entries:
+        for e in row:
+            den = math.lcm(den, int(e.q))
+    return tuple(tuple(int(e.p) * (den // int(e.q)) for e in row) for row in entries), den
 
 
 @functools.lru_cache(maxsize=256)
@@ -640,17 +653,19 @@ def _greedy_nodes(f_np, lo: float, hi: float, n: int, k: int):
     """:func:`greedy`'s step ``k`` (degree ``n``): the ``k`` Chebyshev nodes of
     ``[lo, hi]``, their powers ``k..n``, ``f`` there and the transposed
     Chebyshev-Vandermonde matrix (read-only; shared by every quantization
-    of one function on one interval)."""
+    of one function on one interval); the powers also as rows ``n, n - 1,
+    .., k`` after a row of zeros (the order :func:`greedy` sums them in)."""
     cheb_deg = k - 1
     t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
     x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
     with np.errstate(all="ignore"):
         fx = np.array(f_np(x))
     xj = {j: clib.power(x, j) for j in range(k, n + 1)}
+    rows = np.array([np.zeros_like(x)] + [xj[j] for j in range(n, k - 1, -1)])
     vander_t = np.polynomial.chebyshev.chebvander(t, cheb_deg).T
-    for a in (fx, vander_t, *xj.values()):
+    for a in (fx, vander_t, rows, *xj.values()):
         a.flags.writeable = False
-    return xj, fx, vander_t
+    return xj, fx, vander_t, rows
 
 
 def greedy(prob: Problem, real, quanta) -> list[int] | None:
@@ -673,11 +688,15 @@ def greedy(prob: Problem, real, quanta) -> list[int] | None:
         nodes = prob.greedy_nodes.get(k)
         if nodes is None:                     # the same at every set of quanta
             nodes = prob.greedy_nodes[k] = _greedy_nodes(f_np, lo, hi, n, k)
-        xj, fx, vander_t = nodes
+        xj, fx, vander_t, rows = nodes
         # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
-        # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
+        # in a fixed order (BLAS sums in a CPU-dependent order): the residual
+        # f - (0 + c_n x^n + .. + c_k x^k) and each row of the product summed
+        # left to right, running sums (add.accumulate) of the same products
+        c = np.array([0.0] + [high[j] for j in range(n, k - 1, -1)])
         with np.errstate(all="ignore"):
-            cheb = matvec(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
+            resid = fx - np.add.accumulate(c[:, None] * rows, axis=0)[-1]
+            cheb = np.add.accumulate(vander_t * resid, axis=1)[:, -1]
             cheb[0] /= k
             cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
