@@ -353,6 +353,8 @@ class _Grid:
     def __init__(self, x, f, w, xp):
         self.x, self.f, self.w, self.xp = x, f, w, xp
         self.views: dict = {}
+        #: every weight is 1 (absolute error): a product by them changes nothing
+        self.unit_weights = bool(np.all(w == 1.0))
 
     def view(self, key, index) -> "_Grid":
         """The grid at ``x[index]`` (``key`` names the view)."""
@@ -427,26 +429,33 @@ class _Sampler:
         if not self.x.size:
             return [0.0] * len(rows)
         absf = np.abs(self.f)
+        unit = self.grid.unit_weights
         for i in range(0, len(rows), chunk):
             c = np.array(rows[i:i + chunk], dtype=float)
-            p = np.zeros((len(c), self.x.size))
-            mag = np.zeros_like(p)
-            term = np.empty_like(p)
+            p = mag = term = None
             for k in range(c.shape[1]):
                 if not c[:, k].any():         # a zero column adds zeros: no sum changes
+                    continue
+                if p is None:                 # 0 + t: t (a -0 differs only in a sign
+                    p = c[:, k:k + 1] * self.xp[k]      # that |p - f| drops)
+                    mag = np.abs(p)
+                    term = np.empty_like(p)
                     continue
                 np.multiply(c[:, k:k + 1], self.xp[k], out=term)
                 p += term
                 np.abs(term, out=term)
                 mag += term
+            if p is None:
+                p, mag = np.zeros((len(c), self.x.size)), np.zeros((len(c), self.x.size))
             # w * (|p - f| - 2^-50 (mag + |f|)), the same operations in place
             p -= self.f
             np.abs(p, out=p)
             mag += absf
             mag *= 2.0 ** -50
             p -= mag
-            p *= self.w
-            out.extend(float(v) for v in np.max(p, axis=1))
+            if not unit:                      # absolute error: weights 1, p * 1 = p
+                p *= self.w
+            out.extend(np.max(p, axis=1).tolist())
         return out
 
 
