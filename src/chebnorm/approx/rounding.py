@@ -375,6 +375,7 @@ class _Sampler:
         self._use(_sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f, prob.error_kind, samples))
         self.point_sets: dict = {}            # real coefficients -> _point_sets
         self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
+        self.thin_lows: dict = {}             # coefficients -> error on thinned()
         self._thin = None
 
     def _use(self, grid: "_Grid") -> None:
@@ -394,7 +395,10 @@ class _Sampler:
     def ordered(self) -> "_Sampler":
         """These points in increasing order (with ``f``, weights and powers)."""
         srt = object.__new__(_Sampler)
-        grid = self.grid.views.get("sorted") or self.grid.view("sorted", np.argsort(self.x))
+        # stable: the two sorted runs (uniform, Chebyshev) merge in linear time; tied
+        # points hold the same values, so any order of them gives the same arrays
+        grid = self.grid.views.get("sorted") or self.grid.view(
+            "sorted", np.argsort(self.x, kind="stable"))
         srt._use(grid)
         return srt
 
@@ -747,10 +751,14 @@ def _ranked(sampler: _Sampler, cands, batch: int = 8):
     rows = _distinct(cands)
     if not rows:
         return
-    coarse = sampler.thinned().errors([r[3] for r in rows])
+    # the thinned error of the rows whose error on every point is not known yet
+    # (each row's error is computed on its own: the same float in any batch)
+    lows, thin = sampler.lows, sampler.thin_lows
+    new = [r[3] for r in rows if r[3] not in lows and r[3] not in thin]
+    thin.update(zip(new, sampler.thinned().errors(new) if new else ()))
     # (error, 1 = on every point / 0 = thinned, method, index): a row whose error on
     # every point is on top comes before every other row, as in _rank's sort
-    heap = [(sampler.lows.get(r[3], coarse[i]), int(r[3] in sampler.lows), r[0], i)
+    heap = [(lows[r[3]], 1, r[0], i) if r[3] in lows else (thin[r[3]], 0, r[0], i)
             for i, r in enumerate(rows)]
     heapq.heapify(heap)
     while heap:
