@@ -319,3 +319,21 @@ def test_greedy_sums_as_the_plain_loop(expr, lo, hi, degree, quantum):
         current = cheb_to_monomial(cheb, lo, hi) + [math.ldexp(ints[j], quanta[j])
                                                     for j in range(k, degree + 1)]
     assert greedy(prob, real, quanta) == [ints[k] for k in range(degree + 1)]
+
+
+def test_power_of_an_array_exponent_is_math_pow_element_by_element():
+    """``clib.power`` with an array of exponents (``2^x`` on the sample grids) is
+    ``math.pow`` of each pair; where one pair raises (a negative base, an
+    overflow) every element still is, and that one numpy's NaN or infinity."""
+    import numpy as np
+
+    from chebnorm.core import clib
+
+    x = np.linspace(-3.0, 3.0, 1001)
+    assert clib.power(2.0, x).tolist() == [math.pow(2.0, v) for v in x]
+    assert clib.power(x, 3.5)[x >= 0].tolist() == [math.pow(v, 3.5) for v in x if v >= 0]
+    bases = np.array([2.0, -8.0, 10.0, 0.5])
+    exps = np.array([0.5, 1 / 3, 400.0, -3.0])
+    got = clib.power(bases, exps)
+    assert got[0] == math.pow(2.0, 0.5) and got[3] == math.pow(0.5, -3.0)
+    assert math.isnan(got[1]) and got[2] == math.inf
