@@ -337,3 +337,28 @@ def test_power_of_an_array_exponent_is_math_pow_element_by_element():
     got = clib.power(bases, exps)
     assert got[0] == math.pow(2.0, 0.5) and got[3] == math.pow(0.5, -3.0)
     assert math.isnan(got[1]) and got[2] == math.inf
+
+
+@pytest.mark.parametrize("mantissa, exponent, ok", [
+    (3, -2, True), (-5, 7, True), ((1 << 53) - 1, -1075, False), (3, -1075, False),
+    ((1 << 52) + 1, -1074, True), (-((1 << 53) - 1), -1076, False), (1, -1074, True),
+    ((1 << 53) - 1, -1074, True)])
+def test_quantized_coefficient_must_be_a_double(mantissa, exponent, ok):
+    """The contract's integer check of ``m * 2^e`` against the double it rounds
+    to refuses exactly what the rational (Fraction) comparison refuses."""
+    from fractions import Fraction
+
+    from chebnorm.approx import CoefficientTable
+
+    t = quantize(fit("exp(x)", ("0", "1"), 2, kind="minimax"), coef_format="binary64")
+    d = t.to_dict()
+    d["quantized"]["mantissas"][1], d["quantized"]["exponents"][1] = mantissa, exponent
+    c = math.ldexp(mantissa, exponent)
+    assert ok == (Fraction(c) == Fraction(mantissa) * Fraction(2) ** exponent)
+    if ok:   # exact: refused later (a changed coefficient), never as "not a double"
+        with pytest.raises(ValueError) as err:
+            CoefficientTable.from_dict(d)
+        assert "is not a double" not in str(err.value)
+    else:
+        with pytest.raises(ValueError, match=r"quantized.mantissas\[1\]: .* is not a double"):
+            CoefficientTable.from_dict(d)
