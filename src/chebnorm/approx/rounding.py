@@ -209,12 +209,15 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool,
         c = round(_dot(resid, stars[i]) / norms[i])
         coords[i] = c
         resid = resid - c * b[i]
-    base = [sum(coords[i] * tr[i][k] for i in range(n)) for k in range(n)]
+    base = [0] * n                        # sum_i coords[i] tr[i], exact integers
+    for c, row in zip(coords, tr):
+        if c:
+            base = [a + c * v for a, v in zip(base, row)]
     out = [base]
     if spread:                            # coords +- e_i: base +- row i of the transform
         for i in range(n):
-            for d in (-1, 1):
-                out.append([a + d * v for a, v in zip(base, tr[i])])
+            out.append(list(map(operator.sub, base, tr[i])))
+            out.append(list(map(operator.add, base, tr[i])))
     return out
 
 
@@ -254,7 +257,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
         vecs = _babai(basis, ints(y), spread=True, cache=cache)
     except (ValueError, ZeroDivisionError, OverflowError):
         return []
-    return [[b + v for b, v in zip(base, vec)] for vec in vecs]
+    return [list(map(operator.add, base, vec)) for vec in vecs]
 
 
 @dataclass
@@ -593,9 +596,17 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
                         [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
                         prob.reductions, xp)
+        # _full of each answer: the free powers set, then the fixed ones
+        ms0, es0 = _full(prob, {})
+        held = [(k, int(m), int(e)) for k, (m, e) in prob.fixed.items()]
+        pos = [(k, int(s)) for k, s in zip(prob.powers, free_exps)]
         for j, ints in enumerate(vecs):
-            cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
-                prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
+            ms, es = ms0.copy(), es0.copy()
+            for (k, s), q in zip(pos, ints):
+                ms[k], es[k] = int(q), s
+            for k, m, e in held:
+                ms[k], es[k] = m, e
+            cands[f"lattice{count}.{len(cands)}.{j}"] = (ms, es)
     if greedy is not None:
         ints = greedy([quanta[k] for k in range(prob.degree + 1)])
         if ints is not None:
