@@ -234,7 +234,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    xp = _Powers(x) if xp is None else xp         # libm's pow, not numpy's loop (CPU)
+    xp = _Powers(x) if xp is None else xp         # IEEE products: the same bits on every CPU
     xe = {e: xp[e] for e in powers}
     vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
