@@ -209,14 +209,20 @@ def test_shared_sample_grid_is_the_one_computed_afresh():
         order = np.argsort(x)
         assert s.f.tobytes() == f[order][idx].tobytes()
         assert s.w.tobytes() == w[order][idx].tobytes()
+        powers = [np.ones_like(s.x)]     # x^k: the rounded products (..(x * x) ..) * x
+        for k in range(1, 6):
+            powers.append(powers[-1] * s.x)
         for k in range(6):
-            assert s.xp[k].tobytes() == clib.power(s.x, k).tobytes()
+            assert s.xp[k].tobytes() == powers[k].tobytes()
+            # within (k - 1) 2^-53 of the C library's pow, the samplers' allowance
+            assert np.all(np.abs(s.xp[k] - clib.power(s.x, k))
+                          <= max(k - 1, 0) * 2.0 ** -52 * np.abs(s.xp[k]))
         for c in coeffs:   # the error as the sampler defines it, term by term
             p, mag = np.zeros_like(s.x), np.zeros_like(s.x)
             for k, v in enumerate(c):
                 if v:
-                    p += v * clib.power(s.x, k)
-                    mag += np.abs(v * clib.power(s.x, k))
+                    p += v * powers[k]
+                    mag += np.abs(v * powers[k])
             want = float(np.max(s.w * (np.abs(p - s.f) - 2.0 ** -50 * (mag + np.abs(s.f)))))
             assert s.errors([c]) == [want] == [s.error(c)]
         for a in (s.x, s.f, s.w, s.xp[3]):
@@ -240,3 +246,119 @@ def test_quantize_with_shared_grids_gives_the_same_table():
         cold = quantize(base, **kw)
         warm = quantize(base, **kw)
         assert cold.to_json() == warm.to_json(), expr
+
+
+def test_to_monomial_is_cheb_to_monomial_bit_for_bit():
+    """The greedy refit's conversion (integers over one common denominator) rounds
+    the same exact rationals as ``cheb_to_monomial`` (fmpq polynomials): the same
+    floats, on awkward intervals (denominators with factors of 3, pi/4 rounded)
+    and coefficients from 1e-300 to 1e3 (zeros and signs included)."""
+    import random
+
+    import numpy as np
+
+    from chebnorm.approx.fitting import cheb_to_monomial
+    from chebnorm.approx.rounding import Problem as _Problem, _to_monomial
+
+    rng = random.Random(41)
+    for _ in range(300):
+        lo = rng.choice([0.0, 0.25, 1.0, -math.pi / 4, -1.0, -0.125])
+        hi = lo + rng.choice([1.0, 0.75, math.pi / 2, 3.0, 0.25])
+        n = rng.randint(1, 11)
+        cheb = [0.0 if rng.random() < 0.1 else
+                rng.uniform(-1, 1) * 10.0 ** rng.randint(-300, 3) for _ in range(n)]
+        prob = _Problem(fn=None, lo=sp.Float(lo), hi=sp.Float(hi), lo_f=lo, hi_f=hi,
+                        error_kind="abs", degree=n - 1, powers=tuple(range(n)), fixed={},
+                        word_limit=None)
+        got = _to_monomial(prob, np.array(cheb))
+        assert [v.hex() for v in got] == [v.hex() for v in cheb_to_monomial(cheb, lo, hi)]
+
+
+@pytest.mark.parametrize("expr, lo, hi, degree, quantum", [
+    ("log(1+x)", 0.0, 1.0, 8, -24), ("exp(x)", -0.5, 0.5, 6, -20),
+    ("1/sqrt(x)", 0.25, 1.0, 5, -12), ("atan(x)", 0.0, 1.0, 9, -28)])
+def test_greedy_sums_as_the_plain_loop(expr, lo, hi, degree, quantum):
+    """The greedy refit's running sums (``add.accumulate``) give the integers of
+    the plain loop: residual ``f - sum(c_j x^j)`` from the highest power down,
+    each Chebyshev coefficient a left-to-right sum of products, converted by
+    ``cheb_to_monomial``."""
+    import numpy as np
+
+    from chebnorm.approx.fitting import cheb_to_monomial
+    from chebnorm.approx.rounding import Problem as _Problem, greedy
+    from chebnorm.core import clib
+
+    fn = parse_function(expr)
+    real = list(fit(expr, (sp.nsimplify(lo), sp.nsimplify(hi)), degree, kind="minimax",
+                    basis="monomial").coefficients)
+    quanta = [quantum - k for k in range(degree + 1)]
+    prob = _Problem(fn=fn, lo=sp.nsimplify(lo), hi=sp.nsimplify(hi), lo_f=lo, hi_f=hi,
+                    error_kind="abs", degree=degree, powers=tuple(range(degree + 1)),
+                    fixed={}, word_limit=None)
+    current, ints = list(real), {}
+    for k in range(degree, -1, -1):
+        ints[k] = round(math.ldexp(current[k], -quanta[k]))
+        if k == 0:
+            break
+        t = np.polynomial.chebyshev.chebpts1(k)
+        x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+        resid = np.asarray(fn.numpy(x), dtype=float)
+        acc = np.zeros_like(x)
+        for j in range(degree, k - 1, -1):
+            acc = acc + math.ldexp(ints[j], quanta[j]) * clib.power(x, j)
+        resid = resid - acc
+        vt = np.polynomial.chebyshev.chebvander(t, k - 1).T
+        cheb = np.zeros(k)
+        for i in range(k):
+            s = vt[i, 0] * resid[0]
+            for j in range(1, k):
+                s = s + vt[i, j] * resid[j]
+            cheb[i] = s
+        cheb[0] /= k
+        cheb[1:] /= 0.5 * k
+        current = cheb_to_monomial(cheb, lo, hi) + [math.ldexp(ints[j], quanta[j])
+                                                    for j in range(k, degree + 1)]
+    assert greedy(prob, real, quanta) == [ints[k] for k in range(degree + 1)]
+
+
+def test_power_of_an_array_exponent_is_math_pow_element_by_element():
+    """``clib.power`` with an array of exponents (``2^x`` on the sample grids) is
+    ``math.pow`` of each pair; where one pair raises (a negative base, an
+    overflow) every element still is, and that one numpy's NaN or infinity."""
+    import numpy as np
+
+    from chebnorm.core import clib
+
+    x = np.linspace(-3.0, 3.0, 1001)
+    assert clib.power(2.0, x).tolist() == [math.pow(2.0, v) for v in x]
+    assert clib.power(x, 3.5)[x >= 0].tolist() == [math.pow(v, 3.5) for v in x if v >= 0]
+    bases = np.array([2.0, -8.0, 10.0, 0.5])
+    exps = np.array([0.5, 1 / 3, 400.0, -3.0])
+    got = clib.power(bases, exps)
+    assert got[0] == math.pow(2.0, 0.5) and got[3] == math.pow(0.5, -3.0)
+    assert math.isnan(got[1]) and got[2] == math.inf
+
+
+@pytest.mark.parametrize("mantissa, exponent, ok", [
+    (3, -2, True), (-5, 7, True), ((1 << 53) - 1, -1075, False), (3, -1075, False),
+    ((1 << 52) + 1, -1074, True), (-((1 << 53) - 1), -1076, False), (1, -1074, True),
+    ((1 << 53) - 1, -1074, True)])
+def test_quantized_coefficient_must_be_a_double(mantissa, exponent, ok):
+    """The contract's integer check of ``m * 2^e`` against the double it rounds
+    to refuses exactly what the rational (Fraction) comparison refuses."""
+    from fractions import Fraction
+
+    from chebnorm.approx import CoefficientTable
+
+    t = quantize(fit("exp(x)", ("0", "1"), 2, kind="minimax"), coef_format="binary64")
+    d = t.to_dict()
+    d["quantized"]["mantissas"][1], d["quantized"]["exponents"][1] = mantissa, exponent
+    c = math.ldexp(mantissa, exponent)
+    assert ok == (Fraction(c) == Fraction(mantissa) * Fraction(2) ** exponent)
+    if ok:   # exact: refused later (a changed coefficient), never as "not a double"
+        with pytest.raises(ValueError) as err:
+            CoefficientTable.from_dict(d)
+        assert "is not a double" not in str(err.value)
+    else:
+        with pytest.raises(ValueError, match=r"quantized.mantissas\[1\]: .* is not a double"):
+            CoefficientTable.from_dict(d)

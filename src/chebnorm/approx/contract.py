@@ -27,6 +27,7 @@ import abc
 import contextlib
 import contextvars
 import dataclasses
+import functools
 import json
 import math
 import weakref
@@ -396,12 +397,25 @@ def sealed(t) -> bool:
         return False
 
 
+#: the types :func:`_plain` returns as they are (exact types: a subclass such as
+#: numpy's float64 takes the general path)
+_PLAIN_SCALARS = frozenset({float, int, str, bool, type(None)})
+
+
+@functools.lru_cache(maxsize=None)
+def _field_names(cls) -> tuple[str, ...]:
+    """The field names of the dataclass ``cls``, in order (fixed once it is defined)."""
+    return tuple(f.name for f in dataclasses.fields(cls))
+
+
 def _plain(value):
     """A value as JSON would hold it: tuples, numpy arrays and dataclasses as
     lists and objects, numpy scalars as Python numbers; anything else as it is
     (for the reader to refuse, naming the field)."""
+    if type(value) in _PLAIN_SCALARS:
+        return value
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name, None)) for f in dataclasses.fields(value)}
+        return {name: _plain(getattr(value, name, None)) for name in _field_names(type(value))}
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
     if isinstance(value, np.ndarray):

@@ -432,6 +432,20 @@ def parse_number(text: str | float | int) -> sp.Expr:
     >>> parse_number("0.1"), parse_number(0.5), parse_number("2*cos(pi/4)")
     (1/10, 1/2, sqrt(2))
     """
+    if type(text) is str:                 # kept: a table's endpoints are read again
+        return _parse_number_text(text)   # by every fit and quantization of it
+    return _parse_number(text)
+
+
+@functools.lru_cache(maxsize=512)
+def _parse_number_text(text: str) -> sp.Expr:
+    """:func:`parse_number` of a text, cached (sympy constants are immutable; a
+    refusal raises again each time, not cached)."""
+    return _parse_number(text)
+
+
+def _parse_number(text) -> sp.Expr:
+    """:func:`parse_number`'s work."""
     if isinstance(text, (bool, np.bool_)):
         raise ValueError(f"interval endpoint {text!r} is not a number")
     if isinstance(text, (int, np.integer)):

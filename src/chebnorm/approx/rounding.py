@@ -35,6 +35,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,7 +43,6 @@ from flint import fmpz_mat
 
 from chebnorm.core import clib
 from .certify import certify
-from chebnorm.core.detlinalg import matvec
 
 # an implementation module of chebnorm.approx: the API is what chebnorm.approx exports
 __all__: list[str] = []
@@ -209,12 +209,15 @@ def _babai(basis: list[list[int]], target: list[int], spread: bool,
         c = round(_dot(resid, stars[i]) / norms[i])
         coords[i] = c
         resid = resid - c * b[i]
-    base = [sum(coords[i] * tr[i][k] for i in range(n)) for k in range(n)]
+    base = [0] * n                        # sum_i coords[i] tr[i], exact integers
+    for c, row in zip(coords, tr):
+        if c:
+            base = [a + c * v for a, v in zip(base, row)]
     out = [base]
     if spread:                            # coords +- e_i: base +- row i of the transform
         for i in range(n):
-            for d in (-1, 1):
-                out.append([a + d * v for a, v in zip(base, tr[i])])
+            out.append(list(map(operator.sub, base, tr[i])))
+            out.append(list(map(operator.add, base, tr[i])))
     return out
 
 
@@ -231,7 +234,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
     """
     x = np.asarray(points, dtype=float)
     w = np.asarray(weights, dtype=float)
-    xp = _Powers(x) if xp is None else xp         # libm's pow, not numpy's loop (CPU)
+    xp = _Powers(x) if xp is None else xp         # IEEE products: the same bits on every CPU
     xe = {e: xp[e] for e in powers}
     vecs = [w * xe[e] * math.ldexp(1.0, s) for e, s in zip(powers, quanta)]
     base = [0] * len(powers) if base is None else list(base)
@@ -254,7 +257,7 @@ def _lattice(points, f_vals, weights, powers, quanta, fixed_poly, base=None, cac
         vecs = _babai(basis, ints(y), spread=True, cache=cache)
     except (ValueError, ZeroDivisionError, OverflowError):
         return []
-    return [[b + v for b, v in zip(base, vec)] for vec in vecs]
+    return [list(map(operator.add, base, vec)) for vec in vecs]
 
 
 @dataclass
@@ -284,11 +287,27 @@ class Problem:
     reductions: dict = field(default_factory=dict, repr=False)
 
 
+def int_powers(x: np.ndarray, k: int, lower: np.ndarray | None = None) -> np.ndarray:
+    """``x ** k`` for an integer ``k >= 0`` as the rounded product ``(..((x * x) * x)
+    ..) * x`` (``lower``: ``x ** (k - 1)`` so computed, when at hand): IEEE
+    products, the same bits on every CPU, at a fraction of the cost of the C
+    library's ``pow`` element by element; within ``(k - 1) 2^-53`` relative of
+    ``x ** k`` (the samplers' allowance covers it: they only rank candidates)."""
+    x = np.asarray(x, dtype=float)
+    if k == 0:
+        return np.ones_like(x)
+    if k == 1:
+        return x.copy()
+    if lower is None:
+        lower = int_powers(x, k - 1)
+    return lower * x
+
+
 class _Powers:
-    """``x ** k`` (:func:`chebnorm.core.clib.power`, element by element) of the
-    points ``x``, each power computed when first asked for and kept; or, with
-    ``parent`` and ``index``, ``parent[k][index]`` (the same floats: every
-    element is computed on its own)."""
+    """``x ** k`` (:func:`int_powers`: repeated products) of the points ``x``,
+    each power computed when first asked for and kept; or, with ``parent`` and
+    ``index``, ``parent[k][index]`` (the same floats: every element is computed
+    on its own)."""
 
     def __init__(self, x: np.ndarray, parent: "_Powers | None" = None, index=None):
         self.x, self.parent, self.index = x, parent, index
@@ -297,8 +316,10 @@ class _Powers:
     def __getitem__(self, k: int) -> np.ndarray:
         v = self.cache.get(k)
         if v is None:
-            v = (clib.power(self.x, k) if self.parent is None
-                 else self.parent[k][self.index])
+            if self.parent is not None:
+                v = self.parent[k][self.index]
+            else:
+                v = int_powers(self.x, k, None if k < 2 else self[k - 1])
             v.flags.writeable = False
             self.cache[k] = v
         return v
@@ -335,6 +356,8 @@ class _Grid:
     def __init__(self, x, f, w, xp):
         self.x, self.f, self.w, self.xp = x, f, w, xp
         self.views: dict = {}
+        #: every weight is 1 (absolute error): a product by them changes nothing
+        self.unit_weights = bool(np.all(w == 1.0))
 
     def view(self, key, index) -> "_Grid":
         """The grid at ``x[index]`` (``key`` names the view)."""
@@ -355,6 +378,7 @@ class _Sampler:
         self._use(_sample_grid(prob.fn.numpy, prob.lo_f, prob.hi_f, prob.error_kind, samples))
         self.point_sets: dict = {}            # real coefficients -> _point_sets
         self.lows: dict = {}                  # coefficients -> error (memo of _ranked)
+        self.thin_lows: dict = {}             # coefficients -> error on thinned()
         self._thin = None
 
     def _use(self, grid: "_Grid") -> None:
@@ -374,7 +398,10 @@ class _Sampler:
     def ordered(self) -> "_Sampler":
         """These points in increasing order (with ``f``, weights and powers)."""
         srt = object.__new__(_Sampler)
-        grid = self.grid.views.get("sorted") or self.grid.view("sorted", np.argsort(self.x))
+        # stable: the two sorted runs (uniform, Chebyshev) merge in linear time; tied
+        # points hold the same values, so any order of them gives the same arrays
+        grid = self.grid.views.get("sorted") or self.grid.view(
+            "sorted", np.argsort(self.x, kind="stable"))
         srt._use(grid)
         return srt
 
@@ -409,26 +436,33 @@ class _Sampler:
         if not self.x.size:
             return [0.0] * len(rows)
         absf = np.abs(self.f)
+        unit = self.grid.unit_weights
         for i in range(0, len(rows), chunk):
             c = np.array(rows[i:i + chunk], dtype=float)
-            p = np.zeros((len(c), self.x.size))
-            mag = np.zeros_like(p)
-            term = np.empty_like(p)
+            p = mag = term = None
             for k in range(c.shape[1]):
                 if not c[:, k].any():         # a zero column adds zeros: no sum changes
+                    continue
+                if p is None:                 # 0 + t: t (a -0 differs only in a sign
+                    p = c[:, k:k + 1] * self.xp[k]      # that |p - f| drops)
+                    mag = np.abs(p)
+                    term = np.empty_like(p)
                     continue
                 np.multiply(c[:, k:k + 1], self.xp[k], out=term)
                 p += term
                 np.abs(term, out=term)
                 mag += term
+            if p is None:
+                p, mag = np.zeros((len(c), self.x.size)), np.zeros((len(c), self.x.size))
             # w * (|p - f| - 2^-50 (mag + |f|)), the same operations in place
             p -= self.f
             np.abs(p, out=p)
             mag += absf
             mag *= 2.0 ** -50
             p -= mag
-            p *= self.w
-            out.extend(float(v) for v in np.max(p, axis=1))
+            if not unit:                      # absolute error: weights 1, p * 1 = p
+                p *= self.w
+            out.extend(np.max(p, axis=1).tolist())
         return out
 
 
@@ -470,8 +504,8 @@ def _select(prob: Problem, sampler: _Sampler, cands: dict, best: Candidate | Non
     ranked = []
     seen = set()
     for method, (ms, es) in cands.items():
-        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
-        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+        coeffs = tuple(map(math.ldexp, ms, es))
+        if coeffs in seen or not all(map(math.isfinite, coeffs)):
             continue
         seen.add(coeffs)
         ranked.append((method, ms, es, coeffs))
@@ -562,9 +596,17 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
         vecs = _lattice(pts, fv, w, prob.powers, free_exps, _fixed_poly(prob),
                         [round(math.ldexp(real[k], -quanta[k])) for k in prob.powers],
                         prob.reductions, xp)
+        # _full of each answer: the free powers set, then the fixed ones
+        ms0, es0 = _full(prob, {})
+        held = [(k, int(m), int(e)) for k, (m, e) in prob.fixed.items()]
+        pos = [(k, int(s)) for k, s in zip(prob.powers, free_exps)]
         for j, ints in enumerate(vecs):
-            cands[f"lattice{count}.{len(cands)}.{j}"] = _full(
-                prob, {k: (q, s) for k, q, s in zip(prob.powers, ints, free_exps)})
+            ms, es = ms0.copy(), es0.copy()
+            for (k, s), q in zip(pos, ints):
+                ms[k], es[k] = int(q), s
+            for k, m, e in held:
+                ms[k], es[k] = m, e
+            cands[f"lattice{count}.{len(cands)}.{j}"] = (ms, es)
     if greedy is not None:
         ints = greedy([quanta[k] for k in range(prob.degree + 1)])
         if ints is not None:
@@ -572,7 +614,7 @@ def _candidates(prob, sampler, real, quanta, greedy, fmt, lattice: bool = True) 
     out = {}
     for method, (ms, es) in cands.items():
         if fmt == "fixed":
-            if prob.word_limit is not None and max(abs(m) for m in ms) > prob.word_limit:
+            if prob.word_limit is not None and max(map(abs, ms)) > prob.word_limit:
                 continue
             out[method] = (ms, es)
         else:
@@ -591,15 +633,28 @@ def _to_monomial(prob: Problem, cheb) -> list[float]:
     interval, the same exact rationals rounded once (so the same floats): the
     monomial coefficients of each ``T_k(u(x))`` are kept (:func:`_cheb_rows`),
     and each answer is an exact sum of their multiples (one exact
-    matrix-vector product)."""
-    from flint import fmpq_mat
-
-    from .fitting import exact_rational
-
+    matrix-vector product in integers over one common denominator, each
+    quotient rounded once by Python's correctly rounded integer division)."""
     n = len(cheb)
-    rows = _cheb_rows(float(prob.lo_f), float(prob.hi_f), n)
-    total = rows * fmpq_mat(n, 1, [exact_rational(c) for c in cheb])
-    return [int(t.p) / int(t.q) for t in total.entries()]
+    num, den = _cheb_rows_int(float(prob.lo_f), float(prob.hi_f), n)
+    ratios = [float(c).as_integer_ratio() for c in cheb]   # raises on inf and nan
+    scale = max(q for _, q in ratios)                       # powers of two
+    ints = [p * (scale // q) for p, q in ratios]
+    den = den * scale
+    return [sum(map(operator.mul, row, ints)) / den for row in num]
+
+
+@functools.lru_cache(maxsize=256)
+def _cheb_rows_int(lo: float, hi: float, n: int):
+    """:func:`_cheb_rows` as integers over one positive common denominator:
+    ``(rows, den)``, ``rows`` a tuple of tuples of int (read only)."""
+    rows = _cheb_rows(lo, hi, n)
+    entries = [[rows[i, j] for j in range(n)] for i in range(n)]
+    den = 1
+    for row in entries:
+        for e in row:
+            den = math.lcm(den, int(e.q))
+    return tuple(tuple(int(e.p) * (den // int(e.q)) for e in row) for row in entries), den
 
 
 @functools.lru_cache(maxsize=256)
@@ -622,17 +677,19 @@ def _greedy_nodes(f_np, lo: float, hi: float, n: int, k: int):
     """:func:`greedy`'s step ``k`` (degree ``n``): the ``k`` Chebyshev nodes of
     ``[lo, hi]``, their powers ``k..n``, ``f`` there and the transposed
     Chebyshev-Vandermonde matrix (read-only; shared by every quantization
-    of one function on one interval)."""
+    of one function on one interval); the powers also as rows ``n, n - 1,
+    .., k`` after a row of zeros (the order :func:`greedy` sums them in)."""
     cheb_deg = k - 1
     t = np.polynomial.chebyshev.chebpts1(cheb_deg + 1)
     x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
     with np.errstate(all="ignore"):
         fx = np.array(f_np(x))
     xj = {j: clib.power(x, j) for j in range(k, n + 1)}
+    rows = np.array([np.zeros_like(x)] + [xj[j] for j in range(n, k - 1, -1)])
     vander_t = np.polynomial.chebyshev.chebvander(t, cheb_deg).T
-    for a in (fx, vander_t, *xj.values()):
+    for a in (fx, vander_t, rows, *xj.values()):
         a.flags.writeable = False
-    return xj, fx, vander_t
+    return xj, fx, vander_t, rows
 
 
 def greedy(prob: Problem, real, quanta) -> list[int] | None:
@@ -655,11 +712,15 @@ def greedy(prob: Problem, real, quanta) -> list[int] | None:
         nodes = prob.greedy_nodes.get(k)
         if nodes is None:                     # the same at every set of quanta
             nodes = prob.greedy_nodes[k] = _greedy_nodes(f_np, lo, hi, n, k)
-        xj, fx, vander_t = nodes
+        xj, fx, vander_t, rows = nodes
         # numpy's chebinterpolate(residual, k - 1) on cached nodes, its product
-        # in a fixed order (detlinalg: BLAS sums in a CPU-dependent order)
+        # in a fixed order (BLAS sums in a CPU-dependent order): the residual
+        # f - (0 + c_n x^n + .. + c_k x^k) and each row of the product summed
+        # left to right, running sums (add.accumulate) of the same products
+        c = np.array([0.0] + [high[j] for j in range(n, k - 1, -1)])
         with np.errstate(all="ignore"):
-            cheb = matvec(vander_t, fx - sum(c * xj[j] for j, c in high.items()))
+            resid = fx - np.add.accumulate(c[:, None] * rows, axis=0)[-1]
+            cheb = np.add.accumulate(vander_t * resid, axis=1)[:, -1]
             cheb[0] /= k
             cheb[1:] /= 0.5 * k
         if not np.all(np.isfinite(cheb)):
@@ -673,8 +734,8 @@ def _distinct(cands) -> list:
     the first of each set of values kept, non-finite ones dropped."""
     rows, seen = [], set()
     for method, ms, es in cands:
-        coeffs = tuple(math.ldexp(m, e) for m, e in zip(ms, es))
-        if coeffs in seen or not all(math.isfinite(c) for c in coeffs):
+        coeffs = tuple(map(math.ldexp, ms, es))
+        if coeffs in seen or not all(map(math.isfinite, coeffs)):
             continue
         seen.add(coeffs)
         rows.append((method, list(ms), list(es), coeffs))
@@ -701,10 +762,14 @@ def _ranked(sampler: _Sampler, cands, batch: int = 8):
     rows = _distinct(cands)
     if not rows:
         return
-    coarse = sampler.thinned().errors([r[3] for r in rows])
+    # the thinned error of the rows whose error on every point is not known yet
+    # (each row's error is computed on its own: the same float in any batch)
+    lows, thin = sampler.lows, sampler.thin_lows
+    new = [r[3] for r in rows if r[3] not in lows and r[3] not in thin]
+    thin.update(zip(new, sampler.thinned().errors(new) if new else ()))
     # (error, 1 = on every point / 0 = thinned, method, index): a row whose error on
     # every point is on top comes before every other row, as in _rank's sort
-    heap = [(sampler.lows.get(r[3], coarse[i]), int(r[3] in sampler.lows), r[0], i)
+    heap = [(lows[r[3]], 1, r[0], i) if r[3] in lows else (thin[r[3]], 0, r[0], i)
             for i, r in enumerate(rows)]
     heapq.heapify(heap)
     while heap:
@@ -779,7 +844,7 @@ def _point_errors(prob: Problem, x, coeffs, sampler: _Sampler | None = None) -> 
     if sampler is None:
         with np.errstate(all="ignore"):
             f = np.asarray(prob.fn.numpy(x), dtype=float) * np.ones_like(x)
-        xp = {k: clib.power(x, k) for k, c in enumerate(coeffs) if c}
+        xp = _Powers(x)
         w = 1.0 / np.abs(f) if prob.error_kind == "rel" else np.ones_like(f)
     else:
         f, xp, w = sampler.f, sampler.xp, sampler.w
@@ -967,7 +1032,7 @@ def _fixed_pool(prob: Problem, sampler: _Sampler, real, fracs, greedy,
     def members(level):
         out = _chain_level(prob, coarse, real, fracs, level, greedy)
         if prob.word_limit is not None:
-            out = [c for c in out if max(abs(m) for m in c[1]) <= prob.word_limit]
+            out = [c for c in out if max(map(abs, c[1])) <= prob.word_limit]
         return out
 
     for level in range(min(fracs) + 1):       # F bits first, then fewer

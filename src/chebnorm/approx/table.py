@@ -803,6 +803,13 @@ def _read_fixed(fp, degree: int) -> FixedPoint | None:
                       method=choice(fp["method"], "fixed_point.method", FIXED_METHODS), **claims)
 
 
+def _exactly(c: float, m: int, e: int) -> bool:
+    """True when the double ``c`` is exactly ``m * 2**e`` (integers: c = p/q, q a
+    power of two)."""
+    p, q = c.as_integer_ratio()
+    return p * (1 << -e) == m * q if e < 0 else p == (m << e) * q
+
+
 def _read_binary(q, degree: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
     """``quantized.mantissas`` and ``quantized.exponents``: each ``m * 2**e`` a double."""
     lim_m, lim_e = (1 << 53) - 1, 1100
@@ -812,7 +819,7 @@ def _read_binary(q, degree: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
                       lambda v, f: integer(v, f, -lim_e, lim_e))
     for k, (m, e) in enumerate(zip(mants, exps)):
         c = math.ldexp(m, e) if e < 1024 else math.inf
-        if m and (not math.isfinite(c) or Fraction(c) != Fraction(m) * Fraction(2) ** e):
+        if m and (not math.isfinite(c) or not _exactly(c, m, e)):
             raise ValueError(f"quantized.mantissas[{k}]: {m} * 2^{e} is not a double; accepted: "
                              f"a finite double (the certifier evaluates it exactly)")
     return mants, exps

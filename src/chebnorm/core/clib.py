@@ -125,8 +125,11 @@ def power(x, y) -> np.ndarray:
             return _FAST_POWER[y](x)
         return elementwise(math.pow, x, y, numpy_fn=np.power)
     x, y = np.broadcast_arrays(x, np.asarray(y, dtype=np.float64))
-    out = np.fromiter(map(_pow, x.ravel().tolist(), y.ravel().tolist()), dtype=np.float64,
-                      count=x.size)
+    xs, ys = x.ravel().tolist(), y.ravel().tolist()
+    try:  # math.pow itself where no element raises (2^x on a grid), else element by element
+        out = np.fromiter(map(math.pow, xs, ys), dtype=np.float64, count=x.size)
+    except (ValueError, OverflowError):
+        out = np.fromiter(map(_pow, xs, ys), dtype=np.float64, count=x.size)
     return out.reshape(x.shape)
 
 
