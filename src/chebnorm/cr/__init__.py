@@ -105,8 +105,9 @@ def correctly_rounded(expr: str, fmt="binary16", *, arithmetic: str = "binary64"
     ------
     ValueError
         On an unknown ``expr``, ``fmt``, ``arithmetic`` or ``lang``.
-    NotImplementedError
-        For sin and cos on formats wider than binary16's exponent range.
+    ArithmeticError
+        When no piecewise polynomial is found (none of the ten functions on
+        binary16 or bfloat16).
 
     Examples
     --------
@@ -140,7 +141,6 @@ def correctly_rounded(expr: str, fmt="binary16", *, arithmetic: str = "binary64"
               f" * Correctly rounded in all five rounding modes on every {f.name} input, "
               f"checked exhaustively.\n"
               f" * Compile with -ffp-contract=off -frounding-math (no FMA contraction).\n */")
-    banner = banner.replace("*/", "* /").replace("* / *", "*/ *") if False else banner
     hdr = (f"{banner}\n#ifndef {c_name.upper()}_H\n#define {c_name.upper()}_H\n#include <stdint.h>\n"
            f"/* x and the result are {f.name} bit patterns; the result is {name}(x) rounded in the\n"
            f"   current rounding mode (fegetround), which is left unchanged. */\n"

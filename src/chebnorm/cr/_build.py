@@ -102,7 +102,7 @@ def c_source(kernel, coefs, fmt, fname, header_name, banner) -> str:
         rows = ",\n".join("    {" + ", ".join(c.hex() for c in map(float, row)) + "}"
                           for row in table)
         lines.append(f"static const double CR_{fam}[{len(table)}][{len(table[0])}] = {{\n{rows}\n}};")
-    lines.append("")
+    lines.append(kernel.c_tables())
     body = kernel.c_reduce()
     core = ["static double cr_core(double x)", "{"]
     if kernel.families:

@@ -50,6 +50,9 @@ class Kernel:
     def npieces(self, fam: str) -> int:
         return 1
 
+    def c_tables(self) -> str:
+        return ""
+
 
 def _err(*a):
     return np.seterr(all="ignore")
@@ -181,8 +184,13 @@ class Log(Kernel):
 
 
 class Trig(Kernel):
-    """sin and cos: symmetry, Cody-Waite reduction by pi/2 (exact products),
-    quadrant selection; one polynomial for sin and one for cos on [-pi/4, pi/4]."""
+    """sin and cos: symmetry and reduction by pi/2 with quadrant selection;
+    one polynomial for sin and one for cos on about [-pi/4, pi/4].
+
+    Up to 2**18 (binary16): Cody-Waite with 33-bit parts of pi/2 (exact
+    products). Beyond (bfloat16): x = M 2**E with M < 2**p an integer, and
+    x 2/pi = M W[E] (mod 4) with W[E] = 2**E 2/pi mod 4 from a table of three
+    binary64 parts of 52 - p bits (exact products), as Payne and Hanek."""
 
     families = {"S": "odd1", "C": "even1"}
 
@@ -190,19 +198,42 @@ class Trig(Kernel):
         super().__init__(name, fmt, h)
         p = fmt.precision
         self.tiny = math.ldexp(1.0, -(p // 2 + 3))
+        from mpmath import floor as mfloor
         from mpmath import mp, mpf, pi
-        with mp.workprec(300):
+        self.inv = float(2 / math.pi)
+        self.table = fmt.max_finite >= 2.0 ** 18
+        with mp.workprec(300 + max(0, fmt.emax)):
             pio2 = pi / 2
-            self.p1 = float(mpf(math.ldexp(math.floor(math.ldexp(float(pio2), 33)), -33)))
+            self.pio2 = float(pio2)
+            self.p1 = math.ldexp(math.floor(math.ldexp(float(pio2), 33)), -33)
             rest = pio2 - self.p1
             m, e = math.frexp(float(rest))
             self.p2 = math.ldexp(math.floor(m * 2 ** 33), e - 33)
             self.p3 = float(rest - self.p2)
-        self.inv = float(2 / math.pi)
-        self.xmax = 2.0 ** 18  # Cody-Waite exactness: |k| < 2**18, 33-bit parts
+            if self.table:
+                wb = 52 - p
+                self.e_lo = -(p // 2 + 3) - p  # smallest E of a non-tiny input
+                self.e_hi = fmt.emax - p + 1
+                rows = []
+                for E in range(self.e_lo, self.e_hi + 1):
+                    w = mpf(2) ** E * 2 / pi
+                    w = w - 4 * mfloor(w / 4)
+                    parts = []
+                    for _ in range(2):
+                        if w == 0:
+                            parts.append(0.0)
+                            continue
+                        m, e = math.frexp(float(w))
+                        part = math.ldexp(math.floor(m * 2 ** wb), e - wb)
+                        parts.append(part)
+                        w = w - part
+                    parts.append(float(w))
+                    rows.append(parts)
+                self.w = np.array(rows)
 
     def reduce(self, x):
         n = len(x)
+        p = self.fmt.precision
         with np.errstate(all="ignore"):
             ax = np.abs(x)
             sp = np.isnan(x) | np.isinf(x) | (ax < self.tiny)
@@ -212,9 +243,21 @@ class Trig(Kernel):
                 ysm = np.full(n, 1.0 - 2.0 ** -40)
             ys = np.where(np.isnan(x), x, np.where(np.isinf(x), np.nan, np.where(
                 x == 0, (x if self.name == "sin" else 1.0), ysm)))
-            xx = np.where(sp, 0.0, x)
-            k = np.floor(xx * self.inv + 0.5)
-            r = ((xx - k * self.p1) - k * self.p2) - k * self.p3
+            xx = np.where(sp, 1.0, x)
+            if self.table:
+                m, e = np.frexp(xx)
+                M = np.ldexp(m, p)
+                idx = np.clip(e - p - self.e_lo, 0, len(self.w) - 1)
+                w1, w2, w3 = self.w[idx, 0], self.w[idx, 1], self.w[idx, 2]
+                t1 = M * w1
+                t2 = M * w2
+                t3 = M * w3
+                k = np.floor(t1 + 0.5)
+                fr = ((t1 - k) + t2) + t3
+                r = fr * self.pio2
+            else:
+                k = np.floor(xx * self.inv + 0.5)
+                r = ((xx - k * self.p1) - k * self.p2) - k * self.p3
             q = (k.astype(np.int64)) & 3
             if self.name == "cos":
                 q = (q + 1) & 3
@@ -222,16 +265,32 @@ class Trig(Kernel):
             B = np.where(q >= 2, -1.0, 1.0)
         return sp, ys, fam, np.zeros(n, int), r, np.zeros(n), B
 
+    def c_tables(self) -> str:
+        if not self.table:
+            return ""
+        rows = ",\n".join("    {" + ", ".join(float(v).hex() for v in row) + "}" for row in self.w)
+        return f"static const double CR_W[{len(self.w)}][3] = {{\n{rows}\n}};\n"
+
     def c_reduce(self):
         small = "x - x * 0x1p-50" if self.name == "sin" else _hex(1.0 - 2.0 ** -40)
         zero = "x" if self.name == "sin" else "1.0"
         shift = "" if self.name == "sin" else "    q = (q + 1) & 3;\n"
-        return ("    if (isnan(x)) return x;\n    if (isinf(x)) return NAN;\n"
-                f"    if (x == 0) return {zero};\n    if (fabs(x) < {_hex(self.tiny)}) return {small};\n"
-                f"    double k = floor(x * {_hex(self.inv)} + 0.5);\n"
-                f"    double r = ((x - k * {_hex(self.p1)}) - k * {_hex(self.p2)}) - k * {_hex(self.p3)};\n"
-                "    int q = (int)((long long)k & 3);\n" + shift +
-                "    fam = (q & 1) ? 1 : 0; piece = 0; u = r; A = 0.0; B = q >= 2 ? -1.0 : 1.0;\n")
+        p = self.fmt.precision
+        s = ("    if (isnan(x)) return x;\n    if (isinf(x)) return NAN;\n"
+             f"    if (x == 0) return {zero};\n    if (fabs(x) < {_hex(self.tiny)}) return {small};\n")
+        if self.table:
+            s += ("    int e;\n    double M = ldexp(frexp(x, &e), " + str(p) + ");\n"
+                  f"    int i = e - {p} - ({self.e_lo});\n"
+                  f"    if (i < 0) i = 0;\n    if (i > {len(self.w) - 1}) i = {len(self.w) - 1};\n"
+                  "    double t1 = M * CR_W[i][0];\n    double t2 = M * CR_W[i][1];\n"
+                  "    double t3 = M * CR_W[i][2];\n    double k = floor(t1 + 0.5);\n"
+                  "    double fr = ((t1 - k) + t2) + t3;\n"
+                  f"    double r = fr * {_hex(self.pio2)};\n")
+        else:
+            s += (f"    double k = floor(x * {_hex(self.inv)} + 0.5);\n"
+                  f"    double r = ((x - k * {_hex(self.p1)}) - k * {_hex(self.p2)}) - k * {_hex(self.p3)};\n")
+        return s + ("    int q = (int)((long long)k & 3);\n" + shift +
+                    "    fam = (q & 1) ? 1 : 0; piece = 0; u = r; A = 0.0; B = q >= 2 ? -1.0 : 1.0;\n")
 
 
 class Sigmoid(Kernel):
@@ -297,9 +356,6 @@ def make_kernel(name, fmt, level: int, ro=None, values=None) -> Kernel:
     if name in ("log", "log2"):
         return Log(name, fmt, h=0.125 / 2 ** level)
     if name in ("sin", "cos"):
-        if fmt.emax > 15 and fmt.max_finite >= 2.0 ** 18:
-            raise NotImplementedError(f"{name} on {fmt.name}: the reduction of arguments beyond "
-                                      f"2**18 (Payne-Hanek) is not implemented yet")
         return Trig(name, fmt)
     # tanh, erf: saturation from the oracle (every larger input rounds as 1 - q)
     one = 1.0 - 2.0 ** -(fmt.precision + 2)
