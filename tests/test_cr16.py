@@ -223,3 +223,13 @@ def test_cli_refusals_are_one_line_and_status_2(argv, flag, tmp_path):
     r = run_cli("correctly-rounded", *argv, "-o", str(tmp_path / "o"))
     assert r.code == 2
     assert len(r.err.strip().splitlines()) == 1 and flag in r.err and "Traceback" not in r.err
+
+
+@needs_gcc
+@pytest.mark.parametrize("name", FUNCTIONS)
+def test_a_small_format_given_by_precision_and_exponents(name):
+    # 9 bits: precision 5, exponents -6..7 (every input, the compiled check too)
+    r = correctly_rounded("1/sqrt" if name == "rsqrt" else name, "5,-6,7")
+    assert r.format == "p5e7" and r.figures["inputs"] == 512
+    assert r.figures["wrong"] == {m: 0 for m in MODES}
+    assert r.check() == {"RNE": 0, "RTZ": 0, "RUP": 0, "RDN": 0}
