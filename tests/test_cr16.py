@@ -196,6 +196,7 @@ def test_bad_arguments_name_themselves(kwargs, word):
 
 
 @needs_gcc
+@pytest.mark.slow  # 5.3 s measured: two generations and a compiled check
 def test_cli_writes_deterministic_files_with_provenance(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     r1 = run_cli("correctly-rounded", "exp2", "--format", "binary16", "--arithmetic",
@@ -217,7 +218,7 @@ def test_cli_writes_deterministic_files_with_provenance(tmp_path):
 @pytest.mark.parametrize("argv,flag", [
     (["exp3"], "EXPR"), (["exp", "--format", "binary32"], "--format"),
     (["exp", "--arithmetic", "float32"], "--arithmetic"), (["exp", "--lang", "wgsl"], "--lang"),
-    (["exp", "--interval", "0", "1"], "--interval"),
+    (["exp", "--interval", "1", "0"], "--interval"), (["exp", "--interval", "0", "x"], "--interval"),
 ])
 def test_cli_refusals_are_one_line_and_status_2(argv, flag, tmp_path):
     r = run_cli("correctly-rounded", *argv, "-o", str(tmp_path / "o"))
@@ -233,3 +234,23 @@ def test_a_small_format_given_by_precision_and_exponents(name):
     assert r.format == "p5e7" and r.figures["inputs"] == 512
     assert r.figures["wrong"] == {m: 0 for m in MODES}
     assert r.check() == {"RNE": 0, "RTZ": 0, "RUP": 0, "RDN": 0}
+
+
+@needs_gcc
+@pytest.mark.parametrize("name,interval", [("tanh", (-1.0, 1.0)), ("exp", (-1.0, 1.0)),
+                                           ("log", (0.5, 2.0))])
+def test_an_interval_is_proved_on_its_inputs_only(name, interval):
+    r = correctly_rounded(name, "binary16", interval=interval)
+    x = BINARY16.decode(BINARY16.all_bits())
+    inside = np.isfinite(x) & (x >= interval[0]) & (x <= interval[1])
+    assert r.figures["inputs"] == int(inside.sum())
+    assert r.figures["wrong"] == {m: 0 for m in MODES}
+    assert r.check() == {"RNE": 0, "RTZ": 0, "RUP": 0, "RDN": 0}
+    assert f"every binary16 input in [{interval[0]!r}, {interval[1]!r}]" in r.files[
+        f"{r.c_name}.c"]
+
+
+@pytest.mark.parametrize("interval", [(1.0, -1.0), (0.0, float("nan")), (1e9, 2e9), "ab"])
+def test_a_bad_interval_is_refused(interval):
+    with pytest.raises(ValueError, match="interval"):
+        correctly_rounded("exp", "binary16", interval=interval)

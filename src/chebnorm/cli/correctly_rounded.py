@@ -33,8 +33,8 @@ def register(sub) -> None:
                    "or 1/sqrt")
     p.add_argument("--format", default="binary16", help="binary16 (default), bfloat16, or "
                    "'p,emin,emax' of at most 16 bits")
-    p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), default=None,
-                   help="not accepted yet: the whole format is always proved")
+    p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), type=float, default=None,
+                   help="prove only the finite inputs in [LO, HI] (default: every input)")
     p.add_argument("--arithmetic", default="binary64", help="binary64 (the only one for now)")
     p.add_argument("--lang", default="c", help="c (the only one for now)")
     p.add_argument("-o", "--output", metavar="DIR", required=True,
@@ -69,9 +69,6 @@ def run(args) -> int:
     from chebnorm.core.files import write_atomic
     from chebnorm.cr import correctly_rounded
 
-    if args.interval is not None:
-        raise ValueError("--interval is not accepted yet; accepted: the whole format (leave "
-                         "--interval out)")
     if args.arithmetic != "binary64":
         raise ValueError(f"--arithmetic {args.arithmetic[:40]!r} is not accepted; accepted: "
                          f"binary64 (float32 is not implemented yet)")
@@ -81,10 +78,12 @@ def run(args) -> int:
     argv = getattr(args, "argv", None)
     command = " ".join(argv) if argv else ""
     try:
-        result = correctly_rounded(args.expr, args.format, arithmetic=args.arithmetic,
+        result = correctly_rounded(args.expr, args.format, interval=args.interval,
+                                   arithmetic=args.arithmetic,
                                    lang=args.lang, command=command)
     except ValueError as exc:
-        msg = str(exc).replace("expr ", "EXPR ", 1).replace("fmt ", "--format ", 1)
+        msg = (str(exc).replace("expr ", "EXPR ", 1).replace("fmt ", "--format ", 1)
+               .replace("interval ", "--interval ", 1))
         raise ValueError(msg) from None
     os.makedirs(args.output, exist_ok=True)
     for name, text in sorted(result.files.items()):

@@ -32,23 +32,41 @@ def simulate(kernel, coefs, x):
     return y
 
 
-def wrong_counts(fmt, y, ro):
-    """Wrongly rounded outputs of y against the oracle, per mode (NaN = NaN)."""
+def wrong_counts(fmt, y, ro, domain=None):
+    """Wrongly rounded outputs of y against the oracle, per mode (NaN = NaN),
+    counted on ``domain`` (a mask; default every input)."""
     out = {}
     for mode in MODES:
         got, want = fmt.round(y, mode), fmt.round(ro, mode)
         nan_g = np.isnan(y)
         nan_w = np.isnan(ro)
-        out[mode] = int(np.count_nonzero(np.where(nan_w, ~nan_g, got != want)))
+        bad = np.where(nan_w, ~nan_g, got != want)
+        if domain is not None:
+            bad &= domain
+        out[mode] = int(np.count_nonzero(bad))
     return out
 
 
-def build(name, fmt):
-    """(kernel, coefficients, figures) for ``name`` on ``fmt``."""
+def domain_mask(x, interval):
+    """The inputs proved: all, or the finite ones in [lo, hi]."""
+    if interval is None:
+        return np.ones(len(x), bool)
+    lo, hi = interval
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(x) & (x >= lo) & (x <= hi)
+
+
+def build(name, fmt, interval=None):
+    """(kernel, coefficients, figures, oracle values, domain) for ``name`` on
+    ``fmt`` (every input, or the finite inputs of ``interval``)."""
     t0 = time.perf_counter()
     bits = fmt.all_bits()
-    x = fmt.decode(bits)
+    x_all = fmt.decode(bits)
+    dom = domain_mask(x_all, interval)
+    # outside the domain the oracle is not asked (the value stands for "any")
+    x = np.where(dom, x_all, np.nan)
     ro = oracle(name, fmt, x)
+    x = x_all
     t_oracle = time.perf_counter() - t0
     lo, hi, exact = ro_interval(ro, fmt)
     for level in range(MAX_LEVEL + 1):
@@ -58,7 +76,7 @@ def build(name, fmt):
         for fi, (fname, form) in enumerate(kernel.families.items()):
             table = []
             for j in range(kernel.npieces(fname)):
-                m = ~sp & (fam == fi) & (piece == j)
+                m = ~sp & (fam == fi) & (piece == j) & dom
                 if not m.any():
                     table.append(np.zeros(1))
                     continue
@@ -77,14 +95,14 @@ def build(name, fmt):
             coefs[fname] = table
         if ok:
             y = simulate(kernel, coefs, x)
-            wrong = wrong_counts(fmt, y, ro)
-            figures = {"inputs": int(len(x)), "wrong": wrong, "level": level,
+            wrong = wrong_counts(fmt, y, ro, dom)
+            figures = {"inputs": int(dom.sum()), "wrong": wrong, "level": level,
                        "oracle_seconds": t_oracle,
                        "seconds": time.perf_counter() - t0,
                        "pieces": {f: len(t) for f, t in coefs.items()},
                        "coefficients": {f: (len(t[0]) if t else 0) for f, t in coefs.items()}}
             if sum(wrong.values()) == 0:
-                return kernel, coefs, figures, ro
+                return kernel, coefs, figures, ro, dom
     raise ArithmeticError(f"{name} on {fmt.name}: no piecewise polynomial found up to level "
                           f"{MAX_LEVEL}")
 

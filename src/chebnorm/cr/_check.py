@@ -36,6 +36,7 @@ int main(int argc, char **argv)
         for (unsigned long i = 0; i < n; i++) {{
             uint32_t got = {fn}(({ctype})i);
             uint32_t w = want[k][i];
+            if (w == 0xffffffffu) continue; /* outside the proved interval */
             int wnan = (w & {inf}u) == {inf}u && (w & {mant}u);
             int gnan = (got & {inf}u) == {inf}u && (got & {mant}u);
             if (wnan ? !gnan : got != w) {{
@@ -53,7 +54,8 @@ int main(int argc, char **argv)
 """
 
 
-def check_c(source: str, header: str, fname: str, fmt, ro: np.ndarray, *, timeout=300.0):
+def check_c(source: str, header: str, fname: str, fmt, ro: np.ndarray, *, domain=None,
+            timeout=300.0):
     """Compile ``source`` and run it over every input in RNE, RTZ, RUP, RDN.
 
     Returns {mode: wrongly rounded count} (a mode whose rounding the function
@@ -63,6 +65,8 @@ def check_c(source: str, header: str, fname: str, fmt, ro: np.ndarray, *, timeou
     gcc = require("gcc", "the exhaustive check of correctly rounded functions")
     n = 1 << fmt.bits
     want = np.stack([fmt.round(ro, m) for m in C_MODES]).astype(np.uint32)
+    if domain is not None:
+        want[:, ~domain] = 0xFFFFFFFF
     with tempfile.TemporaryDirectory(prefix="chebnorm-cr-") as d:
         hname = f"{fname}.h"
         with open(os.path.join(d, hname), "w", encoding="utf-8") as fh:

@@ -360,7 +360,9 @@ def make_kernel(name, fmt, level: int, ro=None, values=None) -> Kernel:
     # tanh, erf: saturation from the oracle (every larger input rounds as 1 - q)
     one = 1.0 - 2.0 ** -(fmt.precision + 2)
     pos = (values > 0) & np.isfinite(values)
-    bad = pos & (ro != one)
-    sat = float(values[bad].max()) if bad.any() else 0.0
-    sat = float(values[pos & (values > sat)].min())
+    bad = pos & (ro != one) & ~np.isnan(ro)  # NaN: outside the proved interval
+    bad |= (values < 0) & np.isfinite(values) & (ro != -one) & ~np.isnan(ro)
+    sat = float(np.abs(values[bad]).max()) if bad.any() else 0.0
+    above = pos & (values > sat)
+    sat = float(values[above].min()) if above.any() else 2 * sat
     return Sigmoid(name, fmt, h=0.5 / 2 ** level, sat=sat)
