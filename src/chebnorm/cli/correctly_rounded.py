@@ -58,7 +58,7 @@ def run(args) -> int:
     int
         0 when every output is correctly rounded (and, with ``--check``,
         the compiled code agrees), 1 when the compiled check finds a wrongly
-        rounded output (one line on stderr).
+        rounded output or no implementation is found (one line on stderr).
 
     Raises
     ------
@@ -81,6 +81,9 @@ def run(args) -> int:
         result = correctly_rounded(args.expr, args.format, interval=args.interval,
                                    arithmetic=args.arithmetic,
                                    lang=args.lang, command=command)
+    except ArithmeticError as exc:  # no implementation found: the one line, status 1
+        print(f"chebnorm: correctly-rounded: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
     except ValueError as exc:
         msg = (str(exc).replace("expr ", "EXPR ", 1).replace("fmt ", "--format ", 1)
                .replace("interval ", "--interval ", 1))

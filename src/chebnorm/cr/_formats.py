@@ -154,7 +154,10 @@ def parse_format(text) -> Format:
         if len(parts) == 3 and all(s.strip().lstrip("-").isdigit() and s.strip().isascii()
                                    for s in parts):
             p, emin, emax = (int(s) for s in parts)
-            if p <= 16 and emax < 1 << 10:
-                return Format(f"p{p}e{emax}", p, emin, emax)
+            if p <= 16 and emax < 1 << 9:  # 2**(emax+2) and q_min stay normal binary64
+                try:
+                    return Format(f"p{p}e{emax}", p, emin, emax)
+                except ValueError as exc:
+                    raise ValueError(f"fmt {text[:40]!r}: {exc}") from None
     raise ValueError(f"fmt {str(text)[:40]!r} is not accepted; accepted: binary16, bfloat16, or "
-                     f"'p,emin,emax' of at most 16 bits")
+                     f"'p,emin,emax' of at most 16 bits with emax <= 511")
