@@ -87,11 +87,10 @@ def build(name, fmt, interval=None):
                 table.append(c)
             if not ok:
                 break
+            # one width per family: zero highest coefficients change nothing in Horner's
+            # rule (0 * u + c is c), and the simulation below runs the padded table
             width = max(len(c) for c in table)
-            if form == "horner":  # leading zeros change nothing in Horner's rule
-                table = [np.r_[c, np.zeros(width - len(c))] for c in table]
-            else:  # pad in front by re-solving is not needed: pad the highest powers with 0
-                table = [np.r_[c, np.zeros(width - len(c))] for c in table]
+            table = [np.r_[c, np.zeros(width - len(c))] for c in table]
             coefs[fname] = table
         if ok:
             y = simulate(kernel, coefs, x)

@@ -54,10 +54,6 @@ class Kernel:
         return ""
 
 
-def _err(*a):
-    return np.seterr(all="ignore")
-
-
 class Exact(Kernel):
     """sqrt and 1/sqrt: one or two correctly rounded binary64 operations."""
 

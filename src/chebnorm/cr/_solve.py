@@ -3,7 +3,6 @@ every input by the exact binary64 simulation (counterexample-guided)."""
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
