@@ -95,6 +95,7 @@ CONTRACT = {
                         'SplitGouraudStudy', 'bump_comparison', 'BumpCase', 'write_bump_figures', 'render_sweep',
                         'render_sweep_cases', 'RenderCase', 'RenderSweepRow', 'RenderSweep',
                         'RENDER_SWEEP_COLUMNS', 'RenderComparison', 'render_html', 'png_data_uri'),
+    'chebnorm.cr': ('correctly_rounded',),
     'chebnorm.raster.engines': ('ENGINES', 'HAVE_NUMBA', 'Engine', 'FrameUnsupported', 'resolve_engine',
                                 'get_engine'),
     'chebnorm.raster.engines.numba': ('HAVE_NUMBA', 'NumbaEngine', 'GatheredSetup'),

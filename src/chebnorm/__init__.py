@@ -37,7 +37,9 @@ access such as ``chebnorm.raster.render`` after ``import chebnorm``):
    and through hw the Verilog and VHDL); imports core, symbolic, approx, hw.
 5. ``chebnorm.raster``   -- meshes, spans, shading modes, image metrics;
    imports core, symbolic, approx and methods (not hw, not export).
-6. ``chebnorm.cli``      -- the command line; imports any stage.
+6. ``chebnorm.cr``       -- correctly rounded functions of small formats, proved
+   on every input; imports core, symbolic and approx.
+7. ``chebnorm.cli``      -- the command line; imports any stage.
 
 Where a change goes: the table format in ``approx/schema.py`` and the
 contract both kinds of table share in ``approx/contract.py`` (read either
@@ -125,7 +127,8 @@ LAYERS = {
     "hw": ("exceptions", "core", "symbolic", "approx"),
     "export": ("exceptions", "core", "symbolic", "approx", "hw"),
     "raster": ("exceptions", "core", "symbolic", "approx", "methods"),
-    "cli": ("exceptions", "core", "symbolic", "approx", "methods", "hw", "export", "raster"),
+    "cr": ("exceptions", "core", "symbolic", "approx"),
+    "cli": ("exceptions", "core", "symbolic", "approx", "methods", "hw", "export", "raster", "cr"),
 }
 
 

@@ -24,7 +24,7 @@ __all__ = ["main", "build_parser", "UsageError"]
 
 #: subcommand modules, in the order ``chebnorm --help`` lists them
 SUBCOMMANDS = ("fit", "export", "targets", "methods", "render", "render_sweep", "hw", "design",
-               "repro", "verify")
+               "repro", "verify", "correctly_rounded")
 
 
 class _Parser(argparse.ArgumentParser):
