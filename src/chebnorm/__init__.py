@@ -133,7 +133,8 @@ LAYERS = {
 
 
 #: the stage subpackages, imported on first attribute access
-_SUBPACKAGES = ("exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster")
+_SUBPACKAGES = ("exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster",
+                "cr")
 
 #: facade name -> (module, attribute); imported on first use
 _LAZY = {
@@ -154,13 +155,15 @@ _LAZY = {
     "render": ("chebnorm.raster", "render"),
     "compare": ("chebnorm.raster", "compare"),
     "RenderComparison": ("chebnorm.raster", "RenderComparison"),
+    "correctly_rounded": ("chebnorm.cr", "correctly_rounded"),
 }
 
 __all__ = [  # noqa: RUF022 - grouped: facade names, then the stage subpackages
     "__version__", "LAYERS", "fit", "quantize", "certify", "fit_target", "CoefficientTable", "FixedPoint",
     "PiecewiseTable", "load_table",
     "FitWarning", "ChebnormDeprecationWarning", "target", "target_names", "span_normals", "method_names", "render", "compare", "RenderComparison",
-    "exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster",
+    "correctly_rounded",
+    "exceptions", "core", "symbolic", "approx", "export", "methods", "hw", "raster", "cr",
 ]
 assert set(__all__) == {"__version__", "LAYERS", *_LAZY, *_SUBPACKAGES}
 

@@ -14,6 +14,8 @@ from math import isqrt
 
 import numpy as np
 
+from chebnorm.core.numeric import arb_precision
+
 __all__: list[str] = []
 
 #: the largest working precision tried before an ambiguous ball is an exact case
@@ -125,7 +127,7 @@ def oracle_value(name: str, x: float, fmt) -> float:
     """RO_{p+2}(f(x)) as a binary64 (exact); an overflow beyond 2**(emax+2)
     gives +-2**(emax+2)*(1 + 2**-(p+1)) (odd, above every finite value); f(x)
     undefined (log of a negative, ...) gives NaN. ``x`` finite."""
-    from flint import arb, ctx
+    from flint import arb
 
     funcs = _arb_funcs()
     f, exact = funcs[name][0], funcs[name][1]
@@ -152,11 +154,9 @@ def oracle_value(name: str, x: float, fmt) -> float:
         # 1 - |f| < 2 exp(-64) (tanh) or < exp(-1024) (erf): below 2**-(p+2)
         r = 1 - Fraction(1, 2 ** (fmt.precision + 2))
         return float(r if x > 0 else -r)
-    old = ctx.prec
-    try:
-        prec = 64 + max(0, abs(int(np.frexp(x)[1])))
-        while prec <= MAX_PREC:
-            ctx.prec = prec
+    prec = 64 + max(0, abs(int(np.frexp(x)[1])))
+    while prec <= MAX_PREC:
+        with arb_precision(prec):   # one scope per try: the process-wide lock
             a = arb(x)
             c = _complement(name, a)
             if c is not None:
@@ -176,9 +176,7 @@ def oracle_value(name: str, x: float, fmt) -> float:
                     r = _ro_of_interval(alo, ahi, fmt)
                     if r is not None:
                         return float(s * r)
-            prec *= 2
-    finally:
-        ctx.prec = old
+        prec *= 2
     raise ArithmeticError(f"oracle: {name}({x!r}) is not resolved at {MAX_PREC} bits and is "
                           f"not a known exact case")
 

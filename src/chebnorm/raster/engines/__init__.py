@@ -6,7 +6,8 @@ implementations with the same image bytes: :mod:`.numpy` (the reference) and
 from __future__ import annotations
 
 from .base import Engine, FrameUnsupported
-from .numba import HAVE_NUMBA, NumbaEngine
+from .numba import NumbaEngine
+from .numba.jit import HAVE_NUMBA
 from .numba.jit import JIT_DISABLED
 from .numpy import NumpyEngine
 

@@ -18,13 +18,15 @@ import numpy as np
 from ..base import Setup, dot
 from ..numpy import NumpyEngine
 from . import frame
-from .jit import HAVE_NUMBA, announce_slow
+from .jit import announce_slow
 from .kernels import fast_half_vectors, fast_shade, fast_span_normals
 from .kernels import supports as kernels_support
 from .rasterize import (default_camera_of, fast_lerp, fast_setup_spans, fast_zbuffer,
                         gather_setup, project)
 
-__all__ = ["HAVE_NUMBA", "NumbaEngine", "GatheredSetup"]
+# HAVE_NUMBA is chebnorm.raster.engines' (from .jit); the gathered set-up is
+# the engine's own type: the API of this package is its engine
+__all__ = ["NumbaEngine"]
 
 
 class GatheredSetup(Setup):
