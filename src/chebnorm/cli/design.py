@@ -15,9 +15,12 @@ _PHRASES = (("with synth=True", "without --no-synth"), ("synth=True", "without -
             ("index='exponent'", "--index exponent"), ("index='uniform'", "--index uniform"),
             ("frequency=None", "without --frequency"), ("device ice40", "--target ice40"),
             ("device '", "--target '"), ("max_segments, degrees", "max_segments, --degrees"),
-            ("<= degrees <=", "<= --degrees <="))
+            ("<= degrees <=", "<= --degrees <="), ("out_bits=N", "--out-bits N"),
+            ("lsb=L", "--lsb L"), ("lsb >=", "--lsb >="), ("lsb=None", "without --lsb"),
+            ("architecture=None", "without --architecture"), ("or a larger lsb", "or a larger "
+            "--lsb"), ("architecture 'table' or None", "--architecture table or none"))
 #: one-word arguments named at the start of a refusal
-_LEADING = re.compile(r"^(frequency|degrees|max_segments|interval|var|name) ")
+_LEADING = re.compile(r"^(frequency|degrees|max_segments|interval|var|name|lsb|architecture) ")
 
 
 def register(sub) -> None:
@@ -40,7 +43,14 @@ def register(sub) -> None:
     p.add_argument("--interval", nargs=2, metavar=("LO", "HI"), required=True,
                    help="rational endpoints: the input code maps onto [LO, HI)")
     p.add_argument("--in-bits", type=int, required=True, help="input code width, 2..20")
-    p.add_argument("--out-bits", type=int, required=True, help="output code width, 1..32")
+    p.add_argument("--out-bits", type=int, default=None,
+                   help="output code width, 1..32; at least one of --out-bits and --lsb: "
+                   "alone, the output's last place is the finest at which f's range over the "
+                   "input codes fits; with --lsb, checked to hold that range")
+    p.add_argument("--lsb", type=int, default=None, metavar="L",
+                   help="the output's last place is 2^L for every architecture (FloPoCo's "
+                   "lsbOut), -60..60; --faithful and --max-error are then relative to it; "
+                   "without --out-bits the width is derived from f's range (printed)")
     acc = p.add_mutually_exclusive_group(required=True)
     acc.add_argument("--max-error", default=None, metavar="E",
                      help="certified bound on |y - f(x)|, > 0 (a number or e.g. 2^-16)")
@@ -68,6 +78,14 @@ def register(sub) -> None:
                    "the segment; exponent: 1/sqrt(x) only, x = code / 2^in-bits with --interval "
                    "2^-m 1, a leading-zero count picks the binade pair, the output is a "
                    "mantissa (--out-bits) and a shift (chebnorm.hw.exponent)")
+    p.add_argument("--architecture", default=None,
+                   choices=("piecewise", "piecewise-sized", "multipartite", "table"),
+                   help="only this architecture (the reproduce line of a winner names it); "
+                   "default: every one competes")
+    p.add_argument("--simulate", action="store_true",
+                   help="simulate the winner's Verilog over every input code in Icarus "
+                   "Verilog against its bit-accurate model, and measure its error over every "
+                   "code against the rigorous reference of f")
     p.add_argument("--name", default=None,
                    help="module name (an identifier; default: from EXPR, the interval, the "
                    "widths and the accuracy, e.g. rsqrt_1_4_i8_o8_faithful, so different "
@@ -119,7 +137,8 @@ def run(args) -> int:
                      frequency=args.frequency, degrees=args.degrees,
                      max_segments=args.max_segments, index=args.index, var=args.var,
                      name=args.name, synth=not args.no_synth, workers=args.workers,
-                     scheduler=args.scheduler)
+                     scheduler=args.scheduler, lsb=args.lsb, architecture=args.architecture,
+                     simulate=args.simulate)
     except ValueError as exc:
         raise ValueError(cli_phrases(str(exc))) from None
     for path in write_folder(out, res.files(command=command_line(args), version=__version__)):
