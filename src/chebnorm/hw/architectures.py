@@ -658,8 +658,7 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                                  d, float(b["total"]), float(b["y_lsb"]), model=model,
                                  model_rom=model_rom))
         if items and items[-1][0] == "multipartite" and isinstance(built[-1], str):
-            out.append(Candidate("multipartite", "no design", note=f"no design meets the "
-                                 f"accuracy: {built[-1]}"))
+            out.append(Candidate("multipartite", "no design", note=built[-1]))
         elif items and items[-1][0] == "multipartite":
             m = built[-1]
             model, model_rom = model_parts(m.features(), target)

@@ -1,0 +1,154 @@
+"""``design --lsb``: the output format the user states, one format for every
+candidate, no architecture's failure ending the design, a reproduce line for
+every winner (issue 46)."""
+
+from __future__ import annotations
+
+import csv
+import shlex
+
+import mpmath
+import pytest
+
+from chebnorm.hw import design
+from chebnorm.hw.design_api import _winner_design
+from chebnorm.hw.pipeline import verify_pipelined
+from conftest import run_cli
+
+LOG2 = "log(1+x, 2)"
+
+
+def _off_by_ulp(d, lsb: int) -> int:
+    """Codes of ``d`` whose output is off by >= 2^lsb from log2(1 + k 2^-W), by an
+    mpmath reference at 80 bits (independent of chebnorm's Arb reference)."""
+    ys = d.evaluate()
+    fmt = d.y_format
+    assert fmt.frac_bits == -lsb
+    ulp = mpmath.mpf(2) ** lsb
+    bad = 0
+    with mpmath.workprec(80):
+        for k, y in enumerate(ys.tolist()):
+            x = mpmath.mpf(k) / 2 ** d.in_bits
+            f = mpmath.log(1 + x) / mpmath.log(2)
+            v = mpmath.mpf(int(fmt.offset_code) + int(y)) * ulp
+            bad += abs(v - f) >= ulp
+    return bad
+
+
+# -- the format: stated, derived, checked --------------------------------------------
+
+@pytest.mark.slow   # two model-only searches: 7 s measured
+def test_lsb_alone_derives_the_width_from_the_range():
+    # log2(1+x) on [0, 1), 8 bits in: f's largest value, log2(2 - 2^-8) = 0.99718, is
+    # within one 2^-8 of 1: at 2^-8 the codes are 0 .. ceil(255.28) = 256, 9 bits
+    r = design(LOG2, ("0", "1"), in_bits=8, lsb=-8, max_error="2^-8", synth=False, workers=1)
+    assert (r.lsb, r.out_bits) == (-8, 9)
+    assert r.winner.design.y_format.frac_bits == 8
+    assert "output LSB 2^-8 (y = k / 2^8 + offset, 9 bits, f in [0, 0.997179]; stated)" in r.lines()[0]
+    # 2^-7: 0 .. ceil(127.64) = 128, 8 bits
+    r = design(LOG2, ("0", "1"), in_bits=8, lsb=-7, max_error="2^-7", synth=False, workers=1)
+    assert (r.lsb, r.out_bits, r.winner.design.y_format.frac_bits) == (-7, 8, 7)
+
+
+def test_out_bits_too_few_for_the_lsb_is_refused_naming_both():
+    # exp on [0, 1), 8 bits in: 1 .. exp(255/256) = 2.70768 at 2^-8 needs the codes
+    # 256 .. ceil(693.17) = 694, 439 of them: 9 bits
+    with pytest.raises(ValueError, match=r"^out_bits 8: f spans \[1, 2\.70768\], which needs 9 "
+                       r"bits at lsb -8 \(codes 256 \.\. 694\); accepted: out_bits >= 9, or lsb >= -7 with out_bits "
+                       r"8, or out_bits omitted"):
+        design("exp(x)", ("0", "1"), in_bits=8, out_bits=8, lsb=-8, faithful=True)
+    code, out, err = run_cli("design", "exp(x)", "--interval", "0", "1", "--in-bits", "8",
+                             "--out-bits", "8", "--lsb", "-8", "--faithful", "-o", "unused")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith("chebnorm: error: --out-bits 8: f spans") and "--lsb >= -7" in err
+    assert "Traceback" not in err
+
+
+def test_neither_width_nor_lsb_and_lsb_with_exponent_are_refused():
+    with pytest.raises(ValueError, match="give out_bits=N .* or lsb=L"):
+        design("exp(x)", ("0", "1"), in_bits=8, faithful=True)
+    code, _, err = run_cli("design", "exp(x)", "--interval", "0", "1", "--in-bits", "8",
+                           "--faithful", "-o", "unused")
+    assert code == 2 and "--out-bits N" in err and "--lsb L" in err
+    with pytest.raises(ValueError, match="^lsb: not available with index='exponent'"):
+        design("1/sqrt(x)", ("2^-4", "1"), in_bits=8, out_bits=8, lsb=-8, faithful=True,
+               index="exponent")
+    with pytest.raises(ValueError, match=r"^lsb = 61 is out of range"):
+        design("exp(x)", ("0", "1"), in_bits=8, lsb=61, faithful=True)
+    code, _, err = run_cli("design", "exp(x)", "--interval", "0", "1", "--in-bits", "8",
+                           "--lsb", "-8", "--faithful", "--architecture", "fpga", "-o", "unused")
+    assert code == 2 and "--architecture" in err
+
+
+@pytest.mark.slow   # four architectures synthesized: 30 s measured under load
+@pytest.mark.requires_tool("yosys")
+def test_without_lsb_every_candidate_is_built_at_one_format(tmp_path):
+    """Issue 46's spec at 8 bits: f's range [0, 0.99718] at 8 bits out holds 2^-7 at
+    best (2^-8 needs code 256); every architecture's output is at 2^-7 and the winner
+    line and the CSV say so."""
+    r = design(LOG2, ("0", "1"), in_bits=8, out_bits=8, faithful=True, workers=1)
+    assert (r.lsb, r.out_bits) == (-7, 8)
+    assert r.lines()[0].startswith("winner") and "output LSB 2^-7" in r.lines()[0]
+    assert "the finest 8 bits hold" in r.lines()[0]
+    built = [c for c in r.candidates if c.design is not None]
+    assert built and {c.design.y_format.frac_bits for c in built} == {7}
+    assert r.search.winner.y_frac_bits == 7
+    assert r.winner.design.y_format.frac_bits == 7
+    rows = list(csv.DictReader(r.files()[f"design_{r.name}_architectures.csv"].splitlines()))
+    assert {row["lsb"] for row in rows if row["ulp"]} == {"-7"}
+
+
+# -- no architecture's failure ends the design ---------------------------------------
+
+@pytest.mark.slow   # two designs synthesized and simulated: 75 s measured under load
+@pytest.mark.requires_tool("yosys")
+@pytest.mark.requires_tool("iverilog")
+def test_max_error_met_by_some_architecture_never_exits_2(tmp_path):
+    """exp(4x) on [0, 1), 12 bits, 2^-6 LSB, max error 0.52 ulp: no multipartite
+    structure and no one-width piecewise design meets it, the sized piecewise and the
+    table do. The command used to exit 2 on the multipartite failure."""
+    code, out, err = run_cli("design", "exp(4*x)", "--interval", "0", "1", "--in-bits", "12",
+                             "--lsb", "-6", "--max-error", "0.008125", "-o", tmp_path / "d")
+    assert code == 0, err
+    lines = out.splitlines()
+    win = next(s for s in lines if s.startswith("winner: "))
+    assert "output LSB 2^-6 (y = k / 2^6 + offset, 12 bits" in win
+    assert any(s.startswith("  multipartite: no design -- no multipartite design of 12 input "
+                            "bits meets the target") for s in lines), out
+    assert any(s.startswith("  piecewise (one width): no design meets max_error 0.008125")
+               for s in lines), out
+    # the printed command rebuilds the winner alone and simulates it over every code
+    line = next(s for s in lines if s.startswith("reproduce: "))
+    words = shlex.split(line[len("reproduce: "):])
+    assert words[:2] == ["chebnorm", "design"] and "--architecture" in words
+    words[words.index("DIR")] = str(tmp_path / "r")
+    code, out2, err = run_cli(*words[1:])
+    assert code == 0, err
+    win2 = next(s for s in out2.splitlines() if s.startswith("winner: "))
+    assert win2 == win
+    sim = next(s for s in out2.splitlines() if s.startswith("simulation (Icarus Verilog"))
+    assert "PASS: 4096 vectors, 0 mismatches" in sim
+
+
+# -- acceptance: log2(1+x), 16 bits in, LSB 2^-16, faithful ---------------------------
+
+@pytest.mark.slow   # a 16-bit design per device and every candidate simulated: ~3 min
+@pytest.mark.requires_tool("yosys")
+@pytest.mark.requires_tool("iverilog")
+@pytest.mark.parametrize("device", ["generic", "xc7-nodsp"])
+def test_log2_lsb_16_faithful_on_every_code(device):
+    """Issue 46's acceptance: every architecture's design at LSB 2^-16, its Verilog
+    simulated over all 65,536 codes (Icarus against the bit-accurate model) and the
+    model's outputs against mpmath: 0 codes off by >= 2^-16."""
+    r = design(LOG2, ("0", "1"), in_bits=16, lsb=-16, faithful=True, device=device)
+    assert (r.lsb, r.out_bits) == (-16, 17)   # codes 0 .. 65536: 17 bits
+    assert "output LSB 2^-16" in next(s for s in r.lines() if s.startswith("winner"))
+    designs = [r.winner.design] + [c.design for c in r.candidates if c.design is not None]
+    if r.search is not None and r.search.winner is not None:
+        designs.append(_winner_design(r.search))
+    assert len(designs) >= 3
+    for d in designs:
+        sim = verify_pipelined(d)
+        assert sim.passed and sim.vectors == 65536, (d.module_name, sim.line)
+        assert _off_by_ulp(d, -16) == 0, d.module_name
+    print(device, r.winner.architecture, r.winner.description, r.winner.score)
