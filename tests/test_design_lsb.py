@@ -5,6 +5,7 @@ every winner (issue 46)."""
 from __future__ import annotations
 
 import csv
+import re
 import shlex
 
 import mpmath
@@ -152,3 +153,76 @@ def test_log2_lsb_16_faithful_on_every_code(device):
         assert sim.passed and sim.vectors == 65536, (d.module_name, sim.line)
         assert _off_by_ulp(d, -16) == 0, d.module_name
     print(device, r.winner.architecture, r.winner.description, r.winner.score)
+
+
+# -- the docs' per-spec table states each design's LSB --------------------------------
+
+def _table_rows():
+    """The rows of docs/hardware.md's "Architectures per spec" table: (spec,
+    architecture, out LSB)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "hardware.md").read_text("utf-8")
+    head = next(i for i, s in enumerate(text.splitlines()) if s.startswith("| spec | "))
+    lines = text.splitlines()
+    names = [c.strip() for c in lines[head].strip("|").split("|")]
+    rows = []
+    for s in lines[head + 2:]:
+        if not s.startswith("| "):
+            break
+        cells = dict(zip(names, (c.strip() for c in s.strip("|").split("|"))))
+        rows.append((cells["spec"], cells["architecture"] + (" (not run)" if "not run" in s
+                                                             else ""), cells["out LSB"]))
+    return rows
+
+
+def test_per_spec_table_states_an_lsb_on_every_row():
+    rows = _table_rows()
+    assert len(rows) >= 40
+    for spec, arch, lsb in rows:
+        if arch.startswith("exp"):
+            assert re.fullmatch(r"mantissa 2\^-\d+", lsb), (spec, arch, lsb)
+        elif "not run" not in arch:
+            assert re.fullmatch(r"2\^-\d+", lsb), (spec, arch, lsb)
+
+
+@pytest.mark.slow   # every uniform row's design rebuilt: ~4 min measured
+def test_per_spec_table_lsb_is_the_banners():
+    """Each row's "out LSB" is the one the rebuilt design's Verilog banner states
+    (``// y: ... value = (O + k) / 2^F``): the sized piecewise rows rebuilt as
+    ``bench_specs`` builds them, the tables by their designers' format rule."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_specs import SPECS, sized_piecewise
+
+    from chebnorm.hw.exponent import design_exponent
+    from chebnorm.hw.multipartite import design_multipartite
+    from chebnorm.hw.plain_table import design_plain_table
+
+    spec_of = {s[0]: s for s in SPECS}
+    built: dict = {}
+    for spec, arch, lsb in _table_rows():
+        if "not run" in arch:
+            continue
+        _, expr, iv, wi, wo = spec_of[spec]
+        kind = arch.split(" (")[0].replace(" pipe", "")
+        key = (spec, kind)
+        if key not in built:
+            if kind.startswith("pw"):
+                seg = int(re.search(r"\((\d+) seg", arch).group(1))
+                built[key] = sized_piecewise(expr, iv, wi, wo, int(kind[2]),
+                                             only_k=seg.bit_length() - 1)[0]
+            elif kind.startswith("exp"):
+                built[key] = design_exponent(expr, iv, wi, wo, degree=int(kind[3]))
+            elif kind == "multipartite":
+                built[key] = design_multipartite(expr, iv, wi, wo)
+            else:
+                built[key] = design_plain_table(expr, iv, wi, wo)
+        banner = re.search(r"// y: .*value = \(-?\d+ \+ k\) / 2\^(-?\d+)",
+                           built[key].verilog() if not kind.startswith("exp")
+                           else built[key].core.verilog())
+        assert banner, (spec, arch)
+        stated = lsb.replace("mantissa ", "")
+        assert stated == f"2^-{banner.group(1)}", (spec, arch, lsb, banner.group(0))
