@@ -402,13 +402,19 @@ def design(expr, interval, *, in_bits: int, out_bits: int | None = None, max_err
                   device, frequency, degrees, max_segments, index, var, name, synth, workers,
                   scheduler, lsb, architecture, simulate)
     if spec.index == "exponent":
-        return _design_exponent(spec)
+        res = _design_exponent(spec)
+        d = res.winner.design
+        lines = list(res.lines())
+        if spec.simulate:
+            lines.insert(1, _simulate(spec, d, -d.frac_bits, "mantissa "))
+        again = replace(spec, degrees=(d.degree,), simulate=True).command()
+        return replace(res, _lines=(*lines, f"reproduce: {again}"), out_bits=spec.out_bits)
     res = _design_uniform(spec)
     lines = list(res.lines())
     k = next((i for i, t in enumerate(lines) if t.startswith("winner")), 0)
     lines[k] += f"; {spec.format_phrase()}"
     if spec.simulate:
-        lines.insert(k + 1, _simulate(spec, res.winner))
+        lines.insert(k + 1, _simulate(spec, res.winner.design, spec.lsb))
     return replace(res, _lines=tuple(lines), lsb=spec.lsb, out_bits=spec.out_bits)
 
 
@@ -684,20 +690,21 @@ def _no_design(spec: _Spec, res, others) -> str:
                                           if spec.accuracy == "correctly-rounded" else ""))
 
 
-def _simulate(spec: _Spec, winner) -> str:
-    """The winner's Verilog simulated over every input code in Icarus Verilog against
-    its bit-accurate model, and the model's error measured over every code against
-    the rigorous reference of ``f``: one line (ValueError when either fails)."""
+def _simulate(spec: _Spec, d, lsb: int, what: str = "") -> str:
+    """The winner ``d``'s Verilog simulated over every input code in Icarus Verilog
+    against its bit-accurate model, and the model's error measured over every code
+    against the rigorous reference of ``f`` (``what``: "mantissa " for the exponent
+    index, whose error is its mantissa's, last place ``2^lsb``): one line
+    (ValueError when either fails)."""
     from .pipeline import verify_pipelined
 
-    d = winner.design
     sim = verify_pipelined(d)
     if not sim.passed:
         raise ValueError(f"internal: the Verilog of {d.module_name} disagrees with its "
                          f"bit-accurate model ({sim.line}); nothing written")
     m = d.measure()
     err = float(m["max_error"])
-    ulp = 2.0 ** spec.lsb
+    ulp = 2.0 ** lsb
     if spec.accuracy == "max-error":
         ok = err <= spec.max_error
     else:
@@ -705,10 +712,10 @@ def _simulate(spec: _Spec, winner) -> str:
             spec.accuracy == "correctly-rounded" and err <= ulp / 2
     if not ok:
         raise ValueError(f"internal: {d.module_name} errs by {err:.6g} over the input codes, "
-                         f"beyond its accuracy ({spec.accuracy}, LSB 2^{spec.lsb}); nothing "
+                         f"beyond its accuracy ({spec.accuracy}, LSB 2^{lsb}); nothing "
                          f"written")
-    return (f"simulation (Icarus Verilog, every code): {sim.line}; measured max |y - f| "
-            f"{format_up(err, '.4e')} ({format_up(err / ulp, '.4f')} ulp of 2^{spec.lsb})")
+    return (f"simulation (Icarus Verilog, every code): {sim.line}; measured max {what}|y - f| "
+            f"{format_up(err, '.4e')} ({format_up(err / ulp, '.4f')} ulp of 2^{lsb})")
 
 
 def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
