@@ -205,7 +205,7 @@ def test_per_spec_table_states_an_lsb_on_every_row():
             assert re.fullmatch(r"2\^-\d+", lsb), (spec, arch, lsb)
 
 
-@pytest.mark.slow   # every uniform row's design rebuilt: ~4 min measured
+@pytest.mark.slow   # every row's design rebuilt: 216 s measured
 def test_per_spec_table_lsb_is_the_banners():
     """Each row's "out LSB" is the one the rebuilt design's Verilog banner states
     (``// y: ... value = (O + k) / 2^F``): the sized piecewise rows rebuilt as
