@@ -99,6 +99,28 @@ def test_without_lsb_every_candidate_is_built_at_one_format(tmp_path):
     assert {row["lsb"] for row in rows if row["ulp"]} == {"-7"}
 
 
+@pytest.mark.requires_tool("iverilog")
+def test_one_width_reproduce_line_keeps_the_stated_lsb(tmp_path):
+    """9 output bits could hold 2^-8; at --lsb -7 the one-width winner's reproduce line
+    rebuilds it at 2^-7 (hw verilog --y-frac-bits 7), not at the finest 9 bits hold."""
+    code, out, err = run_cli("design", LOG2, "--interval", "0", "1", "--in-bits", "8",
+                             "--out-bits", "9", "--lsb", "-7", "--max-error", "2^-7",
+                             "--no-synth", "--workers", "1", "-o", tmp_path / "d")
+    assert code == 0, err
+    line = next(s for s in out.splitlines() if s.startswith("reproduce: "))
+    cmds = [shlex.split(c) for c in line[len("reproduce: "):].split(" && ")]
+    assert [c[:3] for c in cmds] == [["chebnorm", "fit", LOG2], ["chebnorm", "hw", "verilog"]]
+    assert cmds[1][cmds[1].index("--y-frac-bits") + 1] == "7"
+    (tmp_path / "DIR").mkdir()
+    for cmd in cmds:
+        code, out, err = run_cli(*cmd[1:], cwd=tmp_path)
+        assert code == 0, (cmd, err)
+    assert "PASS:" in out
+    banner = "\n".join(p.read_text() for p in (tmp_path / "DIR").glob("*.v")
+                       if not p.name.startswith("tb_"))
+    assert re.search(r"// y: unsigned 9-bit code k, value = \(-?\d+ \+ k\) / 2\^7\n", banner)
+
+
 # -- no architecture's failure ends the design ---------------------------------------
 
 @pytest.mark.slow   # two designs synthesized and simulated: 75 s measured under load
