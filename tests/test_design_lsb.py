@@ -79,6 +79,12 @@ def test_neither_width_nor_lsb_and_lsb_with_exponent_are_refused():
     code, _, err = run_cli("design", "exp(x)", "--interval", "0", "1", "--in-bits", "8",
                            "--lsb", "-8", "--faithful", "--architecture", "fpga", "-o", "unused")
     assert code == 2 and "--architecture" in err
+    code, _, err = run_cli("design", "exp(x)", "--interval", "0", "1", "--in-bits", "8",
+                           "--lsb", "-8", "--max-error", "0.01", "--no-synth", "--architecture",
+                           "table", "-o", "unused")
+    assert code == 2 and err == ("chebnorm: error: --architecture 'table' is priced by "
+                                 "synthesis: not available with --no-synth; accepted: without "
+                                 "--no-synth\n")
 
 
 @pytest.mark.slow   # four architectures synthesized: 30 s measured under load

@@ -500,6 +500,9 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
                          f"synth=True (or max_error=E with synth=False)")
     workers = None if workers is None else check_workers(workers)
     check_scheduler(scheduler)
+    if architecture not in (None, "piecewise") and not synth:
+        raise ValueError(f"architecture {architecture!r} is priced by synthesis: not "
+                         f"available with synth=False; accepted: synth=True")
     if architecture == "piecewise" and accuracy == "correctly-rounded":
         raise ValueError("architecture 'piecewise' is faithful at best; accepted with "
                          "correctly_rounded=True: architecture 'table' or None")
