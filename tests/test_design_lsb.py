@@ -127,6 +127,25 @@ def test_one_width_reproduce_line_keeps_the_stated_lsb(tmp_path):
     assert re.search(r"// y: unsigned 9-bit code k, value = \(-?\d+ \+ k\) / 2\^7\n", banner)
 
 
+@pytest.mark.requires_tool("yosys")
+@pytest.mark.requires_tool("iverilog")
+@pytest.mark.parametrize("arch", ["multipartite", "table", "piecewise-sized"])
+def test_each_architecture_alone_simulates_at_the_stated_lsb(arch, tmp_path):
+    code, out, err = run_cli("design", "2**x", "--interval", "0", "1", "--in-bits", "8",
+                             "--lsb", "-8", "--faithful", "--architecture", arch, "--simulate",
+                             "--workers", "1", "-o", tmp_path / "d")
+    assert code == 0, err
+    lines = out.splitlines()
+    win = next(s for s in lines if s.startswith("winner: "))
+    # 2^x on [0, 1): 1 .. 2^(255/256) = 1.99459 at 2^-8: codes 256 .. 511, 8 bits
+    assert win.startswith(f"winner: {arch}: ") and win.endswith(
+        "output LSB 2^-8 (y = k / 2^8 + offset, 8 bits, f in [1, 1.99459]; stated)")
+    sim = next(s for s in lines if s.startswith("simulation (Icarus Verilog"))
+    assert "PASS: 256 vectors, 0 mismatches" in sim and "ulp of 2^-8" in sim
+    assert lines[-1].startswith("reproduce: chebnorm design '2**x'") and \
+        f"--architecture {arch} --simulate" in lines[-1]
+
+
 # -- no architecture's failure ends the design ---------------------------------------
 
 @pytest.mark.slow   # two designs synthesized and simulated: 19 s measured idle, 75 s under load
