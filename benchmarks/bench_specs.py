@@ -151,7 +151,7 @@ def _piecewise_detail(d, info) -> str:
 def _piecewise_row(d, info) -> dict:
     m = d.measure()
     lsb = Fraction(1, 2 ** d.y_format.frac_bits)
-    return {"detail": _piecewise_detail(d, info),
+    return {"detail": _piecewise_detail(d, info), "out_lsb": f"2^-{d.y_format.frac_bits}",
             "sweep": info["sweep"], "bound_ulp": round(d.budget()["total"] / float(lsb), 4),
             "max_error_ulp": round(m["max_error"] / float(lsb), 4), "latency": d.latency,
             "verilog": d_verilog(d), "top": d.module_name, "clocked": d.latency > 0}
@@ -166,7 +166,8 @@ def d_verilog(d) -> str:
 def _table_row(d, detail) -> dict:
     m = d.measure()
     lsb = 2.0 ** -d.y_format.frac_bits
-    return {"detail": detail, "bound_ulp": round(m["upper"] / lsb, 4),
+    return {"detail": detail, "out_lsb": f"2^-{d.y_format.frac_bits}",
+            "bound_ulp": round(m["upper"] / lsb, 4),
             "max_error_ulp": round(m["upper"] / lsb, 4), "latency": 0,
             "verilog": d.verilog(), "top": d.module_name, "clocked": False}
 
@@ -181,7 +182,7 @@ def _exponent_row(d) -> dict:
     m = d.measure()
     b = d.budget()
     lsb = 2.0 ** -d.frac_bits
-    return {"detail": _exponent_detail(d),
+    return {"detail": _exponent_detail(d), "out_lsb": f"mantissa 2^-{d.frac_bits}",
             "bound_ulp": round(b["mantissa"] / lsb, 4),
             "max_error_ulp": round(m["max_error"] / lsb, 4),
             "max_rel_error": m["max_rel_error"], "latency": d.latency,
@@ -397,10 +398,10 @@ def _wins(r: dict, targets) -> str:
 
 
 def markdown(results: dict, specs) -> str:
-    head = ("| spec | architecture | generic cells | xc7 LUT+DSP | xc7 Fmax MHz (model) "
+    head = ("| spec | architecture | out LSB | generic cells | xc7 LUT+DSP | xc7 Fmax MHz (model) "
             "| xc7-nodsp LUT | ice40 LUT4 | ice40 Fmax MHz | latency | certified / ulp "
             "| max error / ulp | wins on (exhaustive simulation) |")
-    lines = [head, "|" + "---|" * 12]
+    lines = [head, "|" + "---|" * 13]
     for spec in specs:
         won = {a: ts for a, ts in winners(results, spec).items()}
         for arch in SPEC_ARCHS.get(spec[0], ARCHS):
@@ -409,13 +410,14 @@ def markdown(results: dict, specs) -> str:
                 continue
             if "targets" not in r:
                 what = "not run" if r.get("error", "").startswith("in_bits") else "failed"
-                lines.append(f"| {spec[0]} | {arch} | {what}: {r.get('error', '?')[:170]} "
+                lines.append(f"| {spec[0]} | {arch} |  | {what}: {r.get('error', '?')[:170]} "
                              f"|" + " |" * 10)
                 continue
             t = r["targets"]
             name = f"{arch} ({r['detail']})"
             lines.append(
-                f"| {spec[0]} | {name} | {t['generic']['cells']} | {t['xc7']['luts']} + "
+                f"| {spec[0]} | {name} | {r.get('out_lsb', '?')} | {t['generic']['cells']} | "
+                f"{t['xc7']['luts']} + "
                 f"{t['xc7']['dsps']}{_ram(t['xc7'])} | {_cell(r.get('fmax_xc7_model_mhz'))} | "
                 f"{t['xc7-nodsp']['luts']}{_ram(t['xc7-nodsp'])} | "
                 f"{t['ice40']['luts']}{_ram(t['ice40'])} | {_fmax(r)} | {r['latency']} | "

@@ -500,15 +500,17 @@ def _piecewise_design(args, table):
     """The hardware design of the piecewise ``table`` (read from ``args.table``)."""
     from chebnorm.hw.piecewise import design_piecewise
 
-    for opt in ("coef_bits", "acc_bits", "x_frac_bits", "y_frac_bits"):
+    for opt in ("coef_bits", "acc_bits", "x_frac_bits"):
         if getattr(args, opt, None) is not None:
             raise ValueError(f"--{opt.replace('_', '-')} is not available for a piecewise table "
                              f"(its coefficient format is the table's; the widths are sized "
-                             f"exactly); accepted: --in-bits and --out-bits")
+                             f"exactly); accepted: --in-bits, --out-bits and --y-frac-bits")
     if getattr(args, "rounding", "rne") != "rne":
         raise ValueError(f"rounding {args.rounding!r}: a piecewise evaluator rounds to nearest "
                          f"even; accepted: rne")
-    return design_piecewise(table, args.in_bits, args.out_bits)
+    # --y-frac-bits: the output's last place 2^-F stated (chebnorm design --lsb -F)
+    return design_piecewise(table, args.in_bits, args.out_bits,
+                            out_frac_bits=getattr(args, "y_frac_bits", None))
 
 
 def hw_verilog(args, table) -> int:

@@ -34,7 +34,7 @@ from chebnorm.approx.piecewise_table import MAX_COEF_FRAC_BITS
 
 from chebnorm.core.display import summary_html, summary_repr
 from chebnorm.core.parallel import map_ordered
-from chebnorm.core.numeric import format_down, format_up
+from chebnorm.core.numeric import check_int, format_down, format_up
 
 from .design_base import Design
 from .multipartite import design_multipartite
@@ -159,7 +159,7 @@ def _sized_chain(item) -> list:
     segments, after a rise at 128)."""
     from .target_model import model_parts
 
-    expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target = item
+    expr, interval, in_bits, out_bits, degree, k0, max_error, var, name, target, fy = item
     mult = "full" if get_target(target).name == "xc7" else "truncated"
     f_hi = out_bits + 10 if max_error is None else math.ceil(-math.log2(max_error)) + 10
     found: list = []
@@ -169,7 +169,7 @@ def _sized_chain(item) -> list:
                           var=var, name=name)
         try:
             d = design_piecewise(t, in_bits, out_bits, widths="auto", max_error=max_error,
-                                 multipliers=mult)
+                                 multipliers=mult, out_frac_bits=fy)
         except ValueError:  # not reachable at this segment count
             continue
         model, rom = model_parts(d.features(), target)
@@ -185,9 +185,12 @@ def _build_item(item):
     chain, or the multipartite design."""
     if item[0] == "sized":
         return _sized_chain(item[1:])
-    expr, interval, in_bits, out_bits, e, var, name = item[1:]
-    return design_multipartite(expr, interval, in_bits, out_bits, max_error=e,
-                               faithful=e is None, var=var, name=name)
+    expr, interval, in_bits, out_bits, e, var, name, fy = item[1:]
+    try:
+        return design_multipartite(expr, interval, in_bits, out_bits, max_error=e,
+                                   faithful=e is None, var=var, name=name, out_frac_bits=fy)
+    except ValueError as exc:   # one line of the report: the other architectures compete
+        return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
 
 
 def _synth_item(item):
@@ -572,7 +575,7 @@ def cheapest_candidates(cands) -> list[Candidate]:
 def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: str,
                      max_error=None, degrees=(1, 2, 3), k_start=None, var: str = "x",
                      name: str = "design", target: str = "generic", workers: int | None = 1,
-                     scheduler=None) -> list[Candidate]:
+                     scheduler=None, out_frac_bits: int | None = None) -> list[Candidate]:
     """Every candidate of :func:`architecture_candidates` (all the sized ones the
     walk built, not only the cheapest per degree), built and priced by the
     model, not synthesized: :func:`synthesize_candidates` and
@@ -586,6 +589,10 @@ def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: s
         Parallel workers for the sized chains and the multipartite design.
     scheduler : object, optional
         A shared scheduler (:func:`chebnorm.core.parallel.map_ordered`).
+    out_frac_bits : int, optional
+        Every candidate's output at this many fractional bits (last place
+        ``2^-out_frac_bits``, -60..60), so that all are compared at one output
+        format; default: each designer's own, the most that fit ``out_bits``.
 
     Returns
     -------
@@ -610,13 +617,15 @@ def build_candidates(expr, interval, in_bits: int, out_bits: int, *, accuracy: s
     """
     if accuracy not in ACCURACIES:
         raise ValueError(f"accuracy {accuracy!r}; accepted: {', '.join(ACCURACIES)}")
+    if out_frac_bits is not None:
+        out_frac_bits = check_int(out_frac_bits, "out_frac_bits", -60, 60)
     return _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees,
                              dict(k_start or {}), var, name, get_target(target).name, workers,
-                             scheduler)
+                             scheduler, out_frac_bits)
 
 
 def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, degrees, k_start,
-                      var, name, target, workers, scheduler) -> list[Candidate]:
+                      var, name, target, workers, scheduler, fy=None) -> list[Candidate]:
     """Every candidate of :func:`architecture_candidates`, built, not synthesized."""
     from .target_model import model_parts, model_score
 
@@ -630,10 +639,11 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                                  "proved rounding of every code (a plain table)"))
     else:
         items = [("sized", expr, interval, in_bits, out_bits, degree, k_start[degree], e, var,
-                  f"{name}_sized_d{degree}", target) for degree in degrees if degree in k_start]
+                  f"{name}_sized_d{degree}", target, fy) for degree in degrees
+                 if degree in k_start]
         if in_bits <= 20:
             items.append(("multipartite", expr, interval, in_bits, out_bits, e, var,
-                          f"{name}_mp"))
+                          f"{name}_mp", fy))
         built = map_ordered(_build_item, items, workers=workers, scheduler=scheduler)
         mult = "full" if get_target(target).name == "xc7" else "truncated"
         sized = [(k, d, m, r) for item, res in zip(items, built) if item[0] == "sized"
@@ -647,15 +657,27 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                                  f"segments, ROM {sum(d.rom_bits) << k} bits, {mult} multipliers",
                                  d, float(b["total"]), float(b["y_lsb"]), model=model,
                                  model_rom=model_rom))
-        if items and items[-1][0] == "multipartite":
+        if items and items[-1][0] == "multipartite" and isinstance(built[-1], str):
+            out.append(Candidate("multipartite", "no design", note=built[-1]))
+        elif items and items[-1][0] == "multipartite":
             m = built[-1]
             model, model_rom = model_parts(m.features(), target)
             out.append(Candidate("multipartite", f"{len(m.offsets)} offset tables, ROM "
                                  f"{m.rom_bits} bits", m, float(m.certificate.upper),
                                  2.0 ** -m.y_format.frac_bits, model=model,
                                  model_rom=model_rom))
+    table = None
     if rom <= MAX_TABLE_ROM_BITS:
-        p = design_plain_table(expr, interval, in_bits, out_bits, var=var, name=f"{name}_table")
+        try:
+            table = design_plain_table(expr, interval, in_bits, out_bits, var=var,
+                                       name=f"{name}_table", out_frac_bits=fy)
+        except ValueError as exc:
+            if fy is None:
+                raise
+            out.append(Candidate("table", f"{2 ** in_bits} entries", note=f"no design: "
+                                 f"{str(exc).splitlines()[0]}"))
+    if table is not None:
+        p = table
         ok = accuracy != "correctly-rounded" or p.correctly_rounded
         out.append(Candidate("table", f"{2 ** in_bits} entries, ROM {p.rom_bits} bits"
                              + (", correctly rounded (proved)" if p.correctly_rounded else ""),
@@ -664,7 +686,7 @@ def _build_candidates(expr, interval, in_bits, out_bits, accuracy, max_error, de
                              note="" if ok else f"{p.unproved} codes' rounding not proved",
                              model=model_score(p.features(), target),
                              model_rom=model_parts(p.features(), target)[1]))
-    else:
+    elif rom > MAX_TABLE_ROM_BITS:
         out.append(Candidate("table", f"{2 ** in_bits} entries", note=f"ROM of {rom} bits, over "
                              f"{MAX_TABLE_ROM_BITS}: not built (it cannot win)"))
     return out

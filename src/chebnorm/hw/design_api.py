@@ -20,7 +20,7 @@ import keyword
 import math
 import shlex
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from chebnorm.approx.piecewise_table import MAX_PIECEWISE_DEGREE
 from chebnorm.core.numeric import check_int, format_up
@@ -36,6 +36,8 @@ __all__: list[str] = []
 ACCURACIES = ("max-error", "faithful", "correctly-rounded")
 #: the ways an input code picks its segment
 INDEXES = ("uniform", "exponent")
+#: the architectures ``architecture=`` (``--architecture``) may restrict a design to
+ARCHITECTURES = ("piecewise", "piecewise-sized", "multipartite", "table")
 
 
 @dataclass(frozen=True)
@@ -111,6 +113,14 @@ class DesignResult:
     _hdl : str
         Internal: the winner's HDL files to print in :meth:`files` (``""``: none,
         ``"architecture"``, ``"exponent"``).
+    lsb : int or None
+        The output's last place is ``2^lsb`` (FloPoCo's ``lsbOut``): the one
+        stated (``lsb=``), else the one every architecture was built at (the
+        smallest the range of ``f`` lets ``out_bits`` hold); None for
+        ``index="exponent"`` (a mantissa and a shift).
+    out_bits : int or None
+        The output code width (stated, or derived from ``lsb`` and the range
+        of ``f``).
     timings : tuple
         With ``frequency``: per architecture that meets the accuracy,
         ``(architecture, description, PipelineResult, score)``, each pipelined for
@@ -141,6 +151,8 @@ class DesignResult:
     _data: dict = field(default_factory=dict, repr=False, compare=False)
     _hdl: str = field(default="", repr=False)
     timings: tuple = ()
+    lsb: int | None = None
+    out_bits: int | None = None
 
     def lines(self) -> list[str]:
         """The text ``chebnorm design`` prints after the paths of its files.
@@ -226,6 +238,25 @@ class _Spec:
     synth: bool
     workers: int | None
     scheduler: object
+    lsb: int | None = None          # the output's last place 2^lsb (None: exponent index)
+    lsb_stated: bool = False        # given by the caller (the command says --lsb)
+    f_range: tuple = ()             # (min, max) of f over the input codes
+    architecture: str | None = None  # only this architecture (None: every one)
+    simulate: bool = False          # the winner simulated over every code
+
+    @property
+    def frac_bits(self) -> int | None:
+        """y's fractional bits: ``-lsb``."""
+        return None if self.lsb is None else -self.lsb
+
+    def format_phrase(self) -> str:
+        """The output format every candidate was built at, in words."""
+        if self.lsb is None:
+            return ""
+        lo, hi = self.f_range
+        how = "stated" if self.lsb_stated else f"the finest {self.out_bits} bits hold"
+        return (f"output LSB 2^{self.lsb} (y = k / 2^{-self.lsb} + offset, {self.out_bits} "
+                f"bits, f in [{lo:.6g}, {hi:.6g}]; {how})")
 
     def parallel(self) -> dict:
         return {"workers": self.workers, "scheduler": self.scheduler}
@@ -234,6 +265,8 @@ class _Spec:
         """The ``chebnorm design`` command of this spec."""
         words = ["chebnorm", "design", self.expr, "--var", self.var, "--interval",
                  *self.interval, "--in-bits", self.in_bits, "--out-bits", self.out_bits]
+        if self.lsb_stated:
+            words += ["--lsb", self.lsb]
         words += (["--max-error", repr(self.max_error)] if self.accuracy == "max-error"
                   else [f"--{self.accuracy}"])
         words += ["--degrees", *self.degrees, "--target", self.device, "--index", self.index,
@@ -244,14 +277,19 @@ class _Spec:
             words += ["--frequency", repr(self.frequency)]
         if not self.synth:
             words.append("--no-synth")
+        if self.architecture is not None:
+            words += ["--architecture", self.architecture]
+        if self.simulate:
+            words.append("--simulate")
         return " ".join(shlex.quote(str(w)) for w in words + ["-o", "DIR"])
 
 
-def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
+def design(expr, interval, *, in_bits: int, out_bits: int | None = None, max_error=None,
            faithful: bool = False, correctly_rounded: bool = False, device: str = "generic",
            frequency=None, degrees=(1, 2, 3), max_segments=None, index: str = "uniform",
            var: str = "x", name: str | None = None, synth: bool = True,
-           workers: int | None = None, scheduler=None) -> DesignResult:
+           workers: int | None = None, scheduler=None, lsb: int | None = None,
+           architecture: str | None = None, simulate: bool = False) -> DesignResult:
     """The cheapest certified hardware evaluator of ``expr`` meeting an accuracy.
 
     Exactly what ``chebnorm design`` computes (it parses its flags and calls this):
@@ -263,6 +301,15 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
     does, the fastest, with a warning naming it); the winner's pipelined RTL is
     simulated cycle by cycle over every input code.
 
+    Every candidate is built at one output format, so that they are compared at
+    the same format and accuracy: the output's last place is ``2^lsb``
+    (FloPoCo's ``lsbOut``) when ``lsb`` is given, else ``2^-F`` with ``F`` the
+    most fractional bits at which the range of ``f`` over the input codes has
+    ``out_bits``-bit codes (with an offset). ``faithful`` and ``max_error`` are
+    relative to that format; the result's ``lsb`` and the winner line say it.
+    An architecture that finds no design meeting the accuracy is one line of
+    the report; the others still compete.
+
     Parameters
     ----------
     expr : str
@@ -272,8 +319,10 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
         ``k`` of ``in_bits`` maps onto ``[lo, hi)``.
     in_bits : int
         Input code width, 2..20 (4..20 with ``index="exponent"``).
-    out_bits : int
-        Output code width, 1..32.
+    out_bits : int, optional
+        Output code width, 1..32. At least one of ``out_bits`` and ``lsb`` is
+        given; with ``lsb`` alone it is derived from the range of ``f``, with
+        both it is checked to hold that range at ``2^lsb``.
     max_error : float or str, optional
         Certified bound on ``|y - f(x)|``, a finite number > 0 (text such as
         ``"2^-16"`` is read exactly). Exactly one of ``max_error``,
@@ -313,6 +362,19 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
         Local worker processes (default: the core count; 1 in this process).
     scheduler : str, optional
         A Dask distributed scheduler address (overrides ``workers``).
+    lsb : int, optional
+        The output's last place is ``2^lsb`` for every architecture (-60..60;
+        the command's ``--lsb``); ``index="uniform"`` only (the exponent
+        index outputs a mantissa and a shift).
+    architecture : str, optional
+        Only this architecture: ``"piecewise"`` (the one-width search),
+        ``"piecewise-sized"``, ``"multipartite"`` or ``"table"`` (the
+        reproduce line of a winner names it); default: every one.
+    simulate : bool, default False
+        Simulate the winner's Verilog over every input code in Icarus Verilog
+        against its bit-accurate model and measure its error against the
+        rigorous reference of ``f`` (a line of the report; ValueError when
+        they disagree).
 
     Returns
     -------
@@ -338,15 +400,27 @@ def design(expr, interval, *, in_bits: int, out_bits: int, max_error=None,
     """
     spec = _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rounded,
                   device, frequency, degrees, max_segments, index, var, name, synth, workers,
-                  scheduler)
+                  scheduler, lsb, architecture, simulate)
     if spec.index == "exponent":
-        return _design_exponent(spec)
-    return _design_uniform(spec)
+        res = _design_exponent(spec)
+        d = res.winner.design
+        lines = list(res.lines())
+        if spec.simulate:
+            lines.insert(1, _simulate(spec, d, -d.frac_bits, "mantissa "))
+        again = replace(spec, degrees=(d.degree,), simulate=True).command()
+        return replace(res, _lines=(*lines, f"reproduce: {again}"), out_bits=spec.out_bits)
+    res = _design_uniform(spec)
+    lines = list(res.lines())
+    k = next((i for i, t in enumerate(lines) if t.startswith("winner")), 0)
+    lines[k] += f"; {spec.format_phrase()}"
+    if spec.simulate:
+        lines.insert(k + 1, _simulate(spec, res.winner.design, spec.lsb))
+    return replace(res, _lines=tuple(lines), lsb=spec.lsb, out_bits=spec.out_bits)
 
 
 def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rounded, device,
            frequency, degrees, max_segments, index, var, name, synth, workers,
-           scheduler) -> _Spec:
+           scheduler, lsb=None, architecture=None, simulate=False) -> _Spec:
     """Every argument of :func:`design`, checked; the spec."""
     from chebnorm.core.parallel import check_scheduler, check_workers
 
@@ -363,9 +437,18 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
                          f"identifier such as x or z, not a keyword, function or constant "
                          f"name and not starting with '_'")
     in_bits = check_int(in_bits, "in_bits", 2, 20)
-    out_bits = check_int(out_bits, "out_bits", 1, 32)
+    if out_bits is None and lsb is None:
+        raise ValueError("give out_bits=N (the output width) or lsb=L (its last place 2^L), "
+                         "or both")
+    if out_bits is not None:
+        out_bits = check_int(out_bits, "out_bits", 1, 32)
+    if lsb is not None:
+        lsb = check_int(lsb, "lsb", -60, 60)
+    if architecture is not None and architecture not in ARCHITECTURES:
+        raise ValueError(f"architecture {str(architecture)[:40]!r}: accepted: "
+                         f"{', '.join(map(repr, ARCHITECTURES))}")
     for flag, value in (("faithful", faithful), ("correctly_rounded", correctly_rounded),
-                        ("synth", synth)):
+                        ("synth", synth), ("simulate", simulate)):
         if not isinstance(value, bool):
             raise ValueError(f"{flag} {str(value)[:40]!r}: accepted: True or False")
     if (max_error is not None) + faithful + correctly_rounded != 1:
@@ -400,6 +483,12 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
             raise ValueError(f"max_segments {str(max_segments)[:40]}: with in_bits {in_bits} "
                              f"accepted: 2^0 .. 2^{top} (at most half the input codes, and "
                              f"2^12)")
+    if index == "exponent" and (lsb is not None or architecture is not None):
+        raise ValueError(f"{'lsb' if lsb is not None else 'architecture'}: not available "
+                         f"with index='exponent' (its output is a mantissa and a shift: its "
+                         f"last place moves with the shift); accepted: "
+                         f"{'lsb' if lsb is not None else 'architecture'}=None, or "
+                         f"index='uniform'")
     if frequency is not None and index == "exponent":   # never silently ignored
         raise ValueError(f"frequency {str(frequency)[:40]}: not available with "
                          f"index='exponent' (its winner is written combinational); accepted: "
@@ -411,16 +500,65 @@ def _check(expr, interval, in_bits, out_bits, max_error, faithful, correctly_rou
                          f"synth=True (or max_error=E with synth=False)")
     workers = None if workers is None else check_workers(workers)
     check_scheduler(scheduler)
+    if architecture not in (None, "piecewise") and not synth:
+        raise ValueError(f"architecture {architecture!r} is priced by synthesis: not "
+                         f"available with synth=False; accepted: synth=True")
+    if architecture == "piecewise" and accuracy == "correctly-rounded":
+        raise ValueError("architecture 'piecewise' is faithful at best; accepted with "
+                         "correctly_rounded=True: architecture 'table' or None")
+    f_range, stated = (), lsb is not None
+    if index == "uniform":
+        out_bits, lsb, f_range = _output_format(expr, interval, in_bits, var, out_bits, lsb)
     if name is None:
         tags = (["faithful"] if faithful else ["cr"] if correctly_rounded else
                 ["e", _error_tag(max_error)])
         if index == "exponent":
             tags.append("lz")
+        if stated:
+            tags.insert(0, f"lsb{'m' if lsb < 0 else ''}{abs(lsb)}")
         name = design_name(expr, interval, in_bits, out_bits, var=var, tags=tags)
     name = identifier(name, field="name")
     return _Spec(expr, interval, in_bits, out_bits, max_error, accuracy, device, frequency,
                  degrees, max_index_bits, max_segments, index, var, name, synth, workers,
-                 scheduler)
+                 scheduler, lsb, stated, f_range, architecture, simulate)
+
+
+def _output_format(expr, interval, in_bits, var, out_bits, lsb):
+    """``(out_bits, lsb, (min f, max f))``: the output format every architecture is
+    built at. The range of ``f`` over the input codes (its float64 midpoints, as
+    the table and multipartite designers read it) needs the codes
+    ``floor(min f 2^F) .. ceil(max f 2^F)`` at ``F = -lsb`` fractional bits: with
+    ``lsb`` alone their width is ``out_bits``, with both it is checked; with
+    ``out_bits`` alone ``F`` is the most that fit."""
+    from .exhaustive import reference
+
+    ref = reference(expr, interval, in_bits, var)
+    lo, hi = float(ref.mid.min()), float(ref.mid.max())
+
+    def codes(f: int) -> int:
+        return math.ceil(hi * 2.0 ** f) - math.floor(lo * 2.0 ** f)
+
+    if lsb is None:
+        f = next((f for f in range(60, -61, -1) if codes(f) <= 2 ** out_bits - 1), None)
+        if f is None:
+            raise ValueError(f"out_bits {out_bits}: f spans [{lo:.6g}, {hi:.6g}], which no "
+                             f"last place 2^-60 .. 2^60 holds; accepted: more out_bits")
+        return out_bits, -f, (lo, hi)
+    need = max(1, codes(-lsb).bit_length())
+    if out_bits is None:
+        if need > 32:
+            least = next(L for L in range(lsb, 61) if codes(-L).bit_length() <= 32)
+            raise ValueError(f"lsb {lsb}: f spans [{lo:.6g}, {hi:.6g}], which needs {need} "
+                             f"output bits at 2^{lsb}; accepted: lsb >= {least} (at most 32 "
+                             f"bits)")
+        return need, lsb, (lo, hi)
+    if need > out_bits:
+        fits = next((L for L in range(lsb, 61) if codes(-L) <= 2 ** out_bits - 1), None)
+        raise ValueError(f"out_bits {out_bits}: f spans [{lo:.6g}, {hi:.6g}], which needs "
+                         f"{need} bits at lsb {lsb} (codes {math.floor(lo * 2.0 ** -lsb)} .. "
+                         f"{math.ceil(hi * 2.0 ** -lsb)}); accepted: out_bits >= {need}, or "
+                         f"lsb >= {fits} with out_bits {out_bits}, or out_bits omitted (derived)")
+    return out_bits, lsb, (lo, hi)
 
 
 def _python(accuracy: str) -> str:
@@ -471,8 +609,13 @@ def _design_uniform(spec: _Spec) -> DesignResult:
         others, res = [], _search(spec, spec.max_error)
     else:
         others, res = _synth_both(spec)
-        if res is None:   # correctly rounded: a plain table or nothing
+        if res is None:   # correctly rounded, or one other architecture asked
             return _other_wins(spec, others, None, {})
+    if res.winner is None:   # the one-width search met nothing: the others compete
+        files = {f"design_{spec.name}.csv": res.csv()} if res.points else {}
+        if _best_other(others) is None:
+            raise ValueError(_no_design(spec, res, others))
+        return _other_wins(spec, others, res, files)
     files = {f"design_{spec.name}.csv": res.csv(), f"design_{spec.name}.png": res.plot_png()}
     synthesized = res.winner.target_cost is not None or res.winner.yosys_cells is not None
     best, timed = _best_other(others), None
@@ -506,7 +649,7 @@ def _design_uniform(spec: _Spec) -> DesignResult:
            "--degree", w.degree, "--segments", w.segments, "--kind", "minimax",
            "--coef-frac-bits", w.coef_frac_bits, "-o", "T.json"]
     verilog = ["chebnorm", "hw", "verilog", "T.json", "--in-bits", spec.in_bits, "--out-bits",
-               spec.out_bits, "-o", "DIR", "--simulate"]
+               spec.out_bits, "--y-frac-bits", w.y_frac_bits, "-o", "DIR", "--simulate"]
     lines.append(f"reproduce: {_words(fit)} && {_words(verilog)}")
     winner = Winner("piecewise", w.describe(), d if piped is None else piped.design,
                     _score(w) if timed is None else timed.score, w.total_bound)
@@ -521,6 +664,63 @@ def _words(words) -> str:
     return " ".join(shlex.quote(str(w)) for w in words)
 
 
+def _reproduce(spec: _Spec, best) -> str:
+    """The command that rebuilds ``best`` (a candidate of another architecture than
+    the one-width search) alone and simulates it over every input code."""
+    degrees = (best.design.degree,) if best.architecture == "piecewise-sized" else spec.degrees
+    return replace(spec, degrees=degrees, architecture=best.architecture, simulate=True,
+                   lsb_stated=True).command()
+
+
+def _search_failure(res) -> str:
+    """The one-width search's failure, in one line."""
+    if not res.points:
+        return "no design: no polynomial's range fits the output format"
+    best = min(res.points, key=lambda p: p.total_bound)
+    return (f"no design meets max_error {res.max_error:.4g}: the smallest certified error "
+            f"reached is {format_up(best.total_bound, '.4g')} (degree {best.degree}, "
+            f"{best.segments} segments, {best.coef_frac_bits} coefficient bits)")
+
+
+def _no_design(spec: _Spec, res, others) -> str:
+    """Why no architecture meets the accuracy: each one's line."""
+    why = ([] if res is None else [f"piecewise (one width): {_search_failure(res)}"]) + [
+        c.line() for c in others]
+    return (f"no architecture meets the accuracy asked at {spec.format_phrase()} ("
+            + "; ".join(why) + "); accepted: a larger max_error, more max_segments, degrees, "
+            "out_bits or a larger lsb" + (", or faithful=True / max_error=E instead of "
+                                          "correctly_rounded=True"
+                                          if spec.accuracy == "correctly-rounded" else ""))
+
+
+def _simulate(spec: _Spec, d, lsb: int, what: str = "") -> str:
+    """The winner ``d``'s Verilog simulated over every input code in Icarus Verilog
+    against its bit-accurate model, and the model's error measured over every code
+    against the rigorous reference of ``f`` (``what``: "mantissa " for the exponent
+    index, whose error is its mantissa's, last place ``2^lsb``): one line
+    (ValueError when either fails)."""
+    from .pipeline import verify_pipelined
+
+    sim = verify_pipelined(d)
+    if not sim.passed:
+        raise ValueError(f"internal: the Verilog of {d.module_name} disagrees with its "
+                         f"bit-accurate model ({sim.line}); nothing written")
+    m = d.measure()   # the tables' measure is the rigorous upper bound over every code
+    err = float(m["max_error"] if "max_error" in m else m["upper"])
+    ulp = 2.0 ** lsb
+    if spec.accuracy == "max-error":
+        ok = err <= spec.max_error
+    else:
+        ok = err < (ulp / 2 if spec.accuracy == "correctly-rounded" else ulp) or \
+            spec.accuracy == "correctly-rounded" and err <= ulp / 2
+    if not ok:
+        raise ValueError(f"internal: {d.module_name} errs by {err:.6g} over the input codes, "
+                         f"beyond its accuracy ({spec.accuracy}, LSB 2^{lsb}); nothing "
+                         f"written")
+    return (f"simulation (Icarus Verilog, every code): {sim.line}; measured max {what}|y - f| "
+            f"{format_up(err, '.4e')} ({format_up(err / ulp, '.4f')} ulp of 2^{lsb})")
+
+
 def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
     """Another architecture than the one-width search wins: its HDL beside the CSVs
     (``timed``: every architecture pipelined for the frequency, :func:`_time_all`)."""
@@ -528,9 +728,7 @@ def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
         timed = _time_all(spec, others, res)
     best = _best_other(others) if timed is None else timed.candidate
     if best is None:
-        raise ValueError("no architecture meets the accuracy asked (" + "; ".join(
-            c.line() for c in others) + "); accepted: more out_bits, or faithful=True / "
-            "max_error=E instead of correctly_rounded=True")
+        raise ValueError(_no_design(spec, res, others))
     files = dict(files)
     files[f"design_{spec.name}_architectures.csv"] = _architectures_csv(others, res, best)
     d = best.design
@@ -545,7 +743,9 @@ def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
                              latency=d.latency)
         figures = [f"winner {fig['line']}", f"timing: {fig['timing']}"]
     lines = [f"winner: {best.line()}", *figures]
-    if res is not None:
+    if res is not None and res.winner is None:
+        lines.append(f"  piecewise (one width): {_search_failure(res)}")
+    elif res is not None:
         w = res.winner
         why = (f"score {_score(w):.1f}, costlier than the winner" if w.target_cost is not None
                or w.yosys_cells is not None else "not synthesized: its model cannot beat the "
@@ -558,6 +758,7 @@ def _other_wins(spec: _Spec, others, res, files, timed=None) -> DesignResult:
             lines.append(f"  {c.line()}" + (_lost(spec) if c.cost is not None else ""))
     winner = Winner(best.architecture, best.description, d,
                     best.cost.score if timed is None else timed.score, best.error)
+    lines.append(f"reproduce: {_reproduce(spec, best)}")
     return DesignResult(spec.name, spec.device, spec.accuracy, winner, tuple(others), res,
                         piped, (), tuple(lines), {"static": files, "command": spec.command()},
                         "architecture", () if timed is None else timed.timings)
@@ -584,8 +785,8 @@ def _time_all(spec: _Spec, others, res) -> _Timed:
     and left out."""
     from .pipeline import pipeline_to_frequency
 
-    entries = [] if res is None else [("piecewise (one width)", res.winner.describe(), None,
-                                       _winner_design(res))]
+    entries = [] if res is None or res.winner is None else [
+        ("piecewise (one width)", res.winner.describe(), None, _winner_design(res))]
     for c in others:
         if c.design is not None and (spec.accuracy != "max-error" or c.error is None
                                      or c.error <= spec.max_error):
@@ -741,17 +942,22 @@ def _winner_figures(res, d) -> list[str]:
     return [f"winner {fig['line']}", f"timing: {fig['timing']}"]
 
 
-def _search(spec: _Spec, max_error, synth=None, workers=None):
+def _search(spec: _Spec, max_error, synth=None, workers=None, strict=True):
     """The one-width piecewise Pareto search (:mod:`.piecewise_search`); ``synth``
-    False for the model only; ``workers``: instead of the spec's."""
+    False for the model only; ``workers``: instead of the spec's; ``strict``:
+    ValueError when no point meets ``max_error`` (else the result, winner None)."""
     from .piecewise_search import search
 
     parallel = spec.parallel() if workers is None else {"workers": workers, "scheduler": None}
     res = search(spec.expr, spec.interval, spec.in_bits, spec.out_bits, max_error,
                  degrees=spec.degrees, max_index_bits=spec.max_index_bits, var=spec.var,
                  synth=spec.synth if synth is None else synth, name=spec.name,
-                 target=spec.device, **parallel)
-    if res.winner is None:  # one line, exit 2, nothing written (docs/cli.md)
+                 target=spec.device, out_frac_bits=spec.frac_bits, **parallel)
+    if res.winner is None and not res.points:
+        raise ValueError(f"no design meets max_error {max_error:.4g}: no polynomial's range "
+                         f"fits {spec.format_phrase()}; accepted: more out_bits or a larger "
+                         f"lsb")
+    if res.winner is None and strict:  # one line, exit 2, nothing written (docs/cli.md)
         best = min(res.points, key=lambda p: p.total_bound)
         raise ValueError(f"no design meets max_error {max_error:.4g}: the smallest "
                          f"certified error reached is {format_up(best.total_bound, '.4g')} "
@@ -783,25 +989,40 @@ def _synth_both(spec: _Spec):
                              k_start={d: max(0, min(spec.in_bits - 2, 3 + 2 * (3 - d)))
                                       for d in degrees},
                              var=spec.var, name=spec.name, target=spec.device,
-                             **spec.parallel())
-    if spec.accuracy == "correctly-rounded" or which("yosys") is None:
+                             out_frac_bits=spec.frac_bits, **spec.parallel())
+    built = [_meets(spec, c) for c in built
+             if spec.architecture in (None, c.architecture)]
+    if spec.accuracy == "correctly-rounded" or which("yosys") is None or \
+            spec.architecture not in (None, "piecewise"):
         # yosys missing: each candidate's error, one line
         others = cheapest_candidates(synthesize_candidates(built, spec.device,
                                                            **spec.parallel()))
-        if spec.accuracy == "correctly-rounded":
+        if spec.accuracy == "correctly-rounded" or spec.architecture is not None:
             return others, None
     max_error = spec.max_error
     if spec.accuracy == "faithful":  # the piecewise search's bound must stay below one ulp
-        max_error = math.nextafter(min(c.ulp for c in built if c.ulp is not None), 0.0)
+        max_error = math.nextafter(2.0 ** spec.lsb, 0.0)
     # the search evaluates its points here, in one thread (no worker start-up to pay),
     # while yosys maps the first round of candidates; its points join from round two
     with ThreadPoolExecutor(max_workers=1) as pool:
-        job = pool.submit(_search, spec, max_error, synth=False, workers=1)
+        job = pool.submit(_search, spec, max_error, synth=False, workers=1, strict=False)
         try:
             others, res = synthesize_with_search(built, job, spec.device, **spec.parallel())
         finally:
             job.cancel()
     return cheapest_candidates(others), res
+
+
+def _meets(spec: _Spec, c):
+    """``c``, or unbuilt with a note when its certified error misses the accuracy
+    (a plain table's half ulp above a ``max_error`` below it)."""
+    from .architectures import Candidate
+
+    if c.design is None or c.error is None or spec.accuracy != "max-error" or \
+            c.error <= spec.max_error:
+        return c
+    return Candidate(c.architecture, c.description, note=f"certified error "
+                     f"{format_up(c.error, '.4e')} > max_error {spec.max_error:.4e}")
 
 
 def _score(point) -> float:
@@ -823,15 +1044,18 @@ def _architectures_csv(others, res, winner) -> str:
     buf = io.StringIO()
     w = csvmod.writer(buf, lineterminator="\n")
     w.writerow(["architecture", "description", "score", "cells", "luts", "dsps", "carries",
-                "brams", "error", "ulp", "winner", "note"])
-    if res is not None:
+                "brams", "error", "ulp", "lsb", "winner", "note"])
+    if res is not None and res.winner is None:
+        w.writerow(["piecewise", "no design", "", "", "", "", "", "", "", "", "", 0,
+                    csv_cell(_search_failure(res))])
+    elif res is not None:
         p = res.winner
         c = p.target_cost
         w.writerow(["piecewise", csv_cell(p.describe()), f"{_score(p):.1f}",
                     "" if c is None else c.cells, "" if c is None else c.luts,
                     "" if c is None else c.dsps, "" if c is None else c.carries,
-                    "" if c is None else c.brams, f"{format_up(p.total_bound, '.6e')}", "",
-                    int(winner is None), ""])
+                    "" if c is None else c.brams, f"{format_up(p.total_bound, '.6e')}",
+                    f"{2.0 ** -p.y_frac_bits:.6e}", -p.y_frac_bits, int(winner is None), ""])
     for o in others:
         c = o.cost
         w.writerow([o.architecture, csv_cell(o.description),
@@ -839,7 +1063,9 @@ def _architectures_csv(others, res, winner) -> str:
                     "" if c is None else c.luts, "" if c is None else c.dsps,
                     "" if c is None else c.carries, "" if c is None else c.brams,
                     "" if o.error is None else f"{format_up(o.error, '.6e')}",
-                    "" if o.ulp is None else f"{o.ulp:.6e}", int(o is winner), csv_cell(o.note)])
+                    "" if o.ulp is None else f"{o.ulp:.6e}",
+                    "" if o.ulp is None else round(math.log2(o.ulp)), int(o is winner),
+                    csv_cell(o.note)])
     return buf.getvalue()
 
 

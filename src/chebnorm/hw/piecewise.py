@@ -1074,7 +1074,8 @@ def _check_cuts(pipeline, n: int) -> tuple[int, ...]:
 def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
                      guard_bits: int = 2, name: str | None = None, widths=None,
                      max_error=None, pipeline=None, multipliers: str = "full",
-                     rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
+                     rom_weight: float = ROM_WEIGHT,
+                     out_frac_bits: int | None = None) -> PiecewiseDesign:
     """Size the ROM + Horner evaluator of a uniform piecewise ``table``.
 
     ``in_bits`` must exceed the table's index bits (the rest is the local
@@ -1190,12 +1191,12 @@ def design_piecewise(table: PiecewiseTable, in_bits: int, out_bits: int, *,
     table.verify()   # a table changed behind its back is proved again (or refused)
     with drafting():
         d = _design_piecewise(table, in_bits, out_bits, guard_bits, name, widths, max_error,
-                              pipeline, multipliers, rom_weight)
+                              pipeline, multipliers, rom_weight, out_frac_bits)
     return seal(d)
 
 
 def _design_piecewise(table, in_bits, out_bits, guard_bits, name, widths, max_error, pipeline,
-                      multipliers, rom_weight) -> PiecewiseDesign:
+                      multipliers, rom_weight, out_frac_bits=None) -> PiecewiseDesign:
     """:func:`design_piecewise`'s sizing (its drafts unchecked)."""
     nseg = table.segment_count
     if table.segment_by != "uniform" and nseg & (nseg - 1):
@@ -1220,18 +1221,28 @@ def _design_piecewise(table, in_bits, out_bits, guard_bits, name, widths, max_er
     top, tf = exact["top"], exact["top_frac"]
     span = Fraction(int(top.max()) - int(top.min()), 2 ** tf)
     fy_max = out_bits - (math.floor(math.log2(span)) if span > 0 else -8)
-    for fy in range(min(fy_max, 60), -60, -1):
+    if out_frac_bits is not None:   # the output's last place stated: checked, never moved
+        fy = check_width(out_frac_bits, "out_frac_bits", -60, 60)
+        fys = [fy]
+    else:
+        fys = list(range(min(fy_max, 60), -60, -1))
+    for fy in fys:
         fa = fy + guard_bits
         w = _run(proto, k, fa, fy)
         r = w["rounded"]
         y_off = int(r.min())
         if int(r.max()) - y_off <= 2 ** out_bits - 1:
             break
+    else:
+        if widths is None:
+            raise ValueError(f"out_bits = {out_bits}: y's range at out_frac_bits {fy} (last "
+                             f"place 2^{-fy}) needs {(int(r.max()) - y_off).bit_length()} "
+                             f"bits; accepted: more out_bits or fewer out_frac_bits")
     if widths is not None:
         if multipliers not in ("full", "truncated"):
             raise ValueError(f"multipliers {multipliers!r}; accepted: 'full', 'truncated'")
         return _design_sized(proto, fy, widths, max_error, pipeline, multipliers == "truncated",
-                             span, _check_weight(rom_weight))
+                             span, _check_weight(rom_weight), fixed=out_frac_bits is not None)
     if pipeline is not None or multipliers != "full":
         raise ValueError("pipeline, multipliers: need the sized architecture; accepted: "
                          "widths='auto' or a widths dict with them, or their defaults")
@@ -1287,7 +1298,7 @@ def _prove(d: PiecewiseDesign) -> None:
                 raise ValueError(f"acc_frac_bits {_short(d.acc_frac_bits)}: accepted: y's "
                                  f"fractional bits plus 0 .. 16 guard bits")
             ref = _design_piecewise(t, W, d.out_bits, guard, d.name, None, None, None, "full",
-                                    ROM_WEIGHT)
+                                    ROM_WEIGHT, d.y_format.frac_bits)
             # pipeline registers (chebnorm.hw.pipeline.with_cuts): the same values, later
             ref = replace(ref, cuts=_check_cuts(d.cuts, n),
                           mult_cuts=_check_mult_cuts(d.mult_cuts, n))
@@ -1326,10 +1337,10 @@ def _uniform_design(proto: PiecewiseDesign, w: dict, fa: int, fy: int,
 
 def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
                   truncated: bool = False, span: Fraction = Fraction(0),
-                  rom_weight: float = ROM_WEIGHT) -> PiecewiseDesign:
+                  rom_weight: float = ROM_WEIGHT, fixed: bool = False) -> PiecewiseDesign:
     """:func:`design_piecewise` with ``widths`` given: y's fractional bits
     lowered from the uniform design's ``fy`` until y's range fits (``span``:
-    the exact polynomial's range of values)."""
+    the exact polynomial's range of values); ``fixed``: ``fy`` only (stated)."""
     t = proto.table
     n, L = t.degree, proto.local_bits
     cuts = _check_cuts(pipeline, n)
@@ -1338,7 +1349,7 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
     else:
         limit, strict = _error_limit(max_error), False
     failed = None
-    for f in range(fy, fy - 8, -1):
+    for f in range(fy, fy - (1 if fixed else 8), -1):
         lim = Fraction(2) ** -f if limit is None else limit
         if widths == "auto":
             try:  # faithful at fewer fractional bits of y may still be reachable
@@ -1346,7 +1357,7 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
             except ValueError as exc:
                 # only where y's range is tight at f bits is f given up for fewer bits
                 # (else max_error is out of reach and y keeps its last place)
-                if span * Fraction(2) ** f + 2 <= 2 ** proto.out_bits - 1:
+                if fixed or span * Fraction(2) ** f + 2 <= 2 ** proto.out_bits - 1:
                     if limit is None:
                         raise ValueError(f"max_error None (faithful: error < 2^-{f}, y's last "
                                          f"place): {exc}") from None
@@ -1360,7 +1371,8 @@ def _design_sized(proto: PiecewiseDesign, fy: int, widths, max_error, pipeline,
             return d
     if failed is not None:
         raise failed
-    raise ValueError(f"out_bits = {proto.out_bits}: y's range does not fit; accepted: more bits")
+    raise ValueError(f"out_bits = {proto.out_bits}: y's range does not fit" + (
+        f" at out_frac_bits {fy}" if fixed else "") + "; accepted: more bits")
 
 
 def _check_weight(w) -> float:

@@ -344,28 +344,39 @@ def _evaluate_chain(item) -> list:
     segment count ``2**k`` up at ``F_hi`` coefficient bits until the bound is met,
     then lower the coefficient bits at the first meeting ``k`` and at ``k + 1``.
     Returns ``[(key, DesignPoint, PiecewiseDesign)]`` sorted by ``key = (d, k, f)``."""
-    expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name = item
+    expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name, out_frac = item
     designs: dict[tuple[int, int, int], PiecewiseDesign] = {}
     points: dict[tuple[int, int, int], DesignPoint] = {}
+    unfit: set = set()
 
-    def evaluate(k, f):
+    def evaluate(k, f) -> bool:
+        """Whether the point ``(d, k, f)`` meets ``max_error`` (False, and no point,
+        when y's range does not fit the stated output format)."""
         key = (d, k, f)
+        if key in unfit:
+            return False
         if key not in designs:
             t = piecewise_fit(expr, interval, d, segments=2 ** k, coef_frac_bits=f, var=var,
                               name=name)
-            designs[key] = design_piecewise(t, in_bits, out_bits)
+            try:
+                designs[key] = design_piecewise(t, in_bits, out_bits, out_frac_bits=out_frac)
+            except ValueError:
+                if out_frac is None:
+                    raise
+                unfit.add(key)
+                return False   # this polynomial's range overflows the stated format
             p = _point(designs[key])
             points[key] = replace(p, meets=p.total_bound <= max_error)
-        return points[key]
+        return points[key].meets
 
     with _FIT_LOCK:
-        first = next((k for k in range(kmax + 1) if evaluate(k, f_hi).meets), None)
+        first = next((k for k in range(kmax + 1) if evaluate(k, f_hi)), None)
         if first is not None:
             for k in (first, first + 1):
                 if k > kmax:
                     continue
                 for f in range(f_hi - 1, 0, -1):
-                    if not evaluate(k, f).meets:
+                    if not evaluate(k, f):
                         break
                 evaluate(k, f_hi)
     return [(key, points[key], designs[key]) for key in sorted(points)]
@@ -388,7 +399,8 @@ def _check_max_error(max_error) -> float:
 def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
            degrees=(1, 2, 3), max_index_bits: int = 8, var: str = "x", synth: bool = True,
            progress: bool = True, name: str = "design", workers: int | None = None,
-           scheduler=None, target: str = "generic", bound: float | None = None) -> SearchResult:
+           scheduler=None, target: str = "generic", bound: float | None = None,
+           out_frac_bits: int | None = None) -> SearchResult:
     """Cheapest certified piecewise design meeting ``max_error`` (module docstring);
     ``target`` (:func:`chebnorm.hw.targets.target_names`) prices the points by that
     target's model and synthesizes the front's meeting points on it.
@@ -442,6 +454,11 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     bound : float, optional
         A score synthesized elsewhere: points that cannot beat it are not
         synthesized.
+    out_frac_bits : int, optional
+        Every design's output at this many fractional bits (last place
+        ``2^-out_frac_bits``; -60..60, checked to fit ``out_bits``); a point
+        whose range does not fit is left out. Default: each design the most
+        that fit ``out_bits``.
 
     Returns
     -------
@@ -479,8 +496,10 @@ def search(expr, interval, in_bits: int, out_bits: int, max_error: float, *,
     with _FIT_LOCK:
         piecewise_fit(expr, interval, degrees[0], segments=1, coef_frac_bits=f_hi, var=var,
                       name=name)
-    items = [(expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name)
-             for d in degrees]
+    if out_frac_bits is not None:
+        out_frac_bits = check_width(out_frac_bits, "out_frac_bits", -60, 60)
+    items = [(expr, interval, d, kmax, f_hi, in_bits, out_bits, max_error, var, name,
+              out_frac_bits) for d in degrees]
     par = dict(workers=workers, scheduler=scheduler, progress=progress)
     designs: dict[tuple[int, int, int], PiecewiseDesign] = {}
     points: dict[tuple[int, int, int], DesignPoint] = {}
