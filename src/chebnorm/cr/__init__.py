@@ -10,6 +10,10 @@ p + 2 bits (an Arb oracle), so that its one final rounding to the format is
 correct in all five IEEE 754 rounding modes. Every input is checked by the
 exact binary64 simulation of the generated code; :meth:`CorrectlyRounded.check`
 compiles the C with gcc and runs it on every input in the four modes C has.
+
+binary32 1/sqrt (``arithmetic="float32"``) is the one 32-bit case: C with
+float operations only, correctly rounded to nearest by an exact midpoint
+test, checked on all 2^32 inputs by an integer-exact checker.
 """
 
 from __future__ import annotations

@@ -106,7 +106,7 @@ static float cr_rsqrt_reduced(float m)
     float g = (0.5f * y) * e;
     float d, yn = cr_two_sum(y, g, &d);
     y = yn;
-    if (y >= 0.5f && y <= 0x1.fffffep-1f && (d < 0.0f ? -d : d) <= 0x1.fcp-26f) return y;
+    if (y >= 0.5f && y <= 0x1.fffffep-1f && fabsf(d) <= 0x1.fcp-26f) return y;
     /* the correctly rounded result lies in [0.5, 1 - 2^-24], where the ulp is u = 2^-24 */
     if (y > 0x1.fffffep-1f) y = 0x1.fffffep-1f;
     if (y < 0.5f) y = 0.5f;
@@ -150,7 +150,7 @@ float {name}(float x)
     int E = (int)(b >> 23) - 127 - bias;
     int odd = E & 1;
     int k = (E - odd) / 2;
-    uint32_t mb = (b & 0x007fffffu) | (odd ? 0x40000000u : 0x3f800000u);
+    uint32_t mb = (b & 0x007fffffu) | (0x3f800000u + ((uint32_t)odd << 23));
     uint32_t sb = (uint32_t)(127 - k) << 23;                /* 2^-k, k in -75..63: normal */
     float m, scale;
     memcpy(&m, &mb, sizeof m);
@@ -180,7 +180,7 @@ def c_files(c_name: str, banner: str, fma: bool = True) -> dict:
     src = "\n".join([
         banner,
         "#include <float.h>",
-        "#include <math.h>" if fma else "",
+        "#include <math.h>",
         "#include <stdint.h>",
         "#include <string.h>",
         f'#include "{c_name}.h"',
