@@ -262,3 +262,16 @@ def test_every_float32_input_is_correctly_rounded(fma):
     got = r.figures["check"]
     assert sum(got[k][0] for k in ("normal", "subnormal", "special")) == 1 << 32
     assert got["seconds"] <= 600
+
+
+@needs_gcc
+def test_cli_check_runs_the_compiled_check(tmp_path, monkeypatch):
+    # the CLI's --check runs every input; here the run is narrowed to QUICK
+    import chebnorm.cr._check32 as check32
+
+    monkeypatch.setattr(check32, "ALL", QUICK)
+    res = run_cli("correctly-rounded", "1/sqrt", "--format", "binary32", "--arithmetic",
+                  "float32", "-o", str(tmp_path / "c"), "--check")
+    assert res.code == 0, res.err
+    assert f"subnormal 0 wrong of {(1 << 23) - 1}" in res.out
+    assert f"special 0 wrong of {QUICK_SPECIAL}" in res.out
