@@ -65,6 +65,9 @@ ALLOWED = {
     ("cli/fit.py", "float(table.provenance['max_error'])"):
         "the user's --max-error echoed (the requirement, not a bound)",
     ("hw/hdl/tables.py", "b['target']"): "the requirement (faithful: one LSB), not a bound",
+    ("hw/design_api.py", "res.max_error"): "the search's max_error echoed (the requirement)",
+    ("hw/design_api.py", "spec.max_error"): "the user's max_error echoed beside the certified "
+                                            "error it refuses (rounded up)",
     ("approx/piecewise_table.py", "bound"):
         "a forged table's own stated value echoed in its refusal (the certified error beside "
         "it is rounded up)",

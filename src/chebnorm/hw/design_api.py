@@ -714,7 +714,7 @@ def _simulate(spec: _Spec, d, lsb: int, what: str = "") -> str:
         ok = err < (ulp / 2 if spec.accuracy == "correctly-rounded" else ulp) or \
             spec.accuracy == "correctly-rounded" and err <= ulp / 2
     if not ok:
-        raise ValueError(f"internal: {d.module_name} errs by {err:.6g} over the input codes, "
+        raise ValueError(f"internal: {d.module_name} errs by {format_up(err, '.6g')} over the input codes, "
                          f"beyond its accuracy ({spec.accuracy}, LSB 2^{lsb}); nothing "
                          f"written")
     return (f"simulation (Icarus Verilog, every code): {sim.line}; measured max {what}|y - f| "

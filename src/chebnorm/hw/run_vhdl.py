@@ -9,6 +9,7 @@ every design and language, bit-identical to the Verilog).
 from __future__ import annotations
 
 import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -55,16 +56,23 @@ def simulate_vhdl(directory, design, timeout: float = 600) -> SimResult:
     d = Path(directory)
     name = design if isinstance(design, str) else design.module_name
     with tempfile.TemporaryDirectory() as work:
-        # GHDL's library (work-obj08.cf) goes to a folder of its own, not the user's
-        std = [f"--std={VHDL_STD}", f"--workdir={work}"]
+        # GHDL runs in a folder of its own: its library (work-obj08.cf) records the paths
+        # of the files it analysed, and the user's folder name may hold any character
+        w = Path(work)
+        for fname in (f"{name}.vhd", f"tb_{name}.vhd", f"{name}.hex"):
+            if (d / fname).is_file():
+                shutil.copyfile(d / fname, w / fname)
+        std = [f"--std={VHDL_STD}"]
         for cmd in ([ghdl, "-a", *std, f"{name}.vhd"], [ghdl, "-a", *std, f"tb_{name}.vhd"],
                     [ghdl, "-e", *std, f"tb_{name}"]):
-            proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=d)
+            proc = run_tool(cmd, tool=f"ghdl {cmd[1]}", timeout=timeout, cwd=w)
             if proc.returncode != 0:
                 raise ToolFailed(f"ghdl {cmd[1]}", proc.returncode,
                                  proc.stdout + "\n" + proc.stderr, subject=name)
         run = run_tool([ghdl, "-r", *std, f"tb_{name}", "--ieee-asserts=disable-at-0"],
-                       tool="ghdl -r", timeout=timeout, cwd=d)
+                       tool="ghdl -r", timeout=timeout, cwd=w)
+        if (w / f"{name}_vhdl_y.hex").is_file():   # the bench's outputs, beside its inputs
+            shutil.copyfile(w / f"{name}_vhdl_y.hex", d / f"{name}_vhdl_y.hex")
     text = run.stdout + run.stderr
     m = re.search(r"(PASS|FAIL): (\d+) vectors, (\d+) mismatches[^\n]*", text)
     if not m:
