@@ -37,6 +37,8 @@ access such as ``chebnorm.raster.render`` after ``import chebnorm``):
    and through hw the Verilog and VHDL); imports core, symbolic, approx, hw.
 5. ``chebnorm.raster``   -- meshes, spans, shading modes, image metrics;
    imports core, symbolic, approx and methods (not hw, not export).
+   ``chebnorm.cr``       -- correctly rounded functions of a floating-point
+   format, proved on every input; imports core, symbolic and approx.
 6. ``chebnorm.cr``       -- correctly rounded functions of small formats, proved
    on every input; imports core, symbolic and approx.
 7. ``chebnorm.cli``      -- the command line; imports any stage.
