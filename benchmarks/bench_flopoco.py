@@ -4,22 +4,25 @@ on specs that chebnorm's search was never tuned on (issue 46).
     python benchmarks/bench_flopoco.py --flopoco-src DIR [--devices generic xc7-nodsp ...]
                                        [--spec exp log2 ...] [--tool chebnorm flopoco] [--force]
     python benchmarks/bench_flopoco.py --flopoco BINARY ...
-    python benchmarks/bench_flopoco.py --markdown [--json FILE]
+    python benchmarks/bench_flopoco.py --markdown [--json FILE] [--write-docs]
 
 For each spec of :data:`SPECS` (a function on an interval, 16-bit input code,
 faithful output of a stated LSB -- FloPoCo's ``lsbOut``):
 
 * FloPoCo: ``FixFunctionByPiecewisePoly`` with ``d=1, 2, 3``,
   ``FixFunctionByMultipartiteTable`` and ``FixFunctionByTable`` (only up to
-  16 input bits), combinational (``frequency=1``: "Not pipelined"; ``plainVHDL=1``, which this FloPoCo
+  :data:`TABLE_BITS` ROM bits: 12-bit inputs), combinational (``frequency=1``: "Not pipelined"; ``plainVHDL=1``, which this FloPoCo
   requires for the Horner evaluator), the function in FloPoCo's
   terms (on [0, 1): ``1/x`` on [1, 2) is ``f="1/(1+x)"``). The VHDL is
   converted to Verilog by ``ghdl --synth --out=verilog`` (GHDL's own
   synthesis, ``-fsynopsys`` for FloPoCo's ``std_logic_arith``) after its
   tables are rewritten as constant arrays (:func:`rom_arrays`: GHDL turns a
   ``with ... select`` table into comparators that yosys does not see as a
-  ROM), and flattened (:func:`flatten_verilog`), so both tools' designs go
-  through the same yosys flows.
+  ROM), its products given their operands' widths again
+  (:func:`narrow_products`) and flattened (:func:`flatten_verilog`), so both
+  tools' designs go through the same yosys flows; the Icarus simulation of
+  that Verilog must give the codes GHDL gives for FloPoCo's own VHDL
+  (``same_codes_as_icarus``).
 * chebnorm: ``chebnorm design EXPR --interval LO HI --in-bits 16 --out-bits N
   --faithful --target T`` for each device ``T``; the winner's Verilog is
   synthesized again here by the same flow as FloPoCo's. The LSB the winner
@@ -42,7 +45,8 @@ ice40 score is ``LC + 240 * RAM`` (an HX8K has 7680 LCs and 32 RAM4K).
 
 Output: ``benchmarks/flopoco_results.json`` (``--json``; sorted keys), written
 after every design; a rerun skips what is there unless ``--force``.
-``--markdown`` prints the docs table from the JSON (no run).
+``--markdown`` prints the docs table from the JSON (no run); ``--write-docs``
+puts it into docs/flopoco.md (tests/test_bench_flopoco.py checks they agree).
 
 Building FloPoCo (``--flopoco-src DIR``: a FloPoCo 4.1/5.0 source tree, e.g.
 a clone of a GitHub mirror such as ``hyf6661669/FloPoCo`` at commit
@@ -81,6 +85,9 @@ HERE = Path(__file__).resolve().parent
 DEFAULT_JSON = HERE / "flopoco_results.json"
 DEVICES = ("generic", "xc7-nodsp", "xc7", "ice40")
 FLOPOCO_DESIGNS = ("pp1", "pp2", "pp3", "multipartite", "table")
+#: the largest FixFunctionByTable built, in ROM bits (chebnorm design's plain-table
+#: limit: a 16-bit table of 2^16 entries is not synthesized in useful time)
+TABLE_BITS = 1 << 18
 #: ice40 score: LUT equivalents of one RAM4K (HX8K: 7680 LCs, 32 RAM4K)
 ICE40_RAM_LC = 7680 / 32
 
@@ -325,6 +332,41 @@ def rom_arrays(vhdl: str) -> tuple[str, int]:
     return "".join(out), n
 
 
+_SEXT = re.compile(r"assign (\w+) = \{(?:\{\d+\{(\w+)\[\d+\]\}\}|(\w+)\[\d+\]), (\w+)\}; // sext")
+_UEXT = re.compile(r"assign (\w+) = \{\d+'b0+, (\w+)\}; // uext")
+_MUL = re.compile(r"assign (\w+) = (\w+) \* (\w+); // ([su])mul")
+
+
+def narrow_products(verilog: str) -> tuple[str, int]:
+    """GHDL's Verilog of a VHDL ``signed``/``unsigned`` product: both operands
+    sign- (zero-) extended to the product's width, then an unsigned ``*`` of
+    that width, which yosys cannot narrow (FloPoCo's 8 x 10-bit signed product
+    becomes an 18 x 18 one). Rewritten as ``$signed(a) * $signed(b)`` (or
+    ``a * b``) of the operands before extension: the same value in the
+    product's width (Verilog extends signed operands of a signed product by
+    their sign). Returns the text and the number of products rewritten."""
+    ext = {}
+    for m in _SEXT.finditer(verilog):
+        src = m.group(4)
+        if (m.group(2) or m.group(3)) == src:
+            ext[m.group(1)] = ("s", src)
+    for m in _UEXT.finditer(verilog):
+        ext[m.group(1)] = ("u", m.group(2))
+    n = 0
+
+    def repl(m):
+        nonlocal n
+        a, b, kind = ext.get(m.group(2)), ext.get(m.group(3)), m.group(4)
+        if not a or not b or a[0] != kind or b[0] != kind:
+            return m.group(0)
+        n += 1
+        if kind == "s":
+            return f"assign {m.group(1)} = $signed({a[1]}) * $signed({b[1]}); // smul"
+        return f"assign {m.group(1)} = {a[1]} * {b[1]}; // umul"
+
+    return _MUL.sub(repl, verilog), n
+
+
 def vhdl_to_verilog(vhdl: Path, top: str, workdir: Path) -> str:
     """GHDL's synthesis of entity ``top`` printed as Verilog."""
     flags = ["-fsynopsys", "--std=08", f"--workdir={workdir}"]
@@ -355,8 +397,10 @@ def flopoco_design(binary: Path, spec: Spec, design: str, workdir: Path) -> dict
     rom.write_text(text)
     conv = workdir / "ghdl"
     conv.mkdir()
-    verilog = flatten_verilog(vhdl_to_verilog(rom, name, conv), name, conv)
+    verilog, products = narrow_products(vhdl_to_verilog(rom, name, conv))
+    verilog = flatten_verilog(verilog, name, conv)
     return {"verilog": verilog, "top": name, "gen_s": gen, "tables_as_arrays": tables,
+            "products_narrowed": products,
             "command": "flopoco " + " ".join(flopoco_argv(spec, design, name)),
             "log": [ln for ln in (p.stdout + p.stderr).splitlines()
                     if "error" in ln.lower() or "msbOut" in ln or "degree" in ln.lower()][:6]}
@@ -588,8 +632,10 @@ def run_flopoco(doc, path, binary, spec, designs, devices, force):
     entry = doc["specs"].setdefault(spec.name, {"spec": _spec_meta(spec)})
     flo = entry.setdefault("flopoco", {})
     for design in designs:
-        if design == "table" and spec.in_bits > 16:
-            flo[design] = {"skipped": "table above 16 input bits"}
+        if design == "table" and (1 << spec.in_bits) * spec.out_bits > TABLE_BITS:
+            flo[design] = {"skipped": f"a table of 2^{spec.in_bits} entries is over "
+                                      f"{TABLE_BITS} bits (chebnorm's own limit)"}
+            _save(path, doc)
             continue
         row = flo.get(design, {})
         todo = [d for d in devices if force or d not in row.get("devices", {})]
@@ -623,7 +669,8 @@ def run_flopoco(doc, path, binary, spec, designs, devices, force):
                     row["sim_ghdl"] = {"error": str(e)[:300]}
             row.update({"command": g["command"], "gen_s": g["gen_s"], "top": g["top"],
                         "log": g["log"], "lsb_out": spec.lsb_out,
-                        "tables_as_arrays": g["tables_as_arrays"]})
+                        "tables_as_arrays": g["tables_as_arrays"],
+                        "products_narrowed": g["products_narrowed"]})
             row.pop("error", None)
             devs = row.setdefault("devices", {})
             for dev in todo:
@@ -774,6 +821,24 @@ def markdown(doc: dict) -> str:
     return "\n".join(lines)
 
 
+DOCS = HERE.parent / "docs" / "flopoco.md"
+MARKS = ("<!-- flopoco-table -->\n", "<!-- /flopoco-table -->\n")
+
+
+def docs_table(page: str) -> str:
+    """The table between the page's markers."""
+    i, j = page.index(MARKS[0]) + len(MARKS[0]), page.index(MARKS[1])
+    return page[i:j]
+
+
+def write_docs(doc: dict, page: Path = DOCS) -> None:
+    """Put :func:`markdown` of ``doc`` between the markers of ``page``."""
+    text = page.read_text(encoding="utf-8")
+    old = docs_table(text)
+    i = text.index(MARKS[0]) + len(MARKS[0])
+    page.write_text(text[:i] + markdown(doc) + "\n" + text[i + len(old):], encoding="utf-8")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--flopoco-src", type=Path, help="FloPoCo source tree to build (cached)")
@@ -793,12 +858,17 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=1, help="chebnorm design --workers")
     ap.add_argument("--force", action="store_true", help="measure again what the JSON has")
     ap.add_argument("--markdown", action="store_true", help="print the docs table (no run)")
+    ap.add_argument("--write-docs", action="store_true",
+                    help="with --markdown: also write it into docs/flopoco.md")
     a = ap.parse_args(argv)
     if a.markdown:
         if not a.json.exists():
             print(f"--json {a.json}: no such file", file=sys.stderr)
             return 2
-        print(markdown(json.loads(a.json.read_text())))
+        doc = json.loads(a.json.read_text())
+        print(markdown(doc))
+        if a.write_docs:
+            write_docs(doc)
         return 0
     doc = _load(a.json)
     meta = doc.setdefault("meta", {})

@@ -151,3 +151,39 @@ def test_merge_keeps_the_other_tools_rows():
 def test_markdown_cli_without_json_exits_2(tmp_path, capsys):
     assert bf.main(["--markdown", "--json", str(tmp_path / "none.json")]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def test_rom_arrays_keeps_every_entry():
+    vhdl = ('architecture arch of T is\nsignal Y0 : std_logic_vector(2 downto 0);\nbegin\n'
+            '   with X  select  Y0 <= \n      "101" when "00",\n      "011" when "01",\n'
+            '      "110" when "11",\n      "---" when others;\nY <= Y0;\nend architecture;\n')
+    text, n = bf.rom_arrays(vhdl)
+    assert n == 1
+    assert 'constant rom_1 : rom_1_t := (\n  0 => "101",\n  1 => "011",\n  3 => "110",\n' \
+        "  others => (others => '0'));" in text
+    assert "type rom_1_t is array(0 to 3) of std_logic_vector(2 downto 0);" in text
+    assert text.index("constant rom_1") < text.index("\nbegin") < \
+        text.index("Y0 <= rom_1(conv_integer(X));") < text.index("Y <= Y0;")
+    assert "select" not in text
+    assert bf.rom_arrays("architecture a of b is\nbegin\nend;\n") == \
+        ("architecture a of b is\nbegin\nend;\n", 0)
+
+
+def test_narrow_products_only_for_extended_operands():
+    v = ("  assign n1 = {{10{a[7]}}, a}; // sext\n  assign n2 = {b[9], b}; // sext\n"
+         "  assign n3 = n1 * n2; // smul\n  assign n4 = {8'b00000000, c}; // uext\n"
+         "  assign n5 = n4 * n2; // smul\n  assign n6 = n4 * n4; // umul\n")
+    out, n = bf.narrow_products(v)
+    assert n == 2
+    assert "assign n3 = $signed(a) * $signed(b); // smul" in out
+    assert "assign n5 = n4 * n2; // smul" in out          # mixed extension: left alone
+    assert "assign n6 = c * c; // umul" in out
+
+
+def test_docs_table_is_the_committed_json():
+    """docs/flopoco.md shows exactly the table of benchmarks/flopoco_results.json."""
+    import json
+
+    doc = json.loads(bf.DEFAULT_JSON.read_text(encoding="utf-8"))
+    page = bf.DOCS.read_text(encoding="utf-8")
+    assert bf.docs_table(page) == bf.markdown(doc) + "\n"
