@@ -615,9 +615,16 @@ def _merge(old: dict, new: dict) -> dict:
     return out
 
 
-def _save(path: Path, doc: dict) -> None:
-    """Write ``doc`` merged over the file's rows (two runs, one per tool, may share it)."""
-    merged = _merge(_load(path), doc)
+def _save(path: Path, doc: dict, tool: str = "") -> None:
+    """Write ``doc``'s rows of ``tool`` (every row when empty) and its ``meta``
+    over the file's: two runs, one per tool, may share the file."""
+    if tool:
+        part = {"meta": doc.get("meta", {}), "specs": {
+            name: {"spec": e["spec"], tool: e[tool]}
+            for name, e in doc.get("specs", {}).items() if tool in e}}
+    else:
+        part = doc
+    merged = _merge(_load(path), part)
     tmp = path.with_suffix(f".{os.getpid()}.tmp")
     tmp.write_text(json.dumps(merged, sort_keys=True, indent=1) + "\n")
     tmp.replace(path)
@@ -635,7 +642,7 @@ def run_flopoco(doc, path, binary, spec, designs, devices, force):
         if design == "table" and (1 << spec.in_bits) * spec.out_bits > TABLE_BITS:
             flo[design] = {"skipped": f"a table of 2^{spec.in_bits} entries is over "
                                       f"{TABLE_BITS} bits (chebnorm's own limit)"}
-            _save(path, doc)
+            _save(path, doc, "flopoco")
             continue
         row = flo.get(design, {})
         todo = [d for d in devices if force or d not in row.get("devices", {})]
@@ -647,7 +654,7 @@ def run_flopoco(doc, path, binary, spec, designs, devices, force):
                 g = flopoco_design(binary, spec, design, w)
             except (RuntimeError, subprocess.TimeoutExpired) as e:
                 flo[design] = {"error": str(e)[:400]}
-                _save(path, doc)
+                _save(path, doc, "flopoco")
                 print(f"{spec.name} flopoco {design}: {e}", file=sys.stderr)
                 continue
             if force or "sim" not in row:
@@ -684,10 +691,10 @@ def run_flopoco(doc, path, binary, spec, designs, devices, force):
                 devs[dev]["synth_s"] = round(time.perf_counter() - t0, 1)
                 devs[dev]["load"] = round(os.getloadavg()[0], 2)
                 flo[design] = row
-                _save(path, doc)
+                _save(path, doc, "flopoco")
                 print(f"{spec.name} flopoco {design} {dev}: {devs[dev]}", file=sys.stderr)
             flo[design] = row
-            _save(path, doc)
+            _save(path, doc, "flopoco")
 
 
 def _frac(code: int, lsb: int):
@@ -729,7 +736,7 @@ def run_chebnorm(doc, path, spec, devices, force, workers):
             except (RuntimeError, ValueError, subprocess.TimeoutExpired) as e:
                 row = {"error": str(e)[:400]}
             ch[dev] = row
-            _save(path, doc)
+            _save(path, doc, "chebnorm")
             print(f"{spec.name} chebnorm {dev}: {json.dumps(row)[:300]}", file=sys.stderr)
 
 
@@ -757,8 +764,9 @@ def _fmt(v) -> str:
 def markdown(doc: dict) -> str:
     """The docs table: per spec and device, chebnorm's winner, the best FloPoCo
     design and their ratio (``<= 0.8``: the issue's acceptance)."""
-    lines = ["| spec | device (figure) | chebnorm winner | its LSB | best FloPoCo | ratio | <= 0.8x |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["| spec | device (figure) | chebnorm winner | its LSB | best FloPoCo | ratio | <= 0.8x "
+             "| ratio to smallest FloPoCo, faithful or not |",
+             "|---|---|---|---|---|---|---|---|"]
     misses = []
     order = [s.name for s in SPECS]
     for name in sorted(doc.get("specs", {}), key=lambda n: (order.index(n) if n in order
@@ -811,8 +819,9 @@ def markdown(doc: dict) -> str:
                         misses.append(f"{name}/{dev}")
                 else:
                     ratio, ok = "", ""
+            any_ratio = f"{cval / any_best[0]:.2f}" if any_best and cval is not None else ""
             lines.append(f"| {label} | {dev} ({fig}) | {ctext} | {lsb} | {btext} | {ratio} "
-                         f"| {ok} |")
+                         f"| {ok} | {any_ratio} |")
     meta = doc.get("meta", {})
     lines.append("")
     lines.append(f"FloPoCo: {meta.get('flopoco_repo', '?')} at "
@@ -888,7 +897,7 @@ def main(argv=None) -> int:
                   file=sys.stderr)
             return 2
         meta["flopoco_repo"] = a.flopoco_repo
-    _save(a.json, doc)
+    _save(a.json, {"meta": meta})
     for name in a.spec:
         spec = SPEC_BY_NAME[name]
         if "flopoco" in a.tool:
@@ -896,7 +905,7 @@ def main(argv=None) -> int:
         if "chebnorm" in a.tool:
             run_chebnorm(doc, a.json, spec, a.devices, a.force, a.workers)
     meta["load_at_end"] = round(os.getloadavg()[0], 2)
-    _save(a.json, doc)
+    _save(a.json, {"meta": meta})
     print(markdown(doc))
     return 0
 

@@ -129,10 +129,10 @@ def test_markdown_ratios_and_misses():
     md = bf.markdown(_doc())
     rows = [ln for ln in md.splitlines() if ln.startswith("| exp")]
     assert len(rows) == 2
-    assert "| 700 |" in rows[0] and "1000 (pp1)" in rows[0] and "| 0.70 | yes |" in rows[0]
+    assert "| 700 |" in rows[0] and "1000 (pp1)" in rows[0] and "| 0.70 | yes | 70.00 |" in rows[0]
     assert "table: 10 but 3 codes off" in rows[0]       # shown, never the reference
     assert "codes off" not in rows[1]
-    assert "225" in rows[1] and "250 (pp2)" in rows[1] and "| 0.90 | **no** |" in rows[1]
+    assert "225" in rows[1] and "250 (pp2)" in rows[1] and "| 0.90 | **no** | 0.90 |" in rows[1]
     assert "misses of 0.8x: exp/xc7-nodsp." in md and "abcdef123456" in md
     doc = _doc()
     doc["specs"]["exp"]["chebnorm"]["generic"]["lsb_match"] = False
@@ -187,3 +187,18 @@ def test_docs_table_is_the_committed_json():
     doc = json.loads(bf.DEFAULT_JSON.read_text(encoding="utf-8"))
     page = bf.DOCS.read_text(encoding="utf-8")
     assert bf.docs_table(page) == bf.markdown(doc) + "\n"
+
+
+def test_save_writes_only_its_tools_rows(tmp_path):
+    """A run of one tool started from an older copy of the file never undoes
+    the rows the other tool's run wrote since."""
+    import json
+
+    path = tmp_path / "r.json"
+    bf._save(path, {"specs": {"exp": {"spec": {}, "flopoco": {"pp1": {"v": 1}}}}})
+    stale = json.loads(path.read_text())                       # the chebnorm run's copy
+    bf._save(path, {"specs": {"exp": {"spec": {}, "flopoco": {"pp1": {"v": 2}}}}}, "flopoco")
+    stale["specs"]["exp"]["chebnorm"] = {"generic": {"w": 3}}
+    bf._save(path, stale, "chebnorm")
+    got = json.loads(path.read_text())["specs"]["exp"]
+    assert got["flopoco"]["pp1"] == {"v": 2} and got["chebnorm"]["generic"] == {"w": 3}
