@@ -138,6 +138,9 @@ def test_markdown_ratios_and_misses():
     doc["specs"]["exp"]["chebnorm"]["generic"]["lsb_match"] = False
     md = bf.markdown(doc)
     assert "2^-15 (mismatch)" in md and "exp/generic" in md       # a ratio at another LSB fails
+    doc["specs"]["exp"]["chebnorm"]["xc7-nodsp"] = {"error": "chebnorm design: exit 2"}
+    md = bf.markdown(doc)
+    assert "error: chebnorm design: exit 2 |" in md and "exp/generic, exp/xc7-nodsp." in md
 
 
 def test_merge_keeps_the_other_tools_rows():
@@ -161,7 +164,7 @@ def test_rom_arrays_keeps_every_entry():
     assert n == 1
     assert 'constant rom_1 : rom_1_t := (\n  0 => "101",\n  1 => "011",\n  3 => "110",\n' \
         "  others => (others => '0'));" in text
-    assert "type rom_1_t is array(0 to 3) of std_logic_vector(2 downto 0);" in text
+    assert "type rom_1_t is array(3 downto 0) of std_logic_vector(2 downto 0);" in text
     assert text.index("constant rom_1") < text.index("\nbegin") < \
         text.index("Y0 <= rom_1(conv_integer(X));") < text.index("Y <= Y0;")
     assert "select" not in text
