@@ -1,5 +1,5 @@
 """Held-out benchmark: ``chebnorm design`` against FloPoCo built from its public source,
-on specs that chebnorm's search was never tuned on (issue 46).
+on specs that chebnorm's search was never tuned on.
 
     python benchmarks/bench_flopoco.py --flopoco-src DIR [--devices generic xc7-nodsp ...]
                                        [--spec exp log2 ...] [--tool chebnorm flopoco] [--force]
