@@ -8,7 +8,7 @@ from a small catalogue, then a piecewise polynomial evaluated in binary64
 whose result lies, for every input, in the round-to-odd interval of f(x) at
 p + 2 bits (an Arb oracle), so that its one final rounding to the format is
 correct in all five IEEE 754 rounding modes. Every input is checked by the
-exact binary64 simulation of the generated code; :meth:`CorrectlyRounded.check`
+exact binary64 simulation of the generated code; the result's ``check()``
 compiles the C with gcc and runs it on every input in the four modes C has.
 
 binary32 1/sqrt (``arithmetic="float32"``) is the one 32-bit case: C with
