@@ -171,3 +171,34 @@ def test_yosys_in_design_is_one_line_and_exit_2(sleepy_path, capped, tmp_path):
     line = err.split("\r")[-1]  # after the search's progress bar
     assert line.startswith("chebnorm: error: yosys") and "did not finish within its time limit" in line
     assert not (tmp_path / "d").exists() or not any((tmp_path / "d").iterdir())
+
+
+@pytest.mark.parametrize("outputs, calls, ok", [
+    # an ABC child killed by SIGABRT: yosys runs once more
+    ([(1, 'ERROR: ABC: execution of command ""berkeley-abc" -s -f ./yosys-abc-x/abc.script '
+          '2>&1" failed: return code 134.'), (0, "done")], 2, True),
+    # crashing twice is reported
+    ([(1, "ERROR: ABC: execution of command \"abc\" failed: return code 134.")] * 2, 2, False),
+    # any other failure is reported at once
+    ([(1, "ERROR: Module `top' not found!"), (0, "done")], 1, False),
+])
+def test_an_abc_crash_is_run_once_more(monkeypatch, outputs, calls, ok):
+    import subprocess
+
+    from chebnorm.exceptions import ToolFailed
+    from chebnorm.hw import targets
+
+    seen = []
+
+    def fake(argv, **kw):
+        code, text = outputs[len(seen)]
+        seen.append(argv)
+        return subprocess.CompletedProcess(argv, code, text, "")
+
+    monkeypatch.setattr(targets, "run_tool", fake)
+    if ok:
+        assert targets._run(["yosys", "-p", "synth"], ".", "yosys (test)", 60) == "done"
+    else:
+        with pytest.raises(ToolFailed):
+            targets._run(["yosys", "-p", "synth"], ".", "yosys (test)", 60)
+    assert len(seen) == calls

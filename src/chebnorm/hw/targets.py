@@ -359,8 +359,16 @@ def _check_top(top) -> str:
     return top
 
 
+#: yosys's report of an ABC child killed by a signal (an abort, not a verdict on the netlist)
+_ABC_CRASH = re.compile(r"ERROR: ABC: execution of command .* failed: return code (13[0-9]|14[0-9])")
+
+
 def _run(argv: list[str], cwd: str, what: str, timeout: float) -> str:
     proc = run_tool(argv, tool=what, timeout=timeout, cwd=cwd, env=tool_env())
+    if proc.returncode != 0 and _ABC_CRASH.search(proc.stdout + proc.stderr):
+        # ABC, run by yosys as a child, now and then aborts on a loaded machine: the same
+        # script once more (a second crash, or any other failure, is reported)
+        proc = run_tool(argv, tool=what, timeout=timeout, cwd=cwd, env=tool_env())
     if proc.returncode != 0:  # yosys and nextpnr print their errors on both streams
         raise ToolFailed(what, proc.returncode, proc.stdout[-300:] + "\n" + proc.stderr)
     return proc.stdout
